@@ -1,0 +1,3 @@
+//! The `kerf` command-line tool (placeholder).
+
+fn main() {}

@@ -1,0 +1,1 @@
+//! kerf-discretize (placeholder while the workspace is laid out).

@@ -1,0 +1,1 @@
+//! kerf-format (placeholder while the workspace is laid out).

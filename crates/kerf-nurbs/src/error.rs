@@ -1,0 +1,183 @@
+//! The error type of the NURBS crate.
+
+use thiserror::Error;
+
+/// Everything that can be wrong with the data of a NURBS curve or surface, or with a request
+/// made of one.
+///
+/// Each variant names the offending field (`knots`, `knots_u`, `weights`, ...) and index, so that
+/// a file reader can prefix it with the JSON path of the curve and produce messages such as
+/// `curves[3].knots[5]: knots must be non-decreasing (0.5 after 0.7)`.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum NurbsError {
+    /// The degree is 0. Fix: a polyline is degree 1; use at least 1.
+    #[error("{field}: degree must be at least 1 (got 0)")]
+    DegreeZero {
+        /// `degree`, `degree_u` or `degree_v`.
+        field: &'static str,
+    },
+    /// The degree is above [`crate::MAX_DEGREE`]. Fix: reduce the degree (CAD systems stay
+    /// far below this limit; such a degree is almost certainly a corrupt file).
+    #[error("{field}: degree {degree} is above the maximum {max}")]
+    DegreeTooHigh {
+        /// `degree`, `degree_u` or `degree_v`.
+        field: &'static str,
+        /// The degree found.
+        degree: usize,
+        /// The largest degree supported.
+        max: usize,
+    },
+    /// Fewer control points than `degree + 1`. Fix: lower the degree or add control points.
+    #[error(
+        "{field}: {got} control points are too few for degree {degree} (need at least {needed})"
+    )]
+    TooFewPoints {
+        /// `control_points` (or the direction of a surface).
+        field: &'static str,
+        /// The number found.
+        got: usize,
+        /// The degree.
+        degree: usize,
+        /// `degree + 1`.
+        needed: usize,
+    },
+    /// The knot vector does not have `points + degree + 1` entries. Fix: supply the full knot
+    /// vector (including the end knots).
+    #[error("{field}: expected {expected} knots (control points + degree + 1), got {got}")]
+    KnotCount {
+        /// `knots`, `knots_u` or `knots_v`.
+        field: &'static str,
+        /// Control points + degree + 1.
+        expected: usize,
+        /// The number found.
+        got: usize,
+    },
+    /// A knot is NaN or infinite.
+    #[error("{field}[{index}]: knot must be finite (got {value})")]
+    KnotNotFinite {
+        /// `knots`, `knots_u` or `knots_v`.
+        field: &'static str,
+        /// Index of the knot.
+        index: usize,
+        /// The value found.
+        value: f64,
+    },
+    /// A knot is smaller than the one before it. Fix: sort the knot vector.
+    #[error("{field}[{index}]: knots must be non-decreasing ({value} after {previous})")]
+    KnotsDecreasing {
+        /// `knots`, `knots_u` or `knots_v`.
+        field: &'static str,
+        /// Index of the knot that is smaller than its predecessor.
+        index: usize,
+        /// Its value.
+        value: f64,
+        /// The predecessor's value.
+        previous: f64,
+    },
+    /// A knot value is repeated more than `degree + 1` times. Fix: remove the extra copies.
+    #[error("{field}[{index}]: knot {value} is repeated {multiplicity} times, more than degree + 1 = {max}")]
+    KnotMultiplicity {
+        /// `knots`, `knots_u` or `knots_v`.
+        field: &'static str,
+        /// Index of the first copy beyond the allowed multiplicity.
+        index: usize,
+        /// The knot value.
+        value: f64,
+        /// How often it occurs.
+        multiplicity: usize,
+        /// `degree + 1`.
+        max: usize,
+    },
+    /// The domain `[knots[p], knots[len - p - 1]]` has zero length. Fix: the knot vector must
+    /// span a non-empty parameter interval.
+    #[error("{field}: empty parameter domain [{start}, {end}]")]
+    EmptyDomain {
+        /// `knots`, `knots_u` or `knots_v`.
+        field: &'static str,
+        /// First parameter of the domain.
+        start: f64,
+        /// Last parameter of the domain.
+        end: f64,
+    },
+    /// A control point coordinate is NaN or infinite.
+    #[error("{field}{index}: control point must be finite (got [{x}, {y}, {z}])")]
+    PointNotFinite {
+        /// `control_points`.
+        field: &'static str,
+        /// Index as written in a path: `[3]` for a curve, `[2][5]` for a surface.
+        index: String,
+        /// x coordinate.
+        x: f64,
+        /// y coordinate.
+        y: f64,
+        /// z coordinate.
+        z: f64,
+    },
+    /// The number of weights differs from the number of control points.
+    #[error("{field}: expected {expected} weights (one per control point), got {got}")]
+    WeightCount {
+        /// `weights`.
+        field: &'static str,
+        /// The number of control points.
+        expected: usize,
+        /// The number of weights.
+        got: usize,
+    },
+    /// A weight is NaN, infinite, zero or negative. Fix: NURBS weights must be finite and > 0;
+    /// a zero weight puts the curve at infinity.
+    #[error("{field}{index}: weight must be finite and > 0 (got {value})")]
+    BadWeight {
+        /// `weights`.
+        field: &'static str,
+        /// Index as written in a path: `[3]` or `[2][5]`.
+        index: String,
+        /// The value found.
+        value: f64,
+    },
+    /// The rows of a surface's control net (or weights) differ in length.
+    #[error("{field}[{row}]: row has {got} entries, expected {expected}")]
+    RaggedGrid {
+        /// `control_points` or `weights`.
+        field: &'static str,
+        /// Index of the offending row.
+        row: usize,
+        /// Its length.
+        got: usize,
+        /// The length of row 0.
+        expected: usize,
+    },
+    /// A parameter passed to an operation is NaN or lies outside the domain.
+    #[error("parameter {value} is outside the domain [{start}, {end}]")]
+    ParameterOutsideDomain {
+        /// The parameter.
+        value: f64,
+        /// Start of the domain.
+        start: f64,
+        /// End of the domain.
+        end: f64,
+    },
+    /// A knot insertion would raise a knot's multiplicity above the degree.
+    #[error(
+        "inserting {value} {times} times would raise its multiplicity above the degree {degree}"
+    )]
+    InsertionTooMany {
+        /// The knot value.
+        value: f64,
+        /// Requested insertions.
+        times: usize,
+        /// The degree.
+        degree: usize,
+    },
+    /// A parameter interval `[t0, t1]` is empty or reversed.
+    #[error("interval [{t0}, {t1}] is empty or reversed")]
+    BadInterval {
+        /// Start.
+        t0: f64,
+        /// End.
+        t1: f64,
+    },
+}
+
+/// `Result` with [`NurbsError`].
+pub type Result<T> = std::result::Result<T, NurbsError>;

@@ -1,0 +1,47 @@
+//! Rational B-spline curves and surfaces for kerf.
+//!
+//! Everything downstream of the file reader evaluates geometry through this crate: points,
+//! derivatives of any order, curvature, arc length, knot insertion, the rational Bezier pieces of
+//! any sub-interval (on which the discretizer's chord-error proof rests) and closest points.
+//! The algorithms follow Piegl and Tiller, *The NURBS Book* (2nd ed.); `docs/nurbs.md` derives
+//! the formulas.
+//!
+//! ```
+//! use kerf_nurbs::NurbsCurve;
+//! use nalgebra::Point3;
+//!
+//! // A quarter of the unit circle as a rational quadratic.
+//! let h = std::f64::consts::FRAC_1_SQRT_2;
+//! let arc = NurbsCurve::try_new(
+//!     2,
+//!     vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+//!     vec![Point3::new(1.0, 0.0, 0.0), Point3::new(1.0, 1.0, 0.0), Point3::new(0.0, 1.0, 0.0)],
+//!     Some(vec![1.0, h, 1.0]),
+//! )?;
+//! let p = arc.point(0.3);
+//! assert!((p.coords.norm() - 1.0).abs() < 1e-15, "every point lies on the circle");
+//! assert!((arc.curvature(0.7) - 1.0).abs() < 1e-12, "curvature of the unit circle is 1");
+//! # Ok::<(), kerf_nurbs::NurbsError>(())
+//! ```
+
+pub mod arclength;
+pub mod basis;
+pub mod bezier;
+pub mod closest;
+pub mod curve;
+pub mod error;
+pub mod knots;
+pub mod surface;
+
+pub use bezier::RationalBezier;
+pub use closest::CurveProjection;
+pub use curve::{FrenetFrame, NurbsCurve};
+pub use error::{NurbsError, Result};
+pub use surface::{NurbsSurface, SurfaceProjection};
+
+/// The largest degree kerf accepts. CAD systems use degree <= 11 in practice; the fixed-size
+/// scratch arrays of the evaluator are sized by this constant.
+pub const MAX_DEGREE: usize = 24;
+
+/// `MAX_DEGREE + 1`: the most basis functions that are non-zero at one parameter.
+pub const MAX_ORDER: usize = MAX_DEGREE + 1;

@@ -1,0 +1,249 @@
+//! The reference-sphere walk of paper 004 (and the parameter-bisection walk of the classic
+//! "equal error" method), with every accepted segment certified by [`crate::bound`].
+
+use kerf_nurbs::curve::curvature_of;
+use kerf_nurbs::NurbsCurve;
+use nalgebra::{Point3, Vector3};
+
+use crate::bound::{chord_error_with, Bound, Scratch};
+use crate::error::{DiscretizeError, Result};
+use crate::options::Options;
+use crate::sphere::{first_crossing, Hit};
+use crate::Discretization;
+
+/// Iterations of the radius search per cutting point before giving up.
+const MAX_ITERS: usize = 80;
+/// Consecutive failures with no good radius after which the search bisects the parameter
+/// instead (guaranteed progress on pathological curves).
+const PARAM_FALLBACK_AFTER: usize = 10;
+/// The radius search stops when the bracket is this narrow (relative).
+const BRACKET_TOL: f64 = 2e-3;
+
+#[derive(Debug, Clone, Copy)]
+struct Cand {
+    r: f64,
+    hit: Hit,
+    bound: Bound,
+}
+
+/// Walks one C0 piece `[a, b]`; `out` already holds the point at `a`.
+pub(crate) struct Walker<'a> {
+    pub curve: &'a NurbsCurve,
+    pub opts: &'a Options,
+    pub scratch: Scratch,
+    /// Start in parameter-bisection mode (the classic "equal error" method).
+    pub param_only: bool,
+}
+
+impl Walker<'_> {
+    fn certify(&mut self, t0: f64, p0: &Point3<f64>, hit: &Hit) -> (Bound, bool) {
+        let tol = self.opts.tolerance;
+        let bound = chord_error_with(
+            &mut self.scratch,
+            self.curve,
+            t0,
+            hit.t,
+            p0,
+            &hit.p,
+            tol,
+            self.opts.band * tol,
+        );
+        let mut ok = bound.upper <= tol;
+        if ok && self.opts.max_turn.is_finite() {
+            let (u, v) = end_tangents(self.curve, t0, hit.t);
+            if let (Some(u), Some(v)) = (u, v) {
+                ok = u.angle(&v) <= self.opts.max_turn;
+            }
+        }
+        if ok && (hit.p - p0).norm() > self.opts.max_segment_length {
+            ok = false;
+        }
+        (bound, ok)
+    }
+
+    /// Discretizes `[a, b]`, appending every cutting point after `a` (the last one is `b`).
+    pub(crate) fn piece(
+        &mut self,
+        a: f64,
+        b: f64,
+        pb: Point3<f64>,
+        out: &mut Discretization,
+    ) -> Result<()> {
+        let tol = self.opts.tolerance;
+        let emin = self.opts.band * tol;
+        let hp = 0.5 * (emin + tol);
+        let max_len = self.opts.max_segment_length;
+        let min_len = self.opts.min_segment_length;
+        let mut t0 = a;
+        let mut p0 = *out.points.last().expect("start point pushed");
+        // Ratio of the accepted radius to the curvature prediction at the previous point: the
+        // walk learns the systematic error of the osculating-circle model (warm start).
+        let mut bias = 1.0f64;
+        let mut last_dt = (b - a) / 8.0;
+        while t0 < b {
+            let (_, d1, d2) = self.curve.eval_d2(t0);
+            let k = curvature_of(&d1, &d2);
+            let remaining = (pb - p0).norm();
+            // Paper 004 eq 4-5: the chord of the osculating circle with sagitta H_p.
+            let r_curv = if k > 0.0 {
+                let r = 1.0 / k;
+                if hp >= r {
+                    2.0 * r
+                } else {
+                    2.0 * (hp * (2.0 * r - hp)).sqrt()
+                }
+            } else {
+                f64::INFINITY
+            };
+            let mut r = if r_curv.is_finite() {
+                r_curv * bias
+            } else {
+                // Straight here: try the rest of the piece (first-order length if it closes).
+                remaining.max(d1.norm() * (b - t0)) * (1.0 + 1e-9)
+            };
+            r = r.min(max_len).max(min_len);
+            if r.is_nan() || r <= 0.0 {
+                r = max_len.min(f64::MAX);
+            }
+            let max_dt = (8.0 * last_dt).min(b - a);
+            let mut good: Option<Cand> = None;
+            let mut bad: Option<Cand> = None;
+            let mut param_mode = self.param_only;
+            let mut fails = 0usize;
+            let mut t_try = t0 + last_dt.min(b - t0);
+            for _ in 0..MAX_ITERS {
+                let hit = if param_mode {
+                    let p = if t_try >= b {
+                        pb
+                    } else {
+                        self.curve.point(t_try)
+                    };
+                    Hit { t: t_try.min(b), p }
+                } else {
+                    let lo = good.map_or(t0, |g| g.hit.t);
+                    match bad {
+                        Some(bd) if bd.r > r => {
+                            first_crossing(self.curve, &p0, r, lo, bd.hit.t, true, None, max_dt)
+                        }
+                        _ => first_crossing(self.curve, &p0, r, lo, b, false, Some(pb), max_dt),
+                    }
+                };
+                if hit.t <= t0 {
+                    break;
+                }
+                let (bound, ok) = self.certify(t0, &p0, &hit);
+                let cand = Cand {
+                    r: (hit.p - p0).norm(),
+                    hit,
+                    bound,
+                };
+                if ok {
+                    good = Some(cand);
+                    fails = 0;
+                    if hit.t >= b || bound.lower >= emin || cand.r >= max_len * (1.0 - 1e-12) {
+                        break;
+                    }
+                } else {
+                    bad = Some(cand);
+                    fails += 1;
+                    if good.is_none() && fails >= PARAM_FALLBACK_AFTER {
+                        param_mode = true;
+                    }
+                }
+                // Next trial.
+                match (good, bad) {
+                    (Some(g), None) => {
+                        let f = if g.bound.lower > 0.0 {
+                            (hp / g.bound.lower).sqrt().clamp(1.1, 4.0)
+                        } else {
+                            4.0
+                        };
+                        r = (g.r * f).min(max_len);
+                        t_try = t0 + 2.0 * (g.hit.t - t0);
+                    }
+                    (None, Some(bd)) => {
+                        let f = if bd.bound.lower > 0.0 {
+                            (hp / bd.bound.lower).sqrt().clamp(0.05, 0.7)
+                        } else {
+                            0.5
+                        };
+                        r = (bd.r * f).max(if fails == 1 { min_len } else { 0.0 });
+                        if r >= bd.r {
+                            r = 0.5 * bd.r;
+                        }
+                        t_try = t0 + 0.5 * (bd.hit.t - t0);
+                    }
+                    (Some(g), Some(bd)) => {
+                        let gap_t = bd.hit.t - g.hit.t;
+                        if gap_t <= 1e-9 * (g.hit.t - t0) {
+                            break;
+                        }
+                        if param_mode {
+                            if gap_t <= BRACKET_TOL * (g.hit.t - t0) {
+                                break;
+                            }
+                            t_try = 0.5 * (g.hit.t + bd.hit.t);
+                        } else {
+                            let gap = bd.r - g.r;
+                            if gap <= BRACKET_TOL * g.r {
+                                break;
+                            }
+                            let model = if g.bound.lower > 0.0 {
+                                g.r * (hp / g.bound.lower).sqrt()
+                            } else {
+                                0.5 * (g.r + bd.r)
+                            };
+                            r = model.clamp(g.r + 0.1 * gap, bd.r - 0.1 * gap);
+                        }
+                    }
+                    (None, None) => unreachable!("a trial was made"),
+                }
+            }
+            let Some(g) = good else {
+                return Err(DiscretizeError::ToleranceBelowPrecision {
+                    t: t0,
+                    tolerance: tol,
+                });
+            };
+            if r_curv.is_finite() && g.hit.t < b {
+                bias = (g.r / r_curv).clamp(0.25, 4.0);
+            }
+            last_dt = g.hit.t - t0;
+            out.max_chord_error = out.max_chord_error.max(g.bound.upper);
+            out.estimated_chord_error = out.estimated_chord_error.max(g.bound.lower);
+            let (t1, p1) = if g.hit.t >= b {
+                (b, pb)
+            } else {
+                (g.hit.t, g.hit.p)
+            };
+            out.params.push(t1);
+            out.points.push(p1);
+            t0 = t1;
+            p0 = p1;
+        }
+        Ok(())
+    }
+}
+
+/// Tangent directions at the two ends of `[t0, t1]` (right-sided at `t0`, left-sided at
+/// `t1`), from the Bezier control polygons; `None` where a polygon end is degenerate.
+pub(crate) fn end_tangents(
+    curve: &NurbsCurve,
+    t0: f64,
+    t1: f64,
+) -> (Option<Vector3<f64>>, Option<Vector3<f64>>) {
+    let mut first = None;
+    let mut last = None;
+    curve.for_each_bezier_piece(t0, t1, |bez| {
+        let pts: Vec<Point3<f64>> = bez.control_points().collect();
+        if first.is_none() {
+            first = pts.windows(2).map(|w| w[1] - w[0]).find(|v| v.norm() > 0.0);
+        }
+        last = pts
+            .windows(2)
+            .rev()
+            .map(|w| w[1] - w[0])
+            .find(|v| v.norm() > 0.0);
+    });
+    (first, last)
+}

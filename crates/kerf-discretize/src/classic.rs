@@ -8,7 +8,7 @@ use nalgebra::Point3;
 use crate::bound::{chord_error_with, Scratch};
 use crate::error::{DiscretizeError, Result};
 use crate::options::Options;
-use crate::sphere::first_crossing;
+use crate::sphere::{first_crossing, End, Start};
 use crate::Discretization;
 
 /// Points of one trial: parameters, points, worst upper bound and worst lower bound.
@@ -197,7 +197,13 @@ pub(crate) fn equal_chord(
                 }
                 let t0 = *params.last().expect("non-empty");
                 let p0 = *points.last().expect("non-empty");
-                let hit = first_crossing(curve, &p0, r, t0, b, false, Some(pb), 8.0 * dt);
+                let start = Start {
+                    t: t0,
+                    d: 0.0,
+                    speed: None,
+                };
+                let end = End::PieceEnd { t: b, p: pb };
+                let hit = first_crossing(curve, &p0, r, start, end, 8.0 * dt);
                 if hit.t <= t0 {
                     return None;
                 }

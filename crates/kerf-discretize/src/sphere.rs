@@ -5,7 +5,7 @@ use nalgebra::Point3;
 
 /// Relative accuracy of the intersection radius. The exact crossing is not needed: the step is
 /// certified for whatever parameter is returned, so a loose tolerance saves evaluations.
-pub(crate) const RADIUS_TOL: f64 = 1e-4;
+pub(crate) const RADIUS_TOL: f64 = 5e-4;
 
 /// Where the sphere search ended.
 #[derive(Debug, Clone, Copy)]
@@ -16,54 +16,79 @@ pub(crate) struct Hit {
     pub p: Point3<f64>,
 }
 
-/// Finds the first parameter in `(lo, hi]` where `|C(t) - centre|` reaches `radius`, given
-/// `|C(lo) - centre| < radius`.
+/// What is known at the low end of the search: the parameter, its distance from the centre
+/// and (if known) the speed `|C'|` there.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Start {
+    pub t: f64,
+    pub d: f64,
+    pub speed: Option<f64>,
+}
+
+/// The high end of the search.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum End {
+    /// A parameter known to lie outside the sphere, with its distance from the centre.
+    Outside { t: f64, d: f64 },
+    /// The end of the piece and its point; the sphere may not reach it.
+    PieceEnd { t: f64, p: Point3<f64> },
+}
+
+/// Finds the first parameter after `start.t` where `|C(t) - centre|` reaches `radius`, given
+/// `start.d < radius`.
 ///
-/// When `hi_outside` is true, `|C(hi) - centre| > radius` is known and the root is bracketed;
-/// otherwise the curve is marched from `lo` by steps that, to first order, cannot cross the
-/// sphere (`dt = (radius - d) / |C'|`, as in sphere tracing), never longer than `max_dt`. If the
-/// sphere is not reached before `hi`, returns `hi` itself.
-#[allow(clippy::too_many_arguments)]
+/// With [`End::Outside`] the root is bracketed and found by safeguarded Newton, starting from
+/// the linear interpolation of the distance. With [`End::PieceEnd`] the curve is marched from
+/// the start by steps that, to first order, cannot cross the sphere (`dt = (radius - d) / |C'|`,
+/// as in sphere tracing), never longer than `max_dt`; if the sphere is not reached before the
+/// piece end, the piece end itself is returned.
 pub(crate) fn first_crossing(
     curve: &NurbsCurve,
     centre: &Point3<f64>,
     radius: f64,
-    lo: f64,
-    hi: f64,
-    hi_outside: bool,
-    p_hi: Option<Point3<f64>>,
+    start: Start,
+    end: End,
     max_dt: f64,
 ) -> Hit {
-    if hi_outside {
-        return solve(curve, centre, radius, lo, hi);
-    }
+    let lo = start.t;
+    let (hi, p_hi) = match end {
+        End::Outside { t, d } => {
+            // Distance is close to linear in t over a short step: start from the interpolation.
+            let f = ((radius - start.d) / (d - start.d)).clamp(0.0, 1.0);
+            return solve(curve, centre, radius, lo, t, lo + f * (t - lo));
+        }
+        End::PieceEnd { t, p } => (t, p),
+    };
     let mut t = lo;
+    let mut known = start.speed.map(|s| (start.d, s));
     for _ in 0..96 {
-        let (c, d1) = curve.eval_d1(t);
-        let d = (c - centre).norm();
-        if d >= radius {
-            // Crossed during the last step: the root lies in [previous t, t].
-            return if d <= radius * (1.0 + RADIUS_TOL) {
-                Hit { t, p: c }
-            } else {
-                solve(curve, centre, radius, lo, t)
-            };
-        }
-        let gap = radius - d;
-        if gap <= radius * RADIUS_TOL && t > lo {
-            return Hit { t, p: c };
-        }
-        let speed = d1.norm();
-        let mut dt = if speed > 0.0 { gap / speed } else { max_dt };
-        dt = dt.min(max_dt);
-        if t + dt >= hi {
-            let p = p_hi.unwrap_or_else(|| curve.point(hi));
-            if (p - centre).norm() < radius {
-                return Hit { t: hi, p };
+        let (d, speed) = match known.take() {
+            Some(ds) => ds,
+            None => {
+                let (c, d1) = curve.eval_d1(t);
+                let d = (c - centre).norm();
+                if d >= radius {
+                    // Crossed during the last step: the root lies in [lo, t].
+                    return if d <= radius * (1.0 + RADIUS_TOL) {
+                        Hit { t, p: c }
+                    } else {
+                        solve(curve, centre, radius, lo, t, 0.5 * (lo + t))
+                    };
+                }
+                if radius - d <= radius * RADIUS_TOL {
+                    return Hit { t, p: c };
+                }
+                (d, d1.norm())
             }
-            return solve(curve, centre, radius, t, hi);
+        };
+        let gap = radius - d;
+        let dt = if speed > 0.0 { gap / speed } else { max_dt }.min(max_dt);
+        if t + dt >= hi {
+            if (p_hi - centre).norm() < radius {
+                return Hit { t: hi, p: p_hi };
+            }
+            return solve(curve, centre, radius, t, hi, 0.5 * (t + hi));
         }
-        // Keep `lo` as the last parameter known to be inside the sphere.
         let next = t + dt;
         if next <= t {
             break;
@@ -76,9 +101,20 @@ pub(crate) fn first_crossing(
 
 /// Newton's method on `|C(t) - centre|^2 - radius^2` safeguarded by bisection in `[lo, hi]`,
 /// where the function is negative at `lo` and positive at `hi`.
-fn solve(curve: &NurbsCurve, centre: &Point3<f64>, radius: f64, mut lo: f64, mut hi: f64) -> Hit {
+fn solve(
+    curve: &NurbsCurve,
+    centre: &Point3<f64>,
+    radius: f64,
+    mut lo: f64,
+    mut hi: f64,
+    guess: f64,
+) -> Hit {
     let r2 = radius * radius;
-    let mut t = 0.5 * (lo + hi);
+    let mut t = if guess > lo && guess < hi {
+        guess
+    } else {
+        0.5 * (lo + hi)
+    };
     let mut best = None;
     for _ in 0..80 {
         let (c, d1) = curve.eval_d1(t);

@@ -8,7 +8,7 @@ use nalgebra::{Point3, Vector3};
 use crate::bound::{chord_error_with, Bound, Scratch};
 use crate::error::{DiscretizeError, Result};
 use crate::options::Options;
-use crate::sphere::{first_crossing, Hit};
+use crate::sphere::{first_crossing, End, Hit, Start};
 use crate::Discretization;
 
 /// Iterations of the radius search per cutting point before giving up.
@@ -83,6 +83,7 @@ impl Walker<'_> {
         while t0 < b {
             let (_, d1, d2) = self.curve.eval_d2(t0);
             let k = curvature_of(&d1, &d2);
+            let speed0 = d1.norm();
             let remaining = (pb - p0).norm();
             // Paper 004 eq 4-5: the chord of the osculating circle with sagitta H_p.
             let r_curv = if k > 0.0 {
@@ -120,13 +121,26 @@ impl Walker<'_> {
                     };
                     Hit { t: t_try.min(b), p }
                 } else {
-                    let lo = good.map_or(t0, |g| g.hit.t);
-                    match bad {
-                        Some(bd) if bd.r > r => {
-                            first_crossing(self.curve, &p0, r, lo, bd.hit.t, true, None, max_dt)
-                        }
-                        _ => first_crossing(self.curve, &p0, r, lo, b, false, Some(pb), max_dt),
-                    }
+                    let start = good.map_or(
+                        Start {
+                            t: t0,
+                            d: 0.0,
+                            speed: Some(speed0),
+                        },
+                        |g| Start {
+                            t: g.hit.t,
+                            d: g.r,
+                            speed: None,
+                        },
+                    );
+                    let end = match bad {
+                        Some(bd) if bd.r > r => End::Outside {
+                            t: bd.hit.t,
+                            d: bd.r,
+                        },
+                        _ => End::PieceEnd { t: b, p: pb },
+                    };
+                    first_crossing(self.curve, &p0, r, start, end, max_dt)
                 };
                 if hit.t <= t0 {
                     break;
@@ -188,8 +202,13 @@ impl Walker<'_> {
                             if gap <= BRACKET_TOL * g.r {
                                 break;
                             }
-                            let model = if g.bound.lower > 0.0 {
-                                g.r * (hp / g.bound.lower).sqrt()
+                            // Power law e = c r^q through both ends of the bracket.
+                            let (eg, eb) = (g.bound.lower, bd.bound.lower);
+                            let model = if eg > 0.0 && eb > eg {
+                                let q = (eb / eg).ln() / (bd.r / g.r).ln();
+                                g.r * (hp / eg).powf(1.0 / q)
+                            } else if eg > 0.0 {
+                                g.r * (hp / eg).sqrt()
                             } else {
                                 0.5 * (g.r + bd.r)
                             };
@@ -205,8 +224,9 @@ impl Walker<'_> {
                     tolerance: tol,
                 });
             };
-            if r_curv.is_finite() && g.hit.t < b {
-                bias = (g.r / r_curv).clamp(0.25, 4.0);
+            if r_curv.is_finite() && g.hit.t < b && g.bound.lower > 0.0 {
+                // The radius that would have hit H_p exactly, relative to the prediction.
+                bias = (g.r * (hp / g.bound.lower).sqrt() / r_curv).clamp(0.25, 4.0);
             }
             last_dt = g.hit.t - t0;
             out.max_chord_error = out.max_chord_error.max(g.bound.upper);

@@ -11,8 +11,21 @@ use crate::MAX_ORDER;
 /// `span` must satisfy `knots[span] < knots[span + 1]`, as [`crate::knots::find_span`] returns.
 #[inline]
 pub fn basis_funs(span: usize, u: f64, degree: usize, knots: &[f64], out: &mut [f64; MAX_ORDER]) {
-    let mut left = [0.0; MAX_ORDER];
-    let mut right = [0.0; MAX_ORDER];
+    basis_funs_m(span, u, degree, knots, out);
+}
+
+/// [`basis_funs`] with scratch arrays of `M >= degree + 1` entries. Evaluation picks a small `M`
+/// for the common low degrees so that no time goes into clearing unused stack space.
+#[inline]
+pub fn basis_funs_m<const M: usize>(
+    span: usize,
+    u: f64,
+    degree: usize,
+    knots: &[f64],
+    out: &mut [f64; M],
+) {
+    let mut left = [0.0; M];
+    let mut right = [0.0; M];
     out[0] = 1.0;
     for j in 1..=degree {
         left[j] = u - knots[span + 1 - j];
@@ -38,11 +51,24 @@ pub fn ders_basis_funs(
     knots: &[f64],
     ders: &mut [[f64; MAX_ORDER]],
 ) {
+    ders_basis_funs_m(span, u, degree, n, knots, ders);
+}
+
+/// [`ders_basis_funs`] with scratch arrays of `M >= degree + 1` entries.
+#[inline]
+pub fn ders_basis_funs_m<const M: usize>(
+    span: usize,
+    u: f64,
+    degree: usize,
+    n: usize,
+    knots: &[f64],
+    ders: &mut [[f64; M]],
+) {
     let p = degree;
     let n = n.min(p);
-    let mut ndu = [[0.0; MAX_ORDER]; MAX_ORDER];
-    let mut left = [0.0; MAX_ORDER];
-    let mut right = [0.0; MAX_ORDER];
+    let mut ndu = [[0.0; M]; M];
+    let mut left = [0.0; M];
+    let mut right = [0.0; M];
     ndu[0][0] = 1.0;
     for j in 1..=p {
         left[j] = u - knots[span + 1 - j];
@@ -61,7 +87,7 @@ pub fn ders_basis_funs(
     for j in 0..=p {
         ders[0][j] = ndu[j][p];
     }
-    let mut a = [[0.0; MAX_ORDER]; 2];
+    let mut a = [[0.0; M]; 2];
     for r in 0..=p {
         let (mut s1, mut s2) = (0usize, 1usize);
         a[0][0] = 1.0;

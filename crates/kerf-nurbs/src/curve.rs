@@ -2,7 +2,7 @@
 
 use nalgebra::{Point3, Vector3, Vector4};
 
-use crate::basis::{basis_funs, binomial, ders_basis_funs};
+use crate::basis::{basis_funs_m, binomial, ders_basis_funs_m};
 use crate::error::{NurbsError, Result};
 use crate::knots;
 use crate::MAX_ORDER;
@@ -208,10 +208,21 @@ impl NurbsCurve {
     /// The point `C(t)`. Parameters outside the domain (and NaN) are clamped to it.
     #[inline]
     pub fn point(&self, t: f64) -> Point3<f64> {
+        // Scratch arrays sized for the degree: clearing 25-entry arrays would cost more than
+        // the arithmetic for the common degrees.
+        match self.degree {
+            0..=3 => self.point_m::<4>(t),
+            4..=7 => self.point_m::<8>(t),
+            _ => self.point_m::<MAX_ORDER>(t),
+        }
+    }
+
+    #[inline]
+    fn point_m<const M: usize>(&self, t: f64) -> Point3<f64> {
         let t = self.clamp(t);
         let span = self.span(t);
-        let mut n = [0.0; MAX_ORDER];
-        basis_funs(span, t, self.degree, &self.knots, &mut n);
+        let mut n = [0.0; M];
+        basis_funs_m(span, t, self.degree, &self.knots, &mut n);
         let mut acc = Vector4::zeros();
         let first = span - self.degree;
         for (j, nj) in n.iter().enumerate().take(self.degree + 1) {
@@ -224,12 +235,21 @@ impl NurbsCurve {
     /// Orders above the degree are zero.
     #[inline]
     fn homogeneous_derivs(&self, t: f64, n: usize, out: &mut [Vector4<f64>]) {
+        match self.degree {
+            0..=3 => self.homogeneous_derivs_m::<4>(t, n, out),
+            4..=7 => self.homogeneous_derivs_m::<8>(t, n, out),
+            _ => self.homogeneous_derivs_m::<MAX_ORDER>(t, n, out),
+        }
+    }
+
+    #[inline]
+    fn homogeneous_derivs_m<const M: usize>(&self, t: f64, n: usize, out: &mut [Vector4<f64>]) {
         let p = self.degree;
         let t = self.clamp(t);
         let span = self.span(t);
         let nd = n.min(p);
-        let mut ders = [[0.0; MAX_ORDER]; MAX_ORDER];
-        ders_basis_funs(span, t, p, nd, &self.knots, &mut ders[..]);
+        let mut ders = [[0.0; M]; M];
+        ders_basis_funs_m(span, t, p, nd, &self.knots, &mut ders[..]);
         let first = span - p;
         for (k, o) in out.iter_mut().enumerate().take(n + 1) {
             *o = Vector4::zeros();
@@ -241,6 +261,20 @@ impl NurbsCurve {
         }
     }
 
+    /// Cartesian derivatives from homogeneous ones: A4.2 for rational curves; for equal
+    /// weights `w` the weight's derivatives vanish and `C^(k) = A^(k) / w`.
+    #[inline]
+    fn cartesian_derivs(&self, a: &[Vector4<f64>], c: &mut [Vector3<f64>]) {
+        if self.rational {
+            rational_from_homogeneous(a, c);
+        } else {
+            let inv = 1.0 / a[0].w;
+            for (ck, ak) in c.iter_mut().zip(a) {
+                *ck = ak.xyz() * inv;
+            }
+        }
+    }
+
     /// The point and derivatives `C, C', ..., C^(n)` at `t` (index 0 is the point as a vector),
     /// for any order `n`: rational derivatives from the homogeneous ones by The NURBS Book
     /// A4.2, `C^(k) = (A^(k) - sum_{i=1..k} binom(k, i) w^(i) C^(k-i)) / w`.
@@ -248,7 +282,7 @@ impl NurbsCurve {
         let mut a = vec![Vector4::zeros(); n + 1];
         self.homogeneous_derivs(t, n, &mut a);
         let mut c = vec![Vector3::zeros(); n + 1];
-        rational_from_homogeneous(&a, &mut c);
+        self.cartesian_derivs(&a, &mut c);
         c
     }
 
@@ -258,7 +292,7 @@ impl NurbsCurve {
         let mut a = [Vector4::zeros(); 3];
         self.homogeneous_derivs(t, 2, &mut a);
         let mut c = [Vector3::zeros(); 3];
-        rational_from_homogeneous(&a, &mut c);
+        self.cartesian_derivs(&a, &mut c);
         (Point3::from(c[0]), c[1], c[2])
     }
 
@@ -268,7 +302,7 @@ impl NurbsCurve {
         let mut a = [Vector4::zeros(); 2];
         self.homogeneous_derivs(t, 1, &mut a);
         let mut c = [Vector3::zeros(); 2];
-        rational_from_homogeneous(&a, &mut c);
+        self.cartesian_derivs(&a, &mut c);
         (Point3::from(c[0]), c[1])
     }
 
@@ -277,7 +311,7 @@ impl NurbsCurve {
         let mut a = [Vector4::zeros(); 4];
         self.homogeneous_derivs(t, 3, &mut a);
         let mut c = [Vector3::zeros(); 4];
-        rational_from_homogeneous(&a, &mut c);
+        self.cartesian_derivs(&a, &mut c);
         c
     }
 
@@ -379,11 +413,29 @@ impl NurbsCurve {
         (self.point(a) - self.point(b)).norm() <= 1e-12 * self.size().max(f64::MIN_POSITIVE)
     }
 
-    /// The same curve traversed backwards: `reversed.point(a + b - t) == self.point(t)`.
+    /// The same curve traversed backwards over the same domain `[a, b]`:
+    /// `reversed.point(a + b - t) == self.point(t)`.
     pub fn reversed(&self) -> Self {
         let m = self.knots.len();
-        let (a, b) = (self.knots[0], self.knots[m - 1]);
-        let knots = (0..m).map(|i| a + b - self.knots[m - 1 - i]).collect();
+        // Reflect about the domain (not the first and last knot, which differ from the domain
+        // ends for unclamped knot vectors) so that the domain is kept.
+        let (a, b) = self.domain();
+        // `a + b - k`, but exact at the domain ends and kept on the right side of them under
+        // rounding, so that the mirrored knot vector is sorted and has the same domain.
+        let mirror = |k: f64| {
+            if k == a {
+                b
+            } else if k == b {
+                a
+            } else if k < a {
+                (a + b - k).max(b)
+            } else if k > b {
+                (a + b - k).min(a)
+            } else {
+                (a + b - k).clamp(a, b)
+            }
+        };
+        let knots = (0..m).map(|i| mirror(self.knots[m - 1 - i])).collect();
         let cpw = self.cpw.iter().rev().copied().collect();
         Self::from_homogeneous_unchecked(self.degree, knots, cpw)
     }
@@ -415,10 +467,12 @@ impl NurbsCurve {
                 degree: p,
             });
         }
-        // k: the span with knots[k] <= u < knots[k + 1] (the last such index, in the domain).
+        // k: the index with knots[k] <= u < knots[k + 1], as A5.1 requires. It may lie beyond
+        // the domain's last span when u is the domain end of an unclamped knot vector: the
+        // copies of u then sit at k - s + 1 ..= k, and a knot > u exists because s + r <= p.
         let np = self.cpw.len() - 1;
         let mut k = p;
-        while k < np && self.knots[k + 1] <= u {
+        while self.knots[k + 1] <= u {
             k += 1;
         }
         let r = times;

@@ -99,19 +99,27 @@ impl NurbsCurve {
             t1,
             cpw: [Vector4::zeros(); MAX_ORDER],
         };
-        // Apply t0 p - j times and t1 j times. Shared prefixes: first apply t0 at levels
-        // 1..=p-j; reuse across j would save work, but p^3 is small for practical degrees.
-        for j in 0..=p {
-            let mut d = [Vector4::zeros(); MAX_ORDER];
-            d[..=p].copy_from_slice(&cpw[span - p..=span]);
-            for r in 1..=p {
-                let x = if r <= p - j { t0 } else { t1 };
-                for k in (r..=p).rev() {
-                    let lo = knots[span - p + k];
-                    let hi = knots[span + 1 + k - r];
-                    let alpha = (x - lo) / (hi - lo);
-                    d[k] = d[k - 1] * (1.0 - alpha) + d[k] * alpha;
-                }
+        // Control point j applies t0 at p - j de Boor levels and t1 at j levels. The t0 levels
+        // are shared: `pre` holds the state after `p - j` levels of t0, for j = p down to 0.
+        let level = |d: &mut [Vector4<f64>; MAX_ORDER], r: usize, x: f64| {
+            for k in (r..=p).rev() {
+                let lo = knots[span - p + k];
+                let hi = knots[span + 1 + k - r];
+                let alpha = (x - lo) / (hi - lo);
+                d[k] = d[k - 1] * (1.0 - alpha) + d[k] * alpha;
+            }
+        };
+        let mut pre = [Vector4::zeros(); MAX_ORDER];
+        pre[..=p].copy_from_slice(&cpw[span - p..=span]);
+        let mut d = pre;
+        for j in (0..=p).rev() {
+            if j < p {
+                // One more level of t0: level p - j.
+                level(&mut pre, p - j, t0);
+            }
+            d[..=p].copy_from_slice(&pre[..=p]);
+            for r in (p - j + 1)..=p {
+                level(&mut d, r, t1);
             }
             out.cpw[j] = d[p];
         }

@@ -57,6 +57,34 @@ fn bench(c: &mut Criterion) {
         }
         group.finish();
     }
+    // The real parts of fixtures/realdata, all curves as one batch.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/realdata");
+    for file in ["nori_sheetmetal.json", "occt_propeller.json"] {
+        let doc = kerf::format::curves::load(root.join(file)).expect("fixture loads");
+        let curves: Vec<NurbsCurve> = doc.curves.into_iter().map(|r| r.curve).collect();
+        let mut group = c.benchmark_group(format!("discretize/{file}"));
+        group.sample_size(10);
+        for tol in [0.1, 0.01, 0.001] {
+            let opts = Options::with_tolerance(tol);
+            let points: usize = discretize_all(&curves, &opts)
+                .into_iter()
+                .map(|d| d.expect("discretizes").points.len())
+                .sum();
+            group.throughput(Throughput::Elements(points as u64));
+            group.bench_with_input(BenchmarkId::new("single", tol), &opts, |b, o| {
+                b.iter(|| {
+                    curves
+                        .iter()
+                        .map(|c| discretize(c, o).expect("discretizes").points.len())
+                        .sum::<usize>()
+                })
+            });
+            group.bench_with_input(BenchmarkId::new("rayon", tol), &opts, |b, o| {
+                b.iter(|| discretize_all(&curves, o).len())
+            });
+        }
+        group.finish();
+    }
 }
 
 criterion_group!(benches, bench);

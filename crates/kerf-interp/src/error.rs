@@ -1,0 +1,138 @@
+//! The error type of the interpolator.
+
+use thiserror::Error;
+
+/// What can go wrong when interpolating, planning or writing a program.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum InterpError {
+    /// A parameter is out of range: NaN, infinite, zero or negative where a positive finite value
+    /// is needed (feed, cycle time, tolerance, limit). Fix: pass a finite positive value; the
+    /// parameter's documentation gives its unit.
+    #[error("{name}: {reason} (got {value})")]
+    BadParameter {
+        /// The parameter's name.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// A point or axis vector holds NaN or an infinite coordinate. Fix: check the input file
+    /// (the index counts points from 0 within the path).
+    #[error("point {index}: non-finite coordinate")]
+    NonFinite {
+        /// Index of the offending point.
+        index: usize,
+    },
+    /// The three points of a space arc are collinear or two of them coincide, so no circle
+    /// passes through them. [`crate::Block::arc_or_line`] falls back to a line instead; fix for
+    /// [`crate::Arc::through`]: give three distinct, non-collinear points.
+    #[error("arc points are collinear or coincide (|P1P2 x P2P3| = {cross:e} mm^2)")]
+    CollinearArc {
+        /// Norm of the cross product of the two chords.
+        cross: f64,
+    },
+    /// A path has fewer points than the operation needs (1 for interpolation, 2 for a spline).
+    /// Fix: drop the path or give it more points.
+    #[error("path has {got} point(s), needs at least {need}")]
+    TooFewPoints {
+        /// Points given.
+        got: usize,
+        /// Points needed.
+        need: usize,
+    },
+    /// Two parallel arrays (points and their parameters or axes) differ in length. Fix: give
+    /// one entry per point.
+    #[error("{what}: {got} entries for {expected} points")]
+    LengthMismatch {
+        /// Which array.
+        what: &'static str,
+        /// Its length.
+        got: usize,
+        /// The number of points.
+        expected: usize,
+    },
+    /// The machine model could not reach a pose (inverse kinematics failed: outside the axis
+    /// ranges, or not a unit tool axis). Fix: see the message from the kinematics.
+    #[error("point {index}: kinematics: {message}")]
+    Kinematics {
+        /// Index of the pose within its path.
+        index: usize,
+        /// The kinematics' own message.
+        message: String,
+    },
+    /// An interpolated set-point leaves an axis range of the machine (an arc bulging past a
+    /// limit between two reachable points). Fix: move the part, or interpolate lines only
+    /// ([`crate::FitOptions::arcs`] = false).
+    #[error("cycle {cycle}: axis {axis} = {value} outside its range [{min}, {max}]")]
+    OutOfRange {
+        /// Cycle index of the set-point.
+        cycle: usize,
+        /// Axis name.
+        axis: String,
+        /// The set-point value.
+        value: f64,
+        /// Lower limit.
+        min: f64,
+        /// Upper limit.
+        max: f64,
+    },
+    /// The feed plan did not bring every axis within its velocity and acceleration limits after
+    /// the allowed number of refinements. This does not happen with consistent limits; fix:
+    /// check that the machine's limits are positive and finite, or lower the feed.
+    #[error(
+        "feed plan: axis {axis} exceeds its {what} limit at cycle {cycle} ({value} > {limit})"
+    )]
+    LimitsNotMet {
+        /// Axis name.
+        axis: String,
+        /// "velocity" or "acceleration".
+        what: &'static str,
+        /// Cycle index.
+        cycle: usize,
+        /// Measured value (per second or per second squared).
+        value: f64,
+        /// The limit.
+        limit: f64,
+    },
+    /// The program would have more cycles than [`crate::PlanOptions::max_cycles`]. Fix: raise
+    /// the feed or the cycle time, or raise the limit.
+    #[error("program needs {cycles} cycles, more than the limit {limit}")]
+    TooManyCycles {
+        /// Cycles needed (estimated).
+        cycles: f64,
+        /// The limit.
+        limit: usize,
+    },
+    /// Writing an output file failed. Fix: check that the directory exists and is writable.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The operating system's message.
+        message: String,
+    },
+}
+
+/// `Result` with [`InterpError`].
+pub type Result<T> = std::result::Result<T, InterpError>;
+
+/// Checks that `value` is finite and > 0.
+pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
+    if !value.is_finite() {
+        return Err(InterpError::BadParameter {
+            name,
+            value,
+            reason: "must be finite",
+        });
+    }
+    if value <= 0.0 {
+        return Err(InterpError::BadParameter {
+            name,
+            value,
+            reason: "must be > 0",
+        });
+    }
+    Ok(value)
+}

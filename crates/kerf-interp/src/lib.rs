@@ -1,0 +1,98 @@
+//! The interpolator of kerf: cutting points to motion, cycle by cycle, and to G-code.
+//!
+//! The last stage of the pipeline. A path's cutting points (poses with their machine axes,
+//! [`Station`]s from [`solve_stations`] or from a `kerf.axes/1` file) become a program:
+//!
+//! 1. [`fit_blocks`]: runs of points become space arcs (or long lines) where the block stays
+//!    within the tolerance of the points and of the curve; [`BlockCounts`] counts them.
+//! 2. [`plan()`]: a look-ahead feed plan along the blocks such that no axis exceeds its velocity
+//!    or acceleration limit in any cycle, stopping at the end; [`Motion::cycles`] is the
+//!    program's cycle count.
+//! 3. [`Motion::iter`]: the set-points, one per interpolation cycle: the tip on the line or arc
+//!    (paper 000 eq 3 and 6-8), the rotary axes in proportion to the distance (eq 4, 9-12), the
+//!    linear axes from the machine model (eq 16 for paper 000's head, [`AxisModel`] in general).
+//! 4. [`output`]: the set-points CSV of `formats.md`, generic and Sinumerik-style G-code.
+//!
+//! [`Block::constant_feed`] is paper 000's interpolator of one block at constant feed, and
+//! [`recursive`] is paper 001's recursive spline interpolator. The maths, the tolerance budget
+//! and the measured figures are in `docs/interpolation.md`.
+//!
+//! ```
+//! use kerf_interp::{fit_blocks, plan, solve_stations, AcHead, FitOptions, PlanOptions};
+//! use nalgebra::{Point3, Vector3};
+//!
+//! let machine = AcHead::paper_000();
+//! // A half circle of radius 20 mm, tool vertical, 41 cutting points (chord error 0.0154 mm).
+//! let tips: Vec<Point3<f64>> = (0..=40)
+//!     .map(|i| {
+//!         let a = std::f64::consts::PI * i as f64 / 40.0;
+//!         Point3::new(20.0 * a.cos(), 20.0 * a.sin(), 0.0)
+//!     })
+//!     .collect();
+//! let stations = solve_stations(&machine, &tips, None, None, None)?;
+//! let blocks = fit_blocks(&machine, &stations, None, 0, &FitOptions::with_tolerance(0.02))?;
+//! assert_eq!(blocks.len(), 1, "one arc");
+//! let motion = plan(&machine, &blocks, &PlanOptions::new(6000.0, 0.001))?;
+//! let rows = motion.setpoints(&machine);
+//! assert_eq!(rows.len(), motion.cycles() + 1);
+//! assert_eq!(*rows.last().unwrap(), stations[40].axes, "ends exactly on the last point");
+//! # Ok::<(), kerf_interp::InterpError>(())
+//! ```
+
+pub mod block;
+pub mod chord;
+pub mod error;
+pub mod fit;
+pub mod geometry;
+pub mod model;
+pub mod output;
+pub mod plan;
+pub mod recursive;
+
+pub use block::{increments, solve_stations, Block, Geometry, Station};
+pub use error::{InterpError, Result};
+pub use fit::{fit_blocks, BlockCounts, CurveFn, FitOptions};
+pub use geometry::Arc;
+pub use model::{AcHead, AxisLimits, AxisModel};
+pub use output::{csv_string, gcode, write_csv, write_gcode, Dialect, GcodeOptions};
+pub use plan::{link_paths, plan, Cycles, Motion, PlanOptions};
+
+/// One path of a program: its id (the source curve's), its stations and, when known, the
+/// curve itself.
+pub struct PathInput<'a> {
+    /// The id of the source curve (written in G-code comments).
+    pub id: String,
+    /// The cutting points with their machine axes.
+    pub stations: Vec<Station>,
+    /// The curve point at a parameter, for the arc fit's curve test (`None`: the polyline
+    /// stands in for the curve).
+    pub curve: Option<CurveFn<'a>>,
+}
+
+impl std::fmt::Debug for PathInput<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PathInput")
+            .field("id", &self.id)
+            .field("stations", &self.stations.len())
+            .field("curve", &self.curve.is_some())
+            .finish()
+    }
+}
+
+/// Fits every path ([`fit_blocks`], path `n` numbered `n`) and links them with rapid moves
+/// ([`link_paths`]): the blocks of one program, ready for [`plan()`] and [`gcode`]. Paths with a
+/// single point give no block.
+///
+/// # Errors
+/// As [`fit_blocks`].
+pub fn fit_program<M: AxisModel + ?Sized>(
+    model: &M,
+    paths: &[PathInput<'_>],
+    opts: &FitOptions,
+) -> Result<Vec<Block>> {
+    let mut all = Vec::with_capacity(paths.len());
+    for (n, p) in paths.iter().enumerate() {
+        all.push(fit_blocks(model, &p.stations, p.curve, n, opts)?);
+    }
+    Ok(link_paths(all))
+}

@@ -1,0 +1,206 @@
+//! CSV and G-code: the header and rows of formats.md, and programs that parse back (with a
+//! simple line parser written here) to the positions they were made from.
+
+mod common;
+
+use std::collections::HashMap;
+
+use common::{circle, freeform, stations};
+use kerf_interp::{
+    csv_string, fit_blocks, gcode, plan, write_csv, write_gcode, AcHead, AxisModel, Dialect,
+    FitOptions, GcodeOptions, Geometry, PlanOptions,
+};
+use nalgebra::Vector3;
+
+/// Words of one G-code line: `G1 X1.5 A3=0.2` -> {"G": 1, "X": 1.5, "A3": 0.2}; comments
+/// (`;` to the end) dropped.
+fn words(line: &str) -> (String, HashMap<String, f64>) {
+    let code = line.split(';').next().unwrap_or("").trim();
+    let mut it = code.split_whitespace();
+    let head = it.next().unwrap_or("").to_string();
+    let mut map = HashMap::new();
+    for w in it {
+        let (k, v) = match w.split_once('=') {
+            Some((k, v)) => (k.to_string(), v),
+            None => {
+                let i = w
+                    .find(|c: char| c == '-' || c == '.' || c.is_ascii_digit())
+                    .unwrap_or(w.len());
+                (w[..i].to_string(), &w[i..])
+            }
+        };
+        map.insert(
+            k,
+            v.parse::<f64>()
+                .unwrap_or_else(|_| panic!("number in {line:?}")),
+        );
+    }
+    (head, map)
+}
+
+#[test]
+fn csv_header_and_rows() {
+    let m = AcHead::paper_000();
+    let st = stations(&m, &circle(10.0, 0.0, 0.0, 0.0), 0.001, |_| Vector3::z());
+    let blocks = fit_blocks(&m, &st, None, 0, &FitOptions::default()).expect("fit");
+    let motion = plan(&m, &blocks, &PlanOptions::new(3000.0, 0.004)).expect("plan");
+    let rows = motion.setpoints(&m);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("out.csv");
+    write_csv(&path, m.axis_names(), 0.004, &rows).expect("write");
+    let text = std::fs::read_to_string(&path).expect("read");
+    assert_eq!(
+        text,
+        csv_string(m.axis_names(), 0.004, &rows),
+        "file = string"
+    );
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t,X,Y,Z,A,C"), "header of formats.md");
+    let parsed: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().expect("number")).collect())
+        .collect();
+    assert_eq!(parsed.len(), rows.len(), "one row per cycle");
+    for (i, (p, q)) in parsed.iter().zip(&rows).enumerate() {
+        assert_eq!(p.len(), 6, "six columns");
+        assert!((p[0] - i as f64 * 0.004).abs() < 1e-9, "t of row {i}");
+        for k in 0..5 {
+            assert_eq!(p[k + 1], q[k], "row {i} axis {k} reads back exactly");
+        }
+    }
+    // No temporary file left behind.
+    assert_eq!(
+        std::fs::read_dir(dir.path()).expect("dir").count(),
+        1,
+        "only the CSV"
+    );
+    // A directory that does not exist is an error, not a panic.
+    let e = write_csv(
+        dir.path().join("no/such/dir.csv"),
+        m.axis_names(),
+        0.004,
+        &rows,
+    );
+    assert!(
+        matches!(e, Err(kerf_interp::InterpError::Io { .. })),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn generic_gcode_parses_back_to_the_machine_axes() {
+    let m = AcHead::paper_000();
+    let c = freeform();
+    let st = stations(&m, &c, 0.001, |p| {
+        Vector3::new(0.3 * (p.x / 50.0).sin(), 0.2, 1.0).normalize()
+    });
+    let curve = |t: f64| c.point(t);
+    let blocks = fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::default()).expect("fit");
+    let opts = GcodeOptions::new(Dialect::Generic, 6000.0);
+    let text = gcode(&m, &blocks, &["door-trim-1".to_string()], None, &opts).expect("gcode");
+    assert!(
+        text.contains("; curve door-trim-1"),
+        "comment names the source curve"
+    );
+    assert!(
+        text.contains("; machine: paper-000 laser head"),
+        "header names the machine"
+    );
+    assert!(text.contains("units: mm"), "header states units");
+    assert!(
+        text.contains("tolerance: arc fit 0.001 mm"),
+        "header states tolerance"
+    );
+    let moves: Vec<HashMap<String, f64>> = text
+        .lines()
+        .map(words)
+        .filter(|(h, _)| h == "G0" || h == "G1")
+        .map(|(_, w)| w)
+        .collect();
+    let q = |w: &HashMap<String, f64>| -> [f64; 5] { ["X", "Y", "Z", "A", "C"].map(|k| w[k]) };
+    assert_eq!(
+        q(&moves[0]),
+        blocks[0].start_axes.map(|v| (v * 1e6).round() / 1e6),
+        "G0 to the start"
+    );
+    // Every block end appears, in order; arcs add chord points lying on the arc.
+    let mut it = moves.iter().skip(1);
+    for b in &blocks {
+        let mut found = false;
+        for w in it.by_ref() {
+            let got = q(w);
+            if (0..5).all(|k| (got[k] - b.end_axes[k]).abs() <= 5e-7) {
+                found = true;
+                break;
+            }
+            assert!(b.is_arc(), "only arcs have intermediate G1 points");
+        }
+        assert!(found, "block end {:?} in the program", b.end_axes);
+    }
+    assert!(moves[1].contains_key("F"), "first cut sets the feed");
+    assert_eq!(moves[1]["F"], 6000.0, "feed");
+    assert!(text.trim_end().ends_with("M30"), "program end");
+}
+
+#[test]
+fn sinumerik_gcode_parses_back_to_tips_orientations_and_arcs() {
+    let m = AcHead::paper_000();
+    let c = circle(40.0, 10.0, -5.0, 3.0);
+    let st = stations(&m, &c, 0.001, |p| {
+        Vector3::new((p.x - 10.0) / 120.0, (p.y + 5.0) / 120.0, 1.0).normalize()
+    });
+    let curve = |t: f64| c.point(t);
+    let blocks = fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::default()).expect("fit");
+    let motion = plan(&m, &blocks, &PlanOptions::new(5000.0, 0.001)).expect("plan");
+    let feeds: Vec<f64> = (0..blocks.len()).map(|b| motion.block_feed(b)).collect();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("ring.mpf");
+    let opts = GcodeOptions::new(Dialect::Sinumerik, 5000.0);
+    write_gcode(
+        &path,
+        &m,
+        &blocks,
+        &["ring".to_string()],
+        Some(&feeds),
+        &opts,
+    )
+    .expect("write");
+    let text = std::fs::read_to_string(&path).expect("read");
+    assert!(text.contains("TRAORI"), "orientation transformation on");
+    assert!(text.contains("TRAFOOF"), "and off");
+    let moves: Vec<(String, HashMap<String, f64>)> = text
+        .lines()
+        .map(words)
+        .filter(|(h, _)| h == "G0" || h == "G1" || h == "CIP")
+        .collect();
+    assert_eq!(
+        moves.len(),
+        blocks.len() + 1,
+        "a positioning move and one line per block"
+    );
+    for (b, (head, w)) in blocks.iter().zip(&moves[1..]) {
+        let tip = b.end_tip();
+        for (k, v) in [
+            ("X", tip.x),
+            ("Y", tip.y),
+            ("Z", tip.z),
+            ("A3", b.end_tool_axis.x),
+            ("B3", b.end_tool_axis.y),
+            ("C3", b.end_tool_axis.z),
+        ] {
+            assert!((w[k] - v).abs() <= 5e-7, "{k}: {} vs {v}", w[k]);
+        }
+        if let Geometry::Arc(a) = &b.geometry {
+            assert_eq!(head, "CIP", "arc as CIP");
+            for (k, v) in [("I1", a.mid.x), ("J1", a.mid.y), ("K1", a.mid.z)] {
+                assert!((w[k] - v).abs() <= 5e-7, "{k}: {} vs {v}", w[k]);
+            }
+        } else {
+            assert_eq!(head, "G1", "line");
+        }
+    }
+    let f = moves[1].1["F"];
+    assert!(
+        f > 0.0 && f <= 5000.0 + 0.05,
+        "planned feed within the programmed one: {f}"
+    );
+}

@@ -1,3 +1,34 @@
-//! The `kerf` command-line tool (placeholder).
+//! The `kerf` command-line tool.
+//!
+//! Layout: [`cli`] holds the clap definitions of every subcommand, one module per subcommand
+//! does its work (`validate`), and `main` dispatches and turns errors into messages and exit
+//! codes: 0 success, 1 a failure (invalid or unreadable input, unwritable output), 2 a usage
+//! error (reported by clap). To add a subcommand, add its arguments and a variant to
+//! [`cli::Command`], a module with a `run` function, and a line to the `match` below.
 
-fn main() {}
+mod cli;
+mod error;
+mod validate;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use crate::cli::{Cli, Command};
+use crate::error::CliError;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Validate(args) => validate::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        // The reader of our output went away (`kerf validate x | head -1`): nothing to report.
+        Err(CliError::Output(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,38 @@
+//! The errors a command can end with; `main` prints them as `error: <message>`.
+
+use std::fmt;
+use std::io;
+
+use kerf_format::FormatError;
+
+/// Why a command failed.
+#[derive(Debug)]
+pub(crate) enum CliError {
+    /// An input file is unreadable or invalid; the message starts with the file's path.
+    Format(FormatError),
+    /// Writing to standard output failed.
+    Output(io::Error),
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CliError::Format(e) => write!(f, "{e}"),
+            CliError::Output(e) => write!(f, "cannot write to standard output: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for CliError {}
+
+impl From<FormatError> for CliError {
+    fn from(e: FormatError) -> Self {
+        CliError::Format(e)
+    }
+}
+
+impl From<io::Error> for CliError {
+    fn from(e: io::Error) -> Self {
+        CliError::Output(e)
+    }
+}

@@ -1,0 +1,193 @@
+//! `kerf validate` as a user runs it: the binary, the shipped fixtures, exit codes and messages.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+fn kerf(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kerf"))
+        .args(args)
+        .output()
+        .expect("the kerf binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn validate(path: &Path) -> Output {
+    kerf(&["validate", path.to_str().expect("UTF-8 path")])
+}
+
+#[test]
+fn valid_fixtures_exit_0_with_a_summary() {
+    let out = validate(&fixture("mixed.json"));
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "stderr: {}", text(&out.stderr));
+    assert!(
+        out.stderr.is_empty(),
+        "nothing on stderr: {}",
+        text(&out.stderr)
+    );
+    assert!(stdout.contains("4 curves, 1 surface"), "{stdout}");
+    for id in [
+        "v-corner",
+        "straight",
+        "freeform-quintic",
+        "slot-on-plane",
+        "tilted-plane",
+    ] {
+        assert!(stdout.contains(id), "mentions {id}: {stdout}");
+    }
+    let corner = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("v-corner"))
+        .expect("a line for v-corner");
+    let cells: Vec<&str> = corner.split_whitespace().collect();
+    // id degree points rational domain(2 words) length C0-breaks closed surface
+    assert_eq!(
+        cells,
+        ["v-corner", "3", "7", "no", "[0,", "1]", "68.868", "1", "no", "-"],
+        "{corner}"
+    );
+
+    let out = validate(&fixture("circle.json"));
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "circle");
+    let line = stdout
+        .lines()
+        .find(|l| l.contains("circle-r50"))
+        .expect("a line for the circle");
+    assert!(line.contains("314.159"), "length 100 pi: {line}");
+    assert!(line.contains("yes"), "rational and closed: {line}");
+
+    for name in ["quarter_arc.json", "mesh_surfaces.json"] {
+        let out = validate(&fixture(name));
+        assert_eq!(out.status.code(), Some(0), "{name}: {}", text(&out.stderr));
+    }
+}
+
+#[test]
+fn json_summary_is_machine_readable() {
+    let path = fixture("mesh_surfaces.json");
+    let out = kerf(&["validate", "--json", path.to_str().expect("UTF-8")]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    assert_eq!(v["valid"], true, "valid");
+    assert_eq!(v["curves"][0]["id"], "top-diagonal", "first curve");
+    assert_eq!(v["curves"][1]["rational"], true, "arc is rational");
+    assert_eq!(v["curves"][0]["surface"], "cube", "surface");
+    assert_eq!(v["surfaces"][1]["type"], "stl", "STL surface");
+    assert_eq!(v["surfaces"][1]["triangles"], 12, "STL cube facets");
+    let length = v["curves"][0]["length"].as_f64().expect("length");
+    assert!(
+        (length - 80.0 * 2f64.sqrt()).abs() < 1e-9,
+        "diagonal length {length}"
+    );
+
+    let bad = fixture("bad/negative_weight.json");
+    let out = kerf(&["validate", "--json", bad.to_str().expect("UTF-8")]);
+    assert_eq!(out.status.code(), Some(1), "invalid");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    assert_eq!(v["valid"], false, "not valid");
+    assert!(
+        v["error"].as_str().is_some_and(
+            |e| e.ends_with("curves[0].weights[2]: weight must be finite and > 0 (got -1)")
+        ),
+        "{v}"
+    );
+}
+
+#[test]
+fn each_bad_fixture_exits_1_naming_file_path_and_defect() {
+    let cases = [
+        ("decreasing_knots.json", "curves[1].knots[5]: knots must be non-decreasing (0.5 after 0.7)"),
+        ("negative_weight.json", "curves[0].weights[2]: weight must be finite and > 0 (got -1)"),
+        ("unknown_surface_type.json", "surfaces[1]: unknown type \"nurb\""),
+        ("unknown_format.json", "format: unsupported format \"kerf.curves/2\" (this reader reads \"kerf.curves/1\")"),
+        ("malformed.json", "curves[0].degree: invalid JSON at line 8, column 7: expected `,` or `}`"),
+        ("empty.json", "the file is empty"),
+        ("missing_surface.json", "curves[0].surface: no surface with id \"panel\""),
+        ("short_point.json", "curves[0].control_points[1]: invalid length 2"),
+        ("huge_number.json", "curves[0].control_points[1][0]: invalid JSON at line 9, column 42: number out of range"),
+        ("bad_triangle.json", "surfaces[0].triangles[4][1]: vertex index 9 out of range (8 vertices)"),
+        ("missing_stl.json", "surfaces[0].path: "),
+        ("inches.json", "units: unsupported units \"in\""),
+    ];
+    for (name, defect) in cases {
+        let path = fixture("bad").join(name);
+        let out = validate(&path);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{name}: {stderr}");
+        assert!(out.stdout.is_empty(), "{name}: no summary on stdout");
+        let expected = format!("error: {}: {defect}", path.display());
+        assert!(
+            stderr.starts_with(&expected),
+            "{name}: got {stderr:?}, expected it to start with {expected:?}"
+        );
+        assert_eq!(stderr.lines().count(), 1, "{name}: one line");
+    }
+}
+
+#[test]
+fn missing_file_exits_1_naming_the_path() {
+    let path = fixture("no_such_file.json");
+    let out = validate(&path);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.starts_with(&format!("error: {}: cannot read: ", path.display())),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn standard_input_is_read_with_a_dash() {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kerf"))
+        .args(["validate", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let json = std::fs::read(fixture("quarter_arc.json")).expect("fixture");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(&json)
+        .expect("write stdin");
+    let out = child.wait_with_output().expect("wait");
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("quarter-arc-r50"), "summary");
+}
+
+#[test]
+fn usage_errors_exit_2_and_help_has_an_example() {
+    assert_eq!(kerf(&[]).status.code(), Some(2), "no subcommand");
+    assert_eq!(kerf(&["validate"]).status.code(), Some(2), "no file");
+    assert_eq!(
+        kerf(&["validate", "--frobnicate", "x.json"]).status.code(),
+        Some(2),
+        "unknown option"
+    );
+    let help = kerf(&["validate", "--help"]);
+    assert_eq!(help.status.code(), Some(0), "help");
+    assert!(
+        text(&help.stdout).contains("kerf validate fixtures/circle.json"),
+        "example"
+    );
+    let version = kerf(&["--version"]);
+    assert_eq!(
+        text(&version.stdout).trim(),
+        format!("kerf {}", env!("CARGO_PKG_VERSION")),
+        "version"
+    );
+}

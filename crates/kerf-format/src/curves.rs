@@ -1,0 +1,515 @@
+//! The reader of `kerf.curves/1`: cut contours as NURBS curves, with the surfaces that carry
+//! them.
+//!
+//! Reading has two layers:
+//! - the *raw* structs ([`RawCurvesFile`], [`RawCurve`], [`RawSurface`], ...) mirror the JSON
+//!   key for key and are what serde reads and writes; they hold unchecked data;
+//! - [`from_raw`] checks every value and builds the *validated model* ([`CurvesFile`], whose
+//!   curves are [`NurbsCurve`]s and whose surfaces are [`NurbsSurface`]s or triangle meshes,
+//!   STL files loaded), which is what the rest of kerf uses.
+//!
+//! [`load`], [`from_str`] and [`from_reader`] do both. The first defect found is reported, with
+//! its JSON path: `curves[3].knots[5]: knots must be non-decreasing (0.5 after 0.7)`.
+//!
+//! ```
+//! let json = r#"{
+//!     "format": "kerf.curves/1",
+//!     "units": "mm",
+//!     "curves": [
+//!         {"id": "line", "degree": 1, "knots": [0, 0, 1, 1],
+//!          "control_points": [[0, 0, 0], [10, 0, 0]]}
+//!     ]
+//! }"#;
+//! let file = kerf_format::curves::from_str(json, std::path::Path::new("."))?;
+//! assert_eq!(file.curves[0].id, "line");
+//! assert!((file.curves[0].curve.arc_length() - 10.0).abs() < 1e-12, "a 10 mm line");
+//!
+//! let bad = json.replace("[0, 0, 1, 1]", "[0, 0, 1, 0.5]");
+//! let err = kerf_format::curves::from_str(&bad, std::path::Path::new(".")).unwrap_err();
+//! assert_eq!(err.to_string(), "curves[0].knots[3]: knots must be non-decreasing (0.5 after 1)");
+//! # Ok::<(), kerf_format::FormatError>(())
+//! ```
+
+use std::collections::HashMap;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use kerf_nurbs::{NurbsCurve, NurbsSurface};
+use nalgebra::Point3;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use crate::error::{json_type_name, FormatError, MeshDefect, Result};
+use crate::{json, stl, Units, CURVES_FORMAT};
+
+// ---------------------------------------------------------------------------------------------
+// Raw layer: the JSON as written.
+// ---------------------------------------------------------------------------------------------
+
+/// A `kerf.curves/1` document exactly as written, before any check. Serialising it writes a
+/// valid document if [`from_raw`] accepts it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RawCurvesFile {
+    /// Must be `"kerf.curves/1"`.
+    pub format: String,
+    /// Must be `"mm"`.
+    pub units: String,
+    /// The cut contours, in cutting order.
+    pub curves: Vec<RawCurve>,
+    /// The surfaces that carry curves (optional key, default empty).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub surfaces: Vec<RawSurface>,
+}
+
+/// One entry of `curves`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RawCurve {
+    /// Unique, non-empty name; the toolpath keeps it.
+    pub id: String,
+    /// Polynomial degree, >= 1.
+    pub degree: usize,
+    /// The full knot vector: control points + degree + 1 non-decreasing values.
+    pub knots: Vec<f64>,
+    /// Control points `[x, y, z]` in mm.
+    pub control_points: Vec<[f64; 3]>,
+    /// One weight per control point, finite and > 0; absent means all 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weights: Option<Vec<f64>>,
+    /// The id of the surface carrying the curve (which gives the tool axis), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<String>,
+}
+
+/// One entry of `surfaces`, told apart by its `type` key.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum RawSurface {
+    /// `"type": "nurbs"`.
+    Nurbs(RawNurbsSurface),
+    /// `"type": "mesh"`.
+    Mesh(RawMesh),
+    /// `"type": "stl"`.
+    Stl(RawStl),
+}
+
+/// A NURBS surface as written (`"type": "nurbs"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RawNurbsSurface {
+    /// Unique, non-empty name, referred to by the curves' `surface`.
+    pub id: String,
+    /// Degree along u (first index of `control_points`).
+    pub degree_u: usize,
+    /// Degree along v (second index).
+    pub degree_v: usize,
+    /// Full knot vector along u.
+    pub knots_u: Vec<f64>,
+    /// Full knot vector along v.
+    pub knots_v: Vec<f64>,
+    /// `control_points[a][b]`: `a` runs along u, `b` along v.
+    pub control_points: Vec<Vec<[f64; 3]>>,
+    /// Weights in the same layout as the control points; absent means all 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weights: Option<Vec<Vec<f64>>>,
+}
+
+/// A triangle mesh written inline (`"type": "mesh"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RawMesh {
+    /// Unique, non-empty name.
+    pub id: String,
+    /// Vertex coordinates `[x, y, z]` in mm.
+    pub vertices: Vec<[f64; 3]>,
+    /// Vertex indices (from 0) of each triangle, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// A triangle mesh in an STL file (`"type": "stl"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RawStl {
+    /// Unique, non-empty name.
+    pub id: String,
+    /// The STL file (binary or ASCII), relative to the directory of the JSON file.
+    pub path: String,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Validated model.
+// ---------------------------------------------------------------------------------------------
+
+/// A checked `kerf.curves/1` document: every curve is a valid NURBS curve, every surface valid,
+/// ids unique, every `surface` reference resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvesFile {
+    /// The length unit of all coordinates (always millimetres).
+    pub units: Units,
+    /// The cut contours, in file order.
+    pub curves: Vec<CurveRecord>,
+    /// The surfaces, in file order.
+    pub surfaces: Vec<SurfaceRecord>,
+}
+
+/// One cut contour.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveRecord {
+    /// Its id, unique among the curves.
+    pub id: String,
+    /// The curve.
+    pub curve: NurbsCurve,
+    /// The id of the surface carrying it, guaranteed to exist in [`CurvesFile::surfaces`].
+    pub surface: Option<String>,
+}
+
+/// One surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceRecord {
+    /// Its id, unique among the surfaces.
+    pub id: String,
+    /// Its geometry.
+    pub geometry: SurfaceGeometry,
+    /// Where the geometry came from (for reports).
+    pub source: SurfaceSource,
+}
+
+/// The geometry of a surface.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SurfaceGeometry {
+    /// A NURBS surface; its normal is `Su x Sv` normalised.
+    Nurbs(NurbsSurface),
+    /// A triangle mesh (inline or from an STL file); its normal follows the triangles' winding
+    /// (counter-clockwise seen from outside).
+    ///
+    /// Guarantees: vertices finite, indices in range, no triangle uses a vertex twice, at least
+    /// one triangle of non-zero area. Other zero-area triangles (three distinct but collinear
+    /// vertices) may remain; a consumer computing normals must skip them.
+    Mesh {
+        /// Vertex coordinates in mm.
+        vertices: Vec<Point3<f64>>,
+        /// Vertex indices of each triangle.
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+/// Where a surface's geometry came from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SurfaceSource {
+    /// Written in the JSON file (`"type": "nurbs"` or `"mesh"`).
+    Inline,
+    /// Read from an STL file (`"type": "stl"`).
+    Stl {
+        /// The file, resolved against the JSON file's directory.
+        path: PathBuf,
+        /// Facets dropped because two of their corners coincide (they have no normal).
+        dropped_facets: usize,
+    },
+}
+
+impl CurvesFile {
+    /// The surface with this id.
+    pub fn surface(&self, id: &str) -> Option<&SurfaceRecord> {
+        self.surfaces.iter().find(|s| s.id == id)
+    }
+
+    /// The surface carrying `curve`, if it names one.
+    pub fn surface_of(&self, curve: &CurveRecord) -> Option<&SurfaceRecord> {
+        curve.surface.as_deref().and_then(|id| self.surface(id))
+    }
+}
+
+impl SurfaceRecord {
+    /// The `type` the surface has in the file: `nurbs`, `mesh` or `stl`.
+    pub fn type_name(&self) -> &'static str {
+        match (&self.geometry, &self.source) {
+            (_, SurfaceSource::Stl { .. }) => "stl",
+            (SurfaceGeometry::Nurbs(_), _) => "nurbs",
+            (SurfaceGeometry::Mesh { .. }, _) => "mesh",
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Entry points.
+// ---------------------------------------------------------------------------------------------
+
+/// Reads and checks a `kerf.curves/1` file. STL paths are relative to the file's directory.
+///
+/// # Errors
+/// Any [`FormatError`], wrapped in [`FormatError::File`] naming `path`.
+pub fn load(path: impl AsRef<Path>) -> Result<CurvesFile> {
+    let path = path.as_ref();
+    let base_dir = path.parent().unwrap_or(Path::new(""));
+    json::read_file(path)
+        .and_then(|bytes| from_slice(&bytes, base_dir))
+        .map_err(|e| e.in_file(path))
+}
+
+/// Reads and checks a `kerf.curves/1` document held in memory. STL paths are resolved against
+/// `base_dir` (the directory the document would live in).
+///
+/// # Errors
+/// Any [`FormatError`] about the document's content.
+pub fn from_str(text: &str, base_dir: &Path) -> Result<CurvesFile> {
+    from_slice(text.as_bytes(), base_dir)
+}
+
+/// Reads and checks a `kerf.curves/1` document from a reader (read to the end). STL paths are
+/// resolved against `base_dir`.
+///
+/// # Errors
+/// [`FormatError::Read`] if reading fails, else any [`FormatError`] about the content.
+pub fn from_reader(reader: impl Read, base_dir: &Path) -> Result<CurvesFile> {
+    from_slice(&json::read_all(reader)?, base_dir)
+}
+
+/// Reads a `kerf.curves/1` document into the raw structs, checking only its JSON shape,
+/// `format` and `units`.
+///
+/// # Errors
+/// [`FormatError::Empty`], [`FormatError::Syntax`], [`FormatError::NotAnObject`],
+/// [`FormatError::UnsupportedFormat`], [`FormatError::UnsupportedUnits`],
+/// [`FormatError::Shape`] or [`FormatError::UnknownSurfaceType`].
+pub fn raw_from_slice(bytes: &[u8]) -> Result<RawCurvesFile> {
+    /// Everything but the surfaces, which are told apart by hand so that errors inside them
+    /// keep their path (serde's internally tagged enums buffer their content and lose it).
+    #[derive(Deserialize)]
+    struct Body {
+        format: String,
+        units: String,
+        curves: Vec<RawCurve>,
+        #[serde(default)]
+        surfaces: Vec<Value>,
+    }
+    let map = json::parse_document(bytes, CURVES_FORMAT)?;
+    let body: Body = json::deserialize(Value::Object(map), "")?;
+    let surfaces = body
+        .surfaces
+        .into_iter()
+        .enumerate()
+        .map(|(index, value)| raw_surface(index, value))
+        .collect::<Result<_>>()?;
+    Ok(RawCurvesFile {
+        format: body.format,
+        units: body.units,
+        curves: body.curves,
+        surfaces,
+    })
+}
+
+fn raw_surface(index: usize, value: Value) -> Result<RawSurface> {
+    let prefix = format!("surfaces[{index}]");
+    let Value::Object(map) = &value else {
+        return Err(FormatError::Shape {
+            message: format!(
+                "expected an object {{\"id\": ..., \"type\": ...}}, got {}",
+                json_type_name(&value)
+            ),
+            path: prefix,
+        });
+    };
+    let kind = match map.get("type") {
+        Some(Value::String(s)) => s.clone(),
+        other => {
+            return Err(FormatError::UnknownSurfaceType {
+                index,
+                found: other.map(Value::to_string),
+            })
+        }
+    };
+    match kind.as_str() {
+        "nurbs" => json::deserialize(value, &prefix).map(RawSurface::Nurbs),
+        "mesh" => json::deserialize(value, &prefix).map(RawSurface::Mesh),
+        "stl" => json::deserialize(value, &prefix).map(RawSurface::Stl),
+        _ => Err(FormatError::UnknownSurfaceType {
+            index,
+            found: Some(Value::String(kind).to_string()),
+        }),
+    }
+}
+
+fn from_slice(bytes: &[u8], base_dir: &Path) -> Result<CurvesFile> {
+    from_raw(raw_from_slice(bytes)?, base_dir)
+}
+
+/// Checks raw data and builds the validated model. STL files are read, relative to
+/// `base_dir`.
+///
+/// Checks, in this order, stopping at the first defect: `format` and `units`; each curve (id,
+/// then the NURBS data); each surface (id, then its geometry); each curve's `surface`
+/// reference.
+///
+/// # Errors
+/// [`FormatError::UnsupportedFormat`], [`FormatError::UnsupportedUnits`],
+/// [`FormatError::EmptyId`], [`FormatError::DuplicateId`], [`FormatError::Curve`],
+/// [`FormatError::Surface`], [`FormatError::Mesh`], [`FormatError::Stl`] or
+/// [`FormatError::UnknownSurface`].
+pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
+    let units = json::check_header(&raw.format, &raw.units, CURVES_FORMAT)?;
+
+    let mut ids = IdSet::default();
+    let mut curves = Vec::with_capacity(raw.curves.len());
+    for (index, c) in raw.curves.into_iter().enumerate() {
+        ids.insert("curves", index, &c.id)?;
+        let points = c.control_points.iter().map(|&p| Point3::from(p)).collect();
+        let curve = NurbsCurve::try_new(c.degree, c.knots, points, c.weights)
+            .map_err(|error| FormatError::Curve { index, error })?;
+        curves.push(CurveRecord {
+            id: c.id,
+            curve,
+            surface: c.surface,
+        });
+    }
+
+    let mut ids = IdSet::default();
+    let mut surfaces = Vec::with_capacity(raw.surfaces.len());
+    for (index, s) in raw.surfaces.into_iter().enumerate() {
+        let record = match s {
+            RawSurface::Nurbs(n) => {
+                ids.insert("surfaces", index, &n.id)?;
+                let control_points = n
+                    .control_points
+                    .iter()
+                    .map(|row| row.iter().map(|&p| Point3::from(p)).collect())
+                    .collect();
+                let surface = NurbsSurface::try_new(
+                    n.degree_u,
+                    n.degree_v,
+                    n.knots_u,
+                    n.knots_v,
+                    control_points,
+                    n.weights,
+                )
+                .map_err(|error| FormatError::Surface { index, error })?;
+                SurfaceRecord {
+                    id: n.id,
+                    geometry: SurfaceGeometry::Nurbs(surface),
+                    source: SurfaceSource::Inline,
+                }
+            }
+            RawSurface::Mesh(m) => {
+                ids.insert("surfaces", index, &m.id)?;
+                let vertices: Vec<Point3<f64>> =
+                    m.vertices.iter().map(|&p| Point3::from(p)).collect();
+                check_mesh(&vertices, &m.triangles)
+                    .map_err(|defect| FormatError::Mesh { index, defect })?;
+                SurfaceRecord {
+                    id: m.id,
+                    geometry: SurfaceGeometry::Mesh {
+                        vertices,
+                        triangles: m.triangles,
+                    },
+                    source: SurfaceSource::Inline,
+                }
+            }
+            RawSurface::Stl(s) => {
+                ids.insert("surfaces", index, &s.id)?;
+                let file = base_dir.join(&s.path);
+                let mesh = stl::read(&file).map_err(|problem| FormatError::Stl {
+                    index,
+                    file: file.clone(),
+                    problem,
+                })?;
+                SurfaceRecord {
+                    id: s.id,
+                    geometry: SurfaceGeometry::Mesh {
+                        vertices: mesh.vertices,
+                        triangles: mesh.triangles,
+                    },
+                    source: SurfaceSource::Stl {
+                        path: file,
+                        dropped_facets: mesh.dropped_facets,
+                    },
+                }
+            }
+        };
+        surfaces.push(record);
+    }
+
+    for (index, c) in curves.iter().enumerate() {
+        if let Some(id) = &c.surface {
+            if !surfaces.iter().any(|s| &s.id == id) {
+                return Err(FormatError::UnknownSurface {
+                    index,
+                    id: id.clone(),
+                    available: surfaces.iter().map(|s| s.id.clone()).collect(),
+                });
+            }
+        }
+    }
+
+    Ok(CurvesFile {
+        units,
+        curves,
+        surfaces,
+    })
+}
+
+/// Checks an inline mesh: finite vertices, indices in range, no repeated corner, at least one
+/// triangle of non-zero area.
+pub(crate) fn check_mesh(
+    vertices: &[Point3<f64>],
+    triangles: &[[u32; 3]],
+) -> std::result::Result<(), MeshDefect> {
+    for (vertex, p) in vertices.iter().enumerate() {
+        if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+            return Err(MeshDefect::NonFiniteVertex {
+                vertex,
+                x: p.x,
+                y: p.y,
+                z: p.z,
+            });
+        }
+    }
+    if triangles.is_empty() {
+        return Err(MeshDefect::NoTriangles);
+    }
+    let mut any_area = false;
+    for (triangle, t) in triangles.iter().enumerate() {
+        for (corner, &index) in t.iter().enumerate() {
+            if index as usize >= vertices.len() {
+                return Err(MeshDefect::IndexOutOfRange {
+                    triangle,
+                    corner,
+                    index,
+                    count: vertices.len(),
+                });
+            }
+            if t[..corner].contains(&index) {
+                return Err(MeshDefect::RepeatedVertex { triangle, index });
+            }
+        }
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        any_area |= (b - a).cross(&(c - a)).norm() > 0.0;
+    }
+    if !any_area {
+        return Err(MeshDefect::AllDegenerate);
+    }
+    Ok(())
+}
+
+/// Tracks the ids of one list (`curves` or `surfaces`) to report empty and duplicate ones.
+#[derive(Default)]
+pub(crate) struct IdSet {
+    seen: HashMap<String, usize>,
+}
+
+impl IdSet {
+    /// Records the id of `list[index]`.
+    pub(crate) fn insert(&mut self, list: &str, index: usize, id: &str) -> Result<()> {
+        if id.is_empty() {
+            return Err(FormatError::EmptyId {
+                path: format!("{list}[{index}].id"),
+            });
+        }
+        if let Some(&first) = self.seen.get(id) {
+            return Err(FormatError::DuplicateId {
+                path: format!("{list}[{index}].id"),
+                id: id.to_owned(),
+                first: format!("{list}[{first}]"),
+            });
+        }
+        self.seen.insert(id.to_owned(), index);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests;

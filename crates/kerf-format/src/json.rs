@@ -1,0 +1,289 @@
+//! The JSON layer shared by the readers: bytes to a checked top-level object, and serde
+//! deserialization that reports the JSON path of every error.
+//!
+//! Reading goes in three steps so that the most useful message wins:
+//! 1. parse the text into a [`serde_json::Value`]; a syntax error gets its line, column and the
+//!    JSON path of the value being read ([`path_at`]), so that even `1e400` (a number out of
+//!    the range of a double, which serde_json rejects rather than turning into infinity) is
+//!    reported as `curves[0].knots[3]: invalid JSON at line 5, column 31: number out of range`;
+//! 2. check `format` and `units` before anything else, so that a toolpath handed to the curves
+//!    reader says so instead of complaining about a missing `curves` key;
+//! 3. deserialize the typed structs through `serde_path_to_error`, so that a control point with
+//!    two coordinates is reported as `curves[0].control_points[2]: invalid length 2, ...`.
+//!
+//! Known limit: a key given twice in one object keeps its last value (serde_json's `Value`
+//! does so silently).
+
+use std::io::Read;
+use std::path::Path;
+
+use serde::de::DeserializeOwned;
+use serde_json::{Map, Value};
+
+use crate::error::{json_type_name, FormatError, Result};
+use crate::Units;
+
+/// Reads a whole file.
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|error| FormatError::Read { error })
+}
+
+/// Reads a whole reader.
+pub(crate) fn read_all(mut reader: impl Read) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    reader
+        .read_to_end(&mut bytes)
+        .map_err(|error| FormatError::Read { error })?;
+    Ok(bytes)
+}
+
+/// Parses `bytes` as a JSON object whose `format` is `expected` and whose `units` are `"mm"`.
+pub(crate) fn parse_document(bytes: &[u8], expected: &'static str) -> Result<Map<String, Value>> {
+    // Editors on Windows like to start UTF-8 files with a byte-order mark; JSON forbids it but
+    // it carries no information, so skip it rather than fail at "line 1, column 1".
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(FormatError::Empty { expected });
+    }
+    let value: Value = serde_json::from_slice(bytes).map_err(|e| syntax_error(bytes, &e))?;
+    let Value::Object(map) = value else {
+        return Err(FormatError::NotAnObject {
+            expected,
+            found: json_type_name(&value),
+        });
+    };
+    check_format(map.get("format"), expected)?;
+    check_units(map.get("units"))?;
+    Ok(map)
+}
+
+/// Checks the `format` value.
+fn check_format(value: Option<&Value>, expected: &'static str) -> Result<()> {
+    match value {
+        Some(Value::String(s)) if s == expected => Ok(()),
+        other => Err(FormatError::UnsupportedFormat {
+            found: other.map(Value::to_string),
+            expected,
+        }),
+    }
+}
+
+/// Checks the `units` value.
+fn check_units(value: Option<&Value>) -> Result<Units> {
+    match value {
+        Some(Value::String(s)) if Units::from_name(s).is_some() => Ok(Units::Millimetres),
+        other => Err(FormatError::UnsupportedUnits {
+            found: other.map(Value::to_string),
+        }),
+    }
+}
+
+/// Checks `format` and `units` given as strings (for documents built in memory).
+pub(crate) fn check_header(format: &str, units: &str, expected: &'static str) -> Result<Units> {
+    check_format(Some(&Value::String(format.to_owned())), expected)?;
+    check_units(Some(&Value::String(units.to_owned())))
+}
+
+/// Deserializes `value` into `T`; errors carry the JSON path, starting with `prefix` (the path
+/// of `value` itself in the document, empty for the top level).
+pub(crate) fn deserialize<T: DeserializeOwned>(value: Value, prefix: &str) -> Result<T> {
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let inner = e.path().to_string();
+        let mut path = if inner == "." {
+            prefix.to_owned()
+        } else if prefix.is_empty() {
+            inner
+        } else if inner.starts_with('[') {
+            format!("{prefix}{inner}")
+        } else {
+            format!("{prefix}.{inner}")
+        };
+        let mut message = tidy_message(&e.into_inner().to_string());
+        // "curves[0]: missing field `knots`" reads better as "curves[0].knots: missing".
+        if let Some(field) = message
+            .strip_prefix("missing field `")
+            .and_then(|rest| rest.strip_suffix('`'))
+        {
+            path = if path.is_empty() {
+                field.to_owned()
+            } else {
+                format!("{path}.{field}")
+            };
+            message = "required key is missing".to_owned();
+        }
+        if path.is_empty() {
+            path = "top level".to_owned();
+        }
+        FormatError::Shape { path, message }
+    })
+}
+
+/// Replaces Rust type names in serde's messages with words a user of the format knows.
+fn tidy_message(message: &str) -> String {
+    message
+        .replace("expected usize", "expected a non-negative integer")
+        .replace("expected u32", "expected a non-negative integer")
+        .replace("expected f64", "expected a number")
+        .replace("a sequence", "an array")
+        .replace("invalid type: map", "invalid type: object")
+        .replace("invalid type: sequence", "invalid type: array")
+}
+
+/// Turns a serde_json parse error into [`FormatError::Syntax`] with the JSON path of the
+/// position.
+fn syntax_error(bytes: &[u8], e: &serde_json::Error) -> FormatError {
+    let (line, column) = (e.line(), e.column());
+    let full = e.to_string();
+    let suffix = format!(" at line {line} column {column}");
+    let message = full.strip_suffix(&suffix).unwrap_or(&full);
+    let message = if message == "number out of range" {
+        "number out of range (a number must fit in a double: |x| < 1.8e308)".to_owned()
+    } else {
+        message.to_owned()
+    };
+    FormatError::Syntax {
+        line,
+        column,
+        path: path_at(bytes, offset_of(bytes, line, column)),
+        message,
+    }
+}
+
+/// The byte offset of serde_json's 1-based `line` and `column` (the column counts bytes; the
+/// offending byte itself is excluded).
+fn offset_of(bytes: &[u8], line: usize, column: usize) -> usize {
+    let mut start = 0;
+    for _ in 1..line {
+        match bytes[start..].iter().position(|&b| b == b'\n') {
+            Some(n) => start += n + 1,
+            None => return bytes.len(),
+        }
+    }
+    (start + column.saturating_sub(1)).min(bytes.len())
+}
+
+/// The JSON path of the value being read at byte `offset` of `bytes`, e.g.
+/// `curves[0].knots[3]`, or an empty string at the top level.
+///
+/// Scans the (well-formed, since the parser got that far) text before `offset`, keeping a stack
+/// of the open arrays with their current index and the open objects with their current key.
+pub(crate) fn path_at(bytes: &[u8], offset: usize) -> String {
+    enum Frame {
+        Array(usize),
+        Object(Option<String>),
+    }
+    let end = offset.min(bytes.len());
+    let mut stack: Vec<Frame> = Vec::new();
+    let mut i = 0;
+    while i < end {
+        match bytes[i] {
+            b'{' => stack.push(Frame::Object(None)),
+            b'[' => stack.push(Frame::Array(0)),
+            b'}' | b']' => {
+                stack.pop();
+            }
+            b',' => match stack.last_mut() {
+                Some(Frame::Array(n)) => *n += 1,
+                Some(Frame::Object(key)) => *key = None,
+                None => {}
+            },
+            b'"' => {
+                let start = i;
+                i += 1;
+                while i < end && bytes[i] != b'"' {
+                    i += if bytes[i] == b'\\' { 2 } else { 1 };
+                }
+                if i >= end {
+                    break;
+                }
+                if let Some(Frame::Object(key @ None)) = stack.last_mut() {
+                    let raw = &bytes[start..=i];
+                    *key = Some(
+                        serde_json::from_slice::<String>(raw)
+                            .unwrap_or_else(|_| String::from_utf8_lossy(raw).into_owned()),
+                    );
+                }
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    let mut path = String::new();
+    for frame in &stack {
+        match frame {
+            Frame::Array(n) => path.push_str(&format!("[{n}]")),
+            Frame::Object(Some(key)) => {
+                if !path.is_empty() {
+                    path.push('.');
+                }
+                path.push_str(key);
+            }
+            Frame::Object(None) => break,
+        }
+    }
+    path
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn path_of_error(text: &str) -> String {
+        match parse_document(text.as_bytes(), "kerf.curves/1") {
+            Err(FormatError::Syntax { path, .. }) => path,
+            other => panic!("expected a syntax error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn syntax_errors_name_the_value_being_read() {
+        assert_eq!(
+            path_of_error("{\"curves\": [{\"knots\": [0, 1e400]}]}"),
+            "curves[0].knots[1]",
+            "number out of range"
+        );
+        assert_eq!(
+            path_of_error("{\"a\": {\"b\\\"c\": [1, 2 3]}}"),
+            "a.b\"c[1]",
+            "escaped key, missing comma"
+        );
+        assert_eq!(
+            path_of_error("{\"curves\": [{}, {\"id\": \"x\",, }]}"),
+            "curves[1]",
+            "error at a key position names the object"
+        );
+        assert_eq!(
+            path_of_error("{\"a\": 1,}"),
+            "",
+            "trailing comma at top level"
+        );
+        assert_eq!(
+            path_of_error("{\"curves\": [[1, 2],\n [3, 4"),
+            "curves[1][1]",
+            "end of file inside an array"
+        );
+    }
+
+    #[test]
+    fn line_and_column_are_reported() {
+        let err = parse_document(
+            b"{\n  \"format\": \"kerf.curves/1\"\n  \"units\": \"mm\"\n}",
+            "x",
+        )
+        .expect_err("missing comma");
+        let FormatError::Syntax { line, column, .. } = err else {
+            panic!("expected a syntax error, got {err:?}");
+        };
+        assert_eq!((line, column), (3, 3), "position of the unexpected key");
+    }
+
+    #[test]
+    fn byte_order_mark_is_skipped() {
+        let map = parse_document(
+            b"\xEF\xBB\xBF{\"format\": \"kerf.curves/1\", \"units\": \"mm\"}",
+            "kerf.curves/1",
+        )
+        .expect("a BOM is tolerated");
+        assert_eq!(map.len(), 2, "both keys read");
+    }
+}

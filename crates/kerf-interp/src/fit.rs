@@ -12,10 +12,10 @@
 //! - the tool axis interpolated at each point (rotary axes in proportion to the distance, or
 //!   to the swept angle piecewise `i -> m -> j` on arcs) is within `orientation_tolerance` of
 //!   the point's own tool axis;
-//! - **the curve**: when the curve is known (a closure giving the curve point at a parameter,
-//!   and the points carry their parameters), `curve_samples` points of the curve between each
-//!   pair of neighbouring cutting points lie within `tolerance` of the block; when it is not
-//!   known, the polyline stands in for it: each piece of the block between neighbouring points
+//! - **the curve**: where the curve is known (a closure giving the curve point at a parameter,
+//!   and both neighbouring points carry their parameters), `curve_samples` points of the curve
+//!   between them lie within `tolerance` of the block; where it is not known (no closure, or a
+//!   point inserted by the kinematics without a parameter), the polyline stands in for it: each piece of the block between neighbouring points
 //!   lies within `tolerance` of their chord (for an arc: its sagitta over the chord plus the
 //!   points' own distances).
 //!
@@ -156,25 +156,25 @@ pub fn fit_blocks<M: AxisModel + ?Sized>(
         }
     }
     let n = stations.len();
-    // Curve samples between each pair of neighbours, when known.
-    let samples: Option<Vec<Vec<Point3<f64>>>> = curve.and_then(|f| {
-        let k = opts.curve_samples;
-        stations
-            .windows(2)
-            .map(|w| {
-                let (a, b) = (w[0].param?, w[1].param?);
-                Some(
-                    (1..=k)
-                        .map(|m| f(a + (b - a) * m as f64 / (k + 1) as f64))
-                        .collect(),
-                )
-            })
-            .collect()
-    });
+    // Curve samples between each pair of neighbours, where the curve and both parameters are
+    // known (points inserted by the kinematics may carry no parameter).
+    let samples: Vec<Option<Vec<Point3<f64>>>> = stations
+        .windows(2)
+        .map(|w| {
+            let f = curve?;
+            let (a, b) = (w[0].param?, w[1].param?);
+            let k = opts.curve_samples;
+            Some(
+                (1..=k)
+                    .map(|m| f(a + (b - a) * m as f64 / (k + 1) as f64))
+                    .collect(),
+            )
+        })
+        .collect();
     let fitter = Fitter {
         model,
         st: stations,
-        samples: samples.as_deref(),
+        samples: &samples,
         opts,
     };
     let mut blocks = Vec::new();
@@ -240,7 +240,8 @@ fn longest(lo: usize, hi: usize, fits: impl Fn(usize) -> bool) -> usize {
 struct Fitter<'a, M: ?Sized> {
     model: &'a M,
     st: &'a [Station],
-    samples: Option<&'a [Vec<Point3<f64>>]>,
+    /// Curve samples of each segment `k -> k + 1`, `None` where the curve is not known.
+    samples: &'a [Option<Vec<Point3<f64>>>],
     opts: &'a FitOptions,
 }
 
@@ -277,14 +278,12 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
                 return false;
             }
         }
-        if let Some(samples) = self.samples {
-            for seg in &samples[i..j] {
-                if seg
-                    .iter()
-                    .any(|p| segment_distance(p, &a.tip, &b.tip).0 > tol)
-                {
-                    return false;
-                }
+        for seg in self.samples[i..j].iter().flatten() {
+            if seg
+                .iter()
+                .any(|p| segment_distance(p, &a.tip, &b.tip).0 > tol)
+            {
+                return false;
             }
         }
         true
@@ -315,7 +314,7 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
             if d > tol || theta <= last.0 || theta > arc.angle_end {
                 return false;
             }
-            if self.samples.is_none() {
+            if self.samples[k - 1].is_none() {
                 // The polyline stands in for the curve: the arc piece between neighbours stays
                 // within the tolerance of their chord.
                 let sagitta = arc.radius * (1.0 - (0.5 * (theta - last.0)).cos());
@@ -343,11 +342,9 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
                 }
             }
         }
-        if let Some(samples) = self.samples {
-            for seg in &samples[i..j] {
-                if seg.iter().any(|p| arc.distance(p).0 > tol) {
-                    return false;
-                }
+        for seg in self.samples[i..j].iter().flatten() {
+            if seg.iter().any(|p| arc.distance(p).0 > tol) {
+                return false;
             }
         }
         true

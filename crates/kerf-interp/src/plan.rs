@@ -54,6 +54,14 @@ pub struct PlanOptions {
     pub max_cycles: usize,
     /// Most re-plans after a verification finds a cycle over a limit. Default 60.
     pub max_refinements: usize,
+    /// Land every block's end exactly on a cycle, as paper 000's block-by-block interpolator
+    /// does (default false). Each block then takes a whole number of cycles, at least one: its
+    /// planned profile is slowed to fill them. That caps the speed on a block of length `L`
+    /// at `L / T` and makes the speed jump slightly where two blocks meet (the verification
+    /// lowers the caps until those jumps are within the acceleration limits), so it costs
+    /// cycle time on programs of many short blocks. With false the set-points sample one
+    /// continuous motion; block ends fall between cycles, the program's end is still exact.
+    pub block_ends_on_cycles: bool,
 }
 
 impl PlanOptions {
@@ -65,6 +73,7 @@ impl PlanOptions {
             chord_tolerance: 0.001,
             max_cycles: 50_000_000,
             max_refinements: 60,
+            block_ends_on_cycles: false,
         }
     }
 
@@ -137,6 +146,19 @@ pub struct Motion {
     refinements: usize,
     axis_names: [String; 5],
     peak_speed: Vec<f64>,
+    /// With [`PlanOptions::block_ends_on_cycles`]: when each block runs.
+    clock: Option<Vec<BlockClock>>,
+    total_cycles: usize,
+}
+
+/// The cycles of one block when block ends land on cycles: cycles `first..first + n`, mapped
+/// linearly onto the block's planned time `start..start + duration`.
+#[derive(Debug, Clone, Copy)]
+struct BlockClock {
+    first: usize,
+    n: usize,
+    start: f64,
+    duration: f64,
 }
 
 impl Motion {
@@ -150,7 +172,8 @@ impl Motion {
         BlockCounts::of(&self.blocks)
     }
 
-    /// Planned motion time from rest to rest, seconds.
+    /// Planned motion time from rest to rest, seconds (with block ends on cycles, the whole
+    /// cycles the blocks take).
     pub fn duration(&self) -> f64 {
         self.duration
     }
@@ -163,7 +186,7 @@ impl Motion {
     /// Number of cycles: the set-points are cycles `0..=cycles()`, the last one at rest on the
     /// program's end. The program's cycle time is `cycles() * cycle()` seconds.
     pub fn cycles(&self) -> usize {
-        (self.duration / self.cycle - 1e-9).ceil().max(0.0) as usize
+        self.total_cycles
     }
 
     /// How many times the verification lowered caps and planned again.
@@ -218,6 +241,7 @@ impl Motion {
             i: 0,
             n: self.cycles(),
             piece: 0,
+            block: 0,
         }
     }
 }
@@ -230,6 +254,7 @@ pub struct Cycles<'a, M: ?Sized> {
     i: usize,
     n: usize,
     piece: usize,
+    block: usize,
 }
 
 impl<M: AxisModel + ?Sized> Cycles<'_, M> {
@@ -244,7 +269,16 @@ impl<M: AxisModel + ?Sized> Cycles<'_, M> {
             self.piece = m.pieces.len().saturating_sub(1);
             m.blocks[m.blocks.len() - 1].end_axes
         } else {
-            let t = self.i as f64 * m.cycle;
+            let t = match &m.clock {
+                Some(clock) => {
+                    while self.block + 1 < clock.len() && self.i >= clock[self.block + 1].first {
+                        self.block += 1;
+                    }
+                    let c = &clock[self.block];
+                    c.start + (self.i - c.first) as f64 / c.n as f64 * c.duration
+                }
+                None => self.i as f64 * m.cycle,
+            };
             let (p, (b, s)) = m.locate_from(self.piece, t);
             self.piece = p;
             m.blocks[b].axes_at(self.model, s)
@@ -317,6 +351,16 @@ pub fn plan<M: AxisModel + ?Sized>(
     opts.validate()?;
     let limits = model.limits();
     limits.validate()?;
+    for (bi, b) in blocks.iter().enumerate() {
+        let finite = b.length().is_finite()
+            && [b.start_axes, b.mid_axes, b.end_axes]
+                .iter()
+                .flatten()
+                .all(|v| v.is_finite());
+        if !finite {
+            return Err(InterpError::NonFinite { index: bi });
+        }
+    }
     let blocks: Vec<Block> = blocks
         .iter()
         .filter(|b| b.length() > 0.0)
@@ -367,6 +411,38 @@ pub fn plan<M: AxisModel + ?Sized>(
                 limit: opts.max_cycles,
             });
         }
+        let mut total_cycles = (cycles - 1e-9).ceil().max(0.0) as usize;
+        let mut duration = t;
+        let clock = opts.block_ends_on_cycles.then(|| {
+            let mut clock: Vec<BlockClock> = Vec::with_capacity(blocks.len());
+            let mut first = 0;
+            for (p, piece) in pieces.iter().enumerate() {
+                let d = profiles[p].duration();
+                match clock.last_mut() {
+                    Some(c) if pieces[p - 1].block == piece.block => c.duration += d,
+                    _ => clock.push(BlockClock {
+                        first: 0,
+                        n: 0,
+                        start: starts[p],
+                        duration: d,
+                    }),
+                }
+            }
+            for c in &mut clock {
+                c.first = first;
+                c.n = ((c.duration / opts.cycle - 1e-9).ceil() as usize).max(1);
+                first += c.n;
+            }
+            total_cycles = first;
+            duration = first as f64 * opts.cycle;
+            clock
+        });
+        if total_cycles > opts.max_cycles {
+            return Err(InterpError::TooManyCycles {
+                cycles: total_cycles as f64,
+                limit: opts.max_cycles,
+            });
+        }
         let mut peak_speed = vec![0.0f64; blocks.len()];
         for (p, pr) in pieces.iter().zip(&profiles) {
             peak_speed[p.block] = peak_speed[p.block].max(pr.vp);
@@ -376,11 +452,13 @@ pub fn plan<M: AxisModel + ?Sized>(
             pieces: pieces.clone(),
             profiles,
             starts,
-            duration: t,
+            duration,
             cycle: opts.cycle,
             refinements,
             axis_names: names.clone(),
             peak_speed,
+            clock,
+            total_cycles,
         };
         let worst = verify(&motion, model);
         if worst.is_empty() {
@@ -577,21 +655,19 @@ struct Violation {
 fn verify<M: AxisModel + ?Sized>(motion: &Motion, model: &M) -> Vec<Violation> {
     let lim = model.limits();
     let t = motion.cycle;
-    let mut it = motion.iter(model);
-    let mut rows: Vec<([f64; 5], usize)> = Vec::with_capacity(motion.cycles() + 1);
-    while let Some(r) = it.next_with_piece() {
-        rows.push(r);
-    }
-    let n = rows.len();
     let mut out = Vec::new();
-    if n == 0 {
-        return out;
-    }
     let slack = 1.0 - 1e-6;
-    let at = |i: isize| -> [f64; 5] { rows[i.clamp(0, n as isize - 1) as usize].0 };
-    let piece = |i: isize| -> usize { rows[i.clamp(0, n as isize - 1) as usize].1 };
-    for i in 0..=n as isize {
-        let (qm, q0, qp) = (at(i - 1), at(i), at(i + 1));
+    // Rows i - 2 .. i + 1 streamed from the iterator, so memory does not grow with the
+    // program; rows before the first and after the last are the first and the last (rest).
+    let mut it = motion.iter(model);
+    let n = it.size_hint().0;
+    let Some(first) = it.next_with_piece() else {
+        return out;
+    };
+    let (mut r2, mut r1, mut r0) = (first, first, first);
+    let mut r3 = it.next_with_piece().unwrap_or(r0);
+    for i in 0..=n {
+        let (qm, q0, qp) = (r1.0, r0.0, r3.0);
         let mut worst: Option<Violation> = None;
         for k in 0..5 {
             let v = ((q0[k] - qm[k]) / t).abs();
@@ -606,17 +682,19 @@ fn verify<M: AxisModel + ?Sized>(motion: &Motion, model: &M) -> Vec<Violation> {
                         .is_none_or(|w| value / limit > w.value / w.limit)
                 {
                     worst = Some(Violation {
-                        cycle: i.max(0) as usize,
+                        cycle: i,
                         axis: k,
                         acceleration,
                         value,
                         limit,
-                        pieces: [piece(i - 2), piece(i + 1)],
+                        pieces: [r2.1, r3.1],
                     });
                 }
             }
         }
         out.extend(worst);
+        (r2, r1, r0) = (r1, r0, r3);
+        r3 = it.next_with_piece().unwrap_or(r0);
     }
     out.sort_by(|a, b| (b.value / b.limit).total_cmp(&(a.value / a.limit)));
     out

@@ -225,3 +225,97 @@ fn pure_rotation_is_a_turn_block() {
     assert_eq!(rows.len(), 61, "cycles");
     assert_close(&rows[30], &eq16(&m, p, 15.0, -30.0), 1e-9, "half way");
 }
+
+#[test]
+fn station_and_fit_errors() {
+    use kerf_interp::{fit_blocks, solve_stations, FitOptions};
+    let m = AcHead::paper_000();
+    let tips = [Point3::origin(), Point3::new(1.0, 0.0, 0.0)];
+    let e = solve_stations(&m, &[], None, None, None);
+    assert!(
+        matches!(e, Err(InterpError::TooFewPoints { got: 0, .. })),
+        "{e:?}"
+    );
+    let e = solve_stations(&m, &tips, Some(&[Vector3::z()]), None, None);
+    assert!(
+        matches!(
+            e,
+            Err(InterpError::LengthMismatch {
+                what: "tool axes",
+                ..
+            })
+        ),
+        "{e:?}"
+    );
+    let e = solve_stations(&m, &tips, None, Some(&[0.0]), None);
+    assert!(
+        matches!(e, Err(InterpError::LengthMismatch { what: "params", .. })),
+        "{e:?}"
+    );
+    let nan = [Point3::origin(), Point3::new(f64::NAN, 0.0, 0.0)];
+    let e = solve_stations(&m, &nan, None, None, None);
+    assert!(
+        matches!(e, Err(InterpError::NonFinite { index: 1 })),
+        "{e:?}"
+    );
+    // A tool axis pointing down is out of A's range: the kinematics' error with the index.
+    let down = [Vector3::z(), -Vector3::z()];
+    let e = solve_stations(&m, &tips, Some(&down), None, None);
+    assert!(
+        matches!(e, Err(InterpError::Kinematics { index: 1, .. })),
+        "{e:?}"
+    );
+    let st = solve_stations(&m, &tips, None, None, None).expect("stations");
+    let e = fit_blocks(&m, &st, None, 0, &FitOptions::with_tolerance(f64::NAN));
+    assert!(
+        matches!(
+            e,
+            Err(InterpError::BadParameter {
+                name: "tolerance",
+                ..
+            })
+        ),
+        "{e:?}"
+    );
+    let one = fit_blocks(&m, &st[..1], None, 0, &FitOptions::default()).expect("one point");
+    assert!(one.is_empty(), "a single point gives no block");
+}
+
+mod prop {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// Any arc through three points of a circle: every set-point on the circle, steps of
+        /// `F T` (the last shorter), and the end exact.
+        #[test]
+        fn arcs_stay_on_their_circle(
+            r in 0.5f64..500.0,
+            t1 in 0.0f64..6.0, d12 in 0.05f64..2.0, d23 in 0.05f64..2.0,
+            tilt in -1.0f64..1.0, spin in 0.0f64..6.3,
+            feed in 100.0f64..30000.0, cycle in 0.0005f64..0.01,
+        ) {
+            let m = AcHead::paper_000();
+            let e = Vector3::new(spin.cos(), spin.sin(), 0.0);
+            let f = Vector3::new(-spin.sin() * tilt.cos(), spin.cos() * tilt.cos(), tilt.sin());
+            let o = Point3::new(3.0, -7.0, 11.0);
+            let at = |th: f64| o + (e * th.cos() + f * th.sin()) * r;
+            let s = |th: f64| station(&m, at(th), 10.0, 20.0);
+            let (s1, s3) = (s(t1), s(t1 + d12 + d23));
+            let b = Block::arc(&s1, &s(t1 + d12), &s3).expect("arc");
+            let dl = feed / 60.0 * cycle;
+            prop_assume!(b.length() / dl < 200_000.0);
+            let rows = b.constant_feed(&m, feed, cycle).expect("interpolates");
+            // Rotary axes constant: X, Y, Z = tip + the head's offset (eq 16 at the origin).
+            let off = eq16(&m, Point3::origin(), 10.0, 20.0);
+            let tip = |q: &[f64; 5]| Point3::new(q[0] - off[0], q[1] - off[1], q[2] - off[2]);
+            for w in rows.windows(2) {
+                let (p, q) = (tip(&w[0]), tip(&w[1]));
+                prop_assert!(((q - o).norm() - r).abs() < 1e-9 * r.max(1.0));
+                prop_assert!((q - p).norm() <= dl * (1.0 + 1e-9));
+            }
+            prop_assert_eq!(rows[rows.len() - 1], s3.axes);
+        }
+    }
+}

@@ -16,7 +16,17 @@ fn check_program(
     feed: f64,
     cycle: f64,
 ) -> kerf_interp::Motion {
-    let motion = plan(m, blocks, &PlanOptions::new(feed, cycle)).expect("plan");
+    check_with(name, m, blocks, &PlanOptions::new(feed, cycle))
+}
+
+fn check_with(
+    name: &str,
+    m: &AcHead,
+    blocks: &[kerf_interp::Block],
+    opts: &PlanOptions,
+) -> kerf_interp::Motion {
+    let cycle = opts.cycle;
+    let motion = plan(m, blocks, opts).expect("plan");
     let rows = motion.setpoints(m);
     assert_eq!(rows.len(), motion.cycles() + 1, "{name}: one row per cycle");
     let (rv, ra, iv, ia) = limit_ratios(m, &rows, cycle);
@@ -200,4 +210,91 @@ fn plan_refuses_bad_options() {
     let motion = plan(&m, &[], &PlanOptions::new(1000.0, 0.001)).expect("empty");
     assert_eq!(motion.setpoints(&m).len(), 0, "no set-points");
     let _ = m.limits();
+}
+
+#[test]
+fn block_ends_on_cycles() {
+    // Paper 000's block-by-block mode: every block end is a set-point, exactly.
+    let m = AcHead::paper_000();
+    let c = freeform();
+    let st = stations(&m, &c, 0.001, |p| {
+        Vector3::new(0.4 * (p.x / 40.0).sin(), 0.3 * (p.y / 25.0).cos(), 1.0).normalize()
+    });
+    let curve = |t: f64| c.point(t);
+    let fitted = fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::default()).expect("fit");
+    let lines = fit_blocks(
+        &m,
+        &st,
+        None,
+        0,
+        &FitOptions {
+            arcs: false,
+            merge_lines: false,
+            ..FitOptions::default()
+        },
+    )
+    .expect("lines");
+    for (name, blocks) in [("fitted", &fitted), ("lines", &lines)] {
+        let opts = PlanOptions {
+            block_ends_on_cycles: true,
+            ..PlanOptions::new(15000.0, 0.001)
+        };
+        let motion = check_with(&format!("{name}, block ends on cycles"), &m, blocks, &opts);
+        let rows = motion.setpoints(&m);
+        let mut r = rows.iter();
+        for (b, block) in blocks.iter().enumerate() {
+            assert!(
+                r.any(|q| *q == block.end_axes),
+                "{name}: end of block {b} is a set-point"
+            );
+        }
+    }
+}
+
+#[test]
+fn plan_error_variants() {
+    let m = AcHead::paper_000();
+    let c = freeform();
+    let st = stations(&m, &c, 0.001, |_| Vector3::z());
+    let lines = fit_blocks(
+        &m,
+        &st,
+        None,
+        0,
+        &FitOptions {
+            arcs: false,
+            merge_lines: false,
+            ..FitOptions::default()
+        },
+    )
+    .expect("lines");
+    // Block ends on cycles need refinements here; with none allowed the plan says so.
+    let opts = PlanOptions {
+        block_ends_on_cycles: true,
+        max_refinements: 0,
+        ..PlanOptions::new(15000.0, 0.001)
+    };
+    let e = plan(&m, &lines, &opts);
+    assert!(
+        matches!(e, Err(kerf_interp::InterpError::LimitsNotMet { .. })),
+        "{e:?}"
+    );
+    // A block with NaN axes is refused, not planned.
+    let mut bad = lines.clone();
+    bad[3].end_axes[1] = f64::NAN;
+    let e = plan(&m, &bad, &PlanOptions::new(15000.0, 0.001));
+    assert!(
+        matches!(e, Err(kerf_interp::InterpError::NonFinite { index: 3 })),
+        "{e:?}"
+    );
+    // An arc bulging past an axis range is reported.
+    let mut small = AcHead::paper_000();
+    small.limits.range[1] = Some([-10.0, 10.0]);
+    let ring = stations(&m, &circle(20.0, 0.0, 30.0, 0.0), 0.001, |_| Vector3::z());
+    let blocks = fit_blocks(&m, &ring, None, 0, &FitOptions::default()).expect("fit");
+    let e = plan(&small, &blocks, &PlanOptions::new(5000.0, 0.001));
+    assert!(
+        matches!(e, Err(kerf_interp::InterpError::OutOfRange { .. })),
+        "{e:?}"
+    );
 }

@@ -1,0 +1,348 @@
+//! `kerf.axes/1`: the machine axis positions of every path, written atomically.
+//!
+//! ```json
+//! {
+//!   "format": "kerf.axes/1",
+//!   "machine": "paper-000 laser head",
+//!   "axes": ["X", "Y", "Z", "A", "C"],
+//!   "paths": [
+//!     { "id": "door-trim-1", "positions": [[0, 0, 0, 0, 0], ...], "poses": [[0, 0, 0, 0, 0, 1], ...],
+//!       "inserted": 12, "max_rotary_step": 0.8, "max_linearization_error": 0.0049,
+//!       "pole_tip_error": 0 }
+//!   ]
+//! }
+//! ```
+//!
+//! `positions[n]` drives the machine to `poses[n]`; `poses` holds the cutting points plus the
+//! inserted points, `inserted` counts the latter (kerf inserts against the non-linearity error
+//! and, when `max_rotary_step` is set, against long rotary moves; both are counted). The last
+//! three keys of a path are optional extensions (the report of [`crate::SolvedPath`]); readers
+//! of the format may ignore them.
+//!
+//! Numbers are written with Rust's shortest round-trip formatting, so reading the file back
+//! gives the same doubles. The file is written to a temporary file in the destination's
+//! directory and renamed over the destination once complete: a failure never leaves a
+//! half-written file.
+
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+use serde::Deserialize;
+
+use crate::error::{KinematicsError, Result};
+use crate::machine::Machine;
+use crate::path::SolvedPath;
+
+/// The `format` value of an axes file.
+pub const AXES_FORMAT: &str = "kerf.axes/1";
+
+/// A `kerf.axes/1` document.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxesFile {
+    /// The machine's name.
+    pub machine: String,
+    /// The axis names, `["X", "Y", "Z", "A" or "B", "C"]`.
+    pub axes: [String; 5],
+    /// One entry per path, in toolpath order.
+    pub paths: Vec<AxesPath>,
+}
+
+/// The axes of one path.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxesPath {
+    /// The path's id.
+    pub id: String,
+    /// `[X, Y, Z, tilt, C]` per point (mm, degrees).
+    pub positions: Vec<[f64; 5]>,
+    /// `[x, y, z, i, j, k]` per point.
+    pub poses: Vec<[f64; 6]>,
+    /// How many of the points were inserted.
+    pub inserted: usize,
+    /// Optional: the largest rotary step between two points (degrees).
+    #[serde(default)]
+    pub max_rotary_step: Option<f64>,
+    /// Optional: the largest non-linearity error of a move (mm, estimated).
+    #[serde(default)]
+    pub max_linearization_error: Option<f64>,
+    /// Optional: the largest tip error of the pole rule (mm).
+    #[serde(default)]
+    pub pole_tip_error: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Document {
+    format: String,
+    machine: String,
+    axes: [String; 5],
+    paths: Vec<AxesPath>,
+}
+
+impl AxesFile {
+    /// The document for solved paths on `machine`.
+    pub fn new(machine: &Machine, paths: &[SolvedPath]) -> Self {
+        Self {
+            machine: machine.name.clone(),
+            axes: machine.axis_names().map(str::to_owned),
+            paths: paths
+                .iter()
+                .map(|p| AxesPath {
+                    id: p.id.clone(),
+                    positions: p.positions(),
+                    poses: p.poses.iter().map(|q| q.to_array()).collect(),
+                    inserted: p.inserted,
+                    max_rotary_step: Some(p.max_rotary_step),
+                    max_linearization_error: Some(p.max_linearization_error),
+                    pole_tip_error: Some(p.pole_tip_error),
+                })
+                .collect(),
+        }
+    }
+
+    /// Checks the document: one position per pose, finite numbers, `inserted` at most the
+    /// number of points, the axis names `X, Y, Z, A|B, C`.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Document`] naming the JSON path of the defect.
+    pub fn validate(&self) -> Result<()> {
+        let tilt_ok = self.axes[3] == "A" || self.axes[3] == "B";
+        if self.axes[0] != "X"
+            || self.axes[1] != "Y"
+            || self.axes[2] != "Z"
+            || !tilt_ok
+            || self.axes[4] != "C"
+        {
+            return Err(KinematicsError::doc(
+                "axes",
+                format!(
+                    "expected [\"X\", \"Y\", \"Z\", \"A\" or \"B\", \"C\"], found {:?}",
+                    self.axes
+                ),
+            ));
+        }
+        for (n, p) in self.paths.iter().enumerate() {
+            let at = |key: &str| format!("paths[{n}].{key}");
+            if p.positions.len() != p.poses.len() {
+                return Err(KinematicsError::doc(
+                    at("positions"),
+                    format!(
+                        "{} positions for {} poses",
+                        p.positions.len(),
+                        p.poses.len()
+                    ),
+                ));
+            }
+            if p.inserted > p.poses.len() {
+                return Err(KinematicsError::doc(
+                    at("inserted"),
+                    format!("{} inserted of {} points", p.inserted, p.poses.len()),
+                ));
+            }
+            for (key, rows) in [
+                (
+                    "positions",
+                    p.positions.iter().map(|r| r.as_slice()).collect::<Vec<_>>(),
+                ),
+                ("poses", p.poses.iter().map(|r| r.as_slice()).collect()),
+            ] {
+                for (i, row) in rows.iter().enumerate() {
+                    if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+                        return Err(KinematicsError::doc(
+                            format!("paths[{n}].{key}[{i}][{k}]"),
+                            format!("must be finite (got {})", row[k]),
+                        ));
+                    }
+                }
+            }
+            for (key, v) in [
+                ("max_rotary_step", p.max_rotary_step),
+                ("max_linearization_error", p.max_linearization_error),
+                ("pole_tip_error", p.pole_tip_error),
+            ] {
+                if let Some(v) = v.filter(|v| !v.is_finite()) {
+                    return Err(KinematicsError::doc(
+                        at(key),
+                        format!("must be finite (got {v})"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the document and writes it as JSON to `writer`.
+    ///
+    /// # Errors
+    /// Any error of [`AxesFile::validate`], or [`KinematicsError::Io`].
+    pub fn to_writer(&self, writer: impl Write) -> Result<()> {
+        self.validate()?;
+        let mut w = BufWriter::new(writer);
+        self.write_json(&mut w)
+            .and_then(|()| w.flush())
+            .map_err(|e| io_error("<writer>", &e))
+    }
+
+    /// Checks the document and returns it as JSON text.
+    ///
+    /// # Errors
+    /// Any error of [`AxesFile::validate`].
+    pub fn to_json(&self) -> Result<String> {
+        let mut bytes = Vec::new();
+        self.to_writer(&mut bytes)?;
+        Ok(String::from_utf8_lossy(&bytes).into_owned())
+    }
+
+    /// Checks the document and writes it to `dest` atomically (a temporary file in the same
+    /// directory, renamed over `dest` once complete); `-` writes to standard output.
+    ///
+    /// # Errors
+    /// Any error of [`AxesFile::validate`], or [`KinematicsError::Io`] (nothing was written to
+    /// `dest`).
+    pub fn write(&self, dest: impl AsRef<Path>) -> Result<()> {
+        let dest = dest.as_ref();
+        self.validate()?;
+        if dest == Path::new("-") {
+            return self.to_writer(io::stdout().lock());
+        }
+        let dir = match dest.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let name = dest.display().to_string();
+        let result = (|| -> io::Result<()> {
+            let mut builder = tempfile::Builder::new();
+            builder.prefix(".kerf-axes-").suffix(".tmp");
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::PermissionsExt;
+                // Like File::create: 0o666 less the umask (tempfile's default is 0o600).
+                builder.permissions(std::fs::Permissions::from_mode(0o666));
+            }
+            let mut tmp = builder.tempfile_in(dir)?;
+            {
+                let mut w = BufWriter::new(tmp.as_file_mut());
+                self.write_json(&mut w)?;
+                w.flush()?;
+            }
+            tmp.as_file().sync_all()?;
+            tmp.persist(dest).map_err(|e| e.error)?;
+            Ok(())
+        })();
+        result.map_err(|e| io_error(&name, &e))
+    }
+
+    /// Reads `kerf.axes/1` JSON text.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Syntax`], or [`KinematicsError::Document`] for a wrong format, a
+    /// wrong shape or a failed [`AxesFile::validate`].
+    #[allow(clippy::should_implement_trait)] // as Machine::from_str
+    pub fn from_str(text: &str) -> Result<Self> {
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+            let full = e.to_string();
+            let suffix = format!(" at line {} column {}", e.line(), e.column());
+            KinematicsError::Syntax {
+                line: e.line(),
+                column: e.column(),
+                message: full.strip_suffix(&suffix).unwrap_or(&full).to_owned(),
+            }
+        })?;
+        match value.get("format") {
+            Some(serde_json::Value::String(s)) if s == AXES_FORMAT => {}
+            other => {
+                return Err(KinematicsError::doc(
+                    "format",
+                    format!(
+                        "unknown format {} (this reader reads \"{AXES_FORMAT}\")",
+                        other.map_or("(missing)".to_owned(), |v| v.to_string())
+                    ),
+                ))
+            }
+        }
+        let doc: Document = serde_json::from_value(value)
+            .map_err(|e| KinematicsError::doc("top level", e.to_string()))?;
+        debug_assert_eq!(doc.format, AXES_FORMAT, "checked above");
+        let file = AxesFile {
+            machine: doc.machine,
+            axes: doc.axes,
+            paths: doc.paths,
+        };
+        file.validate()?;
+        Ok(file)
+    }
+
+    /// The JSON text, one point per line.
+    fn write_json(&self, w: &mut impl Write) -> io::Result<()> {
+        writeln!(w, "{{")?;
+        writeln!(w, "  \"format\": \"{AXES_FORMAT}\",")?;
+        writeln!(w, "  \"machine\": {},", json_string(&self.machine))?;
+        let axes: Vec<String> = self.axes.iter().map(|a| json_string(a)).collect();
+        writeln!(w, "  \"axes\": [{}],", axes.join(", "))?;
+        write!(w, "  \"paths\": [")?;
+        for (n, p) in self.paths.iter().enumerate() {
+            if n > 0 {
+                write!(w, ",")?;
+            }
+            writeln!(w)?;
+            writeln!(w, "    {{")?;
+            writeln!(w, "      \"id\": {},", json_string(&p.id))?;
+            write_rows(w, "positions", p.positions.iter().map(|r| r.as_slice()))?;
+            write_rows(w, "poses", p.poses.iter().map(|r| r.as_slice()))?;
+            write!(w, "      \"inserted\": {}", p.inserted)?;
+            for (key, v) in [
+                ("max_rotary_step", p.max_rotary_step),
+                ("max_linearization_error", p.max_linearization_error),
+                ("pole_tip_error", p.pole_tip_error),
+            ] {
+                if let Some(v) = v {
+                    write!(w, ",\n      \"{key}\": {v}")?;
+                }
+            }
+            write!(w, "\n    }}")?;
+        }
+        if !self.paths.is_empty() {
+            writeln!(w)?;
+            write!(w, "  ")?;
+        }
+        writeln!(w, "]")?;
+        writeln!(w, "}}")
+    }
+}
+
+/// `"key": [[...], ...],` one row per line.
+fn write_rows<'a>(
+    w: &mut impl Write,
+    key: &str,
+    rows: impl Iterator<Item = &'a [f64]>,
+) -> io::Result<()> {
+    write!(w, "      \"{key}\": [")?;
+    for (i, row) in rows.enumerate() {
+        if i > 0 {
+            write!(w, ",")?;
+        }
+        write!(w, "\n        [")?;
+        for (k, v) in row.iter().enumerate() {
+            if k > 0 {
+                write!(w, ", ")?;
+            }
+            // Display of f64 is the shortest text that reads back to the same double, and is
+            // valid JSON for finite values (checked by validate).
+            write!(w, "{v}")?;
+        }
+        write!(w, "]")?;
+    }
+    writeln!(w, "\n      ],")
+}
+
+fn json_string(s: &str) -> String {
+    serde_json::to_string(s).unwrap_or_else(|_| "\"\"".to_owned())
+}
+
+fn io_error(file: &str, e: &io::Error) -> KinematicsError {
+    KinematicsError::Io {
+        file: file.to_owned(),
+        action: "write",
+        message: e.to_string(),
+    }
+}

@@ -1,0 +1,156 @@
+//! The error type of the kinematics crate.
+//!
+//! Machine-file errors name the JSON path of the defect, e.g.
+//! `kinematics.r_a: must be finite and >= 0 (got NaN)` or `limits.A: min 10 > max -10`; path
+//! errors name the path id, the index of the cutting point and the axis, e.g.
+//! `path "rim": point 73: C = 362 is outside its limits [-360, 360]; ...`.
+
+use thiserror::Error;
+
+/// `Result` with [`KinematicsError`].
+pub type Result<T> = std::result::Result<T, KinematicsError>;
+
+/// Everything that can go wrong when reading a machine, solving a path or writing axes.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum KinematicsError {
+    /// An error inside the file `file` (added by [`crate::Machine::read`]).
+    /// Fix: see `error`.
+    #[error("{file}: {error}")]
+    File {
+        /// The file, as given.
+        file: String,
+        /// What is wrong in it.
+        error: Box<KinematicsError>,
+    },
+    /// A file could not be read or written (nothing was written to the destination).
+    /// Fix: check the path, the directory and its permissions.
+    #[error("{file}: cannot {action}: {message}")]
+    Io {
+        /// The file, as given.
+        file: String,
+        /// `"read"` or `"write"`.
+        action: &'static str,
+        /// The operating system's message.
+        message: String,
+    },
+    /// The document is not well-formed JSON (or holds a number out of the range of a double,
+    /// such as `1e400`). Fix: correct the text at the given line and column.
+    #[error("invalid JSON at line {line}, column {column}: {message}")]
+    Syntax {
+        /// Line, from 1.
+        line: usize,
+        /// Column, from 1.
+        column: usize,
+        /// What the parser found wrong.
+        message: String,
+    },
+    /// A value of a `kerf.machine/1` (or `kerf.axes/1`) document is missing, of the wrong type or
+    /// out of range; `path` is its JSON path, e.g. `kinematics.r_a` or `limits.A`.
+    /// Fix: see `shared/formats.md` and the message.
+    #[error("{path}: {message}")]
+    Document {
+        /// The JSON path of the defect (`format`, `kinematics.type`, `limits.A[0]`, ...).
+        path: String,
+        /// What is wrong, and what was found.
+        message: String,
+    },
+    /// An option is out of range. Fix: see the option's documentation in
+    /// [`crate::PathOptions`].
+    #[error("option {name}: {reason} (got {value})")]
+    BadOption {
+        /// The option's name.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// A pose or the parameters of a path are unusable (not finite, a tool axis of length far
+    /// from 1, params not increasing, ...). Fix: regenerate the toolpath with normals.
+    #[error("path \"{path_id}\": point {index}: {reason}")]
+    BadPose {
+        /// The id of the path.
+        path_id: String,
+        /// The index of the cutting point.
+        index: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// No inverse solution of a cutting point (or of a point inserted before it) fits the axis
+    /// limits while keeping the axes continuous. `axis` is the axis the preferred (least
+    /// travel) solution violates; `detail` says why the other solution does not help either.
+    /// Fix: move or re-fixture the part, or check the limits of the machine file.
+    #[error("path \"{path_id}\": point {index}{}: {axis} = {value} is outside its limits [{min}, {max}]; {detail}", if *.inserted { " (at a point inserted before it)" } else { "" })]
+    OutOfLimits {
+        /// The id of the path.
+        path_id: String,
+        /// The index of the cutting point.
+        index: usize,
+        /// True if the failing point is one inserted between cutting points `index - 1` and
+        /// `index`.
+        inserted: bool,
+        /// The axis name: `X`, `Y`, `Z`, `A`, `B` or `C`.
+        axis: &'static str,
+        /// The axis value the preferred solution needs.
+        value: f64,
+        /// The lower limit of that axis.
+        min: f64,
+        /// The upper limit of that axis.
+        max: f64,
+        /// Why the other solution is not used.
+        detail: String,
+    },
+    /// The axes must jump between two poses that are (numerically) the same, so no number of
+    /// inserted points makes the motion continuous. Fix: split the path at that point.
+    #[error("path \"{path_id}\": point {index}: the axes jump ({detail}); split the path there")]
+    Discontinuity {
+        /// The id of the path.
+        path_id: String,
+        /// The index of the cutting point.
+        index: usize,
+        /// Which axes jump, and by how much.
+        detail: String,
+    },
+    /// More than [`crate::PathOptions::max_inserted`] points would have to be inserted in
+    /// one path. Fix: raise `linearization_tolerance` or `max_rotary_step`, or the limit.
+    #[error("path \"{path_id}\": more than {limit} points would have to be inserted (at point {index}); raise linearization_tolerance or max_rotary_step")]
+    TooManyInserted {
+        /// The id of the path.
+        path_id: String,
+        /// The index of the cutting point being reached.
+        index: usize,
+        /// The limit.
+        limit: usize,
+    },
+}
+
+impl KinematicsError {
+    /// The error without the [`KinematicsError::File`] wrapper, for matching.
+    pub fn without_file(&self) -> &KinematicsError {
+        match self {
+            KinematicsError::File { error, .. } => error.without_file(),
+            other => other,
+        }
+    }
+
+    /// A [`KinematicsError::Document`] error.
+    pub(crate) fn doc(path: impl Into<String>, message: impl Into<String>) -> Self {
+        KinematicsError::Document {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// `"number"`, `"string"`, ... for messages.
+pub(crate) fn json_type_name(value: &serde_json::Value) -> &'static str {
+    match value {
+        serde_json::Value::Null => "null",
+        serde_json::Value::Bool(_) => "a boolean",
+        serde_json::Value::Number(_) => "a number",
+        serde_json::Value::String(_) => "a string",
+        serde_json::Value::Array(_) => "an array",
+        serde_json::Value::Object(_) => "an object",
+    }
+}

@@ -1,0 +1,162 @@
+//! `fork-head`: the double swing head of paper 002 (C primary, A or B tilting).
+//!
+//! `u = Rz(C) R_tilt(t) ez`, `P = XYZ + Rz(C) (d + R_tilt(t) (tx, ty, -L))`: the machine's
+//! X, Y, Z is the C axis' reference point; `d` goes from it (in the C-rotated frame) to the
+//! tilt axis, and the tool tip sits `L` below the tilt axis, shifted sideways by
+//! `tool_lateral = (tx, ty)`.
+//!
+//! Inverse: the tilt and C from the tool axis (as for every type), then
+//! `XYZ = P - Rz(C) (d + R_tilt(t) (tx, ty, -L))`.
+
+use std::sync::Arc;
+
+use nalgebra::{Point3, Vector3};
+use serde_json::Value;
+
+use crate::error::{KinematicsError, Result};
+use crate::kinematics::Kinematics;
+use crate::pose::{Axes, Pose};
+use crate::registry::{finite, non_negative, KinematicsType, Params};
+use crate::rotation::{rot_z, Angles, Orientation, TiltAbout};
+
+/// The registry entry.
+pub(crate) const TYPE: KinematicsType = KinematicsType {
+    name: "fork-head",
+    parse: |p: &mut Params<'_>| {
+        let tilt = match p.string("tilt")? {
+            "A" => ForkTilt::A,
+            "B" => ForkTilt::B,
+            other => {
+                return Err(KinematicsError::doc(
+                    "kinematics.tilt",
+                    format!("expected \"A\" or \"B\", found {other:?}"),
+                ))
+            }
+        };
+        let l = p.number("L")?;
+        let d = p.numbers::<3>("d")?;
+        let lateral = p.numbers::<2>("tool_lateral")?;
+        Ok(Arc::new(ForkHead::try_new(
+            tilt,
+            l,
+            Vector3::from(d),
+            lateral,
+        )?))
+    },
+};
+
+/// The tilt axis of a fork head.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ForkTilt {
+    /// A: the tilt turns about x.
+    A,
+    /// B: the tilt turns about y.
+    B,
+}
+
+/// A double swing head: C on the machine, the tilt (A or B) carried by C, the tool on the
+/// tilt.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForkHead {
+    orientation: Orientation,
+    /// The pivot length: from the tilt axis down to the tool tip (mm, >= 0).
+    pub l: f64,
+    /// From the C reference point to the tilt axis, in the C-rotated frame (mm).
+    pub d: Vector3<f64>,
+    /// The tool tip's sideways offset `(tx, ty)` in the tilted frame (mm).
+    pub tool_lateral: [f64; 2],
+}
+
+impl ForkHead {
+    /// A fork head with the given tilt axis, pivot length, axis offset and lateral offset.
+    ///
+    /// # Errors
+    /// [`crate::KinematicsError::Document`] naming the parameter (`kinematics.L`,
+    /// `kinematics.d`, `kinematics.tool_lateral`) if `L` is negative or a value is not finite.
+    pub fn try_new(
+        tilt: ForkTilt,
+        l: f64,
+        d: Vector3<f64>,
+        tool_lateral: [f64; 2],
+    ) -> Result<Self> {
+        non_negative("L", l)?;
+        for v in d.iter() {
+            finite("d", *v)?;
+        }
+        for v in tool_lateral {
+            finite("tool_lateral", v)?;
+        }
+        let about = match tilt {
+            ForkTilt::A => TiltAbout::X,
+            ForkTilt::B => TiltAbout::Y,
+        };
+        Ok(Self {
+            orientation: Orientation::head(about),
+            l,
+            d,
+            tool_lateral,
+        })
+    }
+
+    /// `Rz(C) (d + R_tilt(t) (tx, ty, -L))`: from X, Y, Z to the tip.
+    #[inline]
+    fn offset(&self, s: &Angles) -> Vector3<f64> {
+        let tool = Vector3::new(self.tool_lateral[0], self.tool_lateral[1], -self.l);
+        let local = self.d + self.orientation.rot_tilt(&tool, s.a);
+        rot_z(&local, s.g)
+    }
+
+    #[inline]
+    fn place(&self, p: &Point3<f64>, s: &Angles) -> Axes {
+        let m = p - self.offset(s);
+        Axes::new(m.x, m.y, m.z, s.tilt, s.c)
+    }
+}
+
+impl Kinematics for ForkHead {
+    fn type_name(&self) -> &'static str {
+        TYPE.name
+    }
+
+    fn tilt_name(&self) -> &'static str {
+        match self.orientation.about {
+            TiltAbout::X => "A",
+            TiltAbout::Y => "B",
+        }
+    }
+
+    fn forward(&self, axes: &Axes) -> Pose {
+        let angles = self.orientation.at(axes.tilt, axes.c);
+        Pose {
+            position: Point3::from(axes.xyz() + self.offset(&angles)),
+            axis: self.orientation.axis(&angles),
+        }
+    }
+
+    fn inverse(&self, pose: &Pose) -> [Axes; 2] {
+        self.orientation
+            .solve(&pose.axis)
+            .map(|s| self.place(&pose.position, &s))
+    }
+
+    fn inverse_with_c(&self, pose: &Pose, c: f64) -> Axes {
+        self.place(&pose.position, &self.orientation.tilt_for_c(&pose.axis, c))
+    }
+
+    fn pivot_length(&self) -> f64 {
+        // The tip's distance from the tilt axis: the part of (tx, ty, -L) across it.
+        match self.orientation.about {
+            TiltAbout::X => self.tool_lateral[1].hypot(self.l),
+            TiltAbout::Y => self.tool_lateral[0].hypot(self.l),
+        }
+    }
+
+    fn parameters(&self) -> Vec<(&'static str, Value)> {
+        vec![
+            ("tilt", self.tilt_name().into()),
+            ("L", self.l.into()),
+            ("d", vec![self.d.x, self.d.y, self.d.z].into()),
+            ("tool_lateral", self.tool_lateral.to_vec().into()),
+        ]
+    }
+}

@@ -1,0 +1,60 @@
+//! Five-axis kinematics: poses `(x, y, z, i, j, k)` to machine axes `[X, Y, Z, A|B, C]`.
+//!
+//! The stage after the discretizer (and its normals): a cutting point with its tool axis is a
+//! [`Pose`]; a [`Machine`] (`kerf.machine/1`, `shared/formats.md`) turns it into [`Axes`] by
+//! inverse kinematics, and [`solve_path`] does so along a whole path, keeping the axes
+//! continuous and within their limits, handling the pole, and inserting poses where the
+//! controller's linear axis interpolation would take the tool tip off the path
+//! ([`nonlinear`], paper 002). [`AxesFile`] writes the result as `kerf.axes/1`.
+//!
+//! Four kinematic types, one file each: [`AcHead`] (the laser head of paper 000),
+//! [`ForkHead`] (a double swing head), [`TableTable`] (LinuxCNC's `xyzac-trt`) and
+//! [`HeadTable`] (a B head over a C table). Each implements [`Kinematics`]; a fifth is one
+//! new file and one line in the registry. The derivations, hand-checked values and the error
+//! budget are in `docs/kinematics.md`.
+//!
+//! ```
+//! use kerf_kinematics::{solve_path, Kinematics, Machine, PathInput, PathOptions, Pose};
+//!
+//! let machine = Machine::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/machines/ac_head.json"))?;
+//! // Tip at (100, 50, 20), tool axis tilted 30 degrees toward +x.
+//! let pose = Pose::new(100.0, 50.0, 20.0, 0.5, 0.0, 0.75_f64.sqrt());
+//! let [first, second] = machine.kinematics.inverse(&pose);
+//! assert!((first.tilt - 30.0).abs() < 1e-12 && (first.c - 90.0).abs() < 1e-12, "{first:?}");
+//! assert!((second.tilt + 30.0).abs() < 1e-12 && (second.c - 270.0).abs() < 1e-12, "{second:?}");
+//! let back = machine.kinematics.forward(&first);
+//! assert!((back.position - pose.position).norm() < 1e-12, "forward undoes inverse");
+//!
+//! let poses = [pose, Pose::new(101.0, 50.0, 20.0, 0.5, 0.0, 0.75_f64.sqrt())];
+//! let input = PathInput { id: "demo", poses: &poses, curve: None };
+//! let solved = solve_path(&machine, &input, &PathOptions::default())?;
+//! assert_eq!(solved.axes.len(), 2, "a pure translation needs no inserted point");
+//! # Ok::<(), kerf_kinematics::KinematicsError>(())
+//! ```
+
+pub mod ac_head;
+pub mod axes_file;
+pub mod error;
+pub mod fork_head;
+pub mod head_table;
+pub mod kinematics;
+pub mod machine;
+pub mod nonlinear;
+pub mod path;
+pub mod pose;
+mod registry;
+mod rotation;
+pub mod table_table;
+
+pub use ac_head::AcHead;
+pub use axes_file::{AxesFile, AxesPath, AXES_FORMAT};
+pub use error::{KinematicsError, Result};
+pub use fork_head::{ForkHead, ForkTilt};
+pub use head_table::HeadTable;
+pub use kinematics::Kinematics;
+pub use machine::{Machine, Range, MACHINE_FORMAT};
+pub use nonlinear::{linearization_error, Deviation};
+pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
+pub use pose::{Axes, Axis, Pose};
+pub use registry::kinematics_types;
+pub use table_table::TableTable;

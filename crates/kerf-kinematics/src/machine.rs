@@ -1,0 +1,366 @@
+//! `kerf.machine/1`: a machine's kinematics, axis limits, velocities and accelerations.
+//!
+//! ```
+//! use kerf_kinematics::{Axis, Machine};
+//!
+//! let machine = Machine::from_str(r#"{
+//!   "format": "kerf.machine/1",
+//!   "name": "paper-000 laser head",
+//!   "kinematics": { "type": "ac-head", "r_a": 180.0, "r_c": 95.0 },
+//!   "limits": { "X": [-1500, 1500], "Y": [-800, 800], "Z": [-100, 600], "A": [-135, 135], "C": null },
+//!   "max_velocity": { "X": 60000, "Y": 60000, "Z": 30000, "A": 36000, "C": 36000 },
+//!   "max_acceleration": { "X": 10000, "Y": 10000, "Z": 8000, "A": 20000, "C": 20000 }
+//! }"#)?;
+//! assert_eq!(machine.axis_names(), ["X", "Y", "Z", "A", "C"]);
+//! assert!(machine.limit(Axis::C).is_none(), "C is continuous");
+//!
+//! let err = Machine::from_str(r#"{"format": "kerf.machine/1", "name": "m",
+//!   "kinematics": { "type": "xyz" }}"#).unwrap_err();
+//! assert_eq!(err.to_string(),
+//!     "kinematics.type: unknown type \"xyz\" (known: ac-head, fork-head, table-table, head-table)");
+//! # Ok::<(), kerf_kinematics::KinematicsError>(())
+//! ```
+//!
+//! Reading is strict inside `kinematics`, `limits`, `max_velocity` and `max_acceleration`: a
+//! key that is not a parameter of the type or an axis of the machine is an error (a misspelt
+//! key must not silently become a default). Unknown top-level keys are ignored, so that a file
+//! may carry comments or later optional keys. Every axis must be listed in `limits`,
+//! `max_velocity` and `max_acceleration` (`null` in `limits` for an unlimited axis).
+
+use std::path::Path;
+use std::sync::Arc;
+
+use serde_json::{Map, Value};
+
+use crate::error::{json_type_name, KinematicsError, Result};
+use crate::kinematics::Kinematics;
+use crate::pose::{Axes, Axis};
+use crate::registry;
+
+/// The `format` value of a machine file.
+pub const MACHINE_FORMAT: &str = "kerf.machine/1";
+
+/// The closed range `[min, max]` of a limited axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// The lowest allowed value (mm or degrees).
+    pub min: f64,
+    /// The highest allowed value.
+    pub max: f64,
+}
+
+impl Range {
+    /// `[min, max]`.
+    pub fn new(min: f64, max: f64) -> Self {
+        Self { min, max }
+    }
+
+    /// True if `value` lies in `[min - slack, max + slack]`.
+    pub fn contains(&self, value: f64, slack: f64) -> bool {
+        value >= self.min - slack && value <= self.max + slack
+    }
+}
+
+/// A five-axis machine: `kerf.machine/1`.
+#[derive(Debug, Clone)]
+pub struct Machine {
+    /// The machine's name (copied into `kerf.axes/1`).
+    pub name: String,
+    /// The kinematic type with its parameters.
+    pub kinematics: Arc<dyn Kinematics>,
+    /// The limits of `[X, Y, Z, tilt, C]`; `None` for an unlimited (continuous) axis.
+    pub limits: [Option<Range>; 5],
+    /// The largest velocity of each axis, mm/min or deg/min.
+    pub max_velocity: [f64; 5],
+    /// The largest acceleration of each axis, mm/s^2 or deg/s^2.
+    pub max_acceleration: [f64; 5],
+}
+
+impl Machine {
+    /// A machine from its parts, checked like a file.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Document`] naming the first bad value (`limits.A: min 10 > max -10`,
+    /// `max_velocity.X: must be finite and > 0 (got 0)`, `name: must not be empty`).
+    pub fn try_new(
+        name: impl Into<String>,
+        kinematics: Arc<dyn Kinematics>,
+        limits: [Option<Range>; 5],
+        max_velocity: [f64; 5],
+        max_acceleration: [f64; 5],
+    ) -> Result<Self> {
+        let machine = Self {
+            name: name.into(),
+            kinematics,
+            limits,
+            max_velocity,
+            max_acceleration,
+        };
+        machine.validate()?;
+        Ok(machine)
+    }
+
+    /// Checks the name, the limits, the velocities and the accelerations (the kinematic
+    /// parameters are checked by each type's constructor).
+    ///
+    /// # Errors
+    /// [`KinematicsError::Document`] naming the first bad value.
+    pub fn validate(&self) -> Result<()> {
+        if self.name.trim().is_empty() {
+            return Err(KinematicsError::doc("name", "must not be empty"));
+        }
+        let names = self.axis_names();
+        for axis in Axis::ALL {
+            let name = names[axis.index()];
+            if let Some(r) = self.limits[axis.index()] {
+                for (k, v) in [r.min, r.max].into_iter().enumerate() {
+                    if !v.is_finite() {
+                        return Err(KinematicsError::doc(
+                            format!("limits.{name}[{k}]"),
+                            format!("must be finite (got {v}); use null for an unlimited axis"),
+                        ));
+                    }
+                }
+                if r.min > r.max {
+                    return Err(KinematicsError::doc(
+                        format!("limits.{name}"),
+                        format!("min {} > max {}", r.min, r.max),
+                    ));
+                }
+            }
+            for (key, v) in [
+                ("max_velocity", self.max_velocity[axis.index()]),
+                ("max_acceleration", self.max_acceleration[axis.index()]),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(KinematicsError::doc(
+                        format!("{key}.{name}"),
+                        format!("must be finite and > 0 (got {v})"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The axis names in file order, e.g. `["X", "Y", "Z", "A", "C"]`.
+    pub fn axis_names(&self) -> [&'static str; 5] {
+        let tilt = self.kinematics.tilt_name();
+        Axis::ALL.map(|a| a.name(tilt))
+    }
+
+    /// The name of one axis.
+    pub fn axis_name(&self, axis: Axis) -> &'static str {
+        axis.name(self.kinematics.tilt_name())
+    }
+
+    /// The limits of one axis; `None` if unlimited.
+    pub fn limit(&self, axis: Axis) -> Option<Range> {
+        self.limits[axis.index()]
+    }
+
+    /// The first axis of `axes` outside its limits (with `slack` mm or degrees of tolerance),
+    /// with its range.
+    pub fn violation(&self, axes: &Axes, slack: f64) -> Option<(Axis, Range)> {
+        Axis::ALL.into_iter().find_map(|axis| {
+            let range = self.limits[axis.index()]?;
+            (!range.contains(axes.get(axis), slack)).then_some((axis, range))
+        })
+    }
+
+    /// Reads a machine file.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Io`] if the file cannot be read, else the errors of
+    /// [`Machine::from_str`] wrapped in [`KinematicsError::File`], so that the message names
+    /// the file: `machine.json: limits.A: min 10 > max -10`.
+    pub fn read(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| KinematicsError::Io {
+            file: file.clone(),
+            action: "read",
+            message: e.to_string(),
+        })?;
+        Self::from_str(&text).map_err(|error| KinematicsError::File {
+            file,
+            error: Box::new(error),
+        })
+    }
+
+    /// Reads a machine from `kerf.machine/1` JSON text.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Syntax`] for malformed JSON, [`KinematicsError::Document`] naming
+    /// the JSON path of the first defect.
+    #[allow(clippy::should_implement_trait)] // FromStr would hide the error type's meaning.
+    pub fn from_str(text: &str) -> Result<Self> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let value: Value = serde_json::from_str(text).map_err(|e| {
+            let full = e.to_string();
+            let suffix = format!(" at line {} column {}", e.line(), e.column());
+            KinematicsError::Syntax {
+                line: e.line(),
+                column: e.column(),
+                message: full.strip_suffix(&suffix).unwrap_or(&full).to_owned(),
+            }
+        })?;
+        Self::from_value(&value)
+    }
+
+    /// Reads a machine from a parsed JSON document.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Document`] naming the JSON path of the first defect.
+    pub fn from_value(value: &Value) -> Result<Self> {
+        let Value::Object(top) = value else {
+            return Err(KinematicsError::doc(
+                "top level",
+                format!(
+                    "expected an object {{\"format\": \"{MACHINE_FORMAT}\", ...}}, found {}",
+                    json_type_name(value)
+                ),
+            ));
+        };
+        match top.get("format") {
+            Some(Value::String(s)) if s == MACHINE_FORMAT => {}
+            Some(other) => {
+                return Err(KinematicsError::doc(
+                    "format",
+                    format!("unknown format {other} (this reader reads \"{MACHINE_FORMAT}\")"),
+                ))
+            }
+            None => {
+                return Err(KinematicsError::doc(
+                    "format",
+                    format!("missing (expected \"{MACHINE_FORMAT}\")"),
+                ))
+            }
+        }
+        let name = match top.get("name") {
+            Some(Value::String(s)) => s.clone(),
+            Some(other) => {
+                return Err(KinematicsError::doc(
+                    "name",
+                    format!("expected a string, found {}", json_type_name(other)),
+                ))
+            }
+            None => return Err(KinematicsError::doc("name", "missing")),
+        };
+        let kinematics = registry::parse(required(top, "kinematics")?)?;
+        let names = Axis::ALL.map(|a| a.name(kinematics.tilt_name()));
+        let limits = per_axis(top, "limits", &names, |path, v| match v {
+            Value::Null => Ok(None),
+            Value::Array(items) if items.len() == 2 => {
+                let number = |k: usize| {
+                    items[k].as_f64().ok_or_else(|| {
+                        KinematicsError::doc(
+                            format!("{path}[{k}]"),
+                            format!("expected a number, found {}", json_type_name(&items[k])),
+                        )
+                    })
+                };
+                Ok(Some(Range::new(number(0)?, number(1)?)))
+            }
+            other => Err(KinematicsError::doc(
+                path,
+                format!("expected [min, max] or null (unlimited), found {other}"),
+            )),
+        })?;
+        let number = |path: String, v: &Value| {
+            v.as_f64()
+                .ok_or_else(|| KinematicsError::doc(path, format!("expected a number, found {v}")))
+        };
+        let max_velocity = per_axis(top, "max_velocity", &names, number)?;
+        let max_acceleration = per_axis(top, "max_acceleration", &names, number)?;
+        Self::try_new(name, kinematics, limits, max_velocity, max_acceleration)
+    }
+
+    /// The machine as `kerf.machine/1` JSON text (reads back to an equal machine).
+    pub fn to_json(&self) -> String {
+        let names = self.axis_names();
+        let mut kin = vec![format!("\"type\": {}", json(self.kinematics.type_name()))];
+        for (key, value) in self.kinematics.parameters() {
+            kin.push(format!("{}: {value}", json(key)));
+        }
+        let object = |values: Vec<String>| {
+            let body: Vec<String> = names
+                .iter()
+                .zip(values)
+                .map(|(n, v)| format!("\"{n}\": {v}"))
+                .collect();
+            format!("{{ {} }}", body.join(", "))
+        };
+        let limits = object(
+            self.limits
+                .iter()
+                .map(|r| match r {
+                    Some(r) => format!("[{}, {}]", json(r.min), json(r.max)),
+                    None => "null".to_owned(),
+                })
+                .collect(),
+        );
+        let numbers = |v: &[f64; 5]| object(v.iter().map(|x| json(*x)).collect());
+        format!(
+            "{{\n  \"format\": \"{MACHINE_FORMAT}\",\n  \"name\": {},\n  \"kinematics\": {{ {} }},\n  \"limits\": {limits},\n  \"max_velocity\": {},\n  \"max_acceleration\": {}\n}}\n",
+            json(self.name.as_str()),
+            kin.join(", "),
+            numbers(&self.max_velocity),
+            numbers(&self.max_acceleration),
+        )
+    }
+}
+
+/// A value as JSON text.
+fn json(value: impl serde::Serialize) -> String {
+    serde_json::to_string(&value).unwrap_or_else(|_| "null".to_owned())
+}
+
+fn required<'a>(top: &'a Map<String, Value>, key: &str) -> Result<&'a Value> {
+    top.get(key)
+        .ok_or_else(|| KinematicsError::doc(key, "missing"))
+}
+
+/// Reads an object with one entry per axis (`names`), every axis required, no other key.
+fn per_axis<T>(
+    top: &Map<String, Value>,
+    key: &str,
+    names: &[&'static str; 5],
+    mut read: impl FnMut(String, &Value) -> Result<T>,
+) -> Result<[T; 5]> {
+    let value = required(top, key)?;
+    let Value::Object(map) = value else {
+        return Err(KinematicsError::doc(
+            key,
+            format!(
+                "expected an object with the axes {}, found {}",
+                names.join(", "),
+                json_type_name(value)
+            ),
+        ));
+    };
+    if let Some(extra) = map.keys().find(|k| !names.contains(&k.as_str())) {
+        return Err(KinematicsError::doc(
+            format!("{key}.{extra}"),
+            format!(
+                "not an axis of this machine (its axes are {})",
+                names.join(", ")
+            ),
+        ));
+    }
+    let mut out = Vec::with_capacity(5);
+    for name in names {
+        let path = format!("{key}.{name}");
+        let Some(v) = map.get(*name) else {
+            let hint = if key == "limits" {
+                " (give [min, max], or null for an unlimited axis)"
+            } else {
+                ""
+            };
+            return Err(KinematicsError::doc(path, format!("missing{hint}")));
+        };
+        out.push(read(path, v)?);
+    }
+    out.try_into()
+        .map_err(|_| KinematicsError::doc(key, "internal: wrong axis count"))
+}

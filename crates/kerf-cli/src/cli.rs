@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand};
     name = "kerf",
     version,
     propagate_version = true,
-    after_help = "Examples:\n  kerf validate fixtures/mixed.json\n  kerf validate --json part.json > summary.json\n\nExit status: 0 success, 1 invalid or unreadable input, 2 usage error.\nFile formats: shared/formats.md (kerf.curves/1 in, kerf.toolpath/1 out)."
+    after_help = "Examples:\n  kerf validate fixtures/mixed.json\n  kerf discretize fixtures/mixed.json --tolerance 0.01 -o mixed.toolpath.json\n  kerf validate --json part.json > summary.json\n\nExit status: 0 success, 1 invalid or unreadable input, 2 usage error.\nFile formats: shared/formats.md (kerf.curves/1 in, kerf.toolpath/1 out)."
 )]
 pub(crate) struct Cli {
     /// What to do.
@@ -32,6 +32,17 @@ pub(crate) enum Command {
         after_help = "Examples:\n  kerf validate fixtures/circle.json\n  kerf validate --json fixtures/mixed.json\n  cat part.json | kerf validate -    (STL paths are then relative to the current directory)"
     )]
     Validate(ValidateArgs),
+
+    /// Cutting points with a certified chord error for every curve, as kerf.toolpath/1.
+    ///
+    /// Places cutting points by the reference-sphere method (paper 004) so that every
+    /// segment's chord error is proven <= the tolerance and every C0 corner is a cutting point.
+    /// Prints a summary to standard error: curves, points, worst certified chord error, the
+    /// theoretical minimum N* and the time.
+    #[command(
+        after_help = "Examples:\n  kerf discretize fixtures/mixed.json --tolerance 0.01 -o mixed.toolpath.json\n  kerf discretize part.json -t 0.001 --max-segment-length 20 -o -\n  kerf discretize part.json -t 0.01 --strategy equal-parameter --json"
+    )]
+    Discretize(DiscretizeArgs),
 }
 
 /// Arguments of `kerf validate`.
@@ -45,4 +56,74 @@ pub(crate) struct ValidateArgs {
     /// {"valid": false, "error": ...}).
     #[arg(long)]
     pub(crate) json: bool,
+}
+
+/// Arguments of `kerf discretize`.
+#[derive(Debug, Args)]
+pub(crate) struct DiscretizeArgs {
+    /// The kerf.curves/1 file; `-` reads standard input.
+    #[arg(value_name = "CURVES.json")]
+    pub(crate) curves: PathBuf,
+
+    /// Chord tolerance in mm: every segment's chord error is at most this.
+    #[arg(short, long, default_value_t = 0.01, value_name = "MM")]
+    pub(crate) tolerance: f64,
+
+    /// Output kerf.toolpath/1 file (`-` for standard output). Default: `<input stem>.toolpath.json`
+    /// in the current directory.
+    #[arg(short, long, value_name = "TOOLPATH.json")]
+    pub(crate) output: Option<PathBuf>,
+
+    /// Lower edge of the accepted chord-error band, as a fraction of the tolerance (0 < band <
+    /// 1; default 0.9). Higher: fewer points, slower.
+    #[arg(long, value_name = "FRACTION")]
+    pub(crate) band: Option<f64>,
+
+    /// Longest chord allowed, in mm (machines limit block length).
+    #[arg(long, value_name = "MM")]
+    pub(crate) max_segment_length: Option<f64>,
+
+    /// Shortest sphere radius the search proposes, in mm (the tolerance still wins).
+    #[arg(long, value_name = "MM")]
+    pub(crate) min_segment_length: Option<f64>,
+
+    /// Largest turn of the tangent across one segment, in degrees.
+    #[arg(long, value_name = "DEG")]
+    pub(crate) max_turn: Option<f64>,
+
+    /// How cutting points are placed (the classic methods carry the same guarantee).
+    #[arg(long, value_enum, default_value_t = StrategyArg::ReferenceSphere)]
+    pub(crate) strategy: StrategyArg,
+
+    /// Print the summary as one JSON object instead of a sentence.
+    #[arg(long)]
+    pub(crate) json: bool,
+
+    /// Print no summary.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
+}
+
+/// `--strategy` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum StrategyArg {
+    /// The reference-sphere method of paper 004 (default).
+    ReferenceSphere,
+    /// Longest certified step by bisection on the parameter.
+    EqualError,
+    /// Equal chord lengths, smallest certifying count.
+    EqualChord,
+    /// Equal parameter steps, smallest certifying count.
+    EqualParameter,
+}
+
+impl From<StrategyArg> for kerf_discretize::Strategy {
+    fn from(s: StrategyArg) -> Self {
+        match s {
+            StrategyArg::ReferenceSphere => Self::ReferenceSphere,
+            StrategyArg::EqualError => Self::EqualError,
+            StrategyArg::EqualChord => Self::EqualChordLength,
+            StrategyArg::EqualParameter => Self::EqualParameter,
+        }
+    }
 }

@@ -12,6 +12,19 @@ pub(crate) enum CliError {
     Format(FormatError),
     /// Writing to standard output failed.
     Output(io::Error),
+    /// A command-line option is out of range.
+    Options(kerf_discretize::DiscretizeError),
+    /// A curve could not be discretized.
+    Discretize {
+        /// The input file.
+        file: std::path::PathBuf,
+        /// Index of the curve in `curves`.
+        index: usize,
+        /// Its id.
+        id: String,
+        /// What went wrong.
+        error: kerf_discretize::DiscretizeError,
+    },
 }
 
 impl fmt::Display for CliError {
@@ -19,6 +32,13 @@ impl fmt::Display for CliError {
         match self {
             CliError::Format(e) => write!(f, "{e}"),
             CliError::Output(e) => write!(f, "cannot write to standard output: {e}"),
+            CliError::Options(e) => write!(f, "{e}"),
+            CliError::Discretize {
+                file,
+                index,
+                id,
+                error,
+            } => write!(f, "{}: curves[{index}] ({id:?}): {error}", file.display()),
         }
     }
 }

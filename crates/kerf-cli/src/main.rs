@@ -7,6 +7,7 @@
 //! [`cli::Command`], a module with a `run` function, and a line to the `match` below.
 
 mod cli;
+mod discretize;
 mod error;
 mod validate;
 
@@ -21,6 +22,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Validate(args) => validate::run(args),
+        Command::Discretize(args) => discretize::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

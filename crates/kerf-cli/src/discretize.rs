@@ -1,0 +1,159 @@
+//! `kerf discretize`: cutting points with a certified chord error for every curve of a
+//! `kerf.curves/1` file, written as `kerf.toolpath/1`.
+
+use std::io::{self, Write};
+use std::path::Path;
+use std::time::Instant;
+
+use kerf_discretize::{discretize_all, minimum_count, Discretization, Options};
+use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
+use kerf_format::{curves, CurvesFile};
+use serde_json::json;
+
+use crate::cli::DiscretizeArgs;
+use crate::error::CliError;
+
+/// Loads a curves file, or standard input for `-`.
+pub(crate) fn load_curves(path: &Path) -> Result<CurvesFile, CliError> {
+    let loaded = if path == Path::new("-") {
+        curves::from_reader(io::stdin().lock(), Path::new(".")).map_err(|e| e.in_file("<stdin>"))
+    } else {
+        curves::load(path)
+    };
+    Ok(loaded?)
+}
+
+/// The discretizer options the arguments ask for.
+pub(crate) fn options(args: &DiscretizeArgs) -> Options {
+    let d = Options::default();
+    Options {
+        tolerance: args.tolerance,
+        band: args.band.unwrap_or(d.band),
+        max_segment_length: args.max_segment_length.unwrap_or(d.max_segment_length),
+        min_segment_length: args.min_segment_length.unwrap_or(d.min_segment_length),
+        max_turn: args.max_turn.map_or(d.max_turn, f64::to_radians),
+        strategy: args.strategy.into(),
+        ..d
+    }
+}
+
+/// Discretizes every curve of `file` (in parallel, results in input order).
+pub(crate) fn discretize_file(
+    path: &Path,
+    file: &CurvesFile,
+    opts: &Options,
+) -> Result<Vec<Discretization>, CliError> {
+    opts.validate().map_err(CliError::Options)?;
+    let curves: Vec<_> = file.curves.iter().map(|r| r.curve.clone()).collect();
+    discretize_all(&curves, opts)
+        .into_iter()
+        .enumerate()
+        .map(|(i, r)| {
+            r.map_err(|error| CliError::Discretize {
+                file: path.to_path_buf(),
+                index: i,
+                id: file.curves[i].id.clone(),
+                error,
+            })
+        })
+        .collect()
+}
+
+/// Runs `kerf discretize`.
+pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
+    let start = Instant::now();
+    let path = args.curves.as_path();
+    let file = load_curves(path)?;
+    let opts = options(args);
+    let results = discretize_file(path, &file, &opts)?;
+    let out = ToolpathFile {
+        units: file.units,
+        tolerance: opts.tolerance,
+        paths: file
+            .curves
+            .iter()
+            .zip(&results)
+            .map(|(rec, d)| ToolPath {
+                id: rec.id.clone(),
+                params: d.params.clone(),
+                points: ToolPathPoints::Positions(
+                    d.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                ),
+                max_chord_error: d.max_chord_error,
+            })
+            .collect(),
+    };
+    let dest = args.output.clone().unwrap_or_else(|| default_output(path));
+    if dest == Path::new("-") {
+        let stdout = io::stdout();
+        let mut lock = stdout.lock();
+        toolpath::to_writer(&out, &mut lock)?;
+        lock.flush()?;
+    } else {
+        toolpath::write(&out, &dest)?;
+    }
+    let elapsed = start.elapsed().as_secs_f64();
+    let points: usize = results.iter().map(|d| d.points.len()).sum();
+    let segments: usize = results.iter().map(Discretization::segments).sum();
+    let worst = results
+        .iter()
+        .map(|d| d.max_chord_error)
+        .fold(0.0, f64::max);
+    let nstar: f64 = file
+        .curves
+        .iter()
+        .map(|r| minimum_count(&r.curve, opts.tolerance))
+        .sum();
+    let breaks: usize = results.iter().map(|d| d.c0_breaks.len()).sum();
+    if args.json {
+        let summary = json!({
+            "file": path.display().to_string(),
+            "output": dest.display().to_string(),
+            "curves": file.curves.len(),
+            "points": points,
+            "segments": segments,
+            "c0_breaks": breaks,
+            "tolerance": opts.tolerance,
+            "max_chord_error": worst,
+            "n_star": nstar,
+            "segments_over_n_star": if nstar > 0.0 { segments as f64 / nstar } else { f64::NAN },
+            "seconds": elapsed,
+        });
+        // The summary goes to standard output unless the toolpath itself does.
+        if dest == Path::new("-") {
+            eprintln!("{summary}");
+        } else {
+            println!("{summary}");
+        }
+    } else if !args.quiet {
+        eprintln!(
+            "{}: {} curves, {points} points ({segments} segments, {breaks} C0 corners kept), \
+             worst certified chord error {worst:.3e} mm <= {} mm, N* {nstar:.1} \
+             (segments / N* = {:.3}), {:.3} s -> {}",
+            path.display(),
+            file.curves.len(),
+            opts.tolerance,
+            if nstar > 0.0 {
+                segments as f64 / nstar
+            } else {
+                f64::NAN
+            },
+            elapsed,
+            dest.display()
+        );
+    }
+    Ok(())
+}
+
+/// `dir/part.json` -> `part.toolpath.json` in the current directory (the input's folder may be
+/// read-only).
+fn default_output(input: &Path) -> std::path::PathBuf {
+    if input == Path::new("-") {
+        return "-".into();
+    }
+    let stem = input.file_stem().map_or_else(
+        || "curves".to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    format!("{stem}.toolpath.json").into()
+}

@@ -1,0 +1,125 @@
+//! `kerf discretize` end to end: the binary on fixtures, its output read back and checked.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn kerf() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_kerf"))
+}
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+#[test]
+fn writes_a_certified_toolpath_for_every_curve() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mixed.toolpath.json");
+    let status = kerf()
+        .arg("discretize")
+        .arg(fixture("mixed.json"))
+        .args(["--tolerance", "0.005", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&status.stderr);
+    assert!(
+        stderr.contains("4 curves"),
+        "summary names the curves: {stderr}"
+    );
+    let tp = kerf_format::toolpath::load(&out).unwrap();
+    let curves = kerf_format::curves::load(fixture("mixed.json")).unwrap();
+    assert_eq!(tp.tolerance, 0.005, "tolerance recorded");
+    assert_eq!(tp.paths.len(), curves.curves.len(), "one path per curve");
+    for (p, c) in tp.paths.iter().zip(&curves.curves) {
+        assert_eq!(p.id, c.id, "same ids, same order");
+        assert!(
+            p.max_chord_error <= 0.005,
+            "{}: certified bound within tolerance",
+            p.id
+        );
+        let (a, b) = c.curve.domain();
+        assert_eq!(p.params[0], a, "{}: starts at the domain start", p.id);
+        assert_eq!(
+            *p.params.last().unwrap(),
+            b,
+            "{}: ends at the domain end",
+            p.id
+        );
+        for (n, t) in p.params.iter().enumerate() {
+            let q = c.curve.point(*t);
+            assert!(
+                (q - p.points.position(n)).norm() < 1e-9,
+                "{}: point {n} on the curve",
+                p.id
+            );
+        }
+        for br in c.curve.c0_breaks() {
+            assert!(p.params.contains(&br), "{}: C0 break {br} kept", p.id);
+        }
+    }
+}
+
+#[test]
+fn stdout_output_and_json_summary() {
+    let out = kerf()
+        .arg("discretize")
+        .arg(fixture("circle.json"))
+        .args(["-t", "0.01", "-o", "-", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "exit 0");
+    let tp = kerf_format::toolpath::from_str(&String::from_utf8(out.stdout).unwrap()).unwrap();
+    assert_eq!(tp.paths.len(), 1, "the circle");
+    let summary: serde_json::Value = serde_json::from_slice(&out.stderr).unwrap();
+    assert_eq!(summary["curves"], 1, "summary curves");
+    assert!(summary["n_star"].as_f64().unwrap() > 100.0, "N* reported");
+}
+
+#[test]
+fn bad_options_and_bad_input_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.json");
+    for (args, file, needle) in [
+        (vec!["-t", "0"], "mixed.json", "tolerance"),
+        (vec!["-t", "nan"], "mixed.json", "tolerance"),
+        (vec!["--band", "1.5"], "mixed.json", "band"),
+        (vec![], "bad/decreasing_knots.json", "curves[1].knots[5]"),
+        (vec![], "bad/negative_weight.json", "weight"),
+        (vec![], "bad/malformed.json", "line"),
+        (vec![], "no-such-file.json", "no-such-file.json"),
+    ] {
+        let o = kerf()
+            .arg("discretize")
+            .arg(fixture(file))
+            .args(&args)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{file} {args:?}: exit 1, stderr {stderr}"
+        );
+        assert!(
+            stderr.contains(needle),
+            "{file} {args:?}: message names {needle}: {stderr}"
+        );
+        assert!(!out.exists(), "{file} {args:?}: no output file left behind");
+    }
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    let o = kerf().args(["discretize", "--tolerance"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "missing value is a usage error");
+}

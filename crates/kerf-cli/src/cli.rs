@@ -43,6 +43,18 @@ pub(crate) enum Command {
         after_help = "Examples:\n  kerf discretize fixtures/mixed.json --tolerance 0.01 -o mixed.toolpath.json\n  kerf discretize part.json -t 0.001 --max-segment-length 20 -o -\n  kerf discretize part.json -t 0.01 --strategy equal-parameter --json"
     )]
     Discretize(DiscretizeArgs),
+
+    /// Machine axes for a toolpath with normals, as kerf.axes/1.
+    ///
+    /// Solves the inverse kinematics of the machine for every pose, choosing the solution and
+    /// the turn of a continuous C axis for continuity within the axis limits, keeps C at the
+    /// pole, splits rotary steps above --max-rotary-step and inserts poses until the tool tip
+    /// stays within --linearization-tolerance of the straight segments while the axes move
+    /// linearly.
+    #[command(
+        after_help = "Examples:\n  kerf post part.toolpath.json --machine fixtures/machines/ac_head.json -o part.axes.json\n  kerf post part.toolpath.json -m fixtures/machines/table_table.json --max-rotary-step 2 --json"
+    )]
+    Post(PostArgs),
 }
 
 /// Arguments of `kerf validate`.
@@ -126,4 +138,42 @@ impl From<StrategyArg> for kerf_discretize::Strategy {
             StrategyArg::EqualParameter => Self::EqualParameter,
         }
     }
+}
+
+/// Arguments of `kerf post`.
+#[derive(Debug, Args)]
+pub(crate) struct PostArgs {
+    /// The kerf.toolpath/1 file, with normals (`[x, y, z, i, j, k]` points).
+    #[arg(value_name = "TOOLPATH.json")]
+    pub(crate) toolpath: PathBuf,
+
+    /// The kerf.machine/1 file.
+    #[arg(short, long, value_name = "MACHINE.json")]
+    pub(crate) machine: PathBuf,
+
+    /// Output kerf.axes/1 file (`-` for standard output). Default: `<input stem>.axes.json` in
+    /// the current directory.
+    #[arg(short, long, value_name = "AXES.json")]
+    pub(crate) output: Option<PathBuf>,
+
+    /// Largest tool-tip deviation from the straight segment while the axes move linearly, in
+    /// mm (default 0.005).
+    #[arg(long, value_name = "MM")]
+    pub(crate) linearization_tolerance: Option<f64>,
+
+    /// Largest rotary-axis move between two points, in degrees (default: no limit).
+    #[arg(long, value_name = "DEG")]
+    pub(crate) max_rotary_step: Option<f64>,
+
+    /// Tool axes within this angle of the C axis count as the pole, in radians (default 1e-6).
+    #[arg(long, value_name = "RAD")]
+    pub(crate) pole_tolerance: Option<f64>,
+
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub(crate) json: bool,
+
+    /// Print no summary.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
 }

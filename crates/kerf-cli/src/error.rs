@@ -12,6 +12,11 @@ pub(crate) enum CliError {
     Format(FormatError),
     /// Writing to standard output failed.
     Output(io::Error),
+    /// The machine file is invalid, or a path cannot be solved on the machine. The optional
+    /// path names the toolpath file the path came from.
+    Kinematics(kerf_kinematics::KinematicsError, Option<std::path::PathBuf>),
+    /// An input is unusable for this command (the message names file and place).
+    Input(String),
     /// A command-line option is out of range.
     Options(kerf_discretize::DiscretizeError),
     /// A curve could not be discretized.
@@ -33,6 +38,9 @@ impl fmt::Display for CliError {
             CliError::Format(e) => write!(f, "{e}"),
             CliError::Output(e) => write!(f, "cannot write to standard output: {e}"),
             CliError::Options(e) => write!(f, "{e}"),
+            CliError::Kinematics(e, Some(file)) => write!(f, "{}: {e}", file.display()),
+            CliError::Kinematics(e, None) => write!(f, "{e}"),
+            CliError::Input(m) => write!(f, "{m}"),
             CliError::Discretize {
                 file,
                 index,
@@ -54,5 +62,11 @@ impl From<FormatError> for CliError {
 impl From<io::Error> for CliError {
     fn from(e: io::Error) -> Self {
         CliError::Output(e)
+    }
+}
+
+impl From<kerf_kinematics::KinematicsError> for CliError {
+    fn from(e: kerf_kinematics::KinematicsError) -> Self {
+        CliError::Kinematics(e, None)
     }
 }

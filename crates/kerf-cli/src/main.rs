@@ -9,6 +9,7 @@
 mod cli;
 mod discretize;
 mod error;
+mod post;
 mod validate;
 
 use std::process::ExitCode;
@@ -23,6 +24,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Validate(args) => validate::run(args),
         Command::Discretize(args) => discretize::run(args),
+        Command::Post(args) => post::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

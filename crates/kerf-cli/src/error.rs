@@ -14,7 +14,10 @@ pub(crate) enum CliError {
     Output(io::Error),
     /// The machine file is invalid, or a path cannot be solved on the machine. The optional
     /// path names the toolpath file the path came from.
-    Kinematics(kerf_kinematics::KinematicsError, Option<std::path::PathBuf>),
+    Kinematics(
+        Box<kerf_kinematics::KinematicsError>,
+        Option<std::path::PathBuf>,
+    ),
     /// An input is unusable for this command (the message names file and place).
     Input(String),
     /// A command-line option is out of range.
@@ -67,6 +70,6 @@ impl From<io::Error> for CliError {
 
 impl From<kerf_kinematics::KinematicsError> for CliError {
     fn from(e: kerf_kinematics::KinematicsError) -> Self {
-        CliError::Kinematics(e, None)
+        CliError::Kinematics(Box::new(e), None)
     }
 }

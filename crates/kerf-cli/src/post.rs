@@ -35,12 +35,14 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
             ToolPathPoints::Poses(v) => {
                 poses.push(v.iter().copied().map(Pose::from_array).collect::<Vec<_>>())
             }
-            ToolPathPoints::Positions(_) => return Err(CliError::Input(format!(
+            ToolPathPoints::Positions(_) => {
+                return Err(CliError::Input(format!(
                 "{}: paths[{i}] ({:?}): points have no normals; run `kerf discretize --normals` \
                      on curves that name their surface",
                 args.toolpath.display(),
                 p.id
-            ))),
+            )))
+            }
         }
     }
     let inputs: Vec<PathInput<'_>> = tp
@@ -55,7 +57,7 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
         .collect();
     let opts = options(args);
     let solved = solve_paths(&machine, &inputs, &opts)
-        .map_err(|e| CliError::Kinematics(e, Some(args.toolpath.clone())))?;
+        .map_err(|e| CliError::Kinematics(Box::new(e), Some(args.toolpath.clone())))?;
     let file = AxesFile::new(&machine, &solved);
     let dest = args
         .output

@@ -29,7 +29,9 @@ fn main() {
         ("realdata/occt_propeller.json", false),
     ];
     println!("tolerance {tol} mm; points (time) per strategy; N* = theoretical minimum segments\n");
-    println!("| file | curve | N* | reference sphere | equal error | equal chord | equal parameter |");
+    println!(
+        "| file | curve | N* | reference sphere | equal error | equal chord | equal parameter |"
+    );
     println!("|---|---|---|---|---|---|---|");
     for (file, per_curve) in files {
         let doc = kerf_format::curves::load(root.join(file)).expect("fixture loads");
@@ -52,7 +54,11 @@ fn main() {
                 cells.push(format!("{} ({:.0} us)", d.points.len(), secs * 1e6));
             }
             if per_curve {
-                println!("| {file} | {} | {nstar:.1} | {} |", rec.id, cells.join(" | "));
+                println!(
+                    "| {file} | {} | {nstar:.1} | {} |",
+                    rec.id,
+                    cells.join(" | ")
+                );
             }
         }
         let cells: Vec<String> = totals

@@ -111,8 +111,37 @@ pub fn piece_ends(curve: &NurbsCurve, tolerance: f64) -> Result<Vec<f64>> {
 /// [`Options::max_points`], and [`DiscretizeError::ToleranceBelowPrecision`] when the tolerance
 /// cannot be resolved in double precision.
 pub fn discretize(curve: &NurbsCurve, opts: &Options) -> Result<Discretization> {
+    let (a, b) = curve.domain();
+    discretize_range(curve, a, b, opts)
+}
+
+/// Discretizes the part `[a, b]` of the curve's domain (`a < b`, both inside the domain), with
+/// the same guarantees as [`discretize`]: the first and last parameters are `a` and `b`, and the
+/// C0 breaks strictly inside are cutting points. Later stages use it to refine a stretch of an
+/// existing discretization.
+///
+/// # Errors
+/// As [`discretize`], and [`DiscretizeError::BadOption`] (named `range`) if `[a, b]` is empty or
+/// outside the domain.
+pub fn discretize_range(
+    curve: &NurbsCurve,
+    a: f64,
+    b: f64,
+    opts: &Options,
+) -> Result<Discretization> {
     opts.validate()?;
-    let ends = piece_ends(curve, opts.tolerance)?;
+    let (da, db) = curve.domain();
+    if !(a >= da && b <= db && a < b) {
+        return Err(DiscretizeError::BadOption {
+            name: "range",
+            value: a,
+            reason: "must satisfy domain start <= a < b <= domain end",
+        });
+    }
+    let mut ends = piece_ends(curve, opts.tolerance)?;
+    ends.retain(|&t| t > a && t < b);
+    ends.insert(0, a);
+    ends.push(b);
     let estimate = estimate_count(curve, opts.tolerance);
     let by_length = if opts.max_segment_length.is_finite() {
         curve.size() / opts.max_segment_length

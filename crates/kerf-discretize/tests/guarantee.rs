@@ -298,3 +298,31 @@ proptest! {
         check(&c, &d, tol);
     }
 }
+
+#[test]
+fn a_range_keeps_its_ends_inner_breaks_and_the_guarantee() {
+    let c = full_circle(30.0);
+    let d =
+        kerf_discretize::discretize_range(&c, 0.1, 0.6, &Options::with_tolerance(0.001)).unwrap();
+    assert_eq!(d.params[0], 0.1, "starts at a");
+    assert_eq!(*d.params.last().unwrap(), 0.6, "ends at b");
+    assert!(
+        d.params.contains(&0.25) && d.params.contains(&0.5),
+        "inner breaks kept"
+    );
+    assert!(!d.params.contains(&0.75), "outer break not added");
+    for i in 1..d.params.len() {
+        let e = brute_chord_error(
+            &c,
+            d.params[i - 1],
+            d.params[i],
+            &d.points[i - 1],
+            &d.points[i],
+        );
+        assert!(e <= 0.001, "segment {i}: {e}");
+    }
+    assert!(
+        kerf_discretize::discretize_range(&c, 0.6, 0.1, &Options::default()).is_err(),
+        "reversed range refused"
+    );
+}

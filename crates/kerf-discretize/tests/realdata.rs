@@ -8,7 +8,9 @@ use std::path::Path;
 use kerf_discretize::{discretize, minimum_count, Options};
 
 fn run(file: &str) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/realdata").join(file);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/realdata")
+        .join(file);
     let doc = kerf_format::curves::load(&path).unwrap_or_else(|e| panic!("{e}"));
     assert!(!doc.curves.is_empty(), "{file} has curves");
     for tol in [0.01, 0.001] {

@@ -2,6 +2,8 @@
 //!
 //! - `program`: one set-point of a planned 5-axis program (locate the piece, trapezoid
 //!   profile, tip on the line or arc, rotary axes, paper 000 eq 16 for the linear axes).
+//! - `program-arcs-machine-file`: the same on `fixtures/machines/ac_head.json` through
+//!   kerf-kinematics (`MachineModel`).
 //! - `recurrence`: one step of paper 001's recursive spline in 5 coordinates (three-term form
 //!   and Reinsch form), and of forward differences of a cubic, for comparison.
 //!
@@ -55,6 +57,35 @@ fn program(c: &mut Criterion) {
             })
         });
     }
+    // The same program on the ac-head machine file through kerf-kinematics.
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/machines/ac_head.json"
+    );
+    let mm = kerf_interp::MachineModel::new(kerf_kinematics::Machine::read(file).expect("machine"))
+        .expect("limits");
+    let blocks = fit_blocks(
+        &mm,
+        &st,
+        None,
+        0,
+        &FitOptions {
+            tolerance: 0.005,
+            ..FitOptions::default()
+        },
+    )
+    .expect("fit");
+    let motion = plan(&mm, &blocks, &PlanOptions::new(10000.0, 0.001)).expect("plan");
+    group.throughput(Throughput::Elements(motion.cycles() as u64 + 1));
+    group.bench_function("program-arcs-machine-file", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for q in motion.iter(&mm) {
+                acc += q[0] + q[4];
+            }
+            black_box(acc)
+        })
+    });
     let q0 = [1200.0, -800.0, 300.0, 10.0, 45.0];
     let q1 = [3900.0, 1500.0, -200.0, 35.0, 120.0];
     let d0 = [2500.0, 2600.0, -300.0, 20.0, 60.0];

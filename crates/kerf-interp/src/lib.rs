@@ -13,6 +13,10 @@
 //!    linear axes from the machine model (eq 16 for paper 000's head, [`AxisModel`] in general).
 //! 4. [`output`]: the set-points CSV of `formats.md`, generic and Sinumerik-style G-code.
 //!
+//! The machine is any [`AxisModel`]: [`MachineModel`] for kerf's `kerf.machine/1` machines
+//! (all four types, from `kerf-kinematics`; [`stations_from_solved`] takes its solved paths),
+//! [`AcHead`] as a small self-contained reference (paper 000's head).
+//!
 //! [`Block::constant_feed`] is paper 000's interpolator of one block at constant feed, and
 //! [`recursive`] is paper 001's recursive spline interpolator. The maths, the tolerance budget
 //! and the measured figures are in `docs/interpolation.md`.
@@ -44,6 +48,7 @@ pub mod chord;
 pub mod error;
 pub mod fit;
 pub mod geometry;
+pub mod machine;
 pub mod model;
 pub mod output;
 pub mod plan;
@@ -53,6 +58,7 @@ pub use block::{increments, solve_stations, Block, Geometry, Station};
 pub use error::{InterpError, Result};
 pub use fit::{fit_blocks, BlockCounts, CurveFn, FitOptions};
 pub use geometry::Arc;
+pub use machine::{stations_from_axes, stations_from_solved, MachineModel};
 pub use model::{AcHead, AxisLimits, AxisModel};
 pub use output::{csv_string, gcode, write_csv, write_gcode, Dialect, GcodeOptions};
 pub use plan::{link_paths, plan, Cycles, Motion, PlanOptions};
@@ -95,4 +101,20 @@ pub fn fit_program<M: AxisModel + ?Sized>(
         all.push(fit_blocks(model, &p.stations, p.curve, n, opts)?);
     }
     Ok(link_paths(all))
+}
+
+/// What `kerf interpolate` does once its inputs are read: [`fit_program`] then [`plan()`].
+/// The returned [`Motion`] has the blocks ([`Motion::blocks`], [`Motion::counts`]), the program's
+/// cycle count ([`Motion::cycles`]) and the set-points ([`Motion::setpoints`], [`Motion::iter`]).
+///
+/// # Errors
+/// As [`fit_blocks`] and [`plan()`].
+pub fn interpolate<M: AxisModel + ?Sized>(
+    model: &M,
+    paths: &[PathInput<'_>],
+    fit: &FitOptions,
+    plan_options: &PlanOptions,
+) -> Result<Motion> {
+    let blocks = fit_program(model, paths, fit)?;
+    plan(model, &blocks, plan_options)
 }

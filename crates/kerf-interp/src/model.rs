@@ -7,9 +7,10 @@
 //! block ends come from the inverse kinematics ([`AxisModel::inverse`]), which chooses the
 //! solution and the turn of a continuous C for continuity.
 //!
-//! kerf's machines (`kerf.machine/1`, four types) live in `kerf-kinematics`; this crate has its
-//! own small trait so that it does not depend on that crate's internals, plus [`AcHead`], the
-//! head of paper 000, as a reference implementation for tests, examples and benches.
+//! kerf's machines (`kerf.machine/1`, four types) live in `kerf-kinematics`;
+//! [`crate::MachineModel`] adapts them. The trait keeps the interpolator's needs in one small
+//! place (and lets a controller plug in its own kinematics); [`AcHead`], the head of paper 000,
+//! is a self-contained reference implementation for tests, examples and benches.
 
 use nalgebra::{Point3, Vector3};
 

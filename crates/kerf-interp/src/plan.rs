@@ -205,6 +205,11 @@ impl Motion {
         self.peak_speed.get(b).copied().unwrap_or(0.0) * 60.0
     }
 
+    /// [`Motion::block_feed`] of every block, for the `F` words of [`crate::gcode`].
+    pub fn block_feeds(&self) -> Vec<f64> {
+        (0..self.blocks.len()).map(|b| self.block_feed(b)).collect()
+    }
+
     /// The block index and path parameter at time `t` (seconds from the start).
     pub fn locate(&self, t: f64) -> (usize, f64) {
         let p = self.starts.partition_point(|&s| s <= t).saturating_sub(1);

@@ -151,7 +151,7 @@ fn sinumerik_gcode_parses_back_to_tips_orientations_and_arcs() {
     let curve = |t: f64| c.point(t);
     let blocks = fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::default()).expect("fit");
     let motion = plan(&m, &blocks, &PlanOptions::new(5000.0, 0.001)).expect("plan");
-    let feeds: Vec<f64> = (0..blocks.len()).map(|b| motion.block_feed(b)).collect();
+    let feeds = motion.block_feeds();
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("ring.mpf");
     let opts = GcodeOptions::new(Dialect::Sinumerik, 5000.0);

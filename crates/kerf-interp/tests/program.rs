@@ -167,6 +167,18 @@ fn two_paths_are_linked_by_a_rapid_move() {
         },
     ];
     let blocks = fit_program(&m, &paths, &FitOptions::default()).expect("fit");
+    let one_call = kerf_interp::interpolate(
+        &m,
+        &paths,
+        &FitOptions::default(),
+        &PlanOptions::new(8000.0, 0.002),
+    )
+    .expect("interpolate");
+    assert_eq!(
+        one_call.blocks(),
+        blocks.as_slice(),
+        "interpolate = fit_program + plan"
+    );
     assert_eq!(
         blocks.iter().filter(|b| b.rapid).count(),
         1,

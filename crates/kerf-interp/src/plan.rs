@@ -210,7 +210,9 @@ impl Motion {
         (0..self.blocks.len()).map(|b| self.block_feed(b)).collect()
     }
 
-    /// The block index and path parameter at time `t` (seconds from the start).
+    /// The block index and path parameter at time `t` (seconds from the start) of the planned
+    /// motion (with [`PlanOptions::block_ends_on_cycles`], before each block is slowed to whole
+    /// cycles).
     pub fn locate(&self, t: f64) -> (usize, f64) {
         let p = self.starts.partition_point(|&s| s <= t).saturating_sub(1);
         self.locate_from(p, t).1

@@ -1,0 +1,254 @@
+//! Surface normals for cutting points: `(x, y, z)` becomes `(x, y, z, i, j, k)`.
+//!
+//! The laser beam stands normal to the part, so every cutting point gets the unit normal of the
+//! surface that carries its curve: a NURBS surface ([`NurbsNormals`], `Su x Sv` at the closest
+//! point, warm-started from the previous point) or a triangle mesh ([`MeshNormals`], parry3d's
+//! `TriMesh` with crease-aware smooth normals). [`orient`] also
+//!
+//! - rejects a curve that does not lie on its surface (`on_surface_tolerance`),
+//! - inserts cutting points (on the curve) until neighbouring normals differ by at most
+//!   `max_normal_step`, re-certifying every new segment so the chord-error guarantee holds,
+//! - refuses a normal that reverses between neighbouring points (inconsistent orientation),
+//!   and reports normal jumps that insertion cannot remove (a curve crossing a sharp mesh edge).
+//!
+//! `docs/normals.md` has the details.
+
+pub mod error;
+pub mod mesh;
+pub mod surface;
+
+pub use error::{NormalsError, Result};
+pub use mesh::{MeshNormals, DEFAULT_CREASE_ANGLE_DEG};
+pub use surface::{Hint, NormalSource, NurbsNormals, Projection};
+
+use kerf_discretize::bound::chord_error;
+use kerf_discretize::{discretize_range, Discretization, Options};
+use kerf_nurbs::NurbsCurve;
+use nalgebra::{Point3, Vector3};
+
+/// Options of the normals stage. Lengths in mm, angles in radians.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalOptions {
+    /// A cutting point farther than this from its surface is an error. Default 0.01 mm.
+    pub on_surface_tolerance: f64,
+    /// The largest angle between the normals of neighbouring cutting points; points are
+    /// inserted until it holds. Default 1 degree.
+    pub max_normal_step: f64,
+    /// Refuse a curve that needs more inserted points than this. Default 1,000,000.
+    pub max_inserted: usize,
+}
+
+impl Default for NormalOptions {
+    fn default() -> Self {
+        Self {
+            on_surface_tolerance: 0.01,
+            max_normal_step: 1f64.to_radians(),
+            max_inserted: 1_000_000,
+        }
+    }
+}
+
+impl NormalOptions {
+    /// Checks every option.
+    ///
+    /// # Errors
+    /// [`NormalsError::BadOption`] naming the first bad option.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.on_surface_tolerance.is_finite() && self.on_surface_tolerance > 0.0) {
+            return Err(NormalsError::BadOption {
+                name: "on_surface_tolerance",
+                value: self.on_surface_tolerance,
+                reason: "must be finite and > 0",
+            });
+        }
+        if !(self.max_normal_step > 0.0 && self.max_normal_step < std::f64::consts::PI) {
+            return Err(NormalsError::BadOption {
+                name: "max_normal_step",
+                value: self.max_normal_step,
+                reason: "must lie strictly between 0 and 180 degrees",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Cutting points with their normals.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Oriented {
+    /// Curve parameters, strictly increasing (the discretization's plus inserted ones).
+    pub params: Vec<f64>,
+    /// The points `C(t)`.
+    pub points: Vec<Point3<f64>>,
+    /// The unit normals.
+    pub normals: Vec<Vector3<f64>>,
+    /// Certified chord-error bound over all segments (including the new ones).
+    pub max_chord_error: f64,
+    /// How many points were inserted for the normal step (and the re-certification).
+    pub inserted: usize,
+    /// The largest distance from a cutting point to the surface.
+    pub max_surface_distance: f64,
+    /// The largest angle between neighbouring normals, radians.
+    pub max_normal_angle: f64,
+    /// Parameters where the normal jumps by more than the step however close the points are
+    /// (the curve crosses a sharp edge of the surface): the head must turn in place there.
+    pub jumps: Vec<f64>,
+}
+
+impl Oriented {
+    /// `[x, y, z, i, j, k]` per point.
+    pub fn poses(&self) -> Vec<[f64; 6]> {
+        self.points
+            .iter()
+            .zip(&self.normals)
+            .map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
+            .collect()
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    t: f64,
+    p: Point3<f64>,
+    n: Vector3<f64>,
+    hint: Hint,
+}
+
+struct Ctx<'a> {
+    curve: &'a NurbsCurve,
+    surface: &'a dyn NormalSource,
+    dopts: &'a Options,
+    nopts: &'a NormalOptions,
+    min_dt: f64,
+    out: Oriented,
+}
+
+impl Ctx<'_> {
+    fn sample(&mut self, t: f64, p: Point3<f64>, hint: Hint) -> Result<Sample> {
+        let mut pr = self.surface.project(&p, hint);
+        if pr.distance > self.nopts.on_surface_tolerance && hint != Hint::None {
+            // A warm start can settle in a local minimum: decide off-surface only globally.
+            pr = self.surface.project(&p, Hint::None);
+        }
+        if pr.distance > self.nopts.on_surface_tolerance || pr.distance.is_nan() {
+            return Err(NormalsError::OffSurface {
+                t,
+                distance: pr.distance,
+                tolerance: self.nopts.on_surface_tolerance,
+            });
+        }
+        self.out.max_surface_distance = self.out.max_surface_distance.max(pr.distance);
+        let n = pr.normal.ok_or(NormalsError::NoNormal { t })?;
+        Ok(Sample {
+            t,
+            p,
+            n,
+            hint: pr.hint,
+        })
+    }
+
+    fn push(&mut self, s: &Sample) {
+        self.out.params.push(s.t);
+        self.out.points.push(s.p);
+        self.out.normals.push(s.n);
+    }
+
+    /// Emits the segment `(a, b]`: splits it until the normal step holds; `certified` says
+    /// whether `[a, b]` already carries the chord-error guarantee.
+    fn segment(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
+        let angle = a.n.angle(&b.n);
+        if angle > self.nopts.max_normal_step {
+            if b.t - a.t <= self.min_dt {
+                if a.n.dot(&b.n) < 0.0 {
+                    return Err(NormalsError::Reversed {
+                        t: a.t,
+                        angle: angle.to_degrees(),
+                    });
+                }
+                self.out.jumps.push(a.t);
+                return self.finish(a, b, certified);
+            }
+            if self.out.inserted >= self.nopts.max_inserted {
+                return Err(NormalsError::TooManyInserted {
+                    limit: self.nopts.max_inserted,
+                });
+            }
+            let tm = 0.5 * (a.t + b.t);
+            let m = self.sample(tm, self.curve.point(tm), a.hint)?;
+            self.out.inserted += 1;
+            self.segment(a, m, false)?;
+            return self.segment(m, b, false);
+        }
+        self.finish(a, b, certified)
+    }
+
+    /// Certifies `[a, b]` if needed (re-discretizing it when a split made it worse), then
+    /// pushes `b`.
+    fn finish(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
+        if !certified {
+            let tol = self.dopts.tolerance;
+            let bound = chord_error(self.curve, a.t, b.t, &a.p, &b.p, tol, 0.0);
+            if bound.upper > tol {
+                let d = discretize_range(self.curve, a.t, b.t, self.dopts)?;
+                let mut prev = a;
+                let last = d.params.len() - 1;
+                for i in 1..last {
+                    let s = self.sample(d.params[i], d.points[i], prev.hint)?;
+                    self.out.inserted += 1;
+                    self.segment(prev, s, true)?;
+                    prev = s;
+                }
+                self.out.max_chord_error = self.out.max_chord_error.max(d.max_chord_error);
+                return self.segment(prev, b, true);
+            }
+            self.out.max_chord_error = self.out.max_chord_error.max(bound.upper);
+        }
+        let angle = a.n.angle(&b.n);
+        self.out.max_normal_angle = self.out.max_normal_angle.max(angle);
+        self.push(&b);
+        Ok(())
+    }
+}
+
+/// Gives every cutting point of `disc` (a discretization of `curve` with options `dopts`) the
+/// unit normal of `surface`, inserting points where neighbouring normals differ by more than
+/// `nopts.max_normal_step`.
+///
+/// # Errors
+/// [`NormalsError::OffSurface`] naming the parameter and distance, [`NormalsError::NoNormal`],
+/// [`NormalsError::Reversed`], [`NormalsError::TooManyInserted`], [`NormalsError::BadOption`],
+/// and discretizer errors from re-certification.
+pub fn orient(
+    curve: &NurbsCurve,
+    disc: &Discretization,
+    surface: &dyn NormalSource,
+    dopts: &Options,
+    nopts: &NormalOptions,
+) -> Result<Oriented> {
+    nopts.validate()?;
+    let (da, db) = curve.domain();
+    let mut ctx = Ctx {
+        curve,
+        surface,
+        dopts,
+        nopts,
+        min_dt: 1e-9 * (db - da),
+        out: Oriented {
+            max_chord_error: disc.max_chord_error,
+            params: Vec::with_capacity(disc.params.len()),
+            points: Vec::with_capacity(disc.params.len()),
+            normals: Vec::with_capacity(disc.params.len()),
+            ..Default::default()
+        },
+    };
+    let Some((&t0, &p0)) = disc.params.first().zip(disc.points.first()) else {
+        return Ok(ctx.out);
+    };
+    let mut prev = ctx.sample(t0, p0, Hint::None)?;
+    ctx.push(&prev);
+    for i in 1..disc.params.len() {
+        let s = ctx.sample(disc.params[i], disc.points[i], prev.hint)?;
+        ctx.segment(prev, s, true)?;
+        prev = s;
+    }
+    Ok(ctx.out)
+}

@@ -40,7 +40,7 @@ pub(crate) enum Command {
     /// Prints a summary to standard error: curves, points, worst certified chord error, the
     /// theoretical minimum N* and the time.
     #[command(
-        after_help = "Examples:\n  kerf discretize fixtures/mixed.json --tolerance 0.01 -o mixed.toolpath.json\n  kerf discretize part.json -t 0.001 --max-segment-length 20 -o -\n  kerf discretize part.json -t 0.01 --strategy equal-parameter --json"
+        after_help = "Examples:\n  kerf discretize fixtures/mixed.json --tolerance 0.01 -o mixed.toolpath.json\n  kerf discretize fixtures/realdata/occt_propeller.json -t 0.01 --normals -o propeller.toolpath.json\n  kerf discretize part.json -t 0.001 --max-segment-length 20 -o -\n  kerf discretize part.json -t 0.01 --strategy equal-parameter --json"
     )]
     Discretize(DiscretizeArgs),
 
@@ -55,6 +55,32 @@ pub(crate) enum Command {
         after_help = "Examples:\n  kerf post part.toolpath.json --machine fixtures/machines/ac_head.json -o part.axes.json\n  kerf post part.toolpath.json -m fixtures/machines/table_table.json --max-rotary-step 2 --json"
     )]
     Post(PostArgs),
+
+    /// Verify a kerf.toolpath/1 file against its curves, independently, by brute force.
+    ///
+    /// Works on toolpaths from any tool and trusts nothing in them: measures the chord error
+    /// of every segment by dense sampling (every knot inside included) and golden-section
+    /// refinement, and checks the ids and their order, params (strictly increasing, from one
+    /// end of the domain to the other), every point on the curve at its param, every C0 corner
+    /// a cutting point, unit normals, each segment's error against the tolerance and the
+    /// file's max_chord_error against the measurement. Prints a table per path and every
+    /// violation (path, segment, params, measured error vs tolerance); exits with status 1 if
+    /// there is any.
+    #[command(
+        after_help = "Examples:\n  kerf check fixtures/mixed.json mixed.toolpath.json\n  kerf check part.json other-cam.toolpath.json --json > report.json\n  kerf discretize part.json -o - | kerf check part.json -"
+    )]
+    Check(crate::check::CheckArgs),
+
+    /// Draw a toolpath on its curves (and the machine axes) as one SVG picture.
+    ///
+    /// Top, front, side and isometric views of the curves, cutting points and tool axes, with
+    /// segments coloured by chord error / tolerance; a chart of every segment's chord error
+    /// against the tolerance; with --axes, the machine axes over the point index with the
+    /// machine's limits dashed. Opens in any browser.
+    #[command(
+        after_help = "Examples:\n  kerf plot fixtures/mixed.json mixed.toolpath.json -o mixed.svg\n  kerf plot part.json part.toolpath.json --axes part.axes.json --machine fixtures/machines/ac_head.json -o part.svg"
+    )]
+    Plot(crate::plot::PlotArgs),
 }
 
 /// Arguments of `kerf validate`.
@@ -106,6 +132,26 @@ pub(crate) struct DiscretizeArgs {
     /// How cutting points are placed (the classic methods carry the same guarantee).
     #[arg(long, value_enum, default_value_t = StrategyArg::ReferenceSphere)]
     pub(crate) strategy: StrategyArg,
+
+    /// Give every cutting point the unit normal of its curve's surface: points become
+    /// `[x, y, z, i, j, k]`. Every curve must name a surface.
+    #[arg(long)]
+    pub(crate) normals: bool,
+
+    /// With --normals: a cutting point farther than this from its surface is an error (mm,
+    /// default 0.01).
+    #[arg(long, value_name = "MM", requires = "normals")]
+    pub(crate) on_surface_tolerance: Option<f64>,
+
+    /// With --normals: the largest angle between neighbouring normals; points are inserted
+    /// until it holds (degrees, default 1).
+    #[arg(long, value_name = "DEG", requires = "normals")]
+    pub(crate) max_normal_step: Option<f64>,
+
+    /// With --normals, for meshes: faces meeting at more than this angle form a sharp edge
+    /// whose normals are not blended (degrees, default 30).
+    #[arg(long, value_name = "DEG", requires = "normals")]
+    pub(crate) crease_angle: Option<f64>,
 
     /// Print the summary as one JSON object instead of a sentence.
     #[arg(long)]

@@ -7,7 +7,9 @@ use std::time::Instant;
 
 use kerf_discretize::{discretize_all, minimum_count, Discretization, Options};
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
-use kerf_format::{curves, CurvesFile};
+use kerf_format::{curves, CurvesFile, SurfaceGeometry};
+use kerf_normals::{orient, MeshNormals, NormalOptions, NormalSource, NurbsNormals, Oriented};
+use rayon::prelude::*;
 use serde_json::json;
 
 use crate::cli::DiscretizeArgs;
@@ -66,10 +68,13 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
     let file = load_curves(path)?;
     let opts = options(args);
     let results = discretize_file(path, &file, &opts)?;
-    let out = ToolpathFile {
-        units: file.units,
-        tolerance: opts.tolerance,
-        paths: file
+    let oriented = if args.normals {
+        Some(normals_for_file(path, &file, &results, &opts, args)?)
+    } else {
+        None
+    };
+    let paths = match &oriented {
+        None => file
             .curves
             .iter()
             .zip(&results)
@@ -82,6 +87,22 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
                 max_chord_error: d.max_chord_error,
             })
             .collect(),
+        Some(o) => file
+            .curves
+            .iter()
+            .zip(o)
+            .map(|(rec, o)| ToolPath {
+                id: rec.id.clone(),
+                params: o.params.clone(),
+                points: ToolPathPoints::Poses(o.poses()),
+                max_chord_error: o.max_chord_error,
+            })
+            .collect(),
+    };
+    let out = ToolpathFile {
+        units: file.units,
+        tolerance: opts.tolerance,
+        paths,
     };
     let dest = args.output.clone().unwrap_or_else(|| default_output(path));
     if dest == Path::new("-") {
@@ -93,12 +114,20 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
         toolpath::write(&out, &dest)?;
     }
     let elapsed = start.elapsed().as_secs_f64();
-    let points: usize = results.iter().map(|d| d.points.len()).sum();
     let segments: usize = results.iter().map(Discretization::segments).sum();
-    let worst = results
+    let points: usize = out.paths.iter().map(|p| p.params.len()).sum();
+    let worst = out
+        .paths
         .iter()
-        .map(|d| d.max_chord_error)
+        .map(|p| p.max_chord_error)
         .fold(0.0, f64::max);
+    let (added, surface_dist, jumps) = oriented.as_ref().map_or((0, 0.0, 0), |o| {
+        (
+            o.iter().map(|o| o.inserted).sum::<usize>(),
+            o.iter().map(|o| o.max_surface_distance).fold(0.0, f64::max),
+            o.iter().map(|o| o.jumps.len()).sum::<usize>(),
+        )
+    });
     let nstar: f64 = file
         .curves
         .iter()
@@ -118,6 +147,10 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             "n_star": nstar,
             "segments_over_n_star": if nstar > 0.0 { segments as f64 / nstar } else { f64::NAN },
             "seconds": elapsed,
+            "normals": args.normals,
+            "normal_points_added": added,
+            "max_surface_distance": surface_dist,
+            "normal_jumps": jumps,
         });
         // The summary goes to standard output unless the toolpath itself does.
         if dest == Path::new("-") {
@@ -126,6 +159,12 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             println!("{summary}");
         }
     } else if !args.quiet {
+        if args.normals {
+            eprintln!(
+                "normals: {added} points added for the normal step, worst curve-to-surface \
+                 distance {surface_dist:.2e} mm, {jumps} normal jumps at sharp edges"
+            );
+        }
         eprintln!(
             "{}: {} curves, {points} points ({segments} segments, {breaks} C0 corners kept), \
              worst certified chord error {worst:.3e} mm <= {} mm, N* {nstar:.1} \
@@ -156,4 +195,94 @@ fn default_output(input: &Path) -> std::path::PathBuf {
         |s| s.to_string_lossy().into_owned(),
     );
     format!("{stem}.toolpath.json").into()
+}
+
+/// The normal source of every surface the curves use, built once per surface.
+fn normal_sources(
+    path: &Path,
+    file: &CurvesFile,
+    args: &DiscretizeArgs,
+) -> Result<Vec<Option<Box<dyn NormalSource>>>, CliError> {
+    let crease = args
+        .crease_angle
+        .unwrap_or(kerf_normals::DEFAULT_CREASE_ANGLE_DEG);
+    file.surfaces
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let used = file
+                .curves
+                .iter()
+                .any(|c| c.surface.as_deref() == Some(&s.id));
+            if !used {
+                return Ok(None);
+            }
+            let src: Box<dyn NormalSource> = match &s.geometry {
+                SurfaceGeometry::Nurbs(n) => Box::new(NurbsNormals::new(n.clone(), s.flip)),
+                SurfaceGeometry::Mesh {
+                    vertices,
+                    triangles,
+                } => Box::new(
+                    MeshNormals::new(
+                        vertices.clone(),
+                        triangles.clone(),
+                        crease.to_radians(),
+                        s.flip,
+                    )
+                    .map_err(|error| CliError::Normals {
+                        file: path.to_path_buf(),
+                        place: format!("surfaces[{i}] ({:?})", s.id),
+                        error,
+                    })?,
+                ),
+            };
+            Ok(Some(src))
+        })
+        .collect()
+}
+
+/// Normals for every curve (in parallel, results in input order).
+fn normals_for_file(
+    path: &Path,
+    file: &CurvesFile,
+    results: &[Discretization],
+    opts: &Options,
+    args: &DiscretizeArgs,
+) -> Result<Vec<Oriented>, CliError> {
+    let defaults = NormalOptions::default();
+    let nopts = NormalOptions {
+        on_surface_tolerance: args
+            .on_surface_tolerance
+            .unwrap_or(defaults.on_surface_tolerance),
+        max_normal_step: args
+            .max_normal_step
+            .map_or(defaults.max_normal_step, f64::to_radians),
+        ..defaults
+    };
+    let sources = normal_sources(path, file, args)?;
+    let place = |i: usize| format!("curves[{i}] ({:?})", file.curves[i].id);
+    file.curves
+        .par_iter()
+        .enumerate()
+        .map(|(i, rec)| {
+            let Some(sid) = &rec.surface else {
+                return Err(CliError::Input(format!(
+                    "{}: {}: --normals needs a surface, but the curve names none (add \"surface\": \"<id>\")",
+                    path.display(),
+                    place(i)
+                )));
+            };
+            let si = file
+                .surfaces
+                .iter()
+                .position(|s| &s.id == sid)
+                .expect("the reader resolved every surface id");
+            let src = sources[si].as_deref().expect("a source exists for every used surface");
+            orient(&rec.curve, &results[i], src, opts, &nopts).map_err(|error| CliError::Normals {
+                file: path.to_path_buf(),
+                place: place(i),
+                error,
+            })
+        })
+        .collect()
 }

@@ -22,6 +22,28 @@ pub(crate) enum CliError {
     Input(String),
     /// A command-line option is out of range.
     Options(kerf_discretize::DiscretizeError),
+    /// A curve's normals could not be found (off its surface, reversed orientation, ...), or
+    /// a surface cannot give normals.
+    Normals {
+        /// The input file.
+        file: std::path::PathBuf,
+        /// Where: `curves[3] ("id")` or `surfaces[1] ("id")`.
+        place: String,
+        /// What went wrong.
+        error: kerf_normals::NormalsError,
+    },
+    /// A toolpath could not be read by `kerf check` (not JSON, not kerf.toolpath/1, wrong
+    /// shape); the message names the file and the JSON path.
+    Check(kerf_check::CheckError),
+    /// `kerf check` found violations (listed in its report).
+    CheckFailed {
+        /// The toolpath file.
+        toolpath: std::path::PathBuf,
+        /// How many.
+        violations: usize,
+    },
+    /// `kerf plot` could not make its picture (the message names the file).
+    Plot(String),
     /// A curve could not be discretized.
     Discretize {
         /// The input file.
@@ -41,9 +63,23 @@ impl fmt::Display for CliError {
             CliError::Format(e) => write!(f, "{e}"),
             CliError::Output(e) => write!(f, "cannot write to standard output: {e}"),
             CliError::Options(e) => write!(f, "{e}"),
+            CliError::Normals { file, place, error } => {
+                write!(f, "{}: {place}: {error}", file.display())
+            }
             CliError::Kinematics(e, Some(file)) => write!(f, "{}: {e}", file.display()),
             CliError::Kinematics(e, None) => write!(f, "{e}"),
             CliError::Input(m) => write!(f, "{m}"),
+            CliError::Check(e) => write!(f, "{e}"),
+            CliError::CheckFailed {
+                toolpath,
+                violations,
+            } => write!(
+                f,
+                "{}: {violations} violation{} (listed above)",
+                toolpath.display(),
+                if *violations == 1 { "" } else { "s" }
+            ),
+            CliError::Plot(m) => write!(f, "{m}"),
             CliError::Discretize {
                 file,
                 index,
@@ -71,5 +107,11 @@ impl From<io::Error> for CliError {
 impl From<kerf_kinematics::KinematicsError> for CliError {
     fn from(e: kerf_kinematics::KinematicsError) -> Self {
         CliError::Kinematics(Box::new(e), None)
+    }
+}
+
+impl From<kerf_check::CheckError> for CliError {
+    fn from(e: kerf_check::CheckError) -> Self {
+        CliError::Check(e)
     }
 }

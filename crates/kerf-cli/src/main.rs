@@ -6,9 +6,11 @@
 //! error (reported by clap). To add a subcommand, add its arguments and a variant to
 //! [`cli::Command`], a module with a `run` function, and a line to the `match` below.
 
+mod check;
 mod cli;
 mod discretize;
 mod error;
+mod plot;
 mod post;
 mod validate;
 
@@ -25,6 +27,8 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate::run(args),
         Command::Discretize(args) => discretize::run(args),
         Command::Post(args) => post::run(args),
+        Command::Check(args) => check::run(args),
+        Command::Plot(args) => plot::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

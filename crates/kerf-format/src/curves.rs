@@ -110,6 +110,9 @@ pub struct RawNurbsSurface {
     /// Weights in the same layout as the control points; absent means all 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weights: Option<Vec<Vec<f64>>>,
+    /// Optional (kerf extension): reverse this surface's normal. Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub flip: bool,
 }
 
 /// A triangle mesh written inline (`"type": "mesh"`).
@@ -121,6 +124,9 @@ pub struct RawMesh {
     pub vertices: Vec<[f64; 3]>,
     /// Vertex indices (from 0) of each triangle, counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
+    /// Optional (kerf extension): reverse this surface's normal. Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub flip: bool,
 }
 
 /// A triangle mesh in an STL file (`"type": "stl"`).
@@ -130,6 +136,9 @@ pub struct RawStl {
     pub id: String,
     /// The STL file (binary or ASCII), relative to the directory of the JSON file.
     pub path: String,
+    /// Optional (kerf extension): reverse this surface's normal. Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub flip: bool,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -168,6 +177,8 @@ pub struct SurfaceRecord {
     pub geometry: SurfaceGeometry,
     /// Where the geometry came from (for reports).
     pub source: SurfaceSource,
+    /// Reverse the normal (the optional `flip` key).
+    pub flip: bool,
 }
 
 /// The geometry of a surface.
@@ -379,6 +390,7 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
                 )
                 .map_err(|error| FormatError::Surface { index, error })?;
                 SurfaceRecord {
+                    flip: n.flip,
                     id: n.id,
                     geometry: SurfaceGeometry::Nurbs(surface),
                     source: SurfaceSource::Inline,
@@ -391,6 +403,7 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
                 check_mesh(&vertices, &m.triangles)
                     .map_err(|defect| FormatError::Mesh { index, defect })?;
                 SurfaceRecord {
+                    flip: m.flip,
                     id: m.id,
                     geometry: SurfaceGeometry::Mesh {
                         vertices,
@@ -408,6 +421,7 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
                     problem,
                 })?;
                 SurfaceRecord {
+                    flip: s.flip,
                     id: s.id,
                     geometry: SurfaceGeometry::Mesh {
                         vertices: mesh.vertices,

@@ -203,6 +203,7 @@ fn non_finite_values_built_in_memory_are_refused_with_a_path() {
             [0.0, 1.0, 0.0],
         ],
         triangles: vec![[0, 1, 2]],
+        flip: false,
     }));
     let e = from_raw(r, Path::new(".")).expect_err("infinite vertex");
     assert_eq!(

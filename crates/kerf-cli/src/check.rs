@@ -1,0 +1,157 @@
+//! `kerf check`: an independent verification of a `kerf.toolpath/1` file (from kerf or any
+//! other tool) against the curves it claims to discretize. The checking itself is the
+//! `kerf-check` crate; this module reads the files and prints the report.
+
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use kerf_check::{check, CheckOptions, Report, Toolpath};
+
+use crate::error::CliError;
+
+/// Violations listed in the text report; `--json` lists all.
+const MAX_LISTED: usize = 50;
+
+/// Arguments of `kerf check`.
+#[derive(Debug, Args)]
+pub(crate) struct CheckArgs {
+    /// The kerf.curves/1 file the toolpath claims to discretize; `-` reads standard input.
+    #[arg(value_name = "CURVES.json")]
+    pub(crate) curves: PathBuf,
+
+    /// The kerf.toolpath/1 file to verify; `-` reads standard input.
+    #[arg(value_name = "TOOLPATH.json")]
+    pub(crate) toolpath: PathBuf,
+
+    /// Print the report as one JSON object on standard output (also on failure).
+    #[arg(long)]
+    pub(crate) json: bool,
+
+    /// Samples per knot span in each segment before the local maxima are refined (default
+    /// 32; at least 4 (degree + 1) are used).
+    #[arg(long, value_name = "N")]
+    pub(crate) samples: Option<usize>,
+}
+
+/// Runs `kerf check`: exit status 0 if every rule holds, 1 with the violations listed.
+pub(crate) fn run(args: &CheckArgs) -> Result<(), CliError> {
+    if args.curves == Path::new("-") && args.toolpath == Path::new("-") {
+        return Err(CliError::Check(kerf_check::CheckError::Shape {
+            path: "arguments".into(),
+            message: "only one of CURVES.json and TOOLPATH.json can be `-` (standard input)".into(),
+        }));
+    }
+    let curves = crate::discretize::load_curves(&args.curves)?;
+    let toolpath = if args.toolpath == Path::new("-") {
+        let mut bytes = Vec::new();
+        io::stdin()
+            .read_to_end(&mut bytes)
+            .map_err(|error| kerf_check::CheckError::Read {
+                path: "<stdin>".into(),
+                error,
+            })?;
+        Toolpath::from_slice(&bytes).map_err(|e| e.in_file("<stdin>"))?
+    } else {
+        Toolpath::load(&args.toolpath)?
+    };
+    let defaults = CheckOptions::default();
+    let opts = CheckOptions {
+        samples: args.samples.unwrap_or(defaults.samples),
+        ..defaults
+    };
+    let report = check(&curves.curves, &toolpath, &opts);
+    let stdout = io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        let mut json = report.to_json();
+        if let serde_json::Value::Object(map) = &mut json {
+            map.insert("curves".into(), args.curves.display().to_string().into());
+            map.insert(
+                "toolpath".into(),
+                args.toolpath.display().to_string().into(),
+            );
+        }
+        writeln!(out, "{json}")?;
+    } else {
+        print_text(&mut out, args, &report)?;
+    }
+    out.flush()?;
+    if report.passed() {
+        Ok(())
+    } else {
+        Err(CliError::CheckFailed {
+            toolpath: args.toolpath.clone(),
+            violations: report.violations.len(),
+        })
+    }
+}
+
+/// The human-readable report: a table of the paths, then the verdict or the violations.
+fn print_text(out: &mut impl Write, args: &CheckArgs, report: &Report) -> io::Result<()> {
+    writeln!(
+        out,
+        "{} against {}: tolerance {} mm, {} paths, {} segments measured",
+        args.toolpath.display(),
+        args.curves.display(),
+        report.tolerance,
+        report.paths.len(),
+        report.segments()
+    )?;
+    let w = report
+        .paths
+        .iter()
+        .map(|p| p.id.chars().count())
+        .max()
+        .unwrap_or(2)
+        .clamp(2, 32);
+    writeln!(
+        out,
+        "  {:<w$}  {:>7}  {:>8}  {:>15}  {:<44}  claimed max_chord_error",
+        "id", "points", "segments", "max chord error", "worst segment (t0 .. t1)"
+    )?;
+    for p in &report.paths {
+        let worst = p.worst.map_or_else(
+            || "-".to_owned(),
+            |s| format!("{} ({:.6} .. {:.6})", s.segment, s.t0, s.t1),
+        );
+        let claim = match (p.claimed, p.claim_holds) {
+            (Some(c), Some(true)) => format!("{c:.4e} mm >= measured: ok"),
+            (Some(c), Some(false)) => format!("{c:.4e} mm < measured: UNDERSTATED"),
+            (Some(c), None) => format!("{c:.4e} mm (not measured)"),
+            (None, _) => "missing".to_owned(),
+        };
+        let error = if p.measured {
+            format!("{:.4e} mm", p.max_chord_error)
+        } else {
+            "not measured".to_owned()
+        };
+        writeln!(
+            out,
+            "  {:<w$}  {:>7}  {:>8}  {:>15}  {:<44}  {claim}",
+            p.id, p.points, p.segments, error, worst
+        )?;
+    }
+    if report.passed() {
+        writeln!(
+            out,
+            "passed: every segment's chord error <= {} mm (largest measured {:.4e} mm), every \
+             point on its curve at its param, every C0 corner a cutting point, every claim holds",
+            report.tolerance,
+            report.max_chord_error()
+        )?;
+    } else {
+        writeln!(out, "FAILED: {} violations", report.violations.len())?;
+        for v in report.violations.iter().take(MAX_LISTED) {
+            writeln!(out, "  {v}")?;
+        }
+        if report.violations.len() > MAX_LISTED {
+            writeln!(
+                out,
+                "  ... and {} more (--json lists them all)",
+                report.violations.len() - MAX_LISTED
+            )?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,114 @@
+//! `kerf plot`: one SVG picture of a toolpath on its curves (four views, chord errors), and of
+//! the machine axes when given. The drawing is the `kerf-plot` crate.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use kerf_format::{curves, toolpath};
+use kerf_kinematics::{AxesFile, Machine};
+use kerf_plot::{render, write_svg, AxesChart, Scene, SceneOptions};
+
+use crate::error::CliError;
+
+/// Arguments of `kerf plot`.
+#[derive(Debug, Args)]
+pub(crate) struct PlotArgs {
+    /// The kerf.curves/1 file.
+    #[arg(value_name = "CURVES.json")]
+    pub(crate) curves: PathBuf,
+
+    /// The kerf.toolpath/1 file computed from it.
+    #[arg(value_name = "TOOLPATH.json")]
+    pub(crate) toolpath: PathBuf,
+
+    /// A kerf.axes/1 file of the toolpath (from `kerf post`): adds a chart of the machine axes.
+    #[arg(long, value_name = "AXES.json")]
+    pub(crate) axes: Option<PathBuf>,
+
+    /// The kerf.machine/1 file the axes were computed for: draws its axis limits.
+    #[arg(short, long, value_name = "MACHINE.json", requires = "axes")]
+    pub(crate) machine: Option<PathBuf>,
+
+    /// Output SVG file (`-` for standard output). Default: `<toolpath stem>.svg` in the current
+    /// directory.
+    #[arg(short, long, value_name = "PLOT.svg")]
+    pub(crate) output: Option<PathBuf>,
+
+    /// Print no summary.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
+}
+
+/// Runs `kerf plot`.
+pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
+    let curves_file = curves::load(&args.curves)?;
+    let tp = toolpath::load(&args.toolpath)?;
+    let mut scene = Scene::new(&curves_file, &tp, &SceneOptions::default()).map_err(|e| {
+        CliError::Plot(format!(
+            "{} on {}: {e}",
+            args.toolpath.display(),
+            args.curves.display()
+        ))
+    })?;
+    scene.title = format!("kerf plot \u{2014} {}", file_name(&args.toolpath));
+    scene.subtitle = format!(
+        "{} on {}: {}",
+        args.toolpath.display(),
+        args.curves.display(),
+        scene.subtitle
+    );
+    if let Some(axes_path) = &args.axes {
+        let text = std::fs::read_to_string(axes_path)
+            .map_err(|e| CliError::Plot(format!("{}: cannot read: {e}", axes_path.display())))?;
+        let axes = AxesFile::from_str(&text)
+            .map_err(|e| CliError::Plot(format!("{}: {e}", axes_path.display())))?;
+        let machine = args
+            .machine
+            .as_ref()
+            .map(Machine::read)
+            .transpose()
+            .map_err(|e| CliError::Plot(e.to_string()))?;
+        let chart = AxesChart::new(&axes, machine.as_ref())
+            .map_err(|e| CliError::Plot(format!("{}: {e}", axes_path.display())))?;
+        scene.subtitle.push_str(&format!(
+            "; axes {} ({})",
+            axes_path.display(),
+            axes.machine
+        ));
+        scene.axes = Some(chart);
+    }
+    let svg = render(&scene);
+    let dest = args.output.clone().unwrap_or_else(|| {
+        let stem = args
+            .toolpath
+            .file_stem()
+            .map_or_else(|| "toolpath".into(), |s| s.to_string_lossy().into_owned());
+        format!("{stem}.svg").into()
+    });
+    write_svg(&dest, &svg)
+        .map_err(|e| CliError::Plot(format!("{}: cannot write: {e}", dest.display())))?;
+    if !args.quiet && dest != Path::new("-") {
+        let points: usize = scene.paths.iter().map(|p| p.points.len()).sum();
+        eprintln!(
+            "{}: {} paths, {points} points{} -> {} ({} KiB)",
+            args.toolpath.display(),
+            scene.paths.len(),
+            if scene.axes.is_some() {
+                ", machine axes"
+            } else {
+                ""
+            },
+            dest.display(),
+            svg.len().div_ceil(1024)
+        );
+    }
+    Ok(())
+}
+
+/// The last component of `path`, for titles.
+fn file_name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    )
+}

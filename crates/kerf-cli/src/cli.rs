@@ -56,6 +56,25 @@ pub(crate) enum Command {
     )]
     Post(PostArgs),
 
+    /// Interpolate a program: per-cycle machine axis set-points (paper 000's time-division
+    /// lines and 3-point space arcs, with a look-ahead feed plan within every axis limit).
+    ///
+    /// Takes a kerf.axes/1 file, or a kerf.toolpath/1 file (then solved on the machine first).
+    /// Fits 3-point space arcs where they stay within the fit tolerance, plans the feed so that
+    /// no axis exceeds its velocity or acceleration limit in any cycle, and writes one CSV row
+    /// per cycle (`t,X,Y,Z,<tilt>,C`).
+    #[command(
+        after_help = "Examples:\n  kerf interpolate part.axes.json --machine fixtures/machines/ac_head.json --feed 6000 --cycle 0.001 --csv part.csv\n  kerf interpolate part.toolpath.json -m fixtures/machines/fork_head.json --feed 3000 --json"
+    )]
+    Interpolate(InterpolateArgs),
+
+    /// Write the G-code program of a path: generic `G1 X Y Z A C F` or Sinumerik TRAORI with
+    /// `CIP` arcs.
+    #[command(
+        after_help = "Examples:\n  kerf gcode part.axes.json -m fixtures/machines/ac_head.json --feed 6000 -o part.nc\n  kerf gcode part.toolpath.json -m fixtures/machines/ac_head.json --feed 6000 --dialect sinumerik -o part.mpf"
+    )]
+    Gcode(GcodeArgs),
+
     /// Verify a kerf.toolpath/1 file against its curves, independently, by brute force.
     ///
     /// Works on toolpaths from any tool and trusts nothing in them: measures the chord error
@@ -222,4 +241,95 @@ pub(crate) struct PostArgs {
     /// Print no summary.
     #[arg(short, long)]
     pub(crate) quiet: bool,
+}
+
+/// The inputs shared by `kerf interpolate` and `kerf gcode`.
+#[derive(Debug, Args)]
+pub(crate) struct MotionArgs {
+    /// A kerf.axes/1 file (from `kerf post`) or a kerf.toolpath/1 file.
+    #[arg(value_name = "AXES_OR_TOOLPATH.json")]
+    pub(crate) input: PathBuf,
+
+    /// The kerf.machine/1 file.
+    #[arg(short, long, value_name = "MACHINE.json")]
+    pub(crate) machine: PathBuf,
+
+    /// Programmed cutting feed, mm/min.
+    #[arg(short, long, value_name = "MM_PER_MIN")]
+    pub(crate) feed: f64,
+
+    /// Interpolation cycle, seconds.
+    #[arg(short, long, default_value_t = 0.001, value_name = "S")]
+    pub(crate) cycle: f64,
+
+    /// Arc-fit tolerance, mm (default: the toolpath's tolerance, else 0.001).
+    #[arg(long, value_name = "MM")]
+    pub(crate) fit_tolerance: Option<f64>,
+
+    /// Chord error allowed between two set-points on an arc, mm (caps the feed on small
+    /// radii; default 0.001).
+    #[arg(long, value_name = "MM")]
+    pub(crate) chord_tolerance: Option<f64>,
+}
+
+/// Arguments of `kerf interpolate`.
+#[derive(Debug, Args)]
+pub(crate) struct InterpolateArgs {
+    /// Inputs.
+    #[command(flatten)]
+    pub(crate) motion: MotionArgs,
+
+    /// Write the set-points CSV here (one row per cycle).
+    #[arg(long, value_name = "OUT.csv")]
+    pub(crate) csv: Option<PathBuf>,
+
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub(crate) json: bool,
+
+    /// Print no summary.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
+}
+
+/// Arguments of `kerf gcode`.
+#[derive(Debug, Args)]
+pub(crate) struct GcodeArgs {
+    /// Inputs.
+    #[command(flatten)]
+    pub(crate) motion: MotionArgs,
+
+    /// The program file to write.
+    #[arg(short, long, value_name = "OUT.nc")]
+    pub(crate) output: PathBuf,
+
+    /// The G-code dialect.
+    #[arg(long, value_enum, default_value_t = DialectArg::Generic)]
+    pub(crate) dialect: DialectArg,
+
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub(crate) json: bool,
+
+    /// Print no summary.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
+}
+
+/// `--dialect` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum DialectArg {
+    /// `G1 X Y Z A C F` with machine axis values.
+    Generic,
+    /// Sinumerik-style TRAORI: tool tip, orientation vector, CIP arcs.
+    Sinumerik,
+}
+
+impl From<DialectArg> for kerf_interp::Dialect {
+    fn from(d: DialectArg) -> Self {
+        match d {
+            DialectArg::Generic => Self::Generic,
+            DialectArg::Sinumerik => Self::Sinumerik,
+        }
+    }
 }

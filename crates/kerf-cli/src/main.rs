@@ -10,6 +10,7 @@ mod check;
 mod cli;
 mod discretize;
 mod error;
+mod motion;
 mod plot;
 mod post;
 mod validate;
@@ -27,6 +28,8 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate::run(args),
         Command::Discretize(args) => discretize::run(args),
         Command::Post(args) => post::run(args),
+        Command::Interpolate(args) => motion::run_interpolate(args),
+        Command::Gcode(args) => motion::run_gcode(args),
         Command::Check(args) => check::run(args),
         Command::Plot(args) => plot::run(args),
     };

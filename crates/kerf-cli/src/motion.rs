@@ -1,0 +1,188 @@
+//! `kerf interpolate` and `kerf gcode`: the interpolator on a `kerf.axes/1` or
+//! `kerf.toolpath/1` file.
+
+use std::path::{Path, PathBuf};
+
+use kerf_format::toolpath;
+use kerf_interp::{
+    stations_from_axes, stations_from_solved, write_csv, write_gcode, AxisModel, Dialect,
+    FitOptions, GcodeOptions, MachineModel, Motion, PathInput, PlanOptions,
+};
+use kerf_kinematics::{solve_path, AxesFile, Machine, PathOptions, Pose};
+use nalgebra::Vector3;
+use serde_json::json;
+
+use crate::cli::{GcodeArgs, InterpolateArgs, MotionArgs};
+use crate::error::CliError;
+
+/// A program ready to be written: the machine model, the path ids and the planned motion.
+pub(crate) struct Program {
+    /// The machine.
+    pub model: MachineModel,
+    /// The source curve of each path.
+    pub ids: Vec<String>,
+    /// The planned motion.
+    pub motion: Motion,
+    /// The tolerance the blocks were fitted with, mm.
+    pub fit_tolerance: f64,
+}
+
+fn interp_err(file: &Path) -> impl Fn(kerf_interp::InterpError) -> CliError + '_ {
+    move |e| CliError::Input(format!("{}: {e}", file.display()))
+}
+
+/// Reads the input (axes or toolpath), solves it on the machine if needed, fits blocks and
+/// plans the motion.
+pub(crate) fn program(args: &MotionArgs) -> Result<Program, CliError> {
+    let machine = Machine::read(&args.machine)?;
+    let model = MachineModel::new(machine.clone()).map_err(interp_err(&args.machine))?;
+    let input = &args.input;
+    let text = std::fs::read_to_string(input)
+        .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", input.display())))?;
+    let format = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_owned))
+        .unwrap_or_default();
+    let (ids, paths, file_tol) = if format == kerf_kinematics::AXES_FORMAT {
+        let axes = AxesFile::from_str(&text)
+            .map_err(|e| CliError::Kinematics(Box::new(e), Some(input.clone())))?;
+        let mut paths = Vec::new();
+        for p in &axes.paths {
+            paths.push(PathInput {
+                id: p.id.clone(),
+                stations: stations_from_axes(&p.positions, &p.poses).map_err(interp_err(input))?,
+                curve: None,
+            });
+        }
+        (
+            axes.paths.iter().map(|p| p.id.clone()).collect(),
+            paths,
+            None,
+        )
+    } else {
+        let tp = toolpath::from_str(&text).map_err(|e| e.in_file(input))?;
+        let mut paths = Vec::new();
+        for p in &tp.paths {
+            let poses: Vec<Pose> = (0..p.points.len())
+                .map(|n| {
+                    let q = p.points.position(n);
+                    let a = p.points.normal(n).unwrap_or_else(Vector3::z);
+                    Pose::new(q.x, q.y, q.z, a.x, a.y, a.z)
+                })
+                .collect();
+            let solved = solve_path(
+                &machine,
+                &kerf_kinematics::PathInput {
+                    id: &p.id,
+                    poses: &poses,
+                    curve: None,
+                },
+                &PathOptions::default(),
+            )
+            .map_err(|e| CliError::Kinematics(Box::new(e), Some(input.clone())))?;
+            paths.push(PathInput {
+                id: p.id.clone(),
+                stations: stations_from_solved(&solved, Some(&p.params))
+                    .map_err(interp_err(input))?,
+                curve: None,
+            });
+        }
+        (
+            tp.paths.iter().map(|p| p.id.clone()).collect(),
+            paths,
+            Some(tp.tolerance),
+        )
+    };
+    let fit_tolerance = args.fit_tolerance.or(file_tol).unwrap_or(0.001);
+    let mut plan = PlanOptions::new(args.feed, args.cycle);
+    if let Some(c) = args.chord_tolerance {
+        plan.chord_tolerance = c;
+    }
+    let motion = kerf_interp::interpolate(
+        &model,
+        &paths,
+        &FitOptions::with_tolerance(fit_tolerance),
+        &plan,
+    )
+    .map_err(interp_err(input))?;
+    Ok(Program {
+        model,
+        ids,
+        motion,
+        fit_tolerance,
+    })
+}
+
+fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, quiet: bool) {
+    let c = p.motion.counts();
+    if json {
+        println!(
+            "{}",
+            json!({
+                "input": args.input.display().to_string(),
+                "machine": p.model.name(),
+                "lines": c.lines,
+                "arcs": c.arcs,
+                "turns": c.turns,
+                "cycles": p.motion.cycles(),
+                "cycle": args.cycle,
+                "duration_s": p.motion.duration(),
+                "output": out.map(|o| o.display().to_string()),
+            })
+        );
+    } else if !quiet {
+        eprintln!(
+            "{}: {} lines, {} arcs, {} turns; {} cycles of {} s = {:.3} s of motion{}",
+            args.input.display(),
+            c.lines,
+            c.arcs,
+            c.turns,
+            p.motion.cycles(),
+            args.cycle,
+            p.motion.duration(),
+            out.map_or(String::new(), |o| format!(" -> {}", o.display()))
+        );
+    }
+}
+
+/// Runs `kerf interpolate`.
+pub(crate) fn run_interpolate(args: &InterpolateArgs) -> Result<(), CliError> {
+    let p = program(&args.motion)?;
+    if let Some(csv) = &args.csv {
+        let rows = p.motion.setpoints(&p.model);
+        write_csv(csv, p.model.axis_names(), args.motion.cycle, &rows).map_err(interp_err(csv))?;
+    }
+    summary(&args.motion, &p, args.csv.as_ref(), args.json, args.quiet);
+    Ok(())
+}
+
+/// Writes the G-code of a program.
+pub(crate) fn write_program(
+    p: &Program,
+    dest: &Path,
+    dialect: Dialect,
+    feed: f64,
+) -> Result<(), CliError> {
+    let opts = GcodeOptions {
+        fit_tolerance: p.fit_tolerance,
+        ..GcodeOptions::new(dialect, feed)
+    };
+    let feeds = p.motion.block_feeds();
+    write_gcode(
+        dest,
+        &p.model,
+        p.motion.blocks(),
+        &p.ids,
+        Some(&feeds),
+        &opts,
+    )
+    .map_err(interp_err(dest))
+}
+
+/// Runs `kerf gcode`.
+pub(crate) fn run_gcode(args: &GcodeArgs) -> Result<(), CliError> {
+    let p = program(&args.motion)?;
+    write_program(&p, &args.output, args.dialect.into(), args.motion.feed)?;
+    summary(&args.motion, &p, Some(&args.output), args.json, args.quiet);
+    Ok(())
+}

@@ -2,16 +2,21 @@
 //! other tool) against the curves it claims to discretize. The checking itself is the
 //! `kerf-check` crate; this module reads the files and prints the report.
 
+use std::collections::HashMap;
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use kerf_check::{check, CheckOptions, Report, Toolpath};
+use kerf_check::{check, CheckOptions, Report, Toolpath, Violation};
 
 use crate::error::CliError;
 
 /// Violations listed in the text report; `--json` lists all.
 const MAX_LISTED: usize = 50;
+
+/// Violations of one kind on one path listed before the rest are summed up (reversed params
+/// break every one of them).
+const MAX_PER_KIND: usize = 3;
 
 /// Arguments of `kerf check`.
 #[derive(Debug, Args)]
@@ -105,16 +110,29 @@ fn print_text(out: &mut impl Write, args: &CheckArgs, report: &Report) -> io::Re
         .max()
         .unwrap_or(2)
         .clamp(2, 32);
+    let worst: Vec<String> = report
+        .paths
+        .iter()
+        .map(|p| {
+            p.worst.map_or_else(
+                || "-".to_owned(),
+                |s| format!("{} ({:.6} .. {:.6})", s.segment, s.t0, s.t1),
+            )
+        })
+        .collect();
+    let heading = "worst segment (t0 .. t1)";
+    let ww = worst
+        .iter()
+        .map(String::len)
+        .chain([heading.len()])
+        .max()
+        .unwrap_or(0);
     writeln!(
         out,
-        "  {:<w$}  {:>7}  {:>8}  {:>15}  {:<44}  claimed max_chord_error",
-        "id", "points", "segments", "max chord error", "worst segment (t0 .. t1)"
+        "  {:<w$}  {:>7}  {:>8}  {:>15}  {heading:<ww$}  claimed max_chord_error",
+        "id", "points", "segments", "max chord error"
     )?;
-    for p in &report.paths {
-        let worst = p.worst.map_or_else(
-            || "-".to_owned(),
-            |s| format!("{} ({:.6} .. {:.6})", s.segment, s.t0, s.t1),
-        );
+    for (p, worst) in report.paths.iter().zip(&worst) {
         let claim = match (p.claimed, p.claim_holds) {
             (Some(c), Some(true)) => format!("{c:.4e} mm >= measured: ok"),
             (Some(c), Some(false)) => format!("{c:.4e} mm < measured: UNDERSTATED"),
@@ -128,7 +146,7 @@ fn print_text(out: &mut impl Write, args: &CheckArgs, report: &Report) -> io::Re
         };
         writeln!(
             out,
-            "  {:<w$}  {:>7}  {:>8}  {:>15}  {:<44}  {claim}",
+            "  {:<w$}  {:>7}  {:>8}  {:>15}  {:<ww$}  {claim}",
             p.id, p.points, p.segments, error, worst
         )?;
     }
@@ -140,16 +158,34 @@ fn print_text(out: &mut impl Write, args: &CheckArgs, report: &Report) -> io::Re
             report.tolerance,
             report.max_chord_error()
         )?;
-    } else {
-        writeln!(out, "FAILED: {} violations", report.violations.len())?;
-        for v in report.violations.iter().take(MAX_LISTED) {
-            writeln!(out, "  {v}")?;
+        return Ok(());
+    }
+    writeln!(out, "FAILED: {} violations", report.violations.len())?;
+    let key = |v: &Violation| (v.path, std::mem::discriminant(&v.defect));
+    let mut totals = HashMap::new();
+    for v in &report.violations {
+        *totals.entry(key(v)).or_insert(0usize) += 1;
+    }
+    let mut seen = HashMap::new();
+    let mut listed = 0;
+    for v in &report.violations {
+        let n = seen.entry(key(v)).or_insert(0usize);
+        *n += 1;
+        if *n > MAX_PER_KIND {
+            continue;
         }
-        if report.violations.len() > MAX_LISTED {
+        if listed == MAX_LISTED {
+            writeln!(out, "  ... (more; --json lists every violation)")?;
+            break;
+        }
+        writeln!(out, "  {v}")?;
+        listed += 1;
+        let total = totals[&key(v)];
+        if *n == MAX_PER_KIND && total > MAX_PER_KIND {
             writeln!(
                 out,
-                "  ... and {} more (--json lists them all)",
-                report.violations.len() - MAX_LISTED
+                "  ... and {} more like this one (--json lists them all)",
+                total - MAX_PER_KIND
             )?;
         }
     }

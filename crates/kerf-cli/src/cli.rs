@@ -56,6 +56,17 @@ pub(crate) enum Command {
     )]
     Post(PostArgs),
 
+    /// The whole pipeline: discretize, normals, machine axes, interpolation and G-code, with a
+    /// report and a picture, in one output directory.
+    ///
+    /// Writes toolpath.json, axes.json, program.nc, setpoints.csv, report.json and plot.svg into
+    /// --out, all at once after every stage has succeeded (a failed run leaves the directory as
+    /// it was). Curves without a surface are cut with a vertical beam.
+    #[command(
+        after_help = "Examples:\n  kerf run fixtures/dome.json --machine fixtures/machines/ac_head.json --tolerance 0.01 --out out\n  kerf run part.json -m machine.json -t 0.005 --feed 4000 --dialect sinumerik --out part-out"
+    )]
+    Run(RunArgs),
+
     /// Interpolate a program: per-cycle machine axis set-points (paper 000's time-division
     /// lines and 3-point space arcs, with a look-ahead feed plan within every axis limit).
     ///
@@ -332,4 +343,60 @@ impl From<DialectArg> for kerf_interp::Dialect {
             DialectArg::Sinumerik => Self::Sinumerik,
         }
     }
+}
+
+/// Arguments of `kerf run`.
+#[derive(Debug, Args)]
+pub(crate) struct RunArgs {
+    /// The kerf.curves/1 file.
+    #[arg(value_name = "CURVES.json")]
+    pub(crate) curves: PathBuf,
+
+    /// The kerf.machine/1 file.
+    #[arg(short, long, value_name = "MACHINE.json")]
+    pub(crate) machine: PathBuf,
+
+    /// Chord tolerance in mm (every segment's chord error is at most this).
+    #[arg(short, long, default_value_t = 0.01, value_name = "MM")]
+    pub(crate) tolerance: f64,
+
+    /// Output directory (created if needed).
+    #[arg(short, long, default_value = "kerf-out", value_name = "DIR")]
+    pub(crate) out: PathBuf,
+
+    /// Programmed cutting feed, mm/min.
+    #[arg(short, long, default_value_t = 6000.0, value_name = "MM_PER_MIN")]
+    pub(crate) feed: f64,
+
+    /// Interpolation cycle, seconds.
+    #[arg(short, long, default_value_t = 0.001, value_name = "S")]
+    pub(crate) cycle: f64,
+
+    /// The G-code dialect.
+    #[arg(long, value_enum, default_value_t = DialectArg::Generic)]
+    pub(crate) dialect: DialectArg,
+
+    /// Longest chord allowed, in mm.
+    #[arg(long, value_name = "MM")]
+    pub(crate) max_segment_length: Option<f64>,
+
+    /// Largest angle between neighbouring normals, degrees (default 1).
+    #[arg(long, value_name = "DEG")]
+    pub(crate) max_normal_step: Option<f64>,
+
+    /// Largest tool-tip deviation while the axes move linearly, mm (default 0.005).
+    #[arg(long, value_name = "MM")]
+    pub(crate) linearization_tolerance: Option<f64>,
+
+    /// Largest rotary-axis move between two points, degrees (default: no limit).
+    #[arg(long, value_name = "DEG")]
+    pub(crate) max_rotary_step: Option<f64>,
+
+    /// Print the report as JSON on standard output.
+    #[arg(long)]
+    pub(crate) json: bool,
+
+    /// Print no summary.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
 }

@@ -69,7 +69,14 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
     let opts = options(args);
     let results = discretize_file(path, &file, &opts)?;
     let oriented = if args.normals {
-        Some(normals_for_file(path, &file, &results, &opts, args)?)
+        Some(normals_for_file(
+            path,
+            &file,
+            &results,
+            &opts,
+            &normal_args(args),
+            false,
+        )?)
     } else {
         None
     };
@@ -197,11 +204,30 @@ fn default_output(input: &Path) -> std::path::PathBuf {
     format!("{stem}.toolpath.json").into()
 }
 
+/// The options of the normals stage (shared by `discretize --normals` and `run`).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct NormalArgs {
+    /// mm.
+    pub on_surface_tolerance: Option<f64>,
+    /// Degrees.
+    pub max_normal_step: Option<f64>,
+    /// Degrees.
+    pub crease_angle: Option<f64>,
+}
+
+fn normal_args(args: &DiscretizeArgs) -> NormalArgs {
+    NormalArgs {
+        on_surface_tolerance: args.on_surface_tolerance,
+        max_normal_step: args.max_normal_step,
+        crease_angle: args.crease_angle,
+    }
+}
+
 /// The normal source of every surface the curves use, built once per surface.
 fn normal_sources(
     path: &Path,
     file: &CurvesFile,
-    args: &DiscretizeArgs,
+    args: &NormalArgs,
 ) -> Result<Vec<Option<Box<dyn NormalSource>>>, CliError> {
     let crease = args
         .crease_angle
@@ -241,13 +267,16 @@ fn normal_sources(
         .collect()
 }
 
-/// Normals for every curve (in parallel, results in input order).
-fn normals_for_file(
+/// Normals for every curve (in parallel, results in input order). A curve without a surface is
+/// an error, or, with `vertical_without_surface`, gets the tool axis +z at every point (flat
+/// 2D cutting).
+pub(crate) fn normals_for_file(
     path: &Path,
     file: &CurvesFile,
     results: &[Discretization],
     opts: &Options,
-    args: &DiscretizeArgs,
+    args: &NormalArgs,
+    vertical_without_surface: bool,
 ) -> Result<Vec<Oriented>, CliError> {
     let defaults = NormalOptions::default();
     let nopts = NormalOptions {
@@ -266,6 +295,16 @@ fn normals_for_file(
         .enumerate()
         .map(|(i, rec)| {
             let Some(sid) = &rec.surface else {
+                if vertical_without_surface {
+                    let d = &results[i];
+                    return Ok(Oriented {
+                        params: d.params.clone(),
+                        points: d.points.clone(),
+                        normals: vec![nalgebra::Vector3::z(); d.points.len()],
+                        max_chord_error: d.max_chord_error,
+                        ..Default::default()
+                    });
+                }
                 return Err(CliError::Input(format!(
                     "{}: {}: --normals needs a surface, but the curve names none (add \"surface\": \"<id>\")",
                     path.display(),

@@ -13,6 +13,7 @@ mod error;
 mod motion;
 mod plot;
 mod post;
+mod run;
 mod validate;
 
 use std::process::ExitCode;
@@ -28,6 +29,7 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate::run(args),
         Command::Discretize(args) => discretize::run(args),
         Command::Post(args) => post::run(args),
+        Command::Run(args) => run::run(args),
         Command::Interpolate(args) => motion::run_interpolate(args),
         Command::Gcode(args) => motion::run_gcode(args),
         Command::Check(args) => check::run(args),

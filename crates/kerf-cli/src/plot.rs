@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use kerf_format::{curves, toolpath};
+use kerf_format::{curves, toolpath, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_kinematics::{AxesFile, Machine};
 use kerf_plot::{render, write_svg, AxesChart, Scene, SceneOptions};
 
@@ -42,7 +42,24 @@ pub(crate) struct PlotArgs {
 /// Runs `kerf plot`.
 pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
     let curves_file = curves::load(&args.curves)?;
-    let tp = toolpath::load(&args.toolpath)?;
+    let tp = match toolpath::load(&args.toolpath) {
+        Ok(tp) => tp,
+        // A toolpath that breaks the format's rules (a chord error above the tolerance,
+        // params out of order, ...) is still drawn if it has a usable shape: the picture is
+        // how one looks at what is wrong.
+        Err(strict) => {
+            let loose = kerf_check::Toolpath::load(&args.toolpath).ok();
+            match loose.as_ref().and_then(drawable) {
+                Some(tp) => {
+                    eprintln!(
+                        "warning: {strict}; drawing it anyway (`kerf check` lists every defect)"
+                    );
+                    tp
+                }
+                None => return Err(strict.into()),
+            }
+        }
+    };
     let mut scene = Scene::new(&curves_file, &tp, &SceneOptions::default()).map_err(|e| {
         CliError::Plot(format!(
             "{} on {}: {e}",
@@ -103,6 +120,43 @@ pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// A toolpath read leniently, as a [`ToolpathFile`] for drawing, if its points are all 3 or all
+/// 6 numbers and its tolerance is positive.
+fn drawable(loose: &kerf_check::Toolpath) -> Option<ToolpathFile> {
+    if !(loose.tolerance.is_finite() && loose.tolerance > 0.0) {
+        return None;
+    }
+    let paths = loose
+        .paths
+        .iter()
+        .map(|p| {
+            let points = if p.points.iter().all(|q| q.len() == 3) {
+                ToolPathPoints::Positions(p.points.iter().map(|q| [q[0], q[1], q[2]]).collect())
+            } else if p.points.iter().all(|q| q.len() == 6) {
+                ToolPathPoints::Poses(
+                    p.points
+                        .iter()
+                        .map(|q| [q[0], q[1], q[2], q[3], q[4], q[5]])
+                        .collect(),
+                )
+            } else {
+                return None;
+            };
+            Some(ToolPath {
+                id: p.id.clone(),
+                params: p.params.clone(),
+                points,
+                max_chord_error: p.max_chord_error.unwrap_or(0.0),
+            })
+        })
+        .collect::<Option<Vec<_>>>()?;
+    Some(ToolpathFile {
+        units: kerf_format::Units::Millimetres,
+        tolerance: loose.tolerance,
+        paths,
+    })
 }
 
 /// The last component of `path`, for titles.

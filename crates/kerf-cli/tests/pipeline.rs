@@ -1,0 +1,214 @@
+//! The whole chain through the binary: run, post, interpolate, gcode, and what a failed run
+//! leaves behind.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn kerf() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_kerf"))
+}
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+fn ok(c: &mut Command) -> std::process::Output {
+    let o = c.output().unwrap();
+    assert!(
+        o.status.success(),
+        "{:?}: {}",
+        c,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+#[test]
+fn run_writes_every_stage_and_they_agree() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    ok(kerf()
+        .arg("run")
+        .arg(fixture("dome.json"))
+        .arg("-m")
+        .arg(fixture("machines/ac_head.json"))
+        .args(["-t", "0.01", "--out"])
+        .arg(&out));
+    for f in [
+        "toolpath.json",
+        "axes.json",
+        "program.nc",
+        "setpoints.csv",
+        "report.json",
+        "plot.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f} written");
+    }
+    let tp = kerf_format::toolpath::load(out.join("toolpath.json")).unwrap();
+    assert!(
+        tp.paths.iter().all(|p| p.points.has_normals()),
+        "poses with normals"
+    );
+    assert!(
+        tp.paths.iter().all(|p| p.max_chord_error <= 0.01),
+        "certified"
+    );
+    let axes = kerf_kinematics::AxesFile::from_str(
+        &std::fs::read_to_string(out.join("axes.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(
+        axes.paths.len(),
+        tp.paths.len(),
+        "one axes path per toolpath path"
+    );
+    let csv = std::fs::read_to_string(out.join("setpoints.csv")).unwrap();
+    assert!(csv.starts_with("t,X,Y,Z,A,C\n"), "CSV header as formats.md");
+    let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
+    assert!(
+        nc.contains("dome-latitude-60"),
+        "comments name the source curve"
+    );
+    let svg = std::fs::read_to_string(out.join("plot.svg")).unwrap();
+    assert!(
+        svg.starts_with("<?xml") || svg.starts_with("<svg"),
+        "an SVG"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["discretize"]["curves"], 2, "report counts curves");
+    // The independent checker agrees with the toolpath.
+    ok(kerf()
+        .arg("check")
+        .arg(fixture("dome.json"))
+        .arg(out.join("toolpath.json")));
+}
+
+#[test]
+fn a_failed_run_leaves_the_output_directory_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("keep.txt"), "before").unwrap();
+    // The head-table machine's Y travel is too short for the dome: a limit error.
+    let o = kerf()
+        .arg("run")
+        .arg(fixture("dome.json"))
+        .arg("-m")
+        .arg(fixture("machines/head_table.json"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "limit violation exits 1: {stderr}"
+    );
+    assert!(
+        stderr.contains("outside its limits"),
+        "names the limit: {stderr}"
+    );
+    let names: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        vec!["keep.txt".to_string()],
+        "nothing added, nothing left behind"
+    );
+    // Bad input: the same.
+    let o = kerf()
+        .arg("run")
+        .arg(fixture("bad/decreasing_knots.json"))
+        .arg("-m")
+        .arg(fixture("machines/ac_head.json"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "bad knots exit 1");
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        1,
+        "directory untouched"
+    );
+}
+
+#[test]
+fn post_interpolate_and_gcode_step_by_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let tp = dir.path().join("dome.toolpath.json");
+    let axes = dir.path().join("dome.axes.json");
+    let csv = dir.path().join("dome.csv");
+    let machine = fixture("machines/ac_head.json");
+    ok(kerf()
+        .arg("discretize")
+        .arg(fixture("dome.json"))
+        .args(["--normals", "-o"])
+        .arg(&tp));
+    ok(kerf()
+        .arg("post")
+        .arg(&tp)
+        .arg("-m")
+        .arg(&machine)
+        .arg("-o")
+        .arg(&axes));
+    ok(kerf()
+        .arg("interpolate")
+        .arg(&axes)
+        .arg("-m")
+        .arg(&machine)
+        .args(["--feed", "6000", "--cycle", "0.002", "--csv"])
+        .arg(&csv));
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert!(rows.len() > 100, "one row per cycle");
+    for w in rows.windows(2) {
+        assert!((w[1][0] - w[0][0] - 0.002).abs() < 1e-9, "cycle spacing");
+    }
+    for dialect in ["generic", "sinumerik"] {
+        let nc = dir.path().join(format!("dome.{dialect}.nc"));
+        ok(kerf()
+            .arg("gcode")
+            .arg(&tp)
+            .arg("-m")
+            .arg(&machine)
+            .args(["--feed", "6000", "--dialect", dialect, "-o"])
+            .arg(&nc));
+        let text = std::fs::read_to_string(&nc).unwrap();
+        let want = if dialect == "generic" {
+            "G1 X"
+        } else {
+            "TRAORI"
+        };
+        assert!(text.contains(want), "{dialect} program has {want}");
+    }
+    // A toolpath without normals cannot be posted.
+    let flat = dir.path().join("flat.json");
+    ok(kerf()
+        .arg("discretize")
+        .arg(fixture("mixed.json"))
+        .arg("-o")
+        .arg(&flat));
+    let o = kerf()
+        .arg("post")
+        .arg(&flat)
+        .arg("-m")
+        .arg(&machine)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "exit 1");
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("no normals"),
+        "says why"
+    );
+}

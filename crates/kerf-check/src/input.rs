@@ -1,0 +1,209 @@
+//! A lenient reader of `kerf.toolpath/1`.
+//!
+//! [`kerf_format::toolpath::load`] refuses a file at its first defect, which is right for the
+//! pipeline but not for a checker: a file from another tool whose params run backwards should
+//! come back with every defect listed. This reader only insists on the shape of the document
+//! (an object with `format: "kerf.toolpath/1"`, a numeric `tolerance`, `paths` of objects with
+//! a string `id`, numeric `params`, `points` as arrays of numbers); every rule about the
+//! values is left to [`crate::check()`]. Unknown keys are ignored (the format may grow).
+
+use std::path::Path;
+
+use kerf_format::{ToolPathPoints, ToolpathFile, TOOLPATH_FORMAT};
+use serde::Deserialize;
+use serde_json::Value;
+
+use crate::error::{CheckError, Result};
+
+/// A toolpath document as written, before any rule about its values is checked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Toolpath {
+    /// The `units` value, if present (the format requires `"mm"`).
+    pub units: Option<String>,
+    /// The chord tolerance the file claims, in mm.
+    pub tolerance: f64,
+    /// The paths, in file order.
+    pub paths: Vec<PathRecord>,
+}
+
+/// One path of a [`Toolpath`], as written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathRecord {
+    /// The id of the curve the path claims to discretize.
+    pub id: String,
+    /// The curve parameter of each point.
+    pub params: Vec<f64>,
+    /// Each point as written: 3 numbers, or 6 with the normal.
+    pub points: Vec<Vec<f64>>,
+    /// The `max_chord_error` the file claims, if present.
+    pub max_chord_error: Option<f64>,
+}
+
+#[derive(Deserialize)]
+struct RawFile {
+    #[serde(default)]
+    units: Option<String>,
+    tolerance: f64,
+    paths: Vec<RawPath>,
+}
+
+#[derive(Deserialize)]
+struct RawPath {
+    id: String,
+    params: Vec<f64>,
+    points: Vec<Vec<f64>>,
+    #[serde(default)]
+    max_chord_error: Option<f64>,
+}
+
+impl Toolpath {
+    /// Reads a toolpath file leniently (see the module documentation).
+    ///
+    /// # Errors
+    /// [`CheckError::Read`] if the file cannot be read, else any error of
+    /// [`Toolpath::from_slice`], wrapped in [`CheckError::File`].
+    pub fn load(path: impl AsRef<Path>) -> Result<Toolpath> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|error| CheckError::Read {
+            path: path.to_path_buf(),
+            error,
+        })?;
+        Toolpath::from_slice(&bytes).map_err(|e| e.in_file(path))
+    }
+
+    /// Reads a toolpath document held in memory leniently.
+    ///
+    /// # Errors
+    /// [`CheckError::Syntax`] for text that is not JSON, [`CheckError::Format`] if `format` is
+    /// not `kerf.toolpath/1`, [`CheckError::Shape`] naming the JSON path of a value of the
+    /// wrong type or a missing key.
+    pub fn from_slice(bytes: &[u8]) -> Result<Toolpath> {
+        let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+        let value: Value = serde_json::from_slice(bytes).map_err(|e| {
+            let full = e.to_string();
+            let suffix = format!(" at line {} column {}", e.line(), e.column());
+            CheckError::Syntax {
+                line: e.line(),
+                column: e.column(),
+                message: full.strip_suffix(&suffix).unwrap_or(&full).to_owned(),
+            }
+        })?;
+        match value.get("format") {
+            Some(Value::String(s)) if s == TOOLPATH_FORMAT => {}
+            other => {
+                return Err(CheckError::Format {
+                    found: other.map(Value::to_string),
+                })
+            }
+        }
+        let raw: RawFile = serde_path_to_error::deserialize(value).map_err(|e| {
+            let mut path = e.path().to_string();
+            let mut message = e
+                .into_inner()
+                .to_string()
+                .replace("expected f64", "expected a number")
+                .replace("a sequence", "an array")
+                .replace("invalid type: map", "invalid type: object")
+                .replace("invalid type: sequence", "invalid type: array");
+            if let Some(field) = message
+                .strip_prefix("missing field `")
+                .and_then(|rest| rest.strip_suffix('`'))
+            {
+                path = if path == "." {
+                    field.to_owned()
+                } else {
+                    format!("{path}.{field}")
+                };
+                message = "required key is missing".to_owned();
+            }
+            if path == "." {
+                path = "top level".to_owned();
+            }
+            CheckError::Shape { path, message }
+        })?;
+        Ok(Toolpath {
+            units: raw.units,
+            tolerance: raw.tolerance,
+            paths: raw
+                .paths
+                .into_iter()
+                .map(|p| PathRecord {
+                    id: p.id,
+                    params: p.params,
+                    points: p.points,
+                    max_chord_error: p.max_chord_error,
+                })
+                .collect(),
+        })
+    }
+}
+
+impl From<&ToolpathFile> for Toolpath {
+    fn from(file: &ToolpathFile) -> Self {
+        Toolpath {
+            units: Some(file.units.name().to_owned()),
+            tolerance: file.tolerance,
+            paths: file
+                .paths
+                .iter()
+                .map(|p| PathRecord {
+                    id: p.id.clone(),
+                    params: p.params.clone(),
+                    points: match &p.points {
+                        ToolPathPoints::Positions(v) => v.iter().map(|q| q.to_vec()).collect(),
+                        ToolPathPoints::Poses(v) => v.iter().map(|q| q.to_vec()).collect(),
+                    },
+                    max_chord_error: Some(p.max_chord_error),
+                })
+                .collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_what_kerf_format_would_refuse() {
+        let text = r#"{"format": "kerf.toolpath/1", "units": "mm", "tolerance": 0.1,
+            "paths": [{"id": "a", "params": [1, 0], "points": [[0,0,0],[1,0,0,0]],
+                       "max_chord_error": 5, "extra": true}]}"#;
+        let tp = Toolpath::from_slice(text.as_bytes()).unwrap();
+        assert_eq!(tp.paths[0].params, vec![1.0, 0.0], "reversed params kept");
+        assert_eq!(tp.paths[0].points[1].len(), 4, "odd point length kept");
+        assert_eq!(tp.paths[0].max_chord_error, Some(5.0), "claim kept");
+    }
+
+    #[test]
+    fn errors_name_the_json_path() {
+        let bad = r#"{"format": "kerf.toolpath/1", "tolerance": 0.1,
+            "paths": [{"id": "a", "params": [0, "x"], "points": []}]}"#;
+        let e = Toolpath::from_slice(bad.as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("paths[0].params[1]: invalid type: string"),
+            "{e}"
+        );
+        let missing = r#"{"format": "kerf.toolpath/1", "paths": []}"#;
+        let e = Toolpath::from_slice(missing.as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "tolerance: required key is missing", "{e}");
+        let curves = r#"{"format": "kerf.curves/1", "curves": []}"#;
+        let e = Toolpath::from_slice(curves.as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("expected \"kerf.toolpath/1\", found \"kerf.curves/1\""),
+            "{e}"
+        );
+        let e = Toolpath::from_slice(b"{").unwrap_err().to_string();
+        assert!(e.starts_with("invalid JSON at line 1"), "{e}");
+        let e = Toolpath::load("/nonexistent/x.json")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("/nonexistent/x.json: cannot read"), "{e}");
+    }
+}

@@ -1,0 +1,49 @@
+//! Independent verification of `kerf.toolpath/1` files against the curves they discretize.
+//!
+//! The discretizer (crate `kerf-discretize`) proves a chord-error bound for every segment it
+//! writes. This crate does not trust that proof, nor any other tool's: it reads a toolpath
+//! leniently ([`Toolpath`], so that a file kerf would refuse still gets every defect listed),
+//! and [`check()`] measures every segment's chord error by brute force ([`measure`]: dense
+//! sampling between the two params including every knot inside, then golden-section
+//! refinement of each local maximum), and checks every rule of the format
+//! (`shared/formats.md`): same ids in the same order, params strictly increasing from one end
+//! of the domain to the other, every point on the curve at its param (to `1e-9` of the curve
+//! size), every C0 corner a cutting point, unit normals, every segment's chord error at most
+//! the tolerance and a `max_chord_error` claim that does not understate the measurement.
+//!
+//! The measurement is an estimate from below of the true chord error (the maximum of a
+//! distance is found by sampling and local search, not proved), good to about `1e-12` of the
+//! curve size on smooth segments; it is a check of the discretizer's guarantee, not a second
+//! guarantee.
+//!
+//! ```
+//! use kerf_check::{check, CheckOptions, Toolpath};
+//!
+//! let curves = kerf_format::curves::from_str(
+//!     r#"{"format": "kerf.curves/1", "units": "mm", "curves": [{"id": "arc", "degree": 2,
+//!         "knots": [0, 0, 0, 1, 1, 1], "control_points": [[0, 0, 0], [10, 10, 0], [20, 0, 0]]}]}"#,
+//!     std::path::Path::new("."),
+//! )?;
+//! // Two points only: the chord misses the arc's apex (5 mm away) by far.
+//! let toolpath = Toolpath::from_slice(
+//!     br#"{"format": "kerf.toolpath/1", "units": "mm", "tolerance": 0.01, "paths": [
+//!         {"id": "arc", "params": [0, 1], "points": [[0, 0, 0], [20, 0, 0]], "max_chord_error": 0}]}"#,
+//! )?;
+//! let report = check(&curves.curves, &toolpath, &CheckOptions::default());
+//! assert!(!report.passed(), "one segment cannot follow the arc");
+//! assert!((report.paths[0].max_chord_error - 5.0).abs() < 1e-12, "the apex is 5 mm off the chord");
+//! for v in &report.violations {
+//!     println!("{v}"); // paths[0] ("arc"): segment 0 (t 0 .. 1): chord error 5.000000e0 mm > ...
+//! }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod check;
+pub mod error;
+pub mod input;
+pub mod measure;
+
+pub use check::{check, CheckOptions, Defect, PathReport, Report, Violation, WorstSegment};
+pub use error::{CheckError, Result};
+pub use input::{PathRecord, Toolpath};
+pub use measure::{distance_to_segment, segment_chord_error, SegmentError};

@@ -1,7 +1,17 @@
 //! kerf: NURBS cut contours to the motion of a 5-axis laser cutting machine.
 //!
-//! This facade re-exports the stage crates in pipeline order.
+//! This facade re-exports the stage crates in pipeline order; read them in that order:
+//!
+//! 1. [`nurbs`]: rational curves and surfaces (evaluation, derivatives, Bezier pieces).
+//! 2. [`format`]: `kerf.curves/1` in, `kerf.toolpath/1` out.
+//! 3. [`discretize`]: cutting points with a certified chord error.
+//! 4. [`normals`]: the surface normal of every cutting point.
+//! 5. [`kinematics`]: poses to machine axes, `kerf.axes/1`.
+//! 6. [`interp`]: time-division interpolation, feed planning, set-points and G-code.
 
 pub use kerf_discretize as discretize;
 pub use kerf_format as format;
+pub use kerf_interp as interp;
+pub use kerf_kinematics as kinematics;
+pub use kerf_normals as normals;
 pub use kerf_nurbs as nurbs;

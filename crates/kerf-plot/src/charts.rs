@@ -385,12 +385,23 @@ pub(crate) fn draw_axes_chart(doc: &mut Doc, chart: &AxesChart, panel: Rect) {
             _ => None,
         };
         if let Some(note) = note {
-            doc.text(
-                frame.x + 8.0,
-                frame.y + frame.h - 6.0,
-                &note,
-                "class=\"note halo\"",
-            );
+            // Bottom left, or top left if the curve passes there.
+            let right = frame.x + 16.0 + text_width(&note, 11.0);
+            let mut s = 0usize;
+            let near_bottom = chart.paths.iter().any(|(_, p)| {
+                let hit = p.iter().enumerate().any(|(k, q)| {
+                    let px = x.at((s + k) as f64);
+                    px <= right && y.at(q[axis]) > frame.y + frame.h - 20.0
+                });
+                s += p.len();
+                hit
+            });
+            let ny = if near_bottom {
+                frame.y + 14.0
+            } else {
+                frame.y + frame.h - 6.0
+            };
+            doc.text(frame.x + 8.0, ny, &note, "class=\"note halo\"");
         }
         doc.vtext(
             panel.x + 22.0,

@@ -270,10 +270,25 @@ pub(crate) fn draw_view(doc: &mut Doc, scene: &Scene, view: View, panel: Rect, n
     doc.close();
     if view == View::Top && scene.paths.len() <= 12 {
         doc.open("class=\"labels\"");
+        // Beside each path's first point, moved down a line at a time while it would cover
+        // a label already placed (paths often start side by side).
+        let mut placed: Vec<(f64, f64, f64)> = Vec::new();
         for p in &scene.paths {
             if let Some(q) = p.points.first() {
-                let (x, y) = fit.px(view.project(q));
-                doc.text(x + 5.0, y - 5.0, &p.id, "class=\"label\"");
+                let (x, mut y) = fit.px(view.project(q));
+                let (x, w) = (x + 5.0, text_width(&p.id, 11.0));
+                y -= 5.0;
+                for _ in 0..12 {
+                    let clash = placed
+                        .iter()
+                        .any(|&(px, py, pw)| (py - y).abs() < 13.0 && x < px + pw && px < x + w);
+                    if !clash {
+                        break;
+                    }
+                    y += 13.0;
+                }
+                placed.push((x, y, w));
+                doc.text(x, y, &p.id, "class=\"label\"");
             }
         }
         doc.close();

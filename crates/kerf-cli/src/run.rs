@@ -119,6 +119,14 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     // 5. Picture and report.
     let mut scene = kerf_plot::Scene::new(&file, &tp, &kerf_plot::SceneOptions::default())
         .map_err(|e| CliError::Plot(e.to_string()))?;
+    scene.title = format!(
+        "kerf run \u{2014} {} on {}",
+        path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned()
+        ),
+        machine.name
+    );
     scene.axes = Some(
         kerf_plot::AxesChart::new(&axes, Some(&machine))
             .map_err(|e| CliError::Plot(e.to_string()))?,

@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use kerf::kinematics::{Machine, Pose};
+use kerf::kinematics::{solve_path, Machine, PathInput, PathOptions, Pose};
 use kerf::normals::{Hint, MeshNormals, NormalSource, NurbsNormals};
 use nalgebra::Point3;
 
@@ -101,6 +101,43 @@ fn bench(c: &mut Criterion) {
         let k = machine.kinematics.clone();
         g.bench_function(m, |b| {
             b.iter(|| poses.iter().map(|p| k.inverse(p)[0].c).sum::<f64>())
+        });
+    }
+    g.finish();
+
+    // Whole paths: a 10,000-point helix with the tool tilting outward, default options
+    // (continuity, limits lifted, non-linearity insertion).
+    let helix: Vec<Pose> = (0..10_000)
+        .map(|k| {
+            let th = (k as f64 * 0.2).to_radians();
+            let tilt = (30.0 + 10.0 * (5.0 * th).sin()).to_radians();
+            Pose::new(
+                300.0 * th.cos(),
+                300.0 * th.sin(),
+                0.01 * k as f64,
+                tilt.sin() * th.cos(),
+                tilt.sin() * th.sin(),
+                tilt.cos(),
+            )
+        })
+        .collect();
+    let mut g = c.benchmark_group("solve_path");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(helix.len() as u64));
+    for m in ["ac_head", "fork_head", "table_table", "head_table"] {
+        let mut machine = Machine::read(root.join(format!("machines/{m}.json"))).expect("machine");
+        machine.limits = [None; 5];
+        let input = PathInput {
+            id: "helix",
+            poses: &helix,
+            curve: None,
+        };
+        g.bench_function(m, |b| {
+            b.iter(|| {
+                solve_path(&machine, &input, &PathOptions::default())
+                    .expect("solves")
+                    .inserted
+            })
         });
     }
     g.finish();

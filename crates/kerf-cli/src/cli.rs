@@ -290,7 +290,7 @@ pub(crate) struct InterpolateArgs {
     #[command(flatten)]
     pub(crate) motion: MotionArgs,
 
-    /// Write the set-points CSV here (one row per cycle).
+    /// Write the set-points CSV here (one row per cycle; `-` for standard output).
     #[arg(long, value_name = "OUT.csv")]
     pub(crate) csv: Option<PathBuf>,
 
@@ -310,7 +310,7 @@ pub(crate) struct GcodeArgs {
     #[command(flatten)]
     pub(crate) motion: MotionArgs,
 
-    /// The program file to write.
+    /// The program file to write (`-` for standard output).
     #[arg(short, long, value_name = "OUT.nc")]
     pub(crate) output: PathBuf,
 

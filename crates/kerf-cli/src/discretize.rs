@@ -46,8 +46,22 @@ pub(crate) fn discretize_file(
     opts: &Options,
 ) -> Result<Vec<Discretization>, CliError> {
     opts.validate().map_err(CliError::Options)?;
-    let curves: Vec<_> = file.curves.iter().map(|r| r.curve.clone()).collect();
-    discretize_all(&curves, opts)
+    let results: Vec<_> = if show_progress(file.curves.len()) {
+        use indicatif::ParallelProgressIterator;
+        let bar = progress_bar(file.curves.len(), "discretizing");
+        let out = file
+            .curves
+            .par_iter()
+            .progress_with(bar.clone())
+            .map(|r| kerf_discretize::discretize(&r.curve, opts))
+            .collect();
+        bar.finish_and_clear();
+        out
+    } else {
+        let curves: Vec<_> = file.curves.iter().map(|r| r.curve.clone()).collect();
+        discretize_all(&curves, opts)
+    };
+    results
         .into_iter()
         .enumerate()
         .map(|(i, r)| {
@@ -324,4 +338,23 @@ pub(crate) fn normals_for_file(
             })
         })
         .collect()
+}
+
+/// A progress bar is worth showing for batches long enough to wait for, and only when
+/// standard error is a terminal (never in pipes, logs or CI).
+pub(crate) fn show_progress(items: usize) -> bool {
+    use std::io::IsTerminal;
+    items >= 200 && io::stderr().is_terminal()
+}
+
+/// A progress bar on standard error.
+pub(crate) fn progress_bar(len: usize, what: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(len as u64);
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} curves, {eta} left")
+    {
+        bar.set_style(style);
+    }
+    bar.set_message(what.to_string());
+    bar
 }

@@ -116,9 +116,7 @@ pub(crate) fn program(args: &MotionArgs) -> Result<Program, CliError> {
 fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, quiet: bool) {
     let c = p.motion.counts();
     if json {
-        println!(
-            "{}",
-            json!({
+        let text = json!({
                 "input": args.input.display().to_string(),
                 "machine": p.model.name(),
                 "lines": c.lines,
@@ -128,8 +126,13 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
                 "cycle": args.cycle,
                 "duration_s": p.motion.duration(),
                 "output": out.map(|o| o.display().to_string()),
-            })
-        );
+        });
+        // The summary goes to standard output unless the program or CSV itself does.
+        if out.is_some_and(|o| o == Path::new("-")) {
+            eprintln!("{text}");
+        } else {
+            println!("{text}");
+        }
     } else if !quiet {
         eprintln!(
             "{}: {} lines, {} arcs, {} turns; {} cycles of {} s = {:.3} s of motion{}",
@@ -150,7 +153,13 @@ pub(crate) fn run_interpolate(args: &InterpolateArgs) -> Result<(), CliError> {
     let p = program(&args.motion)?;
     if let Some(csv) = &args.csv {
         let rows = p.motion.setpoints(&p.model);
-        write_csv(csv, p.model.axis_names(), args.motion.cycle, &rows).map_err(interp_err(csv))?;
+        if csv == Path::new("-") {
+            let text = kerf_interp::csv_string(p.model.axis_names(), args.motion.cycle, &rows);
+            std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes())?;
+        } else {
+            write_csv(csv, p.model.axis_names(), args.motion.cycle, &rows)
+                .map_err(interp_err(csv))?;
+        }
     }
     summary(&args.motion, &p, args.csv.as_ref(), args.json, args.quiet);
     Ok(())
@@ -168,6 +177,12 @@ pub(crate) fn write_program(
         ..GcodeOptions::new(dialect, feed)
     };
     let feeds = p.motion.block_feeds();
+    if dest == Path::new("-") {
+        let text = kerf_interp::gcode(&p.model, p.motion.blocks(), &p.ids, Some(&feeds), &opts)
+            .map_err(interp_err(dest))?;
+        std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes())?;
+        return Ok(());
+    }
     write_gcode(
         dest,
         &p.model,

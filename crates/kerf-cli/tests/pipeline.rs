@@ -192,6 +192,24 @@ fn post_interpolate_and_gcode_step_by_step() {
         };
         assert!(text.contains(want), "{dialect} program has {want}");
     }
+    // `-o -` and `--csv -` write to standard output, and no file named `-`.
+    let o = ok(kerf()
+        .current_dir(dir.path())
+        .arg("gcode")
+        .arg(&axes)
+        .arg("-m")
+        .arg(&machine)
+        .args(["--feed", "6000", "-o", "-"]));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("G1 X"), "program on stdout");
+    let o = ok(kerf()
+        .current_dir(dir.path())
+        .arg("interpolate")
+        .arg(&axes)
+        .arg("-m")
+        .arg(&machine)
+        .args(["--feed", "6000", "--csv", "-"]));
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("t,X,Y,Z,A,C"), "CSV on stdout");
+    assert!(!dir.path().join("-").exists(), "no file named -");
     // A toolpath without normals cannot be posted.
     let flat = dir.path().join("flat.json");
     ok(kerf()

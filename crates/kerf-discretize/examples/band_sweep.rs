@@ -8,29 +8,9 @@ use std::time::Instant;
 
 use kerf_discretize::{discretize, minimum_count, Options};
 use kerf_nurbs::NurbsCurve;
-use nalgebra::Point3;
 
 fn smooth_curves(degree: usize, count: usize, seed: u64) -> Vec<NurbsCurve> {
-    let mut s = seed;
-    let mut rnd = move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
-    (0..count)
-        .map(|_| {
-            let n = degree + 1 + 8;
-            let pts: Vec<Point3<f64>> = (0..n)
-                .map(|i| Point3::new(20.0 * i as f64 + 10.0 * rnd(), 60.0 * rnd(), 20.0 * rnd()))
-                .collect();
-            let mut knots = vec![0.0; degree + 1];
-            let inner = n - degree - 1;
-            knots.extend((1..=inner).map(|i| i as f64 / (inner + 1) as f64));
-            knots.extend(vec![1.0; degree + 1]);
-            NurbsCurve::new(degree, knots, pts, None)
-        })
-        .collect()
+    kerf_nurbs::samples::smooth_random_curves(degree, count, seed)
 }
 
 fn main() {

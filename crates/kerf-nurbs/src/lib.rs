@@ -31,6 +31,7 @@ pub mod closest;
 pub mod curve;
 pub mod error;
 pub mod knots;
+pub mod samples;
 pub mod surface;
 
 pub use bezier::RationalBezier;

@@ -281,6 +281,12 @@ pub(crate) struct MotionArgs {
     /// radii; default 0.001).
     #[arg(long, value_name = "MM")]
     pub(crate) chord_tolerance: Option<f64>,
+
+    /// Between two contours the head backs off this far along the tool axis, traverses, and
+    /// approaches the next start along its tool axis (mm; 0 = one straight rapid at cutting
+    /// height). Choose it so that the traverse clears the part.
+    #[arg(long, default_value_t = 10.0, value_name = "MM")]
+    pub(crate) retract: f64,
 }
 
 /// Arguments of `kerf interpolate`.
@@ -391,6 +397,12 @@ pub(crate) struct RunArgs {
     /// Largest rotary-axis move between two points, degrees (default: no limit).
     #[arg(long, value_name = "DEG")]
     pub(crate) max_rotary_step: Option<f64>,
+
+    /// Between two contours the head backs off this far along the tool axis, traverses, and
+    /// approaches the next start along its tool axis (mm; 0 = one straight rapid at cutting
+    /// height). Choose it so that the traverse clears the part.
+    #[arg(long, default_value_t = 10.0, value_name = "MM")]
+    pub(crate) retract: f64,
 
     /// Print the report as JSON on standard output.
     #[arg(long)]

@@ -31,9 +31,23 @@ fn interp_err(file: &Path) -> impl Fn(kerf_interp::InterpError) -> CliError + '_
     move |e| CliError::Input(format!("{}: {e}", file.display()))
 }
 
+/// The fit for a program run by a controller that interpolates the machine axes linearly
+/// (`generic`): one G1 per pose of the kinematics, whose non-linearity error is within the
+/// linearization tolerance; no arcs (their chords would move the rotary axes in steps nobody
+/// checked) and no merged lines. With tool-tip control (Sinumerik TRAORI) arcs and merges are
+/// safe: the controller keeps the tip on the programmed path.
+pub(crate) fn fit_options(tolerance: f64, generic: bool, retract: f64) -> FitOptions {
+    FitOptions {
+        arcs: !generic,
+        merge_lines: !generic,
+        retract,
+        ..FitOptions::with_tolerance(tolerance)
+    }
+}
+
 /// Reads the input (axes or toolpath), solves it on the machine if needed, fits blocks and
 /// plans the motion.
-pub(crate) fn program(args: &MotionArgs) -> Result<Program, CliError> {
+pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliError> {
     let machine = Machine::read(&args.machine)?;
     let model = MachineModel::new(machine.clone()).map_err(interp_err(&args.machine))?;
     let input = &args.input;
@@ -101,7 +115,7 @@ pub(crate) fn program(args: &MotionArgs) -> Result<Program, CliError> {
     let motion = kerf_interp::interpolate(
         &model,
         &paths,
-        &FitOptions::with_tolerance(fit_tolerance),
+        &fit_options(fit_tolerance, generic, args.retract),
         &plan,
     )
     .map_err(interp_err(input))?;
@@ -150,7 +164,8 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
 
 /// Runs `kerf interpolate`.
 pub(crate) fn run_interpolate(args: &InterpolateArgs) -> Result<(), CliError> {
-    let p = program(&args.motion)?;
+    // Set-points are computed with tool-tip control: arcs are safe.
+    let p = program(&args.motion, false)?;
     if let Some(csv) = &args.csv {
         let rows = p.motion.setpoints(&p.model);
         if csv == Path::new("-") {
@@ -196,7 +211,10 @@ pub(crate) fn write_program(
 
 /// Runs `kerf gcode`.
 pub(crate) fn run_gcode(args: &GcodeArgs) -> Result<(), CliError> {
-    let p = program(&args.motion)?;
+    let p = program(
+        &args.motion,
+        args.dialect == crate::cli::DialectArg::Generic,
+    )?;
     write_program(&p, &args.output, args.dialect.into(), args.motion.feed)?;
     summary(&args.motion, &p, Some(&args.output), args.json, args.quiet);
     Ok(())

@@ -8,7 +8,7 @@ use std::time::Instant;
 use kerf_discretize::Discretization;
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_interp::{
-    csv_string, gcode, stations_from_solved, AxisModel, FitOptions, GcodeOptions, MachineModel,
+    csv_string, gcode, stations_from_solved, AxisModel, GcodeOptions, MachineModel,
     PathInput as InterpPath, PlanOptions,
 };
 use kerf_kinematics::{solve_paths, AxesFile, Machine, PathCurve, PathInput, PathOptions, Pose};
@@ -99,7 +99,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             curve: Some(curve),
         });
     }
-    let fit = FitOptions::with_tolerance(dopts.tolerance);
+    let fit = crate::motion::fit_options(
+        dopts.tolerance,
+        args.dialect == crate::cli::DialectArg::Generic,
+        args.retract,
+    );
     let plan = PlanOptions::new(args.feed, args.cycle);
     let motion = kerf_interp::interpolate(&model, &ipaths, &fit, &plan).map_err(interp(path))?;
     let ids: Vec<String> = file.curves.iter().map(|c| c.id.clone()).collect();

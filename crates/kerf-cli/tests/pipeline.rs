@@ -200,7 +200,10 @@ fn post_interpolate_and_gcode_step_by_step() {
         .arg("-m")
         .arg(&machine)
         .args(["--feed", "6000", "-o", "-"]));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("G1 X"), "program on stdout");
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("G1 X"),
+        "program on stdout"
+    );
     let o = ok(kerf()
         .current_dir(dir.path())
         .arg("interpolate")
@@ -208,7 +211,10 @@ fn post_interpolate_and_gcode_step_by_step() {
         .arg("-m")
         .arg(&machine)
         .args(["--feed", "6000", "--csv", "-"]));
-    assert!(String::from_utf8_lossy(&o.stdout).starts_with("t,X,Y,Z,A,C"), "CSV on stdout");
+    assert!(
+        String::from_utf8_lossy(&o.stdout).starts_with("t,X,Y,Z,A,C"),
+        "CSV on stdout"
+    );
     assert!(!dir.path().join("-").exists(), "no file named -");
     // A toolpath without normals cannot be posted.
     let flat = dir.path().join("flat.json");
@@ -228,5 +234,64 @@ fn post_interpolate_and_gcode_step_by_step() {
     assert!(
         String::from_utf8_lossy(&o.stderr).contains("no normals"),
         "says why"
+    );
+}
+
+/// The generic program is run by a controller that moves the machine axes linearly between
+/// two G1 lines: the tool tip must then stay within the linearization tolerance (plus the
+/// 6-decimal rounding of the program) of the straight line between the two programmed tips.
+#[test]
+fn generic_gcode_keeps_the_non_linearity_within_its_tolerance() {
+    let dir = tempfile::tempdir().unwrap();
+    let nc = dir.path().join("blade.nc");
+    let machine_file = fixture("machines/gantry_ac.json");
+    ok(kerf()
+        .arg("run")
+        .arg(fixture("turbine_blade_edge.json"))
+        .arg("-m")
+        .arg(&machine_file)
+        .args(["-q", "--out"])
+        .arg(dir.path()));
+    std::fs::rename(dir.path().join("program.nc"), &nc).unwrap();
+    let machine = kerf_kinematics::Machine::read(&machine_file).unwrap();
+    let k = machine.kinematics.clone();
+    let mut last: Option<[f64; 5]> = None;
+    let mut worst = 0.0f64;
+    for line in std::fs::read_to_string(&nc).unwrap().lines() {
+        let rapid = line.starts_with("G0");
+        if !(line.starts_with("G1") || rapid) {
+            continue;
+        }
+        let mut q = last.unwrap_or([0.0; 5]);
+        for w in line.split_whitespace() {
+            let (key, val) = w.split_at(1);
+            let i = match key {
+                "X" => 0,
+                "Y" => 1,
+                "Z" => 2,
+                "A" => 3,
+                "C" => 4,
+                _ => continue,
+            };
+            q[i] = val.parse().unwrap();
+        }
+        if let (Some(p), false) = (last, rapid) {
+            let tip = |a: &[f64; 5]| {
+                k.forward(&kerf_kinematics::Axes::new(a[0], a[1], a[2], a[3], a[4]))
+                    .position
+            };
+            let (t0, t1) = (tip(&p), tip(&q));
+            for s in [0.25, 0.5, 0.75] {
+                let mid: Vec<f64> = (0..5).map(|i| p[i] + s * (q[i] - p[i])).collect();
+                let m = tip(&[mid[0], mid[1], mid[2], mid[3], mid[4]]);
+                worst = worst.max(kerf_check::distance_to_segment(&m, &t0, &t1));
+            }
+        }
+        last = Some(q);
+    }
+    assert!(worst > 0.0, "the check measured something");
+    assert!(
+        worst <= 0.005 + 1e-4,
+        "tip leaves the line by {worst} mm between two G1 lines"
     );
 }

@@ -55,6 +55,10 @@ pub struct FitOptions {
     /// Curve points tested between two neighbouring cutting points when the curve is known.
     /// Default 4.
     pub curve_samples: usize,
+    /// Retract distance (mm) of the rapid moves between paths ([`crate::fit_program`]): the
+    /// head backs off along the tool axis, traverses, and approaches the next start along its
+    /// tool axis, instead of crossing at cutting height. Default 10; 0 gives one straight rapid.
+    pub retract: f64,
 }
 
 impl Default for FitOptions {
@@ -68,6 +72,7 @@ impl Default for FitOptions {
             max_sweep: 1.5 * std::f64::consts::PI,
             max_radius: 1e5,
             curve_samples: 4,
+            retract: 10.0,
         }
     }
 }

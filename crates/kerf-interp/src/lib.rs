@@ -61,7 +61,7 @@ pub use geometry::Arc;
 pub use machine::{stations_from_axes, stations_from_solved, MachineModel};
 pub use model::{AcHead, AxisLimits, AxisModel};
 pub use output::{csv_string, gcode, write_csv, write_gcode, Dialect, GcodeOptions};
-pub use plan::{link_paths, plan, Cycles, Motion, PlanOptions};
+pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PlanOptions};
 
 /// One path of a program: its id (the source curve's), its stations and, when known, the
 /// curve itself.
@@ -100,7 +100,7 @@ pub fn fit_program<M: AxisModel + ?Sized>(
     for (n, p) in paths.iter().enumerate() {
         all.push(fit_blocks(model, &p.stations, p.curve, n, opts)?);
     }
-    Ok(link_paths(all))
+    Ok(plan::link_paths_with_retract(model, all, opts.retract))
 }
 
 /// What `kerf interpolate` does once its inputs are read: [`fit_program`] then [`plan()`].

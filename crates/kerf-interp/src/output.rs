@@ -178,7 +178,9 @@ pub fn gcode<M: AxisModel + ?Sized>(
         }
     };
     for (bi, b) in blocks.iter().enumerate() {
-        if b.path != last_path && !b.rapid {
+        // The comment comes before the rapid moves that lead to the curve (they carry the
+        // next path's number).
+        if b.path != last_path {
             last_path = b.path;
             let id = path_ids
                 .get(b.path)

@@ -343,6 +343,53 @@ pub fn link_paths(paths: Vec<Vec<Block>>) -> Vec<Block> {
     out
 }
 
+/// Like [`link_paths`], but each rapid move backs off `retract` mm along the tool axis from
+/// the end of one path (rotary axes standing), traverses to `retract` mm above the next path's
+/// start along its tool axis, and approaches it along that axis: the nozzle never crosses the
+/// part at cutting height. `retract <= 0` is [`link_paths`].
+pub fn link_paths_with_retract<M: AxisModel + ?Sized>(
+    model: &M,
+    paths: Vec<Vec<Block>>,
+    retract: f64,
+) -> Vec<Block> {
+    if retract.is_nan() || retract <= 0.0 {
+        return link_paths(paths);
+    }
+    let station = |tip: nalgebra::Point3<f64>, axes: [f64; 5]| {
+        let axis = model.tool_axis(axes[3], axes[4]);
+        let lin = model.linear_axes(&tip, axes[3], axes[4]);
+        crate::block::Station {
+            tip,
+            axis,
+            param: None,
+            axes: [lin[0], lin[1], lin[2], axes[3], axes[4]],
+        }
+    };
+    let mut out: Vec<Block> = Vec::new();
+    for blocks in paths {
+        let Some(first) = blocks.first() else {
+            continue;
+        };
+        if let Some(last) = out.last() {
+            if last.end_axes != first.start_axes {
+                let end = station(last.end_tip(), last.end_axes);
+                let start = station(first.start_tip(), first.start_axes);
+                let up = station(end.tip + end.axis * retract, end.axes);
+                let over = station(start.tip + start.axis * retract, start.axes);
+                for (a, b) in [(&end, &up), (&up, &over), (&over, &start)] {
+                    let mut rapid = Block::line(a, b);
+                    rapid.rapid = true;
+                    rapid.path = first.path;
+                    rapid.stations = [0, 0];
+                    out.push(rapid);
+                }
+            }
+        }
+        out.extend(blocks);
+    }
+    out
+}
+
 /// Plans the feed along `blocks` (one program, run from rest to rest) within the machine's
 /// limits; see the module documentation.
 ///

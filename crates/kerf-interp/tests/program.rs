@@ -179,10 +179,33 @@ fn two_paths_are_linked_by_a_rapid_move() {
         blocks.as_slice(),
         "interpolate = fit_program + plan"
     );
+    // Retract along the tool axis, traverse, approach along the next tool axis.
+    let rapids: Vec<_> = blocks.iter().filter(|b| b.rapid).collect();
+    assert_eq!(rapids.len(), 3, "retract, traverse, approach");
+    let up = rapids[0].end_tip() - rapids[0].start_tip();
+    let along = rapids[0].end_tool_axis * 10.0;
+    assert!(
+        (up - along).norm() < 1e-9,
+        "retract is 10 mm along the tool axis: {up:?}"
+    );
+    let down = rapids[2].end_tip() - rapids[2].start_tip();
+    assert!(
+        (down + rapids[2].end_tool_axis * 10.0).norm() < 1e-9,
+        "approach along the axis"
+    );
+    let straight = fit_program(
+        &m,
+        &paths,
+        &FitOptions {
+            retract: 0.0,
+            ..FitOptions::default()
+        },
+    )
+    .expect("fit");
     assert_eq!(
-        blocks.iter().filter(|b| b.rapid).count(),
+        straight.iter().filter(|b| b.rapid).count(),
         1,
-        "one rapid move"
+        "retract 0: one straight rapid move"
     );
     check_program("two rings", &m, &blocks, 8000.0, 0.002);
 }

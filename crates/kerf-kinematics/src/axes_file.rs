@@ -48,8 +48,8 @@ pub struct AxesFile {
 }
 
 /// The axes of one path.
+/// Unknown keys are ignored: the format allows optional extensions.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct AxesPath {
     /// The path's id.
     pub id: String,
@@ -71,7 +71,6 @@ pub struct AxesPath {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct Document {
     format: String,
     machine: String,

@@ -142,3 +142,14 @@ fn validation_errors() {
         "format: unknown format \"kerf.toolpath/1\" (this reader reads \"kerf.axes/1\")"
     );
 }
+
+#[test]
+fn extra_optional_keys_are_accepted_as_the_contract_allows() {
+    let text = r#"{"format": "kerf.axes/1", "machine": "m", "axes": ["X", "Y", "Z", "A", "C"],
+        "comment": "written by another tool",
+        "paths": [{"id": "p", "positions": [[0, 0, 0, 0, 0], [1, 0, 0, 0, 0]],
+                   "poses": [[0, 0, 0, 0, 0, 1], [1, 0, 0, 0, 0, 1]], "inserted": 0,
+                   "feed": 3000}]}"#;
+    let file = kerf_kinematics::AxesFile::from_str(text).expect("extra keys are fine");
+    assert_eq!(file.paths[0].positions.len(), 2, "read the path");
+}

@@ -16,7 +16,8 @@ fn main() {
             .wrapping_add(1_442_695_040_888_963_407);
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
-    let mut text = String::from("{\"format\": \"kerf.curves/1\", \"units\": \"mm\", \"curves\": [\n");
+    let mut text =
+        String::from("{\"format\": \"kerf.curves/1\", \"units\": \"mm\", \"curves\": [\n");
     for c in 0..n {
         let m = 12;
         let pts: Vec<String> = (0..m)

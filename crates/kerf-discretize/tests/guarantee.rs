@@ -289,7 +289,7 @@ fn brute_force_checker_sees_a_known_sagitta() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 256, .. ProptestConfig::default() })]
 
     #[test]
     fn random_curves_hold_the_guarantee(c in random_curve(), tol_exp in 1u32..4) {

@@ -173,13 +173,16 @@ pub fn random_curve() -> impl Strategy<Value = NurbsCurve> {
             .collect();
         let w: Vec<f64> = (0..n).map(|_| 0.05 * (400.0f64).powf(rnd())).collect();
         // Interior knots with random multiplicities up to p.
+        // Interior knots with multiplicities up to p (C0 breaks allowed, no jumps): a value
+        // drawn twice must not add up beyond p.
         let n_int = n - p - 1;
-        let mut interior = Vec::new();
+        let mut interior: Vec<f64> = Vec::new();
         while interior.len() < n_int {
-            let v = (rnd() * 1000.0).round() / 1000.0;
-            let m = 1 + (rnd() * p as f64) as usize;
+            let v = ((rnd() * 1000.0).round() / 1000.0).clamp(0.001, 0.999);
+            let have = interior.iter().filter(|&&k| k == v).count();
+            let m = (1 + (rnd() * p as f64) as usize).min(p - have.min(p));
             for _ in 0..m.min(n_int - interior.len()) {
-                interior.push(v.clamp(0.001, 0.999));
+                interior.push(v);
             }
         }
         interior.sort_by(f64::total_cmp);

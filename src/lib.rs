@@ -3,7 +3,7 @@
 //! This facade re-exports the stage crates in pipeline order; read them in that order:
 //!
 //! 1. [`nurbs`]: rational curves and surfaces (evaluation, derivatives, Bezier pieces).
-//! 2. [`format`]: `kerf.curves/1` in, `kerf.toolpath/1` out.
+//! 2. [`format`](mod@format): `kerf.curves/1` in, `kerf.toolpath/1` out.
 //! 3. [`discretize`]: cutting points with a certified chord error.
 //! 4. [`normals`]: the surface normal of every cutting point.
 //! 5. [`kinematics`]: poses to machine axes, `kerf.axes/1`.

@@ -178,11 +178,16 @@ pub fn chord_error_with(
             };
         }
         steps += 1;
-        let (l, r) = pieces[worst].bez.subdivide(0.5);
-        let (ul, el) = chord.piece(&l);
-        let (ur, _) = chord.piece(&r);
+        // Split the worst piece in place: its copy at the end becomes the right half.
+        pieces.push(pieces[worst]);
+        let last = pieces.len() - 1;
+        let (head, tail) = pieces.split_at_mut(last);
+        let (l, r) = (&mut head[worst], &mut tail[0]);
+        l.bez.subdivide_in_place(&mut r.bez, 0.5);
+        let (ul, el) = chord.piece(&l.bez);
+        let (ur, _) = chord.piece(&r.bez);
         lower = lower.max(el);
-        pieces[worst] = Piece { bez: l, upper: ul };
-        pieces.push(Piece { bez: r, upper: ur });
+        l.upper = ul;
+        r.upper = ur;
     }
 }

@@ -82,13 +82,19 @@ pub fn minimum_count(curve: &NurbsCurve, tol: f64) -> f64 {
     sqrt_curvature_integral(curve) / (8.0 * tol).sqrt()
 }
 
-/// A cheap estimate of [`minimum_count`] (one 10-point rule per knot span), used to size the
-/// output and to refuse absurd requests before any work.
+/// A cheap estimate of [`minimum_count`] (the 2-point Gauss rule per knot span), used to size
+/// the output and to refuse absurd requests before any work. It only needs the order of
+/// magnitude; a finer rule would cost more evaluations than the walk itself at coarse
+/// tolerances.
 pub fn estimate_count(curve: &NurbsCurve, tol: f64) -> f64 {
+    let x = 1.0 / 3f64.sqrt();
     curve
         .spans()
         .iter()
-        .map(|&(_, a, b)| gauss(curve, a, b))
+        .map(|&(_, a, b)| {
+            let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+            h * (integrand(curve, m - h * x) + integrand(curve, m + h * x))
+        })
         .sum::<f64>()
         / (8.0 * tol).sqrt()
 }

@@ -228,8 +228,11 @@ fn interp(file: &Path) -> impl Fn(kerf_interp::InterpError) -> CliError + '_ {
     move |e| CliError::Input(format!("{}: {e}", file.display()))
 }
 
-/// Writes every file into `dir`: first all into a staging directory beside it, then each is
-/// renamed into place, so a failure while writing leaves `dir` as it was.
+/// Writes every file into `dir`, all or nothing: the new files are written into a staging
+/// directory inside `dir`; then, file by file, an existing old file is moved aside into the
+/// staging directory and the new one renamed into place. If any step fails, the files already
+/// placed are removed and the old ones put back, so `dir` is left as it was. (A crash between
+/// two renames can still leave a mix; the staging directory then remains, named `.kerf-run-*`.)
 fn write_all(dir: &Path, files: &[(&str, String)]) -> Result<(), CliError> {
     let io = |what: &Path, e: std::io::Error| {
         CliError::Input(format!("{}: cannot write: {e}", what.display()))
@@ -239,14 +242,33 @@ fn write_all(dir: &Path, files: &[(&str, String)]) -> Result<(), CliError> {
         .prefix(".kerf-run-")
         .tempdir_in(dir)
         .map_err(|e| io(dir, e))?;
-    let mut staged: Vec<(PathBuf, PathBuf)> = Vec::new();
     for (name, text) in files {
         let p = stage.path().join(name);
         std::fs::write(&p, text).map_err(|e| io(&p, e))?;
-        staged.push((p, dir.join(name)));
     }
-    for (from, to) in staged {
-        std::fs::rename(&from, &to).map_err(|e| io(&to, e))?;
+    let mut old: Vec<(PathBuf, PathBuf)> = Vec::new();
+    let mut placed: Vec<PathBuf> = Vec::new();
+    let mut swap = || -> Result<(), CliError> {
+        for (name, _) in files {
+            let to = dir.join(name);
+            if std::fs::symlink_metadata(&to).is_ok() {
+                let aside = stage.path().join(format!("{name}.old"));
+                std::fs::rename(&to, &aside).map_err(|e| io(&to, e))?;
+                old.push((aside, to.clone()));
+            }
+            std::fs::rename(stage.path().join(name), &to).map_err(|e| io(&to, e))?;
+            placed.push(to);
+        }
+        Ok(())
+    };
+    let result = swap();
+    if result.is_err() {
+        for p in placed.iter().rev() {
+            let _ = std::fs::remove_file(p);
+        }
+        for (aside, to) in old.iter().rev() {
+            let _ = std::fs::rename(aside, to);
+        }
     }
-    Ok(())
+    result
 }

@@ -161,6 +161,13 @@ pub fn chord_error_with(
                 worst = i;
             }
         }
+        // A NaN distance (overflowing homogeneous coordinates) must never look like 0.
+        if pieces.iter().any(|p| p.upper.is_nan()) || lower.is_nan() {
+            return Bound {
+                upper: f64::INFINITY,
+                lower: if lower.is_nan() { f64::INFINITY } else { lower },
+            };
+        }
         let upper_m = upper + margin;
         if lower > limit {
             return Bound {

@@ -145,6 +145,8 @@ impl Walker<'_> {
                 if hit.t <= t0 {
                     break;
                 }
+                // Certify exactly the point that will be output for the piece end.
+                let hit = if hit.t >= b { Hit { t: b, p: pb } } else { hit };
                 let (bound, ok) = self.certify(t0, &p0, &hit);
                 let cand = Cand {
                     r: (hit.p - p0).norm(),
@@ -199,7 +201,7 @@ impl Walker<'_> {
                             t_try = 0.5 * (g.hit.t + bd.hit.t);
                         } else {
                             let gap = bd.r - g.r;
-                            if gap <= BRACKET_TOL * g.r {
+                            if gap <= BRACKET_TOL * g.r || gap <= crate::sphere::RADIUS_TOL * bd.r {
                                 break;
                             }
                             // Power law e = c r^q through both ends of the bracket.
@@ -238,6 +240,12 @@ impl Walker<'_> {
             };
             out.params.push(t1);
             out.points.push(p1);
+            if out.points.len() > self.opts.max_points {
+                return Err(DiscretizeError::TooManyPoints {
+                    limit: self.opts.max_points,
+                    estimate: out.points.len() as f64,
+                });
+            }
             t0 = t1;
             p0 = p1;
         }

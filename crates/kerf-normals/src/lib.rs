@@ -156,8 +156,11 @@ impl Ctx<'_> {
     /// whether `[a, b]` already carries the chord-error guarantee.
     fn segment(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
         let angle = a.n.angle(&b.n);
+        let tm = 0.5 * (a.t + b.t);
         if angle > self.nopts.max_normal_step {
-            if b.t - a.t <= self.min_dt {
+            // Stop splitting when the interval is tiny, or so close to the float spacing that
+            // its midpoint is no longer strictly inside (large parameter values).
+            if b.t - a.t <= self.min_dt || !(a.t < tm && tm < b.t) {
                 if a.n.dot(&b.n) < 0.0 {
                     return Err(NormalsError::Reversed {
                         t: a.t,
@@ -172,7 +175,6 @@ impl Ctx<'_> {
                     limit: self.nopts.max_inserted,
                 });
             }
-            let tm = 0.5 * (a.t + b.t);
             let m = self.sample(tm, self.curve.point(tm), a.hint)?;
             self.out.inserted += 1;
             self.segment(a, m, false)?;
@@ -231,7 +233,7 @@ pub fn orient(
         surface,
         dopts,
         nopts,
-        min_dt: 1e-9 * (db - da),
+        min_dt: (1e-9 * (db - da)).max(8.0 * f64::EPSILON * da.abs().max(db.abs())),
         out: Oriented {
             max_chord_error: disc.max_chord_error,
             params: Vec::with_capacity(disc.params.len()),

@@ -416,3 +416,27 @@ fn real_parts_get_normals_and_never_reverse() {
         }
     }
 }
+
+#[test]
+fn large_parameter_values_do_not_recurse_forever_at_a_jump() {
+    // Parameters near 1e7 are 1.9e-9 apart, coarser than 1e-9 of the domain: the split must
+    // stop when the midpoint is no longer strictly inside, and report the jump.
+    let (v, t) = box_mesh();
+    let mesh = MeshNormals::new(v, t, 30f64.to_radians(), false).unwrap();
+    let base = 1e7;
+    let curve = NurbsCurve::new(
+        1,
+        vec![base, base, base + 0.5, base + 1.0, base + 1.0],
+        vec![
+            Point3::new(2.0, 5.0, 10.0),
+            Point3::new(10.0, 5.0, 10.0),
+            Point3::new(10.0, 5.0, 2.0),
+        ],
+        None,
+    );
+    let o = run(&curve, &mesh, 0.01).unwrap();
+    assert_eq!(o.jumps.len(), 1, "one jump at the edge");
+    for w in o.params.windows(2) {
+        assert!(w[1] > w[0], "params strictly increase");
+    }
+}

@@ -84,6 +84,17 @@ impl NurbsCurve {
                 }
             }
         }
+        if let Some(w) = &weights {
+            for (i, (p, &wi)) in points.iter().zip(w).enumerate() {
+                if !(p.coords * wi).iter().all(|c| c.is_finite()) {
+                    return Err(NurbsError::HomogeneousOverflow {
+                        field: "weights",
+                        index: format!("[{i}]"),
+                        weight: wi,
+                    });
+                }
+            }
+        }
         let rational = weights
             .as_ref()
             .is_some_and(|w| w.iter().any(|&x| x != w[0]));
@@ -572,5 +583,26 @@ pub fn rational_from_homogeneous(a: &[Vector4<f64>], c: &mut [Vector3<f64>]) {
             v -= c[k - i] * (binomial(k, i) * a[i].w);
         }
         c[k] = v / w0;
+    }
+}
+
+#[cfg(test)]
+mod overflow_tests {
+    use super::*;
+
+    #[test]
+    fn weight_times_coordinate_overflow_is_refused() {
+        let e = NurbsCurve::try_new(
+            1,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![Point3::new(0.0, 0.0, 0.0), Point3::new(1e200, 0.0, 0.0)],
+            Some(vec![1.0, 1e200]),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "weights[1]: weight 1e200 times the control point overflows double precision",
+            "message names the place"
+        );
     }
 }

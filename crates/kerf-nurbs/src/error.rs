@@ -114,6 +114,20 @@ pub enum NurbsError {
         /// z coordinate.
         z: f64,
     },
+    /// A weight times a coordinate of its control point overflows double precision (both are
+    /// finite, but `w * x` is not), so the curve cannot be evaluated. Fix: scale the weights
+    /// down (only their ratios matter) or the coordinates.
+    #[error(
+        "{field}{index}: weight {weight:e} times the control point overflows double precision"
+    )]
+    HomogeneousOverflow {
+        /// `weights`.
+        field: &'static str,
+        /// Index as written in a path: `[3]`.
+        index: String,
+        /// The weight.
+        weight: f64,
+    },
     /// The number of weights differs from the number of control points.
     #[error("{field}: expected {expected} weights (one per control point), got {got}")]
     WeightCount {

@@ -5,23 +5,9 @@
 //! length is `sqrt(k / (8 tol))`. Integrating along the curve gives the asymptotic minimum
 //! (`docs/discretization.md` derives it).
 
+use kerf_nurbs::arclength::{GL10_NODES as GL_X, GL10_WEIGHTS as GL_W};
 use kerf_nurbs::curve::curvature_of;
 use kerf_nurbs::NurbsCurve;
-
-const GL_X: [f64; 5] = [
-    0.148_874_338_981_631_2,
-    0.433_395_394_129_247_2,
-    0.679_409_568_299_024_4,
-    0.865_063_366_688_984_5,
-    0.973_906_528_517_171_7,
-];
-const GL_W: [f64; 5] = [
-    0.295_524_224_714_752_9,
-    0.269_266_719_309_996_4,
-    0.219_086_362_515_982_04,
-    0.149_451_349_150_580_6,
-    0.066_671_344_308_688_14,
-];
 
 fn integrand(curve: &NurbsCurve, t: f64) -> f64 {
     let (_, d1, d2) = curve.eval_d2(t);

@@ -9,15 +9,17 @@
 use crate::curve::NurbsCurve;
 use crate::error::{NurbsError, Result};
 
-/// Nodes and weights of the 10-point Gauss-Legendre rule on `[-1, 1]` (positive half).
-const GL_X: [f64; 5] = [
+/// Nodes of the 10-point Gauss-Legendre rule on `[-1, 1]` (positive half; the rule is
+/// symmetric).
+pub const GL10_NODES: [f64; 5] = [
     0.148_874_338_981_631_2,
     0.433_395_394_129_247_2,
     0.679_409_568_299_024_4,
     0.865_063_366_688_984_5,
     0.973_906_528_517_171_7,
 ];
-const GL_W: [f64; 5] = [
+/// Weights of the 10-point Gauss-Legendre rule, matching [`GL10_NODES`].
+pub const GL10_WEIGHTS: [f64; 5] = [
     0.295_524_224_714_752_9,
     0.269_266_719_309_996_4,
     0.219_086_362_515_982_04,
@@ -36,7 +38,8 @@ impl NurbsCurve {
         let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
         let mut s = 0.0;
         for i in 0..5 {
-            s += GL_W[i] * (self.speed(m - h * GL_X[i]) + self.speed(m + h * GL_X[i]));
+            s += GL10_WEIGHTS[i]
+                * (self.speed(m - h * GL10_NODES[i]) + self.speed(m + h * GL10_NODES[i]));
         }
         s * h
     }

@@ -401,14 +401,7 @@ impl NurbsCurve {
     /// The axis-aligned box `(min, max)` of the control points, which contains the curve
     /// (convex-hull property, all weights > 0).
     pub fn bounding_box(&self) -> (Point3<f64>, Point3<f64>) {
-        let mut lo = Point3::from(Vector3::repeat(f64::INFINITY));
-        let mut hi = Point3::from(Vector3::repeat(f64::NEG_INFINITY));
-        for c in &self.cpw {
-            let p = project(c);
-            lo = lo.inf(&p);
-            hi = hi.sup(&p);
-        }
-        (lo, hi)
+        hull_box(&self.cpw)
     }
 
     /// The diagonal of the control-point bounding box: the curve's size, for relative
@@ -561,6 +554,19 @@ impl NurbsCurve {
 #[inline]
 pub fn project(c: &Vector4<f64>) -> Point3<f64> {
     Point3::new(c.x / c.w, c.y / c.w, c.z / c.w)
+}
+
+/// The axis-aligned box `(min, max)` of projected homogeneous control points: with positive
+/// weights it contains the curve or surface they define.
+pub fn hull_box(cpw: &[Vector4<f64>]) -> (Point3<f64>, Point3<f64>) {
+    let mut lo = Point3::from(Vector3::repeat(f64::INFINITY));
+    let mut hi = Point3::from(Vector3::repeat(f64::NEG_INFINITY));
+    for c in cpw {
+        let p = project(c);
+        lo = lo.inf(&p);
+        hi = hi.sup(&p);
+    }
+    (lo, hi)
 }
 
 /// Curvature `|d1 x d2| / |d1|^3` from the first two derivatives; 0 if `d1 = 0`.

@@ -472,14 +472,7 @@ impl NurbsSurface {
     /// The axis-aligned box `(min, max)` of the control points, which contains the surface
     /// (convex-hull property, all weights > 0).
     pub fn bounding_box(&self) -> (Point3<f64>, Point3<f64>) {
-        let mut lo = Point3::from(Vector3::repeat(f64::INFINITY));
-        let mut hi = Point3::from(Vector3::repeat(f64::NEG_INFINITY));
-        for c in &self.cpw {
-            let p = project(c);
-            lo = lo.inf(&p);
-            hi = hi.sup(&p);
-        }
-        (lo, hi)
+        crate::curve::hull_box(&self.cpw)
     }
 
     /// The diagonal of the control-point bounding box: the surface's size, for relative

@@ -5,7 +5,7 @@ use std::io::{self, Write};
 use std::path::Path;
 use std::time::Instant;
 
-use kerf_discretize::{discretize_all, minimum_count, Discretization, Options};
+use kerf_discretize::{minimum_count, Discretization, Options};
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_format::{curves, CurvesFile, SurfaceGeometry};
 use kerf_normals::{orient, MeshNormals, NormalOptions, NormalSource, NurbsNormals, Oriented};
@@ -46,21 +46,24 @@ pub(crate) fn discretize_file(
     opts: &Options,
 ) -> Result<Vec<Discretization>, CliError> {
     opts.validate().map_err(CliError::Options)?;
-    let results: Vec<_> = if show_progress(file.curves.len()) {
-        use indicatif::ParallelProgressIterator;
-        let bar = progress_bar(file.curves.len(), "discretizing");
-        let out = file
-            .curves
-            .par_iter()
-            .progress_with(bar.clone())
-            .map(|r| kerf_discretize::discretize(&r.curve, opts))
-            .collect();
-        bar.finish_and_clear();
-        out
-    } else {
-        let curves: Vec<_> = file.curves.iter().map(|r| r.curve.clone()).collect();
-        discretize_all(&curves, opts)
-    };
+    // The records are discretized in place (no copy of the curves), in parallel, with a
+    // progress bar on a terminal for long batches; results come back in input order.
+    let bar =
+        show_progress(file.curves.len()).then(|| progress_bar(file.curves.len(), "discretizing"));
+    let results: Vec<_> = file
+        .curves
+        .par_iter()
+        .map(|r| {
+            let d = kerf_discretize::discretize(&r.curve, opts);
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+            d
+        })
+        .collect();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
     results
         .into_iter()
         .enumerate()

@@ -205,6 +205,18 @@ impl Motion {
         self.peak_speed.get(b).copied().unwrap_or(0.0) * 60.0
     }
 
+    /// The planned time of block `b` from its start to its end, seconds: what an inverse-time
+    /// (`G93`) feed word must say for the controller to follow this plan
+    /// (`F = 60 / block_duration` in 1/min); 0 for an index out of range.
+    pub fn block_duration(&self, b: usize) -> f64 {
+        self.pieces
+            .iter()
+            .zip(&self.profiles)
+            .filter(|(p, _)| p.block == b)
+            .map(|(_, pr)| pr.duration())
+            .sum()
+    }
+
     /// [`Motion::block_feed`] of every block, for the `F` words of [`crate::gcode`].
     pub fn block_feeds(&self) -> Vec<f64> {
         (0..self.blocks.len()).map(|b| self.block_feed(b)).collect()

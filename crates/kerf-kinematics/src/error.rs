@@ -112,6 +112,21 @@ pub enum KinematicsError {
         /// Which axes jump, and by how much.
         detail: String,
     },
+    /// No placement of the part puts every pose within the machine's limits
+    /// ([`crate::auto_place`]). `axis` is the axis that falls short for the best candidate and
+    /// `missing` by how much (mm, or degrees for a rotary axis). Fix: a machine with more
+    /// travel, or cut the part's contours in several set-ups.
+    #[error("no placement fits the machine: {axis} is {missing:.3} short ({detail}; {rotations_tried} rotations tried)")]
+    NoPlacement {
+        /// The axis name.
+        axis: &'static str,
+        /// How much travel is missing, mm or degrees.
+        missing: f64,
+        /// What needs it.
+        detail: String,
+        /// How many rotations of the part were tried.
+        rotations_tried: usize,
+    },
     /// More than [`crate::PathOptions::max_inserted`] points would have to be inserted in
     /// one path. Fix: raise `linearization_tolerance` or `max_rotary_step`, or the limit.
     #[error("path \"{path_id}\": more than {limit} points would have to be inserted (at point {index}); raise linearization_tolerance or max_rotary_step")]

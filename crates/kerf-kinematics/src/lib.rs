@@ -41,6 +41,7 @@ pub mod kinematics;
 pub mod machine;
 pub mod nonlinear;
 pub mod path;
+pub mod placement;
 pub mod pose;
 mod registry;
 mod rotation;
@@ -55,6 +56,9 @@ pub use kinematics::Kinematics;
 pub use machine::{Machine, Range, MACHINE_FORMAT};
 pub use nonlinear::{linearization_error, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
+pub use placement::{
+    auto_place, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement, Placement,
+};
 pub use pose::{Axes, Axis, Pose};
 pub use registry::kinematics_types;
 pub use table_table::TableTable;

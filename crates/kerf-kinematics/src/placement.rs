@@ -1,0 +1,638 @@
+//! Placing the part on the machine: a rigid part-to-workpiece transform, chosen by hand or
+//! automatically so that every pose of every contour is reachable within the axis limits.
+//!
+//! A part sits where its CAD model put it; the machine's travel is somewhere else. A
+//! [`Placement`] maps part coordinates to workpiece coordinates, `p' = R p + t`, with
+//! `R = Rz(rz) Ry(ry) Rx(rx)` (rotations about the fixed workpiece axes, first about x, then y,
+//! then z; angles in degrees) and `t` in mm. Tool axes turn with `R`.
+//!
+//! [`auto_place`] searches for a placement (see `docs/kinematics.md`, "Placement"):
+//!
+//! 1. For each candidate rotation (the identity first, then the other 23 rotations that map
+//!    the coordinate axes onto coordinate axes), each contour's side is chosen: on a sheet
+//!    either normal is a valid beam direction, so a contour whose tool axes the tilt axis
+//!    cannot reach is turned to the other side if that side is reachable (with
+//!    [`AutoPlaceOptions::with_flip`]).
+//! 2. The paths are solved with the linear axes unlimited. The rotary axes of every pose depend
+//!    only on its tool axis, so they do not change when the part is translated; with them
+//!    fixed, the linear axes are an affine function of the tip, `XYZ_n = M_n P_n + b_n`, with
+//!    `M_n` a rotation (the identity for head machines). A translation `t` of the part moves
+//!    every `XYZ_n` by `M_n t`.
+//! 3. The translation solves `lo <= XYZ_n + M_n t <= hi` for every pose and linear axis. For
+//!    head machines (all `M_n = I`) the feasible set is a box, and `t` is its centre: the part's
+//!    motion envelope sits in the middle of the travel. Otherwise `t` minimises the largest
+//!    normalised limit violation (a convex piecewise-linear function, minimised by the
+//!    ellipsoid method), which also keeps the envelope away from the limits.
+//! 4. The placement with the identity rotation is taken if it fits; else the fitting rotation
+//!    with the largest clearance to the limits. Every candidate is checked by solving the
+//!    placed paths against the real limits.
+//!
+//! If nothing fits, the error names the axis and how much travel is missing.
+
+use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
+
+use crate::error::{KinematicsError, Result};
+use crate::machine::{Machine, Range};
+use crate::path::{solve_paths, PathInput, PathOptions, SolvedPath};
+use crate::pose::{Axes, Pose};
+
+/// A rigid transform from part coordinates to workpiece coordinates: `p' = R p + t`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placement {
+    /// The translation `t`, mm.
+    pub translation_mm: Vector3<f64>,
+    /// The rotation angles `[rx, ry, rz]` in degrees: `R = Rz(rz) Ry(ry) Rx(rx)`.
+    pub rotation_deg: [f64; 3],
+}
+
+impl Default for Placement {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Placement {
+    /// The part where its model put it.
+    pub const IDENTITY: Placement = Placement {
+        translation_mm: Vector3::new(0.0, 0.0, 0.0),
+        rotation_deg: [0.0; 3],
+    };
+
+    /// A placement from a translation (mm) and rotation angles (degrees, `Rz Ry Rx`).
+    pub fn new(translation_mm: Vector3<f64>, rotation_deg: [f64; 3]) -> Self {
+        Self {
+            translation_mm,
+            rotation_deg,
+        }
+    }
+
+    /// The rotation matrix `Rz(rz) Ry(ry) Rx(rx)`.
+    pub fn rotation(&self) -> Rotation3<f64> {
+        let [rx, ry, rz] = self.rotation_deg.map(f64::to_radians);
+        Rotation3::from_axis_angle(&Vector3::z_axis(), rz)
+            * Rotation3::from_axis_angle(&Vector3::y_axis(), ry)
+            * Rotation3::from_axis_angle(&Vector3::x_axis(), rx)
+    }
+
+    /// True if this is the identity (no rotation, no translation).
+    pub fn is_identity(&self) -> bool {
+        self.translation_mm == Vector3::zeros() && self.rotation_deg == [0.0; 3]
+    }
+
+    /// A point of the part in workpiece coordinates.
+    pub fn apply_point(&self, p: &Point3<f64>) -> Point3<f64> {
+        self.rotation() * p + self.translation_mm
+    }
+
+    /// A pose of the part (tip and tool axis) in workpiece coordinates.
+    pub fn apply_pose(&self, pose: &Pose) -> Pose {
+        let r = self.rotation();
+        Pose {
+            position: r * pose.position + self.translation_mm,
+            axis: r * pose.axis,
+        }
+    }
+
+    /// Reads `X,Y,Z` or `X,Y,Z,RX,RY,RZ` (mm and degrees), as the CLI's `--place` takes it.
+    ///
+    /// # Errors
+    /// A message naming the bad field.
+    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+        let fields: Vec<&str> = text.split(',').map(str::trim).collect();
+        if fields.len() != 3 && fields.len() != 6 {
+            return Err(format!(
+                "expected X,Y,Z or X,Y,Z,RX,RY,RZ (mm, degrees) or auto, got {} values",
+                fields.len()
+            ));
+        }
+        let names = ["X", "Y", "Z", "RX", "RY", "RZ"];
+        let mut v = [0.0; 6];
+        for (k, f) in fields.iter().enumerate() {
+            let x: f64 = f
+                .parse()
+                .map_err(|_| format!("{}: not a number: {f:?}", names[k]))?;
+            if !x.is_finite() || x.abs() > 1e7 {
+                return Err(format!("{}: must be finite and within 1e7 (got {f})", names[k]));
+            }
+            v[k] = x;
+        }
+        Ok(Self::new(Vector3::new(v[0], v[1], v[2]), [v[3], v[4], v[5]]))
+    }
+}
+
+impl std::fmt::Display for Placement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let t = self.translation_mm;
+        let [rx, ry, rz] = self.rotation_deg;
+        write!(
+            f,
+            "translation ({:.3}, {:.3}, {:.3}) mm, rotation Rz({rz}) Ry({ry}) Rx({rx}) deg",
+            t.x, t.y, t.z
+        )
+    }
+}
+
+/// Options of [`auto_place`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct AutoPlaceOptions {
+    /// Try the 24 axis-aligned rotations when the part does not fit as modelled. Default true.
+    pub rotate: bool,
+    /// Turn a contour to the other side of its sheet when the machine cannot reach the given
+    /// side. Default true.
+    pub flip: bool,
+    /// Distance kept from every linear limit, mm. Default 1.
+    pub margin_mm: f64,
+    /// The options the paths are solved with (the same as for the final solve).
+    pub path_options: PathOptions,
+}
+
+impl Default for AutoPlaceOptions {
+    fn default() -> Self {
+        Self {
+            rotate: true,
+            flip: true,
+            margin_mm: 1.0,
+            path_options: PathOptions::default(),
+        }
+    }
+}
+
+impl AutoPlaceOptions {
+    /// With or without trying rotations.
+    pub fn with_rotate(mut self, rotate: bool) -> Self {
+        self.rotate = rotate;
+        self
+    }
+    /// With or without turning contours to the reachable side.
+    pub fn with_flip(mut self, flip: bool) -> Self {
+        self.flip = flip;
+        self
+    }
+    /// With this clearance to the linear limits, mm.
+    pub fn with_margin_mm(mut self, margin_mm: f64) -> Self {
+        self.margin_mm = margin_mm;
+        self
+    }
+    /// With these path options.
+    pub fn with_path_options(mut self, path_options: PathOptions) -> Self {
+        self.path_options = path_options;
+        self
+    }
+}
+
+/// What [`auto_place`] chose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AutoPlacement {
+    /// The placement.
+    pub placement: Placement,
+    /// For each path, true if its tool axes were turned to the other side of the sheet.
+    pub flipped: Vec<bool>,
+    /// The smallest distance of any pose to any linear limit, mm (>= the margin).
+    pub clearance_mm: f64,
+    /// How many rotations were tried.
+    pub rotations_tried: usize,
+}
+
+impl AutoPlacement {
+    /// The placed poses of every path (flips applied), ready for [`solve_paths`].
+    pub fn apply(&self, paths: &[Vec<Pose>]) -> Vec<Vec<Pose>> {
+        place_paths(&self.placement, &self.flipped, paths)
+    }
+}
+
+/// `paths` placed by `placement`, each path's tool axes reversed where `flipped` says so.
+pub fn place_paths(placement: &Placement, flipped: &[bool], paths: &[Vec<Pose>]) -> Vec<Vec<Pose>> {
+    paths
+        .iter()
+        .enumerate()
+        .map(|(i, poses)| {
+            let flip = flipped.get(i).copied().unwrap_or(false);
+            poses
+                .iter()
+                .map(|p| {
+                    let q = placement.apply_pose(p);
+                    if flip {
+                        Pose {
+                            position: q.position,
+                            axis: -q.axis,
+                        }
+                    } else {
+                        q
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The 24 rotations that map coordinate axes onto coordinate axes, as `[rx, ry, rz]` degrees,
+/// the identity first, then by the number of non-zero angles and the angles themselves.
+pub fn axis_aligned_rotations() -> Vec<[f64; 3]> {
+    let quarter = [0.0, 90.0, 180.0, 270.0];
+    let mut all: Vec<[f64; 3]> = Vec::new();
+    for &rx in &quarter {
+        for &ry in &quarter {
+            for &rz in &quarter {
+                all.push([rx, ry, rz]);
+            }
+        }
+    }
+    all.sort_by(|a, b| {
+        let nz = |r: &[f64; 3]| r.iter().filter(|v| **v != 0.0).count();
+        nz(a).cmp(&nz(b)).then(
+            a.partial_cmp(b)
+                .unwrap_or(std::cmp::Ordering::Equal),
+        )
+    });
+    let mut out: Vec<[f64; 3]> = Vec::new();
+    let mut seen: Vec<Matrix3<f64>> = Vec::new();
+    for r in all {
+        let m = Placement::new(Vector3::zeros(), r).rotation().into_inner();
+        let m = m.map(f64::round);
+        if !seen.contains(&m) {
+            seen.push(m);
+            out.push(r);
+        }
+    }
+    out
+}
+
+/// Why one candidate rotation does not fit.
+#[derive(Debug, Clone)]
+struct Shortfall {
+    /// The axis name.
+    axis: &'static str,
+    /// How much is missing (mm or degrees).
+    missing: f64,
+    /// What it is about.
+    detail: String,
+}
+
+/// Chooses a placement of the part (and the side of each contour) so that every pose of every
+/// path is reachable within the machine's limits, preferring the middle of the travel; see the
+/// module documentation for the method.
+///
+/// # Errors
+/// [`KinematicsError::NoPlacement`] naming the axis and how much travel (or tilt) is missing
+/// for the best candidate; the errors of [`solve_paths`] for unusable poses.
+pub fn auto_place(
+    machine: &Machine,
+    paths: &[(&str, &[Pose])],
+    options: &AutoPlaceOptions,
+) -> Result<AutoPlacement> {
+    options.path_options.validate()?;
+    if !(options.margin_mm.is_finite() && options.margin_mm >= 0.0) {
+        return Err(KinematicsError::BadOption {
+            name: "margin_mm",
+            value: options.margin_mm,
+            reason: "must be finite and >= 0 (mm)",
+        });
+    }
+    let rotations = if options.rotate {
+        axis_aligned_rotations()
+    } else {
+        vec![[0.0; 3]]
+    };
+    let owned: Vec<Vec<Pose>> = paths.iter().map(|(_, p)| p.to_vec()).collect();
+    let mut best: Option<AutoPlacement> = None;
+    let mut best_short: Option<Shortfall> = None;
+    let mut tried = 0;
+    for (ri, rot) in rotations.iter().enumerate() {
+        tried += 1;
+        match try_rotation(machine, paths, &owned, *rot, options) {
+            Ok(found) => {
+                if ri == 0 {
+                    return Ok(AutoPlacement {
+                        rotations_tried: tried,
+                        ..found
+                    });
+                }
+                if best
+                    .as_ref()
+                    .is_none_or(|b| found.clearance_mm > b.clearance_mm + 1e-9)
+                {
+                    best = Some(found);
+                }
+            }
+            Err(TryError::Short(s)) => {
+                if best_short.as_ref().is_none_or(|b| s.missing < b.missing) {
+                    best_short = Some(s);
+                }
+            }
+            Err(TryError::Hard(e)) => return Err(e),
+        }
+    }
+    if let Some(b) = best {
+        return Ok(AutoPlacement {
+            rotations_tried: tried,
+            ..b
+        });
+    }
+    let s = best_short.unwrap_or(Shortfall {
+        axis: "X",
+        missing: 0.0,
+        detail: "no candidate".into(),
+    });
+    Err(KinematicsError::NoPlacement {
+        axis: s.axis,
+        missing: s.missing,
+        detail: s.detail,
+        rotations_tried: tried,
+    })
+}
+
+enum TryError {
+    Short(Shortfall),
+    Hard(KinematicsError),
+}
+
+/// A pose's tilt reachable with either inverse solution.
+fn tilt_reachable(machine: &Machine, pose: &Pose) -> std::result::Result<(), f64> {
+    let Some(range) = machine.limits[3] else {
+        return Ok(());
+    };
+    let sols = machine.kinematics.inverse(pose);
+    let mut miss = f64::INFINITY;
+    for s in sols {
+        let t = s.tilt;
+        let m = if t < range.min {
+            range.min - t
+        } else if t > range.max {
+            t - range.max
+        } else {
+            0.0
+        };
+        miss = miss.min(m);
+    }
+    if miss <= 1e-9 {
+        Ok(())
+    } else {
+        Err(miss)
+    }
+}
+
+fn path_tilt_shortfall(machine: &Machine, poses: &[Pose]) -> f64 {
+    poses
+        .iter()
+        .filter_map(|p| tilt_reachable(machine, p).err())
+        .fold(0.0, f64::max)
+}
+
+fn try_rotation(
+    machine: &Machine,
+    paths: &[(&str, &[Pose])],
+    owned: &[Vec<Pose>],
+    rot: [f64; 3],
+    options: &AutoPlaceOptions,
+) -> std::result::Result<AutoPlacement, TryError> {
+    let tilt_name = machine.kinematics.tilt_name();
+    let rotation = Placement::new(Vector3::zeros(), rot);
+    let rotated = place_paths(&rotation, &[], owned);
+    // 1. The side of each contour.
+    let mut flipped = vec![false; rotated.len()];
+    for (i, poses) in rotated.iter().enumerate() {
+        let short = path_tilt_shortfall(machine, poses);
+        if short == 0.0 {
+            continue;
+        }
+        let reversed: Vec<Pose> = poses
+            .iter()
+            .map(|p| Pose {
+                position: p.position,
+                axis: -p.axis,
+            })
+            .collect();
+        let short_rev = path_tilt_shortfall(machine, &reversed);
+        if options.flip && short_rev == 0.0 {
+            flipped[i] = true;
+        } else {
+            let missing = if options.flip { short.min(short_rev) } else { short };
+            return Err(TryError::Short(Shortfall {
+                axis: tilt_name,
+                missing,
+                detail: format!(
+                    "path \"{}\": its tool axes need {missing:.3} deg more {tilt_name} travel{}",
+                    paths[i].0,
+                    if options.flip { " on either side of the sheet" } else { "" }
+                ),
+            }));
+        }
+    }
+    let sided = place_paths(&Placement::IDENTITY, &flipped, &rotated);
+    // 2. Solve with the linear axes unlimited.
+    let mut free = machine.clone();
+    for k in 0..3 {
+        free.limits[k] = None;
+    }
+    let solved = solve(&free, paths, &sided, &options.path_options).map_err(|e| match e {
+        KinematicsError::OutOfLimits {
+            axis, value, min, max, ref path_id, ..
+        } => TryError::Short(Shortfall {
+            axis,
+            missing: (min - value).max(value - max),
+            detail: format!("path \"{path_id}\": {e}"),
+        }),
+        other => TryError::Hard(other),
+    })?;
+    // 3. The translation.
+    let t = translation(machine, &solved, options.margin_mm).map_err(TryError::Short)?;
+    let placement = Placement::new(t, rot);
+    // 4. Check against the real limits.
+    let placed = place_paths(&placement, &flipped, owned);
+    let check = solve(machine, paths, &placed, &options.path_options).map_err(|e| match e {
+        KinematicsError::OutOfLimits {
+            axis, value, min, max, ..
+        } => TryError::Short(Shortfall {
+            axis,
+            missing: (min - value).max(value - max),
+            detail: e.to_string(),
+        }),
+        other => TryError::Hard(other),
+    })?;
+    let clearance_mm = clearance(machine, &check);
+    Ok(AutoPlacement {
+        placement,
+        flipped,
+        clearance_mm,
+        rotations_tried: 0,
+    })
+}
+
+fn solve(
+    machine: &Machine,
+    paths: &[(&str, &[Pose])],
+    poses: &[Vec<Pose>],
+    options: &PathOptions,
+) -> Result<Vec<SolvedPath>> {
+    let inputs: Vec<PathInput<'_>> = paths
+        .iter()
+        .zip(poses)
+        .map(|((id, _), p)| PathInput {
+            id,
+            poses: p,
+            curve: None,
+        })
+        .collect();
+    solve_paths(machine, &inputs, options)
+}
+
+/// The smallest distance of any solved linear axis value to its limits.
+fn clearance(machine: &Machine, solved: &[SolvedPath]) -> f64 {
+    let mut c = f64::INFINITY;
+    for s in solved {
+        for a in &s.axes {
+            let q = a.to_array();
+            for k in 0..3 {
+                if let Some(r) = machine.limits[k] {
+                    c = c.min(q[k] - r.min).min(r.max - q[k]);
+                }
+            }
+        }
+    }
+    c
+}
+
+/// `M` of a pose: how the linear axes move when the tip moves, with the rotary axes fixed
+/// (`XYZ = M P + b`). The forward kinematics is affine in `XYZ` at fixed rotaries, so the
+/// columns of its matrix `N` are exact differences, and `M = N^-1`.
+fn tip_to_axes(machine: &Machine, axes: &Axes) -> Matrix3<f64> {
+    let base = machine.kinematics.forward(axes).position;
+    let mut n = Matrix3::zeros();
+    for k in 0..3 {
+        let mut q = axes.to_array();
+        q[k] += 1.0;
+        let p = machine.kinematics.forward(&Axes::from_array(q)).position;
+        n.set_column(k, &(p - base));
+    }
+    n.try_inverse().unwrap_or_else(Matrix3::identity)
+}
+
+/// The translation that puts every solved pose within the linear limits (less the margin),
+/// centred; see the module documentation.
+fn translation(
+    machine: &Machine,
+    solved: &[SolvedPath],
+    margin: f64,
+) -> std::result::Result<Vector3<f64>, Shortfall> {
+    let names = machine.axis_names();
+    // The linear axis values and their sensitivity to a translation of the part.
+    let mut rows: Vec<(Vector3<f64>, Matrix3<f64>)> = Vec::new();
+    let mut all_identity = true;
+    for s in solved {
+        for a in &s.axes {
+            let m = tip_to_axes(machine, a);
+            if (m - Matrix3::identity()).amax() > 1e-9 {
+                all_identity = false;
+            }
+            rows.push((a.xyz(), m));
+        }
+    }
+    if rows.is_empty() {
+        return Ok(Vector3::zeros());
+    }
+    let ranges: [Option<Range>; 3] = [machine.limits[0], machine.limits[1], machine.limits[2]];
+    if all_identity {
+        let mut t = Vector3::zeros();
+        for k in 0..3 {
+            let Some(r) = ranges[k] else { continue };
+            let lo = rows.iter().map(|(q, _)| q[k]).fold(f64::INFINITY, f64::min);
+            let hi = rows.iter().map(|(q, _)| q[k]).fold(f64::NEG_INFINITY, f64::max);
+            let need = hi - lo;
+            let have = (r.max - r.min) - 2.0 * margin;
+            if need > have {
+                return Err(Shortfall {
+                    axis: names[k],
+                    missing: need - have,
+                    detail: format!(
+                        "the part's motion needs {need:.3} mm of {} travel, the machine has {:.3} mm less a margin of {margin} mm on each side: {:.3} mm short",
+                        names[k],
+                        r.max - r.min,
+                        need - have
+                    ),
+                });
+            }
+            t[k] = 0.5 * (r.min + r.max) - 0.5 * (lo + hi);
+        }
+        return Ok(t);
+    }
+    // Table machines: minimise the largest normalised violation f(t) =
+    // max over poses n and limited axes k of (lo_k + margin - (q_nk + (M_n t)_k)) / w_k and
+    // ((q_nk + (M_n t)_k) - hi_k + margin) / w_k, w_k the half-width of the travel. Convex and
+    // piecewise linear: the central-cut ellipsoid method with subgradient cuts.
+    let eval = |t: &Vector3<f64>| -> (f64, Vector3<f64>, usize) {
+        let mut worst = f64::NEG_INFINITY;
+        let mut grad = Vector3::zeros();
+        let mut axis = 0;
+        for (q, m) in &rows {
+            let x = q + m * t;
+            for k in 0..3 {
+                let Some(r) = ranges[k] else { continue };
+                let w = 0.5 * (r.max - r.min).max(1e-9);
+                let low = (r.min + margin - x[k]) / w;
+                let high = (x[k] - r.max + margin) / w;
+                if low > worst {
+                    worst = low;
+                    grad = -m.row(k).transpose() / w;
+                    axis = k;
+                }
+                if high > worst {
+                    worst = high;
+                    grad = m.row(k).transpose() / w;
+                    axis = k;
+                }
+            }
+        }
+        (worst, grad, axis)
+    };
+    // Start at the translation that puts the mean axis position at the middle of the travel
+    // (for the average M), inside a ball of the machine's size plus the part's distance.
+    let mut centre = Vector3::zeros();
+    let mut radius: f64 = 1.0;
+    for k in 0..3 {
+        if let Some(r) = ranges[k] {
+            radius = radius.max(r.max.abs()).max(r.min.abs());
+        }
+    }
+    for (q, _) in &rows {
+        radius = radius.max(q.norm());
+    }
+    radius *= 4.0;
+    let mut shape = Matrix3::identity() * (radius * radius);
+    let (mut best_f, _, mut best_axis) = eval(&centre);
+    let mut best_t = centre;
+    let n = 3.0;
+    for _ in 0..2000 {
+        let (f, g, axis) = eval(&centre);
+        if f < best_f {
+            best_f = f;
+            best_t = centre;
+            best_axis = axis;
+        }
+        let pg = shape * g;
+        let gpg = g.dot(&pg);
+        if !(gpg > 0.0) || gpg.sqrt() < 1e-12 {
+            break;
+        }
+        let step = pg / gpg.sqrt();
+        centre -= step / (n + 1.0);
+        shape = (shape - step * step.transpose() * (2.0 / (n + 1.0))) * (n * n / (n * n - 1.0));
+        // Stop when the ellipsoid is smaller than a micrometre.
+        if shape.trace().sqrt() < 1e-4 {
+            break;
+        }
+    }
+    if best_f > 0.0 {
+        let r = ranges[best_axis].unwrap_or(Range::new(0.0, 0.0));
+        let missing = best_f * 0.5 * (r.max - r.min);
+        return Err(Shortfall {
+            axis: names[best_axis],
+            missing,
+            detail: format!(
+                "no translation keeps every pose within the limits: the best leaves {} {missing:.3} mm outside [{}, {}] (margin {margin} mm)",
+                names[best_axis], r.min, r.max
+            ),
+        });
+    }
+    Ok(best_t)
+}

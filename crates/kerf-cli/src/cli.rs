@@ -241,6 +241,13 @@ pub(crate) struct PostArgs {
     #[arg(long, value_name = "DEG")]
     pub(crate) max_rotary_step: Option<f64>,
 
+    /// Where the part goes on the machine: `auto` (every pose within the axis limits, the
+    /// motion centred in the travel, contours turned to the side the head can reach, the part
+    /// turned by quarter turns if it does not fit as modelled) or `X,Y,Z[,RX,RY,RZ]` (mm,
+    /// degrees; `p' = Rz Ry Rx p + t`). Default: where the CAD model put it.
+    #[arg(long, value_name = "auto|X,Y,Z[,RX,RY,RZ]", value_parser = crate::place::parse_place, allow_hyphen_values = true)]
+    pub(crate) place: Option<crate::place::PlaceArg>,
+
     /// Tool axes within this angle of the C axis count as the pole, in radians (default 1e-6).
     #[arg(long, value_name = "RAD")]
     pub(crate) pole_tolerance: Option<f64>,
@@ -397,6 +404,13 @@ pub(crate) struct RunArgs {
     /// Largest rotary-axis move between two points, degrees (default: no limit).
     #[arg(long, value_name = "DEG")]
     pub(crate) max_rotary_step: Option<f64>,
+
+    /// Where the part goes on the machine: `auto` (every pose within the axis limits, the
+    /// motion centred in the travel, contours turned to the side the head can reach, the part
+    /// turned by quarter turns if it does not fit as modelled) or `X,Y,Z[,RX,RY,RZ]` (mm,
+    /// degrees; `p' = Rz Ry Rx p + t`). Default: where the CAD model put it.
+    #[arg(long, value_name = "auto|X,Y,Z[,RX,RY,RZ]", value_parser = crate::place::parse_place, allow_hyphen_values = true)]
+    pub(crate) place: Option<crate::place::PlaceArg>,
 
     /// Between two contours the head backs off this far along the tool axis, traverses, and
     /// approaches the next start along its tool axis (mm; 0 = one straight rapid at cutting

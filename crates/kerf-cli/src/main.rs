@@ -11,6 +11,7 @@ mod cli;
 mod discretize;
 mod error;
 mod motion;
+mod place;
 mod plot;
 mod post;
 mod run;

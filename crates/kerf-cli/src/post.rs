@@ -45,6 +45,18 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
             }
         }
     }
+    let opts = options(args);
+    let ids: Vec<&str> = tp.paths.iter().map(|p| p.id.as_str()).collect();
+    let placed = crate::place::place(
+        &machine,
+        &ids,
+        &poses,
+        args.place.as_ref(),
+        &opts,
+        crate::place::AUTO_CLEARANCE_MM,
+        &args.toolpath,
+    )?;
+    let poses = placed.apply(&poses);
     let inputs: Vec<PathInput<'_>> = tp
         .paths
         .iter()
@@ -55,7 +67,6 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
             curve: None,
         })
         .collect();
-    let opts = options(args);
     let solved = solve_paths(&machine, &inputs, &opts)
         .map_err(|e| CliError::Kinematics(Box::new(e), Some(args.toolpath.clone())))?;
     let file = AxesFile::new(&machine, &solved);
@@ -90,6 +101,7 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
             "linearization_tolerance": opts.linearization_tolerance,
             "pole_points": pole,
             "pole_tip_error": pole_err,
+            "placement": placed.json(&ids),
             "seconds": elapsed,
         });
         if dest == Path::new("-") {
@@ -101,12 +113,17 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
         eprintln!(
             "{}: {} paths on {:?}, {points} poses ({inserted} inserted), largest rotary step \
              between cutting points {max_rot:.3} deg, worst non-linearity {max_lin:.2e} mm <= {} mm, \
-             {pole} points at the pole (tip error {pole_err:.1e} mm), {elapsed:.3} s -> {}",
+             {pole} points at the pole (tip error {pole_err:.1e} mm), {elapsed:.3} s -> {}{}",
             args.toolpath.display(),
             solved.len(),
             machine.name,
             opts.linearization_tolerance,
-            dest.display()
+            dest.display(),
+            if placed.is_identity() {
+                String::new()
+            } else {
+                format!("; {}", placed.summary())
+            }
         );
     }
     Ok(())

@@ -64,12 +64,28 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         .iter()
         .map(|o| o.poses().into_iter().map(Pose::from_array).collect())
         .collect();
+    // 3a. Where the part goes on the machine; from here on, workpiece coordinates.
+    let id_refs: Vec<&str> = file.curves.iter().map(|c| c.id.as_str()).collect();
+    let placed =
+        crate::place::place(
+        &machine,
+        &id_refs,
+        &poses,
+        args.place.as_ref(),
+        &popts,
+        args.retract.max(0.0) + 1.0,
+        path,
+    )?;
+    let poses = placed.apply(&poses);
     let points: Vec<Box<dyn Fn(f64) -> nalgebra::Point3<f64> + Sync>> = file
         .curves
         .iter()
-        .map(|r| {
+        .enumerate()
+        .map(|(i, r)| {
             let c = r.curve.clone();
-            Box::new(move |t| c.point(t)) as Box<dyn Fn(f64) -> nalgebra::Point3<f64> + Sync>
+            let placement = placed.placement_of(i);
+            Box::new(move |t| placement.apply_point(&c.point(t)))
+                as Box<dyn Fn(f64) -> nalgebra::Point3<f64> + Sync>
         })
         .collect();
     let inputs: Vec<PathInput<'_>> = file
@@ -174,6 +190,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "pole_points": solved.iter().map(|s| s.pole_points).sum::<usize>(),
             "pole_tip_error": solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
         },
+        "placement": placed.json(&id_refs),
         "interpolation": {
             "feed_mm_per_min": args.feed,
             "cycle_s": args.cycle,
@@ -207,7 +224,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     } else if !args.quiet {
         eprintln!(
             "{}: {} curves -> {} cutting points (N* {nstar:.1}), {} poses on {:?}, {} lines + {} arcs, \
-             {:.2} s of motion at {} mm/min; wrote {} in {:.2} s",
+             {:.2} s of motion at {} mm/min; wrote {} in {:.2} s{}",
             path.display(),
             file.curves.len(),
             tp.paths.iter().map(|p| p.params.len()).sum::<usize>(),
@@ -218,7 +235,12 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             motion.duration(),
             args.feed,
             args.out.display(),
-            start.elapsed().as_secs_f64()
+            start.elapsed().as_secs_f64(),
+            if placed.is_identity() {
+                String::new()
+            } else {
+                format!("; {}", placed.summary())
+            }
         );
     }
     Ok(())

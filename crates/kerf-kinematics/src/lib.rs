@@ -57,7 +57,8 @@ pub use machine::{Machine, Range, MACHINE_FORMAT};
 pub use nonlinear::{linearization_error, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
 pub use placement::{
-    auto_place, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement, Placement,
+    auto_place, auto_setups, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement,
+    Placement, Setup, SetupPlan,
 };
 pub use pose::{Axes, Axis, Pose};
 pub use registry::kinematics_types;

@@ -1,0 +1,158 @@
+//! `--place`: where the part goes on the machine (`kerf run` and `kerf post`).
+//!
+//! `--place X,Y,Z[,RX,RY,RZ]` applies a fixed part-to-workpiece transform (mm, degrees,
+//! `Rz Ry Rx`); `--place auto` asks [`kerf_kinematics::auto_place`] for one that puts every pose
+//! within the axis limits (turning contours whose side the head cannot reach, and rotating the
+//! part by quarter turns if it does not fit as modelled). The toolpath stays in part
+//! coordinates; the axes file, the program and the report are in workpiece coordinates, and
+//! the report says which placement was used.
+
+use kerf_kinematics::{
+    auto_setups, AutoPlaceOptions, Machine, PathOptions, Placement, Pose, Setup, SetupPlan,
+};
+use serde_json::{json, Value};
+
+use crate::error::CliError;
+
+/// The clearance `kerf post --place auto` keeps from the linear limits, mm: room for the
+/// default 10 mm retract of `kerf gcode` plus 1 mm.
+pub(crate) const AUTO_CLEARANCE_MM: f64 = 11.0;
+
+/// The `--place` argument.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum PlaceArg {
+    /// Search for a placement that fits.
+    Auto,
+    /// This placement.
+    Fixed(Placement),
+}
+
+/// clap's value parser for `--place` (a bad value is a usage error, exit 2).
+pub(crate) fn parse_place(text: &str) -> Result<PlaceArg, String> {
+    if text.trim().eq_ignore_ascii_case("auto") {
+        Ok(PlaceArg::Auto)
+    } else {
+        Placement::parse(text).map(PlaceArg::Fixed)
+    }
+}
+
+/// The placement used, with what `auto` decided.
+#[derive(Debug, Clone)]
+pub(crate) struct Placed {
+    /// The set-ups (one unless `auto` had to place parts or contours separately).
+    pub(crate) plan: SetupPlan,
+    /// Chosen by `--place auto`.
+    pub(crate) auto: bool,
+}
+
+impl Placed {
+    /// The poses of every path in workpiece coordinates.
+    pub(crate) fn apply(&self, poses: &[Vec<Pose>]) -> Vec<Vec<Pose>> {
+        self.plan.apply(poses)
+    }
+
+    /// The placement of path `i`.
+    pub(crate) fn placement_of(&self, i: usize) -> Placement {
+        self.plan.placement_of(i)
+    }
+
+    /// True if nothing was moved or turned.
+    pub(crate) fn is_identity(&self) -> bool {
+        self.plan.setups.iter().all(|s| s.placement.is_identity())
+            && !self.plan.flipped.contains(&true)
+    }
+
+    /// The `placement` object of `report.json`.
+    pub(crate) fn json(&self, ids: &[&str]) -> Value {
+        let setups: Vec<Value> = self
+            .plan
+            .setups
+            .iter()
+            .map(|s| {
+                let t = s.placement.translation_mm;
+                json!({
+                    "paths": s.paths.iter().map(|&i| ids.get(i).copied().unwrap_or("")).collect::<Vec<_>>(),
+                    "translation_mm": [t.x, t.y, t.z],
+                    "rotation_deg": s.placement.rotation_deg,
+                    "clearance_mm": if self.auto { Some(s.clearance_mm) } else { None },
+                })
+            })
+            .collect();
+        json!({
+            "mode": if self.auto { "auto" } else { "given" },
+            "rotation_order": "Rz Ry Rx (about fixed workpiece axes, x first); p' = R p + t",
+            "setups": setups,
+            "flipped_paths": ids.iter().zip(&self.plan.flipped).filter(|(_, f)| **f).map(|(id, _)| *id).collect::<Vec<_>>(),
+        })
+    }
+
+    /// One line for the summary.
+    pub(crate) fn summary(&self) -> String {
+        let flips = self.plan.flipped.iter().filter(|f| **f).count();
+        let flips = if flips > 0 {
+            format!(", {flips} contours cut from the other side of the sheet")
+        } else {
+            String::new()
+        };
+        match self.plan.setups.as_slice() {
+            [one] => format!(
+                "placed {}: {}{flips}",
+                if self.auto { "automatically" } else { "as given" },
+                one.placement
+            ),
+            many => format!(
+                "placed automatically in {} set-ups (the part does not fit the machine in one; see placement in report.json){flips}",
+                many.len()
+            ),
+        }
+    }
+}
+
+/// The placement for `--place` (identity without it). `auto` keeps `clearance_mm` from every
+/// linear limit (the retract between contours moves the head that far along the tool axis).
+///
+/// # Errors
+/// [`CliError::Kinematics`] when `auto` finds nothing that fits (the message names the axis and
+/// how much travel is missing).
+pub(crate) fn place(
+    machine: &Machine,
+    ids: &[&str],
+    poses: &[Vec<Pose>],
+    arg: Option<&PlaceArg>,
+    path_options: &PathOptions,
+    clearance_mm: f64,
+    file: &std::path::Path,
+) -> Result<Placed, CliError> {
+    let single = |placement: Placement| Placed {
+        plan: SetupPlan {
+            setups: vec![Setup {
+                paths: (0..poses.len()).collect(),
+                placement,
+                clearance_mm: f64::NAN,
+            }],
+            flipped: vec![false; poses.len()],
+            rotations_tried: 0,
+        },
+        auto: false,
+    };
+    match arg {
+        None => Ok(single(Placement::IDENTITY)),
+        Some(PlaceArg::Fixed(p)) => Ok(single(*p)),
+        Some(PlaceArg::Auto) => {
+            let refs: Vec<(&str, &[Pose])> = ids
+                .iter()
+                .copied()
+                .zip(poses.iter().map(Vec::as_slice))
+                .collect();
+            let plan = auto_setups(
+                machine,
+                &refs,
+                &AutoPlaceOptions::default()
+                    .with_path_options(*path_options)
+                    .with_margin_mm(clearance_mm),
+            )
+            .map_err(|e| CliError::Kinematics(Box::new(e), Some(file.to_path_buf())))?;
+            Ok(Placed { plan, auto: true })
+        }
+    }
+}

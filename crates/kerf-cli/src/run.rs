@@ -66,8 +66,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         .collect();
     // 3a. Where the part goes on the machine; from here on, workpiece coordinates.
     let id_refs: Vec<&str> = file.curves.iter().map(|c| c.id.as_str()).collect();
-    let placed =
-        crate::place::place(
+    let placed = crate::place::place(
         &machine,
         &id_refs,
         &poses,

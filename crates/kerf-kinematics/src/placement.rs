@@ -135,11 +135,17 @@ impl Placement {
                 .parse()
                 .map_err(|_| format!("{}: not a number: {f:?}", names[k]))?;
             if !x.is_finite() || x.abs() > 1e7 {
-                return Err(format!("{}: must be finite and within 1e7 (got {f})", names[k]));
+                return Err(format!(
+                    "{}: must be finite and within 1e7 (got {f})",
+                    names[k]
+                ));
             }
             v[k] = x;
         }
-        Ok(Self::new(Vector3::new(v[0], v[1], v[2]), [v[3], v[4], v[5]]))
+        Ok(Self::new(
+            Vector3::new(v[0], v[1], v[2]),
+            [v[3], v[4], v[5]],
+        ))
     }
 }
 
@@ -263,10 +269,9 @@ pub fn axis_aligned_rotations() -> Vec<[f64; 3]> {
     }
     all.sort_by(|a, b| {
         let nz = |r: &[f64; 3]| r.iter().filter(|v| **v != 0.0).count();
-        nz(a).cmp(&nz(b)).then(
-            a.partial_cmp(b)
-                .unwrap_or(std::cmp::Ordering::Equal),
-        )
+        nz(a)
+            .cmp(&nz(b))
+            .then(a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal))
     });
     let mut out: Vec<[f64; 3]> = Vec::new();
     let mut seen: Vec<Matrix3<f64>> = Vec::new();
@@ -407,7 +412,8 @@ fn general_orientations(machine: &Machine, paths: &[Vec<Pose>], flip: bool) -> V
     for d in picked {
         let up = turn_up(&d);
         for k in 0..8 {
-            let yaw = Rotation3::from_axis_angle(&Vector3::z_axis(), (45.0 * k as f64).to_radians());
+            let yaw =
+                Rotation3::from_axis_angle(&Vector3::z_axis(), (45.0 * k as f64).to_radians());
             out.push(yaw * up);
         }
     }
@@ -489,14 +495,22 @@ fn try_rotation(
         if options.flip && short_rev == 0.0 {
             flipped[i] = true;
         } else {
-            let missing = if options.flip { short.min(short_rev) } else { short };
+            let missing = if options.flip {
+                short.min(short_rev)
+            } else {
+                short
+            };
             return Err(TryError::Short(Shortfall {
                 axis: tilt_name,
                 missing,
                 detail: format!(
                     "path \"{}\": its tool axes need {missing:.3} deg more {tilt_name} travel{}",
                     paths[i].0,
-                    if options.flip { " on either side of the sheet" } else { "" }
+                    if options.flip {
+                        " on either side of the sheet"
+                    } else {
+                        ""
+                    }
                 ),
             }));
         }
@@ -509,7 +523,12 @@ fn try_rotation(
     }
     let solved = solve(&free, paths, &sided, &options.path_options).map_err(|e| match e {
         KinematicsError::OutOfLimits {
-            axis, value, min, max, ref path_id, ..
+            axis,
+            value,
+            min,
+            max,
+            ref path_id,
+            ..
         } => TryError::Short(Shortfall {
             axis,
             missing: (min - value).max(value - max),
@@ -524,7 +543,11 @@ fn try_rotation(
     let placed = place_paths(&placement, &flipped, owned);
     let check = solve(machine, paths, &placed, &options.path_options).map_err(|e| match e {
         KinematicsError::OutOfLimits {
-            axis, value, min, max, ..
+            axis,
+            value,
+            min,
+            max,
+            ..
         } => TryError::Short(Shortfall {
             axis,
             missing: (min - value).max(value - max),
@@ -619,7 +642,10 @@ fn translation(
         for k in 0..3 {
             let Some(r) = ranges[k] else { continue };
             let lo = rows.iter().map(|(q, _)| q[k]).fold(f64::INFINITY, f64::min);
-            let hi = rows.iter().map(|(q, _)| q[k]).fold(f64::NEG_INFINITY, f64::max);
+            let hi = rows
+                .iter()
+                .map(|(q, _)| q[k])
+                .fold(f64::NEG_INFINITY, f64::max);
             let need = hi - lo;
             let have = (r.max - r.min) - 2.0 * margin;
             if need > have {
@@ -693,7 +719,7 @@ fn translation(
         }
         let pg = shape * g;
         let gpg = g.dot(&pg);
-        if !(gpg > 0.0) || gpg.sqrt() < 1e-12 {
+        if gpg.is_nan() || gpg <= 0.0 || gpg.sqrt() < 1e-12 {
             break;
         }
         let step = pg / gpg.sqrt();
@@ -875,7 +901,11 @@ fn bisect(
     }
     let axis = (hi - lo).imax();
     let mut order: Vec<usize> = (0..group.len()).collect();
-    order.sort_by(|&a, &b| centres[a][axis].total_cmp(&centres[b][axis]).then(a.cmp(&b)));
+    order.sort_by(|&a, &b| {
+        centres[a][axis]
+            .total_cmp(&centres[b][axis])
+            .then(a.cmp(&b))
+    });
     let half = group.len() / 2;
     let mut first: Vec<usize> = order[..half].iter().map(|&k| group[k]).collect();
     let mut second: Vec<usize> = order[half..].iter().map(|&k| group[k]).collect();
@@ -894,7 +924,11 @@ fn up_directions() -> Vec<Vector3<f64>> {
         .map(|i| {
             let z = 1.0 - 2.0 * (i as f64 + 0.5) / DIRECTIONS as f64;
             let r = (1.0 - z * z).max(0.0).sqrt();
-            Vector3::new(r * (golden * i as f64).cos(), r * (golden * i as f64).sin(), z)
+            Vector3::new(
+                r * (golden * i as f64).cos(),
+                r * (golden * i as f64).sin(),
+                z,
+            )
         })
         .collect()
 }
@@ -956,9 +990,7 @@ fn orientation_groups(machine: &Machine, paths: &[Vec<Pose>], flip: bool) -> Vec
         for (d, dir) in lattice.iter().enumerate() {
             let n = left.iter().filter(|&&i| fits[i][d]).count();
             let angle = dir.angle(&Vector3::z());
-            if n > 0
-                && best.is_none_or(|(bn, _, ba)| n > bn || (n == bn && angle < ba - 1e-12))
-            {
+            if n > 0 && best.is_none_or(|(bn, _, ba)| n > bn || (n == bn && angle < ba - 1e-12)) {
                 best = Some((n, d, angle));
             }
         }

@@ -60,7 +60,10 @@ fn solve_placed(machine: &Machine, paths: &[Vec<Pose>]) -> [[f64; 2]; 3] {
 fn transform_rotates_then_translates() {
     let p = Placement::new(Vector3::new(1.0, 2.0, 3.0), [0.0, 0.0, 90.0]);
     let q = p.apply_point(&Point3::new(1.0, 0.0, 0.0));
-    assert!((q - Point3::new(1.0, 3.0, 3.0)).norm() < 1e-12, "Rz(90) x = y: {q}");
+    assert!(
+        (q - Point3::new(1.0, 3.0, 3.0)).norm() < 1e-12,
+        "Rz(90) x = y: {q}"
+    );
     // Rz Ry Rx order: x first. Rx(90) takes y to z, then Rz(90) leaves z.
     let p = Placement::new(Vector3::zeros(), [90.0, 0.0, 90.0]);
     let u = p.apply_pose(&Pose::new(0.0, 0.0, 0.0, 0.0, 1.0, 0.0));
@@ -70,7 +73,9 @@ fn transform_rotates_then_translates() {
         Placement::new(Vector3::new(10.0, -20.5, 3.0), [0.0; 3])
     );
     assert_eq!(
-        Placement::parse("0,0,0,90,0,-90").expect("six values").rotation_deg,
+        Placement::parse("0,0,0,90,0,-90")
+            .expect("six values")
+            .rotation_deg,
         [90.0, 0.0, -90.0]
     );
     for bad in ["1,2", "1,2,x", "1,2,3,4", "1,2,nan", "1,2,1e30"] {
@@ -88,7 +93,10 @@ fn twenty_four_distinct_axis_rotations_identity_first() {
         assert!((ma.determinant() - 1.0).abs() < 1e-12, "proper rotation");
         for b in &r[i + 1..] {
             let mb = Placement::new(Vector3::zeros(), *b).rotation().into_inner();
-            assert!((ma - mb).amax() > 0.5, "{a:?} and {b:?} are the same rotation");
+            assert!(
+                (ma - mb).amax() > 0.5,
+                "{a:?} and {b:?} are the same rotation"
+            );
         }
     }
 }
@@ -115,7 +123,11 @@ fn head_machine_centres_the_motion_envelope() {
             "axis {k}: envelope centre {mid_env} vs travel centre {mid_travel}"
         );
     }
-    assert!(found.clearance_mm >= 1.0 - 1e-9, "margin kept: {}", found.clearance_mm);
+    assert!(
+        found.clearance_mm >= 1.0 - 1e-9,
+        "margin kept: {}",
+        found.clearance_mm
+    );
 }
 
 #[test]
@@ -142,7 +154,10 @@ fn too_tall_part_names_the_axis_and_the_shortfall() {
     // Rotating the part lays the stack down: the 2,000 mm go along X (3,000 mm of travel); the
     // flat squares become vertical walls, their tool axes horizontal (A = 90 deg, reachable).
     let found = auto_place(&m, &refs, &AutoPlaceOptions::default()).expect("fits rotated");
-    assert_ne!(found.placement.rotation_deg, [0.0; 3], "a rotation was needed");
+    assert_ne!(
+        found.placement.rotation_deg, [0.0; 3],
+        "a rotation was needed"
+    );
     let placed = found.apply(&paths);
     let ext = solve_placed(&m, &placed);
     assert!(ext[2][1] - ext[2][0] < 700.0, "Z envelope {ext:?}");
@@ -158,15 +173,24 @@ fn contours_facing_down_are_cut_from_the_reachable_side() {
     ];
     let refs: Vec<(&str, &[Pose])> = vec![("down", &paths[0]), ("up", &paths[1])];
     let found = auto_place(&m, &refs, &AutoPlaceOptions::default()).expect("fits");
-    assert_eq!(found.flipped, [true, false], "only the downward contour turns over");
+    assert_eq!(
+        found.flipped,
+        [true, false],
+        "only the downward contour turns over"
+    );
     let placed = found.apply(&paths);
-    assert!(placed[0].iter().all(|p| p.axis.z > 0.999), "beam from above");
+    assert!(
+        placed[0].iter().all(|p| p.axis.z > 0.999),
+        "beam from above"
+    );
     solve_placed(&m, &placed);
     // Without flipping, the downward contour cannot be reached: the error says by how much.
     let err = auto_place(
         &m,
         &refs,
-        &AutoPlaceOptions::default().with_flip(false).with_rotate(false),
+        &AutoPlaceOptions::default()
+            .with_flip(false)
+            .with_rotate(false),
     )
     .expect_err("A would need 180 deg");
     assert!(
@@ -214,7 +238,11 @@ fn table_machine_placement_is_verified_against_the_limits() {
         let refs: Vec<(&str, &[Pose])> = vec![("ring", &paths[0])];
         let found = auto_place(&m, &refs, &AutoPlaceOptions::default())
             .unwrap_or_else(|e| panic!("{file}: {e}"));
-        assert!(found.clearance_mm >= 1.0 - 1e-6, "{file}: {}", found.clearance_mm);
+        assert!(
+            found.clearance_mm >= 1.0 - 1e-6,
+            "{file}: {}",
+            found.clearance_mm
+        );
         solve_placed(&m, &found.apply(&paths));
     }
 }

@@ -1,0 +1,245 @@
+//! `--place`: every real part runs end to end with `--place auto` on a shipped machine, and the
+//! outputs are checked independently: every axis value within the machine file's limits, the
+//! forward kinematics of every axis vector giving its pose, and the first and last pose of
+//! every path equal to the toolpath's cutting point moved by the placement the report states
+//! (the rotation rebuilt here from the reported angles, not by the library).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use kerf_kinematics::{Axes, Machine};
+use nalgebra::{Matrix3, Vector3};
+use serde_json::Value;
+
+fn kerf() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_kerf"))
+}
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).expect("read")).expect("JSON")
+}
+
+fn rot_x(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.to_radians().sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+}
+fn rot_y(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.to_radians().sin_cos();
+    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
+}
+fn rot_z(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.to_radians().sin_cos();
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+}
+
+fn vec3(v: &Value) -> Vector3<f64> {
+    let a = v.as_array().expect("array");
+    Vector3::new(
+        a[0].as_f64().expect("x"),
+        a[1].as_f64().expect("y"),
+        a[2].as_f64().expect("z"),
+    )
+}
+
+/// Runs `kerf run` with `place` and checks the outputs; returns the report.
+fn run_placed(curves: &str, machine: &str, place: &str) -> Value {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let machine_path = fixture("machines").join(machine);
+    let out = kerf()
+        .arg("run")
+        .arg(fixture(curves))
+        .arg("--machine")
+        .arg(&machine_path)
+        .arg("--place")
+        .arg(place)
+        .arg("--out")
+        .arg(dir.path())
+        .arg("-q")
+        .output()
+        .expect("run kerf");
+    assert!(
+        out.status.success(),
+        "kerf run {curves} --place {place} on {machine}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = read_json(&dir.path().join("report.json"));
+    let axes = read_json(&dir.path().join("axes.json"));
+    let toolpath = read_json(&dir.path().join("toolpath.json"));
+    let m = Machine::read(&machine_path).expect("machine");
+    let placement = &report["placement"];
+    let setups = placement["setups"].as_array().expect("setups");
+    let flipped: Vec<&str> = placement["flipped_paths"]
+        .as_array()
+        .expect("flipped_paths")
+        .iter()
+        .map(|v| v.as_str().expect("id"))
+        .collect();
+    let tpaths = toolpath["paths"].as_array().expect("toolpath paths");
+    let apaths = axes["paths"].as_array().expect("axes paths");
+    assert_eq!(
+        tpaths.len(),
+        apaths.len(),
+        "one axes path per toolpath path"
+    );
+    let mut seen = 0;
+    for s in setups {
+        let r = s["rotation_deg"].as_array().expect("rotation");
+        let [rx, ry, rz] = [0, 1, 2].map(|k| r[k].as_f64().expect("angle"));
+        let rot = rot_z(rz) * rot_y(ry) * rot_x(rx);
+        let t = vec3(&s["translation_mm"]);
+        for id in s["paths"].as_array().expect("paths") {
+            let id = id.as_str().expect("id");
+            seen += 1;
+            let tp = tpaths
+                .iter()
+                .find(|p| p["id"] == id)
+                .expect("path in the toolpath");
+            let ap = apaths
+                .iter()
+                .find(|p| p["id"] == id)
+                .expect("path in the axes file");
+            let tpts = tp["points"].as_array().expect("points");
+            let poses = ap["poses"].as_array().expect("poses");
+            let sign = if flipped.contains(&id) { -1.0 } else { 1.0 };
+            for (tpi, api) in [(0, 0), (tpts.len() - 1, poses.len() - 1)] {
+                let q: Vec<f64> = tpts[tpi]
+                    .as_array()
+                    .expect("point")
+                    .iter()
+                    .map(|v| v.as_f64().expect("number"))
+                    .collect();
+                let want_p = rot * Vector3::new(q[0], q[1], q[2]) + t;
+                let want_u = rot * Vector3::new(q[3], q[4], q[5]) * sign;
+                let got: Vec<f64> = poses[api]
+                    .as_array()
+                    .expect("pose")
+                    .iter()
+                    .map(|v| v.as_f64().expect("number"))
+                    .collect();
+                let gp = Vector3::new(got[0], got[1], got[2]);
+                let gu = Vector3::new(got[3], got[4], got[5]);
+                assert!((gp - want_p).norm() < 1e-6, "{id}: tip {gp} vs {want_p}");
+                assert!(
+                    (gu - want_u).norm() < 1e-9,
+                    "{id}: tool axis {gu} vs {want_u}"
+                );
+            }
+            for (n, pos) in ap["positions"]
+                .as_array()
+                .expect("positions")
+                .iter()
+                .enumerate()
+            {
+                let q: Vec<f64> = pos
+                    .as_array()
+                    .expect("axes")
+                    .iter()
+                    .map(|v| v.as_f64().expect("number"))
+                    .collect();
+                let a = Axes::new(q[0], q[1], q[2], q[3], q[4]);
+                if let Some((axis, range)) = m.violation(&a, 1e-9) {
+                    panic!("{id}: point {n}: {axis:?} outside {range:?}: {q:?}");
+                }
+                let fk = m.kinematics.forward(&a);
+                let pose: Vec<f64> = poses[n]
+                    .as_array()
+                    .expect("pose")
+                    .iter()
+                    .map(|v| v.as_f64().expect("number"))
+                    .collect();
+                let dp = (fk.position.coords - Vector3::new(pose[0], pose[1], pose[2])).norm();
+                assert!(
+                    dp < 1e-6,
+                    "{id}: point {n}: forward kinematics off by {dp} mm"
+                );
+                let cos = fk.axis.dot(&Vector3::new(pose[3], pose[4], pose[5]));
+                assert!(cos > 1.0 - 1e-9, "{id}: point {n}: tool axis off");
+            }
+        }
+    }
+    assert_eq!(seen, tpaths.len(), "every path in exactly one set-up");
+    report
+}
+
+#[test]
+fn every_real_part_runs_with_place_auto() {
+    let prop = run_placed("realdata/occt_propeller.json", "gantry_ac.json", "auto");
+    assert_eq!(
+        prop["placement"]["setups"].as_array().map(Vec::len),
+        Some(1),
+        "the propeller fits in one set-up: {}",
+        prop["placement"]
+    );
+    assert!(
+        !prop["placement"]["flipped_paths"]
+            .as_array()
+            .expect("list")
+            .is_empty(),
+        "some propeller faces face down and are cut from the other side"
+    );
+    // Eight parts whose bend edges need more tilt than one orientation gives: several set-ups.
+    let sheet = run_placed("realdata/nori_sheetmetal.json", "gantry_ac.json", "auto");
+    let n = sheet["placement"]["setups"].as_array().map_or(0, Vec::len);
+    assert!(
+        n > 1,
+        "sheet metal needs several set-ups on a +-135 deg head"
+    );
+}
+
+#[test]
+fn a_given_placement_is_applied_and_reported() {
+    let report = run_placed("door_trim.json", "ac_head.json", "10,-20,30");
+    let s = &report["placement"]["setups"][0];
+    assert_eq!(
+        s["translation_mm"],
+        serde_json::json!([10.0, -20.0, 30.0]),
+        "{s}"
+    );
+    assert_eq!(report["placement"]["mode"], "given");
+    // A rotation too: a quarter turn about z keeps the door trim within the travel.
+    run_placed("door_trim.json", "ac_head.json", "0,0,0,0,0,90");
+}
+
+#[test]
+fn a_bad_place_is_a_usage_error_and_no_fit_is_named() {
+    for bad in ["1,2", "auto-ish", "1,2,nan"] {
+        let out = kerf()
+            .arg("run")
+            .arg(fixture("door_trim.json"))
+            .arg("--machine")
+            .arg(fixture("machines/ac_head.json"))
+            .arg("--place")
+            .arg(bad)
+            .output()
+            .expect("run kerf");
+        assert_eq!(out.status.code(), Some(2), "--place {bad}: usage error");
+    }
+    // The 3.5 m blade edge is one contour longer than the 800 mm X travel of the trunnion
+    // table in every orientation: the error names the axis and the shortfall.
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let out = kerf()
+        .arg("run")
+        .arg(fixture("turbine_blade_edge.json"))
+        .arg("--machine")
+        .arg(fixture("machines/table_table.json"))
+        .arg("--place")
+        .arg("auto")
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .expect("run kerf");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("no placement fits the machine"), "{err}");
+    assert!(err.contains(" short"), "{err}");
+    assert!(
+        std::fs::read_dir(dir.path()).expect("dir").next().is_none(),
+        "nothing written"
+    );
+}

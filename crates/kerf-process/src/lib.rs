@@ -1,0 +1,183 @@
+//! The laser process around the cut contours, in part coordinates, before the kinematics.
+//!
+//! A laser does not start a cut on the contour: piercing leaves a crater, so the beam pierces in
+//! the scrap, runs a **lead-in** that joins the contour tangentially, cuts the contour, and
+//! leaves it through an **overcut and lead-out** so that no notch remains. Holes are cut before
+//! the outline around them (a part cut free first would drop or tilt before its holes are cut),
+//! and the order between contours keeps the traverses short. This crate decides, from the
+//! cutting points with their normals (`(x, y, z, i, j, k)`, as `kerf.toolpath/1` holds them):
+//!
+//! - which contours are closed, and which closed contours lie inside which ([`plan_cuts`]
+//!   projects each closed contour along its mean normal and tests winding numbers);
+//! - which side of each contour is scrap: the inside of a hole (a closed contour inside an odd
+//!   number of others), the outside of an outline, or the curve's own `scrap` key ([`Side`]);
+//! - where each closed cut starts: never at a corner, on the flattest stretch, and among those
+//!   the point nearest to where the head comes from (a curve may pin it);
+//! - the lead-in (a straight line and a tangent quarter arc on the scrap side, in the tangent
+//!   plane at the start, shrunk until it stays inside the scrap) and lead-out (an overcut along
+//!   the contour and a short exit into the scrap); open contours lead in and out along their
+//!   tangent extensions;
+//! - the cutting order: holes before the contours enclosing them, nearest neighbour with the
+//!   start points chosen on the way, improved by 2-opt moves that keep that precedence, within a
+//!   work budget.
+//!
+//! The derivations and the checks are in `docs/process.md`.
+
+mod geometry;
+mod lead;
+mod order;
+
+pub use lead::{LeadIn, LeadOptions};
+pub use order::CutPlan;
+
+use geometry::Projected;
+use thiserror::Error;
+
+/// A cutting point with its unit normal: `[x, y, z, i, j, k]` (mm; the normal is the tool axis,
+/// pointing from the tip toward the head).
+pub type PoseArray = [f64; 6];
+
+/// The side of a contour, seen along the contour's direction with the normal toward the
+/// viewer (`kerf.curves/1`'s `scrap` key): `Left` is the side of `normal x tangent`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// The side of `normal x tangent`.
+    Left,
+    /// The other side.
+    Right,
+}
+
+impl Side {
+    /// `+1` for left, `-1` for right: the sign of `normal x tangent` toward this side.
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Left => 1.0,
+            Side::Right => -1.0,
+        }
+    }
+
+    /// The other side.
+    pub fn opposite(self) -> Side {
+        match self {
+            Side::Left => Side::Right,
+            Side::Right => Side::Left,
+        }
+    }
+
+    /// `"left"` or `"right"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+}
+
+/// One cut contour: its cutting points in order, and what the file says of it.
+#[derive(Debug, Clone, Copy)]
+pub struct Contour<'a> {
+    /// The curve's id (for messages).
+    pub id: &'a str,
+    /// The cutting points with normals, in curve order (a closed contour repeats its first
+    /// point at the end).
+    pub poses: &'a [PoseArray],
+    /// The scrap side, if the file says (`scrap` key); else it is decided.
+    pub scrap: Option<Side>,
+    /// The index of the cutting point where a closed cut must start (from the curve's `start`
+    /// key); else it is chosen.
+    pub start: Option<usize>,
+}
+
+/// What can go wrong.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ProcessError {
+    /// A contour has fewer than two cutting points or non-finite values. Fix: check the
+    /// toolpath.
+    #[error("contour \"{id}\": {reason}")]
+    BadContour {
+        /// The contour's id.
+        id: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// An option is out of range. Fix: see [`LeadOptions`].
+    #[error("option {name}: {reason} (got {value})")]
+    BadOption {
+        /// The option.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What is wrong.
+        reason: &'static str,
+    },
+}
+
+/// `Result` with [`ProcessError`].
+pub type Result<T> = std::result::Result<T, ProcessError>;
+
+/// Plans the process of every contour: sides, start points, lead-ins and lead-outs, and the
+/// cutting order. Deterministic: the same input gives the same plan.
+///
+/// # Errors
+/// [`ProcessError::BadContour`], [`ProcessError::BadOption`].
+pub fn plan_cuts(contours: &[Contour<'_>], options: &LeadOptions) -> Result<CutPlan> {
+    options.validate()?;
+    for c in contours {
+        if c.poses.len() < 2 {
+            return Err(ProcessError::BadContour {
+                id: c.id.to_string(),
+                reason: format!("{} cutting points; a cut needs two", c.poses.len()),
+            });
+        }
+        if c.poses.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(ProcessError::BadContour {
+                id: c.id.to_string(),
+                reason: "a cutting point holds a non-finite value".into(),
+            });
+        }
+    }
+    let projected: Vec<Option<Projected>> = contours
+        .iter()
+        .map(|c| Projected::of_closed(c.poses, options.closed_tolerance_mm))
+        .collect();
+    // Nesting: which closed contours contain which.
+    let n = contours.len();
+    let mut inside: Vec<Vec<usize>> = vec![Vec::new(); n]; // inside[a] = contours containing a
+    for a in 0..n {
+        let Some(pa) = &projected[a] else { continue };
+        for b in 0..n {
+            if a == b {
+                continue;
+            }
+            let Some(pb) = &projected[b] else { continue };
+            if pa.area.abs() < pb.area.abs() && pb.contains_contour(contours[a].poses) {
+                inside[a].push(b);
+            }
+        }
+    }
+    let sides: Vec<Option<Side>> = (0..n)
+        .map(|i| {
+            if let Some(s) = contours[i].scrap {
+                return Some(s);
+            }
+            let p = projected[i].as_ref()?;
+            // Seen from the normal, a counter-clockwise contour has its inside on the left.
+            let inside_side = if p.area > 0.0 {
+                Side::Left
+            } else {
+                Side::Right
+            };
+            let hole = inside[i].len() % 2 == 1;
+            Some(if hole {
+                inside_side
+            } else {
+                inside_side.opposite()
+            })
+        })
+        .collect();
+    let leads: Vec<lead::Leads> = (0..n)
+        .map(|i| lead::Leads::new(&contours[i], projected[i].as_ref(), sides[i], options))
+        .collect();
+    Ok(order::plan(contours, &inside, sides, leads, options))
+}

@@ -13,7 +13,7 @@
 
 use std::path::Path;
 
-use kerf_kinematics::{AxesFile, Axes, Machine};
+use kerf_kinematics::{Axes, AxesFile, Machine};
 use nalgebra::{Point3, Vector3};
 use serde_json::{json, Value};
 
@@ -60,15 +60,25 @@ fn main() {
     let axes = AxesFile::from_str(&read("axes.json")).unwrap_or_else(|e| fail(e.to_string()));
     let tp = kerf_format::toolpath::from_str(&read("toolpath.json"))
         .unwrap_or_else(|e| fail(e.to_string()));
-    let report: Value = serde_json::from_str(&read("report.json")).unwrap_or_else(|e| fail(e.to_string()));
-    let budget = report["tolerance_budget_mm"]["total"].as_f64().unwrap_or(f64::NAN);
-    let duration = report["interpolation"]["duration_s"].as_f64().unwrap_or(f64::NAN);
-    let feed = report["interpolation"]["feed_mm_per_min"].as_f64().unwrap_or(f64::NAN);
+    let report: Value =
+        serde_json::from_str(&read("report.json")).unwrap_or_else(|e| fail(e.to_string()));
+    let budget = report["tolerance_budget_mm"]["total"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    let duration = report["interpolation"]["duration_s"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    let feed = report["interpolation"]["feed_mm_per_min"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
     let dwell = report["program"]["pierce_dwell_s"].as_f64().unwrap_or(0.0);
-    let standoff = report["program"]["pierce_standoff_mm"].as_f64().unwrap_or(0.0);
+    let standoff = report["program"]["pierce_standoff_mm"]
+        .as_f64()
+        .unwrap_or(0.0);
 
     // Samples.
-    let text = std::fs::read_to_string(&args[2]).unwrap_or_else(|e| fail(format!("{}: {e}", args[2])));
+    let text =
+        std::fs::read_to_string(&args[2]).unwrap_or_else(|e| fail(format!("{}: {e}", args[2])));
     let mut q: Vec<[f64; 5]> = Vec::new();
     let mut beam: Vec<bool> = Vec::new();
     let mut gaps = 0usize;
@@ -76,16 +86,25 @@ fn main() {
     for (i, line) in text.lines().enumerate() {
         let v: Vec<&str> = line.split_whitespace().collect();
         if v.len() != 7 {
-            fail(format!("{}:{}: expected 7 columns, found {}", args[2], i + 1, v.len()));
+            fail(format!(
+                "{}:{}: expected 7 columns, found {}",
+                args[2],
+                i + 1,
+                v.len()
+            ));
         }
-        let n: i64 = v[0].parse().unwrap_or_else(|_| fail(format!("line {}: sample number", i + 1)));
+        let n: i64 = v[0]
+            .parse()
+            .unwrap_or_else(|_| fail(format!("line {}: sample number", i + 1)));
         if last_n.is_some_and(|l| n != l + 1) {
             gaps += 1;
         }
         last_n = Some(n);
         let mut a = [0.0; 5];
         for k in 0..5 {
-            a[k] = v[k + 1].parse().unwrap_or_else(|_| fail(format!("line {}: number", i + 1)));
+            a[k] = v[k + 1]
+                .parse()
+                .unwrap_or_else(|_| fail(format!("line {}: number", i + 1)));
         }
         q.push(a);
         beam.push(v[6] != "0");
@@ -115,7 +134,11 @@ fn main() {
         .iter()
         .zip(&tp.paths)
         .map(|(a, t)| {
-            let poses: Vec<Point3<f64>> = a.poses.iter().map(|p| Point3::new(p[0], p[1], p[2])).collect();
+            let poses: Vec<Point3<f64>> = a
+                .poses
+                .iter()
+                .map(|p| Point3::new(p[0], p[1], p[2]))
+                .collect();
             let pts: Vec<Point3<f64>> = (0..t.points.len()).map(|n| t.points.position(n)).collect();
             let u = Vector3::new(a.poses[0][3], a.poses[0][4], a.poses[0][5]).normalize();
             (poses, pts, u)
@@ -136,9 +159,15 @@ fn main() {
         // cycle before (on) or after (off) within 10 um (the last creep of a decelerating move,
         // under 10 mm/s).
         let on_at = (tips[iv.0].0 - pierce).norm();
-        let before = if iv.0 > 0 { (tips[iv.0 - 1].0 - pierce).norm() } else { f64::INFINITY };
+        let before = if iv.0 > 0 {
+            (tips[iv.0 - 1].0 - pierce).norm()
+        } else {
+            f64::INFINITY
+        };
         let off_at = (tips[iv.1].0 - end).norm();
-        let after = tips.get(iv.1 + 1).map_or(f64::INFINITY, |t| (t.0 - end).norm());
+        let after = tips
+            .get(iv.1 + 1)
+            .map_or(f64::INFINITY, |t| (t.0 - end).norm());
         // Every beam-on sample against the pierce segment and the cut together (where the beam
         // may be: the controller may round the corner between the descent and the cut); the
         // samples nearer the cut than the pierce segment also against the cutting points and
@@ -214,8 +243,11 @@ fn main() {
         }
     }
     let by_axis = |r: &[f64; 5]| -> Value {
-        let m: serde_json::Map<String, Value> =
-            names.iter().zip(r).map(|(n, v)| (n.to_string(), json!(v))).collect();
+        let m: serde_json::Map<String, Value> = names
+            .iter()
+            .zip(r)
+            .map(|(n, v)| (n.to_string(), json!(v)))
+            .collect();
         Value::Object(m)
     };
 
@@ -224,8 +256,15 @@ fn main() {
     let (t_lcnc, predicted) = match (intervals.first(), intervals.last()) {
         (Some(a), Some(b)) => {
             let n = intervals.len() as f64;
-            let descent = if standoff > 0.0 { standoff / (feed / 60.0) } else { 0.0 };
-            ((b.1 + 1 - a.0) as f64 * period, duration + n * (dwell + descent))
+            let descent = if standoff > 0.0 {
+                standoff / (feed / 60.0)
+            } else {
+                0.0
+            };
+            (
+                (b.1 + 1 - a.0) as f64 * period,
+                duration + n * (dwell + descent),
+            )
         }
         _ => (0.0, duration),
     };

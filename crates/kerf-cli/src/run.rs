@@ -8,8 +8,8 @@ use std::time::Instant;
 use kerf_discretize::Discretization;
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_interp::{
-    csv_string, gcode_motion, stations_from_solved, AxisModel, Dialect, GcodeOptions,
-    MachineModel, PathInput as InterpPath, PlanOptions,
+    csv_string, gcode_motion, stations_from_solved, AxisModel, Dialect, GcodeOptions, MachineModel,
+    PathInput as InterpPath, PlanOptions,
 };
 use kerf_kinematics::{solve_paths, AxesFile, Machine, PathCurve, PathInput, PathOptions, Pose};
 use kerf_normals::Oriented;
@@ -111,7 +111,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         ..crate::motion::gcode_options(&model, dialect, args.feed, args.blend_tolerance, path)
     };
     let program = gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?;
-    let process = kerf_interp::ProcessCodes::resolve(dialect, &machine.process).map_err(interp(path))?;
+    let process =
+        kerf_interp::ProcessCodes::resolve(dialect, &machine.process).map_err(interp(path))?;
     let setpoints = csv_string(model.axis_names(), args.cycle, &motion.setpoints(&model));
     // 5. Picture and report.
     let mut scene = kerf_plot::Scene::new(&file, &tp, &kerf_plot::SceneOptions::default())

@@ -84,18 +84,25 @@ def ensure_user():
     return USER
 
 
-def simulate(kerf, measure, fixture, machine, flat, outdir):
+def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), traj=(), edit=None):
+    """One simulator run; `extra` are more `kerf run` arguments, `traj` more [TRAJ] lines of
+    the INI, `edit` a function applied to the program text (for the experiments)."""
     work = Path(tempfile.mkdtemp(prefix=f"kerf-sim-{fixture}-"))
     os.chmod(work, 0o777)
-    kout = outdir / f"sim-{fixture}"
-    r = kerf_run(kerf, fixture, machine, "linuxcnc", kout)
+    fixture_tag = fixture + tag
+    kout = outdir / f"sim-{fixture_tag}"
+    r = kerf_run(kerf, fixture, machine, "linuxcnc", kout, extra)
     if r.returncode != 0:
         fail(f"sim {fixture}: kerf run: {r.stderr.strip()}")
         return None
     shutil.copy(HERE / "display.py", work / "display.py")
     os.chmod(work / "display.py", 0o755)
     config(machine, work, display=str(work / "display.py"))
-    shutil.copy(kout / "program.nc", work / "program.ngc")
+    if traj:
+        ini = (work / "kerf.ini").read_text().replace("[TRAJ]\n", "[TRAJ]\n" + "".join(t + "\n" for t in traj))
+        (work / "kerf.ini").write_text(ini)
+    text = (kout / "program.nc").read_text()
+    (work / "program.ngc").write_text(edit(text) if edit else text)
     user = ensure_user()
     env = {"KERF_PROGRAM": str(work / "program.ngc"), "KERF_SAMPLES": str(work / "samples.txt"),
            "KERF_RESULT": str(work / "result.json"), "KERF_TIMEOUT": "240"}
@@ -111,14 +118,14 @@ def simulate(kerf, measure, fixture, machine, flat, outdir):
         log = p.stdout + p.stderr
     except subprocess.TimeoutExpired as e:
         log = f"timeout: {e}"
-    (outdir / f"sim-{fixture}.log").write_text(log)
+    (outdir / f"sim-{fixture_tag}.log").write_text(log)
     wall = time.time() - t0
     res_path = work / "result.json"
     if not res_path.exists():
-        fail(f"sim {fixture}: LinuxCNC gave no result (log in {outdir}/sim-{fixture}.log)")
+        fail(f"sim {fixture_tag}: LinuxCNC gave no result (log in {outdir}/sim-{fixture_tag}.log)")
         return None
     res = json.loads(res_path.read_text())
-    shutil.copy(work / "samples.txt", outdir / f"sim-{fixture}-samples.txt")
+    shutil.copy(work / "samples.txt", outdir / f"sim-{fixture_tag}-samples.txt")
     m = run([str(measure), str(ROOT / "fixtures" / "machines" / f"{machine}.json"), str(kout),
              str(work / "samples.txt"), "0.001"])
     if m.returncode != 0:
@@ -127,7 +134,8 @@ def simulate(kerf, measure, fixture, machine, flat, outdir):
     fig = json.loads(m.stdout)
     fig.update({"fixture": fixture, "machine": machine, "linuxcnc_errors": res["errors"],
                 "linuxcnc_end": res["code"], "wall_s": wall})
-    name = f"sim {fixture} on {machine}"
+    fig["variant"] = tag
+    name = f"sim {fixture_tag} on {machine}"
     if res["errors"] or res["code"] != "done":
         fail(f"{name}: LinuxCNC errors {res['errors']}, end {res['code']}")
     if fig["sample_gaps"]:

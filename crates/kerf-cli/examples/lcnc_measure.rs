@@ -45,6 +45,25 @@ fn poly_dist(p: &Point3<f64>, pts: &[Point3<f64>]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The segment `pts[j] pts[j + 1]` nearest `p` and the fraction along it of the nearest point.
+fn nearest_segment(p: &Point3<f64>, pts: &[Point3<f64>]) -> (usize, f64) {
+    let mut best = (0, 0.0, f64::INFINITY);
+    for (j, w) in pts.windows(2).enumerate() {
+        let d = w[1] - w[0];
+        let l2 = d.norm_squared();
+        let f = if l2 > 0.0 {
+            ((p - w[0]).dot(&d) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let dist = (p - (w[0] + d * f)).norm();
+        if dist < best.2 {
+            best = (j, f, dist);
+        }
+    }
+    (best.0, best.1)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 3 {
@@ -155,9 +174,9 @@ fn main() {
         let end = *poses.last().unwrap_or(&start);
         let pierce = start + u0 * standoff;
         // The beam switches on where the head has come to rest at the pierce point and off
-        // where it rests at the cut's end: at the switching cycle within 1 um of the point, one
-        // cycle before (on) or after (off) within 10 um (the last creep of a decelerating move,
-        // under 10 mm/s).
+        // where it rests at the cut's end: in the last cycle before and the first cycle after
+        // the switch the head is within 10 um of the point (LinuxCNC reports a move done
+        // during its last creep of a few um, under 10 mm/s).
         let on_at = (tips[iv.0].0 - pierce).norm();
         let before = if iv.0 > 0 {
             (tips[iv.0 - 1].0 - pierce).norm()
@@ -183,18 +202,28 @@ fn main() {
             if d_pierce < d_cut {
                 continue;
             }
-            // Tool axis against the nearest pose's, degrees.
-            let (j, _) = poses
-                .iter()
-                .enumerate()
-                .map(|(j, x)| (j, (p - x).norm()))
-                .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
-            let pj = &axes.paths[k].poses[j];
-            let uj = Vector3::new(pj[3], pj[4], pj[5]).normalize();
+            // Tool axis against the poses' axes interpolated at the nearest point of the
+            // nearest segment, degrees.
+            let (j, f) = nearest_segment(p, poses);
+            let ax = |n: usize| {
+                let pj = &axes.paths[k].poses[n.min(poses.len() - 1)];
+                Vector3::new(pj[3], pj[4], pj[5]).normalize()
+            };
+            let uj = (ax(j) * (1.0 - f) + ax(j + 1) * f).normalize();
             dev_orient = dev_orient.max(u.dot(&uj).clamp(-1.0, 1.0).acos().to_degrees());
         }
         max_dev_union = max_dev_union.max(dev_union);
-        let ok = on_at < 1e-3 && before < 1e-2 && off_at < 1e-3 && after < 1e-2;
+        // The pierce: the beam on while the head stands at the pierce point for the dwell.
+        let dwell_on = tips[iv.0..=iv.1]
+            .iter()
+            .take_while(|(p, _)| (p - pierce).norm() < 1e-2)
+            .count() as f64
+            * period;
+        let ok = on_at < 1e-2
+            && before < 1e-2
+            && off_at < 1e-2
+            && after < 1e-2
+            && dwell_on >= dwell - 2.0 * period;
         framing_ok &= ok;
         max_dev_points = max_dev_points.max(dev_points);
         max_dev_orient_deg = max_dev_orient_deg.max(dev_orient);
@@ -209,6 +238,7 @@ fn main() {
             "max_deviation_beam_on_mm": dev_union,
             "max_deviation_from_cutting_points_mm": dev_points,
             "max_tool_axis_deviation_deg": dev_orient,
+            "beam_on_at_pierce_point_s": dwell_on,
             "framing_ok": ok,
         }));
     }

@@ -146,11 +146,14 @@ impl Dialect {
         }
     }
 
-    /// One whole-line comment in the dialect's syntax, its text through [`comment_text`].
+    /// One whole-line comment in the dialect's syntax, its text escaped as by
+    /// [`comment_text`] but not cut (text from the input must already have been through
+    /// [`comment_text`], which cuts it).
     fn comment(self, text: &str) -> String {
+        let text = escape(text, usize::MAX);
         match self {
-            Dialect::Linuxcnc => format!("({})", comment_text(text)),
-            Dialect::Generic | Dialect::Sinumerik => format!("; {}", comment_text(text)),
+            Dialect::Linuxcnc => format!("({text})"),
+            Dialect::Generic | Dialect::Sinumerik => format!("; {text}"),
         }
     }
 }
@@ -218,7 +221,12 @@ pub const MAX_COMMENT: usize = 160;
 /// assert_eq!(comment_text("Stoßblech"), "Sto\\u{df}blech");
 /// ```
 pub fn comment_text(text: &str) -> String {
-    let mut out = String::with_capacity(text.len().min(MAX_COMMENT) + 8);
+    escape(text, MAX_COMMENT)
+}
+
+/// The escaping of [`comment_text`], cut at `max` bytes.
+fn escape(text: &str, max: usize) -> String {
+    let mut out = String::with_capacity(text.len().min(max) + 8);
     for c in text.chars() {
         let piece = match c {
             '(' => "[".to_string(),
@@ -226,7 +234,7 @@ pub fn comment_text(text: &str) -> String {
             ' '..='~' => c.to_string(),
             _ => format!("\\u{{{:x}}}", c as u32),
         };
-        if out.len() + piece.len() > MAX_COMMENT {
+        if out.len() + piece.len() > max {
             out.push_str("...");
             break;
         }
@@ -398,7 +406,8 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
                 .params
                 .map_or(String::new(), |p| format!(", t = {}", p[0]));
             let line = opts.dialect.comment(&format!(
-                "curve {id}, from cutting point {}{span}",
+                "curve {}, from cutting point {}{span}",
+                comment_text(&id),
                 b.stations[0]
             ));
             w.line(&line);
@@ -516,7 +525,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     "kerf LinuxCNC program: trivkins machine axes {} {} {} {} {}, no tool-tip control",
                     n[0], n[1], n[2], n[3], n[4]
                 ),
-                "feed: G93 inverse time on every cutting block, F = 60 / planned block time in s, so the tool tip moves at kerf's planned speed; rapids G0 in exact path G61".to_string(),
+                "feed: G93 inverse time on every cutting block, F = 60 / planned block time in s,\nfeed: so the tool tip moves at kerf's planned speed; rapids G0 in exact path G61".to_string(),
                 "arcs written as G1 chords",
             ),
             Dialect::Generic => (
@@ -525,7 +534,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     n[0], n[1], n[2], n[3], n[4]
                 ),
                 format!(
-                    "feed: G94, F in mm/min of the combined {} {} {} machine-axis motion, NOT of the tool tip; on blocks without {} {} {} motion F is deg/min of the combined rotary motion (RS274/NGC rule); each F makes its block take kerf's planned time",
+                    "feed: G94, F in mm/min of the combined {} {} {} machine-axis motion, NOT of the tool tip;\nfeed: on blocks without {} {} {} motion F is deg/min of the combined rotary motion (RS274/NGC rule);\nfeed: each F makes its block take kerf's planned time",
                     n[0], n[1], n[2], n[0], n[1], n[2]
                 ),
                 "arcs written as G1 chords",
@@ -537,13 +546,20 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
             ),
         };
         self.comment(&title);
-        let machine = format!("machine: {}", self.model.name());
+        let machine = format!("machine: {}", comment_text(self.model.name()));
         self.comment(&machine);
         if let Some(src) = &o.source {
-            self.comment(&format!("source: {src}"));
+            self.comment(&format!("source: {}", comment_text(src)));
         }
-        self.comment("units: mm, degrees, seconds (G21 / G71)");
-        self.comment(&feed);
+        let unit = if o.dialect == Dialect::Sinumerik {
+            "G71"
+        } else {
+            "G21"
+        };
+        self.comment(&format!("units: mm ({unit}), degrees, seconds"));
+        for part in feed.split('\n') {
+            self.comment(part);
+        }
         let terms: Vec<String> = o
             .budget()
             .iter()
@@ -552,8 +568,13 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 None => format!("{k} unknown"),
             })
             .collect();
+        let unknown = if o.linearization_tolerance.is_none() {
+            " (the known terms; the axes file does not record the linearization tolerance)"
+        } else {
+            ""
+        };
         self.comment(&format!(
-            "tolerance budget mm: {} = {}",
+            "tolerance budget mm: {} = {}{unknown}",
             terms.join(" + "),
             o.budget_total()
         ));
@@ -561,14 +582,16 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
             "blocks: {} lines, {} arcs, {} turns, {arcs_as}",
             counts.lines, counts.arcs, counts.turns
         ));
-        let p = &self.process;
+        let p = self.process.clone();
         let pm = format!(
-            "process: beam on {}; beam off {}; pierce {} mm above the cut start along the tool axis, dwell {} s, descent at {} mm/min",
-            p.beam_on.join(" / "),
-            p.beam_off.join(" / "),
-            p.pierce_standoff,
-            p.pierce_dwell_s,
-            o.feed
+            "process: beam on {}; beam off {};",
+            comment_text(&p.beam_on.join(" / ")),
+            comment_text(&p.beam_off.join(" / ")),
+        );
+        self.comment(&pm);
+        let pm = format!(
+            "process: pierce {} mm above the cut start along the tool axis, dwell {} s, descent at {} mm/min",
+            p.pierce_standoff, p.pierce_dwell_s, o.feed
         );
         self.comment(&pm);
         match o.dialect {

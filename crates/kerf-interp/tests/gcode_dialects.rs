@@ -211,7 +211,7 @@ fn headers_state_units_feed_budget_machine_and_process() {
             ..GcodeOptions::new(dialect, 6000.0)
         };
         let text = gcode_motion(&m, &motion, &[], &opts).expect("gcode");
-        let head: String = text.lines().take(10).collect::<Vec<_>>().join("\n");
+        let head: String = text.lines().take(16).collect::<Vec<_>>().join("\n");
         for want in [
             "machine: paper-000 laser head",
             "source: part.json",

@@ -82,7 +82,7 @@ pub(crate) enum Command {
     /// Write the G-code program of a path: generic `G1 X Y Z A C F` or Sinumerik TRAORI with
     /// `CIP` arcs.
     #[command(
-        after_help = "Examples:\n  kerf gcode part.axes.json -m fixtures/machines/ac_head.json --feed 6000 -o part.nc\n  kerf gcode part.toolpath.json -m fixtures/machines/ac_head.json --feed 6000 --dialect sinumerik -o part.mpf"
+        after_help = "Examples:\n  kerf gcode part.axes.json -m fixtures/machines/ac_head.json --feed 6000 -o part.nc\n  kerf gcode part.toolpath.json -m fixtures/machines/ac_head.json --feed 6000 --dialect sinumerik -o part.mpf\n  kerf gcode part.axes.json -m fixtures/machines/ac_head.json --feed 6000 --dialect linuxcnc -o part.ngc"
     )]
     Gcode(GcodeArgs),
 
@@ -331,6 +331,11 @@ pub(crate) struct GcodeArgs {
     #[arg(long, value_enum, default_value_t = DialectArg::Generic)]
     pub(crate) dialect: DialectArg,
 
+    /// The controller's blending tolerance, mm: a term of the tolerance budget (LinuxCNC
+    /// `G64 P`, Sinumerik `CTOL`/`OTOL`).
+    #[arg(long, default_value_t = kerf_interp::output::DEFAULT_BLEND_TOLERANCE, value_name = "MM")]
+    pub(crate) blend_tolerance: f64,
+
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub(crate) json: bool,
@@ -347,6 +352,8 @@ pub(crate) enum DialectArg {
     Generic,
     /// Sinumerik-style TRAORI: tool tip, orientation vector, CIP arcs.
     Sinumerik,
+    /// LinuxCNC (trivkins): machine axes, G93 inverse-time feed, G64 P blending on cuts.
+    Linuxcnc,
 }
 
 impl From<DialectArg> for kerf_interp::Dialect {
@@ -354,6 +361,7 @@ impl From<DialectArg> for kerf_interp::Dialect {
         match d {
             DialectArg::Generic => Self::Generic,
             DialectArg::Sinumerik => Self::Sinumerik,
+            DialectArg::Linuxcnc => Self::Linuxcnc,
         }
     }
 }
@@ -388,6 +396,11 @@ pub(crate) struct RunArgs {
     /// The G-code dialect.
     #[arg(long, value_enum, default_value_t = DialectArg::Generic)]
     pub(crate) dialect: DialectArg,
+
+    /// The controller's blending tolerance, mm: a term of the tolerance budget (LinuxCNC
+    /// `G64 P`, Sinumerik `CTOL`/`OTOL`).
+    #[arg(long, default_value_t = kerf_interp::output::DEFAULT_BLEND_TOLERANCE, value_name = "MM")]
+    pub(crate) blend_tolerance: f64,
 
     /// Longest chord allowed, in mm.
     #[arg(long, value_name = "MM")]

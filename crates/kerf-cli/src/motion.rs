@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use kerf_format::toolpath;
 use kerf_interp::{
-    stations_from_axes, stations_from_solved, write_csv, write_gcode, AxisModel, Dialect,
+    gcode_motion, stations_from_axes, stations_from_solved, write_csv, AxisModel, Dialect,
     FitOptions, GcodeOptions, MachineModel, Motion, PathInput, PlanOptions,
 };
 use kerf_kinematics::{solve_path, AxesFile, Machine, PathOptions, Pose};
@@ -25,6 +25,9 @@ pub(crate) struct Program {
     pub motion: Motion,
     /// The tolerance the blocks were fitted with, mm.
     pub fit_tolerance: f64,
+    /// The linearization tolerance the axes were solved with, mm (`None` for an axes file,
+    /// which does not record it).
+    pub linearization_tolerance: Option<f64>,
 }
 
 fn interp_err(file: &Path) -> impl Fn(kerf_interp::InterpError) -> CliError + '_ {
@@ -57,6 +60,7 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
         .ok()
         .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_owned))
         .unwrap_or_default();
+    let mut linearization = None;
     let (ids, paths, file_tol) = if format == kerf_kinematics::AXES_FORMAT {
         let axes = AxesFile::from_str(&text)
             .map_err(|e| CliError::Kinematics(Box::new(e), Some(input.clone())))?;
@@ -75,6 +79,7 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
         )
     } else {
         let tp = toolpath::from_str(&text).map_err(|e| e.in_file(input))?;
+        linearization = Some(PathOptions::default().linearization_tolerance);
         let mut paths = Vec::new();
         for p in &tp.paths {
             let poses: Vec<Pose> = (0..p.points.len())
@@ -124,6 +129,7 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
         ids,
         motion,
         fit_tolerance,
+        linearization_tolerance: linearization,
     })
 }
 
@@ -180,42 +186,51 @@ pub(crate) fn run_interpolate(args: &InterpolateArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Writes the G-code of a program.
-pub(crate) fn write_program(
-    p: &Program,
-    dest: &Path,
+/// The G-code options of a program for `dialect`: the budget terms, the machine's process
+/// codes and pivot length, the source file's name.
+pub(crate) fn gcode_options(
+    model: &MachineModel,
     dialect: Dialect,
     feed: f64,
-) -> Result<(), CliError> {
-    let opts = GcodeOptions {
-        fit_tolerance: p.fit_tolerance,
+    blend_tolerance: f64,
+    source: &Path,
+) -> GcodeOptions {
+    GcodeOptions {
+        blend_tolerance,
+        pivot_length: Some(model.machine.kinematics.pivot_length()),
+        process: model.machine.process.clone(),
+        source: Some(source.display().to_string()),
         ..GcodeOptions::new(dialect, feed)
-    };
-    let feeds = p.motion.block_feeds();
+    }
+}
+
+/// Writes the G-code of a program.
+pub(crate) fn write_program(p: &Program, dest: &Path, opts: &GcodeOptions) -> Result<(), CliError> {
+    let text = gcode_motion(&p.model, &p.motion, &p.ids, opts).map_err(interp_err(dest))?;
     if dest == Path::new("-") {
-        let text = kerf_interp::gcode(&p.model, p.motion.blocks(), &p.ids, Some(&feeds), &opts)
-            .map_err(interp_err(dest))?;
         std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes())?;
         return Ok(());
     }
-    write_gcode(
-        dest,
-        &p.model,
-        p.motion.blocks(),
-        &p.ids,
-        Some(&feeds),
-        &opts,
-    )
-    .map_err(interp_err(dest))
+    kerf_interp::output::write_atomic(dest, text.as_bytes()).map_err(interp_err(dest))
 }
 
 /// Runs `kerf gcode`.
 pub(crate) fn run_gcode(args: &GcodeArgs) -> Result<(), CliError> {
-    let p = program(
-        &args.motion,
-        args.dialect == crate::cli::DialectArg::Generic,
-    )?;
-    write_program(&p, &args.output, args.dialect.into(), args.motion.feed)?;
+    let dialect: Dialect = args.dialect.into();
+    let p = program(&args.motion, dialect.raw_axes())?;
+    let opts = GcodeOptions {
+        fit_tolerance: p.fit_tolerance,
+        chord_tolerance: args.motion.chord_tolerance.unwrap_or(0.001),
+        linearization_tolerance: p.linearization_tolerance,
+        ..gcode_options(
+            &p.model,
+            dialect,
+            args.motion.feed,
+            args.blend_tolerance,
+            &args.motion.input,
+        )
+    };
+    write_program(&p, &args.output, &opts)?;
     summary(&args.motion, &p, Some(&args.output), args.json, args.quiet);
     Ok(())
 }

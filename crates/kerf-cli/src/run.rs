@@ -8,7 +8,7 @@ use std::time::Instant;
 use kerf_discretize::Discretization;
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_interp::{
-    csv_string, gcode, stations_from_solved, AxisModel, GcodeOptions, MachineModel,
+    csv_string, gcode_motion, stations_from_solved, AxisModel, Dialect, GcodeOptions, MachineModel,
     PathInput as InterpPath, PlanOptions,
 };
 use kerf_kinematics::{solve_paths, AxesFile, Machine, PathCurve, PathInput, PathOptions, Pose};
@@ -114,26 +114,20 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             curve: Some(curve),
         });
     }
-    let fit = crate::motion::fit_options(
-        dopts.tolerance,
-        args.dialect == crate::cli::DialectArg::Generic,
-        args.retract,
-    );
+    let dialect: Dialect = args.dialect.into();
+    let fit = crate::motion::fit_options(dopts.tolerance, dialect.raw_axes(), args.retract);
     let plan = PlanOptions::new(args.feed, args.cycle);
     let motion = kerf_interp::interpolate(&model, &ipaths, &fit, &plan).map_err(interp(path))?;
     let ids: Vec<String> = file.curves.iter().map(|c| c.id.clone()).collect();
     let gopts = GcodeOptions {
         fit_tolerance: dopts.tolerance,
-        ..GcodeOptions::new(args.dialect.into(), args.feed)
+        chord_tolerance: plan.chord_tolerance,
+        linearization_tolerance: Some(popts.linearization_tolerance),
+        ..crate::motion::gcode_options(&model, dialect, args.feed, args.blend_tolerance, path)
     };
-    let program = gcode(
-        &model,
-        motion.blocks(),
-        &ids,
-        Some(&motion.block_feeds()),
-        &gopts,
-    )
-    .map_err(interp(path))?;
+    let program = gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?;
+    let process =
+        kerf_interp::ProcessCodes::resolve(dialect, &machine.process).map_err(interp(path))?;
     let setpoints = csv_string(model.axis_names(), args.cycle, &motion.setpoints(&model));
     // 5. Picture and report.
     let mut scene = kerf_plot::Scene::new(&file, &tp, &kerf_plot::SceneOptions::default())
@@ -165,7 +159,16 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "chord": dopts.tolerance,
             "linearization": popts.linearization_tolerance,
             "interpolation_chord": plan.chord_tolerance,
-            "total": dopts.tolerance + popts.linearization_tolerance + plan.chord_tolerance,
+            "controller_blending": gopts.blend_tolerance,
+            "total": gopts.budget_total(),
+        },
+        "program": {
+            "dialect": dialect.name(),
+            "beam_on": process.beam_on,
+            "beam_off": process.beam_off,
+            "pierce_dwell_s": process.pierce_dwell_s,
+            "pierce_standoff_mm": process.pierce_standoff,
+            "cuts": motion.blocks().iter().enumerate().filter(|(i, b)| !b.rapid && (*i == 0 || motion.blocks()[i - 1].rapid)).count(),
         },
         "discretize": {
             "curves": file.curves.len(),

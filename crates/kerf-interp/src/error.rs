@@ -113,6 +113,11 @@ pub enum InterpError {
         /// The operating system's message.
         message: String,
     },
+    /// The laser process codes given to the G-code writer are unusable (the message names the
+    /// key, as `process.beam_on[0]: must not be empty`). Fix: correct the `process` object of
+    /// the machine file.
+    #[error("{0}")]
+    Process(String),
 }
 
 /// `Result` with [`InterpError`].

@@ -107,7 +107,7 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
     );
     assert!(text.contains("units: mm"), "header states units");
     assert!(
-        text.contains("tolerance: arc fit 0.001 mm"),
+        text.contains("tolerance budget mm: chord 0.001"),
         "header states tolerance"
     );
     let moves: Vec<HashMap<String, f64>> = text
@@ -117,13 +117,14 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
         .map(|(_, w)| w)
         .collect();
     let q = |w: &HashMap<String, f64>| -> [f64; 5] { ["X", "Y", "Z", "A", "C"].map(|k| w[k]) };
+    // G0 to the pierce point, then the descent to the start.
     assert_eq!(
-        q(&moves[0]),
+        q(&moves[1]),
         blocks[0].start_axes.map(|v| (v * 1e6).round() / 1e6),
-        "G0 to the start"
+        "descent to the start"
     );
     // Every block end appears, in order; arcs add chord points lying on the arc.
-    let mut it = moves.iter().skip(1);
+    let mut it = moves.iter().skip(2);
     for b in &blocks {
         let mut found = false;
         for w in it.by_ref() {
@@ -136,8 +137,22 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
         }
         assert!(found, "block end {:?} in the program", b.end_axes);
     }
-    assert!(moves[1].contains_key("F"), "first cut sets the feed");
-    assert_eq!(moves[1]["F"], 6000.0, "feed");
+    // F is the machine axes' X Y Z feed (RS274/NGC G94) that makes each block take its
+    // time at 6000 mm/min of the tip: the X Y Z times of the cut add up to tip length / feed.
+    let mut t = 0.0;
+    for w in moves.windows(2).skip(1) {
+        let d = ((w[1]["X"] - w[0]["X"]).powi(2)
+            + (w[1]["Y"] - w[0]["Y"]).powi(2)
+            + (w[1]["Z"] - w[0]["Z"]).powi(2))
+        .sqrt();
+        t += d / w[1]["F"] * 60.0;
+    }
+    let tip: f64 = blocks.iter().map(|b| b.length()).sum();
+    assert!(
+        (t - tip / 100.0).abs() <= 1e-4 * t,
+        "time {t} s vs tip length / feed {} s",
+        tip / 100.0
+    );
     assert!(text.trim_end().ends_with("M30"), "program end");
 }
 
@@ -174,10 +189,10 @@ fn sinumerik_gcode_parses_back_to_tips_orientations_and_arcs() {
         .collect();
     assert_eq!(
         moves.len(),
-        blocks.len() + 1,
-        "a positioning move and one line per block"
+        blocks.len() + 2,
+        "a move to the pierce point, the descent and one line per block"
     );
-    for (b, (head, w)) in blocks.iter().zip(&moves[1..]) {
+    for (b, (head, w)) in blocks.iter().zip(&moves[2..]) {
         let tip = b.end_tip();
         for (k, v) in [
             ("X", tip.x),
@@ -198,7 +213,8 @@ fn sinumerik_gcode_parses_back_to_tips_orientations_and_arcs() {
             assert_eq!(head, "G1", "line");
         }
     }
-    let f = moves[1].1["F"];
+    // F is modal: the first block's, or the descent's if equal.
+    let f = *moves[2].1.get("F").unwrap_or(&moves[1].1["F"]);
     assert!(
         f > 0.0 && f <= 5000.0 + 0.05,
         "planned feed within the programmed one: {f}"

@@ -53,7 +53,7 @@ pub use error::{KinematicsError, Result};
 pub use fork_head::{ForkHead, ForkTilt};
 pub use head_table::HeadTable;
 pub use kinematics::Kinematics;
-pub use machine::{Machine, Range, MACHINE_FORMAT};
+pub use machine::{Machine, Process, Range, MACHINE_FORMAT};
 pub use nonlinear::{linearization_error, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
 pub use placement::{

@@ -74,6 +74,151 @@ pub struct Machine {
     pub max_velocity: [f64; 5],
     /// The largest acceleration of each axis, mm/s^2 or deg/s^2.
     pub max_acceleration: [f64; 5],
+    /// The laser process codes of the optional `process` object; every field `None` when the
+    /// file has none (the G-code writer then uses its dialect's defaults).
+    pub process: Process,
+}
+
+/// The optional `process` object of `kerf.machine/1`: how the program switches the beam and
+/// pierces. A `None` field was absent from the file and takes the dialect's documented default
+/// (`kerf_interp::output`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Process {
+    /// Program lines that switch the beam on, written as given (e.g. `["M64 P0"]`); never
+    /// empty, each line non-empty, printable, without `;` or parentheses (they would start a
+    /// comment in some dialects).
+    pub beam_on: Option<Vec<String>>,
+    /// Program lines that switch the beam off, with the same rules.
+    pub beam_off: Option<Vec<String>>,
+    /// Seconds the head stands at the pierce point with the beam on before it moves, >= 0.
+    pub pierce_dwell_s: Option<f64>,
+    /// mm along the tool axis above the start of a cut where the pierce happens, >= 0; the
+    /// head then descends along the tool axis to the cutting height with the beam on.
+    pub pierce_standoff: Option<f64>,
+}
+
+impl Process {
+    /// The keys of the `process` object.
+    pub const KEYS: [&'static str; 4] =
+        ["beam_on", "beam_off", "pierce_dwell_s", "pierce_standoff"];
+
+    /// Checks every present value.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Document`] with the JSON path (`process.pierce_dwell_s: must be
+    /// >= 0 (got -1)`, `process.beam_on[0]: must not be empty`).
+    pub fn validate(&self) -> Result<()> {
+        for (key, lines) in [("beam_on", &self.beam_on), ("beam_off", &self.beam_off)] {
+            let Some(lines) = lines else { continue };
+            if lines.is_empty() {
+                return Err(KinematicsError::doc(
+                    format!("process.{key}"),
+                    "must list at least one program line",
+                ));
+            }
+            for (i, line) in lines.iter().enumerate() {
+                let path = format!("process.{key}[{i}]");
+                if line.trim().is_empty() {
+                    return Err(KinematicsError::doc(path, "must not be empty"));
+                }
+                if let Some(c) = line
+                    .chars()
+                    .find(|c| c.is_control() || !c.is_ascii() || matches!(c, ';' | '(' | ')'))
+                {
+                    return Err(KinematicsError::doc(
+                        path,
+                        format!(
+                            "must be one printable ASCII program line without comments (found {:?})",
+                            c
+                        ),
+                    ));
+                }
+            }
+        }
+        for (key, v) in [
+            ("pierce_dwell_s", self.pierce_dwell_s),
+            ("pierce_standoff", self.pierce_standoff),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(KinematicsError::doc(
+                        format!("process.{key}"),
+                        format!("must be finite and >= 0 (got {v})"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads the `process` object (`value` is its JSON value); unknown keys are refused.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Document`] with the JSON path of the first defect.
+    pub fn from_value(value: &Value) -> Result<Self> {
+        let Value::Object(map) = value else {
+            return Err(KinematicsError::doc(
+                "process",
+                format!("expected an object, found {}", json_type_name(value)),
+            ));
+        };
+        if let Some(extra) = map.keys().find(|k| !Self::KEYS.contains(&k.as_str())) {
+            return Err(KinematicsError::doc(
+                format!("process.{extra}"),
+                format!("unknown key (known: {})", Self::KEYS.join(", ")),
+            ));
+        }
+        let lines = |key: &str| -> Result<Option<Vec<String>>> {
+            let Some(v) = map.get(key) else {
+                return Ok(None);
+            };
+            let Value::Array(items) = v else {
+                return Err(KinematicsError::doc(
+                    format!("process.{key}"),
+                    format!(
+                        "expected a list of program lines, found {}",
+                        json_type_name(v)
+                    ),
+                ));
+            };
+            items
+                .iter()
+                .enumerate()
+                .map(|(i, item)| match item {
+                    Value::String(s) => Ok(s.clone()),
+                    other => Err(KinematicsError::doc(
+                        format!("process.{key}[{i}]"),
+                        format!("expected a string, found {}", json_type_name(other)),
+                    )),
+                })
+                .collect::<Result<Vec<_>>>()
+                .map(Some)
+        };
+        let number = |key: &str| -> Result<Option<f64>> {
+            match map.get(key) {
+                None => Ok(None),
+                Some(v) => v.as_f64().map(Some).ok_or_else(|| {
+                    KinematicsError::doc(
+                        format!("process.{key}"),
+                        format!("expected a number, found {}", json_type_name(v)),
+                    )
+                }),
+            }
+        };
+        let p = Self {
+            beam_on: lines("beam_on")?,
+            beam_off: lines("beam_off")?,
+            pierce_dwell_s: number("pierce_dwell_s")?,
+            pierce_standoff: number("pierce_standoff")?,
+        };
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// True when the file had no `process` object (or an empty one).
+    pub fn is_empty(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 impl Machine {
@@ -95,6 +240,7 @@ impl Machine {
             limits,
             max_velocity,
             max_acceleration,
+            process: Process::default(),
         };
         machine.validate()?;
         Ok(machine)
@@ -140,7 +286,7 @@ impl Machine {
                 }
             }
         }
-        Ok(())
+        self.process.validate()
     }
 
     /// The axis names in file order, e.g. `["X", "Y", "Z", "A", "C"]`.
@@ -273,7 +419,11 @@ impl Machine {
         };
         let max_velocity = per_axis(top, "max_velocity", &names, number)?;
         let max_acceleration = per_axis(top, "max_acceleration", &names, number)?;
-        Self::try_new(name, kinematics, limits, max_velocity, max_acceleration)
+        let mut machine = Self::try_new(name, kinematics, limits, max_velocity, max_acceleration)?;
+        if let Some(p) = top.get("process") {
+            machine.process = Process::from_value(p)?;
+        }
+        Ok(machine)
     }
 
     /// The machine as `kerf.machine/1` JSON text (reads back to an equal machine).
@@ -301,8 +451,28 @@ impl Machine {
                 .collect(),
         );
         let numbers = |v: &[f64; 5]| object(v.iter().map(|x| json(*x)).collect());
+        let mut process = Vec::new();
+        let p = &self.process;
+        for (key, lines) in [("beam_on", &p.beam_on), ("beam_off", &p.beam_off)] {
+            if let Some(l) = lines {
+                process.push(format!("\"{key}\": {}", json(l)));
+            }
+        }
+        for (key, v) in [
+            ("pierce_dwell_s", p.pierce_dwell_s),
+            ("pierce_standoff", p.pierce_standoff),
+        ] {
+            if let Some(v) = v {
+                process.push(format!("\"{key}\": {}", json(v)));
+            }
+        }
+        let process = if process.is_empty() {
+            String::new()
+        } else {
+            format!(",\n  \"process\": {{ {} }}", process.join(", "))
+        };
         format!(
-            "{{\n  \"format\": \"{MACHINE_FORMAT}\",\n  \"name\": {},\n  \"kinematics\": {{ {} }},\n  \"limits\": {limits},\n  \"max_velocity\": {},\n  \"max_acceleration\": {}\n}}\n",
+            "{{\n  \"format\": \"{MACHINE_FORMAT}\",\n  \"name\": {},\n  \"kinematics\": {{ {} }},\n  \"limits\": {limits},\n  \"max_velocity\": {},\n  \"max_acceleration\": {}{process}\n}}\n",
             json(self.name.as_str()),
             kin.join(", "),
             numbers(&self.max_velocity),

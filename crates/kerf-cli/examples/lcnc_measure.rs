@@ -1,0 +1,323 @@
+//! Measures a LinuxCNC simulator run of a `kerf run` output directory (the check in
+//! `tests/linuxcnc/`): the tool tip of every servo cycle through kerf's forward kinematics,
+//! its deviation from the cut, the beam output against the cuts, the axes' limits, velocities
+//! and accelerations, and the time against kerf's plan. Prints one JSON object.
+//!
+//! ```sh
+//! cargo run --release -p kerf-cli --example lcnc_measure -- MACHINE.json KERF_OUT_DIR SAMPLES.txt [PERIOD_S]
+//! ```
+//!
+//! `SAMPLES.txt` is `halsampler -t` output: the sample number, the five joint positions (the
+//! machine file's axis order) and the beam bit, one servo cycle per line. `KERF_OUT_DIR` holds
+//! `axes.json`, `toolpath.json` and `report.json` of the same `kerf run`.
+
+use std::path::Path;
+
+use kerf_kinematics::{Axes, AxesFile, Machine};
+use nalgebra::{Point3, Vector3};
+use serde_json::{json, Value};
+
+fn fail(msg: String) -> ! {
+    eprintln!("lcnc_measure: {msg}");
+    std::process::exit(1)
+}
+
+/// Distance from `p` to the segment `a b`.
+fn seg_dist(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
+    let d = b - a;
+    let l2 = d.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + d * t)).norm()
+}
+
+/// Distance from `p` to the polyline `pts`, searching segments near `hint` first (samples
+/// advance along the path) but always over all segments, so the result is exact.
+fn poly_dist(p: &Point3<f64>, pts: &[Point3<f64>]) -> f64 {
+    if pts.len() == 1 {
+        return (p - pts[0]).norm();
+    }
+    pts.windows(2)
+        .map(|w| seg_dist(p, &w[0], &w[1]))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The segment `pts[j] pts[j + 1]` nearest `p` and the fraction along it of the nearest point.
+fn nearest_segment(p: &Point3<f64>, pts: &[Point3<f64>]) -> (usize, f64) {
+    let mut best = (0, 0.0, f64::INFINITY);
+    for (j, w) in pts.windows(2).enumerate() {
+        let d = w[1] - w[0];
+        let l2 = d.norm_squared();
+        let f = if l2 > 0.0 {
+            ((p - w[0]).dot(&d) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let dist = (p - (w[0] + d * f)).norm();
+        if dist < best.2 {
+            best = (j, f, dist);
+        }
+    }
+    (best.0, best.1)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() < 3 {
+        fail("usage: lcnc_measure MACHINE.json KERF_OUT_DIR SAMPLES.txt [PERIOD_S]".into());
+    }
+    let machine = Machine::read(&args[0]).unwrap_or_else(|e| fail(e.to_string()));
+    let dir = Path::new(&args[1]);
+    let period: f64 = args.get(3).map_or(0.001, |s| s.parse().unwrap_or(0.001));
+    let read = |name: &str| {
+        std::fs::read_to_string(dir.join(name))
+            .unwrap_or_else(|e| fail(format!("{}: {e}", dir.join(name).display())))
+    };
+    let axes = AxesFile::from_str(&read("axes.json")).unwrap_or_else(|e| fail(e.to_string()));
+    let tp = kerf_format::toolpath::from_str(&read("toolpath.json"))
+        .unwrap_or_else(|e| fail(e.to_string()));
+    let report: Value =
+        serde_json::from_str(&read("report.json")).unwrap_or_else(|e| fail(e.to_string()));
+    let budget = report["tolerance_budget_mm"]["total"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    let duration = report["interpolation"]["duration_s"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    let feed = report["interpolation"]["feed_mm_per_min"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    let dwell = report["program"]["pierce_dwell_s"].as_f64().unwrap_or(0.0);
+    let standoff = report["program"]["pierce_standoff_mm"]
+        .as_f64()
+        .unwrap_or(0.0);
+
+    // Samples.
+    let text =
+        std::fs::read_to_string(&args[2]).unwrap_or_else(|e| fail(format!("{}: {e}", args[2])));
+    let mut q: Vec<[f64; 5]> = Vec::new();
+    let mut beam: Vec<bool> = Vec::new();
+    let mut gaps = 0usize;
+    let mut last_n: Option<i64> = None;
+    for (i, line) in text.lines().enumerate() {
+        let v: Vec<&str> = line.split_whitespace().collect();
+        if v.len() != 7 {
+            fail(format!(
+                "{}:{}: expected 7 columns, found {}",
+                args[2],
+                i + 1,
+                v.len()
+            ));
+        }
+        let n: i64 = v[0]
+            .parse()
+            .unwrap_or_else(|_| fail(format!("line {}: sample number", i + 1)));
+        if last_n.is_some_and(|l| n != l + 1) {
+            gaps += 1;
+        }
+        last_n = Some(n);
+        let mut a = [0.0; 5];
+        for k in 0..5 {
+            a[k] = v[k + 1]
+                .parse()
+                .unwrap_or_else(|_| fail(format!("line {}: number", i + 1)));
+        }
+        q.push(a);
+        beam.push(v[6] != "0");
+    }
+    let tips: Vec<(Point3<f64>, Vector3<f64>)> = q
+        .iter()
+        .map(|a| {
+            let p = machine.kinematics.forward(&Axes::from_array(*a));
+            (p.position, p.axis)
+        })
+        .collect();
+
+    // Beam intervals [first on, last on].
+    let mut intervals: Vec<(usize, usize)> = Vec::new();
+    for i in 0..beam.len() {
+        if beam[i] && (i == 0 || !beam[i - 1]) {
+            intervals.push((i, i));
+        }
+        if beam[i] {
+            if let Some(l) = intervals.last_mut() {
+                l.1 = i;
+            }
+        }
+    }
+    let cuts: Vec<(Vec<Point3<f64>>, Vec<Point3<f64>>, Vector3<f64>)> = axes
+        .paths
+        .iter()
+        .zip(&tp.paths)
+        .map(|(a, t)| {
+            let poses: Vec<Point3<f64>> = a
+                .poses
+                .iter()
+                .map(|p| Point3::new(p[0], p[1], p[2]))
+                .collect();
+            let pts: Vec<Point3<f64>> = (0..t.points.len()).map(|n| t.points.position(n)).collect();
+            let u = Vector3::new(a.poses[0][3], a.poses[0][4], a.poses[0][5]).normalize();
+            (poses, pts, u)
+        })
+        .collect();
+
+    let mut per_cut = Vec::new();
+    let mut max_dev_union: f64 = 0.0;
+    let mut max_dev_points: f64 = 0.0;
+    let mut max_dev_orient_deg: f64 = 0.0;
+    let mut framing_ok = intervals.len() == cuts.len();
+    for (k, (iv, (poses, pts, u0))) in intervals.iter().zip(&cuts).enumerate() {
+        let start = poses[0];
+        let end = *poses.last().unwrap_or(&start);
+        let pierce = start + u0 * standoff;
+        // The beam switches on where the head has come to rest at the pierce point and off
+        // where it rests at the cut's end: in the last cycle before and the first cycle after
+        // the switch the head is within 10 um of the point (LinuxCNC reports a move done
+        // during its last creep of a few um, under 10 mm/s).
+        let on_at = (tips[iv.0].0 - pierce).norm();
+        let before = if iv.0 > 0 {
+            (tips[iv.0 - 1].0 - pierce).norm()
+        } else {
+            f64::INFINITY
+        };
+        let off_at = (tips[iv.1].0 - end).norm();
+        let after = tips
+            .get(iv.1 + 1)
+            .map_or(f64::INFINITY, |t| (t.0 - end).norm());
+        // Every beam-on sample against the pierce segment and the cut together (where the beam
+        // may be: the controller may round the corner between the descent and the cut); the
+        // samples nearer the cut than the pierce segment also against the cutting points and
+        // for the tool axis.
+        let mut dev_union: f64 = 0.0;
+        let mut dev_points: f64 = 0.0;
+        let mut dev_orient: f64 = 0.0;
+        for (p, u) in tips.iter().take(iv.1 + 1).skip(iv.0) {
+            let d_cut = poly_dist(p, poses);
+            let d_pierce = seg_dist(p, &start, &pierce);
+            dev_union = dev_union.max(d_cut.min(d_pierce));
+            dev_points = dev_points.max(poly_dist(p, pts).min(d_pierce));
+            if d_pierce < d_cut {
+                continue;
+            }
+            // Tool axis against the poses' axes interpolated at the nearest point of the
+            // nearest segment, degrees.
+            let (j, f) = nearest_segment(p, poses);
+            let ax = |n: usize| {
+                let pj = &axes.paths[k].poses[n.min(poses.len() - 1)];
+                Vector3::new(pj[3], pj[4], pj[5]).normalize()
+            };
+            let uj = (ax(j) * (1.0 - f) + ax(j + 1) * f).normalize();
+            dev_orient = dev_orient.max(u.dot(&uj).clamp(-1.0, 1.0).acos().to_degrees());
+        }
+        max_dev_union = max_dev_union.max(dev_union);
+        // The pierce: the beam on while the head stands at the pierce point for the dwell.
+        let dwell_on = tips[iv.0..=iv.1]
+            .iter()
+            .take_while(|(p, _)| (p - pierce).norm() < 1e-2)
+            .count() as f64
+            * period;
+        let ok = on_at < 1e-2
+            && before < 1e-2
+            && off_at < 1e-2
+            && after < 1e-2
+            && dwell_on >= dwell - 2.0 * period;
+        framing_ok &= ok;
+        max_dev_points = max_dev_points.max(dev_points);
+        max_dev_orient_deg = max_dev_orient_deg.max(dev_orient);
+        per_cut.push(json!({
+            "id": axes.paths[k].id,
+            "beam_on_sample": iv.0,
+            "beam_off_sample": iv.1 + 1,
+            "beam_on_distance_from_pierce_point_mm": on_at,
+            "distance_from_pierce_point_before_beam_on_mm": before,
+            "beam_off_distance_from_cut_end_mm": off_at,
+            "distance_from_cut_end_after_beam_off_mm": after,
+            "max_deviation_beam_on_mm": dev_union,
+            "max_deviation_from_cutting_points_mm": dev_points,
+            "max_tool_axis_deviation_deg": dev_orient,
+            "beam_on_at_pierce_point_s": dwell_on,
+            "framing_ok": ok,
+        }));
+    }
+
+    // Limits, velocities and accelerations (second differences of the commanded positions),
+    // separately while the beam is off (rapids) and on (cuts).
+    let names = machine.axis_names();
+    let mut limit_violations = 0usize;
+    for a in &q {
+        if machine.violation(&Axes::from_array(*a), 1e-6).is_some() {
+            limit_violations += 1;
+        }
+    }
+    let mut vel_ratio = [0.0f64; 5];
+    let mut acc_ratio_rapid = [0.0f64; 5];
+    let mut acc_ratio_cut = [0.0f64; 5];
+    for i in 1..q.len() {
+        for k in 0..5 {
+            let v = (q[i][k] - q[i - 1][k]) / period * 60.0;
+            vel_ratio[k] = vel_ratio[k].max(v.abs() / machine.max_velocity[k]);
+        }
+    }
+    for i in 1..q.len().saturating_sub(1) {
+        for k in 0..5 {
+            let a = (q[i + 1][k] - 2.0 * q[i][k] + q[i - 1][k]) / (period * period);
+            let r = a.abs() / machine.max_acceleration[k];
+            if beam[i] {
+                acc_ratio_cut[k] = acc_ratio_cut[k].max(r);
+            } else {
+                acc_ratio_rapid[k] = acc_ratio_rapid[k].max(r);
+            }
+        }
+    }
+    let by_axis = |r: &[f64; 5]| -> Value {
+        let m: serde_json::Map<String, Value> = names
+            .iter()
+            .zip(r)
+            .map(|(n, v)| (n.to_string(), json!(v)))
+            .collect();
+        Value::Object(m)
+    };
+
+    // Time: from the first beam on to the last beam off, against kerf's plan plus the pierce
+    // dwell and the descent of each cut.
+    let (t_lcnc, predicted) = match (intervals.first(), intervals.last()) {
+        (Some(a), Some(b)) => {
+            let n = intervals.len() as f64;
+            let descent = if standoff > 0.0 {
+                standoff / (feed / 60.0)
+            } else {
+                0.0
+            };
+            (
+                (b.1 + 1 - a.0) as f64 * period,
+                duration + n * (dwell + descent),
+            )
+        }
+        _ => (0.0, duration),
+    };
+    let out = json!({
+        "samples": q.len(),
+        "sample_gaps": gaps,
+        "period_s": period,
+        "cuts": cuts.len(),
+        "beam_intervals": intervals.len(),
+        "framing_ok": framing_ok,
+        "tolerance_budget_mm": budget,
+        "max_deviation_beam_on_mm": max_dev_union,
+        "max_deviation_from_cutting_points_mm": max_dev_points,
+        "max_tool_axis_deviation_deg": max_dev_orient_deg,
+        "limit_violations": limit_violations,
+        "max_velocity_ratio": by_axis(&vel_ratio),
+        "max_acceleration_ratio_rapids": by_axis(&acc_ratio_rapid),
+        "max_acceleration_ratio_cuts": by_axis(&acc_ratio_cut),
+        "linuxcnc_time_s": t_lcnc,
+        "kerf_predicted_s": predicted,
+        "kerf_motion_duration_s": duration,
+        "time_ratio": t_lcnc / predicted,
+        "per_cut": per_cut,
+    });
+    println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
+}

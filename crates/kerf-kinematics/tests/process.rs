@@ -1,0 +1,61 @@
+//! The optional `process` object of `kerf.machine/1`: read, refused with the JSON path when
+//! bad, written back by `to_json`.
+
+use kerf_kinematics::{Machine, Process};
+
+fn machine(process: &str) -> String {
+    format!(
+        r#"{{"format": "kerf.machine/1", "name": "m",
+  "kinematics": {{ "type": "ac-head", "r_a": 180.0, "r_c": 95.0 }},
+  "limits": {{ "X": [-1500, 1500], "Y": [-800, 800], "Z": [-100, 600], "A": [-135, 135], "C": null }},
+  "max_velocity": {{ "X": 60000, "Y": 60000, "Z": 30000, "A": 36000, "C": 36000 }},
+  "max_acceleration": {{ "X": 10000, "Y": 10000, "Z": 8000, "A": 20000, "C": 20000 }}{process}}}"#
+    )
+}
+
+#[test]
+fn absent_process_is_empty_and_a_full_one_reads_back() {
+    let m = Machine::from_str(&machine("")).expect("no process");
+    assert!(m.process.is_empty());
+    let m = Machine::from_str(&machine(
+        r#", "process": { "beam_on": ["M64 P0", "G4 P0.01"], "beam_off": ["M65 P0"], "pierce_dwell_s": 0.2, "pierce_standoff": 1.5 }"#,
+    ))
+    .expect("full process");
+    assert_eq!(
+        m.process,
+        Process {
+            beam_on: Some(vec!["M64 P0".into(), "G4 P0.01".into()]),
+            beam_off: Some(vec!["M65 P0".into()]),
+            pierce_dwell_s: Some(0.2),
+            pierce_standoff: Some(1.5),
+        }
+    );
+    let back = Machine::from_str(&m.to_json()).expect("to_json reads back");
+    assert_eq!(back.process, m.process, "to_json keeps the process");
+    let partial =
+        Machine::from_str(&machine(r#", "process": { "pierce_dwell_s": 0 }"#)).expect("one key");
+    assert_eq!(partial.process.pierce_dwell_s, Some(0.0));
+    assert_eq!(partial.process.beam_on, None, "absent key stays absent");
+}
+
+#[test]
+fn bad_process_values_are_named_errors() {
+    let cases = [
+        (r#"{"pierce_dwell_s": -1}"#, "process.pierce_dwell_s: must be finite and >= 0 (got -1)"),
+        (r#"{"pierce_standoff": -0.5}"#, "process.pierce_standoff: must be finite and >= 0 (got -0.5)"),
+        (r#"{"pierce_dwell_s": "long"}"#, "process.pierce_dwell_s: expected a number, found a string"),
+        (r#"{"beam_on": []}"#, "process.beam_on: must list at least one program line"),
+        (r#"{"beam_on": ["M64 P0", " "]}"#, "process.beam_on[1]: must not be empty"),
+        (r#"{"beam_off": "M65 P0"}"#, "process.beam_off: expected a list of program lines, found a string"),
+        (r#"{"beam_off": [5]}"#, "process.beam_off[0]: expected a string, found a number"),
+        (r#"{"beam_on": ["M64 P0\nG0 X1400"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '\\n')"),
+        (r#"{"beam_on": ["M3 (on)"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '(')"),
+        (r#"{"beam_on": ["M3"], "dwell": 1}"#, "process.dwell: unknown key (known: beam_on, beam_off, pierce_dwell_s, pierce_standoff)"),
+        (r#"["M3"]"#, "process: expected an object, found an array"),
+    ];
+    for (process, want) in cases {
+        let e =
+            Machine::from_str(&machine(&format!(r#", "process": {process}"#))).expect_err(process);
+        assert_eq!(e.to_string(), want, "{process}");
+    }
+}

@@ -1,0 +1,226 @@
+#!/usr/bin/python3
+"""kerf's programs on a real controller: LinuxCNC's interpreter and simulator.
+
+    /usr/bin/python3 tests/linuxcnc/check.py [--out DIR] [--no-sim] [--sim NAME ...]
+
+1. Every shipped fixture on every machine file whose travel holds it (`kerf run` succeeds):
+   the `linuxcnc` program (and the `generic` one) through LinuxCNC's standalone interpreter
+   `rs274` with an INI made from that machine; any message on its error stream (errors and
+   warnings alike) fails the check.
+2. The simulator runs (`SIMS` below: a flat part and a tilted-head part): a headless LinuxCNC
+   (configuration from `make_config.py`, DISPLAY = `display.py`, run by an unprivileged user)
+   executes the program while `halsampler` records the joints and the beam output every servo
+   cycle; `lcnc_measure` (Rust, kerf's forward kinematics) measures the samples; the asserts are
+   below. Figures go to DIR/summary.json.
+
+Exit status 0 when every assertion holds, 1 otherwise (also when LinuxCNC is not installed).
+Python only drives LinuxCNC and compares numbers; the tip comes from kerf's kinematics.
+"""
+import json
+import os
+import pwd
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+HERE = Path(__file__).resolve().parent
+MACHINES = ["ac_head", "gantry_ac", "fork_head", "table_table", "head_table"]
+# (fixture, machine, flat): the flat part must run within 10 % of kerf's predicted time.
+SIMS = [
+    ("sheet_metal_holes", "gantry_ac", True),
+    ("tube_saddle", "ac_head", False),
+]
+USER = "kerfsim"
+failures = []
+
+
+def fail(msg):
+    print("FAIL:", msg, flush=True)
+    failures.append(msg)
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, capture_output=True, text=True, **kw)
+
+
+def kerf_run(kerf, fixture, machine, dialect, out, extra=()):
+    r = run([str(kerf), "run", str(ROOT / "fixtures" / f"{fixture}.json"), "-m",
+             str(ROOT / "fixtures" / "machines" / f"{machine}.json"), "--dialect", dialect,
+             "-o", str(out), "-q", *extra])
+    return r
+
+
+def config(machine, out, display="true"):
+    r = run([sys.executable, str(HERE / "make_config.py"),
+             str(ROOT / "fixtures" / "machines" / f"{machine}.json"), str(out), "--display", display])
+    if r.returncode != 0:
+        raise SystemExit(f"make_config {machine}: {r.stderr}")
+
+
+def rs274(cfg, program):
+    """Parses `program` with rs274; returns the error-stream lines other than 'executing'."""
+    r = run(["rs274", "-i", "kerf.ini", "-n", "0", "-g", str(program), "canon.txt"],
+            cwd=cfg, stdin=subprocess.DEVNULL, timeout=120)
+    lines = [l for l in (r.stderr + r.stdout).splitlines() if l.strip() and l.strip() != "executing"]
+    if r.returncode != 0:
+        lines.append(f"rs274 exit status {r.returncode}")
+    canon = (Path(cfg) / "canon.txt").read_text() if (Path(cfg) / "canon.txt").exists() else ""
+    if "PROGRAM_END()" not in canon:
+        lines.append("rs274 did not reach the program end")
+    return lines
+
+
+def ensure_user():
+    if os.geteuid() != 0:
+        return None
+    try:
+        pwd.getpwnam(USER)
+    except KeyError:
+        subprocess.run(["useradd", "-m", "-s", "/bin/sh", USER], check=True)
+    return USER
+
+
+def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), traj=(), edit=None):
+    """One simulator run; `extra` are more `kerf run` arguments, `traj` more [TRAJ] lines of
+    the INI, `edit` a function applied to the program text (for the experiments)."""
+    work = Path(tempfile.mkdtemp(prefix=f"kerf-sim-{fixture}-"))
+    os.chmod(work, 0o777)
+    fixture_tag = fixture + tag
+    kout = outdir / f"sim-{fixture_tag}"
+    r = kerf_run(kerf, fixture, machine, "linuxcnc", kout, extra)
+    if r.returncode != 0:
+        fail(f"sim {fixture}: kerf run: {r.stderr.strip()}")
+        return None
+    shutil.copy(HERE / "display.py", work / "display.py")
+    os.chmod(work / "display.py", 0o755)
+    config(machine, work, display=str(work / "display.py"))
+    if traj:
+        ini = (work / "kerf.ini").read_text().replace("[TRAJ]\n", "[TRAJ]\n" + "".join(t + "\n" for t in traj))
+        (work / "kerf.ini").write_text(ini)
+    text = (kout / "program.nc").read_text()
+    (work / "program.ngc").write_text(edit(text) if edit else text)
+    user = ensure_user()
+    env = {"KERF_PROGRAM": str(work / "program.ngc"), "KERF_SAMPLES": str(work / "samples.txt"),
+           "KERF_RESULT": str(work / "result.json"), "KERF_TIMEOUT": "240"}
+    cmd = ["env", *[f"{k}={v}" for k, v in env.items()], "linuxcnc", "kerf.ini"]
+    if user:
+        for p in work.iterdir():
+            shutil.chown(p, user)
+        shutil.chown(work, user)
+        cmd = ["runuser", "-u", user, "--", *cmd]
+    t0 = time.time()
+    try:
+        p = run(cmd, cwd=work, timeout=300)
+        log = p.stdout + p.stderr
+    except subprocess.TimeoutExpired as e:
+        log = f"timeout: {e}"
+    (outdir / f"sim-{fixture_tag}.log").write_text(log)
+    wall = time.time() - t0
+    res_path = work / "result.json"
+    if not res_path.exists():
+        fail(f"sim {fixture_tag}: LinuxCNC gave no result (log in {outdir}/sim-{fixture_tag}.log)")
+        return None
+    res = json.loads(res_path.read_text())
+    shutil.copy(work / "samples.txt", outdir / f"sim-{fixture_tag}-samples.txt")
+    m = run([str(measure), str(ROOT / "fixtures" / "machines" / f"{machine}.json"), str(kout),
+             str(work / "samples.txt"), "0.001"])
+    if m.returncode != 0:
+        fail(f"sim {fixture}: lcnc_measure: {m.stderr.strip()}")
+        return None
+    fig = json.loads(m.stdout)
+    fig.update({"fixture": fixture, "machine": machine, "linuxcnc_errors": res["errors"],
+                "linuxcnc_end": res["code"], "wall_s": wall})
+    fig["variant"] = tag
+    name = f"sim {fixture_tag} on {machine}"
+    if res["errors"] or res["code"] != "done":
+        fail(f"{name}: LinuxCNC errors {res['errors']}, end {res['code']}")
+    if fig["sample_gaps"]:
+        fail(f"{name}: {fig['sample_gaps']} gaps in the samples (sampler overrun)")
+    if not fig["framing_ok"] or fig["beam_intervals"] != fig["cuts"]:
+        fail(f"{name}: beam on {fig['beam_intervals']} times for {fig['cuts']} cuts, framing ok {fig['framing_ok']}")
+    if not fig["max_deviation_beam_on_mm"] <= fig["tolerance_budget_mm"]:
+        fail(f"{name}: tip deviation {fig['max_deviation_beam_on_mm']} mm > budget {fig['tolerance_budget_mm']} mm")
+    if fig["limit_violations"]:
+        fail(f"{name}: {fig['limit_violations']} samples outside the axis limits")
+    # 1e-6 mm of sample rounding over 1 ms^2 is 1 mm/s^2: 1 % slack on the limits.
+    for k, v in fig["max_acceleration_ratio_rapids"].items():
+        if v > 1.01:
+            fail(f"{name}: rapid acceleration of {k} at {v:.3f} x its limit")
+    for k, v in fig["max_velocity_ratio"].items():
+        if v > 1.01:
+            fail(f"{name}: velocity of {k} at {v:.3f} x its limit")
+    if flat and not 0.9 <= fig["time_ratio"] <= 1.1:
+        fail(f"{name}: time LinuxCNC / kerf {fig['time_ratio']:.3f} outside [0.9, 1.1]")
+    print(f"{name}: deviation {fig['max_deviation_beam_on_mm']:.5f} mm (budget {fig['tolerance_budget_mm']}), "
+          f"beam {fig['beam_intervals']}/{fig['cuts']} cuts framed {fig['framing_ok']}, "
+          f"time {fig['linuxcnc_time_s']:.3f} s / kerf {fig['kerf_predicted_s']:.3f} s = {fig['time_ratio']:.3f}, "
+          f"wall {wall:.1f} s", flush=True)
+    shutil.rmtree(work, ignore_errors=True)
+    return fig
+
+
+def main():
+    args = sys.argv[1:]
+    outdir = Path(args[args.index("--out") + 1]) if "--out" in args else Path(tempfile.mkdtemp(prefix="kerf-lcnc-"))
+    outdir.mkdir(parents=True, exist_ok=True)
+    sims = SIMS
+    if "--sim" in args:
+        names = args[args.index("--sim") + 1:]
+        sims = [s for s in SIMS if s[0] in names]
+    for tool in ("rs274", "linuxcnc", "halsampler"):
+        if shutil.which(tool) is None:
+            print(f"FAIL: {tool} not found: install LinuxCNC (apt-get install linuxcnc-uspace)")
+            return 1
+    t0 = time.time()
+    b = run(["cargo", "build", "--release", "-p", "kerf-cli", "--bin", "kerf", "--example", "lcnc_measure"], cwd=ROOT)
+    if b.returncode != 0:
+        print(b.stderr)
+        return 1
+    kerf = ROOT / "target" / "release" / "kerf"
+    measure = ROOT / "target" / "release" / "examples" / "lcnc_measure"
+    # 1. The interpreter on every fixture and machine.
+    cfgs = {}
+    for m in MACHINES:
+        cfgs[m] = outdir / f"ini-{m}"
+        config(m, cfgs[m])
+    parsed = []
+    fixtures = sorted(p.stem for p in (ROOT / "fixtures").glob("*.json"))
+    for f in fixtures:
+        ran = []
+        for m in MACHINES:
+            for dialect in ("linuxcnc", "generic"):
+                out = outdir / f"{f}-{m}-{dialect}"
+                r = kerf_run(kerf, f, m, dialect, out)
+                if r.returncode != 0:
+                    continue  # outside this machine's travel: kerf refuses, nothing to parse
+                ran.append(m)
+                msgs = rs274(cfgs[m], out / "program.nc")
+                if msgs:
+                    fail(f"rs274 {f} on {m} ({dialect}): {msgs[:5]}")
+                parsed.append({"fixture": f, "machine": m, "dialect": dialect, "ok": not msgs})
+                shutil.rmtree(out, ignore_errors=True)
+        if not ran:
+            fail(f"{f}: no machine file holds it, nothing parsed")
+    print(f"rs274: {sum(p['ok'] for p in parsed)}/{len(parsed)} programs parse without error or warning "
+          f"({len(fixtures)} fixtures)", flush=True)
+    # 2. The simulator.
+    figs = []
+    if "--no-sim" not in args:
+        for f, m, flat in sims:
+            fig = simulate(kerf, measure, f, m, flat, outdir)
+            if fig:
+                figs.append(fig)
+    summary = {"linuxcnc": run(["dpkg-query", "-W", "-f", "${Version}", "linuxcnc-uspace"]).stdout,
+               "parsed": parsed, "simulations": figs, "failures": failures,
+               "seconds": time.time() - t0}
+    (outdir / "summary.json").write_text(json.dumps(summary, indent=2))
+    print(f"figures in {outdir}/summary.json; {len(failures)} failure(s); {time.time() - t0:.0f} s")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -431,6 +431,17 @@ pub(crate) struct RunArgs {
     #[arg(long, default_value_t = 10.0, value_name = "MM")]
     pub(crate) retract: f64,
 
+    /// Lead-in of every cut: the straight part from the pierce point, then the radius of the
+    /// quarter arc that joins the contour tangentially on the scrap side, mm (`0,0` pierces on
+    /// the contour). Shrunk where the scrap is smaller (small holes).
+    #[arg(long, value_name = "LINE,RADIUS", default_value = "2,1", value_parser = parse_pair)]
+    pub(crate) lead_in: (f64, f64),
+
+    /// Lead-out: how far the cut runs on past its start on a closed contour, then the exit
+    /// into the scrap, mm.
+    #[arg(long, value_name = "OVERCUT,EXIT", default_value = "0.5,1", value_parser = parse_pair)]
+    pub(crate) lead_out: (f64, f64),
+
     /// Print the report as JSON on standard output.
     #[arg(long)]
     pub(crate) json: bool,
@@ -438,4 +449,30 @@ pub(crate) struct RunArgs {
     /// Print no summary.
     #[arg(short, long)]
     pub(crate) quiet: bool,
+}
+
+/// `A,B`: two finite lengths in mm, each in [0, 1000].
+fn parse_pair(text: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [a, b] = parts.as_slice() else {
+        return Err(format!("expected two values A,B in mm, got {text:?}"));
+    };
+    let num = |v: &str| -> Result<f64, String> {
+        let x: f64 = v.parse().map_err(|_| format!("not a number: {v:?}"))?;
+        if x.is_finite() && (0.0..=1000.0).contains(&x) {
+            Ok(x)
+        } else {
+            Err(format!("{v} mm is outside [0, 1000]"))
+        }
+    };
+    Ok((num(a)?, num(b)?))
+}
+
+impl RunArgs {
+    /// The lead-in and lead-out options these arguments ask for.
+    pub(crate) fn lead_options(&self) -> kerf_process::LeadOptions {
+        kerf_process::LeadOptions::default()
+            .with_lead_in(self.lead_in.0, self.lead_in.1)
+            .with_lead_out(self.lead_out.0, self.lead_out.1)
+    }
 }

@@ -8,6 +8,7 @@
 
 mod check;
 mod cli;
+mod cuts;
 mod discretize;
 mod error;
 mod motion;

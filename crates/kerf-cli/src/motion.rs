@@ -68,7 +68,11 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
         for p in &axes.paths {
             paths.push(PathInput {
                 id: p.id.clone(),
-                stations: stations_from_axes(&p.positions, &p.poses).map_err(interp_err(input))?,
+                stations: {
+                    // Lead-in, cut and lead-out, as the machine runs them.
+                    let (positions, poses) = p.run();
+                    stations_from_axes(&positions, &poses).map_err(interp_err(input))?
+                },
                 curve: None,
             });
         }

@@ -51,6 +51,14 @@ impl Placed {
         self.plan.apply(poses)
     }
 
+    /// The poses of path `i` (any sequence of its poses) in workpiece coordinates.
+    pub(crate) fn apply_one(&self, i: usize, poses: &[Pose]) -> Vec<Pose> {
+        let flip = self.plan.flipped.get(i).copied().unwrap_or(false);
+        kerf_kinematics::place_paths(&self.placement_of(i), &[flip], &[poses.to_vec()])
+            .pop()
+            .unwrap_or_default()
+    }
+
     /// The placement of path `i`.
     pub(crate) fn placement_of(&self, i: usize) -> Placement {
         self.plan.placement_of(i)

@@ -75,60 +75,82 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         args.retract.max(0.0) + 1.0,
         path,
     )?;
-    let poses = placed.apply(&poses);
-    let points: Vec<Box<dyn Fn(f64) -> nalgebra::Point3<f64> + Sync>> = file
-        .curves
+    // 3b. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
+    // outlines, the shortest traverse; in part coordinates, then placed.
+    let (cuts, cut_plans) = crate::cuts::plan(&file, &oriented, &placed, &args.lead_options())?;
+    let cut_poses: Vec<Vec<Pose>> = cuts
         .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            let c = r.curve.clone();
-            let placement = placed.placement_of(i);
-            Box::new(move |t| placement.apply_point(&c.point(t)))
+        .map(|c| {
+            let p: Vec<Pose> = c.poses.iter().copied().map(Pose::from_array).collect();
+            placed.apply_one(c.curve, &p)
+        })
+        .collect();
+    let points: Vec<Box<dyn Fn(f64) -> nalgebra::Point3<f64> + Sync + '_>> = cuts
+        .iter()
+        .map(|c| {
+            let placement = placed.placement_of(c.curve);
+            let f = &c.point;
+            Box::new(move |u| placement.apply_point(&f(u)))
                 as Box<dyn Fn(f64) -> nalgebra::Point3<f64> + Sync>
         })
         .collect();
-    let inputs: Vec<PathInput<'_>> = file
-        .curves
+    let inputs: Vec<PathInput<'_>> = cuts
         .iter()
         .enumerate()
-        .map(|(i, rec)| PathInput {
-            id: &rec.id,
-            poses: &poses[i],
+        .map(|(k, c)| PathInput {
+            id: &file.curves[c.curve].id,
+            poses: &cut_poses[k],
             curve: Some(PathCurve {
-                params: &oriented[i].params,
-                point: points[i].as_ref(),
+                params: &c.params,
+                point: points[k].as_ref(),
             }),
         })
         .collect();
     let solved = solve_paths(&machine, &inputs, &popts)
         .map_err(|e| CliError::Kinematics(Box::new(e), Some(args.curves.clone())))?;
-    let axes = AxesFile::new(&machine, &solved);
-    // 4. Interpolation and G-code.
+    let mut axes = AxesFile::new(&machine, &solved);
+    crate::cuts::split_axes(&mut axes, &cuts, &solved);
+    // 4. Interpolation and G-code, one program per set-up.
     let model = MachineModel::new(machine.clone()).map_err(interp(path))?;
-    let mut ipaths = Vec::with_capacity(solved.len());
-    for (i, s) in solved.iter().enumerate() {
-        let curve: &(dyn Fn(f64) -> nalgebra::Point3<f64> + Sync) = points[i].as_ref();
-        ipaths.push(InterpPath {
-            id: s.id.clone(),
-            stations: stations_from_solved(s, Some(&oriented[i].params)).map_err(interp(path))?,
-            curve: Some(curve),
-        });
-    }
     let dialect: Dialect = args.dialect.into();
     let fit = crate::motion::fit_options(dopts.tolerance, dialect.raw_axes(), args.retract);
     let plan = PlanOptions::new(args.feed, args.cycle);
-    let motion = kerf_interp::interpolate(&model, &ipaths, &fit, &plan).map_err(interp(path))?;
-    let ids: Vec<String> = file.curves.iter().map(|c| c.id.clone()).collect();
     let gopts = GcodeOptions {
         fit_tolerance: dopts.tolerance,
         chord_tolerance: plan.chord_tolerance,
         linearization_tolerance: Some(popts.linearization_tolerance),
         ..crate::motion::gcode_options(&model, dialect, args.feed, args.blend_tolerance, path)
     };
-    let program = gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?;
+    let mut motions = Vec::new();
+    let mut programs = Vec::new();
+    let mut setpoint_files = Vec::new();
+    for setup in 0..placed.plan.setups.len() {
+        let mut ipaths = Vec::new();
+        let mut ids: Vec<String> = Vec::new();
+        for (k, s) in solved.iter().enumerate() {
+            if placed.plan.setup_of(cuts[k].curve) != setup {
+                continue;
+            }
+            let curve: &(dyn Fn(f64) -> nalgebra::Point3<f64> + Sync) = points[k].as_ref();
+            ipaths.push(InterpPath {
+                id: s.id.clone(),
+                stations: stations_from_solved(s, Some(&cuts[k].params)).map_err(interp(path))?,
+                curve: Some(curve),
+            });
+            ids.push(s.id.clone());
+        }
+        let motion =
+            kerf_interp::interpolate(&model, &ipaths, &fit, &plan).map_err(interp(path))?;
+        programs.push(gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?);
+        setpoint_files.push(csv_string(
+            model.axis_names(),
+            args.cycle,
+            &motion.setpoints(&model),
+        ));
+        motions.push(motion);
+    }
     let process =
         kerf_interp::ProcessCodes::resolve(dialect, &machine.process).map_err(interp(path))?;
-    let setpoints = csv_string(model.axis_names(), args.cycle, &motion.setpoints(&model));
     // 5. Picture and report.
     let mut scene = kerf_plot::Scene::new(&file, &tp, &kerf_plot::SceneOptions::default())
         .map_err(|e| CliError::Plot(e.to_string()))?;
@@ -145,7 +167,15 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::Plot(e.to_string()))?,
     );
     let svg = kerf_plot::render(&scene);
-    let counts = motion.counts();
+    let mut counts = motions[0].counts();
+    for m in &motions[1..] {
+        let c = m.counts();
+        counts.lines += c.lines;
+        counts.arcs += c.arcs;
+        counts.turns += c.turns;
+    }
+    let duration: f64 = motions.iter().map(|m| m.duration()).sum();
+    let cycles: usize = motions.iter().map(|m| m.cycles()).sum();
     let nstar: f64 = file
         .curves
         .iter()
@@ -168,7 +198,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "beam_off": process.beam_off,
             "pierce_dwell_s": process.pierce_dwell_s,
             "pierce_standoff_mm": process.pierce_standoff,
-            "cuts": motion.blocks().iter().enumerate().filter(|(i, b)| !b.rapid && (*i == 0 || motion.blocks()[i - 1].rapid)).count(),
+            "cuts": motions.iter().map(|motion| motion.blocks().iter().enumerate().filter(|(i, b)| !b.rapid && (*i == 0 || motion.blocks()[i - 1].rapid)).count()).sum::<usize>(),
+            "files": program_names(programs.len()),
         },
         "discretize": {
             "curves": file.curves.len(),
@@ -193,33 +224,38 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "pole_tip_error": solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
         },
         "placement": placed.json(&id_refs),
+        "process": crate::cuts::report(&file, &cuts, &cut_plans),
         "interpolation": {
             "feed_mm_per_min": args.feed,
             "cycle_s": args.cycle,
             "lines": counts.lines,
             "arcs": counts.arcs,
             "turns": counts.turns,
-            "cycles": motion.cycles(),
-            "duration_s": motion.duration(),
+            "cycles": cycles,
+            "duration_s": duration,
         },
         "seconds": start.elapsed().as_secs_f64(),
     });
     // 6. Write everything at once.
-    let files: Vec<(&str, String)> = vec![
+    let names = program_names(programs.len());
+    let csv_names = csv_names(programs.len());
+    let mut files: Vec<(&str, String)> = vec![
         ("toolpath.json", toolpath::to_string(&tp)?),
         (
             "axes.json",
             axes.to_json()
                 .map_err(|e| CliError::Kinematics(Box::new(e), None))?,
         ),
-        ("program.nc", program),
-        ("setpoints.csv", setpoints),
-        (
-            "report.json",
-            serde_json::to_string_pretty(&report).unwrap_or_else(|_| report.to_string()),
-        ),
-        ("plot.svg", svg),
     ];
+    for (k, (program, setpoints)) in programs.into_iter().zip(setpoint_files).enumerate() {
+        files.push((names[k].as_str(), program));
+        files.push((csv_names[k].as_str(), setpoints));
+    }
+    files.push((
+        "report.json",
+        serde_json::to_string_pretty(&report).unwrap_or_else(|_| report.to_string()),
+    ));
+    files.push(("plot.svg", svg));
     write_all(&args.out, &files)?;
     if args.json {
         println!("{report}");
@@ -234,7 +270,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             machine.name,
             counts.lines,
             counts.arcs,
-            motion.duration(),
+            duration,
             args.feed,
             args.out.display(),
             start.elapsed().as_secs_f64(),
@@ -246,6 +282,25 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// `program.nc` for one set-up; `program-1.nc`, `program-2.nc`, ... for several (each set-up is
+/// a job of its own: the part is clamped anew between them).
+fn program_names(setups: usize) -> Vec<String> {
+    if setups == 1 {
+        vec!["program.nc".to_string()]
+    } else {
+        (1..=setups).map(|k| format!("program-{k}.nc")).collect()
+    }
+}
+
+/// The set-point files matching [`program_names`].
+fn csv_names(setups: usize) -> Vec<String> {
+    if setups == 1 {
+        vec!["setpoints.csv".to_string()]
+    } else {
+        (1..=setups).map(|k| format!("setpoints-{k}.csv")).collect()
+    }
 }
 
 fn interp(file: &Path) -> impl Fn(kerf_interp::InterpError) -> CliError + '_ {

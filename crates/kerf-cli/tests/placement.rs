@@ -107,7 +107,19 @@ fn run_placed(curves: &str, machine: &str, place: &str) -> Value {
             let tpts = tp["points"].as_array().expect("points");
             let poses = ap["poses"].as_array().expect("poses");
             let sign = if flipped.contains(&id) { -1.0 } else { 1.0 };
-            for (tpi, api) in [(0, 0), (tpts.len() - 1, poses.len() - 1)] {
+            // The cut begins at its start point (closed contours run round to it again).
+            let sp = ap["start_point"].as_u64().map_or(0, |v| v as usize);
+            let xyz = |v: &Value| -> Vector3<f64> {
+                let a = v.as_array().expect("point");
+                Vector3::new(
+                    a[0].as_f64().expect("x"),
+                    a[1].as_f64().expect("y"),
+                    a[2].as_f64().expect("z"),
+                )
+            };
+            let closed = (xyz(&tpts[0]) - xyz(&tpts[tpts.len() - 1])).norm() < 1e-6;
+            let end = if closed && sp > 0 { sp } else { tpts.len() - 1 };
+            for (tpi, api) in [(sp, 0), (end, poses.len() - 1)] {
                 let q: Vec<f64> = tpts[tpi]
                     .as_array()
                     .expect("point")
@@ -130,12 +142,17 @@ fn run_placed(curves: &str, machine: &str, place: &str) -> Value {
                     "{id}: tool axis {gu} vs {want_u}"
                 );
             }
-            for (n, pos) in ap["positions"]
-                .as_array()
-                .expect("positions")
-                .iter()
-                .enumerate()
-            {
+            let mut positions: Vec<&Value> = Vec::new();
+            let mut all_poses: Vec<&Value> = Vec::new();
+            for part in [&ap["lead_in"], ap, &ap["lead_out"]] {
+                if let (Some(q), Some(p)) = (part["positions"].as_array(), part["poses"].as_array())
+                {
+                    positions.extend(q);
+                    all_poses.extend(p);
+                }
+            }
+            let poses = all_poses;
+            for (n, pos) in positions.iter().enumerate() {
                 let q: Vec<f64> = pos
                     .as_array()
                     .expect("axes")

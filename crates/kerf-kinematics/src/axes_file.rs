@@ -68,6 +68,45 @@ pub struct AxesPath {
     /// Optional: the largest tip error of the pole rule (mm).
     #[serde(default)]
     pub pole_tip_error: Option<f64>,
+    /// Optional: the index into the curve's toolpath `points` where the cut begins (a closed
+    /// path runs round to it again).
+    #[serde(default)]
+    pub start_point: Option<usize>,
+    /// Optional: the move from the pierce point onto the curve (not on the curve; no
+    /// chord-error claim).
+    #[serde(default)]
+    pub lead_in: Option<AxesMove>,
+    /// Optional: the move off the curve after the cut (overcut and exit).
+    #[serde(default)]
+    pub lead_out: Option<AxesMove>,
+}
+
+/// A lead-in or lead-out of a path in `kerf.axes/1`: axis vectors and the poses they give.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct AxesMove {
+    /// `[X, Y, Z, tilt, C]` per point.
+    pub positions: Vec<[f64; 5]>,
+    /// `[x, y, z, i, j, k]` per point.
+    pub poses: Vec<[f64; 6]>,
+}
+
+impl AxesPath {
+    /// The axis vectors and poses as the machine runs them: lead-in, cut, lead-out.
+    pub fn run(&self) -> (Vec<[f64; 5]>, Vec<[f64; 6]>) {
+        let mut q = Vec::new();
+        let mut p = Vec::new();
+        if let Some(m) = &self.lead_in {
+            q.extend_from_slice(&m.positions);
+            p.extend_from_slice(&m.poses);
+        }
+        q.extend_from_slice(&self.positions);
+        p.extend_from_slice(&self.poses);
+        if let Some(m) = &self.lead_out {
+            q.extend_from_slice(&m.positions);
+            p.extend_from_slice(&m.poses);
+        }
+        (q, p)
+    }
 }
 
 #[derive(Deserialize)]
@@ -94,6 +133,9 @@ impl AxesFile {
                     max_rotary_step: Some(p.max_rotary_step),
                     max_linearization_error: Some(p.max_linearization_error),
                     pole_tip_error: Some(p.pole_tip_error),
+                    start_point: None,
+                    lead_in: None,
+                    lead_out: None,
                 })
                 .collect(),
         }
@@ -122,6 +164,28 @@ impl AxesFile {
         }
         for (n, p) in self.paths.iter().enumerate() {
             let at = |key: &str| format!("paths[{n}].{key}");
+            for (key, m) in [("lead_in", &p.lead_in), ("lead_out", &p.lead_out)] {
+                if let Some(m) = m {
+                    if m.positions.len() != m.poses.len() {
+                        return Err(KinematicsError::doc(
+                            at(key),
+                            format!(
+                                "{} positions for {} poses",
+                                m.positions.len(),
+                                m.poses.len()
+                            ),
+                        ));
+                    }
+                    if m.positions
+                        .iter()
+                        .flatten()
+                        .chain(m.poses.iter().flatten())
+                        .any(|v| !v.is_finite())
+                    {
+                        return Err(KinematicsError::doc(at(key), "holds a non-finite number"));
+                    }
+                }
+            }
             if p.positions.len() != p.poses.len() {
                 return Err(KinematicsError::doc(
                     at("positions"),
@@ -296,6 +360,21 @@ impl AxesFile {
             ] {
                 if let Some(v) = v {
                     write!(w, ",\n      \"{key}\": {v}")?;
+                }
+            }
+            if let Some(sp) = p.start_point {
+                write!(w, ",\n      \"start_point\": {sp}")?;
+            }
+            for (key, m) in [("lead_in", &p.lead_in), ("lead_out", &p.lead_out)] {
+                if let Some(m) = m {
+                    writeln!(w, ",\n      \"{key}\": {{")?;
+                    write_rows(w, "positions", m.positions.iter().map(|r| r.as_slice()))?;
+                    // `poses` is the last key: drop write_rows' trailing comma.
+                    let mut rows = Vec::new();
+                    write_rows(&mut rows, "poses", m.poses.iter().map(|r| r.as_slice()))?;
+                    let text = String::from_utf8_lossy(&rows);
+                    let text = text.trim_end().trim_end_matches(',');
+                    write!(w, "{text}\n      }}")?;
                 }
             }
             write!(w, "\n    }}")?;

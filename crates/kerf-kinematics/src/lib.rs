@@ -48,7 +48,7 @@ mod rotation;
 pub mod table_table;
 
 pub use ac_head::AcHead;
-pub use axes_file::{AxesFile, AxesPath, AXES_FORMAT};
+pub use axes_file::{AxesFile, AxesMove, AxesPath, AXES_FORMAT};
 pub use error::{KinematicsError, Result};
 pub use fork_head::{ForkHead, ForkTilt};
 pub use head_table::HeadTable;

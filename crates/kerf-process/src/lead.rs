@@ -246,6 +246,11 @@ fn closed_leads(
     let full = opts.lead_in_mm + opts.lead_in_radius_mm;
     let mut scale = 1.0;
     let in_scrap = |p: &Point3<f64>| poly.contains(p) == scrap_inside;
+    let m = poses.len() - 1;
+    let near = 0.5
+        * (position(&poses[(s + 1) % m]) - start)
+            .norm()
+            .min((position(&poses[(s + m - 1) % m]) - start).norm());
     loop {
         let r = opts.lead_in_radius_mm * scale;
         let l = opts.lead_in_mm * scale;
@@ -267,7 +272,13 @@ fn closed_leads(
         // The overcut: along the contour past the start, then the exit into the scrap.
         let (mut out, exit_from, exit_dir) = overcut(poses, s, opts.overcut_mm, side);
         let exit = exit_from + exit_dir * (opts.lead_out_mm * scale);
-        let ok_in = pts.iter().all(&in_scrap)
+        // Arc points closer to the start than half the neighbouring chords lie between the
+        // contour's tangent and the contour itself, where the chord polygon (within the chord
+        // tolerance of the curve) cannot tell the sides apart: the crossing test covers them.
+        let ok_in = pts
+            .iter()
+            .filter(|p| (*p - start).norm() > near)
+            .all(&in_scrap)
             && pts.windows(2).all(|w| !poly.crosses(&w[0], &w[1], s))
             && pts
                 .last()

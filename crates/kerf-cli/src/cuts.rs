@@ -1,0 +1,243 @@
+//! The cuts of `kerf run`: each contour with its start point, lead-in and lead-out
+//! ([`kerf_process`]), in cutting order within each set-up, as one path of poses with a
+//! parameter and a point function for the kinematics and the interpolator.
+//!
+//! A cut path's parameter `u` runs through three stretches: the lead-in (`u < t_s`, the
+//! lead-in polyline from the pierce point to the start), the contour (from the start `t_s`
+//! to the end of the domain, then for a closed contour on from the beginning shifted by the
+//! period `P = t_end - t_0` up to `t_s + P`), and the lead-out (after the cut's end, the
+//! overcut and exit polyline). Points inserted by the kinematics against the non-linearity
+//! error then lie on the curve on the contour and on the polyline elsewhere.
+
+use kerf_format::CurvesFile;
+use kerf_normals::Oriented;
+use kerf_process::{plan_cuts, Contour, CutPlan, LeadOptions, PoseArray};
+use nalgebra::Point3;
+use serde_json::{json, Value};
+
+use crate::error::CliError;
+use crate::place::Placed;
+
+/// A point function of a cut path (part coordinates).
+type PointFn = Box<dyn Fn(f64) -> Point3<f64> + Sync>;
+
+/// One cut: a contour with its lead-in and lead-out, ready for the kinematics.
+pub(crate) struct CutPath {
+    /// The index of the contour in the curves file.
+    pub(crate) curve: usize,
+    /// Lead-in poses, then the cut from its start point, then the lead-out (part
+    /// coordinates, the surface's normals).
+    pub(crate) poses: Vec<PoseArray>,
+    /// The parameter of every pose (strictly increasing; see the module documentation).
+    pub(crate) params: Vec<f64>,
+    /// The point at a parameter (part coordinates).
+    pub(crate) point: PointFn,
+    /// How many of the poses are the lead-in, the cut and the lead-out.
+    pub(crate) counts: [usize; 3],
+    /// The index of the cutting point where the cut starts.
+    pub(crate) start_point: usize,
+}
+
+/// The cuts of every contour in cutting order (set-up by set-up), with the plans that made
+/// them.
+pub(crate) fn plan(
+    file: &CurvesFile,
+    oriented: &[Oriented],
+    placed: &Placed,
+    options: &LeadOptions,
+) -> Result<(Vec<CutPath>, Vec<(Vec<usize>, CutPlan)>), CliError> {
+    let poses: Vec<Vec<PoseArray>> = oriented.iter().map(Oriented::poses).collect();
+    let mut cuts = Vec::new();
+    let mut plans = Vec::new();
+    for setup in &placed.plan.setups {
+        let contours: Vec<Contour<'_>> = setup
+            .paths
+            .iter()
+            .map(|&i| Contour {
+                id: &file.curves[i].id,
+                poses: &poses[i],
+                scrap: None,
+                start: None,
+            })
+            .collect();
+        let plan = plan_cuts(&contours, options).map_err(|e| CliError::Input(e.to_string()))?;
+        for &k in &plan.order {
+            let i = setup.paths[k];
+            cuts.push(cut_path(file, &oriented[i], &poses[i], i, &plan, k));
+        }
+        plans.push((setup.paths.clone(), plan));
+    }
+    Ok((cuts, plans))
+}
+
+fn cut_path(
+    file: &CurvesFile,
+    o: &Oriented,
+    poses: &[PoseArray],
+    curve: usize,
+    plan: &CutPlan,
+    k: usize,
+) -> CutPath {
+    let lead = &plan.leads[k];
+    let t = &o.params;
+    let n = t.len();
+    let s = lead.start;
+    let closed = plan.closed[k];
+    let period = t[n - 1] - t[0];
+    let cut = plan.cut(k, poses);
+    let mut cut_params: Vec<f64> = Vec::with_capacity(cut.len());
+    if closed && s > 0 {
+        cut_params.extend_from_slice(&t[s..]);
+        cut_params.extend(t[1..=s].iter().map(|v| v + period));
+    } else {
+        cut_params.extend_from_slice(t);
+    }
+    let u_s = cut_params[0];
+    let u_e = cut_params[cut_params.len() - 1];
+    let step = (period / n as f64).max((u_s.abs() + u_e.abs() + 1.0) * 1e-12);
+    let m = lead.lead_in.len();
+    let q = lead.lead_out.len();
+    let mut params = Vec::with_capacity(m + cut.len() + q);
+    params.extend((0..m).map(|j| u_s - (m - j) as f64 * step));
+    params.extend_from_slice(&cut_params);
+    params.extend((0..q).map(|j| u_e + (j + 1) as f64 * step));
+    let mut all = Vec::with_capacity(params.len());
+    all.extend_from_slice(&lead.lead_in);
+    all.extend_from_slice(&cut);
+    all.extend_from_slice(&lead.lead_out);
+    // Polylines of the lead-in (ending at the start) and the lead-out (from the cut's end).
+    let pt = |p: &PoseArray| Point3::new(p[0], p[1], p[2]);
+    let lead_in: Vec<Point3<f64>> = lead
+        .lead_in
+        .iter()
+        .chain(std::iter::once(&cut[0]))
+        .map(pt)
+        .collect();
+    let lead_out: Vec<Point3<f64>> = std::iter::once(&cut[cut.len() - 1])
+        .chain(&lead.lead_out)
+        .map(pt)
+        .collect();
+    let c = file.curves[curve].curve.clone();
+    let (t0, t_end) = (t[0], t[n - 1]);
+    let in_start = u_s - m as f64 * step;
+    let point: PointFn = Box::new(move |u: f64| {
+        let along = |poly: &[Point3<f64>], x: f64| {
+            let x = x.clamp(0.0, (poly.len() - 1) as f64);
+            let j = (x.floor() as usize).min(poly.len().saturating_sub(2));
+            let f = x - j as f64;
+            if poly.len() == 1 {
+                poly[0]
+            } else {
+                poly[j] + (poly[j + 1] - poly[j]) * f
+            }
+        };
+        if u < u_s && m > 0 {
+            along(&lead_in, (u - in_start) / step)
+        } else if u > u_e && q > 0 {
+            along(&lead_out, (u - u_e) / step)
+        } else if u > t_end {
+            c.point((u - period).clamp(t0, t_end))
+        } else {
+            c.point(u.clamp(t0, t_end))
+        }
+    });
+    CutPath {
+        curve,
+        poses: all,
+        params,
+        point,
+        counts: [m, cut.len(), q],
+        start_point: if closed { s } else { 0 },
+    }
+}
+
+/// `kerf.axes/1` with the lead-in and lead-out of every path kept apart from its cut (the
+/// contract's `lead_in`, `lead_out` and `start_point` keys): `solved[k]` is the solved
+/// `cuts[k]`, and `axes.paths[k]` was made from it.
+pub(crate) fn split_axes(
+    axes: &mut kerf_kinematics::AxesFile,
+    cuts: &[CutPath],
+    solved: &[kerf_kinematics::SolvedPath],
+) {
+    for ((p, cut), s) in axes.paths.iter_mut().zip(cuts).zip(solved) {
+        let [m, c, _] = cut.counts;
+        let first = s.source.iter().position(|v| *v == Some(m));
+        let last = s.source.iter().position(|v| *v == Some(m + c - 1));
+        let (Some(a), Some(b)) = (first, last) else {
+            continue;
+        };
+        let part = |r: std::ops::Range<usize>| kerf_kinematics::AxesMove {
+            positions: p.positions[r.clone()].to_vec(),
+            poses: p.poses[r].to_vec(),
+        };
+        let len = p.poses.len();
+        let lead_in = (a > 0).then(|| part(0..a));
+        let lead_out = (b + 1 < len).then(|| part(b + 1..len));
+        p.positions = p.positions[a..=b].to_vec();
+        p.poses = p.poses[a..=b].to_vec();
+        p.inserted = s.source[a..=b].iter().filter(|v| v.is_none()).count();
+        p.lead_in = lead_in;
+        p.lead_out = lead_out;
+        p.start_point = Some(cut.start_point);
+    }
+}
+
+/// The `process` object of `report.json`: pierces, lengths, order and what each cut got.
+pub(crate) fn report(
+    file: &CurvesFile,
+    cuts: &[CutPath],
+    plans: &[(Vec<usize>, CutPlan)],
+) -> Value {
+    let len = |p: &[PoseArray]| -> f64 {
+        p.windows(2)
+            .map(|w| {
+                ((w[1][0] - w[0][0]).powi(2)
+                    + (w[1][1] - w[0][1]).powi(2)
+                    + (w[1][2] - w[0][2]).powi(2))
+                .sqrt()
+            })
+            .sum()
+    };
+    let cut_length: f64 = cuts
+        .iter()
+        .map(|c| len(&c.poses[c.counts[0]..c.counts[0] + c.counts[1]]))
+        .sum();
+    let lead_length: f64 = cuts
+        .iter()
+        .map(|c| len(&c.poses[..c.counts[0] + 1]) + len(&c.poses[c.counts[0] + c.counts[1] - 1..]))
+        .sum();
+    let mut holes = Vec::new();
+    let mut shortened = Vec::new();
+    let mut on_contour = Vec::new();
+    let mut traverse = 0.0;
+    let mut file_order = 0.0;
+    for (paths, plan) in plans {
+        traverse += plan.traverse_mm;
+        file_order += plan.file_order_traverse_mm;
+        for (k, &i) in paths.iter().enumerate() {
+            let id = file.curves[i].id.as_str();
+            if plan.is_hole(k) {
+                holes.push(id);
+            }
+            let l = &plan.leads[k];
+            if l.pierce_on_contour {
+                on_contour.push(id);
+            } else if l.scale < 1.0 {
+                shortened.push(json!({ "id": id, "scale": l.scale }));
+            }
+        }
+    }
+    json!({
+        "pierces": cuts.len(),
+        "order": cuts.iter().map(|c| file.curves[c.curve].id.as_str()).collect::<Vec<_>>(),
+        "holes_cut_first": holes,
+        "cut_length_mm": cut_length,
+        "lead_length_mm": lead_length,
+        "traverse_mm": traverse,
+        "file_order_traverse_mm": file_order,
+        "traverse_saved_mm": file_order - traverse,
+        "lead_ins_shortened": shortened,
+        "pierce_on_contour": on_contour,
+        "traverse_note": "straight distances from each cut's exit to the next pierce point, in part coordinates, within each set-up; the program adds the retract and approach along the tool axes",
+    })
+}

@@ -22,6 +22,10 @@ fn fail(msg: String) -> ! {
     std::process::exit(1)
 }
 
+/// One cut: the tips of its poses (axes file), its cutting points (toolpath) and the tool axis
+/// at its start.
+type Cut = (Vec<Point3<f64>>, Vec<Point3<f64>>, Vector3<f64>);
+
 /// Distance from `p` to the segment `a b`.
 fn seg_dist(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     let d = b - a;
@@ -34,8 +38,7 @@ fn seg_dist(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     (p - (a + d * t)).norm()
 }
 
-/// Distance from `p` to the polyline `pts`, searching segments near `hint` first (samples
-/// advance along the path) but always over all segments, so the result is exact.
+/// Distance from `p` to the polyline `pts`, over all its segments (exact, no search window).
 fn poly_dist(p: &Point3<f64>, pts: &[Point3<f64>]) -> f64 {
     if pts.len() == 1 {
         return (p - pts[0]).norm();
@@ -148,7 +151,7 @@ fn main() {
             }
         }
     }
-    let cuts: Vec<(Vec<Point3<f64>>, Vec<Point3<f64>>, Vector3<f64>)> = axes
+    let cuts: Vec<Cut> = axes
         .paths
         .iter()
         .zip(&tp.paths)

@@ -153,12 +153,14 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
     for k, v in fig["max_velocity_ratio"].items():
         if v > 1.01:
             fail(f"{name}: velocity of {k} at {v:.3f} x its limit")
+    if fig["max_tip_speed_beam_on_mm_per_min"] > 1.01 * fig["feed_mm_per_min"]:
+        fail(f"{name}: tip at {fig['max_tip_speed_beam_on_mm_per_min']:.0f} mm/min, feed {fig['feed_mm_per_min']}")
     if flat and not 0.9 <= fig["time_ratio"] <= 1.1:
         fail(f"{name}: time LinuxCNC / kerf {fig['time_ratio']:.3f} outside [0.9, 1.1]")
     print(f"{name}: deviation {fig['max_deviation_beam_on_mm']:.5f} mm (budget {fig['tolerance_budget_mm']}), "
           f"beam {fig['beam_intervals']}/{fig['cuts']} cuts framed {fig['framing_ok']}, "
           f"time {fig['linuxcnc_time_s']:.3f} s / kerf {fig['kerf_predicted_s']:.3f} s = {fig['time_ratio']:.3f}, "
-          f"wall {wall:.1f} s", flush=True)
+          f"tip speed max {fig['max_tip_speed_beam_on_mm_per_min']:.0f} mm/min, wall {wall:.1f} s", flush=True)
     shutil.rmtree(work, ignore_errors=True)
     return fig
 

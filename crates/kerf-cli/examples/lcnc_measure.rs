@@ -275,6 +275,12 @@ fn main() {
             }
         }
     }
+    // The tip's speed while the beam is on (first differences), mm/min: kerf's plan never
+    // exceeds the programmed feed.
+    let max_tip_speed = (1..tips.len())
+        .filter(|&i| beam[i] && beam[i - 1])
+        .map(|i| (tips[i].0 - tips[i - 1].0).norm() / period * 60.0)
+        .fold(0.0, f64::max);
     let by_axis = |r: &[f64; 5]| -> Value {
         let m: serde_json::Map<String, Value> = names
             .iter()
@@ -313,6 +319,8 @@ fn main() {
         "max_deviation_from_cutting_points_mm": max_dev_points,
         "max_tool_axis_deviation_deg": max_dev_orient_deg,
         "limit_violations": limit_violations,
+        "max_tip_speed_beam_on_mm_per_min": max_tip_speed,
+        "feed_mm_per_min": feed,
         "max_velocity_ratio": by_axis(&vel_ratio),
         "max_acceleration_ratio_rapids": by_axis(&acc_ratio_rapid),
         "max_acceleration_ratio_cuts": by_axis(&acc_ratio_cut),

@@ -32,6 +32,9 @@ VARIANTS = [
     # the dwell runs with the beam off; the last M63 has no move after it and never fires.
     ("-m62m63", "tube_saddle", "ac_head", (), (),
      lambda t: t.replace("M64 P0", "M62 P0").replace("M65 P0", "M63 P0")),
+    ("-door", "door_trim", "ac_head", (), (), None),
+    ("-door-blend0.001", "door_trim", "ac_head", ("--blend-tolerance", "0.001"), (), None),
+    ("-door-g61", "door_trim", "ac_head", (), (), lambda t: re.sub(r"G64 P\S+ Q0", "G61", t)),
     ("-flat-default", "sheet_metal_holes", "gantry_ac", (), (), None),
 ]
 
@@ -61,7 +64,7 @@ def main():
     for r in rows:
         print(f"{r['fixture'][:5] + r['variant']:<16} {r['linuxcnc_time_s']:8.3f} {r['kerf_predicted_s']:8.3f} "
               f"{r['time_ratio']:6.3f} {r['max_deviation_beam_on_mm']:8.5f} {r['tolerance_budget_mm']:7.3f} "
-              f"{max(r['max_acceleration_ratio_rapids'].values()):9.3f} {max(r['max_acceleration_ratio_cuts'].values()):8.3f}")
+              f"{max(r['max_acceleration_ratio_rapids'].values()):9.3f} {max(r['max_acceleration_ratio_cuts'].values()):8.3f} tip max {r['max_tip_speed_beam_on_mm_per_min']:.0f}")
     return 0
 
 

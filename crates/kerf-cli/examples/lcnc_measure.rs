@@ -22,6 +22,10 @@ fn fail(msg: String) -> ! {
     std::process::exit(1)
 }
 
+/// One cut: the tips of its poses (axes file), its cutting points (toolpath) and the tool axis
+/// at its start.
+type Cut = (Vec<Point3<f64>>, Vec<Point3<f64>>, Vector3<f64>);
+
 /// Distance from `p` to the segment `a b`.
 fn seg_dist(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     let d = b - a;
@@ -34,8 +38,7 @@ fn seg_dist(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     (p - (a + d * t)).norm()
 }
 
-/// Distance from `p` to the polyline `pts`, searching segments near `hint` first (samples
-/// advance along the path) but always over all segments, so the result is exact.
+/// Distance from `p` to the polyline `pts`, over all its segments (exact, no search window).
 fn poly_dist(p: &Point3<f64>, pts: &[Point3<f64>]) -> f64 {
     if pts.len() == 1 {
         return (p - pts[0]).norm();
@@ -148,7 +151,7 @@ fn main() {
             }
         }
     }
-    let cuts: Vec<(Vec<Point3<f64>>, Vec<Point3<f64>>, Vector3<f64>)> = axes
+    let cuts: Vec<Cut> = axes
         .paths
         .iter()
         .zip(&tp.paths)
@@ -272,6 +275,12 @@ fn main() {
             }
         }
     }
+    // The tip's speed while the beam is on (first differences), mm/min: kerf's plan never
+    // exceeds the programmed feed.
+    let max_tip_speed = (1..tips.len())
+        .filter(|&i| beam[i] && beam[i - 1])
+        .map(|i| (tips[i].0 - tips[i - 1].0).norm() / period * 60.0)
+        .fold(0.0, f64::max);
     let by_axis = |r: &[f64; 5]| -> Value {
         let m: serde_json::Map<String, Value> = names
             .iter()
@@ -310,6 +319,8 @@ fn main() {
         "max_deviation_from_cutting_points_mm": max_dev_points,
         "max_tool_axis_deviation_deg": max_dev_orient_deg,
         "limit_violations": limit_violations,
+        "max_tip_speed_beam_on_mm_per_min": max_tip_speed,
+        "feed_mm_per_min": feed,
         "max_velocity_ratio": by_axis(&vel_ratio),
         "max_acceleration_ratio_rapids": by_axis(&acc_ratio_rapid),
         "max_acceleration_ratio_cuts": by_axis(&acc_ratio_cut),

@@ -177,8 +177,8 @@ impl ProcessCodes {
     /// (a library caller may have built `process` by hand).
     ///
     /// # Errors
-    /// [`InterpError::Process`] naming the key (`process.pierce_dwell_s: must be finite and
-    /// >= 0 (got -1)`).
+    /// [`InterpError::Process`] naming the key, as
+    /// `process.pierce_dwell_s: must be finite and >= 0 (got -1)`.
     pub fn resolve(dialect: Dialect, process: &kerf_kinematics::Process) -> Result<Self> {
         process
             .validate()

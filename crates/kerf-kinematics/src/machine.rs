@@ -105,8 +105,9 @@ impl Process {
     /// Checks every present value.
     ///
     /// # Errors
-    /// [`KinematicsError::Document`] with the JSON path (`process.pierce_dwell_s: must be
-    /// >= 0 (got -1)`, `process.beam_on[0]: must not be empty`).
+    /// [`KinematicsError::Document`] with the JSON path, as
+    /// `process.pierce_dwell_s: must be finite and >= 0 (got -1)` or
+    /// `process.beam_on[0]: must not be empty`.
     pub fn validate(&self) -> Result<()> {
         for (key, lines) in [("beam_on", &self.beam_on), ("beam_off", &self.beam_off)] {
             let Some(lines) = lines else { continue };

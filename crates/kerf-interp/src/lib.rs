@@ -53,6 +53,8 @@ pub mod model;
 pub mod output;
 pub mod plan;
 pub mod recursive;
+pub(crate) mod smooth;
+pub(crate) mod topp;
 
 pub use block::{increments, solve_stations, Block, Geometry, Station};
 pub use error::{InterpError, Result};
@@ -61,7 +63,9 @@ pub use geometry::Arc;
 pub use machine::{stations_from_axes, stations_from_solved, MachineModel};
 pub use model::{AcHead, AxisLimits, AxisModel};
 pub use output::{csv_string, gcode, write_csv, write_gcode, Dialect, GcodeOptions};
-pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PlanOptions};
+pub use plan::{
+    link_paths, link_paths_with_retract, plan, Cycles, Motion, PathStats, PlanOptions,
+};
 
 /// One path of a program: its id (the source curve's), its stations and, when known, the
 /// curve itself.

@@ -182,6 +182,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "turns": counts.turns,
             "cycles": motion.cycles(),
             "duration_s": motion.duration(),
+            "time_share_at_feed": motion.time_share_at_feed(),
+            "paths": crate::motion::path_report(&motion, &ids),
         },
         "seconds": start.elapsed().as_secs_f64(),
     });

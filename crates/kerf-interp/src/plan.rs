@@ -36,6 +36,9 @@ use crate::topp;
 pub const ACCELERATION_MARGIN: f64 = 0.99;
 /// Share of each jerk limit the curvature term `q''' v^3` alone may take.
 pub const JERK_STATIC_SHARE: f64 = 0.5;
+/// Share of each jerk limit the term `3 q'' v a` (acceleration along a curve) may take: it caps
+/// the path acceleration where the path curves at speed.
+pub const JERK_CROSS_SHARE: f64 = 1.0;
 
 /// Options of [`plan`].
 #[derive(Debug, Clone, PartialEq)]
@@ -101,6 +104,8 @@ struct RunGrid {
     tip_speed: Vec<f64>,
     /// The static cap on `x` (velocity, feed, chord, jerk).
     cap: Vec<f64>,
+    /// `|q''|` of each axis (for the jerk budget of the path acceleration).
+    d2_abs_max: Vec<[f64; 5]>,
     /// Caps on `x` set by refinements, and factors on the accelerations.
     xlim: Vec<f64>,
     mult_a: Vec<f64>,
@@ -617,19 +622,12 @@ pub fn plan<M: AxisModel + ?Sized>(
         .collect();
     let mut timed: Vec<Timed> = grids
         .iter()
-        .map(|g| time_run(g, limits.max_acceleration, tau))
+        .map(|g| time_run(g, limits.max_acceleration, limits.max_jerk, tau))
         .collect();
     let mut refinements = 0;
     loop {
         let motion = assemble(&blocks, &runs, &grids, timed.clone(), opts, &names, refinements)?;
         let worst = verify(&motion, model);
-        if std::env::var_os("KERF_PLAN_DEBUG").is_some() {
-            if let Some(v) = worst.first() {
-                let (b, sb) = motion.locate(v.time);
-                let r = motion.runs.iter().position(|r| r.first <= b && b <= r.last).unwrap_or(0);
-                eprintln!("refinement {refinements}: {} bad cycles, worst {v:?} block {b} s {sb} run {r} [{}..{}] len {}", worst.len(), motion.runs[r].first, motion.runs[r].last, motion.runs[r].len());
-            }
-        }
         if worst.is_empty() {
             check_ranges(&motion, model)?;
             return Ok(motion);
@@ -654,7 +652,7 @@ pub fn plan<M: AxisModel + ?Sized>(
             let (fx, fa) = match v.kind {
                 0 => (f * f, 1.0),
                 1 => (f, f),
-                _ => (f.powf(2.0 / 3.0), f),
+                _ => (f.powf(1.0 / 3.0), f),
             };
             let (mut lo, mut hi) = (v.time - 3.0 * opts.cycle, v.time + 3.0 * opts.cycle);
             if opts.block_ends_on_cycles {
@@ -696,7 +694,7 @@ pub fn plan<M: AxisModel + ?Sized>(
                     }
                     g.mult_a[i] *= fas[r][i];
                 }
-                timed[r] = time_run(&grids[r], limits.max_acceleration, tau);
+                timed[r] = time_run(&grids[r], limits.max_acceleration, limits.max_jerk, tau);
             }
         }
         refinements += 1;
@@ -794,6 +792,7 @@ fn run_grid<M: AxisModel + ?Sized>(model: &M, run: &Run, step: f64, opts: &PlanO
     }
     RunGrid {
         xlim: vec![f64::INFINITY; n],
+        d2_abs_max: d2.iter().map(|b: &[f64; 5]| b.map(f64::abs)).collect(),
         mult_a: vec![1.0; n],
         s,
         d1,
@@ -804,14 +803,28 @@ fn run_grid<M: AxisModel + ?Sized>(model: &M, run: &Run, step: f64, opts: &PlanO
 }
 
 /// Plans one run on its grid (rest to rest) and times it.
-fn time_run(g: &RunGrid, acc: [f64; 5], tau: f64) -> Timed {
+fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: f64) -> Timed {
     let n = g.s.len();
     let mut pts: Vec<topp::Point> = (0..n)
-        .map(|i| topp::Point {
-            d1: g.d1[i],
-            d2: g.d2[i],
-            acc: acc.map(|a| a * ACCELERATION_MARGIN * g.mult_a[i]),
-            cap: g.cap[i].min(g.xlim[i]),
+        .map(|i| {
+            let cap = g.cap[i].min(g.xlim[i]);
+            let mut path_acc = f64::INFINITY;
+            if let Some(j) = jerk {
+                let v = cap.sqrt();
+                for k in 0..5 {
+                    let c = 3.0 * g.d2_abs_max[i][k] * v;
+                    if c > 0.0 {
+                        path_acc = path_acc.min(JERK_CROSS_SHARE * j[k] / c);
+                    }
+                }
+            }
+            topp::Point {
+                d1: g.d1[i],
+                d2: g.d2[i],
+                acc: acc.map(|a| a * ACCELERATION_MARGIN * g.mult_a[i]),
+                cap,
+                path_acc,
+            }
         })
         .collect();
     let mut mv: Vec<f64> = pts.iter().map(topp::xmax).collect();
@@ -849,9 +862,6 @@ fn time_run(g: &RunGrid, acc: [f64; 5], tau: f64) -> Timed {
             let d = g.s[i + 1] - g.s[i];
             let den = x[i].sqrt() + x[i + 1].sqrt();
             let dt = if den > 0.0 { 2.0 * d / den } else { f64::INFINITY };
-            if !dt.is_finite() && std::env::var_os("KERF_PLAN_DEBUG").is_some() {
-                eprintln!("inf dt at {i}/{n}: s {} d {d} x {} {} mv {} {} cap {} {} pt {:?}", g.s[i], x[i], x[i+1], mv[i], mv[i+1], pts[i].cap, pts[i+1].cap, pts[i+1]);
-            }
             let v = x[i].sqrt();
             aa += dt * (g.s[i] + dt * (0.5 * v + dt * u[i] / 6.0));
             tt += dt;

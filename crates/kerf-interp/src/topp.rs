@@ -30,14 +30,22 @@ pub(crate) struct Point {
     pub acc: [f64; 5],
     /// Static cap on `x` (velocity, feed, chord, jerk, refinements).
     pub cap: f64,
+    /// Cap on the path acceleration `|u|` (the jerk budget of the curvature term
+    /// `3 q'' v u`); infinite for none.
+    pub path_acc: f64,
 }
 
 /// Lower and upper bounds on `u` as `alpha + beta x`, one pair per constraining axis.
 #[inline]
-fn bounds(p: &Point) -> ([(f64, f64); 5], [(f64, f64); 5], usize, f64) {
-    let mut lo = [(0.0, 0.0); 5];
-    let mut hi = [(0.0, 0.0); 5];
+fn bounds(p: &Point) -> ([(f64, f64); 6], [(f64, f64); 6], usize, f64) {
+    let mut lo = [(0.0, 0.0); 6];
+    let mut hi = [(0.0, 0.0); 6];
     let mut n = 0;
+    if p.path_acc.is_finite() {
+        lo[0] = (-p.path_acc, 0.0);
+        hi[0] = (p.path_acc, 0.0);
+        n = 1;
+    }
     let mut cap = p.cap;
     for k in 0..5 {
         let (a, b, lim) = (p.d1[k], p.d2[k], p.acc[k]);
@@ -135,6 +143,7 @@ mod tests {
             d2: [0.0; 5],
             acc: [2.0; 5],
             cap: 9.0,
+            path_acc: f64::INFINITY,
         };
         let (x, u) = solve(&s, &vec![p; s.len()]);
         for (i, &si) in s.iter().enumerate() {
@@ -152,6 +161,7 @@ mod tests {
             d2: [1.0, 0.0, 0.0, 0.0, 0.0],
             acc: [4.0; 5],
             cap: f64::INFINITY,
+            path_acc: f64::INFINITY,
         };
         assert_eq!(xmax(&p), 4.0);
         // A circle of radius R at angle 0: q' = (0, 1), q'' = (-1/R, 0); x <= A R.
@@ -161,6 +171,7 @@ mod tests {
             d2: [-1.0 / r, 0.0, 0.0, 0.0, 0.0],
             acc: [6.0; 5],
             cap: f64::INFINITY,
+            path_acc: f64::INFINITY,
         };
         assert!((xmax(&p) - 30.0).abs() < 1e-12);
     }

@@ -199,7 +199,9 @@ impl Timed {
         }
     }
 
-    /// The earliest time at which `s_at(t) >= s` (bisection; `s_at` does not decrease).
+    /// The earliest time at which `s_at(t) >= s`: exact from the grid when unfiltered (block
+    /// starts are grid points), else by bisection in `[t_raw(s), t_raw(s) + tau]` (the average
+    /// of `s` over `[t - tau, t]` lies between `s(t - tau)` and `s(t)`).
     fn time_of(&self, s: f64) -> f64 {
         if s <= 0.0 {
             return 0.0;
@@ -207,13 +209,35 @@ impl Timed {
         if s >= self.len() {
             return self.duration;
         }
-        let (mut lo, mut hi) = (0.0, self.duration);
-        for _ in 0..60 {
+        let i = self.s.partition_point(|&v| v < s).min(self.s.len() - 1);
+        let raw = if self.s[i] == s || i == 0 {
+            self.t[i]
+        } else {
+            // Inside interval i - 1: solve s_i + v tau + u tau^2 / 2 = s by bisection too.
+            let (mut lo, mut hi) = (self.t[i - 1], self.t[i]);
+            for _ in 0..50 {
+                let mid = 0.5 * (lo + hi);
+                if self.s_raw(mid) >= s {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            hi
+        };
+        if self.tau <= 0.0 {
+            return raw;
+        }
+        let (mut lo, mut hi) = (raw, (raw + self.tau).min(self.duration));
+        for _ in 0..50 {
             let mid = 0.5 * (lo + hi);
             if self.s_at(mid) >= s {
                 hi = mid;
             } else {
                 lo = mid;
+            }
+            if hi - lo <= 1e-13 * self.duration {
+                break;
             }
         }
         hi
@@ -626,9 +650,25 @@ pub fn plan<M: AxisModel + ?Sized>(
         .collect();
     let mut refinements = 0;
     loop {
-        let motion = assemble(&blocks, &runs, &grids, timed.clone(), opts, &names, refinements)?;
+        // Block times, feeds and statistics only when needed (the block clock) or final.
+        let full = opts.block_ends_on_cycles;
+        let motion = assemble(
+            &blocks,
+            &runs,
+            &grids,
+            timed.clone(),
+            opts,
+            &names,
+            refinements,
+            full,
+        )?;
         let worst = verify(&motion, model);
         if worst.is_empty() {
+            let motion = if full {
+                motion
+            } else {
+                assemble(&blocks, &runs, &grids, timed, opts, &names, refinements, true)?
+            };
             check_ranges(&motion, model)?;
             return Ok(motion);
         }
@@ -881,6 +921,7 @@ fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: f64) -> Tim
 
 /// Puts the runs' profiles together into a program: start times, block times and feeds, the
 /// block clock, statistics.
+#[allow(clippy::too_many_arguments)]
 fn assemble(
     blocks: &[Block],
     runs: &[Run],
@@ -889,6 +930,7 @@ fn assemble(
     opts: &PlanOptions,
     names: &[String; 5],
     refinements: usize,
+    full: bool,
 ) -> Result<Motion> {
     let mut starts = Vec::with_capacity(runs.len());
     let mut total = 0.0;
@@ -908,6 +950,9 @@ fn assemble(
     let mut feeds = vec![0.0; blocks.len()];
     let mut stats: Vec<PathStats> = Vec::new();
     for (r, run) in runs.iter().enumerate() {
+        if !full {
+            break;
+        }
         let (tm, g) = (&timed[r], &grids[r]);
         for b in run.first..=run.last {
             let j = b - run.first;
@@ -950,8 +995,8 @@ fn assemble(
         if run.cutting && run.moves_tip {
             st.cutting_time += tm.duration;
             st.cutting_length += run.len();
-            // Sample the run at a tenth of a cycle.
-            let dt = opts.cycle / 10.0;
+            // Sample the run at half a cycle.
+            let dt = opts.cycle / 2.0;
             let steps = (tm.duration / dt).ceil() as usize;
             let dt = tm.duration / steps.max(1) as f64;
             for k in 0..steps {

@@ -328,8 +328,9 @@ fn build(blocks: &[Block], first: usize, last: usize) -> Run {
     rs.push(s);
     ry.push([end.end_axes[3], end.end_axes[4]]);
     let (m0, m1) = if moves_tip {
-        let a = own_tangent(&run[0], false).unwrap_or_else(Vector3::zeros);
-        let b = own_tangent(end, true).unwrap_or_else(Vector3::zeros);
+        // The curve's tangent where it can be estimated (circle through the neighbours).
+        let a = tangent(blocks, first, false).unwrap_or_else(Vector3::zeros);
+        let b = tangent(blocks, last, true).unwrap_or_else(Vector3::zeros);
         ([a.x, a.y, a.z], [b.x, b.y, b.z])
     } else {
         ([0.0; 3], [0.0; 3])

@@ -296,3 +296,35 @@ fn planning_work_is_bounded_on_a_long_path() {
     let r = ratios(&m, &motion.setpoints(&m), 0.001);
     assert!(r[0] <= 1.0 && r[1] <= 1.0, "{r:?}");
 }
+
+#[test]
+fn the_smooth_path_stays_on_the_curve() {
+    // Cutting points of the free-form curve and of a 10 mm hole at chord tolerance 0.01 mm, one
+    // line per chord (the generic fit): the set-points follow the spline through the points,
+    // whose distance from the true curve (closest point on the NURBS) is far below the chord
+    // error of the polyline. Tool vertical: the tip is XYZ - (-r_c, 0, r_a).
+    let m = AcHead::paper_000();
+    for (name, c) in [("free-form", common::freeform()), ("hole", circle(5.0, 0.0, 0.0, 0.0))] {
+        let st = stations(&m, &c, 0.01, vertical);
+        let lines = fit_blocks(
+            &m,
+            &st,
+            None,
+            0,
+            &FitOptions {
+                arcs: false,
+                merge_lines: false,
+                ..FitOptions::default()
+            },
+        )
+        .expect("lines");
+        let motion = plan(&m, &lines, &PlanOptions::new(6000.0, 0.001)).expect("plan");
+        let mut worst = 0.0f64;
+        for q in motion.iter(&m) {
+            let tip = Point3::new(q[0] + m.r_c, q[1], q[2] - m.r_a);
+            worst = worst.max(c.closest_point(&tip).distance);
+        }
+        println!("{name}: {} set-points, largest distance from the curve {worst:.2e} mm", motion.cycles() + 1);
+        assert!(worst < 0.002, "{name}: {worst}");
+    }
+}

@@ -15,7 +15,10 @@ use kerf_interp::{fit_blocks, plan, solve_stations, FitOptions, MachineModel, Pl
 use nalgebra::{Point3, Vector3};
 
 fn planning(c: &mut Criterion) {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/machines/ac_head.json");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/machines/ac_head.json"
+    );
     let machine = kerf_kinematics::Machine::read(path).expect("machine");
     let jerk = MachineModel::new(machine.clone()).expect("model");
     let plain = MachineModel::new(machine.with_max_jerk(None).expect("valid")).expect("model");

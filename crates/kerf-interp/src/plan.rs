@@ -169,8 +169,7 @@ impl Timed {
         }
         let i = self.interval(t);
         let h = t - self.t[i];
-        self.area[i]
-            + h * (self.s[i] + h * (0.5 * self.x[i].sqrt() + h * self.u[i] / 6.0))
+        self.area[i] + h * (self.s[i] + h * (0.5 * self.x[i].sqrt() + h * self.u[i] / 6.0))
     }
 
     /// `s` at time `t` of the run (filtered when jerk-limited).
@@ -667,7 +666,16 @@ pub fn plan<M: AxisModel + ?Sized>(
             let motion = if full {
                 motion
             } else {
-                assemble(&blocks, &runs, &grids, timed, opts, &names, refinements, true)?
+                assemble(
+                    &blocks,
+                    &runs,
+                    &grids,
+                    timed,
+                    opts,
+                    &names,
+                    refinements,
+                    true,
+                )?
             };
             check_ranges(&motion, model)?;
             return Ok(motion);
@@ -782,7 +790,9 @@ fn run_grid<M: AxisModel + ?Sized>(model: &M, run: &Run, step: f64, opts: &PlanO
             break;
         }
         let (p, q) = (norm(&first[i].0), norm(&first[i + 1].0));
-        let scale = (0..5).map(|k| p[k].abs().max(q[k].abs())).fold(0.0, f64::max);
+        let scale = (0..5)
+            .map(|k| p[k].abs().max(q[k].abs()))
+            .fold(0.0, f64::max);
         let change = (0..5).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max);
         if scale > 0.0 && change > 0.02 * scale {
             let m = ((change / (0.02 * scale)).ceil() as usize).min(64);
@@ -901,7 +911,11 @@ fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: f64) -> Tim
         if i + 1 < n {
             let d = g.s[i + 1] - g.s[i];
             let den = x[i].sqrt() + x[i + 1].sqrt();
-            let dt = if den > 0.0 { 2.0 * d / den } else { f64::INFINITY };
+            let dt = if den > 0.0 {
+                2.0 * d / den
+            } else {
+                f64::INFINITY
+            };
             let v = x[i].sqrt();
             aa += dt * (g.s[i] + dt * (0.5 * v + dt * u[i] / 6.0));
             tt += dt;

@@ -19,9 +19,9 @@ use crate::model::AxisModel;
 use nalgebra::{Point3, Vector3};
 
 /// Tangent turn (degrees) above which two blocks meet at a true corner.
-pub const CORNER_DEG: f64 = 5.0;
+pub(crate) const CORNER_DEG: f64 = 5.0;
 /// Largest sweep (degrees) between two spline nodes on an arc.
-pub const ARC_NODE_DEG: f64 = 5.0;
+pub(crate) const ARC_NODE_DEG: f64 = 5.0;
 
 /// A clamped C2 cubic spline of `D` components in Hermite form (values and slopes at nodes).
 #[derive(Debug, Clone)]
@@ -125,37 +125,37 @@ impl<const D: usize> Spline<D> {
 #[derive(Debug, Clone)]
 pub(crate) struct Run {
     /// First block (index into the planned blocks).
-    pub first: usize,
+    pub(crate) first: usize,
     /// Last block.
-    pub last: usize,
+    pub(crate) last: usize,
     /// Path parameter of each block's start along the run, and the run's length at the end.
-    pub starts: Vec<f64>,
+    pub(crate) starts: Vec<f64>,
     /// True for cutting runs: the programmed feed caps the tip speed.
-    pub cutting: bool,
+    pub(crate) cutting: bool,
     /// The tip moves (false for pure rotations: no feed or chord cap).
-    pub moves_tip: bool,
+    pub(crate) moves_tip: bool,
     /// The tip nodes' parameters (the planner's grid is refined from them).
-    pub nodes: Vec<f64>,
+    pub(crate) nodes: Vec<f64>,
     tip: Spline<3>,
     rot: Spline<2>,
 }
 
 impl Run {
     /// Length of the run's path parameter (mm, degrees for a turn).
-    pub fn len(&self) -> f64 {
+    pub(crate) fn len(&self) -> f64 {
         self.starts[self.starts.len() - 1]
     }
 
     /// Tip position and rotary axes `(tilt, C)` at `s`, the splines extended beyond the ends.
     #[inline]
-    pub fn pose(&self, s: f64) -> (Point3<f64>, [f64; 2]) {
+    pub(crate) fn pose(&self, s: f64) -> (Point3<f64>, [f64; 2]) {
         let p = self.tip.at(s);
         (Point3::new(p[0], p[1], p[2]), self.rot.at(s))
     }
 
     /// Machine axes at `s` without clamping (for derivatives by differences).
     #[inline]
-    pub fn axes_raw<M: AxisModel + ?Sized>(&self, model: &M, s: f64) -> [f64; 5] {
+    pub(crate) fn axes_raw<M: AxisModel + ?Sized>(&self, model: &M, s: f64) -> [f64; 5] {
         let (tip, r) = self.pose(s);
         let xyz = model.linear_axes(&tip, r[0], r[1]);
         [xyz[0], xyz[1], xyz[2], r[0], r[1]]
@@ -164,7 +164,12 @@ impl Run {
     /// Machine axes at `s`: exactly the first block's start axes at `s <= 0`, the last block's
     /// end axes at `s >= len`, and a block's start axes at its start.
     #[inline]
-    pub fn axes_at<M: AxisModel + ?Sized>(&self, model: &M, blocks: &[Block], s: f64) -> [f64; 5] {
+    pub(crate) fn axes_at<M: AxisModel + ?Sized>(
+        &self,
+        model: &M,
+        blocks: &[Block],
+        s: f64,
+    ) -> [f64; 5] {
         if s.is_nan() || s >= self.len() {
             return blocks[self.last].end_axes;
         }
@@ -179,13 +184,13 @@ impl Run {
     }
 
     /// Tip derivatives `(t', t'')` with respect to `s`.
-    pub fn tip_derivatives(&self, s: f64) -> (Vector3<f64>, Vector3<f64>) {
+    pub(crate) fn tip_derivatives(&self, s: f64) -> (Vector3<f64>, Vector3<f64>) {
         let d = self.tip.derivatives(s);
         (Vector3::from(d[0]), Vector3::from(d[1]))
     }
 
     /// The block index (program) and the parameter within it at run parameter `s`.
-    pub fn block_at(&self, s: f64) -> (usize, f64) {
+    pub(crate) fn block_at(&self, s: f64) -> (usize, f64) {
         let j = self
             .starts
             .partition_point(|&v| v <= s)
@@ -279,7 +284,10 @@ fn build(blocks: &[Block], first: usize, last: usize) -> Run {
         Geometry::Arc(a) => (a.angle_end.to_degrees() / ARC_NODE_DEG).ceil().max(2.0) as usize,
         _ => 1,
     };
-    let spacing: Vec<f64> = run.iter().map(|b| b.length() / arc_parts(b) as f64).collect();
+    let spacing: Vec<f64> = run
+        .iter()
+        .map(|b| b.length() / arc_parts(b) as f64)
+        .collect();
     let mut ts = Vec::new();
     let mut ty: Vec<[f64; 3]> = Vec::new();
     let mut rs = Vec::new();
@@ -368,7 +376,10 @@ mod tests {
         for i in 0..=60 {
             let v = i as f64 * 0.05;
             let (a, b) = (sp.at(v), f(v));
-            assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12, "{v}");
+            assert!(
+                (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12,
+                "{v}"
+            );
             let d = sp.derivatives(v);
             assert!((d[1][0] - 6.0 * v).abs() < 1e-9, "second derivative at {v}");
             assert!((d[2][0] - 6.0).abs() < 1e-9, "third derivative at {v}");

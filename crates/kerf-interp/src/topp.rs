@@ -35,9 +35,13 @@ pub(crate) struct Point {
     pub path_acc: f64,
 }
 
-/// Lower and upper bounds on `u` as `alpha + beta x`, one pair per constraining axis.
+/// Bounds `alpha + beta x` on `u`, one per constraining axis (and the path acceleration).
+type Linear = [(f64, f64); 6];
+
+/// Lower and upper bounds on `u` as `alpha + beta x`, one pair per constraining axis, their
+/// count, and the static cap on `x` from the axes that do not constrain `u`.
 #[inline]
-fn bounds(p: &Point) -> ([(f64, f64); 6], [(f64, f64); 6], usize, f64) {
+fn bounds(p: &Point) -> (Linear, Linear, usize, f64) {
     let mut lo = [(0.0, 0.0); 6];
     let mut hi = [(0.0, 0.0); 6];
     let mut n = 0;

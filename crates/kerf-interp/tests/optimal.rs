@@ -22,7 +22,8 @@ fn ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> [f64; 3] {
         for k in 0..5 {
             let v = (at(i)[k] - at(i - 1)[k]) / t;
             let a = (at(i + 1)[k] - 2.0 * at(i)[k] + at(i - 1)[k]) / (t * t);
-            let j = (at(i + 1)[k] - 3.0 * at(i)[k] + 3.0 * at(i - 1)[k] - at(i - 2)[k]) / (t * t * t);
+            let j =
+                (at(i + 1)[k] - 3.0 * at(i)[k] + 3.0 * at(i - 1)[k] - at(i - 2)[k]) / (t * t * t);
             r[0] = r[0].max(v.abs() / lim.max_velocity[k]);
             r[1] = r[1].max(a.abs() / lim.max_acceleration[k]);
             if let Some(jm) = lim.max_jerk {
@@ -118,7 +119,10 @@ fn vertical(_: &Point3<f64>) -> Vector3<f64> {
 #[test]
 fn circles_plan_within_five_percent_of_the_dense_reference() {
     let m = gantry();
-    for (radius, feeds) in [(35.0, [6000.0, 20000.0, 40000.0]), (5.0, [6000.0, 20000.0, 40000.0])] {
+    for (radius, feeds) in [
+        (35.0, [6000.0, 20000.0, 40000.0]),
+        (5.0, [6000.0, 20000.0, 40000.0]),
+    ] {
         let c = circle(radius, 100.0, 50.0, 0.0);
         let st = stations(&m, &c, 0.01, vertical);
         let curve = |t: f64| c.point(t);
@@ -147,9 +151,19 @@ fn circles_plan_within_five_percent_of_the_dense_reference() {
             );
             assert_eq!(motion.runs(), 1, "a circle has no corner");
             assert!(ratio <= 1.05, "R {radius} at {feed}: {ratio} x the optimum");
-            assert!(ratio >= 0.99, "R {radius} at {feed}: faster than the optimum ({ratio})");
-            assert!(r[0] <= 1.0 && r[1] <= 1.0, "R {radius} at {feed}: limits {r:?}");
-            assert!(motion.refinements() <= 10, "work: {} re-plans", motion.refinements());
+            assert!(
+                ratio >= 0.99,
+                "R {radius} at {feed}: faster than the optimum ({ratio})"
+            );
+            assert!(
+                r[0] <= 1.0 && r[1] <= 1.0,
+                "R {radius} at {feed}: limits {r:?}"
+            );
+            assert!(
+                motion.refinements() <= 10,
+                "work: {} re-plans",
+                motion.refinements()
+            );
         }
     }
 }
@@ -209,7 +223,10 @@ fn a_straight_line_is_the_analytic_trapezoid_and_s_curve() {
     let trapezoid = len / v + v / a;
     let motion = plan(&m, &blocks, &PlanOptions::new(feed, 0.001)).expect("plan");
     let ratio = motion.duration() / trapezoid;
-    println!("line: {:.5} s against {trapezoid:.5} s ({ratio:.5} x)", motion.duration());
+    println!(
+        "line: {:.5} s against {trapezoid:.5} s ({ratio:.5} x)",
+        motion.duration()
+    );
     assert!((0.999..=1.011).contains(&ratio), "trapezoid: {ratio}");
     let j = 500_000.0;
     m.limits.max_jerk = Some([j, j, 400_000.0, 1_000_000.0, 1_000_000.0]);
@@ -217,7 +234,10 @@ fn a_straight_line_is_the_analytic_trapezoid_and_s_curve() {
     let jerked = plan(&m, &blocks, &PlanOptions::new(feed, 0.001)).expect("plan");
     let r = ratios(&m, &jerked.setpoints(&m), 0.001);
     let ratio = jerked.duration() / s_curve;
-    println!("line with jerk: {:.5} s against {s_curve:.5} s ({ratio:.5} x), limits {r:?}", jerked.duration());
+    println!(
+        "line with jerk: {:.5} s against {s_curve:.5} s ({ratio:.5} x), limits {r:?}",
+        jerked.duration()
+    );
     assert!((0.999..=1.011).contains(&ratio), "S-curve: {ratio}");
     assert!(r.iter().all(|&x| x <= 1.0), "limits {r:?}");
 }
@@ -291,8 +311,16 @@ fn planning_work_is_bounded_on_a_long_path() {
         motion.refinements(),
         motion.duration()
     );
-    assert!(motion.grid_points() <= 20 * 10_000, "grid {}", motion.grid_points());
-    assert!(motion.refinements() <= 10, "re-plans {}", motion.refinements());
+    assert!(
+        motion.grid_points() <= 20 * 10_000,
+        "grid {}",
+        motion.grid_points()
+    );
+    assert!(
+        motion.refinements() <= 10,
+        "re-plans {}",
+        motion.refinements()
+    );
     let r = ratios(&m, &motion.setpoints(&m), 0.001);
     assert!(r[0] <= 1.0 && r[1] <= 1.0, "{r:?}");
 }
@@ -304,7 +332,10 @@ fn the_smooth_path_stays_on_the_curve() {
     // whose distance from the true curve (closest point on the NURBS) is far below the chord
     // error of the polyline. Tool vertical: the tip is XYZ - (-r_c, 0, r_a).
     let m = AcHead::paper_000();
-    for (name, c) in [("free-form", common::freeform()), ("hole", circle(5.0, 0.0, 0.0, 0.0))] {
+    for (name, c) in [
+        ("free-form", common::freeform()),
+        ("hole", circle(5.0, 0.0, 0.0, 0.0)),
+    ] {
         let st = stations(&m, &c, 0.01, vertical);
         let lines = fit_blocks(
             &m,
@@ -324,7 +355,10 @@ fn the_smooth_path_stays_on_the_curve() {
             let tip = Point3::new(q[0] + m.r_c, q[1], q[2] - m.r_a);
             worst = worst.max(c.closest_point(&tip).distance);
         }
-        println!("{name}: {} set-points, largest distance from the curve {worst:.2e} mm", motion.cycles() + 1);
+        println!(
+            "{name}: {} set-points, largest distance from the curve {worst:.2e} mm",
+            motion.cycles() + 1
+        );
         assert!(worst < 0.002, "{name}: {worst}");
     }
 }

@@ -330,9 +330,9 @@ impl Machine {
                 .collect(),
         );
         let numbers = |v: &[f64; 5]| object(v.iter().map(|x| json(*x)).collect());
-        let jerk = self
-            .max_jerk
-            .map_or(String::new(), |j| format!(",\n  \"max_jerk\": {}", numbers(&j)));
+        let jerk = self.max_jerk.map_or(String::new(), |j| {
+            format!(",\n  \"max_jerk\": {}", numbers(&j))
+        });
         format!(
             "{{\n  \"format\": \"{MACHINE_FORMAT}\",\n  \"name\": {},\n  \"kinematics\": {{ {} }},\n  \"limits\": {limits},\n  \"max_velocity\": {},\n  \"max_acceleration\": {}{jerk}\n}}\n",
             json(self.name.as_str()),

@@ -273,7 +273,10 @@ fn optional_max_jerk_is_read_strictly_and_written_back() {
     // Absent: acceleration-limited.
     let plain = Machine::from_value(&ac_head()).expect("valid");
     assert_eq!(plain.max_jerk, None, "no key, no jerk limit");
-    assert!(!plain.to_json().contains("max_jerk"), "not written when absent");
+    assert!(
+        !plain.to_json().contains("max_jerk"),
+        "not written when absent"
+    );
     let mut doc = ac_head();
     doc["max_jerk"] = json!({ "X": 200000, "Y": 200000, "Z": 150000, "A": 400000, "C": 400000 });
     let m = Machine::from_value(&doc).expect("valid with jerk");
@@ -299,5 +302,7 @@ fn optional_max_jerk_is_read_strictly_and_written_back() {
         error_after(|d| d["max_jerk"] = json!(5)),
         "max_jerk: expected an object with the axes X, Y, Z, A, C, found a number"
     );
-    assert!(plain.with_max_jerk(Some([1.0, 1.0, f64::NAN, 1.0, 1.0])).is_err());
+    assert!(plain
+        .with_max_jerk(Some([1.0, 1.0, f64::NAN, 1.0, 1.0]))
+        .is_err());
 }

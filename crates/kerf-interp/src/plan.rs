@@ -106,6 +106,8 @@ struct RunGrid {
     cap: Vec<f64>,
     /// `|q''|` of each axis (for the jerk budget of the path acceleration).
     d2_abs_max: Vec<[f64; 5]>,
+    /// The maximum velocity curve of the limits alone (no refinement): what the `F` words say.
+    static_mv: Vec<f64>,
     /// Caps on `x` set by refinements, and factors on the accelerations.
     xlim: Vec<f64>,
     mult_a: Vec<f64>,
@@ -120,8 +122,6 @@ struct Timed {
     u: Vec<f64>,
     t: Vec<f64>,
     area: Vec<f64>,
-    /// The maximum velocity curve the profile was planned under (after refinements).
-    mv: Vec<f64>,
     /// Filter width, s (0: acceleration-limited).
     tau: f64,
     /// Run time, s (the grid's time plus `tau`).
@@ -345,8 +345,9 @@ impl Motion {
 
     /// The `F` word of block `b`, mm/min: for a cutting block the programmed feed wherever the
     /// machine can follow it somewhere in the block (so that a smooth contour keeps one modal
-    /// feed), else the highest tip speed the limits allow in the block; for a rapid move its
-    /// planned peak speed. 0 for an index out of range.
+    /// feed), else the tip speed the limits allow all along the block, every stretch of such
+    /// blocks sharing the lowest (one modal `F` the machine can hold all along); for a rapid
+    /// move its planned peak speed. 0 for an index out of range.
     pub fn block_feed(&self, b: usize) -> f64 {
         self.feeds.get(b).copied().unwrap_or(0.0) * 60.0
     }
@@ -810,6 +811,7 @@ fn run_grid<M: AxisModel + ?Sized>(model: &M, run: &Run, step: f64, opts: &PlanO
     let mut d2 = Vec::with_capacity(n);
     let mut tip_speed = Vec::with_capacity(n);
     let mut cap = Vec::with_capacity(n);
+    let mut static_mv = Vec::with_capacity(n);
     let feed = opts.feed / 60.0;
     for (&si, &(a, b, c)) in s.iter().zip(&fine_d) {
         let (t1, t2) = run.tip_derivatives(si);
@@ -835,14 +837,23 @@ fn run_grid<M: AxisModel + ?Sized>(model: &M, run: &Run, step: f64, opts: &PlanO
                 x = x.min((step / opts.cycle / speed).powi(2));
             }
         }
+        let x = x.min(1e18);
+        static_mv.push(topp::xmax(&topp::Point {
+            d1: a,
+            d2: b,
+            acc: lim.max_acceleration.map(|v| v * ACCELERATION_MARGIN),
+            cap: x,
+            path_acc: f64::INFINITY,
+        }));
         d1.push(a);
         d2.push(b);
         tip_speed.push(speed);
-        cap.push(x.min(1e18));
+        cap.push(x);
     }
     RunGrid {
         xlim: vec![f64::INFINITY; n],
         d2_abs_max: d2.iter().map(|b: &[f64; 5]| b.map(f64::abs)).collect(),
+        static_mv,
         mult_a: vec![1.0; n],
         s,
         d1,
@@ -928,7 +939,6 @@ fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: f64) -> Tim
         u,
         t,
         area,
-        mv,
         tau,
     }
 }
@@ -982,19 +992,22 @@ fn assemble(
             let i1 = g.s.partition_point(|&s| s <= s1).max(i0 + 1).min(g.s.len());
             let range = i0.min(g.s.len() - 1)..i1;
             feeds[b] = if run.cutting && run.moves_tip {
-                let best = range
-                    .map(|i| tm.mv[i].sqrt() * g.tip_speed[i])
-                    .fold(0.0, f64::max);
+                let speeds = range.map(|i| g.static_mv[i].sqrt() * g.tip_speed[i]);
+                let (low, best) =
+                    speeds.fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
                 if best >= feed * 0.999 {
                     feed
                 } else {
-                    best
+                    low
                 }
             } else {
                 range
                     .map(|i| tm.x[i].sqrt() * g.tip_speed[i])
                     .fold(0.0, f64::max)
             };
+        }
+        if run.cutting && run.moves_tip {
+            modal_feeds(&mut feeds[run.first..=run.last], feed);
         }
         // Statistics of the path this run belongs to.
         let path = blocks[run.first].path;
@@ -1071,6 +1084,29 @@ fn assemble(
         total_cycles,
         stats,
     })
+}
+
+/// Every stretch of neighbouring blocks of one run below the programmed feed shares the lowest
+/// of their feeds, so that a smooth stretch the machine cannot take at the programmed feed gets
+/// one modal `F` word (the speed it can hold all along) instead of a new one per block.
+fn modal_feeds(feeds: &mut [f64], programmed: f64) {
+    let mut start = 0;
+    while start < feeds.len() {
+        if feeds[start] >= programmed {
+            start += 1;
+            continue;
+        }
+        let mut end = start;
+        let mut lo = f64::INFINITY;
+        while end < feeds.len() && feeds[end] < programmed {
+            lo = lo.min(feeds[end]);
+            end += 1;
+        }
+        for f in &mut feeds[start..end] {
+            *f = lo;
+        }
+        start = end;
+    }
 }
 
 /// A cycle over a limit.

@@ -362,3 +362,41 @@ fn the_smooth_path_stays_on_the_curve() {
         assert!(worst < 0.002, "{name}: {worst}");
     }
 }
+
+#[test]
+fn a_hole_too_small_for_the_feed_gets_one_lower_modal_f_word() {
+    // A 10 mm hole at 20 m/min: the centripetal limit sqrt(A R) = 173 mm/s (10.4 m/min) is below
+    // the feed, so the F word is lower, and the same on every block of the hole.
+    let m = gantry();
+    let c = circle(5.0, 0.0, 0.0, 0.0);
+    let st = stations(&m, &c, 0.01, vertical);
+    let lines = fit_blocks(
+        &m,
+        &st,
+        None,
+        0,
+        &FitOptions {
+            arcs: false,
+            merge_lines: false,
+            ..FitOptions::default()
+        },
+    )
+    .expect("lines");
+    let motion = plan(&m, &lines, &PlanOptions::new(20000.0, 0.001)).expect("plan");
+    let feeds = motion.block_feeds();
+    let first = feeds[0];
+    println!(
+        "10 mm hole at 20 m/min: {} blocks, F{first:.1}",
+        feeds.len()
+    );
+    assert!(feeds.iter().all(|f| *f == first), "one modal F: {feeds:?}");
+    let limit = (m.limits.max_acceleration[0] * 5.0).sqrt() * 60.0; // at 0, 90, 180, 270 degrees
+    assert!(
+        first < 20000.0 && first <= limit * 1.001,
+        "F{first} vs the limit {limit}"
+    );
+    assert!(
+        first > 0.8 * limit,
+        "not needlessly low: F{first} vs {limit}"
+    );
+}

@@ -137,6 +137,25 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
     })
 }
 
+/// The planned time of every path and the share at the programmed feed, for the summaries.
+pub(crate) fn path_report(motion: &Motion, ids: &[String]) -> serde_json::Value {
+    let paths: Vec<serde_json::Value> = motion
+        .path_stats()
+        .iter()
+        .map(|p| {
+            json!({
+                "id": ids.get(p.path).cloned().unwrap_or_else(|| format!("path {}", p.path)),
+                "duration_s": p.duration,
+                "cutting_time_s": p.cutting_time,
+                "cutting_length_mm": p.cutting_length,
+                "time_share_at_feed": if p.cutting_time > 0.0 { p.time_at_feed / p.cutting_time } else { 0.0 },
+                "length_share_at_feed": if p.cutting_length > 0.0 { p.length_at_feed / p.cutting_length } else { 0.0 },
+            })
+        })
+        .collect();
+    json!(paths)
+}
+
 fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, quiet: bool) {
     let c = p.motion.counts();
     if json {
@@ -149,6 +168,8 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
                 "cycles": p.motion.cycles(),
                 "cycle": args.cycle,
                 "duration_s": p.motion.duration(),
+                "time_share_at_feed": p.motion.time_share_at_feed(),
+                "paths": path_report(&p.motion, &p.ids),
                 "output": out.map(|o| o.display().to_string()),
         });
         // The summary goes to standard output unless the program or CSV itself does.
@@ -159,7 +180,7 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
         }
     } else if !quiet {
         eprintln!(
-            "{}: {} lines, {} arcs, {} turns; {} cycles of {} s = {:.3} s of motion{}",
+            "{}: {} lines, {} arcs, {} turns; {} cycles of {} s = {:.3} s of motion, {:.1} % of the cutting time at the programmed feed{}",
             args.input.display(),
             c.lines,
             c.arcs,
@@ -167,8 +188,19 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
             p.motion.cycles(),
             args.cycle,
             p.motion.duration(),
+            100.0 * p.motion.time_share_at_feed(),
             out.map_or(String::new(), |o| format!(" -> {}", o.display()))
         );
+        for st in p.motion.path_stats() {
+            let id = p.ids.get(st.path).map_or("?", String::as_str);
+            eprintln!(
+                "  {id}: {:.3} s ({:.3} s cutting {:.1} mm, {:.1} % of its length at the programmed feed)",
+                st.duration,
+                st.cutting_time,
+                st.cutting_length,
+                if st.cutting_length > 0.0 { 100.0 * st.length_at_feed / st.cutting_length } else { 0.0 }
+            );
+        }
     }
 }
 

@@ -124,6 +124,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     let mut motions = Vec::new();
     let mut programs = Vec::new();
     let mut setpoint_files = Vec::new();
+    let mut setup_ids: Vec<Vec<String>> = Vec::new();
     for setup in 0..placed.plan.setups.len() {
         let mut ipaths = Vec::new();
         let mut ids: Vec<String> = Vec::new();
@@ -142,6 +143,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         let motion =
             kerf_interp::interpolate(&model, &ipaths, &fit, &plan).map_err(interp(path))?;
         programs.push(gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?);
+        setup_ids.push(ids);
         setpoint_files.push(csv_string(
             model.axis_names(),
             args.cycle,
@@ -233,6 +235,21 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "turns": counts.turns,
             "cycles": cycles,
             "duration_s": duration,
+            "time_share_at_feed": if duration > 0.0 {
+                motions.iter().map(|m| m.time_share_at_feed() * m.duration()).sum::<f64>() / duration
+            } else {
+                0.0
+            },
+            "paths": motions
+                .iter()
+                .zip(&setup_ids)
+                .flat_map(|(m, ids)| {
+                    crate::motion::path_report(m, ids)
+                        .as_array()
+                        .cloned()
+                        .unwrap_or_default()
+                })
+                .collect::<Vec<_>>(),
         },
         "seconds": start.elapsed().as_secs_f64(),
     });

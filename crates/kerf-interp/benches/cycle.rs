@@ -1,7 +1,8 @@
 //! Per-cycle cost of the interpolator: what a controller computes every cycle.
 //!
-//! - `program`: one set-point of a planned 5-axis program (locate the piece, trapezoid
-//!   profile, tip on the line or arc, rotary axes, paper 000 eq 16 for the linear axes).
+//! - `program`: one set-point of a planned 5-axis program (locate the run, the path parameter
+//!   from the time-optimal profile, tip and rotary axes on the run's splines, paper 000 eq 16
+//!   for the linear axes).
 //! - `program-arcs-machine-file`: the same on `fixtures/machines/ac_head.json` through
 //!   kerf-kinematics (`MachineModel`).
 //! - `recurrence`: one step of paper 001's recursive spline in 5 coordinates (three-term form

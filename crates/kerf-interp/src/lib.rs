@@ -5,12 +5,15 @@
 //!
 //! 1. [`fit_blocks`]: runs of points become space arcs (or long lines) where the block stays
 //!    within the tolerance of the points and of the curve; [`BlockCounts`] counts them.
-//! 2. [`plan()`]: a look-ahead feed plan along the blocks such that no axis exceeds its velocity
-//!    or acceleration limit in any cycle, stopping at the end; [`Motion::cycles`] is the
-//!    program's cycle count.
-//! 3. [`Motion::iter`]: the set-points, one per interpolation cycle: the tip on the line or arc
-//!    (paper 000 eq 3 and 6-8), the rotary axes in proportion to the distance (eq 4, 9-12), the
-//!    linear axes from the machine model (eq 16 for paper 000's head, [`AxisModel`] in general).
+//! 2. [`plan()`]: the time-optimal feed along a smooth interpolant of the poses between true
+//!    corners, such that no axis exceeds its velocity, acceleration or (with
+//!    [`AxisLimits::max_jerk`]) jerk limit in any cycle, stopping at the end;
+//!    [`Motion::cycles`] is the program's cycle count, [`Motion::path_stats`] the time per path.
+//! 3. [`Motion::iter`]: the set-points, one per interpolation cycle: the tip and the rotary
+//!    axes on the smooth path through the blocks' points (exactly the stations' axes where the
+//!    machine is at rest), the linear axes from the machine model (eq 16 for paper 000's head,
+//!    [`AxisModel`] in general). [`Block::constant_feed`] keeps paper 000's own interpolation
+//!    of one block (eq 3-12).
 //! 4. [`output`]: the set-points CSV of `formats.md`, generic and Sinumerik-style G-code.
 //!
 //! The machine is any [`AxisModel`]: [`MachineModel`] for kerf's `kerf.machine/1` machines
@@ -53,6 +56,8 @@ pub mod model;
 pub mod output;
 pub mod plan;
 pub mod recursive;
+pub(crate) mod smooth;
+pub(crate) mod topp;
 
 pub use block::{increments, solve_stations, Block, Geometry, Station};
 pub use error::{InterpError, Result};
@@ -64,7 +69,7 @@ pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_gcode, Dialect, GcodeOptions,
     ProcessCodes,
 };
-pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PlanOptions};
+pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PathStats, PlanOptions};
 
 /// One path of a program: its id (the source curve's), its stations and, when known, the
 /// curve itself.

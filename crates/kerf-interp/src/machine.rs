@@ -38,8 +38,10 @@ impl MachineModel {
     /// kerf-kinematics has none).
     pub fn new(machine: Machine) -> Result<Self> {
         let range = machine.limits.map(|r| r.map(|r| [r.min, r.max]));
-        let limits =
+        let mut limits =
             AxisLimits::from_machine_units(range, machine.max_velocity, machine.max_acceleration)?;
+        limits.max_jerk = machine.max_jerk;
+        limits.validate()?;
         Ok(Self {
             machine,
             pole_tolerance: 1e-6,

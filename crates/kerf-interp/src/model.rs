@@ -29,6 +29,9 @@ pub struct AxisLimits {
     pub max_velocity: [f64; 5],
     /// Largest acceleration of each axis, mm/s^2 or deg/s^2.
     pub max_acceleration: [f64; 5],
+    /// Largest jerk of each axis, mm/s^3 or deg/s^3 (`max_jerk` of `kerf.machine/1`); `None`:
+    /// the plan is acceleration-limited, with `Some` it is jerk-limited (S-curve) on every axis.
+    pub max_jerk: Option<[f64; 5]>,
 }
 
 impl AxisLimits {
@@ -51,6 +54,7 @@ impl AxisLimits {
             range,
             max_velocity: v,
             max_acceleration,
+            max_jerk: None,
         };
         limits.validate()?;
         Ok(limits)
@@ -64,6 +68,9 @@ impl AxisLimits {
         for k in 0..5 {
             positive("max_velocity", self.max_velocity[k])?;
             positive("max_acceleration", self.max_acceleration[k])?;
+            if let Some(j) = self.max_jerk {
+                positive("max_jerk", j[k])?;
+            }
             if let Some([lo, hi]) = self.range[k] {
                 if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
                     return Err(InterpError::BadParameter {

@@ -25,7 +25,8 @@
 //! key that is not a parameter of the type or an axis of the machine is an error (a misspelt
 //! key must not silently become a default). Unknown top-level keys are ignored, so that a file
 //! may carry comments or later optional keys. Every axis must be listed in `limits`,
-//! `max_velocity` and `max_acceleration` (`null` in `limits` for an unlimited axis).
+//! `max_velocity` and `max_acceleration` (`null` in `limits` for an unlimited axis). The optional
+//! `max_jerk` (mm/s^3, deg/s^3), when present, is read as strictly and must list every axis.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -74,6 +75,9 @@ pub struct Machine {
     pub max_velocity: [f64; 5],
     /// The largest acceleration of each axis, mm/s^2 or deg/s^2.
     pub max_acceleration: [f64; 5],
+    /// The largest jerk of each axis, mm/s^3 or deg/s^3 (optional key `max_jerk`): with it the
+    /// interpolator plans a jerk-limited (S-curve) motion, without it acceleration-limited.
+    pub max_jerk: Option<[f64; 5]>,
     /// The laser process codes of the optional `process` object; every field `None` when the
     /// file has none (the G-code writer then uses its dialect's defaults).
     pub process: Process,
@@ -242,9 +246,20 @@ impl Machine {
             max_velocity,
             max_acceleration,
             process: Process::default(),
+            max_jerk: None,
         };
         machine.validate()?;
         Ok(machine)
+    }
+
+    /// The same machine with jerk limits (mm/s^3, deg/s^3; `None` removes them), checked.
+    ///
+    /// # Errors
+    /// [`KinematicsError::Document`] for a jerk that is not finite and > 0 (`max_jerk.X: ...`).
+    pub fn with_max_jerk(mut self, max_jerk: Option<[f64; 5]>) -> Result<Self> {
+        self.max_jerk = max_jerk;
+        self.validate()?;
+        Ok(self)
     }
 
     /// Checks the name, the limits, the velocities and the accelerations (the kinematic
@@ -282,6 +297,15 @@ impl Machine {
                 if !(v.is_finite() && v > 0.0) {
                     return Err(KinematicsError::doc(
                         format!("{key}.{name}"),
+                        format!("must be finite and > 0 (got {v})"),
+                    ));
+                }
+            }
+            if let Some(j) = self.max_jerk {
+                let v = j[axis.index()];
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(KinematicsError::doc(
+                        format!("max_jerk.{name}"),
                         format!("must be finite and > 0 (got {v})"),
                     ));
                 }
@@ -420,7 +444,12 @@ impl Machine {
         };
         let max_velocity = per_axis(top, "max_velocity", &names, number)?;
         let max_acceleration = per_axis(top, "max_acceleration", &names, number)?;
-        let mut machine = Self::try_new(name, kinematics, limits, max_velocity, max_acceleration)?;
+        let max_jerk = match top.get("max_jerk") {
+            None => None,
+            Some(_) => Some(per_axis(top, "max_jerk", &names, number)?),
+        };
+        let mut machine = Self::try_new(name, kinematics, limits, max_velocity, max_acceleration)?
+            .with_max_jerk(max_jerk);
         if let Some(p) = top.get("process") {
             machine.process = Process::from_value(p)?;
         }
@@ -452,6 +481,9 @@ impl Machine {
                 .collect(),
         );
         let numbers = |v: &[f64; 5]| object(v.iter().map(|x| json(*x)).collect());
+        let jerk = self.max_jerk.map_or(String::new(), |j| {
+            format!(",\n  \"max_jerk\": {}", numbers(&j))
+        });
         let mut process = Vec::new();
         let p = &self.process;
         for (key, lines) in [("beam_on", &p.beam_on), ("beam_off", &p.beam_off)] {
@@ -473,7 +505,7 @@ impl Machine {
             format!(",\n  \"process\": {{ {} }}", process.join(", "))
         };
         format!(
-            "{{\n  \"format\": \"{MACHINE_FORMAT}\",\n  \"name\": {},\n  \"kinematics\": {{ {} }},\n  \"limits\": {limits},\n  \"max_velocity\": {},\n  \"max_acceleration\": {}{process}\n}}\n",
+            "{{\n  \"format\": \"{MACHINE_FORMAT}\",\n  \"name\": {},\n  \"kinematics\": {{ {} }},\n  \"limits\": {limits},\n  \"max_velocity\": {},\n  \"max_acceleration\": {}{jerk}{process}\n}}\n",
             json(self.name.as_str()),
             kin.join(", "),
             numbers(&self.max_velocity),

@@ -267,3 +267,42 @@ fn syntax_and_io_errors() {
         "{err}"
     );
 }
+
+#[test]
+fn optional_max_jerk_is_read_strictly_and_written_back() {
+    // Absent: acceleration-limited.
+    let plain = Machine::from_value(&ac_head()).expect("valid");
+    assert_eq!(plain.max_jerk, None, "no key, no jerk limit");
+    assert!(
+        !plain.to_json().contains("max_jerk"),
+        "not written when absent"
+    );
+    let mut doc = ac_head();
+    doc["max_jerk"] = json!({ "X": 200000, "Y": 200000, "Z": 150000, "A": 400000, "C": 400000 });
+    let m = Machine::from_value(&doc).expect("valid with jerk");
+    assert_eq!(
+        m.max_jerk,
+        Some([200000.0, 200000.0, 150000.0, 400000.0, 400000.0])
+    );
+    let again = Machine::from_str(&m.to_json()).expect("round trip");
+    assert_eq!(again.max_jerk, m.max_jerk, "written back");
+    assert_eq!(
+        error_after(|d| d["max_jerk"] = json!({ "X": 1, "Y": 1, "Z": 1, "A": 1 })),
+        "max_jerk.C: missing"
+    );
+    assert_eq!(
+        error_after(|d| d["max_jerk"] = json!({ "X": 1, "Y": 1, "Z": 1, "A": 1, "C": 0 })),
+        "max_jerk.C: must be finite and > 0 (got 0)"
+    );
+    assert_eq!(
+        error_after(|d| d["max_jerk"] = json!({ "X": 1, "Y": 1, "Z": 1, "A": 1, "C": 1, "B": 1 })),
+        "max_jerk.B: not an axis of this machine (its axes are X, Y, Z, A, C)"
+    );
+    assert_eq!(
+        error_after(|d| d["max_jerk"] = json!(5)),
+        "max_jerk: expected an object with the axes X, Y, Z, A, C, found a number"
+    );
+    assert!(plain
+        .with_max_jerk(Some([1.0, 1.0, f64::NAN, 1.0, 1.0]))
+        .is_err());
+}

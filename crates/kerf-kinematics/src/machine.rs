@@ -449,7 +449,7 @@ impl Machine {
             Some(_) => Some(per_axis(top, "max_jerk", &names, number)?),
         };
         let mut machine = Self::try_new(name, kinematics, limits, max_velocity, max_acceleration)?
-            .with_max_jerk(max_jerk);
+            .with_max_jerk(max_jerk)?;
         if let Some(p) = top.get("process") {
             machine.process = Process::from_value(p)?;
         }

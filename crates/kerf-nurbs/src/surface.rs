@@ -521,6 +521,7 @@ impl NurbsSurface {
     /// entries.
     #[inline]
     fn point_in_m<const M: usize>(&self, u: f64, v: f64, su: usize, sv: usize) -> Point3<f64> {
+        crate::work::tick();
         let (p, q) = (self.degree_u, self.degree_v);
         let mut nu = [0.0; M];
         let mut nv = [0.0; M];
@@ -594,6 +595,7 @@ impl NurbsSurface {
         s: &mut [[Vector3<f64>; KV]; KU],
         bound: Option<&mut [[f64; KV]; KU]>,
     ) {
+        crate::work::tick();
         match self.degree_u.max(self.degree_v) {
             0..=3 => self.derivs_in_m::<KU, KV, 4>(u, v, su, sv, s, bound),
             4..=7 => self.derivs_in_m::<KU, KV, 8>(u, v, su, sv, s, bound),

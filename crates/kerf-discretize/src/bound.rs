@@ -42,7 +42,7 @@ pub fn dist_to_segment(q: &Point3<f64>, a: &Point3<f64>, ab: &Vector3<f64>, ab2:
     (aq - ab * s).norm()
 }
 
-/// Reusable work space of [`chord_error_with`], so that a walk along a curve allocates once.
+/// Reusable work space of [`Certifier::chord_error`], so that a walk along a curve allocates once.
 #[derive(Debug, Default, Clone)]
 pub struct Scratch {
     pieces: Vec<Piece>,

@@ -146,7 +146,7 @@ pub fn discretize_range(
     // margin (known from the control points), then the size of the output.
     let cert = Certifier::new(curve);
     let margin = cert.max_margin() + cert.output_resolution();
-    if !(margin <= 0.5 * opts.tolerance) {
+    if margin.is_nan() || margin > 0.5 * opts.tolerance {
         return Err(DiscretizeError::ToleranceBelowMargin {
             tolerance: opts.tolerance,
             margin,

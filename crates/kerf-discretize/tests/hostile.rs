@@ -59,6 +59,12 @@ fn certified_within_budget(name: &str, tol: f64) {
         let opts = Options::with_tolerance(tol);
         let (r, work) = run(&c, &opts);
         let d = r.unwrap_or_else(|e| panic!("{name} {id} at {tol}: {e}"));
+        // The figure docs/discretization.md quotes (`--nocapture` shows it).
+        eprintln!(
+            "work: {name} {id} at {tol}: {work} evaluations for {} points ({:.0} per point)",
+            d.points.len(),
+            work as f64 / d.points.len() as f64
+        );
         assert!(
             work <= walk_budget(&c, &d),
             "{name} {id}: {work} evaluations for {} points",

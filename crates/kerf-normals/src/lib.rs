@@ -21,7 +21,7 @@ pub use error::{NormalsError, Result};
 pub use mesh::{MeshNormals, DEFAULT_CREASE_ANGLE_DEG};
 pub use surface::{Hint, NormalSource, NurbsNormals, Projection};
 
-use kerf_discretize::bound::chord_error;
+use kerf_discretize::bound::{Certifier, Scratch};
 use kerf_discretize::{discretize_range, Discretization, Options};
 use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3};
@@ -120,6 +120,9 @@ struct Sample {
 
 struct Ctx<'a> {
     curve: &'a NurbsCurve,
+    /// Built once per curve: re-certifying an inserted segment costs no pass over the curve.
+    cert: Certifier<'a>,
+    scratch: Scratch,
     surface: &'a dyn NormalSource,
     dopts: &'a Options,
     nopts: &'a NormalOptions,
@@ -231,7 +234,9 @@ impl Ctx<'_> {
     fn finish(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
         if !certified {
             let tol = self.dopts.tolerance;
-            let bound = chord_error(self.curve, a.t, b.t, &a.p, &b.p, tol, 0.0);
+            let bound = self
+                .cert
+                .chord_error(&mut self.scratch, a.t, b.t, &a.p, &b.p, tol, 0.0);
             if bound.upper > tol {
                 let d = discretize_range(self.curve, a.t, b.t, self.dopts)?;
                 let mut prev = a;
@@ -273,6 +278,8 @@ pub fn orient(
     let (da, db) = curve.domain();
     let mut ctx = Ctx {
         curve,
+        cert: Certifier::new(curve),
+        scratch: Scratch::default(),
         surface,
         dopts,
         nopts,

@@ -59,11 +59,12 @@ struct Piece {
 /// margin covers the de Casteljau levels of this many halvings (see [`MARGIN_FACTOR`]).
 pub const MAX_SUBDIVISION_DEPTH: u32 = 48;
 
-/// The margin constant: `MARGIN_FACTOR (p + 1) eps` times the homogeneous magnitudes. It covers
+/// The margin constant: `MARGIN_FACTOR (p + 1) eps * 2 L` (`L` the span's largest local
+/// coordinate). It covers
 /// the `p` de Boor levels of the Bezier extraction, `p` de Casteljau levels for each of up to
 /// [`MAX_SUBDIVISION_DEPTH`] halvings, the projection and the distance, each one rounding of a
 /// convex combination (`docs/discretization.md`, Step 5).
-pub const MARGIN_FACTOR: f64 = 64.0;
+pub const MARGIN_FACTOR: f64 = 128.0;
 
 struct Chord {
     a: Point3<f64>,
@@ -200,7 +201,7 @@ impl<'a> Certifier<'a> {
     }
 
     /// The largest rounding margin any segment of the curve can get, known before any walk:
-    /// `64 (p + 1) eps * 2 L + 8 eps L` with `L` the largest `|P_i - O|_inf` of a knot span's
+    /// `128 (p + 1) eps * 2 L + 8 eps L` with `L` the largest `|P_i - O|_inf` of a knot span's
     /// control points, plus the representation term. The weights do not enter: every
     /// homogeneous value the certificate computes is a convex combination
     /// `sum_i lambda_i w_i (P_i - O, 1)`, whose rounding is at most a few `eps` times

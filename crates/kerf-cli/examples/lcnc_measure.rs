@@ -213,6 +213,7 @@ fn main() {
         // may be: the controller may round the corner between the descent and the cut); the
         // samples nearer the cut than the pierce segment also against the cutting points and
         // for the tool axis.
+        let (_, run) = axes.paths[k].run();
         let mut dev_union: f64 = 0.0;
         let mut dev_points: f64 = 0.0;
         let mut dev_orient: f64 = 0.0;
@@ -228,7 +229,7 @@ fn main() {
             // nearest segment, degrees.
             let (j, f) = nearest_segment(p, poses);
             let ax = |n: usize| {
-                let pj = &axes.paths[k].poses[n.min(poses.len() - 1)];
+                let pj = &run[n.min(run.len() - 1)];
                 Vector3::new(pj[3], pj[4], pj[5]).normalize()
             };
             let uj = (ax(j) * (1.0 - f) + ax(j + 1) * f).normalize();

@@ -155,9 +155,15 @@ pub(crate) struct DiscretizeArgs {
     #[arg(long, value_name = "MM")]
     pub(crate) min_segment_length: Option<f64>,
 
-    /// Largest turn of the tangent across one segment, in degrees.
+    /// Largest turn of the tangent over one segment (between the tangents at any two of its
+    /// points, certified from the hodograph), in degrees.
     #[arg(long, value_name = "DEG")]
     pub(crate) max_turn: Option<f64>,
+
+    /// Refuse a curve that would need more cutting points than this (guards against a
+    /// tolerance typed in the wrong unit; default 50000000).
+    #[arg(long, value_name = "N")]
+    pub(crate) max_points: Option<usize>,
 
     /// How cutting points are placed (the classic methods carry the same guarantee).
     #[arg(long, value_enum, default_value_t = StrategyArg::ReferenceSphere)]

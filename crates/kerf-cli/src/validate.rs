@@ -168,7 +168,11 @@ fn write_text_summary(out: &mut impl Write, path: &Path, file: &CurvesFile) -> i
                 r.curve.degree().to_string(),
                 r.curve.len().to_string(),
                 yes_no(r.curve.is_rational()),
-                format!("[{}, {}]", s.domain.0, s.domain.1),
+                format!(
+                    "[{}, {}]",
+                    kerf_nurbs::Readable(s.domain.0),
+                    kerf_nurbs::Readable(s.domain.1)
+                ),
                 format!("{:.3}", s.length),
                 s.c0_breaks.len().to_string(),
                 yes_no(s.closed),

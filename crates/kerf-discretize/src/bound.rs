@@ -10,7 +10,7 @@
 //! as soon as the bounds decide the question asked. See `docs/discretization.md`.
 
 use kerf_nurbs::{NurbsCurve, RationalBezier};
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Point3, Vector3, Vector4};
 
 /// The verdict on one segment.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,7 +42,7 @@ pub fn dist_to_segment(q: &Point3<f64>, a: &Point3<f64>, ab: &Vector3<f64>, ab2:
     (aq - ab * s).norm()
 }
 
-/// Reusable work space of [`chord_error_with`], so that a walk along a curve allocates once.
+/// Reusable work space of [`Certifier::chord_error`], so that a walk along a curve allocates once.
 #[derive(Debug, Default, Clone)]
 pub struct Scratch {
     pieces: Vec<Piece>,
@@ -52,7 +52,19 @@ pub struct Scratch {
 struct Piece {
     bez: RationalBezier,
     upper: f64,
+    depth: u32,
 }
+
+/// Subdivisions of one Bezier piece beyond which it is not refined further: the rounding
+/// margin covers the de Casteljau levels of this many halvings (see [`MARGIN_FACTOR`]).
+pub const MAX_SUBDIVISION_DEPTH: u32 = 48;
+
+/// The margin constant: `MARGIN_FACTOR (p + 1) eps * 2 L` (`L` the span's largest local
+/// coordinate). It covers
+/// the `p` de Boor levels of the Bezier extraction, `p` de Casteljau levels for each of up to
+/// [`MAX_SUBDIVISION_DEPTH`] halvings, the projection and the distance, each one rounding of a
+/// convex combination (`docs/discretization.md`, Step 5).
+pub const MARGIN_FACTOR: f64 = 128.0;
 
 struct Chord {
     a: Point3<f64>,
@@ -85,19 +97,328 @@ impl Chord {
     }
 }
 
-/// Certifies the chord error of the curve on `[t0, t1]` against the chord `C(t0) C(t1)`.
+/// The curve prepared for certification: a copy translated to a local origin (so that rounding
+/// is relative to the curve's size, not its distance from the origin) and, per knot span, the
+/// magnitudes that bound the rounding of its Bezier pieces.
 ///
-/// `a` and `b` must be the points the caller will output for `t0` and `t1` (normally
-/// `curve.point(t0)` and `curve.point(t1)`). The search refines until one of:
+/// The origin `O` is the centre of the control points' box rounded to a multiple of a power of
+/// two `g >= ` the box's extent; then `P_i - O` is exact in floating point (checked for every
+/// coordinate; if any were inexact `O = 0` would be used). Build one per curve and reuse it:
+/// construction costs one pass over the control points.
+#[derive(Debug, Clone)]
+pub struct Certifier<'a> {
+    curve: &'a NurbsCurve,
+    local: NurbsCurve,
+    origin: Vector3<f64>,
+    /// Per knot span index: `L = max_i |P_i - O|_inf` over the span's `p + 1` control points.
+    spans: Vec<f64>,
+    /// `4 eps max |P_i|` for curves whose weights are not powers of two (the control points are
+    /// recovered from `w P` by one division, within two ulps), else 0.
+    representation: f64,
+}
+
+/// `a - b` and whether it is exact (Knuth's TwoSum error term is zero).
+fn exact_diff(a: f64, b: f64) -> (f64, bool) {
+    let s = a - b;
+    let bb = s - a;
+    let err = (a - (s - bb)) + (-b - bb);
+    (s, err == 0.0)
+}
+
+impl<'a> Certifier<'a> {
+    /// Prepares `curve` for certification.
+    pub fn new(curve: &'a NurbsCurve) -> Self {
+        let (lo, hi) = curve.bounding_box();
+        let extent = (hi - lo).amax();
+        let centre = (lo.coords + hi.coords) * 0.5;
+        let g = if extent > 0.0 && extent.is_finite() {
+            2f64.powi(extent.log2().ceil() as i32)
+        } else {
+            1.0
+        };
+        let mut origin = centre.map(|c| (c / g).round() * g);
+        if !origin.iter().all(|c| c.is_finite()) {
+            origin = Vector3::zeros();
+        }
+        let points = curve.control_points();
+        let weights = curve.weights();
+        let mut shifted = Vec::with_capacity(points.len());
+        let mut exact = true;
+        for p in &points {
+            let mut d = Vector3::zeros();
+            for k in 0..3 {
+                let (v, ok) = exact_diff(p[k], origin[k]);
+                d[k] = v;
+                exact &= ok;
+            }
+            shifted.push(d);
+        }
+        if !exact {
+            origin = Vector3::zeros();
+            shifted = points.iter().map(|p| p.coords).collect();
+        }
+        let cpw: Vec<Vector4<f64>> = shifted
+            .iter()
+            .zip(&weights)
+            .map(|(d, &w)| Vector4::new(d.x * w, d.y * w, d.z * w, w))
+            .collect();
+        let p = curve.degree();
+        let mut spans = vec![0.0; curve.len()];
+        for (i, _, _) in curve.spans() {
+            spans[i] = shifted[i - p..=i]
+                .iter()
+                .map(|d| d.amax())
+                .fold(0.0, f64::max);
+        }
+        let pow2 = |w: f64| w.log2().fract() == 0.0;
+        let representation = if weights.iter().all(|&w| pow2(w)) {
+            0.0
+        } else {
+            let scale = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
+            4.0 * f64::EPSILON * scale
+        };
+        Self {
+            curve,
+            local: NurbsCurve::from_homogeneous_unchecked(p, curve.knots().to_vec(), cpw),
+            origin,
+            spans,
+            representation,
+        }
+    }
+
+    /// The curve being certified.
+    pub fn curve(&self) -> &NurbsCurve {
+        self.curve
+    }
+
+    /// The local origin `O` the certificate computes in.
+    pub fn origin(&self) -> Vector3<f64> {
+        self.origin
+    }
+
+    fn factor(&self) -> f64 {
+        MARGIN_FACTOR * (self.curve.degree() + 1) as f64 * f64::EPSILON
+    }
+
+    /// The largest rounding margin any segment of the curve can get, known before any walk:
+    /// `128 (p + 1) eps * 2 L + 8 eps L` with `L` the largest `|P_i - O|_inf` of a knot span's
+    /// control points, plus the representation term. The weights do not enter: every
+    /// homogeneous value the certificate computes is a convex combination
+    /// `sum_i lambda_i w_i (P_i - O, 1)`, whose rounding is at most a few `eps` times
+    /// `sum_i lambda_i w_i |P_i - O| <= w L` per level, so after dividing by its weight `w` the
+    /// projected point is off by a few `eps L` per level, whatever the weights' ratio
+    /// (`docs/discretization.md`, Step 5). A tolerance not well above the margin cannot be
+    /// certified.
+    pub fn max_margin(&self) -> f64 {
+        let f = self.factor();
+        let worst = self
+            .curve
+            .spans()
+            .iter()
+            .map(|&(i, _, _)| self.spans[i])
+            .fold(0.0, f64::max);
+        (2.0 * f + 8.0 * f64::EPSILON) * worst + self.representation
+    }
+
+    /// The resolution of the output: one ulp of the largest coordinate of the curve's control
+    /// points. A cutting point is a rounded `f64`, so it is off the curve by up to about half
+    /// of this per coordinate, and no chord error below it can be certified reliably.
+    pub fn output_resolution(&self) -> f64 {
+        let scale = self
+            .curve
+            .control_points()
+            .iter()
+            .map(|p| p.coords.amax())
+            .fold(0.0, f64::max);
+        2.0 * f64::EPSILON * scale
+    }
+
+    /// Certifies the chord error of the curve on `[t0, t1]` against the chord `a b`; see
+    /// [`chord_error`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn chord_error(
+        &self,
+        scratch: &mut Scratch,
+        t0: f64,
+        t1: f64,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        limit: f64,
+        want_lower: f64,
+    ) -> Bound {
+        let (al, bl) = (a - self.origin, b - self.origin);
+        let chord = Chord {
+            a: al,
+            ab: bl - al,
+            ab2: (bl - al).norm_squared(),
+        };
+        let f = self.factor();
+        let mut margin = 8.0 * f64::EPSILON * al.coords.amax().max(bl.coords.amax());
+        let pieces = &mut scratch.pieces;
+        pieces.clear();
+        let mut lower = 0.0f64;
+        let spans = &self.spans;
+        let local = &self.local;
+        local.for_each_bezier_piece(t0, t1, |bez| {
+            let (upper, end) = chord.piece(bez);
+            let l = spans[local.span(bez.t0)];
+            margin = margin.max((2.0 * f + 8.0 * f64::EPSILON) * l);
+            lower = lower.max(end);
+            pieces.push(Piece {
+                bez: *bez,
+                upper,
+                depth: 0,
+            });
+        });
+        margin += self.representation;
+        let budget = 48 + 4 * pieces.len();
+        let mut steps = 0;
+        loop {
+            // The piece with the largest bound decides the global bound.
+            let mut worst = 0;
+            let mut upper = 0.0f64;
+            for (i, p) in pieces.iter().enumerate() {
+                if p.upper > upper {
+                    upper = p.upper;
+                    worst = i;
+                }
+            }
+            // A NaN distance (overflowing homogeneous coordinates) must never look like 0.
+            if pieces.iter().any(|p| p.upper.is_nan()) || lower.is_nan() || margin.is_nan() {
+                return Bound {
+                    upper: f64::INFINITY,
+                    lower: if lower.is_nan() { f64::INFINITY } else { lower },
+                };
+            }
+            let upper_m = upper + margin;
+            if lower > limit {
+                return Bound {
+                    upper: upper_m.max(lower),
+                    lower,
+                };
+            }
+            // Refining further cannot move the estimate by more than the gap.
+            let tight = upper - lower <= 0.002 * limit;
+            let decided =
+                upper_m <= limit && (lower >= want_lower || upper_m < want_lower || tight);
+            let exhausted = steps >= budget
+                || pieces
+                    .get(worst)
+                    .is_none_or(|p| p.depth >= MAX_SUBDIVISION_DEPTH);
+            if decided || exhausted {
+                return Bound {
+                    upper: upper_m,
+                    lower,
+                };
+            }
+            steps += 1;
+            // Split the worst piece in place: its copy at the end becomes the right half.
+            pieces[worst].depth += 1;
+            pieces.push(pieces[worst]);
+            let last = pieces.len() - 1;
+            let (head, tail) = pieces.split_at_mut(last);
+            let (l, r) = (&mut head[worst], &mut tail[0]);
+            l.bez.subdivide_in_place(&mut r.bez, 0.5);
+            let (ul, el) = chord.piece(&l.bez);
+            let (ur, _) = chord.piece(&r.bez);
+            lower = lower.max(el);
+            l.upper = ul;
+            r.upper = ur;
+        }
+    }
+}
+
+impl Certifier<'_> {
+    /// A certified upper bound (radians) of the largest angle between the tangents at any two
+    /// points of `[t0, t1]`, refined until it is `<= limit` or cannot be brought below it; `PI`
+    /// where the tangent may reverse (a cusp).
+    ///
+    /// The derivative of a rational Bezier piece is `C' = sum_{i<k} w_i w_k (B_i B_k' - B_k B_i')
+    /// (Q_k - Q_i) / w^2`, and `B_i B_k' - B_k B_i' >= 0` for `i < k` (the ratio `B_k / B_i`
+    /// increases), so every tangent lies in the cone spanned by the control polygon's edges
+    /// `Q_{j+1} - Q_j`. If every edge is within `theta < 90` degrees of one direction `d`, so is
+    /// every tangent, and two tangents differ by at most `2 theta`. Halving a piece (de
+    /// Casteljau) shrinks its cone to the tangents actually taken; at most `32 + 2 * pieces`
+    /// halvings.
+    pub fn turn_bound(&self, t0: f64, t1: f64, limit: f64) -> f64 {
+        let mut pieces: Vec<(RationalBezier, f64)> = Vec::new();
+        let mut d = self.local.point(t1) - self.local.point(t0);
+        if d.norm() == 0.0 {
+            self.local.for_each_bezier_piece(t0, t1, |bez| {
+                if d.norm() == 0.0 {
+                    if let Some(e) = edges(bez).find(|e| e.norm() > 0.0) {
+                        d = e;
+                    }
+                }
+            });
+        }
+        if d.norm() == 0.0 || !d.norm().is_finite() {
+            return 0.0;
+        }
+        let spread = |bez: &RationalBezier| {
+            edges(bez)
+                .filter(|e| e.norm() > 0.0)
+                .map(|e| e.angle(&d))
+                .fold(0.0f64, f64::max)
+        };
+        self.local.for_each_bezier_piece(t0, t1, |bez| {
+            pieces.push((*bez, spread(bez)));
+        });
+        let budget = 32 + 2 * pieces.len();
+        for _ in 0..=budget {
+            let (worst, theta) = pieces
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (i, p.1))
+                .fold((0, 0.0f64), |acc, x| if x.1 > acc.1 { x } else { acc });
+            let bound = if theta >= std::f64::consts::FRAC_PI_2 || theta.is_nan() {
+                std::f64::consts::PI
+            } else {
+                2.0 * theta
+            };
+            if bound <= limit {
+                return bound;
+            }
+            let mut right = pieces[worst].0;
+            let mut left = right;
+            left.subdivide_in_place(&mut right, 0.5);
+            pieces[worst] = (left, spread(&left));
+            pieces.push((right, spread(&right)));
+            if pieces.len() > budget + 2 {
+                break;
+            }
+        }
+        let theta = pieces.iter().map(|p| p.1).fold(0.0f64, f64::max);
+        if theta >= std::f64::consts::FRAC_PI_2 || theta.is_nan() {
+            std::f64::consts::PI
+        } else {
+            2.0 * theta
+        }
+    }
+}
+
+/// The edges `Q_{j+1} - Q_j` of a piece's projected control polygon.
+fn edges(bez: &RationalBezier) -> impl Iterator<Item = Vector3<f64>> + '_ {
+    let h = bez.homogeneous();
+    h.windows(2)
+        .map(|w| w[1].xyz() / w[1].w - w[0].xyz() / w[0].w)
+}
+
+/// Certifies the chord error of the curve on `[t0, t1]` against the chord `a b`, where `a` and
+/// `b` are the points the caller will output for `t0` and `t1` (normally `curve.point(t0)` and
+/// `curve.point(t1)`; any points are allowed, the bound is about the segment between them).
+/// The search refines until one of:
 /// - the upper bound is `<= limit` and the lower bound is `>= want_lower` (or cannot rise any
 ///   more): returns the bounds;
 /// - the lower bound exceeds `limit`: the segment certainly fails; `upper` is then the
 ///   current (larger) bound;
-/// - the refinement budget is spent: `upper` is the bound reached (possibly `> limit`).
+/// - the refinement budget (`48 + 4 * pieces` subdivisions, none deeper than
+///   [`MAX_SUBDIVISION_DEPTH`]) is spent: `upper` is the bound reached (possibly `> limit`).
 ///
-/// The floating-point margin `64 (p + 1) eps * scale` (scale: the largest coordinate
-/// magnitude involved) is added to the upper bound, so the bound covers the rounding of the
-/// Bezier extraction and of the distance computation.
+/// The rounding margin of [`Certifier`] (from the magnitudes of each span's control points
+/// relative to a local origin, and its weights) is included in `upper`. This builds a
+/// [`Certifier`] per call; a walk along a curve should build one and call
+/// [`Certifier::chord_error`].
 pub fn chord_error(
     curve: &NurbsCurve,
     t0: f64,
@@ -107,94 +428,5 @@ pub fn chord_error(
     limit: f64,
     want_lower: f64,
 ) -> Bound {
-    chord_error_with(
-        &mut Scratch::default(),
-        curve,
-        t0,
-        t1,
-        a,
-        b,
-        limit,
-        want_lower,
-    )
-}
-
-/// [`chord_error`] with caller-provided work space.
-#[allow(clippy::too_many_arguments)]
-pub fn chord_error_with(
-    scratch: &mut Scratch,
-    curve: &NurbsCurve,
-    t0: f64,
-    t1: f64,
-    a: &Point3<f64>,
-    b: &Point3<f64>,
-    limit: f64,
-    want_lower: f64,
-) -> Bound {
-    let chord = Chord {
-        a: *a,
-        ab: b - a,
-        ab2: (b - a).norm_squared(),
-    };
-    let mut scale = a.coords.amax().max(b.coords.amax());
-    let pieces = &mut scratch.pieces;
-    pieces.clear();
-    let mut lower = 0.0f64;
-    curve.for_each_bezier_piece(t0, t1, |bez| {
-        let (upper, end) = chord.piece(bez);
-        for c in bez.homogeneous() {
-            scale = scale.max((c.xyz() / c.w).amax());
-        }
-        lower = lower.max(end);
-        pieces.push(Piece { bez: *bez, upper });
-    });
-    let margin = 64.0 * (curve.degree() + 1) as f64 * f64::EPSILON * scale.max(1e-300);
-    let budget = 48 + 4 * pieces.len();
-    let mut steps = 0;
-    loop {
-        // The piece with the largest bound decides the global bound.
-        let mut worst = 0;
-        let mut upper = 0.0f64;
-        for (i, p) in pieces.iter().enumerate() {
-            if p.upper > upper {
-                upper = p.upper;
-                worst = i;
-            }
-        }
-        // A NaN distance (overflowing homogeneous coordinates) must never look like 0.
-        if pieces.iter().any(|p| p.upper.is_nan()) || lower.is_nan() {
-            return Bound {
-                upper: f64::INFINITY,
-                lower: if lower.is_nan() { f64::INFINITY } else { lower },
-            };
-        }
-        let upper_m = upper + margin;
-        if lower > limit {
-            return Bound {
-                upper: upper_m.max(lower),
-                lower,
-            };
-        }
-        // Refining further cannot move the estimate by more than the gap.
-        let tight = upper - lower <= 0.002 * limit;
-        let decided = upper_m <= limit && (lower >= want_lower || upper_m < want_lower || tight);
-        if decided || steps >= budget {
-            return Bound {
-                upper: upper_m,
-                lower,
-            };
-        }
-        steps += 1;
-        // Split the worst piece in place: its copy at the end becomes the right half.
-        pieces.push(pieces[worst]);
-        let last = pieces.len() - 1;
-        let (head, tail) = pieces.split_at_mut(last);
-        let (l, r) = (&mut head[worst], &mut tail[0]);
-        l.bez.subdivide_in_place(&mut r.bez, 0.5);
-        let (ul, el) = chord.piece(&l.bez);
-        let (ur, _) = chord.piece(&r.bez);
-        lower = lower.max(el);
-        l.upper = ul;
-        r.upper = ur;
-    }
+    Certifier::new(curve).chord_error(&mut Scratch::default(), t0, t1, a, b, limit, want_lower)
 }

@@ -2,10 +2,9 @@
 //! guarantee: equal parameter steps and equal chord lengths with the smallest count that
 //! certifies. (The third, "equal error", is the parameter-bisection mode of the walker.)
 
-use kerf_nurbs::NurbsCurve;
 use nalgebra::Point3;
 
-use crate::bound::{chord_error_with, Scratch};
+use crate::bound::{Certifier, Scratch};
 use crate::error::{DiscretizeError, Result};
 use crate::options::Options;
 use crate::sphere::{first_crossing, End, Start};
@@ -14,37 +13,52 @@ use crate::Discretization;
 /// Points of one trial: parameters, points, worst upper bound and worst lower bound.
 type Trial = (Vec<f64>, Vec<Point3<f64>>, f64, f64);
 
-/// Certifies consecutive segments; `None` at the first failure.
-fn certify_all(
-    curve: &NurbsCurve,
-    opts: &Options,
-    scratch: &mut Scratch,
-    params: Vec<f64>,
-    points: Vec<Point3<f64>>,
-) -> Option<Trial> {
-    let tol = opts.tolerance;
-    let (mut up, mut lo) = (0.0f64, 0.0f64);
-    for i in 1..params.len() {
-        if (points[i] - points[i - 1]).norm() > opts.max_segment_length {
+/// The points of one trial, certified as they are made: a trial stops at its first failing
+/// segment, so a hopeless count costs one segment, not a full allocation (a circle that cannot
+/// be cut used to allocate the whole of `max_points` before failing).
+struct Builder<'c, 'a> {
+    cert: &'c Certifier<'a>,
+    opts: &'c Options,
+    scratch: &'c mut Scratch,
+    trial: Trial,
+}
+
+impl<'c, 'a> Builder<'c, 'a> {
+    fn new(
+        cert: &'c Certifier<'a>,
+        opts: &'c Options,
+        scratch: &'c mut Scratch,
+        t: f64,
+        p: Point3<f64>,
+    ) -> Self {
+        Self {
+            cert,
+            opts,
+            scratch,
+            trial: (vec![t], vec![p], 0.0, 0.0),
+        }
+    }
+
+    /// Appends `(t, p)` if the segment from the last point certifies; `None` otherwise.
+    fn push(&mut self, t: f64, p: Point3<f64>) -> Option<()> {
+        let (params, points, up, lo) = &mut self.trial;
+        let (t0, p0) = (*params.last()?, *points.last()?);
+        if (p - p0).norm() > self.opts.max_segment_length {
             return None;
         }
-        let b = chord_error_with(
-            scratch,
-            curve,
-            params[i - 1],
-            params[i],
-            &points[i - 1],
-            &points[i],
-            tol,
-            0.0,
-        );
+        let tol = self.opts.tolerance;
+        let b = self
+            .cert
+            .chord_error(self.scratch, t0, t, &p0, &p, tol, 0.0);
         if b.upper > tol {
             return None;
         }
-        up = up.max(b.upper);
-        lo = lo.max(b.lower);
+        *up = up.max(b.upper);
+        *lo = lo.max(b.lower);
+        params.push(t);
+        points.push(p);
+        Some(())
     }
-    Some((params, points, up, lo))
 }
 
 /// Searches the smallest `n` for which `make(n)` certifies: doubling, then bisection.
@@ -63,9 +77,12 @@ fn smallest(
         }
         fail = n;
         if n >= limit {
-            return Err(DiscretizeError::ToleranceBelowPrecision {
-                t: t0,
-                tolerance: tol,
+            // Even the largest count allowed fails: the classic method needs more points than
+            // max_points here (a curve it can cut at all is cut with fewer).
+            let _ = (t0, tol);
+            return Err(DiscretizeError::TooManyPoints {
+                limit,
+                estimate: limit as f64,
             });
         }
         n = (n * 2).min(limit);
@@ -122,7 +139,7 @@ pub(crate) struct Piece {
 
 /// Equal parameter steps on `[a, b]`: the smallest count that certifies.
 pub(crate) fn equal_parameter(
-    curve: &NurbsCurve,
+    cert: &Certifier<'_>,
     opts: &Options,
     piece: Piece,
     out: &mut Discretization,
@@ -134,30 +151,22 @@ pub(crate) fn equal_parameter(
         pb,
         start,
     } = piece;
+    let curve = cert.curve();
     let mut scratch = Scratch::default();
     let trial = smallest(
         start,
         opts.max_points,
         |n| {
-            let params: Vec<f64> = (0..=n)
-                .map(|i| {
-                    if i == n {
-                        b
-                    } else {
-                        a + (b - a) * i as f64 / n as f64
-                    }
-                })
-                .collect();
-            let points = params
-                .iter()
-                .enumerate()
-                .map(|(i, &t)| match i {
-                    0 => pa,
-                    _ if i == n => pb,
-                    _ => curve.point(t),
-                })
-                .collect();
-            certify_all(curve, opts, &mut scratch, params, points)
+            let mut tr = Builder::new(cert, opts, &mut scratch, a, pa);
+            for i in 1..=n {
+                if i == n {
+                    tr.push(b, pb)?;
+                } else {
+                    let t = a + (b - a) * i as f64 / n as f64;
+                    tr.push(t, curve.point(t))?;
+                }
+            }
+            Some(tr.trial)
         },
         a,
         opts.tolerance,
@@ -169,7 +178,7 @@ pub(crate) fn equal_parameter(
 /// Equal chord lengths on `[a, b]`: a walk with a fixed reference-sphere radius `L / n`, with the
 /// smallest `n` whose segments all certify (the last chord may be shorter).
 pub(crate) fn equal_chord(
-    curve: &NurbsCurve,
+    cert: &Certifier<'_>,
     opts: &Options,
     piece: Piece,
     out: &mut Discretization,
@@ -181,6 +190,7 @@ pub(crate) fn equal_chord(
         pb,
         start,
     } = piece;
+    let curve = cert.curve();
     let length = curve.arc_length_between(a, b);
     let mut scratch = Scratch::default();
     let trial = smallest(
@@ -188,15 +198,15 @@ pub(crate) fn equal_chord(
         opts.max_points,
         |n| {
             let r = length / n as f64;
-            let mut params = vec![a];
-            let mut points = vec![pa];
+            let mut tr = Builder::new(cert, opts, &mut scratch, a, pa);
             let mut dt = (b - a) / n as f64;
-            while *params.last().expect("non-empty") < b {
-                if params.len() > 4 * n + 8 {
+            let (mut t0, mut p0) = (a, pa);
+            let mut count = 0usize;
+            while t0 < b {
+                count += 1;
+                if count > 4 * n + 8 {
                     return None;
                 }
-                let t0 = *params.last().expect("non-empty");
-                let p0 = *points.last().expect("non-empty");
                 let start = Start {
                     t: t0,
                     d: 0.0,
@@ -208,10 +218,11 @@ pub(crate) fn equal_chord(
                     return None;
                 }
                 dt = hit.t - t0;
-                params.push(hit.t);
-                points.push(if hit.t >= b { pb } else { hit.p });
+                let p = if hit.t >= b { pb } else { hit.p };
+                tr.push(hit.t.min(b), p)?;
+                (t0, p0) = (hit.t, p);
             }
-            certify_all(curve, opts, &mut scratch, params, points)
+            Some(tr.trial)
         },
         a,
         opts.tolerance,

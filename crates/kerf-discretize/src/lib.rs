@@ -35,9 +35,9 @@ pub mod options;
 mod sphere;
 mod walk;
 
-pub use bound::{chord_error, Bound};
+pub use bound::{chord_error, Bound, Certifier};
 pub use error::{DiscretizeError, Result};
-pub use minimum::{estimate_count, minimum_count};
+pub use minimum::{estimate_count, minimum_count, minimum_count_quadrature};
 pub use options::{Options, Strategy};
 
 use kerf_nurbs::NurbsCurve;
@@ -142,20 +142,35 @@ pub fn discretize_range(
     ends.retain(|&t| t > a && t < b);
     ends.insert(0, a);
     ends.push(b);
+    // Everything that can refuse the request is decided here, before any walk: the rounding
+    // margin (known from the control points), then the size of the output.
+    let cert = Certifier::new(curve);
+    let margin = cert.max_margin() + cert.output_resolution();
+    if margin.is_nan() || margin > 0.5 * opts.tolerance {
+        return Err(DiscretizeError::ToleranceBelowMargin {
+            tolerance: opts.tolerance,
+            margin,
+        });
+    }
     let estimate = estimate_count(curve, opts.tolerance);
     let by_length = if opts.max_segment_length.is_finite() {
         curve.size() / opts.max_segment_length
     } else {
         0.0
     };
-    let expected = estimate.max(by_length) + ends.len() as f64;
+    let by_turn = if opts.max_turn.is_finite() {
+        minimum::estimate_turning(curve) / opts.max_turn
+    } else {
+        0.0
+    };
+    let expected = estimate.max(by_length).max(by_turn) + ends.len() as f64;
     if expected.is_nan() || expected > opts.max_points as f64 {
         return Err(DiscretizeError::TooManyPoints {
             limit: opts.max_points,
             estimate: expected,
         });
     }
-    let cap = (expected * 1.2) as usize + 8;
+    let cap = ((expected * 1.2) as usize + 8).min(opts.max_points + 1);
     let mut out = Discretization {
         params: Vec::with_capacity(cap),
         points: Vec::with_capacity(cap),
@@ -170,6 +185,8 @@ pub fn discretize_range(
         opts,
         scratch: Default::default(),
         param_only: opts.strategy == Strategy::EqualError,
+        emin: opts.band * (opts.tolerance - margin),
+        cert,
     };
     for w in ends.windows(2) {
         let (a, b) = (w[0], w[1]);
@@ -186,9 +203,9 @@ pub fn discretize_range(
                     start,
                 };
                 if opts.strategy == Strategy::EqualParameter {
-                    classic::equal_parameter(curve, opts, piece, &mut out)?;
+                    classic::equal_parameter(&walker.cert, opts, piece, &mut out)?;
                 } else {
-                    classic::equal_chord(curve, opts, piece, &mut out)?;
+                    classic::equal_chord(&walker.cert, opts, piece, &mut out)?;
                 }
             }
         }

@@ -5,49 +5,72 @@
 //! length is `sqrt(k / (8 tol))`. Integrating along the curve gives the asymptotic minimum
 //! (`docs/discretization.md` derives it).
 
-use kerf_nurbs::arclength::{GL10_NODES as GL_X, GL10_WEIGHTS as GL_W};
+use kerf_nurbs::arclength::integrate;
 use kerf_nurbs::curve::curvature_of;
-use kerf_nurbs::NurbsCurve;
+use kerf_nurbs::{NurbsCurve, Quadrature};
 
 fn integrand(curve: &NurbsCurve, t: f64) -> f64 {
     let (_, d1, d2) = curve.eval_d2(t);
-    curvature_of(&d1, &d2).sqrt() * d1.norm()
-}
-
-fn gauss(curve: &NurbsCurve, a: f64, b: f64) -> f64 {
-    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
-    let mut s = 0.0;
-    for i in 0..5 {
-        s += GL_W[i] * (integrand(curve, m - h * GL_X[i]) + integrand(curve, m + h * GL_X[i]));
+    let v = curvature_of(&d1, &d2).sqrt() * d1.norm();
+    // Where the speed is zero or overflows, the integrand is a removable (or integrable)
+    // singularity: never let a NaN poison the sum.
+    if v.is_finite() {
+        v
+    } else {
+        0.0
     }
-    s * h
 }
 
-fn adaptive(curve: &NurbsCurve, a: f64, b: f64, whole: f64, tol: f64, depth: u32) -> f64 {
-    let m = 0.5 * (a + b);
-    let (l, r) = (gauss(curve, a, m), gauss(curve, m, b));
-    if depth == 0 || (l + r - whole).abs() <= tol {
-        return l + r;
-    }
-    adaptive(curve, a, m, l, 0.5 * tol, depth - 1) + adaptive(curve, m, b, r, 0.5 * tol, depth - 1)
+/// Relative accuracy asked of `N*`.
+pub const NSTAR_RELATIVE_ACCURACY: f64 = 1e-7;
+
+/// Absolute accuracy asked of `N*`, in chords: a thousandth of a chord is far below anything a
+/// count can show, and rounding noise in the curvature of nearly straight or degenerate curves
+/// (whose `N*` is near 0) can make a relative accuracy unreachable.
+pub const NSTAR_ABSOLUTE_ACCURACY: f64 = 1e-3;
+
+/// Panel splits per knot span for `N*` (40 evaluations each).
+pub const NSTAR_SPLITS_PER_SPAN: usize = 32;
+
+/// `integral sqrt(k) ds` over the curve, to a relative accuracy of about 1e-7, or an absolute
+/// accuracy of `absolute` (in `sqrt(mm)`), whichever is reached first, within
+/// [`NSTAR_SPLITS_PER_SPAN`] panel splits per knot span.
+pub fn sqrt_curvature_quadrature(curve: &NurbsCurve, absolute: f64) -> Quadrature {
+    let pieces: Vec<(f64, f64)> = curve.spans().iter().map(|&(_, a, b)| (a, b)).collect();
+    integrate(
+        |t| integrand(curve, t),
+        None,
+        &pieces,
+        NSTAR_RELATIVE_ACCURACY,
+        absolute,
+        NSTAR_SPLITS_PER_SPAN * pieces.len(),
+    )
 }
 
-/// `integral sqrt(k) ds` over the curve, to a relative accuracy of about 1e-6.
+/// `integral sqrt(k) ds` over the curve, to a relative accuracy of about 1e-7 (or `1e-9
+/// sqrt(size)` absolute, for curves whose integral is near 0), within a work budget linear in
+/// the number of knot spans (see [`sqrt_curvature_quadrature`]).
 pub fn sqrt_curvature_integral(curve: &NurbsCurve) -> f64 {
-    let spans = curve.spans();
-    let rough: f64 = spans.iter().map(|&(_, a, b)| gauss(curve, a, b)).sum();
-    let tol = 1e-7 * rough.max(1e-300);
-    spans
-        .iter()
-        .map(|&(_, a, b)| {
-            let w = gauss(curve, a, b);
-            adaptive(curve, a, b, w, tol, 24)
-        })
-        .sum()
+    sqrt_curvature_quadrature(curve, 1e-9 * curve.size().sqrt()).value
+}
+
+/// [`minimum_count`] with its error estimate and work: relative accuracy
+/// [`NSTAR_RELATIVE_ACCURACY`] or [`NSTAR_ABSOLUTE_ACCURACY`] chords, whichever is reached
+/// first, within [`NSTAR_SPLITS_PER_SPAN`] splits per knot span; `converged` is false if the
+/// budget ran out first (the value is then the best estimate, `error` its estimated error).
+pub fn minimum_count_quadrature(curve: &NurbsCurve, tol: f64) -> Quadrature {
+    let s = (8.0 * tol).sqrt();
+    let q = sqrt_curvature_quadrature(curve, NSTAR_ABSOLUTE_ACCURACY * s);
+    Quadrature {
+        value: q.value / s,
+        error: q.error / s,
+        ..q
+    }
 }
 
 /// The asymptotic minimum number of chords `N* = integral sqrt(k / (8 tol)) ds` that keep every
-/// chord's sagitta within `tol`.
+/// chord's sagitta within `tol`, to a relative accuracy of 1e-7 or a thousandth of a chord,
+/// within a work budget linear in the number of knot spans ([`minimum_count_quadrature`]).
 ///
 /// ```
 /// use kerf_nurbs::NurbsCurve;
@@ -65,7 +88,31 @@ pub fn sqrt_curvature_integral(curve: &NurbsCurve) -> f64 {
 /// assert!((n - exact).abs() < 1e-6 * exact, "N* of a quarter circle");
 /// ```
 pub fn minimum_count(curve: &NurbsCurve, tol: f64) -> f64 {
-    sqrt_curvature_integral(curve) / (8.0 * tol).sqrt()
+    minimum_count_quadrature(curve, tol).value
+}
+
+/// A cheap estimate of the total turning of the tangent, `integral k ds` (radians; the 2-point
+/// Gauss rule per knot span), used to refuse a `max_turn` that would need absurdly many points
+/// before any work. Turns concentrated at a point (a corner inside a span) are not seen.
+pub fn estimate_turning(curve: &NurbsCurve) -> f64 {
+    let x = 1.0 / 3f64.sqrt();
+    let f = |t: f64| {
+        let (_, d1, d2) = curve.eval_d2(t);
+        let v = curvature_of(&d1, &d2) * d1.norm();
+        if v.is_finite() {
+            v
+        } else {
+            0.0
+        }
+    };
+    curve
+        .spans()
+        .iter()
+        .map(|&(_, a, b)| {
+            let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+            h * (f(m - h * x) + f(m + h * x))
+        })
+        .sum()
 }
 
 /// A cheap estimate of [`minimum_count`] (the 2-point Gauss rule per knot span), used to size

@@ -3,9 +3,9 @@
 
 use kerf_nurbs::curve::curvature_of;
 use kerf_nurbs::NurbsCurve;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 
-use crate::bound::{chord_error_with, Bound, Scratch};
+use crate::bound::{Bound, Certifier, Scratch};
 use crate::error::{DiscretizeError, Result};
 use crate::options::Options;
 use crate::sphere::{first_crossing, End, Hit, Start};
@@ -33,32 +33,38 @@ pub(crate) struct Walker<'a> {
     pub scratch: Scratch,
     /// Start in parameter-bisection mode (the classic "equal error" method).
     pub param_only: bool,
+    /// The curve prepared for certification.
+    pub cert: Certifier<'a>,
+    /// The band's lower edge `E_min`: `band * (tolerance - margin)`, so that the band stays
+    /// reachable when the rounding margin is a visible part of the tolerance.
+    pub emin: f64,
+}
+
+/// Why the last trial of a point failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Fail {
+    Chord,
+    Turn,
 }
 
 impl Walker<'_> {
-    fn certify(&mut self, t0: f64, p0: &Point3<f64>, hit: &Hit) -> (Bound, bool) {
+    fn certify(&mut self, t0: f64, p0: &Point3<f64>, hit: &Hit) -> (Bound, Option<Fail>) {
         let tol = self.opts.tolerance;
-        let bound = chord_error_with(
-            &mut self.scratch,
-            self.curve,
-            t0,
-            hit.t,
-            p0,
-            &hit.p,
-            tol,
-            self.opts.band * tol,
-        );
-        let mut ok = bound.upper <= tol;
-        if ok && self.opts.max_turn.is_finite() {
-            let (u, v) = end_tangents(self.curve, t0, hit.t);
-            if let (Some(u), Some(v)) = (u, v) {
-                ok = u.angle(&v) <= self.opts.max_turn;
-            }
+        let bound = self
+            .cert
+            .chord_error(&mut self.scratch, t0, hit.t, p0, &hit.p, tol, self.emin);
+        if bound.upper > tol {
+            return (bound, Some(Fail::Chord));
         }
-        if ok && (hit.p - p0).norm() > self.opts.max_segment_length {
-            ok = false;
+        if (hit.p - p0).norm() > self.opts.max_segment_length {
+            return (bound, Some(Fail::Chord));
         }
-        (bound, ok)
+        if self.opts.max_turn.is_finite()
+            && self.cert.turn_bound(t0, hit.t, self.opts.max_turn) > self.opts.max_turn
+        {
+            return (bound, Some(Fail::Turn));
+        }
+        (bound, None)
     }
 
     /// Discretizes `[a, b]`, appending every cutting point after `a` (the last one is `b`).
@@ -70,7 +76,7 @@ impl Walker<'_> {
         out: &mut Discretization,
     ) -> Result<()> {
         let tol = self.opts.tolerance;
-        let emin = self.opts.band * tol;
+        let emin = self.emin;
         let hp = 0.5 * (emin + tol);
         let max_len = self.opts.max_segment_length;
         let min_len = self.opts.min_segment_length;
@@ -111,6 +117,8 @@ impl Walker<'_> {
             let mut bad: Option<Cand> = None;
             let mut param_mode = self.param_only;
             let mut fails = 0usize;
+            let mut last_fail = Fail::Chord;
+            let mut stuck = false;
             let mut t_try = t0 + last_dt.min(b - t0);
             for _ in 0..MAX_ITERS {
                 let hit = if param_mode {
@@ -143,11 +151,16 @@ impl Walker<'_> {
                     first_crossing(self.curve, &p0, r, start, end, max_dt)
                 };
                 if hit.t <= t0 {
+                    stuck = true;
                     break;
                 }
                 // Certify exactly the point that will be output for the piece end.
                 let hit = if hit.t >= b { Hit { t: b, p: pb } } else { hit };
-                let (bound, ok) = self.certify(t0, &p0, &hit);
+                let (bound, fail) = self.certify(t0, &p0, &hit);
+                let ok = fail.is_none();
+                if let Some(f) = fail {
+                    last_fail = f;
+                }
                 let cand = Cand {
                     r: (hit.p - p0).norm(),
                     hit,
@@ -221,9 +234,18 @@ impl Walker<'_> {
                 }
             }
             let Some(g) = good else {
-                return Err(DiscretizeError::ToleranceBelowPrecision {
-                    t: t0,
-                    tolerance: tol,
+                return Err(if last_fail == Fail::Turn {
+                    DiscretizeError::TurnUnreachable {
+                        t: t0,
+                        max_turn_deg: self.opts.max_turn.to_degrees(),
+                    }
+                } else if stuck || next_float_gap(t0) * 4.0 >= b - t0 {
+                    DiscretizeError::ParameterResolution { t: t0 }
+                } else {
+                    DiscretizeError::ToleranceBelowPrecision {
+                        t: t0,
+                        tolerance: tol,
+                    }
                 });
             };
             if r_curv.is_finite() && g.hit.t < b && g.bound.lower > 0.0 {
@@ -253,25 +275,12 @@ impl Walker<'_> {
     }
 }
 
-/// Tangent directions at the two ends of `[t0, t1]` (right-sided at `t0`, left-sided at
-/// `t1`), from the Bezier control polygons; `None` where a polygon end is degenerate.
-pub(crate) fn end_tangents(
-    curve: &NurbsCurve,
-    t0: f64,
-    t1: f64,
-) -> (Option<Vector3<f64>>, Option<Vector3<f64>>) {
-    let mut first = None;
-    let mut last = None;
-    curve.for_each_bezier_piece(t0, t1, |bez| {
-        let pts: Vec<Point3<f64>> = bez.control_points().collect();
-        if first.is_none() {
-            first = pts.windows(2).map(|w| w[1] - w[0]).find(|v| v.norm() > 0.0);
-        }
-        last = pts
-            .windows(2)
-            .rev()
-            .map(|w| w[1] - w[0])
-            .find(|v| v.norm() > 0.0);
+/// The gap from `t` to the next larger double.
+fn next_float_gap(t: f64) -> f64 {
+    let next = f64::from_bits(if t >= 0.0 {
+        t.to_bits() + 1
+    } else {
+        t.to_bits() - 1
     });
-    (first, last)
+    (next - t).abs()
 }

@@ -1,5 +1,6 @@
 //! The error type of the normals stage.
 
+use kerf_nurbs::Readable;
 use thiserror::Error;
 
 /// What can go wrong when giving cutting points their normals.
@@ -9,7 +10,7 @@ pub enum NormalsError {
     /// A cutting point is farther from its surface than `on_surface_tolerance`: the curve does
     /// not lie on the surface it names. Fix: check that the curve's `surface` id is right, or
     /// raise the tolerance if the CAD export is coarse.
-    #[error("point at t = {t} is {distance:.3e} mm from its surface (on_surface_tolerance {tolerance} mm): the curve does not lie on the surface")]
+    #[error("point at t = {} is {distance:.3e} mm from its surface (on_surface_tolerance {} mm): the curve does not lie on the surface", Readable(*.t), Readable(*.tolerance))]
     OffSurface {
         /// Curve parameter.
         t: f64,
@@ -20,7 +21,7 @@ pub enum NormalsError {
     },
     /// The surface has no defined normal at the point (a degenerate patch or a zero-area
     /// region). Fix: repair the surface.
-    #[error("surface has no normal at the point for t = {t}")]
+    #[error("surface has no normal at the point for t = {}", Readable(*.t))]
     NoNormal {
         /// Curve parameter.
         t: f64,
@@ -28,7 +29,7 @@ pub enum NormalsError {
     /// The normal reverses between neighbouring points: the surface's orientation is
     /// inconsistent there (a flipped patch or triangle). Fix: orient the surface consistently
     /// (or set `flip` on the part that is reversed).
-    #[error("normal reverses at t = {t} ({angle:.1} degrees between neighbouring points): inconsistent surface orientation")]
+    #[error("normal reverses at t = {} ({angle:.1} degrees between neighbouring points): inconsistent surface orientation", Readable(*.t))]
     Reversed {
         /// Curve parameter where the reversal was found.
         t: f64,
@@ -36,7 +37,7 @@ pub enum NormalsError {
         angle: f64,
     },
     /// An option is out of range.
-    #[error("option {name}: {reason} (got {value})")]
+    #[error("option {name}: {reason} (got {})", Readable(*.value))]
     BadOption {
         /// Its name.
         name: &'static str,
@@ -54,7 +55,7 @@ pub enum NormalsError {
     Discretize(#[from] kerf_discretize::DiscretizeError),
     /// Inserting points against the normal step would exceed the limit. Fix: raise
     /// `max_normal_step`.
-    #[error("more than {limit} points inserted for the normal step; raise max_normal_step")]
+    #[error("more than {limit} points inserted for the normal step; raise max_normal_step (--max-normal-step)")]
     TooManyInserted {
         /// The limit.
         limit: usize,

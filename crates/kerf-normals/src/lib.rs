@@ -21,7 +21,7 @@ pub use error::{NormalsError, Result};
 pub use mesh::{MeshNormals, DEFAULT_CREASE_ANGLE_DEG};
 pub use surface::{Hint, NormalSource, NurbsNormals, Projection};
 
-use kerf_discretize::bound::chord_error;
+use kerf_discretize::bound::{Certifier, Scratch};
 use kerf_discretize::{discretize_range, Discretization, Options};
 use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3};
@@ -109,12 +109,20 @@ impl Oriented {
 struct Sample {
     t: f64,
     p: Point3<f64>,
+    /// The normal written for the point: at a degenerate foot, the limit along the curve from
+    /// before `t` (from after it at the curve's start).
     n: Vector3<f64>,
+    /// The normal the curve leaves the point with (the limit from after `t`): differs from `n`
+    /// only at a degenerate foot such as a cone's apex.
+    n_after: Vector3<f64>,
     hint: Hint,
 }
 
 struct Ctx<'a> {
     curve: &'a NurbsCurve,
+    /// Built once per curve: re-certifying an inserted segment costs no pass over the curve.
+    cert: Certifier<'a>,
+    scratch: Scratch,
     surface: &'a dyn NormalSource,
     dopts: &'a Options,
     nopts: &'a NormalOptions,
@@ -125,9 +133,17 @@ struct Ctx<'a> {
 impl Ctx<'_> {
     fn sample(&mut self, t: f64, p: Point3<f64>, hint: Hint) -> Result<Sample> {
         let mut pr = self.surface.project(&p, hint);
-        if pr.distance > self.nopts.on_surface_tolerance && hint != Hint::None {
-            // A warm start can settle in a local minimum: decide off-surface only globally.
-            pr = self.surface.project(&p, Hint::None);
+        let degenerate = self.surface.is_degenerate(pr.hint);
+        if hint != Hint::None
+            && (pr.distance > self.nopts.on_surface_tolerance
+                || (degenerate && pr.distance > 1e-6 * self.nopts.on_surface_tolerance))
+        {
+            // A warm start can settle in a local minimum, or stay on a collapsed edge the
+            // point has left: decide globally, keep the closer.
+            let global = self.surface.project(&p, Hint::None);
+            if global.distance < pr.distance {
+                pr = global;
+            }
         }
         if pr.distance > self.nopts.on_surface_tolerance || pr.distance.is_nan() {
             return Err(NormalsError::OffSurface {
@@ -137,12 +153,42 @@ impl Ctx<'_> {
             });
         }
         self.out.max_surface_distance = self.out.max_surface_distance.max(pr.distance);
-        let n = pr.normal.ok_or(NormalsError::NoNormal { t })?;
+        let mut n = pr.normal.ok_or(NormalsError::NoNormal { t })?;
+        let mut n_after = n;
+        let mut hint = pr.hint;
+        if self.surface.is_degenerate(pr.hint) {
+            // At a collapsed edge or apex the normal is the limit along the curve, on the side
+            // the curve is on: from before t for the point itself, from after t for what
+            // follows (and for the warm start of the next point).
+            let (da, db) = self.curve.domain();
+            let step = 1e-6 * (db - da);
+            let before = (t > da).then(|| {
+                let s = (t - step).max(da);
+                self.surface.normal_from(pr.hint, &self.curve.point(s))
+            });
+            let after = (t < db).then(|| {
+                let s = (t + step).min(db);
+                self.surface.normal_from(pr.hint, &self.curve.point(s))
+            });
+            if let Some(Some((nb, _))) = before {
+                n = nb;
+            }
+            if let Some(Some((na, h))) = after {
+                n_after = na;
+                hint = h;
+                if before.is_none() {
+                    n = na;
+                }
+            } else {
+                n_after = n;
+            }
+        }
         Ok(Sample {
             t,
             p,
             n,
-            hint: pr.hint,
+            n_after,
+            hint,
         })
     }
 
@@ -155,13 +201,13 @@ impl Ctx<'_> {
     /// Emits the segment `(a, b]`: splits it until the normal step holds; `certified` says
     /// whether `[a, b]` already carries the chord-error guarantee.
     fn segment(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
-        let angle = a.n.angle(&b.n);
+        let angle = a.n_after.angle(&b.n);
         let tm = 0.5 * (a.t + b.t);
         if angle > self.nopts.max_normal_step {
             // Stop splitting when the interval is tiny, or so close to the float spacing that
             // its midpoint is no longer strictly inside (large parameter values).
             if b.t - a.t <= self.min_dt || !(a.t < tm && tm < b.t) {
-                if a.n.dot(&b.n) < 0.0 {
+                if a.n_after.dot(&b.n) < 0.0 {
                     return Err(NormalsError::Reversed {
                         t: a.t,
                         angle: angle.to_degrees(),
@@ -188,7 +234,9 @@ impl Ctx<'_> {
     fn finish(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
         if !certified {
             let tol = self.dopts.tolerance;
-            let bound = chord_error(self.curve, a.t, b.t, &a.p, &b.p, tol, 0.0);
+            let bound = self
+                .cert
+                .chord_error(&mut self.scratch, a.t, b.t, &a.p, &b.p, tol, 0.0);
             if bound.upper > tol {
                 let d = discretize_range(self.curve, a.t, b.t, self.dopts)?;
                 let mut prev = a;
@@ -204,7 +252,7 @@ impl Ctx<'_> {
             }
             self.out.max_chord_error = self.out.max_chord_error.max(bound.upper);
         }
-        let angle = a.n.angle(&b.n);
+        let angle = a.n_after.angle(&b.n);
         self.out.max_normal_angle = self.out.max_normal_angle.max(angle);
         self.push(&b);
         Ok(())
@@ -230,6 +278,8 @@ pub fn orient(
     let (da, db) = curve.domain();
     let mut ctx = Ctx {
         curve,
+        cert: Certifier::new(curve),
+        scratch: Scratch::default(),
         surface,
         dopts,
         nopts,
@@ -250,6 +300,11 @@ pub fn orient(
     for i in 1..disc.params.len() {
         let s = ctx.sample(disc.params[i], disc.points[i], prev.hint)?;
         ctx.segment(prev, s, true)?;
+        if s.n.angle(&s.n_after) > ctx.nopts.max_normal_step {
+            // The normal jumps at a degenerate point of the surface (a cone's apex): the head
+            // turns in place there; no insertion can remove it.
+            ctx.out.jumps.push(s.t);
+        }
         prev = s;
     }
     Ok(ctx.out)

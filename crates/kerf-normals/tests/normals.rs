@@ -440,3 +440,64 @@ fn large_parameter_values_do_not_recurse_forever_at_a_jump() {
         assert!(w[1] > w[0], "params strictly increase");
     }
 }
+
+/// Issue 13: a degree-1 curve down one generator of an exact NURBS cone, through the apex and
+/// up the opposite generator. At the apex (a collapsed edge of the surface) the normal is the
+/// limit along the curve: the incoming generator's for the apex point, the outgoing one's for
+/// everything after it; the 90-degree change is reported as a jump at the apex, not squeezed
+/// into normal-step points.
+#[test]
+fn cone_apex_normals_are_the_limits_along_the_curve() {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/hostile/hostile_cone_apex.json");
+    let file = kerf_format::curves::load(&path).expect("fixture loads");
+    let rec = &file.curves[0];
+    let kerf_format::SurfaceGeometry::Nurbs(surface) = &file.surfaces[0].geometry else {
+        panic!("a NURBS cone");
+    };
+    let src = NurbsNormals::new(surface.clone(), false);
+    // Short segments, so that many cutting points lie just past the apex.
+    let dopts = Options {
+        max_segment_length: 0.5,
+        ..Options::with_tolerance(0.01)
+    };
+    let disc = discretize(&rec.curve, &dopts).expect("discretized");
+    let o = orient(&rec.curve, &disc, &src, &dopts, &NormalOptions::default()).expect("oriented");
+    // Analytic: on z = r (half angle 45 degrees) Su x Sv points along (x / r, y / r, -1).
+    let analytic = |p: &Point3<f64>, incoming: bool| {
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        let (cx, cy) = if r > 1e-9 {
+            (p.x / r, p.y / r)
+        } else if incoming {
+            (1.0, 0.0)
+        } else {
+            (-1.0, 0.0)
+        };
+        Vector3::new(cx, cy, -1.0).normalize()
+    };
+    for (i, (t, (p, n))) in o
+        .params
+        .iter()
+        .zip(o.points.iter().zip(&o.normals))
+        .enumerate()
+    {
+        let want = analytic(p, *t <= 0.5);
+        assert!(
+            n.angle(&want) < 1e-6,
+            "point {i} at t = {t} ({p:?}): normal {n:?}, analytic {want:?}"
+        );
+    }
+    assert!(
+        o.params
+            .iter()
+            .filter(|&&t| t > 0.5 && t < 0.5 + 1e-3)
+            .count()
+            <= 1,
+        "no normal-step points squeezed after the apex: {:?}",
+        o.params
+            .iter()
+            .filter(|&&t| t > 0.5 && t < 0.51)
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(o.jumps, vec![0.5], "one jump, at the apex");
+}

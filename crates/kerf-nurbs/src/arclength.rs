@@ -1,10 +1,21 @@
-//! Arc length with error control, and its inverse.
+//! Arc length with error control and a work budget, and its inverse.
 //!
-//! The length of each knot span is integrated by adaptive Gauss-Legendre quadrature: a span is
-//! split in halves until the 10-point rule on the whole and on the halves agree to the
-//! requested tolerance. Within a span the speed `|C'(t)|` is smooth (analytic for rational
-//! pieces with positive weights), so the rule converges fast; the span boundaries are where the
-//! speed may have kinks, which is why the integration never crosses them.
+//! The length of each knot span is integrated by globally adaptive Gauss-Legendre quadrature
+//! ([`integrate`]): every panel carries the 10-point rule on itself and on its two halves, whose
+//! difference estimates its error; the panel with the largest estimate is split next, until the
+//! summed estimate is below the requested accuracy or the work budget (a fixed number of splits
+//! per knot span, so linear in the size of the curve) is spent. Within a span the speed
+//! `|C'(t)|` is smooth (analytic for rational pieces with positive weights), so the rule
+//! converges fast; the span boundaries are where the speed may have kinks, which is why the
+//! integration never crosses them.
+//!
+//! The accuracy asked is never below the rounding noise of the curve's coordinates: the speed is
+//! computed from control points of magnitude `X`, so each span's length carries an error of
+//! order `(p + 1) eps X` whatever the rule does; asking `1e-13` of a 0.1 mm hole 1.4 m from the
+//! origin would otherwise split panels forever. `docs/nurbs.md` has the details.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
 
 use crate::curve::NurbsCurve;
 use crate::error::{NurbsError, Result};
@@ -27,6 +38,175 @@ pub const GL10_WEIGHTS: [f64; 5] = [
     0.066_671_344_308_688_14,
 ];
 
+/// Relative accuracy asked of arc lengths (the absolute floor of [`NurbsCurve::length_floor`]
+/// takes over where rounding makes this unreachable).
+pub const LENGTH_RELATIVE_ACCURACY: f64 = 1e-13;
+
+/// Panel splits allowed per knot span (each costs 40 evaluations of the integrand and two
+/// Bezier extractions) before the quadrature stops and reports itself unconverged. Enough to
+/// chase a speed peak 40 halvings deep at both ends of a span (a weight of 1e12).
+pub const SPLITS_PER_SPAN: usize = 128;
+
+/// The result of an adaptive quadrature with a work budget.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quadrature {
+    /// The integral's value (the sum of the finest rules computed).
+    pub value: f64,
+    /// The estimated absolute error of `value` (sum over panels of the difference between the
+    /// rule on a panel and on its halves, an over-estimate for smooth integrands).
+    pub error: f64,
+    /// True if the estimated error met the requested accuracy; false if the work budget ran
+    /// out first (`value` is then the best estimate reached, `error` its estimated error) or the
+    /// integrand was not finite somewhere.
+    pub converged: bool,
+    /// Integrand evaluations spent.
+    pub evaluations: usize,
+}
+
+/// The 10-point Gauss-Legendre rule on `[a, b]`.
+#[inline]
+pub fn gauss10(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+    let mut s = 0.0;
+    for i in 0..5 {
+        s += GL10_WEIGHTS[i] * (f(m - h * GL10_NODES[i]) + f(m + h * GL10_NODES[i]));
+    }
+    s * h
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Panel {
+    a: f64,
+    b: f64,
+    left: f64,
+    right: f64,
+    error: f64,
+}
+
+/// Guaranteed bounds `(lower, upper)` of the integral over a panel, if the caller knows any.
+pub type Bracket<'a> = &'a dyn Fn(f64, f64) -> (f64, f64);
+
+impl Panel {
+    fn new(
+        f: &impl Fn(f64) -> f64,
+        bracket: Option<Bracket<'_>>,
+        a: f64,
+        b: f64,
+        whole: f64,
+    ) -> Self {
+        let m = 0.5 * (a + b);
+        let (left, right) = (gauss10(f, a, m), gauss10(f, m, b));
+        let mut e = (left + right - whole).abs();
+        if let Some(br) = bracket {
+            // The rule can miss a peak that none of its nodes sees (the speed of a heavy
+            // weight lives in 1e-12 of the parameter); a guaranteed bracket cannot.
+            let (lo, hi) = br(a, b);
+            let v = left + right;
+            e = e.max(lo - v).max(v - hi);
+        }
+        Panel {
+            a,
+            b,
+            left,
+            right,
+            // A NaN difference must be split first and never look converged.
+            error: if e.is_nan() { f64::INFINITY } else { e },
+        }
+    }
+}
+
+impl PartialEq for Panel {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Panel {}
+impl PartialOrd for Panel {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Panel {
+    /// By error (the heap pops the largest), then by position for determinism.
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.error
+            .total_cmp(&other.error)
+            .then(other.a.total_cmp(&self.a))
+    }
+}
+
+/// Integrates `f` over the union of the intervals `pieces` (each integrated separately, so `f`
+/// may have kinks at their ends) to the accuracy `max(relative * |value|, absolute)`, with at
+/// most `SPLITS_PER_SPAN`-like `max_splits` panel splits in all (each costs 40 evaluations; the
+/// start costs 30 per piece).
+///
+/// Globally adaptive: the panel with the largest error estimate is split next, so the budget
+/// goes where the integrand is hard (a peak of the speed at a heavy weight, a corner) instead
+/// of being spread over a recursion tree. Never loops beyond the budget, whatever `f` returns.
+/// With a `bracket` (guaranteed lower and upper bounds of the integral over any panel), a
+/// panel's error estimate is at least the distance of its value outside the bracket.
+pub fn integrate(
+    f: impl Fn(f64) -> f64,
+    bracket: Option<Bracket<'_>>,
+    pieces: &[(f64, f64)],
+    relative: f64,
+    absolute: f64,
+    max_splits: usize,
+) -> Quadrature {
+    let mut heap = BinaryHeap::with_capacity(pieces.len() + 2 * max_splits.min(1 << 16));
+    let mut evaluations = 0usize;
+    for &(a, b) in pieces {
+        if b > a {
+            let whole = gauss10(&f, a, b);
+            heap.push(Panel::new(&f, bracket, a, b, whole));
+            evaluations += 30;
+        }
+    }
+    let sums = |heap: &BinaryHeap<Panel>| {
+        heap.iter().fold((0.0, 0.0), |(v, e), p: &Panel| {
+            (v + p.left + p.right, e + p.error)
+        })
+    };
+    let (mut value, mut error) = sums(&heap);
+    let mut splits = 0;
+    loop {
+        if error <= relative * value.abs() || error <= absolute {
+            // Running sums drift; confirm with exact sums before stopping.
+            (value, error) = sums(&heap);
+            if error <= relative * value.abs() || error <= absolute {
+                return Quadrature {
+                    value,
+                    error,
+                    converged: value.is_finite(),
+                    evaluations,
+                };
+            }
+        }
+        let splittable = heap
+            .peek()
+            .is_some_and(|p| 0.5 * (p.a + p.b) > p.a && 0.5 * (p.a + p.b) < p.b);
+        if splits >= max_splits || !splittable {
+            (value, error) = sums(&heap);
+            return Quadrature {
+                value,
+                error,
+                converged: false,
+                evaluations,
+            };
+        }
+        let p = heap.pop().expect("a panel exists when not converged");
+        let m = 0.5 * (p.a + p.b);
+        let l = Panel::new(&f, bracket, p.a, m, p.left);
+        let r = Panel::new(&f, bracket, m, p.b, p.right);
+        evaluations += 40;
+        splits += 1;
+        value += l.left + l.right + r.left + r.right - p.left - p.right;
+        error += l.error + r.error - p.error;
+        heap.push(l);
+        heap.push(r);
+    }
+}
+
 impl NurbsCurve {
     /// `|C'(t)|`, the speed of the parametrisation.
     #[inline]
@@ -34,43 +214,63 @@ impl NurbsCurve {
         self.eval_d1(t).1.norm()
     }
 
-    fn gauss(&self, a: f64, b: f64) -> f64 {
-        let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
-        let mut s = 0.0;
-        for i in 0..5 {
-            s += GL10_WEIGHTS[i]
-                * (self.speed(m - h * GL10_NODES[i]) + self.speed(m + h * GL10_NODES[i]));
-        }
-        s * h
+    /// The rounding noise of a length measured on `spans` knot spans of this curve: each
+    /// span's speed is computed from `degree + 1` control points of magnitude up to
+    /// `max |P_i|`, so its length carries an error of order `(p + 1) eps max |P_i|` that no
+    /// quadrature can remove. Asking for less only burns the budget.
+    pub fn length_floor(&self, spans: usize) -> f64 {
+        let scale = self
+            .homogeneous_points()
+            .iter()
+            .map(|c| (c.xyz() / c.w).amax())
+            .fold(0.0, f64::max);
+        16.0 * (self.degree() + 1) as f64 * f64::EPSILON * scale * spans.max(1) as f64
     }
 
-    fn adaptive(&self, a: f64, b: f64, whole: f64, tol: f64, depth: u32) -> f64 {
-        let m = 0.5 * (a + b);
-        let (l, r) = (self.gauss(a, m), self.gauss(m, b));
-        if depth == 0 || (l + r - whole).abs() <= tol {
-            return l + r;
-        }
-        self.adaptive(a, m, l, 0.5 * tol, depth - 1) + self.adaptive(m, b, r, 0.5 * tol, depth - 1)
-    }
-
-    /// Length of the curve between parameters `t0 <= t1` (clamped to the domain), to an
-    /// absolute accuracy of about `1e-13` times the curve's size.
-    pub fn arc_length_between(&self, t0: f64, t1: f64) -> f64 {
+    /// The knot-span pieces of `[t0, t1]` (clamped to the domain).
+    fn pieces(&self, t0: f64, t1: f64) -> Vec<(f64, f64)> {
         let (a, b) = self.domain();
         let (t0, t1) = (t0.clamp(a, b), t1.clamp(a, b));
-        if t1 <= t0 {
-            return 0.0;
-        }
-        let tol = 1e-13 * self.size().max(f64::MIN_POSITIVE);
-        let mut total = 0.0;
-        for (_, s0, s1) in self.spans() {
-            let (lo, hi) = (s0.max(t0), s1.min(t1));
-            if hi > lo {
-                let whole = self.gauss(lo, hi);
-                total += self.adaptive(lo, hi, whole, tol, 40);
-            }
-        }
-        total
+        self.spans()
+            .into_iter()
+            .map(|(_, s0, s1)| (s0.max(t0), s1.min(t1)))
+            .filter(|(lo, hi)| hi > lo)
+            .collect()
+    }
+
+    /// The length of the curve between `t0 <= t1` (clamped to the domain) with its error
+    /// estimate: relative accuracy [`LENGTH_RELATIVE_ACCURACY`], absolute floor
+    /// [`NurbsCurve::length_floor`], at most [`SPLITS_PER_SPAN`] panel splits per span. Every
+    /// panel's value is also checked against its guaranteed bracket `[chord, control polygon]`,
+    /// so a speed peak that the Gauss nodes miss is split down to instead of being reported as
+    /// converged.
+    pub fn arc_length_quadrature(&self, t0: f64, t1: f64) -> Quadrature {
+        let pieces = self.pieces(t0, t1);
+        // The length of a rational Bezier piece lies between its chord and its control
+        // polygon (subdivision in homogeneous space projects to corner cutting).
+        let bracket = |a: f64, b: f64| {
+            let bez = self.bezier_in_span(self.span(a), a, b);
+            let q: Vec<_> = bez.control_points().collect();
+            let chord = (q[q.len() - 1] - q[0]).norm();
+            let polygon: f64 = q.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+            let slack = 1e-12 * polygon;
+            (chord - slack, polygon + slack)
+        };
+        integrate(
+            |t| self.speed(t),
+            Some(&bracket),
+            &pieces,
+            LENGTH_RELATIVE_ACCURACY,
+            self.length_floor(pieces.len()),
+            SPLITS_PER_SPAN * pieces.len(),
+        )
+    }
+
+    /// Length of the curve between parameters `t0 <= t1` (clamped to the domain), to a relative
+    /// accuracy of about `1e-13` or the rounding noise of the coordinates, whichever is larger
+    /// (see [`NurbsCurve::arc_length_quadrature`] for the error estimate and the budget).
+    pub fn arc_length_between(&self, t0: f64, t1: f64) -> f64 {
+        self.arc_length_quadrature(t0, t1).value
     }
 
     /// Length of the whole curve.
@@ -80,14 +280,16 @@ impl NurbsCurve {
     }
 
     /// The parameter `t` at which the arc length from the domain start equals `s`, found by
-    /// Newton's method on `L(t) - s` (derivative: the speed) safeguarded by bisection.
+    /// Newton's method on `L(t) - s` (derivative: the speed) safeguarded by bisection, to the
+    /// accuracy of the length itself (at most 100 steps, each one span's quadrature).
     ///
     /// # Errors
     /// [`NurbsError::ParameterOutsideDomain`] if `s` is not in `[0, length]` (the "domain" in
     /// the error is then the length range).
     pub fn param_at_length(&self, s: f64) -> Result<f64> {
         let (a, b) = self.domain();
-        let total = self.arc_length();
+        let whole = self.arc_length_quadrature(a, b);
+        let total = whole.value;
         if !(s >= 0.0 && s <= total) {
             return Err(NurbsError::ParameterOutsideDomain {
                 value: s,
@@ -109,7 +311,10 @@ impl NurbsCurve {
         }
         let target = s - acc;
         let base = lo;
-        let tol = 1e-12 * total.max(f64::MIN_POSITIVE);
+        let tol = (1e-12 * total)
+            .max(2.0 * whole.error)
+            .max(self.length_floor(self.spans().len()))
+            .max(f64::MIN_POSITIVE);
         let mut t =
             lo + (hi - lo) * (target / self.arc_length_between(lo, hi).max(f64::MIN_POSITIVE));
         for _ in 0..100 {
@@ -129,7 +334,7 @@ impl NurbsCurve {
             } else {
                 0.5 * (lo + hi)
             };
-            if hi - lo <= 4.0 * f64::EPSILON * hi.abs().max(1.0) {
+            if hi - lo <= 4.0 * f64::EPSILON * hi.abs().max(lo.abs()) {
                 break;
             }
         }

@@ -51,6 +51,7 @@ impl RationalBezier {
     /// Splits at local parameter `u` into the pieces on `[0, u]` and `[u, 1]`.
     #[inline]
     pub fn subdivide(&self, u: f64) -> (Self, Self) {
+        crate::work::tick();
         let p = self.degree;
         let tm = self.t0 + (self.t1 - self.t0) * u;
         let mut left = *self;
@@ -75,6 +76,7 @@ impl RationalBezier {
     /// `degree + 1` control points in use, so a hot loop copies one piece instead of three.
     #[inline]
     pub fn subdivide_in_place(&mut self, right: &mut Self, u: f64) {
+        crate::work::tick();
         let p = self.degree;
         let tm = self.t0 + (self.t1 - self.t0) * u;
         // De Casteljau on `right`: after level r its entries 0..=p-r are the level-r points; the
@@ -109,6 +111,7 @@ impl NurbsCurve {
     /// each level. For arguments inside the span every de Boor step is a convex combination,
     /// so the Bezier weights stay positive.
     pub fn bezier_in_span(&self, span: usize, t0: f64, t1: f64) -> RationalBezier {
+        crate::work::tick();
         let p = self.degree();
         let knots = self.knots();
         let cpw = self.homogeneous_points();

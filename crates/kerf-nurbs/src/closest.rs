@@ -58,6 +58,10 @@ const NOISE: f64 = 256.0 * f64::EPSILON;
 /// Subdivision depth after which a piece with several candidate roots is resolved by sampling.
 const MAX_DEPTH: u32 = 48;
 
+/// Pieces the global closest-point search may examine per Bezier piece of the curve before it
+/// returns its best candidate.
+pub const CLOSEST_POPS_PER_PIECE: usize = 256;
+
 /// Iteration limit of the one-dimensional Newton methods.
 const ITERATIONS: usize = 100;
 
@@ -142,7 +146,9 @@ impl NurbsCurve {
     /// is represented by the largest parameter below it.
     ///
     /// The result is deterministic; `distance` is `|C(t) - p|` as evaluated by
-    /// [`NurbsCurve::point`].
+    /// [`NurbsCurve::point`]. The search examines at most [`CLOSEST_POPS_PER_PIECE`] pieces per
+    /// Bezier piece of the curve (plus 256); a pathological input that exhausts this gets the
+    /// best candidate found.
     pub fn closest_point(&self, p: &Point3<f64>) -> CurveProjection {
         let (a, b) = self.domain();
         let mut best = Best {
@@ -173,10 +179,19 @@ impl NurbsCurve {
             });
             order += 1;
         });
+        // Work budget: a fixed number of pieces examined per Bezier piece of the curve, so that
+        // no input (however many near-equal candidates it has) makes the search exponential.
+        let mut budget = CLOSEST_POPS_PER_PIECE * heap.len() + 256;
         while let Some(entry) = heap.pop() {
             if entry.lower_bound >= best.distance || entry.lower_bound.is_nan() {
                 break;
             }
+            if budget == 0 {
+                // The best candidate so far (never farther than the true minimum by more than
+                // the spread of the remaining pieces' lower bounds).
+                break;
+            }
+            budget -= 1;
             let piece = entry.piece;
             let (t0, t1) = (piece.t0, piece.t1);
             match classify(&piece, p) {

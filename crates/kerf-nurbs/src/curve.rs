@@ -84,6 +84,10 @@ impl NurbsCurve {
                 }
             }
         }
+        let weights = match weights {
+            Some(w) => Some(normalized_weights(w, "weights")?),
+            None => None,
+        };
         if let Some(w) = &weights {
             for (i, (p, &wi)) in points.iter().zip(w).enumerate() {
                 if !(p.coords * wi).iter().all(|c| c.is_finite()) {
@@ -230,6 +234,7 @@ impl NurbsCurve {
 
     #[inline]
     fn point_m<const M: usize>(&self, t: f64) -> Point3<f64> {
+        crate::work::tick();
         let t = self.clamp(t);
         let span = self.span(t);
         let mut n = [0.0; M];
@@ -255,6 +260,7 @@ impl NurbsCurve {
 
     #[inline]
     fn homogeneous_derivs_m<const M: usize>(&self, t: f64, n: usize, out: &mut [Vector4<f64>]) {
+        crate::work::tick();
         let p = self.degree;
         let t = self.clamp(t);
         let span = self.span(t);
@@ -550,6 +556,69 @@ impl NurbsCurve {
     }
 }
 
+/// Scales weights by a power of two (exact: the curve is unchanged, since a NURBS is invariant
+/// under scaling all its weights) so that the largest lies in `[1, 2)`, unless it already lies
+/// in `[2^-64, 2^64]`. Subnormal weights (only a few significant bits, and `w x` loses more)
+/// become normal numbers with the same value ratios.
+///
+/// # Errors
+/// [`NurbsError::WeightRatio`] if the smallest weight would fall below
+/// [`MIN_NORMALISED_WEIGHT`], i.e. the largest is more than about `2^970` (1e292) times the
+/// smallest: the homogeneous coordinates would lose the precision that evaluation and the
+/// discretizer's rounding margin assume.
+pub fn normalized_weights(mut w: Vec<f64>, field: &'static str) -> Result<Vec<f64>> {
+    let (mut imax, mut imin) = (0, 0);
+    for (i, &x) in w.iter().enumerate() {
+        if x > w[imax] {
+            imax = i;
+        }
+        if x < w[imin] {
+            imin = i;
+        }
+    }
+    let Some(&wmax) = w.get(imax) else {
+        return Ok(w);
+    };
+    let wmin = w[imin];
+    if !(wmax >= 2f64.powi(-64) && wmax <= 2f64.powi(64)) {
+        // log2 is exact enough for subnormals to find the exponent; the loop fixes any off-by-one.
+        let mut k = -(wmax.log2().floor() as i32);
+        while scale_pow2(wmax, k) >= 2.0 {
+            k -= 1;
+        }
+        while scale_pow2(wmax, k) < 1.0 {
+            k += 1;
+        }
+        for x in &mut w {
+            *x = scale_pow2(*x, k);
+        }
+    }
+    if w[imin] < MIN_NORMALISED_WEIGHT {
+        return Err(NurbsError::WeightRatio {
+            field,
+            index: format!("[{imin}]"),
+            ratio: wmax / wmin,
+        });
+    }
+    Ok(w)
+}
+
+/// The smallest weight accepted after normalisation (largest weight in `[1, 2)`): `2^-970`.
+/// Below it, an underflow in a de Casteljau step (at most `2^-1074` absolute) could be more
+/// than `eps` relative to the weights involved.
+pub const MIN_NORMALISED_WEIGHT: f64 = f64::from_bits(53u64 << 52);
+
+/// `x * 2^k`, in steps that never overflow or underflow the factor (exact whenever the result
+/// is a normal number or `x` was subnormal and the result is not).
+pub fn scale_pow2(mut x: f64, mut k: i32) -> f64 {
+    while k != 0 {
+        let step = k.clamp(-1000, 1000);
+        x *= 2f64.powi(step);
+        k -= step;
+    }
+    x
+}
+
 /// Projects a homogeneous point `(w x, w y, w z, w)` to `(x, y, z)`.
 #[inline]
 pub fn project(c: &Vector4<f64>) -> Point3<f64> {
@@ -573,10 +642,13 @@ pub fn hull_box(cpw: &[Vector4<f64>]) -> (Point3<f64>, Point3<f64>) {
 #[inline]
 pub fn curvature_of(d1: &Vector3<f64>, d2: &Vector3<f64>) -> f64 {
     let s = d1.norm();
-    if s == 0.0 {
+    if s == 0.0 || !s.is_finite() {
         return 0.0;
     }
-    d1.cross(d2).norm() / (s * s * s)
+    // `|d1 x d2| / s^3` overflows for tiny parameter ranges (knots scaled by 1e-50 give
+    // `|d1| ~ 1e52`, `|d2| ~ 1e104`): divide by the speed before multiplying.
+    let inv = 1.0 / s;
+    (d1 * inv).cross(&(d2 * inv)).norm() * inv
 }
 
 /// Rational derivatives from homogeneous ones (The NURBS Book A4.2).
@@ -598,17 +670,100 @@ mod overflow_tests {
 
     #[test]
     fn weight_times_coordinate_overflow_is_refused() {
+        // 1.9 needs no normalisation, and 1.9 * 1.5e308 is not finite.
         let e = NurbsCurve::try_new(
+            1,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![Point3::new(0.0, 0.0, 0.0), Point3::new(1.5e308, 0.0, 0.0)],
+            Some(vec![1.0, 1.9]),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "weights[1]: weight 1.9e0 times the control point overflows double precision",
+            "message names the place"
+        );
+    }
+
+    #[test]
+    fn huge_weights_are_normalised_instead_of_overflowing() {
+        // Weights 1 and 1e200 with a point at 1e200: w x overflowed before normalisation.
+        let c = NurbsCurve::try_new(
             1,
             vec![0.0, 0.0, 1.0, 1.0],
             vec![Point3::new(0.0, 0.0, 0.0), Point3::new(1e200, 0.0, 0.0)],
             Some(vec![1.0, 1e200]),
         )
-        .unwrap_err();
+        .expect("normalised weights keep w x finite");
+        assert_eq!(c.point(1.0).x, 1e200, "end point exact");
+        let w = c.weights();
+        assert!(
+            w[1] >= 1.0 && w[1] < 2.0,
+            "largest weight scaled into [1, 2)"
+        );
+        assert_eq!(
+            w[1] / w[0],
+            1e200,
+            "ratio kept exactly (power-of-two scaling)"
+        );
+    }
+
+    #[test]
+    fn subnormal_weights_are_scaled_exactly() {
+        let w = normalized_weights(vec![1e-318, 0.7e-318, 1e-318], "weights").expect("ratio fine");
+        assert!(w[0] >= 1.0 && w[0] < 2.0, "largest weight in [1, 2)");
+        // One power of two for every weight, and scaling back gives the very same subnormals:
+        // nothing was rounded on the way up.
+        let k = (1000..1100)
+            .find(|&k| scale_pow2(1e-318, k) == w[0])
+            .expect("a power of two");
+        assert_eq!(
+            scale_pow2(0.7e-318, k),
+            w[1],
+            "same factor for every weight"
+        );
+        assert_eq!(
+            scale_pow2(w[1], -k),
+            0.7e-318,
+            "exact: scales back to the input"
+        );
+        assert_eq!(
+            scale_pow2(w[0], -k),
+            1e-318,
+            "exact: scales back to the input"
+        );
+    }
+
+    #[test]
+    fn weight_ratio_beyond_precision_is_refused() {
+        let e = normalized_weights(vec![1e300, 1e-300], "weights").unwrap_err();
         assert_eq!(
             e.to_string(),
-            "weights[1]: weight 1e200 times the control point overflows double precision",
-            "message names the place"
+            "weights[1]: weights differ by a ratio of inf, beyond double precision",
+            "names the smallest weight"
         );
+        let e = normalized_weights(vec![1e300, 1e-8], "weights").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "weights[1]: weights differ by a ratio of 1.000e308, beyond double precision",
+            "readable ratio"
+        );
+    }
+
+    #[test]
+    fn min_normalised_weight_is_2_to_the_minus_970() {
+        assert_eq!(
+            MIN_NORMALISED_WEIGHT,
+            2f64.powi(-970),
+            "the documented constant"
+        );
+    }
+
+    #[test]
+    fn curvature_survives_tiny_parameter_ranges() {
+        // |d1| ~ 1e52 and |d2| ~ 1e104: the naive |d1 x d2| / |d1|^3 overflows.
+        let d1 = Vector3::new(1e52, 0.0, 0.0);
+        let d2 = Vector3::new(0.0, 1e104, 0.0);
+        assert!((curvature_of(&d1, &d2) - 1.0).abs() < 1e-15, "curvature 1");
     }
 }

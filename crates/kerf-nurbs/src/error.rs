@@ -54,7 +54,7 @@ pub enum NurbsError {
         got: usize,
     },
     /// A knot is NaN or infinite.
-    #[error("{field}[{index}]: knot must be finite (got {value})")]
+    #[error("{field}[{index}]: knot must be finite (got {})", Readable(*.value))]
     KnotNotFinite {
         /// `knots`, `knots_u` or `knots_v`.
         field: &'static str,
@@ -64,7 +64,7 @@ pub enum NurbsError {
         value: f64,
     },
     /// A knot is smaller than the one before it. Fix: sort the knot vector.
-    #[error("{field}[{index}]: knots must be non-decreasing ({value} after {previous})")]
+    #[error("{field}[{index}]: knots must be non-decreasing ({} after {})", Readable(*.value), Readable(*.previous))]
     KnotsDecreasing {
         /// `knots`, `knots_u` or `knots_v`.
         field: &'static str,
@@ -76,7 +76,7 @@ pub enum NurbsError {
         previous: f64,
     },
     /// A knot value is repeated more than `degree + 1` times. Fix: remove the extra copies.
-    #[error("{field}[{index}]: knot {value} is repeated {multiplicity} times, more than degree + 1 = {max}")]
+    #[error("{field}[{index}]: knot {} is repeated {multiplicity} times, more than degree + 1 = {max}", Readable(*.value))]
     KnotMultiplicity {
         /// `knots`, `knots_u` or `knots_v`.
         field: &'static str,
@@ -91,7 +91,7 @@ pub enum NurbsError {
     },
     /// The domain `[knots[p], knots[len - p - 1]]` has zero length. Fix: the knot vector must
     /// span a non-empty parameter interval.
-    #[error("{field}: empty parameter domain [{start}, {end}]")]
+    #[error("{field}: empty parameter domain [{}, {}]", Readable(*.start), Readable(*.end))]
     EmptyDomain {
         /// `knots`, `knots_u` or `knots_v`.
         field: &'static str,
@@ -101,7 +101,7 @@ pub enum NurbsError {
         end: f64,
     },
     /// A control point coordinate is NaN or infinite.
-    #[error("{field}{index}: control point must be finite (got [{x}, {y}, {z}])")]
+    #[error("{field}{index}: control point must be finite (got [{}, {}, {}])", Readable(*.x), Readable(*.y), Readable(*.z))]
     PointNotFinite {
         /// `control_points`.
         field: &'static str,
@@ -128,6 +128,20 @@ pub enum NurbsError {
         /// The weight.
         weight: f64,
     },
+    /// The largest weight is so many times the smallest (more than about `2^970`) that,
+    /// scaled so the largest is 1, the smallest is near the subnormal range: the homogeneous coordinates
+    /// `w x` would keep only a few significant bits, and evaluation would be wrong by far more
+    /// than rounding. Fix: the curve is almost certainly corrupt; rebuild it with moderate
+    /// weights (only their ratios matter).
+    #[error("{field}{index}: weights differ by a ratio of {ratio:.3e}, beyond double precision")]
+    WeightRatio {
+        /// `weights`.
+        field: &'static str,
+        /// Index of the smallest weight, as written in a path: `[3]` or `[2][5]`.
+        index: String,
+        /// Largest weight divided by smallest.
+        ratio: f64,
+    },
     /// The number of weights differs from the number of control points.
     #[error("{field}: expected {expected} weights (one per control point), got {got}")]
     WeightCount {
@@ -140,7 +154,7 @@ pub enum NurbsError {
     },
     /// A weight is NaN, infinite, zero or negative. Fix: NURBS weights must be finite and > 0;
     /// a zero weight puts the curve at infinity.
-    #[error("{field}{index}: weight must be finite and > 0 (got {value})")]
+    #[error("{field}{index}: weight must be finite and > 0 (got {})", Readable(*.value))]
     BadWeight {
         /// `weights`.
         field: &'static str,
@@ -162,7 +176,7 @@ pub enum NurbsError {
         expected: usize,
     },
     /// A parameter passed to an operation is NaN or lies outside the domain.
-    #[error("parameter {value} is outside the domain [{start}, {end}]")]
+    #[error("parameter {} is outside the domain [{}, {}]", Readable(*.value), Readable(*.start), Readable(*.end))]
     ParameterOutsideDomain {
         /// The parameter.
         value: f64,
@@ -184,13 +198,31 @@ pub enum NurbsError {
         degree: usize,
     },
     /// A parameter interval `[t0, t1]` is empty or reversed.
-    #[error("interval [{t0}, {t1}] is empty or reversed")]
+    #[error("interval [{}, {}] is empty or reversed", Readable(*.t0), Readable(*.t1))]
     BadInterval {
         /// Start.
         t0: f64,
         /// End.
         t1: f64,
     },
+}
+
+/// A number formatted for a message: the shortest round-trip digits when its magnitude is
+/// between `1e-4` and `1e9` (or zero), scientific notation otherwise, so that `1e-50` prints as
+/// `1e-50` rather than as 52 characters of zeros.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Readable(pub f64);
+
+impl std::fmt::Display for Readable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let x = self.0;
+        let a = x.abs();
+        if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&a) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
 }
 
 /// `Result` with [`NurbsError`].

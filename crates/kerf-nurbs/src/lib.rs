@@ -33,11 +33,13 @@ pub mod error;
 pub mod knots;
 pub mod samples;
 pub mod surface;
+pub mod work;
 
+pub use arclength::Quadrature;
 pub use bezier::RationalBezier;
 pub use closest::CurveProjection;
 pub use curve::{FrenetFrame, NurbsCurve};
-pub use error::{NurbsError, Result};
+pub use error::{NurbsError, Readable, Result};
 pub use surface::{NurbsSurface, SurfaceProjection};
 
 /// The largest degree kerf accepts. CAD systems use degree <= 11 in practice; the fixed-size

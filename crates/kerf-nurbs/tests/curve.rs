@@ -1630,3 +1630,89 @@ proptest! {
         prop_assert!((back - s).abs() <= 1e-10 * total, "length to {} is {}, wanted {}", t, back, s);
     }
 }
+
+/// Issue 13: the arc length's quadrature has a floor and a budget, and a guaranteed bracket
+/// that catches speed peaks its Gauss nodes miss.
+#[test]
+fn arc_length_of_extreme_weights_and_far_small_circles_is_budgeted() {
+    let arc = |w: f64| {
+        NurbsCurve::new(
+            2,
+            vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+            vec![
+                Point3::new(50.0, 0.0, 0.0),
+                Point3::new(50.0, 50.0, 0.0),
+                Point3::new(0.0, 50.0, 0.0),
+            ],
+            Some(vec![1.0, w, 1.0]),
+        )
+    };
+    let budget = 30 + 40 * kerf_nurbs::arclength::SPLITS_PER_SPAN;
+    // Weight 1e12: the curve is the control polygon's two legs (length 100 to 1e-10), traced
+    // within 1e-11 of the parameter's ends, where no Gauss node of a coarse panel looks.
+    let q = arc(1e12).arc_length_quadrature(0.0, 1.0);
+    assert!(q.evaluations <= budget, "{q:?}");
+    assert!((q.value - 100.0).abs() <= 1e-6 + q.error, "{q:?}");
+    // Weight 1e-12: the straight chord, length 50 sqrt 2.
+    let q = arc(1e-12).arc_length_quadrature(0.0, 1.0);
+    assert!(q.evaluations <= budget, "{q:?}");
+    assert!((q.value - 50.0 * 2f64.sqrt()).abs() < 1e-6, "{q:?}");
+    // A 0.1 mm circle at x = 1400: 1e-13 of its size is below the coordinates' rounding; the
+    // floor stops the quadrature at once instead of recursing to the full depth.
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let sq = [
+        (1.0, 0.0),
+        (1.0, 1.0),
+        (0.0, 1.0),
+        (-1.0, 1.0),
+        (-1.0, 0.0),
+        (-1.0, -1.0),
+        (0.0, -1.0),
+        (1.0, -1.0),
+        (1.0, 0.0),
+    ];
+    let hole = NurbsCurve::new(
+        2,
+        vec![
+            0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0,
+        ],
+        sq.iter()
+            .map(|&(x, y)| Point3::new(1400.0 + 0.05 * x, 700.0 + 0.05 * y, 0.0))
+            .collect(),
+        Some(vec![1.0, h, 1.0, h, 1.0, h, 1.0, h, 1.0]),
+    );
+    let q = hole.arc_length_quadrature(0.0, 1.0);
+    assert!(q.converged, "converged at the rounding floor: {q:?}");
+    assert!(q.evaluations <= 4 * budget, "{q:?}");
+    assert!(
+        (q.value - std::f64::consts::PI * 0.1).abs() < 1e-10,
+        "{q:?}"
+    );
+}
+
+/// The quadrature never exceeds its budget, whatever the integrand does.
+#[test]
+fn integrate_stops_at_its_budget_on_a_hostile_integrand() {
+    use kerf_nurbs::arclength::integrate;
+    // Rough everywhere: no accuracy is reachable.
+    let q = integrate(
+        |t| (1e6 * t).sin().abs() * 1e3,
+        None,
+        &[(0.0, 1.0)],
+        1e-15,
+        0.0,
+        50,
+    );
+    assert_eq!(q.evaluations, 30 + 40 * 50, "the budget is exact: {q:?}");
+    assert!(!q.converged, "reported unconverged");
+    // NaN somewhere: never reported converged, never loops.
+    let q = integrate(
+        |t| if t > 0.5 { f64::NAN } else { 1.0 },
+        None,
+        &[(0.0, 1.0)],
+        1e-9,
+        0.0,
+        20,
+    );
+    assert!(!q.converged && q.evaluations <= 30 + 40 * 20, "{q:?}");
+}

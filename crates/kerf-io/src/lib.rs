@@ -38,4 +38,4 @@ mod write;
 pub use json::{parse_json, path_at, JsonError};
 pub use read::{read_file, read_to_end, strip_bom, MAX_INPUT_BYTES};
 pub use text::{check_text, TextDefect};
-pub use write::{same_file, write_dir_all_or_nothing, write_file, DirEntry, DirError};
+pub use write::{same_file, write_dir_all_or_nothing, write_file, Contents, DirEntry, DirError};

@@ -152,12 +152,15 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// A writer of one file's contents, called once with a buffered writer.
+pub type Contents<'a> = Box<dyn FnOnce(&mut dyn Write) -> io::Result<()> + 'a>;
+
 /// One file of [`write_dir_all_or_nothing`].
 pub struct DirEntry<'a> {
     /// The file name inside the directory (no path separator).
     pub name: &'a str,
     /// Writes the contents.
-    pub contents: Box<dyn FnOnce(&mut dyn Write) -> io::Result<()> + 'a>,
+    pub contents: Contents<'a>,
 }
 
 impl fmt::Debug for DirEntry<'_> {

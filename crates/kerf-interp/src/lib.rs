@@ -60,7 +60,7 @@ pub use fit::{fit_blocks, BlockCounts, CurveFn, FitOptions};
 pub use geometry::Arc;
 pub use machine::{stations_from_axes, stations_from_solved, MachineModel};
 pub use model::{AcHead, AxisLimits, AxisModel};
-pub use output::{csv_string, gcode, write_csv, write_gcode, Dialect, GcodeOptions};
+pub use output::{csv_string, gcode, write_csv, write_csv_to, write_gcode, Dialect, GcodeOptions};
 pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PlanOptions};
 
 /// One path of a program: its id (the source curve's), its stations and, when known, the

@@ -42,6 +42,7 @@ pub mod machine;
 pub mod nonlinear;
 pub mod path;
 pub mod pose;
+mod json;
 mod registry;
 mod rotation;
 pub mod table_table;

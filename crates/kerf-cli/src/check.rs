@@ -35,7 +35,7 @@ pub(crate) struct CheckArgs {
 
     /// Samples per knot span in each segment before the local maxima are refined (default
     /// 32; at least 4 (degree + 1) are used).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = crate::guard::samples)]
     pub(crate) samples: Option<usize>,
 }
 

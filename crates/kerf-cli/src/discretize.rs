@@ -1,7 +1,7 @@
 //! `kerf discretize`: cutting points with a certified chord error for every curve of a
 //! `kerf.curves/1` file, written as `kerf.toolpath/1`.
 
-use std::io::{self, Write};
+use std::io;
 use std::path::Path;
 use std::time::Instant;
 
@@ -82,6 +82,8 @@ pub(crate) fn discretize_file(
 pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let path = args.curves.as_path();
+    let dest = args.output.clone().unwrap_or_else(|| default_output(path));
+    crate::guard::refuse_overwrite("--output", &dest, &[path])?;
     let file = load_curves(path)?;
     let opts = options(args);
     let results = discretize_file(path, &file, &opts)?;
@@ -128,15 +130,8 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
         tolerance: opts.tolerance,
         paths,
     };
-    let dest = args.output.clone().unwrap_or_else(|| default_output(path));
-    if dest == Path::new("-") {
-        let stdout = io::stdout();
-        let mut lock = stdout.lock();
-        toolpath::to_writer(&out, &mut lock)?;
-        lock.flush()?;
-    } else {
-        toolpath::write(&out, &dest)?;
-    }
+    // `-` is standard output; kerf_io also writes devices and FIFOs through.
+    toolpath::write(&out, &dest)?;
     let segments: usize = results.iter().map(Discretization::segments).sum();
     let points: usize = out.paths.iter().map(|p| p.params.len()).sum();
     let worst = out

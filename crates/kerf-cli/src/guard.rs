@@ -152,18 +152,30 @@ mod tests {
         }
         assert_eq!(distance_mm("0"), Ok(0.0), "zero retract");
         assert!(distance_mm("-0.1").is_err(), "negative retract");
-        assert!(fraction("1").is_err() && fraction("0").is_err(), "open interval");
+        assert!(
+            fraction("1").is_err() && fraction("0").is_err(),
+            "open interval"
+        );
         assert_eq!(fraction("0.9"), Ok(0.9), "band");
         assert_eq!(angle_deg("180"), Ok(180.0), "half turn");
-        assert!(angle_deg("181").is_err() && angle_deg("0").is_err(), "angle range");
+        assert!(
+            angle_deg("181").is_err() && angle_deg("0").is_err(),
+            "angle range"
+        );
         assert!(small_angle_rad("0.2").is_err(), "pole tolerance");
         assert_eq!(cycle_s("0.001"), Ok(0.001), "1 ms");
         assert_eq!(cycle_s("1e-5"), Ok(1e-5), "lower end");
         let e = cycle_s("1e9").expect_err("a cycle of 30 years");
         assert!(e.contains("between 1e-5 s and 0.1 s"), "{e}");
-        assert!(feed_mm_per_min("0").is_err() && feed_mm_per_min("1e7").is_err(), "feed");
+        assert!(
+            feed_mm_per_min("0").is_err() && feed_mm_per_min("1e7").is_err(),
+            "feed"
+        );
         assert_eq!(samples("64"), Ok(64), "samples");
-        assert!(samples("1").is_err() && samples("-3").is_err(), "samples range");
+        assert!(
+            samples("1").is_err() && samples("-3").is_err(),
+            "samples range"
+        );
     }
 
     #[test]
@@ -173,8 +185,8 @@ mod tests {
         std::fs::write(&input, "{}").expect("write");
         let other = dir.path().join("sub").join("..").join("part.json");
         std::fs::create_dir(dir.path().join("sub")).expect("mkdir");
-        let e = refuse_overwrite("-o", &other, &[Path::new("m.json"), &input])
-            .expect_err("same file");
+        let e =
+            refuse_overwrite("-o", &other, &[Path::new("m.json"), &input]).expect_err("same file");
         assert!(matches!(e, CliError::Usage(_)), "usage error");
         assert!(e.to_string().contains("would destroy the input"), "{e}");
         refuse_overwrite("-o", &dir.path().join("new.json"), &[&input]).expect("new file");

@@ -165,11 +165,7 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
 /// Runs `kerf interpolate`.
 pub(crate) fn run_interpolate(args: &InterpolateArgs) -> Result<(), CliError> {
     if let Some(csv) = &args.csv {
-        crate::guard::refuse_overwrite(
-            "--csv",
-            csv,
-            &[&args.motion.input, &args.motion.machine],
-        )?;
+        crate::guard::refuse_overwrite("--csv", csv, &[&args.motion.input, &args.motion.machine])?;
     }
     // Set-points are computed with tool-tip control: arcs are safe.
     let p = program(&args.motion, false)?;

@@ -71,7 +71,11 @@ pub fn read_machine(data: &[u8]) {
         return;
     };
     if let Ok(m) = kerf_kinematics::Machine::from_str(text) {
-        assert!(safe(&m.name), "machine name with a control character: {:?}", m.name);
+        assert!(
+            safe(&m.name),
+            "machine name with a control character: {:?}",
+            m.name
+        );
     }
 }
 
@@ -183,7 +187,10 @@ pub fn discretize(case: &CurveCase) {
     assert_eq!(d.params.first(), Some(&t0), "starts at the domain start");
     assert_eq!(d.params.last(), Some(&t1), "ends at the domain end");
     assert_eq!(d.params.len(), d.points.len(), "one point per parameter");
-    assert!(d.max_chord_error <= case.tolerance, "certified within the tolerance");
+    assert!(
+        d.max_chord_error <= case.tolerance,
+        "certified within the tolerance"
+    );
     // Rounding in evaluating the samples themselves: a few ulps of the curve's size.
     let size = curve
         .control_points()
@@ -203,7 +210,10 @@ pub fn discretize(case: &CurveCase) {
         );
     }
     for (t, p) in d.params.iter().zip(&d.points) {
-        assert!((curve.point(*t) - p).norm() <= slack, "point on the curve at {t}");
+        assert!(
+            (curve.point(*t) - p).norm() <= slack,
+            "point on the curve at {t}"
+        );
     }
 }
 
@@ -224,7 +234,10 @@ impl<'a> Arbitrary<'a> for SurfaceCase {
         let offset = coordinate(u, 500.0)?;
         // Plane frame: e1, e2 in the plane, n its normal.
         let n = Vector3::new(tilt.sin() * turn.cos(), tilt.sin() * turn.sin(), tilt.cos());
-        let e1 = n.cross(&Vector3::z()).try_normalize(1e-12).unwrap_or(Vector3::x());
+        let e1 = n
+            .cross(&Vector3::z())
+            .try_normalize(1e-12)
+            .unwrap_or(Vector3::x());
         let e2 = n.cross(&e1);
         let origin = Point3::from(n * offset);
         let to_plane = |x: f64, y: f64| origin + e1 * x + e2 * y;
@@ -274,7 +287,10 @@ pub fn normals(case: &SurfaceCase) {
     };
     assert_eq!(o.params.len(), o.normals.len(), "one normal per point");
     for (i, nv) in o.normals.iter().enumerate() {
-        assert!((nv.norm() - 1.0).abs() < 1e-9, "normals[{i}] is a unit vector");
+        assert!(
+            (nv.norm() - 1.0).abs() < 1e-9,
+            "normals[{i}] is a unit vector"
+        );
         assert!(
             nv.cross(&case.normal).norm() < 1e-6,
             "normals[{i}] = {nv:?} is parallel to the plane normal {:?}",
@@ -353,7 +369,8 @@ impl<'a> Arbitrary<'a> for MachineCase {
 }
 
 pub fn kinematics(case: &MachineCase) {
-    let machine = kerf_kinematics::Machine::from_str(&case.json).expect("the built machine is valid");
+    let machine =
+        kerf_kinematics::Machine::from_str(&case.json).expect("the built machine is valid");
     let input = kerf_kinematics::PathInput {
         id: "fuzz",
         poses: &case.poses,
@@ -364,13 +381,23 @@ pub fn kinematics(case: &MachineCase) {
     else {
         return;
     };
-    assert_eq!(solved.poses.len(), solved.axes.len(), "one axis set per pose");
+    assert_eq!(
+        solved.poses.len(),
+        solved.axes.len(),
+        "one axis set per pose"
+    );
     for (i, (pose, axes)) in solved.poses.iter().zip(&solved.axes).enumerate() {
         let back = machine.kinematics.forward(axes);
         let dp = (back.position - pose.position).norm();
         let da = back.axis.angle(&pose.axis);
-        assert!(dp < 1e-6, "poses[{i}]: forward kinematics misses the tip by {dp} mm");
-        assert!(da < 1e-7, "poses[{i}]: forward kinematics misses the axis by {da} rad");
+        assert!(
+            dp < 1e-6,
+            "poses[{i}]: forward kinematics misses the tip by {dp} mm"
+        );
+        assert!(
+            da < 1e-7,
+            "poses[{i}]: forward kinematics misses the axis by {da} rad"
+        );
         assert!(
             machine.violation(axes, 1e-9).is_none(),
             "poses[{i}]: axes {axes:?} outside the limits"

@@ -1146,7 +1146,11 @@ mod tests {
         counted.paths[1].point_count = Some(counted.paths[1].points.len());
         let report = check(&file.curves, &counted, &CheckOptions::default());
         assert_eq!(
-            report.violations.iter().map(|v| (v.path, v.defect.clone())).collect::<Vec<_>>(),
+            report
+                .violations
+                .iter()
+                .map(|v| (v.path, v.defect.clone()))
+                .collect::<Vec<_>>(),
             [(
                 Some(0),
                 Defect::PointCountMismatch {

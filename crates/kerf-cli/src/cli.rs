@@ -155,6 +155,11 @@ pub(crate) struct DiscretizeArgs {
     #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) min_segment_length: Option<f64>,
 
+    /// Most cutting points per curve (default 50,000,000); a curve that needs more is refused
+    /// before any work.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(2..=1_000_000_000))]
+    pub(crate) max_points: Option<u64>,
+
     /// Largest turn of the tangent across one segment, in degrees.
     #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
     pub(crate) max_turn: Option<f64>,

@@ -35,6 +35,9 @@ pub(crate) fn options(args: &DiscretizeArgs) -> Options {
         min_segment_length: args.min_segment_length.unwrap_or(d.min_segment_length),
         max_turn: args.max_turn.map_or(d.max_turn, f64::to_radians),
         strategy: args.strategy.into(),
+        max_points: args
+            .max_points
+            .map_or(d.max_points, |n| usize::try_from(n).unwrap_or(usize::MAX)),
         ..d
     }
 }

@@ -88,12 +88,28 @@ impl fmt::Display for CliError {
                 index,
                 id,
                 error,
-            } => write!(f, "{}: curves[{index}] ({id:?}): {error}", file.display()),
+            } => {
+                write!(f, "{}: curves[{index}] ({id:?}): {error}", file.display())?;
+                if let Some(hint) = discretize_hint(error) {
+                    write!(f, " [{hint}]")?;
+                }
+                Ok(())
+            }
         }
     }
 }
 
 impl std::error::Error for CliError {}
+
+/// The command-line options that change the outcome of a discretizer error.
+fn discretize_hint(e: &kerf_discretize::DiscretizeError) -> Option<&'static str> {
+    use kerf_discretize::DiscretizeError as E;
+    match e {
+        E::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-points"),
+        E::ToleranceBelowPrecision { .. } => Some("option: a larger --tolerance"),
+        _ => None,
+    }
+}
 
 impl From<FormatError> for CliError {
     fn from(e: FormatError) -> Self {

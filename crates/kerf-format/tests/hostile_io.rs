@@ -30,12 +30,19 @@ fn run(reader: &str, read: impl Fn(&Path) -> Result<(), String>) {
             (Ok(()), _) => panic!("{}: read, but expected {expected:?}", file.display()),
             (Err(e), "ok") => panic!("{}: expected to read, got {e}", file.display()),
             (Err(e), _) => {
-                assert!(e.contains(&expected), "{}: {e:?} lacks {expected:?}", file.display());
+                assert!(
+                    e.contains(&expected),
+                    "{}: {e:?} lacks {expected:?}",
+                    file.display()
+                );
                 assert!(
                     e.starts_with(&file.display().to_string()),
                     "the message names the file: {e}"
                 );
-                assert!(!e.contains('\n'), "one line, no raw control character: {e:?}");
+                assert!(
+                    !e.contains('\n'),
+                    "one line, no raw control character: {e:?}"
+                );
             }
         }
     }
@@ -59,7 +66,11 @@ fn hostile_toolpath_files() {
 fn the_bom_file_reads_as_the_file_without_it() {
     let with = curves::load(dir().join("curves_bom.json")).expect("BOM file");
     let bytes = std::fs::read(dir().join("curves_bom.json")).expect("read");
-    assert_eq!(&bytes[..3], b"\xEF\xBB\xBF", "the fixture starts with a BOM");
+    assert_eq!(
+        &bytes[..3],
+        b"\xEF\xBB\xBF",
+        "the fixture starts with a BOM"
+    );
     let without = curves::from_reader(&bytes[3..], Path::new(".")).expect("without BOM");
     assert_eq!(with.curves.len(), without.curves.len(), "same curves");
     assert_eq!(with.curves[0].id, without.curves[0].id, "same id");
@@ -73,11 +84,20 @@ fn a_file_above_the_size_limit_is_refused_without_reading_it() {
     let f = std::fs::File::create(&huge).expect("create");
     f.set_len(kerf_io::MAX_INPUT_BYTES + 1).expect("set_len");
     for e in [
-        curves::load(&huge).map(drop).expect_err("too large").to_string(),
-        toolpath::load(&huge).map(drop).expect_err("too large").to_string(),
+        curves::load(&huge)
+            .map(drop)
+            .expect_err("too large")
+            .to_string(),
+        toolpath::load(&huge)
+            .map(drop)
+            .expect_err("too large")
+            .to_string(),
     ] {
         assert!(e.contains("larger than 1 GiB"), "{e}");
-        assert!(e.starts_with(&huge.display().to_string()), "names the file: {e}");
+        assert!(
+            e.starts_with(&huge.display().to_string()),
+            "names the file: {e}"
+        );
     }
 }
 

@@ -354,7 +354,11 @@ mod tests {
             "a.b\"c[1]",
             "escaped key, missing comma"
         );
-        assert_eq!(syntax_path("{\"a\": 1,}"), "", "trailing comma at top level");
+        assert_eq!(
+            syntax_path("{\"a\": 1,}"),
+            "",
+            "trailing comma at top level"
+        );
         assert_eq!(
             syntax_path("{\"curves\": [[1, 2],\n [3, 4"),
             "curves[1][1]",
@@ -374,7 +378,11 @@ mod tests {
             "BOM"
         );
         assert_eq!(parse_json(b" \n\t"), Err(JsonError::Empty), "white space");
-        assert_eq!(parse_json(b"\xEF\xBB\xBF"), Err(JsonError::Empty), "only a BOM");
+        assert_eq!(
+            parse_json(b"\xEF\xBB\xBF"),
+            Err(JsonError::Empty),
+            "only a BOM"
+        );
     }
 
     #[test]

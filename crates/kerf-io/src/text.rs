@@ -78,7 +78,14 @@ mod tests {
         for c in bad {
             let text = format!("ab{c}G0 X1");
             let e = check_text(&text).expect_err("refused");
-            assert_eq!(e, TextDefect { character: c, index: 2 }, "{c:?}");
+            assert_eq!(
+                e,
+                TextDefect {
+                    character: c,
+                    index: 2
+                },
+                "{c:?}"
+            );
         }
         let e = check_text("hole\nG0 X1400").expect_err("newline");
         assert!(e.to_string().contains("U+000A (line feed)"), "{e}");

@@ -165,7 +165,9 @@ pub struct DirEntry<'a> {
 
 impl fmt::Debug for DirEntry<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("DirEntry").field("name", &self.name).finish()
+        f.debug_struct("DirEntry")
+            .field("name", &self.name)
+            .finish()
     }
 }
 

@@ -32,10 +32,18 @@ fn a_new_file_gets_the_mode_of_any_created_file() {
     fs::File::create(&reference).expect("create");
     let dest = dir.path().join("out.nc");
     write_file(&dest, text("G1 X1\n")).expect("write");
-    assert_eq!(fs::read_to_string(&dest).expect("read"), "G1 X1\n", "contents");
+    assert_eq!(
+        fs::read_to_string(&dest).expect("read"),
+        "G1 X1\n",
+        "contents"
+    );
     assert_eq!(mode(&dest), mode(&reference), "0o666 less the umask");
     assert_ne!(mode(&dest), 0o600, "not tempfile's private mode");
-    assert_eq!(entries_of(dir.path()), ["out.nc", "reference"], "no temporary file");
+    assert_eq!(
+        entries_of(dir.path()),
+        ["out.nc", "reference"],
+        "no temporary file"
+    );
 }
 
 #[test]
@@ -72,7 +80,10 @@ fn a_device_is_written_through_not_replaced() {
     let null = Path::new("/dev/null");
     write_file(null, text("discarded")).expect("write to /dev/null");
     let meta = fs::symlink_metadata(null).expect("metadata");
-    assert!(meta.file_type().is_char_device(), "still a character device");
+    assert!(
+        meta.file_type().is_char_device(),
+        "still a character device"
+    );
 }
 
 #[test]
@@ -89,7 +100,11 @@ fn a_fifo_is_written_through() {
         std::thread::spawn(move || fs::read_to_string(fifo).expect("read the FIFO"))
     };
     write_file(&fifo, text("through the pipe")).expect("write");
-    assert_eq!(reader.join().expect("reader"), "through the pipe", "read back");
+    assert_eq!(
+        reader.join().expect("reader"),
+        "through the pipe",
+        "read back"
+    );
     assert!(
         fs::symlink_metadata(&fifo)
             .expect("metadata")
@@ -118,9 +133,17 @@ fn a_symlink_is_followed_and_stays_a_link() {
             .is_symlink(),
         "the link is still a link"
     );
-    assert_eq!(fs::read_to_string(&target).expect("read"), "new", "target written");
+    assert_eq!(
+        fs::read_to_string(&target).expect("read"),
+        "new",
+        "target written"
+    );
     assert_eq!(mode(&target), 0o604, "target's mode kept");
-    assert_eq!(entries_of(&sub), ["target.nc"], "temporary file was in the target's dir");
+    assert_eq!(
+        entries_of(&sub),
+        ["target.nc"],
+        "temporary file was in the target's dir"
+    );
     // A dangling link: the target is created.
     let dangling = dir.path().join("dangling.nc");
     std::os::unix::fs::symlink("real/new.nc", &dangling).expect("symlink");
@@ -165,7 +188,10 @@ fn same_file_sees_through_links_and_dots() {
     fs::write(&b, "{}").expect("write");
     assert!(!same_file(&a, &b), "different files with equal contents");
     assert!(!same_file(&a, &dir.path().join("none")), "missing");
-    assert!(!same_file(Path::new("-"), Path::new("-")), "stdout is no file");
+    assert!(
+        !same_file(Path::new("-"), Path::new("-")),
+        "stdout is no file"
+    );
 }
 
 fn entry<'a>(name: &'a str, s: &'static str) -> DirEntry<'a> {
@@ -179,8 +205,7 @@ fn entry<'a>(name: &'a str, s: &'static str) -> DirEntry<'a> {
 fn a_directory_is_written_all_or_nothing() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("out");
-    write_dir_all_or_nothing(&out, vec![entry("a.txt", "1"), entry("b.txt", "2")])
-        .expect("write");
+    write_dir_all_or_nothing(&out, vec![entry("a.txt", "1"), entry("b.txt", "2")]).expect("write");
     assert_eq!(entries_of(&out), ["a.txt", "b.txt"], "both, no staging dir");
     fs::set_permissions(out.join("a.txt"), fs::Permissions::from_mode(0o640)).expect("chmod");
     // The second file fails: nothing changes.
@@ -195,8 +220,15 @@ fn a_directory_is_written_all_or_nothing() {
         ],
     )
     .expect_err("fails");
-    assert!(e.to_string().contains("b.txt") && e.to_string().contains("disk full"), "{e}");
-    assert_eq!(fs::read_to_string(out.join("a.txt")).expect("read"), "1", "old kept");
+    assert!(
+        e.to_string().contains("b.txt") && e.to_string().contains("disk full"),
+        "{e}"
+    );
+    assert_eq!(
+        fs::read_to_string(out.join("a.txt")).expect("read"),
+        "1",
+        "old kept"
+    );
     assert_eq!(entries_of(&out), ["a.txt", "b.txt"], "staging removed");
     write_dir_all_or_nothing(&out, vec![entry("a.txt", "3")]).expect("write");
     assert_eq!(mode(&out.join("a.txt")), 0o640, "mode kept");

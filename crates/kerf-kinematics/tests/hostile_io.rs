@@ -28,7 +28,11 @@ fn run(reader: &str, read: impl Fn(&Path) -> Result<(), String>) {
             (Ok(()), _) => panic!("{}: read, but expected {expected:?}", file.display()),
             (Err(e), "ok") => panic!("{}: expected to read, got {e}", file.display()),
             (Err(e), _) => {
-                assert!(e.contains(&expected), "{}: {e:?} lacks {expected:?}", file.display());
+                assert!(
+                    e.contains(&expected),
+                    "{}: {e:?} lacks {expected:?}",
+                    file.display()
+                );
                 assert!(
                     e.starts_with(&file.display().to_string()),
                     "the message names the file: {e}"
@@ -41,12 +45,16 @@ fn run(reader: &str, read: impl Fn(&Path) -> Result<(), String>) {
 
 #[test]
 fn hostile_machine_files() {
-    run("machine", |p| Machine::read(p).map(drop).map_err(|e| e.to_string()));
+    run("machine", |p| {
+        Machine::read(p).map(drop).map_err(|e| e.to_string())
+    });
 }
 
 #[test]
 fn hostile_axes_files() {
-    run("axes", |p| AxesFile::read(p).map(drop).map_err(|e| e.to_string()));
+    run("axes", |p| {
+        AxesFile::read(p).map(drop).map_err(|e| e.to_string())
+    });
 }
 
 #[test]
@@ -61,7 +69,11 @@ fn a_machine_built_in_code_with_a_newline_in_its_name_is_refused() {
     )
     .map(drop)
     .expect_err("refused");
-    assert!(e.to_string().starts_with("name: contains the control character U+000A"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("name: contains the control character U+000A"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -71,6 +83,10 @@ fn an_axes_file_with_a_hostile_id_is_not_written() {
     let dir = tempfile::tempdir().expect("temp dir");
     let dest = dir.path().join("out.axes.json");
     let e = axes.write(&dest).expect_err("refused");
-    assert!(e.to_string().contains("paths[0].id: contains the control character"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("paths[0].id: contains the control character"),
+        "{e}"
+    );
     assert!(!dest.exists(), "nothing written");
 }

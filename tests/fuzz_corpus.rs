@@ -5,7 +5,7 @@
 //! documentation (round trips, sampled chord error within the tolerance, normals parallel to
 //! the plane's, forward kinematics giving back every pose).
 
-#[allow(dead_code, unreachable_pub)]
+#[allow(dead_code)]
 #[path = "../fuzz/src/lib.rs"]
 mod harness;
 

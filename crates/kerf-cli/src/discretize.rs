@@ -26,6 +26,8 @@ pub(crate) fn load_curves(path: &Path) -> Result<CurvesFile, CliError> {
 }
 
 /// The discretizer options the arguments ask for.
+// `..d` keeps the defaults of options added to `Options` later (every field is set today).
+#[allow(clippy::needless_update)]
 pub(crate) fn options(args: &DiscretizeArgs) -> Options {
     let d = Options::default();
     Options {

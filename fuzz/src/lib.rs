@@ -311,28 +311,36 @@ impl<'a> Arbitrary<'a> for MachineCase {
         let len = |u: &mut Unstructured<'a>| -> arbitrary::Result<f64> {
             Ok(f64::from(u.int_in_range(0u16..=400)?))
         };
+        let mut tilt = "A";
         let kin = match u.int_in_range(0u8..=3)? {
             0 => format!(
                 r#"{{"type": "ac-head", "r_a": {}, "r_c": {}}}"#,
                 len(u)?,
                 len(u)?
             ),
-            1 => format!(
-                r#"{{"type": "fork-head", "tilt": "{}", "L": {}, "d": [{}, {}, {}], "tool_lateral": [0.0, 0.0]}}"#,
-                if bool::arbitrary(u)? { "A" } else { "B" },
-                len(u)? + 1.0,
-                coordinate(u, 100.0)?,
-                coordinate(u, 100.0)?,
-                coordinate(u, 100.0)?
-            ),
-            2 => format!(
-                r#"{{"type": "head-table", "L": {}, "c_point": [{}, {}, 0.0], "b_sign": {}, "c_sign": {}}}"#,
-                len(u)? + 1.0,
-                coordinate(u, 500.0)?,
-                coordinate(u, 500.0)?,
-                if bool::arbitrary(u)? { 1 } else { -1 },
-                if bool::arbitrary(u)? { 1 } else { -1 }
-            ),
+            1 => {
+                if bool::arbitrary(u)? {
+                    tilt = "B";
+                }
+                format!(
+                    r#"{{"type": "fork-head", "tilt": "{tilt}", "L": {}, "d": [{}, {}, {}], "tool_lateral": [0.0, 0.0]}}"#,
+                    len(u)? + 1.0,
+                    coordinate(u, 100.0)?,
+                    coordinate(u, 100.0)?,
+                    coordinate(u, 100.0)?
+                )
+            }
+            2 => {
+                tilt = "B";
+                format!(
+                    r#"{{"type": "head-table", "L": {}, "c_point": [{}, {}, 0.0], "b_sign": {}, "c_sign": {}}}"#,
+                    len(u)? + 1.0,
+                    coordinate(u, 500.0)?,
+                    coordinate(u, 500.0)?,
+                    if bool::arbitrary(u)? { 1 } else { -1 },
+                    if bool::arbitrary(u)? { 1 } else { -1 }
+                )
+            }
             _ => format!(
                 r#"{{"type": "table-table", "rot_point": [{}, {}, {}], "y_offset": {}, "z_offset": {}, "tool_offset": {}, "conventional": {}}}"#,
                 coordinate(u, 100.0)?,
@@ -346,9 +354,9 @@ impl<'a> Arbitrary<'a> for MachineCase {
         };
         let json = format!(
             r#"{{"format": "kerf.machine/1", "name": "fuzz", "kinematics": {kin},
-                "limits": {{"X": null, "Y": null, "Z": null, "A": [-120, 120], "C": null}},
-                "max_velocity": {{"X": 60000, "Y": 60000, "Z": 30000, "A": 36000, "C": 36000}},
-                "max_acceleration": {{"X": 10000, "Y": 10000, "Z": 8000, "A": 20000, "C": 20000}}}}"#
+                "limits": {{"X": null, "Y": null, "Z": null, "{tilt}": [-120, 120], "C": null}},
+                "max_velocity": {{"X": 60000, "Y": 60000, "Z": 30000, "{tilt}": 36000, "C": 36000}},
+                "max_acceleration": {{"X": 10000, "Y": 10000, "Z": 8000, "{tilt}": 20000, "C": 20000}}}}"#
         );
         let n = u.int_in_range(1usize..=12)?;
         let mut poses = Vec::with_capacity(n);

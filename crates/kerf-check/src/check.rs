@@ -212,6 +212,14 @@ pub enum Defect {
         /// Number of params.
         params: usize,
     },
+    /// The optional `point_count` differs from the number of points (a truncated or edited
+    /// file): the count must equal the length of `points`.
+    PointCountMismatch {
+        /// The `point_count` written.
+        point_count: usize,
+        /// Number of points.
+        points: usize,
+    },
     /// Fewer than two points: a path holds at least the two ends of the domain.
     TooFewPoints {
         /// Number of points.
@@ -351,6 +359,13 @@ impl fmt::Display for Defect {
                     "{points} points but {params} params (one param per point)"
                 )
             }
+            Defect::PointCountMismatch {
+                point_count,
+                points,
+            } => write!(
+                f,
+                "point_count is {point_count} but there are {points} points"
+            ),
             Defect::TooFewPoints { points } => {
                 write!(
                     f,
@@ -551,6 +566,12 @@ fn check_path(
         found.push(Defect::CountMismatch {
             points: n,
             params: m,
+        });
+    }
+    if let Some(point_count) = path.point_count.filter(|&c| c != n) {
+        found.push(Defect::PointCountMismatch {
+            point_count,
+            points: n,
         });
     }
     if n < 2 {
@@ -770,6 +791,7 @@ mod tests {
                         params: d.params,
                         points: d.points.iter().map(|p| vec![p.x, p.y, p.z]).collect(),
                         max_chord_error: Some(d.max_chord_error),
+                        point_count: None,
                     }
                 })
                 .collect(),
@@ -1117,6 +1139,26 @@ mod tests {
         assert!(
             found.contains(&(Some(1), Defect::TooFewPoints { points: 1 })),
             "{found:#?}"
+        );
+        let mut counted = toolpath(&file, 0.01);
+        let n = counted.paths[0].points.len();
+        counted.paths[0].point_count = Some(n + 1);
+        counted.paths[1].point_count = Some(counted.paths[1].points.len());
+        let report = check(&file.curves, &counted, &CheckOptions::default());
+        assert_eq!(
+            report
+                .violations
+                .iter()
+                .map(|v| (v.path, v.defect.clone()))
+                .collect::<Vec<_>>(),
+            [(
+                Some(0),
+                Defect::PointCountMismatch {
+                    point_count: n + 1,
+                    points: n
+                }
+            )],
+            "a wrong point_count is the only defect; a right one is none"
         );
         assert!(
             !found

@@ -37,6 +37,8 @@ pub struct PathRecord {
     pub points: Vec<Vec<f64>>,
     /// The `max_chord_error` the file claims, if present.
     pub max_chord_error: Option<f64>,
+    /// The optional `point_count` the file claims (kerf's writer adds it), if present.
+    pub point_count: Option<usize>,
 }
 
 #[derive(Deserialize)]
@@ -54,6 +56,8 @@ struct RawPath {
     points: Vec<Vec<f64>>,
     #[serde(default)]
     max_chord_error: Option<f64>,
+    #[serde(default)]
+    point_count: Option<usize>,
 }
 
 impl Toolpath {
@@ -64,7 +68,7 @@ impl Toolpath {
     /// [`Toolpath::from_slice`], wrapped in [`CheckError::File`].
     pub fn load(path: impl AsRef<Path>) -> Result<Toolpath> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|error| CheckError::Read {
+        let bytes = kerf_io::read_file(path).map_err(|error| CheckError::Read {
             path: path.to_path_buf(),
             error,
         })?;
@@ -78,15 +82,31 @@ impl Toolpath {
     /// not `kerf.toolpath/1`, [`CheckError::Shape`] naming the JSON path of a value of the
     /// wrong type or a missing key.
     pub fn from_slice(bytes: &[u8]) -> Result<Toolpath> {
-        let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-        let value: Value = serde_json::from_slice(bytes).map_err(|e| {
-            let full = e.to_string();
-            let suffix = format!(" at line {} column {}", e.line(), e.column());
-            CheckError::Syntax {
-                line: e.line(),
-                column: e.column(),
-                message: full.strip_suffix(&suffix).unwrap_or(&full).to_owned(),
-            }
+        // The shared front end: BOM skipped, a key given twice refused (a checker must not
+        // read a different document than the pipeline did).
+        let value: Value = kerf_io::parse_json(bytes).map_err(|e| match e {
+            kerf_io::JsonError::Empty => CheckError::Shape {
+                path: "top level".to_owned(),
+                message: "the file is empty".to_owned(),
+            },
+            kerf_io::JsonError::Syntax {
+                line,
+                column,
+                path,
+                message,
+            } => CheckError::Syntax {
+                line,
+                column,
+                message: if path.is_empty() {
+                    message
+                } else {
+                    format!("{message} (in {path})")
+                },
+            },
+            kerf_io::JsonError::DuplicateKey { path, line } => CheckError::Shape {
+                path,
+                message: format!("key given twice in one object (line {line})"),
+            },
         })?;
         match value.get("format") {
             Some(Value::String(s)) if s == TOOLPATH_FORMAT => {}
@@ -132,6 +152,7 @@ impl Toolpath {
                     params: p.params,
                     points: p.points,
                     max_chord_error: p.max_chord_error,
+                    point_count: p.point_count,
                 })
                 .collect(),
         })
@@ -154,6 +175,7 @@ impl From<&ToolpathFile> for Toolpath {
                         ToolPathPoints::Poses(v) => v.iter().map(|q| q.to_vec()).collect(),
                     },
                     max_chord_error: Some(p.max_chord_error),
+                    point_count: None,
                 })
                 .collect(),
         }

@@ -3,7 +3,7 @@
 //! `kerf-check` crate; this module reads the files and prints the report.
 
 use std::collections::HashMap;
-use std::io::{self, Read, Write};
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use clap::Args;
@@ -35,7 +35,7 @@ pub(crate) struct CheckArgs {
 
     /// Samples per knot span in each segment before the local maxima are refined (default
     /// 32; at least 4 (degree + 1) are used).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = crate::guard::samples)]
     pub(crate) samples: Option<usize>,
 }
 
@@ -49,13 +49,12 @@ pub(crate) fn run(args: &CheckArgs) -> Result<(), CliError> {
     }
     let curves = crate::discretize::load_curves(&args.curves)?;
     let toolpath = if args.toolpath == Path::new("-") {
-        let mut bytes = Vec::new();
-        io::stdin()
-            .read_to_end(&mut bytes)
-            .map_err(|error| kerf_check::CheckError::Read {
+        let bytes = kerf_io::read_to_end(io::stdin().lock(), kerf_io::MAX_INPUT_BYTES).map_err(
+            |error| kerf_check::CheckError::Read {
                 path: "<stdin>".into(),
                 error,
-            })?;
+            },
+        )?;
         Toolpath::from_slice(&bytes).map_err(|e| e.in_file("<stdin>"))?
     } else {
         Toolpath::load(&args.toolpath)?

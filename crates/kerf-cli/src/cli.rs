@@ -134,7 +134,7 @@ pub(crate) struct DiscretizeArgs {
     pub(crate) curves: PathBuf,
 
     /// Chord tolerance in mm: every segment's chord error is at most this.
-    #[arg(short, long, default_value_t = 0.01, value_name = "MM")]
+    #[arg(short, long, default_value_t = 0.01, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) tolerance: f64,
 
     /// Output kerf.toolpath/1 file (`-` for standard output). Default: `<input stem>.toolpath.json`
@@ -144,26 +144,26 @@ pub(crate) struct DiscretizeArgs {
 
     /// Lower edge of the accepted chord-error band, as a fraction of the tolerance (0 < band <
     /// 1; default 0.9). Higher: fewer points, slower.
-    #[arg(long, value_name = "FRACTION")]
+    #[arg(long, value_name = "FRACTION", value_parser = crate::guard::fraction)]
     pub(crate) band: Option<f64>,
 
     /// Longest chord allowed, in mm (machines limit block length).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) max_segment_length: Option<f64>,
 
     /// Shortest sphere radius the search proposes, in mm (the tolerance still wins).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) min_segment_length: Option<f64>,
+
+    /// Most cutting points per curve (default 50,000,000); a curve that needs more is refused
+    /// before any work.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(2..=1_000_000_000))]
+    pub(crate) max_points: Option<u64>,
 
     /// Largest turn of the tangent over one segment (between the tangents at any two of its
     /// points, certified from the hodograph), in degrees.
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
     pub(crate) max_turn: Option<f64>,
-
-    /// Refuse a curve that would need more cutting points than this (guards against a
-    /// tolerance typed in the wrong unit; default 50000000).
-    #[arg(long, value_name = "N")]
-    pub(crate) max_points: Option<usize>,
 
     /// How cutting points are placed (the classic methods carry the same guarantee).
     #[arg(long, value_enum, default_value_t = StrategyArg::ReferenceSphere)]
@@ -176,17 +176,17 @@ pub(crate) struct DiscretizeArgs {
 
     /// With --normals: a cutting point farther than this from its surface is an error (mm,
     /// default 0.01).
-    #[arg(long, value_name = "MM", requires = "normals")]
+    #[arg(long, value_name = "MM", requires = "normals", value_parser = crate::guard::length_mm)]
     pub(crate) on_surface_tolerance: Option<f64>,
 
     /// With --normals: the largest angle between neighbouring normals; points are inserted
     /// until it holds (degrees, default 1).
-    #[arg(long, value_name = "DEG", requires = "normals")]
+    #[arg(long, value_name = "DEG", requires = "normals", value_parser = crate::guard::angle_deg)]
     pub(crate) max_normal_step: Option<f64>,
 
     /// With --normals, for meshes: faces meeting at more than this angle form a sharp edge
     /// whose normals are not blended (degrees, default 30).
-    #[arg(long, value_name = "DEG", requires = "normals")]
+    #[arg(long, value_name = "DEG", requires = "normals", value_parser = crate::guard::angle_deg)]
     pub(crate) crease_angle: Option<f64>,
 
     /// Print the summary as one JSON object instead of a sentence.
@@ -240,11 +240,11 @@ pub(crate) struct PostArgs {
 
     /// Largest tool-tip deviation from the straight segment while the axes move linearly, in
     /// mm (default 0.005).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) linearization_tolerance: Option<f64>,
 
     /// Largest rotary-axis move between two points, in degrees (default: no limit).
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
     pub(crate) max_rotary_step: Option<f64>,
 
     /// Where the part goes on the machine: `auto` (every pose within the axis limits, the
@@ -255,7 +255,7 @@ pub(crate) struct PostArgs {
     pub(crate) place: Option<crate::place::PlaceArg>,
 
     /// Tool axes within this angle of the C axis count as the pole, in radians (default 1e-6).
-    #[arg(long, value_name = "RAD")]
+    #[arg(long, value_name = "RAD", value_parser = crate::guard::small_angle_rad)]
     pub(crate) pole_tolerance: Option<f64>,
 
     /// Print the summary as one JSON object.
@@ -279,26 +279,26 @@ pub(crate) struct MotionArgs {
     pub(crate) machine: PathBuf,
 
     /// Programmed cutting feed, mm/min.
-    #[arg(short, long, value_name = "MM_PER_MIN")]
+    #[arg(short, long, value_name = "MM_PER_MIN", value_parser = crate::guard::feed_mm_per_min)]
     pub(crate) feed: f64,
 
-    /// Interpolation cycle, seconds.
-    #[arg(short, long, default_value_t = 0.001, value_name = "S")]
+    /// Interpolation cycle, seconds (from 1e-5 to 0.1: 10 microseconds to 100 milliseconds).
+    #[arg(short, long, default_value_t = 0.001, value_name = "S", value_parser = crate::guard::cycle_s)]
     pub(crate) cycle: f64,
 
     /// Arc-fit tolerance, mm (default: the toolpath's tolerance, else 0.001).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) fit_tolerance: Option<f64>,
 
     /// Chord error allowed between two set-points on an arc, mm (caps the feed on small
     /// radii; default 0.001).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) chord_tolerance: Option<f64>,
 
     /// Between two contours the head backs off this far along the tool axis, traverses, and
     /// approaches the next start along its tool axis (mm; 0 = one straight rapid at cutting
     /// height). Choose it so that the traverse clears the part.
-    #[arg(long, default_value_t = 10.0, value_name = "MM")]
+    #[arg(long, default_value_t = 10.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
     pub(crate) retract: f64,
 }
 
@@ -384,7 +384,7 @@ pub(crate) struct RunArgs {
     pub(crate) machine: PathBuf,
 
     /// Chord tolerance in mm (every segment's chord error is at most this).
-    #[arg(short, long, default_value_t = 0.01, value_name = "MM")]
+    #[arg(short, long, default_value_t = 0.01, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) tolerance: f64,
 
     /// Output directory (created if needed).
@@ -392,11 +392,11 @@ pub(crate) struct RunArgs {
     pub(crate) out: PathBuf,
 
     /// Programmed cutting feed, mm/min.
-    #[arg(short, long, default_value_t = 6000.0, value_name = "MM_PER_MIN")]
+    #[arg(short, long, default_value_t = 6000.0, value_name = "MM_PER_MIN", value_parser = crate::guard::feed_mm_per_min)]
     pub(crate) feed: f64,
 
-    /// Interpolation cycle, seconds.
-    #[arg(short, long, default_value_t = 0.001, value_name = "S")]
+    /// Interpolation cycle, seconds (from 1e-5 to 0.1: 10 microseconds to 100 milliseconds).
+    #[arg(short, long, default_value_t = 0.001, value_name = "S", value_parser = crate::guard::cycle_s)]
     pub(crate) cycle: f64,
 
     /// The G-code dialect.
@@ -409,19 +409,19 @@ pub(crate) struct RunArgs {
     pub(crate) blend_tolerance: f64,
 
     /// Longest chord allowed, in mm.
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) max_segment_length: Option<f64>,
 
     /// Largest angle between neighbouring normals, degrees (default 1).
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
     pub(crate) max_normal_step: Option<f64>,
 
     /// Largest tool-tip deviation while the axes move linearly, mm (default 0.005).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
     pub(crate) linearization_tolerance: Option<f64>,
 
     /// Largest rotary-axis move between two points, degrees (default: no limit).
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
     pub(crate) max_rotary_step: Option<f64>,
 
     /// Where the part goes on the machine: `auto` (every pose within the axis limits, the
@@ -434,7 +434,7 @@ pub(crate) struct RunArgs {
     /// Between two contours the head backs off this far along the tool axis, traverses, and
     /// approaches the next start along its tool axis (mm; 0 = one straight rapid at cutting
     /// height). Choose it so that the traverse clears the part.
-    #[arg(long, default_value_t = 10.0, value_name = "MM")]
+    #[arg(long, default_value_t = 10.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
     pub(crate) retract: f64,
 
     /// Lead-in of every cut: the straight part from the pierce point, then the radius of the

@@ -1,7 +1,7 @@
 //! `kerf discretize`: cutting points with a certified chord error for every curve of a
 //! `kerf.curves/1` file, written as `kerf.toolpath/1`.
 
-use std::io::{self, Write};
+use std::io;
 use std::path::Path;
 use std::time::Instant;
 
@@ -26,7 +26,7 @@ pub(crate) fn load_curves(path: &Path) -> Result<CurvesFile, CliError> {
 }
 
 /// The discretizer options the arguments ask for.
-// `..d` keeps this compiling when the discretizer gains an option.
+// `..d` keeps the defaults of options added to `Options` later (every field is set today).
 #[allow(clippy::needless_update)]
 pub(crate) fn options(args: &DiscretizeArgs) -> Options {
     let d = Options::default();
@@ -37,7 +37,9 @@ pub(crate) fn options(args: &DiscretizeArgs) -> Options {
         min_segment_length: args.min_segment_length.unwrap_or(d.min_segment_length),
         max_turn: args.max_turn.map_or(d.max_turn, f64::to_radians),
         strategy: args.strategy.into(),
-        max_points: args.max_points.unwrap_or(d.max_points),
+        max_points: args
+            .max_points
+            .map_or(d.max_points, |n| usize::try_from(n).unwrap_or(usize::MAX)),
         ..d
     }
 }
@@ -85,6 +87,8 @@ pub(crate) fn discretize_file(
 pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let path = args.curves.as_path();
+    let dest = args.output.clone().unwrap_or_else(|| default_output(path));
+    crate::guard::refuse_overwrite("--output", &dest, &[path])?;
     let file = load_curves(path)?;
     let opts = options(args);
     let results = discretize_file(path, &file, &opts)?;
@@ -131,15 +135,8 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
         tolerance: opts.tolerance,
         paths,
     };
-    let dest = args.output.clone().unwrap_or_else(|| default_output(path));
-    if dest == Path::new("-") {
-        let stdout = io::stdout();
-        let mut lock = stdout.lock();
-        toolpath::to_writer(&out, &mut lock)?;
-        lock.flush()?;
-    } else {
-        toolpath::write(&out, &dest)?;
-    }
+    // `-` is standard output; kerf_io also writes devices and FIFOs through.
+    toolpath::write(&out, &dest)?;
     let segments: usize = results.iter().map(Discretization::segments).sum();
     let points: usize = out.paths.iter().map(|p| p.params.len()).sum();
     let worst = out

@@ -20,6 +20,9 @@ pub(crate) enum CliError {
     ),
     /// An input is unusable for this command (the message names file and place).
     Input(String),
+    /// The command line asks for something that cannot be done (an output that is also an
+    /// input); exit status 2 like clap's own usage errors.
+    Usage(String),
     /// A command-line option is out of range.
     Options(kerf_discretize::DiscretizeError),
     /// A curve's normals could not be found (off its surface, reversed orientation, ...), or
@@ -68,7 +71,7 @@ impl fmt::Display for CliError {
             }
             CliError::Kinematics(e, Some(file)) => write!(f, "{}: {e}", file.display()),
             CliError::Kinematics(e, None) => write!(f, "{e}"),
-            CliError::Input(m) => write!(f, "{m}"),
+            CliError::Input(m) | CliError::Usage(m) => write!(f, "{m}"),
             CliError::Check(e) => write!(f, "{e}"),
             CliError::CheckFailed {
                 toolpath,
@@ -85,12 +88,28 @@ impl fmt::Display for CliError {
                 index,
                 id,
                 error,
-            } => write!(f, "{}: curves[{index}] ({id:?}): {error}", file.display()),
+            } => {
+                write!(f, "{}: curves[{index}] ({id:?}): {error}", file.display())?;
+                if let Some(hint) = discretize_hint(error) {
+                    write!(f, " [{hint}]")?;
+                }
+                Ok(())
+            }
         }
     }
 }
 
 impl std::error::Error for CliError {}
+
+/// The command-line options that change the outcome of a discretizer error.
+fn discretize_hint(e: &kerf_discretize::DiscretizeError) -> Option<&'static str> {
+    use kerf_discretize::DiscretizeError as E;
+    match e {
+        E::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-points"),
+        E::ToleranceBelowPrecision { .. } => Some("option: a larger --tolerance"),
+        _ => None,
+    }
+}
 
 impl From<FormatError> for CliError {
     fn from(e: FormatError) -> Self {

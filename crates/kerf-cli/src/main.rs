@@ -11,6 +11,7 @@ mod cli;
 mod cuts;
 mod discretize;
 mod error;
+mod guard;
 mod motion;
 mod place;
 mod plot;
@@ -41,6 +42,10 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // The reader of our output went away (`kerf validate x | head -1`): nothing to report.
         Err(CliError::Output(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(e @ CliError::Usage(_)) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE

@@ -54,15 +54,15 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
     let machine = Machine::read(&args.machine)?;
     let model = MachineModel::new(machine.clone()).map_err(interp_err(&args.machine))?;
     let input = &args.input;
-    let text = std::fs::read_to_string(input)
+    let bytes = kerf_io::read_file(input)
         .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", input.display())))?;
-    let format = serde_json::from_str::<serde_json::Value>(&text)
+    let format = kerf_io::parse_json(&bytes)
         .ok()
         .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_owned))
         .unwrap_or_default();
     let mut linearization = None;
     let (ids, paths, file_tol) = if format == kerf_kinematics::AXES_FORMAT {
-        let axes = AxesFile::from_str(&text)
+        let axes = AxesFile::from_slice(&bytes)
             .map_err(|e| CliError::Kinematics(Box::new(e), Some(input.clone())))?;
         let mut paths = Vec::new();
         for p in &axes.paths {
@@ -82,7 +82,7 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
             None,
         )
     } else {
-        let tp = toolpath::from_str(&text).map_err(|e| e.in_file(input))?;
+        let tp = toolpath::from_reader(&bytes[..]).map_err(|e| e.in_file(input))?;
         linearization = Some(PathOptions::default().linearization_tolerance);
         let mut paths = Vec::new();
         for p in &tp.paths {
@@ -206,17 +206,21 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
 
 /// Runs `kerf interpolate`.
 pub(crate) fn run_interpolate(args: &InterpolateArgs) -> Result<(), CliError> {
+    if let Some(csv) = &args.csv {
+        crate::guard::refuse_overwrite("--csv", csv, &[&args.motion.input, &args.motion.machine])?;
+    }
     // Set-points are computed with tool-tip control: arcs are safe.
     let p = program(&args.motion, false)?;
     if let Some(csv) = &args.csv {
-        let rows = p.motion.setpoints(&p.model);
-        if csv == Path::new("-") {
-            let text = kerf_interp::csv_string(p.model.axis_names(), args.motion.cycle, &rows);
-            std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes())?;
-        } else {
-            write_csv(csv, p.model.axis_names(), args.motion.cycle, &rows)
-                .map_err(interp_err(csv))?;
-        }
+        // Streamed cycle by cycle from the plan into the file (or standard output): memory
+        // stays bounded however long the program runs.
+        write_csv(
+            csv,
+            p.model.axis_names(),
+            args.motion.cycle,
+            p.motion.iter(&p.model),
+        )
+        .map_err(interp_err(csv))?;
     }
     summary(&args.motion, &p, args.csv.as_ref(), args.json, args.quiet);
     Ok(())
@@ -252,6 +256,11 @@ pub(crate) fn write_program(p: &Program, dest: &Path, opts: &GcodeOptions) -> Re
 
 /// Runs `kerf gcode`.
 pub(crate) fn run_gcode(args: &GcodeArgs) -> Result<(), CliError> {
+    crate::guard::refuse_overwrite(
+        "--output",
+        &args.output,
+        &[&args.motion.input, &args.motion.machine],
+    )?;
     let dialect: Dialect = args.dialect.into();
     let p = program(&args.motion, dialect.raw_axes())?;
     let opts = GcodeOptions {

@@ -41,6 +41,17 @@ pub(crate) struct PlotArgs {
 
 /// Runs `kerf plot`.
 pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
+    let dest = args.output.clone().unwrap_or_else(|| {
+        let stem = args
+            .toolpath
+            .file_stem()
+            .map_or_else(|| "toolpath".into(), |s| s.to_string_lossy().into_owned());
+        format!("{stem}.svg").into()
+    });
+    let mut inputs = vec![args.curves.as_path(), args.toolpath.as_path()];
+    inputs.extend(args.axes.as_deref());
+    inputs.extend(args.machine.as_deref());
+    crate::guard::refuse_overwrite("--output", &dest, &inputs)?;
     let curves_file = curves::load(&args.curves)?;
     let tp = match toolpath::load(&args.toolpath) {
         Ok(tp) => tp,
@@ -75,10 +86,8 @@ pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
         scene.subtitle
     );
     if let Some(axes_path) = &args.axes {
-        let text = std::fs::read_to_string(axes_path)
-            .map_err(|e| CliError::Plot(format!("{}: cannot read: {e}", axes_path.display())))?;
-        let axes = AxesFile::from_str(&text)
-            .map_err(|e| CliError::Plot(format!("{}: {e}", axes_path.display())))?;
+        // The same front end as every reader: bounded, BOM skipped, duplicate keys refused.
+        let axes = AxesFile::read(axes_path).map_err(|e| CliError::Plot(e.to_string()))?;
         let machine = args
             .machine
             .as_ref()
@@ -95,13 +104,6 @@ pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
         scene.axes = Some(chart);
     }
     let svg = render(&scene);
-    let dest = args.output.clone().unwrap_or_else(|| {
-        let stem = args
-            .toolpath
-            .file_stem()
-            .map_or_else(|| "toolpath".into(), |s| s.to_string_lossy().into_owned());
-        format!("{stem}.svg").into()
-    });
     write_svg(&dest, &svg)
         .map_err(|e| CliError::Plot(format!("{}: cannot write: {e}", dest.display())))?;
     if !args.quiet && dest != Path::new("-") {

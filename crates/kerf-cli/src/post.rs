@@ -27,6 +27,11 @@ pub(crate) fn options(args: &PostArgs) -> PathOptions {
 /// Runs `kerf post`.
 pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
     let start = Instant::now();
+    let dest = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.toolpath));
+    crate::guard::refuse_overwrite("--output", &dest, &[&args.toolpath, &args.machine])?;
     let machine = Machine::read(&args.machine)?;
     let tp = toolpath::load(&args.toolpath)?;
     let mut poses = Vec::with_capacity(tp.paths.len());
@@ -70,10 +75,6 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
     let solved = solve_paths(&machine, &inputs, &opts)
         .map_err(|e| CliError::Kinematics(Box::new(e), Some(args.toolpath.clone())))?;
     let file = AxesFile::new(&machine, &solved);
-    let dest = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&args.toolpath));
     file.write(&dest)?;
     let inserted: usize = solved.iter().map(|s| s.inserted).sum();
     let points: usize = solved.iter().map(|s| s.poses.len()).sum();

@@ -2,15 +2,17 @@
 //! machine axes, interpolation and G-code, with a report and a picture, all written into one
 //! output directory only once every stage has succeeded.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use kerf_discretize::Discretization;
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_interp::{
-    csv_string, gcode_motion, stations_from_solved, AxisModel, Dialect, GcodeOptions, MachineModel,
+    gcode_motion, stations_from_solved, write_csv_to, AxisModel, Dialect, GcodeOptions,
+    MachineModel,
     PathInput as InterpPath, PlanOptions,
 };
+use kerf_io::DirEntry;
 use kerf_kinematics::{solve_paths, AxesFile, Machine, PathCurve, PathInput, PathOptions, Pose};
 use kerf_normals::Oriented;
 use serde_json::json;
@@ -23,6 +25,13 @@ use crate::error::CliError;
 pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let path = args.curves.as_path();
+    for name in OUTPUTS {
+        crate::guard::refuse_overwrite(
+            "--out",
+            &args.out.join(name),
+            &[path, args.machine.as_path()],
+        )?;
+    }
     let file = load_curves(path)?;
     let machine = Machine::read(&args.machine)?;
     let dopts = kerf_discretize::Options {
@@ -123,7 +132,6 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     };
     let mut motions = Vec::new();
     let mut programs = Vec::new();
-    let mut setpoint_files = Vec::new();
     let mut setup_ids: Vec<Vec<String>> = Vec::new();
     for setup in 0..placed.plan.setups.len() {
         let mut ipaths = Vec::new();
@@ -144,11 +152,6 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             kerf_interp::interpolate(&model, &ipaths, &fit, &plan).map_err(interp(path))?;
         programs.push(gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?);
         setup_ids.push(ids);
-        setpoint_files.push(csv_string(
-            model.axis_names(),
-            args.cycle,
-            &motion.setpoints(&model),
-        ));
         motions.push(motion);
     }
     let process =
@@ -253,27 +256,59 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         },
         "seconds": start.elapsed().as_secs_f64(),
     });
-    // 6. Write everything at once.
+    // 6. Write everything at once; the set-points are streamed from the plan into the file.
     let names = program_names(programs.len());
     let csv_names = csv_names(programs.len());
-    let mut files: Vec<(&str, String)> = vec![
-        ("toolpath.json", toolpath::to_string(&tp)?),
-        (
-            "axes.json",
-            axes.to_json()
-                .map_err(|e| CliError::Kinematics(Box::new(e), None))?,
-        ),
-    ];
-    for (k, (program, setpoints)) in programs.into_iter().zip(setpoint_files).enumerate() {
-        files.push((names[k].as_str(), program));
-        files.push((csv_names[k].as_str(), setpoints));
+    for name in names.iter().chain(&csv_names) {
+        crate::guard::refuse_overwrite(
+            "--out",
+            &args.out.join(name),
+            &[path, args.machine.as_path()],
+        )?;
     }
-    files.push((
-        "report.json",
-        serde_json::to_string_pretty(&report).unwrap_or_else(|_| report.to_string()),
-    ));
-    files.push(("plot.svg", svg));
-    write_all(&args.out, &files)?;
+    let toolpath_text = toolpath::to_string(&tp)?;
+    let axes_text = axes
+        .to_json()
+        .map_err(|e| CliError::Kinematics(Box::new(e), None))?;
+    let report_text = serde_json::to_string_pretty(&report).unwrap_or_else(|_| report.to_string());
+    let text = |s: &str| {
+        let bytes = s.as_bytes().to_vec();
+        Box::new(move |w: &mut dyn std::io::Write| w.write_all(&bytes)) as kerf_io::Contents<'_>
+    };
+    let axis_names = model.axis_names();
+    let mut entries = vec![
+        DirEntry {
+            name: OUTPUTS[0],
+            contents: text(&toolpath_text),
+        },
+        DirEntry {
+            name: OUTPUTS[1],
+            contents: text(&axes_text),
+        },
+    ];
+    for (k, (program, motion)) in programs.iter().zip(&motions).enumerate() {
+        entries.push(DirEntry {
+            name: names[k].as_str(),
+            contents: text(program),
+        });
+        let model = &model;
+        entries.push(DirEntry {
+            name: csv_names[k].as_str(),
+            contents: Box::new(move |w| {
+                write_csv_to(w, axis_names, args.cycle, motion.iter(model))
+            }),
+        });
+    }
+    entries.push(DirEntry {
+        name: OUTPUTS[4],
+        contents: text(&report_text),
+    });
+    entries.push(DirEntry {
+        name: OUTPUTS[5],
+        contents: text(&svg),
+    });
+    kerf_io::write_dir_all_or_nothing(&args.out, entries)
+        .map_err(|e| CliError::Input(e.to_string()))?;
     if args.json {
         println!("{report}");
     } else if !args.quiet {
@@ -324,47 +359,13 @@ fn interp(file: &Path) -> impl Fn(kerf_interp::InterpError) -> CliError + '_ {
     move |e| CliError::Input(format!("{}: {e}", file.display()))
 }
 
-/// Writes every file into `dir`, all or nothing: the new files are written into a staging
-/// directory inside `dir`; then, file by file, an existing old file is moved aside into the
-/// staging directory and the new one renamed into place. If any step fails, the files already
-/// placed are removed and the old ones put back, so `dir` is left as it was. (A crash between
-/// two renames can still leave a mix; the staging directory then remains, named `.kerf-run-*`.)
-fn write_all(dir: &Path, files: &[(&str, String)]) -> Result<(), CliError> {
-    let io = |what: &Path, e: std::io::Error| {
-        CliError::Input(format!("{}: cannot write: {e}", what.display()))
-    };
-    std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
-    let stage = tempfile::Builder::new()
-        .prefix(".kerf-run-")
-        .tempdir_in(dir)
-        .map_err(|e| io(dir, e))?;
-    for (name, text) in files {
-        let p = stage.path().join(name);
-        std::fs::write(&p, text).map_err(|e| io(&p, e))?;
-    }
-    let mut old: Vec<(PathBuf, PathBuf)> = Vec::new();
-    let mut placed: Vec<PathBuf> = Vec::new();
-    let mut swap = || -> Result<(), CliError> {
-        for (name, _) in files {
-            let to = dir.join(name);
-            if std::fs::symlink_metadata(&to).is_ok() {
-                let aside = stage.path().join(format!("{name}.old"));
-                std::fs::rename(&to, &aside).map_err(|e| io(&to, e))?;
-                old.push((aside, to.clone()));
-            }
-            std::fs::rename(stage.path().join(name), &to).map_err(|e| io(&to, e))?;
-            placed.push(to);
-        }
-        Ok(())
-    };
-    let result = swap();
-    if result.is_err() {
-        for p in placed.iter().rev() {
-            let _ = std::fs::remove_file(p);
-        }
-        for (aside, to) in old.iter().rev() {
-            let _ = std::fs::rename(aside, to);
-        }
-    }
-    result
-}
+/// The files `kerf run` writes into its output directory, all or nothing (through
+/// [`kerf_io::write_dir_all_or_nothing`]).
+const OUTPUTS: [&str; 6] = [
+    "toolpath.json",
+    "axes.json",
+    "program.nc",
+    "setpoints.csv",
+    "report.json",
+    "plot.svg",
+];

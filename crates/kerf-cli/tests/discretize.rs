@@ -87,14 +87,15 @@ fn stdout_output_and_json_summary() {
 fn bad_options_and_bad_input_leave_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.json");
-    for (args, file, needle) in [
-        (vec!["-t", "0"], "mixed.json", "tolerance"),
-        (vec!["-t", "nan"], "mixed.json", "tolerance"),
-        (vec!["--band", "1.5"], "mixed.json", "band"),
-        (vec![], "bad/decreasing_knots.json", "curves[1].knots[5]"),
-        (vec![], "bad/negative_weight.json", "weight"),
-        (vec![], "bad/malformed.json", "line"),
-        (vec![], "no-such-file.json", "no-such-file.json"),
+    // Option values out of range are usage errors (exit 2), bad input exit 1.
+    for (args, file, needle, code) in [
+        (vec!["-t", "0"], "mixed.json", "tolerance", 2),
+        (vec!["-t", "nan"], "mixed.json", "tolerance", 2),
+        (vec!["--band", "1.5"], "mixed.json", "band", 2),
+        (vec![], "bad/decreasing_knots.json", "curves[1].knots[5]", 1),
+        (vec![], "bad/negative_weight.json", "weight", 1),
+        (vec![], "bad/malformed.json", "line", 1),
+        (vec![], "no-such-file.json", "no-such-file.json", 1),
     ] {
         let o = kerf()
             .arg("discretize")
@@ -107,8 +108,8 @@ fn bad_options_and_bad_input_leave_no_file() {
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert_eq!(
             o.status.code(),
-            Some(1),
-            "{file} {args:?}: exit 1, stderr {stderr}"
+            Some(code),
+            "{file} {args:?}: exit {code}, stderr {stderr}"
         );
         assert!(
             stderr.contains(needle),

@@ -349,7 +349,7 @@ fn from_slice(bytes: &[u8], base_dir: &Path) -> Result<CurvesFile> {
 ///
 /// # Errors
 /// [`FormatError::UnsupportedFormat`], [`FormatError::UnsupportedUnits`],
-/// [`FormatError::EmptyId`], [`FormatError::DuplicateId`], [`FormatError::Curve`],
+/// [`FormatError::EmptyId`], [`FormatError::UnsafeText`], [`FormatError::DuplicateId`], [`FormatError::Curve`],
 /// [`FormatError::Surface`], [`FormatError::Mesh`], [`FormatError::Stl`] or
 /// [`FormatError::UnknownSurface`].
 pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
@@ -499,7 +499,8 @@ pub(crate) fn check_mesh(
     Ok(())
 }
 
-/// Tracks the ids of one list (`curves` or `surfaces`) to report empty and duplicate ones.
+/// Tracks the ids of one list (`curves`, `surfaces` or `paths`) to report empty, unsafe and
+/// duplicate ones.
 #[derive(Default)]
 pub(crate) struct IdSet {
     seen: HashMap<String, usize>,
@@ -511,6 +512,12 @@ impl IdSet {
         if id.is_empty() {
             return Err(FormatError::EmptyId {
                 path: format!("{list}[{index}].id"),
+            });
+        }
+        if let Err(defect) = kerf_io::check_text(id) {
+            return Err(FormatError::UnsafeText {
+                path: format!("{list}[{index}].id"),
+                defect,
             });
         }
         if let Some(&first) = self.seen.get(id) {

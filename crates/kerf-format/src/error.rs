@@ -126,6 +126,16 @@ pub enum FormatError {
         /// JSON path of the id, e.g. `curves[2].id`.
         path: String,
     },
+    /// An id holds a control character or a line break (`\n`, `\r`, NUL, U+2028, ...). Ids are
+    /// written into G-code comments, where a line break would start a block of its own (a
+    /// rapid move, `M30`) that is no part of any path. Fix: use one line of printable text.
+    #[error("{path}: {defect}")]
+    UnsafeText {
+        /// JSON path of the text, e.g. `curves[2].id`.
+        path: String,
+        /// The offending character and its position.
+        defect: kerf_io::TextDefect,
+    },
     /// Two curves, two surfaces or two toolpaths share an id. Fix: make the ids unique (curves
     /// and surfaces have separate name spaces).
     #[error("{path}: duplicate id \"{id}\" (already used by {first})")]

@@ -11,8 +11,9 @@
 //! 3. deserialize the typed structs through `serde_path_to_error`, so that a control point with
 //!    two coordinates is reported as `curves[0].control_points[2]: invalid length 2, ...`.
 //!
-//! Known limit: a key given twice in one object keeps its last value (serde_json's `Value`
-//! does so silently).
+//! Step 1 is [`kerf_io::parse_json`], the front end every kerf reader shares: a byte-order mark
+//! is skipped, a key given twice in one object is refused with its JSON path, and inputs are
+//! read up to [`kerf_io::MAX_INPUT_BYTES`].
 
 use std::io::Read;
 use std::path::Path;
@@ -20,32 +21,45 @@ use std::path::Path;
 use serde::de::DeserializeOwned;
 use serde_json::{Map, Value};
 
+use kerf_io::JsonError;
+
 use crate::error::{json_type_name, FormatError, Result};
 use crate::Units;
 
-/// Reads a whole file.
+/// Reads a whole file, at most [`kerf_io::MAX_INPUT_BYTES`].
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|error| FormatError::Read { error })
+    kerf_io::read_file(path).map_err(|error| FormatError::Read { error })
 }
 
-/// Reads a whole reader.
-pub(crate) fn read_all(mut reader: impl Read) -> Result<Vec<u8>> {
-    let mut bytes = Vec::new();
-    reader
-        .read_to_end(&mut bytes)
-        .map_err(|error| FormatError::Read { error })?;
-    Ok(bytes)
+/// Reads a whole reader, at most [`kerf_io::MAX_INPUT_BYTES`].
+pub(crate) fn read_all(reader: impl Read) -> Result<Vec<u8>> {
+    kerf_io::read_to_end(reader, kerf_io::MAX_INPUT_BYTES)
+        .map_err(|error| FormatError::Read { error })
 }
 
 /// Parses `bytes` as a JSON object whose `format` is `expected` and whose `units` are `"mm"`.
 pub(crate) fn parse_document(bytes: &[u8], expected: &'static str) -> Result<Map<String, Value>> {
-    // Editors on Windows like to start UTF-8 files with a byte-order mark; JSON forbids it but
-    // it carries no information, so skip it rather than fail at "line 1, column 1".
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    if bytes.iter().all(u8::is_ascii_whitespace) {
-        return Err(FormatError::Empty { expected });
-    }
-    let value: Value = serde_json::from_slice(bytes).map_err(|e| syntax_error(bytes, &e))?;
+    let value = kerf_io::parse_json(bytes).map_err(|e| match e {
+        JsonError::Empty => FormatError::Empty { expected },
+        JsonError::Syntax {
+            line,
+            column,
+            path,
+            message,
+        } => FormatError::Syntax {
+            line,
+            column,
+            path,
+            message,
+        },
+        JsonError::DuplicateKey { path, line } => FormatError::Shape {
+            path,
+            message: format!(
+                "key given twice in one object (line {line}); readers disagree on which one \
+                 counts, so remove one of them"
+            ),
+        },
+    })?;
     let Value::Object(map) = value else {
         return Err(FormatError::NotAnObject {
             expected,
@@ -129,101 +143,6 @@ fn tidy_message(message: &str) -> String {
         .replace("invalid type: sequence", "invalid type: array")
 }
 
-/// Turns a serde_json parse error into [`FormatError::Syntax`] with the JSON path of the
-/// position.
-fn syntax_error(bytes: &[u8], e: &serde_json::Error) -> FormatError {
-    let (line, column) = (e.line(), e.column());
-    let full = e.to_string();
-    let suffix = format!(" at line {line} column {column}");
-    let message = full.strip_suffix(&suffix).unwrap_or(&full);
-    let message = if message == "number out of range" {
-        "number out of range (a number must fit in a double: |x| < 1.8e308)".to_owned()
-    } else {
-        message.to_owned()
-    };
-    FormatError::Syntax {
-        line,
-        column,
-        path: path_at(bytes, offset_of(bytes, line, column)),
-        message,
-    }
-}
-
-/// The byte offset of serde_json's 1-based `line` and `column` (the column counts bytes; the
-/// offending byte itself is excluded).
-fn offset_of(bytes: &[u8], line: usize, column: usize) -> usize {
-    let mut start = 0;
-    for _ in 1..line {
-        match bytes[start..].iter().position(|&b| b == b'\n') {
-            Some(n) => start += n + 1,
-            None => return bytes.len(),
-        }
-    }
-    (start + column.saturating_sub(1)).min(bytes.len())
-}
-
-/// The JSON path of the value being read at byte `offset` of `bytes`, e.g.
-/// `curves[0].knots[3]`, or an empty string at the top level.
-///
-/// Scans the (well-formed, since the parser got that far) text before `offset`, keeping a stack
-/// of the open arrays with their current index and the open objects with their current key.
-pub(crate) fn path_at(bytes: &[u8], offset: usize) -> String {
-    enum Frame {
-        Array(usize),
-        Object(Option<String>),
-    }
-    let end = offset.min(bytes.len());
-    let mut stack: Vec<Frame> = Vec::new();
-    let mut i = 0;
-    while i < end {
-        match bytes[i] {
-            b'{' => stack.push(Frame::Object(None)),
-            b'[' => stack.push(Frame::Array(0)),
-            b'}' | b']' => {
-                stack.pop();
-            }
-            b',' => match stack.last_mut() {
-                Some(Frame::Array(n)) => *n += 1,
-                Some(Frame::Object(key)) => *key = None,
-                None => {}
-            },
-            b'"' => {
-                let start = i;
-                i += 1;
-                while i < end && bytes[i] != b'"' {
-                    i += if bytes[i] == b'\\' { 2 } else { 1 };
-                }
-                if i >= end {
-                    break;
-                }
-                if let Some(Frame::Object(key @ None)) = stack.last_mut() {
-                    let raw = &bytes[start..=i];
-                    *key = Some(
-                        serde_json::from_slice::<String>(raw)
-                            .unwrap_or_else(|_| String::from_utf8_lossy(raw).into_owned()),
-                    );
-                }
-            }
-            _ => {}
-        }
-        i += 1;
-    }
-    let mut path = String::new();
-    for frame in &stack {
-        match frame {
-            Frame::Array(n) => path.push_str(&format!("[{n}]")),
-            Frame::Object(Some(key)) => {
-                if !path.is_empty() {
-                    path.push('.');
-                }
-                path.push_str(key);
-            }
-            Frame::Object(None) => break,
-        }
-    }
-    path
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -275,6 +194,21 @@ mod tests {
             panic!("expected a syntax error, got {err:?}");
         };
         assert_eq!((line, column), (3, 3), "position of the unexpected key");
+    }
+
+    #[test]
+    fn duplicate_keys_are_refused_with_their_path() {
+        let e = parse_document(
+            b"{\"format\": \"kerf.curves/1\", \"units\": \"mm\",\n \"curves\": [{\"id\": \"a\", \"id\": \"b\"}]}",
+            "kerf.curves/1",
+        )
+        .expect_err("duplicate");
+        assert_eq!(
+            e.to_string(),
+            "curves[0].id: key given twice in one object (line 2); readers disagree on which \
+             one counts, so remove one of them",
+            "path and line"
+        );
     }
 
     #[test]

@@ -32,9 +32,10 @@ pub struct StlMesh {
 /// Reads a binary or ASCII STL file.
 ///
 /// # Errors
-/// [`StlProblem::Read`] if the file cannot be read, else as [`parse`].
+/// [`StlProblem::Read`] if the file cannot be read or is larger than
+/// [`kerf_io::MAX_INPUT_BYTES`], else as [`parse`].
 pub fn read(path: &Path) -> Result<StlMesh, StlProblem> {
-    let bytes = std::fs::read(path).map_err(|error| StlProblem::Read { error })?;
+    let bytes = kerf_io::read_file(path).map_err(|error| StlProblem::Read { error })?;
     parse(bytes)
 }
 

@@ -132,7 +132,8 @@ impl ToolpathFile {
     /// Checks every rule of the format (see the module documentation).
     ///
     /// # Errors
-    /// [`FormatError::BadNumber`], [`FormatError::EmptyId`], [`FormatError::DuplicateId`],
+    /// [`FormatError::BadNumber`], [`FormatError::EmptyId`], [`FormatError::UnsafeText`],
+    /// [`FormatError::DuplicateId`],
     /// [`FormatError::PathCount`], [`FormatError::ParamsNotIncreasing`],
     /// [`FormatError::NotUnitNormal`] or [`FormatError::ChordErrorAboveTolerance`].
     pub fn validate(&self) -> Result<()> {
@@ -226,10 +227,11 @@ fn validate_path(index: usize, path: &ToolPath, tolerance: f64) -> Result<()> {
 
 /// Checks `file` and writes it to `dest`, atomically; `-` means standard output.
 ///
-/// The document goes to a temporary file in `dest`'s directory, which is renamed to `dest`
-/// once completely written and flushed; on any failure the temporary file is removed and
-/// `dest` is untouched. The new file gets the permissions of a newly created file (the umask
-/// applies), not the temporary file's private ones.
+/// Written by [`kerf_io::write_file`]: the document goes to a temporary file in `dest`'s
+/// directory, which is renamed to `dest` once completely written and flushed; on any failure
+/// the temporary file is removed and `dest` is untouched. A device or FIFO is written through,
+/// a symbolic link's target is written. A new file gets the permissions of a newly created
+/// file (the umask applies); a replaced one keeps its mode.
 ///
 /// # Errors
 /// Any error of [`ToolpathFile::validate`], or [`FormatError::Write`]; wrapped in
@@ -237,16 +239,8 @@ fn validate_path(index: usize, path: &ToolPath, tolerance: f64) -> Result<()> {
 pub fn write(file: &ToolpathFile, dest: impl AsRef<Path>) -> Result<()> {
     let dest = dest.as_ref();
     let result = file.validate().and_then(|()| {
-        if dest == Path::new("-") {
-            let stdout = io::stdout();
-            let mut w = BufWriter::new(stdout.lock());
-            write_json(file, &mut w)
-                .and_then(|()| w.flush())
-                .map_err(|error| FormatError::Write { error })
-        } else {
-            write_atomically(dest, |w| write_json(file, w))
-                .map_err(|error| FormatError::Write { error })
-        }
+        kerf_io::write_file(dest, |mut w| write_json(file, &mut w))
+            .map_err(|error| FormatError::Write { error })
     });
     result.map_err(|e| e.in_file(dest))
 }
@@ -273,35 +267,6 @@ pub fn to_string(file: &ToolpathFile) -> Result<String> {
     // The writer emits valid UTF-8 (ids are Rust strings, everything else ASCII), so the
     // lossy conversion never replaces anything.
     Ok(String::from_utf8_lossy(&bytes).into_owned())
-}
-
-/// Writes to a temporary file beside `dest`, then renames it to `dest`.
-pub(crate) fn write_atomically(
-    dest: &Path,
-    contents: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> io::Result<()>,
-) -> io::Result<()> {
-    let dir = match dest.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".kerf-").suffix(".tmp");
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        // Like a file created by `File::create`: 0o666 less the umask (the default of
-        // tempfile is 0o600).
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut tmp = builder.tempfile_in(dir)?;
-    {
-        let mut w = BufWriter::new(tmp.as_file_mut());
-        contents(&mut w)?;
-        w.flush()?;
-    }
-    tmp.as_file().sync_all()?;
-    tmp.persist(dest).map_err(|e| e.error)?;
-    Ok(())
 }
 
 /// Writes the JSON text: keys in the order of the format description, one point per line.
@@ -730,7 +695,7 @@ mod tests {
         let dir = tempfile::tempdir().expect("temp dir");
         let dest = dir.path().join("out.json");
         // Failure in the middle of writing.
-        let result = write_atomically(&dest, |w| {
+        let result = kerf_io::write_file(&dest, |w| {
             w.write_all(b"{\"format\": ")?;
             Err(io::Error::other("disk full"))
         });

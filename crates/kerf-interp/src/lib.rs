@@ -66,8 +66,8 @@ pub use geometry::Arc;
 pub use machine::{stations_from_axes, stations_from_solved, MachineModel};
 pub use model::{AcHead, AxisLimits, AxisModel};
 pub use output::{
-    csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_gcode, Dialect, GcodeOptions,
-    ProcessCodes,
+    csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_csv_to, write_gcode, Dialect,
+    GcodeOptions, ProcessCodes,
 };
 pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PathStats, PlanOptions};
 

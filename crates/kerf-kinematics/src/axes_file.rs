@@ -20,9 +20,9 @@
 //! of the format may ignore them.
 //!
 //! Numbers are written with Rust's shortest round-trip formatting, so reading the file back
-//! gives the same doubles. The file is written to a temporary file in the destination's
-//! directory and renamed over the destination once complete: a failure never leaves a
-//! half-written file.
+//! gives the same doubles. The file is written by [`kerf_io::write_file`]: to a temporary file
+//! in the destination's directory, renamed over the destination once complete (a failure never
+//! leaves a half-written file); a device or FIFO is written through.
 
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -162,8 +162,11 @@ impl AxesFile {
                 ),
             ));
         }
+        // The machine name and the path ids are written into program comments.
+        crate::json::check_text("machine", &self.machine)?;
         for (n, p) in self.paths.iter().enumerate() {
             let at = |key: &str| format!("paths[{n}].{key}");
+            crate::json::check_text(&at("id"), &p.id)?;
             for (key, m) in [("lead_in", &p.lead_in), ("lead_out", &p.lead_out)] {
                 if let Some(m) = m {
                     if m.positions.len() != m.poses.len() {
@@ -265,34 +268,22 @@ impl AxesFile {
     pub fn write(&self, dest: impl AsRef<Path>) -> Result<()> {
         let dest = dest.as_ref();
         self.validate()?;
-        if dest == Path::new("-") {
-            return self.to_writer(io::stdout().lock());
-        }
-        let dir = match dest.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => Path::new("."),
-        };
-        let name = dest.display().to_string();
-        let result = (|| -> io::Result<()> {
-            let mut builder = tempfile::Builder::new();
-            builder.prefix(".kerf-axes-").suffix(".tmp");
-            #[cfg(unix)]
-            {
-                use std::os::unix::fs::PermissionsExt;
-                // Like File::create: 0o666 less the umask (tempfile's default is 0o600).
-                builder.permissions(std::fs::Permissions::from_mode(0o666));
-            }
-            let mut tmp = builder.tempfile_in(dir)?;
-            {
-                let mut w = BufWriter::new(tmp.as_file_mut());
-                self.write_json(&mut w)?;
-                w.flush()?;
-            }
-            tmp.as_file().sync_all()?;
-            tmp.persist(dest).map_err(|e| e.error)?;
-            Ok(())
-        })();
-        result.map_err(|e| io_error(&name, &e))
+        kerf_io::write_file(dest, |mut w| self.write_json(&mut w))
+            .map_err(|e| io_error(&dest.display().to_string(), &e))
+    }
+
+    /// Reads a `kerf.axes/1` file (at most [`kerf_io::MAX_INPUT_BYTES`]).
+    ///
+    /// # Errors
+    /// [`KinematicsError::Io`] if the file cannot be read, else the errors of
+    /// [`AxesFile::from_slice`] wrapped in [`KinematicsError::File`] naming the file.
+    pub fn read(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let bytes = crate::json::read(path)?;
+        Self::from_slice(&bytes).map_err(|error| KinematicsError::File {
+            file: path.display().to_string(),
+            error: Box::new(error),
+        })
     }
 
     /// Reads `kerf.axes/1` JSON text.
@@ -302,15 +293,16 @@ impl AxesFile {
     /// wrong shape or a failed [`AxesFile::validate`].
     #[allow(clippy::should_implement_trait)] // as Machine::from_str
     pub fn from_str(text: &str) -> Result<Self> {
-        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| {
-            let full = e.to_string();
-            let suffix = format!(" at line {} column {}", e.line(), e.column());
-            KinematicsError::Syntax {
-                line: e.line(),
-                column: e.column(),
-                message: full.strip_suffix(&suffix).unwrap_or(&full).to_owned(),
-            }
-        })?;
+        Self::from_slice(text.as_bytes())
+    }
+
+    /// Reads `kerf.axes/1` JSON bytes (a UTF-8 byte-order mark is skipped, a key given twice
+    /// in one object is refused).
+    ///
+    /// # Errors
+    /// As [`AxesFile::from_str`].
+    pub fn from_slice(bytes: &[u8]) -> Result<Self> {
+        let value = crate::json::parse(bytes)?;
         match value.get("format") {
             Some(serde_json::Value::String(s)) if s == AXES_FORMAT => {}
             other => {

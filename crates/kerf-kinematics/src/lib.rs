@@ -37,6 +37,7 @@ pub mod axes_file;
 pub mod error;
 pub mod fork_head;
 pub mod head_table;
+mod json;
 pub mod kinematics;
 pub mod machine;
 pub mod nonlinear;

@@ -271,6 +271,8 @@ impl Machine {
         if self.name.trim().is_empty() {
             return Err(KinematicsError::doc("name", "must not be empty"));
         }
+        // The name is written into program headers.
+        crate::json::check_text("name", &self.name)?;
         let names = self.axis_names();
         for axis in Axis::ALL {
             let name = names[axis.index()];
@@ -347,14 +349,9 @@ impl Machine {
     /// the file: `machine.json: limits.A: min 10 > max -10`.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| KinematicsError::Io {
-            file: file.clone(),
-            action: "read",
-            message: e.to_string(),
-        })?;
-        Self::from_str(&text).map_err(|error| KinematicsError::File {
-            file,
+        let bytes = crate::json::read(path)?;
+        Self::from_slice(&bytes).map_err(|error| KinematicsError::File {
+            file: path.display().to_string(),
             error: Box::new(error),
         })
     }
@@ -362,21 +359,19 @@ impl Machine {
     /// Reads a machine from `kerf.machine/1` JSON text.
     ///
     /// # Errors
-    /// [`KinematicsError::Syntax`] for malformed JSON, [`KinematicsError::Document`] naming
-    /// the JSON path of the first defect.
+    /// As [`Machine::from_slice`].
     #[allow(clippy::should_implement_trait)] // FromStr would hide the error type's meaning.
     pub fn from_str(text: &str) -> Result<Self> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let value: Value = serde_json::from_str(text).map_err(|e| {
-            let full = e.to_string();
-            let suffix = format!(" at line {} column {}", e.line(), e.column());
-            KinematicsError::Syntax {
-                line: e.line(),
-                column: e.column(),
-                message: full.strip_suffix(&suffix).unwrap_or(&full).to_owned(),
-            }
-        })?;
-        Self::from_value(&value)
+        Self::from_slice(text.as_bytes())
+    }
+
+    /// Reads a machine from `kerf.machine/1` JSON bytes (a UTF-8 byte-order mark is skipped).
+    ///
+    /// # Errors
+    /// [`KinematicsError::Syntax`] for malformed JSON, [`KinematicsError::Document`] naming
+    /// the JSON path of the first defect (a key given twice in one object is one).
+    pub fn from_slice(bytes: &[u8]) -> Result<Self> {
+        Self::from_value(&crate::json::parse(bytes)?)
     }
 
     /// Reads a machine from a parsed JSON document.

@@ -47,7 +47,7 @@
 //! assert_eq!(svg.matches("class=\"pt\"").count(), 3 * 4, "3 points in 4 views");
 //! ```
 
-use std::io::{self, Write};
+use std::io;
 use std::path::Path;
 
 mod charts;
@@ -167,36 +167,15 @@ pub fn render(scene: &Scene) -> String {
     doc.finish()
 }
 
-/// Writes `svg` to `dest` atomically: to a temporary file in the same directory, renamed over
-/// `dest` once complete, so that a failure never leaves a partial picture. `-` writes to
-/// standard output.
+/// Writes `svg` to `dest` through [`kerf_io::write_file`]: atomically (a temporary file in the
+/// same directory, renamed over `dest` once complete, so that a failure never leaves a partial
+/// picture) onto a new path or a regular file, written through to a device or FIFO; a
+/// symbolic link's target is written. `-` writes to standard output.
 ///
 /// # Errors
 /// Any I/O error; `dest` is then untouched.
 pub fn write_svg(dest: impl AsRef<Path>, svg: &str) -> io::Result<()> {
-    let dest = dest.as_ref();
-    if dest == Path::new("-") {
-        let mut out = io::stdout().lock();
-        out.write_all(svg.as_bytes())?;
-        return out.flush();
-    }
-    let dir = match dest.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".kerf-plot-").suffix(".tmp");
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        // Like a file made by File::create: 0o666 less the umask (tempfile's default is 0o600).
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut tmp = builder.tempfile_in(dir)?;
-    tmp.write_all(svg.as_bytes())?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(dest).map_err(|e| e.error)?;
-    Ok(())
+    kerf_io::write_file(dest.as_ref(), |w| w.write_all(svg.as_bytes()))
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@ mod check;
 mod cli;
 mod discretize;
 mod error;
+mod import;
 mod motion;
 mod plot;
 mod post;
@@ -34,6 +35,7 @@ fn main() -> ExitCode {
         Command::Gcode(args) => motion::run_gcode(args),
         Command::Check(args) => check::run(args),
         Command::Plot(args) => plot::run(args),
+        Command::Import(args) => import::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -23,7 +23,15 @@ use crate::error::CliError;
 pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let path = args.curves.as_path();
-    let file = load_curves(path)?;
+    let file = if crate::import::is_step(path) {
+        let (file, import) = crate::import::load_step(path, &args.step_args)?;
+        if !args.quiet && !args.json {
+            crate::import::print_account(path, &import);
+        }
+        file
+    } else {
+        load_curves(path)?
+    };
     let machine = Machine::read(&args.machine)?;
     let dopts = kerf_discretize::Options {
         max_segment_length: args.max_segment_length.unwrap_or(f64::INFINITY),

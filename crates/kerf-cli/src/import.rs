@@ -31,6 +31,10 @@ pub(crate) struct StepArgs {
     /// STEP: a contour lies on the faces within this distance (mm) of every dense sample.
     #[arg(long, default_value_t = 0.01, value_name = "MM")]
     pub(crate) face_tolerance: f64,
+
+    /// STEP: write every face read as a surface, not only those a contour lies on.
+    #[arg(long)]
+    pub(crate) all_faces: bool,
 }
 
 /// Arguments of `kerf import`.
@@ -68,7 +72,8 @@ pub(crate) fn is_step(path: &Path) -> bool {
 fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
     let mut o = ImportOptions::default()
         .with_close_gaps(a.close_gaps)
-        .with_face_tolerance(a.face_tolerance);
+        .with_face_tolerance(a.face_tolerance)
+        .with_all_faces(a.all_faces);
     if a.edges {
         let ids = a
             .faces

@@ -116,10 +116,11 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
     for q in &vertices {
         add(q);
     }
-    if us.is_empty() {
+    let (pu, pv) = g.periodic();
+    let whole = loops.is_empty();
+    if whole && !matches!(g, Geometry::Sphere(..) | Geometry::Torus(..)) {
         return Err(err(inst, "a face without a boundary edge"));
     }
-    let (pu, pv) = g.periodic();
     let range = |x: &[f64], periodic: bool| {
         if periodic {
             angle_range(x, FULL_TURN_GAP)
@@ -129,8 +130,14 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
             (lo, hi)
         }
     };
-    let mut u = range(&us, pu);
-    let mut v = range(&vs, pv);
+    // A sphere or torus bounded by vertex loops only (as Open CASCADE writes a whole sphere)
+    // is the whole closed surface.
+    let mut u = if whole { (0.0, TAU) } else { range(&us, pu) };
+    let mut v = match (&g, whole) {
+        (Geometry::Sphere(..), true) => (-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2),
+        (_, true) => (0.0, TAU),
+        _ => range(&vs, pv),
+    };
     if let Geometry::Nurbs(s) = &g {
         // Parameters come from projection: keep them inside the domain.
         let (a, b) = s.domain_u();

@@ -73,6 +73,8 @@ pub struct ImportOptions {
     pub edges: bool,
     /// With `edges`: only the faces with these `#id`s (default: every face).
     pub faces: Option<Vec<u64>>,
+    /// Write every face read as a surface, not only those a contour lies on.
+    pub all_faces: bool,
 }
 
 impl Default for ImportOptions {
@@ -88,6 +90,7 @@ impl ImportOptions {
         face_tolerance: 0.01,
         edges: false,
         faces: None,
+        all_faces: false,
     };
 
     /// With a gap threshold (mm).
@@ -99,6 +102,12 @@ impl ImportOptions {
     /// With a face tolerance (mm).
     pub fn with_face_tolerance(mut self, mm: f64) -> Self {
         self.face_tolerance = mm;
+        self
+    }
+
+    /// Write every face read as a surface, used or not.
+    pub fn with_all_faces(mut self, all: bool) -> Self {
+        self.all_faces = all;
         self
     }
 
@@ -340,6 +349,9 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     }
     // Surfaces: the faces named, in file order.
     let mut used: Vec<usize> = contours.iter().flat_map(|c| c.2.iter().copied()).collect();
+    if opts.all_faces {
+        used = (0..faces.len()).collect();
+    }
     used.sort_unstable();
     used.dedup();
     let face_id = |f: &Face| format!("face #{}", f.id);

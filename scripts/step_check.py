@@ -25,11 +25,14 @@ import sys
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
 from OCP.OCP.BRep import BRep_Tool
 from OCP.OCP.BRepTools import BRepTools
 from OCP.OCP.collections import Array1_double, Array1_gp_Pnt, Array1_int, Array2_double, Array2_gp_Pnt
 from OCP.OCP.Bnd import Bnd_Box
 from OCP.OCP.BndLib import BndLib_Add3dCurve
+from OCP.OCP.BRepBndLib import BRepBndLib
 from OCP.OCP.GeomAdaptor import GeomAdaptor_Curve
 from OCP.OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
 from OCP.OCP.GeomAPI import GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
@@ -143,12 +146,20 @@ def box_distance(box, p):
     return math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
-def nearest_on(curves, p):
-    """(distance, curve index, parameter) of the nearest point of the curves to p."""
+def nearest_on(curves, p, boxes=None):
+    """(distance, curve index, parameter) of the nearest point of the curves to p; `boxes` is
+    the (n, 6) array of the curves' bounding boxes (made here if not given)."""
+    if boxes is None:
+        boxes = np.array([cv[4] for cv in curves])
+    q = np.array([p.X(), p.Y(), p.Z()])
+    gap = np.maximum(np.maximum(boxes[:, :3] - q, q - boxes[:, 3:]), 0.0)
+    lower = np.sqrt((gap * gap).sum(axis=1))
     best = (math.inf, -1, 0.0)
-    for i, (c, a, b, _, box) in enumerate(curves):
-        if box_distance(box, p) > best[0]:
-            continue
+    for i in np.argsort(lower, kind="stable"):
+        if lower[i] > best[0]:
+            break
+        i = int(i)
+        c, a, b = curves[i][:3]
         pr = GeomAPI_ProjectPointOnCurve(p, c, a, b)
         cands = []
         if pr.NbPoints() > 0:
@@ -176,6 +187,7 @@ def check_file(kerf, step, edges, failures, counts):
     faces, free, face_edges = occ_by_id(step)
     truth = edge_curves(face_edges if edges else free)
     truth_cover = edge_curves(face_edges if edges else free, with_seams=False)
+    truth_boxes = np.array([cv[4] for cv in truth])
     gap_tol = TOL + summary["largest_pole_move_mm"]
     kcurves = []
     for c in doc["curves"]:
@@ -190,7 +202,7 @@ def check_file(kerf, step, edges, failures, counts):
             p = gp_Pnt()
             v = gp_Vec()
             g.D1(t, p, v)
-            d, i, u = nearest_on(truth, p)
+            d, i, u = nearest_on(truth, p, truth_boxes)
             worst = max(worst, d)
             if v.Magnitude() > 1e-12 and a < t < b and d < 1e-6:
                 cc, _, _, sign, _ = truth[i]
@@ -208,17 +220,24 @@ def check_file(kerf, step, edges, failures, counts):
         if back > 0 and not edges:
             failures.append(f"{step}: curve {c['id']!r}: runs against Open CASCADE's edge at {back} samples")
     # Coverage: every Open CASCADE edge is imported.
+    kboxes = np.array([cv[4] for cv in kcurves])
     for k, (c, a, b, _, _) in enumerate(truth_cover):
         worst = 0.0
         for j in range(51):
             p = c.Value(a + (b - a) * j / 50)
-            worst = max(worst, nearest_on(kcurves, p)[0])
+            worst = max(worst, nearest_on(kcurves, p, kboxes)[0])
         counts["edges"] += 1
         if worst > gap_tol:
             failures.append(f"{step}: Open CASCADE edge {k}: {worst:.3e} mm from every imported curve")
     # Surfaces: each kerf surface is matched to the Open CASCADE face it fits best (Open CASCADE
     # does not keep the STEP entity numbers on its faces): the face whose surface is nearest
     # the kerf grid and whose parameter box the kerf surface covers.
+    face_boxes = []
+    for f in faces:
+        box = Bnd_Box()
+        BRepBndLib.Add_s(f, box)
+        lo, hi = box.CornerMin(), box.CornerMax()
+        face_boxes.append((lo.X(), lo.Y(), lo.Z(), hi.X(), hi.Y(), hi.Z()))
     for s in doc["surfaces"]:
         counts["surfaces"] += 1
         ks = kerf_surface(s)
@@ -233,7 +252,9 @@ def check_file(kerf, step, edges, failures, counts):
                 ks.D1(u, v, p, su, sv)
                 grid.append((p, su.Crossed(sv)))
         best = None
-        for face in faces:
+        for face, fbox in zip(faces, face_boxes):
+            if box_distance(fbox, grid[112][0]) > 1e-6:
+                continue
             os_ = BRep_Tool.Surface_s(face)
             quick = max(project_distance(os_, grid[k][0])[0] for k in (0, 112, 224))
             if quick > 1e-6:

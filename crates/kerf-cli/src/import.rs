@@ -20,7 +20,7 @@ pub(crate) struct StepArgs {
     pub(crate) edges: bool,
 
     /// STEP, with --edges: only these faces, by entity number (`--faces 120,#388`).
-    #[arg(long, value_delimiter = ',', value_name = "ID,...")]
+    #[arg(long, value_delimiter = ',', value_name = "ID,...", requires = "edges")]
     pub(crate) faces: Vec<String>,
 
     /// STEP: close gaps between a contour's segments up to this (mm) by moving the shared pole;

@@ -196,6 +196,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         units: m.units,
         ..Report::default()
     };
+    check_no_placed_parts(&m)?;
     let (faces, face_errors) = faces::read_faces(&m);
     report.faces_read = faces.len();
     report
@@ -400,6 +401,27 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         surfaces,
     };
     Ok(Import { file, report })
+}
+
+/// Assembly placements are not applied: refuse a file that places a part anywhere but where
+/// its own coordinates put it, rather than write its geometry in the wrong place.
+fn check_no_placed_parts(m: &Model<'_>) -> Result<()> {
+    for inst in m.all("ITEM_DEFINED_TRANSFORMATION") {
+        let p = m.rec(inst, "ITEM_DEFINED_TRANSFORMATION")?;
+        let a = m.placement(m.param_ref(inst, p, 2)?)?;
+        let b = m.placement(m.param_ref(inst, p, 3)?)?;
+        let same = (a.origin - b.origin).norm() <= 1e-9 * (1.0 + a.origin.coords.norm())
+            && (a.x - b.x).norm() <= 1e-12
+            && (a.z - b.z).norm() <= 1e-12;
+        if !same {
+            return Err(model::err(
+                inst,
+                "places a part with a transformation that is not the identity; assemblies \
+                 are not supported (export the part alone, or as one body in its place)",
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn note_join(report: &mut Report, what: &str, j: &contour::JoinResult) {

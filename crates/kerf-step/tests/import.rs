@@ -376,3 +376,25 @@ fn real_sheet_metal_parts_read_with_edges() {
         );
     }
 }
+
+#[test]
+fn a_placed_assembly_part_is_refused_not_misplaced() {
+    let body = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=CARTESIAN_POINT('',(100.,0.,0.));\n\
+        #3=AXIS2_PLACEMENT_3D('',#1,$,$);\n#4=AXIS2_PLACEMENT_3D('',#2,$,$);\n\
+        #5=ITEM_DEFINED_TRANSFORMATION('','',#3,#4);\n#6=CIRCLE('',#3,5.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n";
+    let e = import(&step(body), &ImportOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("#5 ITEM_DEFINED_TRANSFORMATION: places a part"),
+        "{e}"
+    );
+    // The identity (as Open CASCADE writes for parts in place) is fine.
+    let same = body.replace(
+        "#5=ITEM_DEFINED_TRANSFORMATION('','',#3,#4)",
+        "#5=ITEM_DEFINED_TRANSFORMATION('','',#3,#3)",
+    );
+    assert!(
+        import(&step(&same), &ImportOptions::default()).is_ok(),
+        "identity accepted"
+    );
+}

@@ -497,7 +497,7 @@ mod tests {
             let want = 0.5 * (t1 + t2);
             let got = mid.y.atan2(mid.x);
             let diff = (got - want).rem_euclid(2.0 * std::f64::consts::PI);
-            assert!(diff < 1.0 || diff > 5.28, "mid angle {got} vs {want}");
+            assert!(!(1.0..=5.28).contains(&diff), "mid angle {got} vs {want}");
         }
     }
 

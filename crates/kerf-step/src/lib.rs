@@ -39,6 +39,10 @@
 //! # Ok::<(), kerf_step::StepError>(())
 //! ```
 
+// `!(x > 0.0)` rejects NaN together with the out-of-range values in one test; every such
+// comparison in this crate guards file data that may be NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod contour;
 mod curves;
 mod error;

@@ -90,8 +90,6 @@ fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
             })
             .collect::<Result<Vec<_>, _>>()?;
         o = o.with_edges((!ids.is_empty()).then_some(ids));
-    } else if !a.faces.is_empty() {
-        return Err(CliError::Input("--faces needs --edges".into()));
     }
     Ok(o)
 }

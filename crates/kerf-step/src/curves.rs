@@ -95,6 +95,20 @@ impl Basis {
 
 /// Reads any supported curve entity as a [`Basis`].
 pub(crate) fn basis(m: &Model<'_>, inst: &Instance) -> Result<Basis> {
+    basis_at(m, inst, 0)
+}
+
+/// The deepest chain of curves referring to curves (surface curve to its 3D curve, composite to
+/// composite) followed; deeper chains are cycles or garbage.
+const MAX_CURVE_DEPTH: usize = 16;
+
+fn basis_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Basis> {
+    if depth > MAX_CURVE_DEPTH {
+        return Err(err(
+            inst,
+            format!("curves refer to curves more than {MAX_CURVE_DEPTH} deep (a cycle?)"),
+        ));
+    }
     let s = m.units.mm_per_length;
     if let Some(p) = inst.record("LINE") {
         let origin = m.point(m.param_ref(inst, p, 1)?)?;
@@ -152,7 +166,7 @@ pub(crate) fn basis(m: &Model<'_>, inst: &Instance) -> Result<Basis> {
         .or_else(|| inst.record("SEAM_CURVE"))
         .or_else(|| inst.record("INTERSECTION_CURVE"))
     {
-        return basis(m, m.param_ref(inst, p, 1)?);
+        return basis_at(m, m.param_ref(inst, p, 1)?, depth + 1);
     }
     if inst.is("TRIMMED_CURVE") || inst.is("COMPOSITE_CURVE") {
         return Err(err(
@@ -173,10 +187,10 @@ fn bspline(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
         if let Some(b) = inst.record("B_SPLINE_CURVE") {
             (b, inst.record("B_SPLINE_CURVE_WITH_KNOTS"))
         } else if let Some(k) = inst.record("B_SPLINE_CURVE_WITH_KNOTS") {
-            (&k[1..], Some(&k[6..]))
+            (k.get(1..).unwrap_or(&[]), Some(k.get(6..).unwrap_or(&[])))
         } else {
             let b = m.rec(inst, "BEZIER_CURVE")?;
-            (&b[1..], None)
+            (b.get(1..).unwrap_or(&[]), None)
         };
     let degree = int(inst, head.first(), "degree")?;
     if degree == 0 || degree > kerf_nurbs::MAX_DEGREE {
@@ -357,12 +371,15 @@ pub(crate) fn oriented_piece(
 ) -> Result<NurbsCurve> {
     if b.periodic() {
         let tau = 2.0 * std::f64::consts::PI;
-        let mut e = t2;
-        while e <= t1 + 1e-12 {
-            e += tau;
+        if !(t1.is_finite() && t2.is_finite()) {
+            return Err(err(inst, format!("non-finite trim parameters {t1}, {t2}")));
         }
-        while e > t1 + tau + 1e-12 {
-            e -= tau;
+        // Angles reduced to one turn, then the end in (t1, t1 + 2 pi]: equal trims mean the
+        // whole turn.
+        let (t1, t2) = (t1.rem_euclid(tau), t2.rem_euclid(tau));
+        let mut e = t1 + (t2 - t1).rem_euclid(tau);
+        if e <= t1 + 1e-12 {
+            e += tau;
         }
         let c = b.piece(inst, t1, e)?;
         return Ok(if sense { c } else { c.reversed() });
@@ -414,6 +431,16 @@ fn trim_param(
 /// Any bounded curve entity as one NURBS curve per segment (a composite gives its segments,
 /// senses applied; others one). Full conics give the closed curve starting at angle 0.
 pub(crate) fn bounded_segments(m: &Model<'_>, inst: &Instance) -> Result<Vec<(NurbsCurve, u64)>> {
+    segments_at(m, inst, 0)
+}
+
+fn segments_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Vec<(NurbsCurve, u64)>> {
+    if depth > MAX_CURVE_DEPTH {
+        return Err(err(
+            inst,
+            format!("composite curves nested more than {MAX_CURVE_DEPTH} deep (a cycle?)"),
+        ));
+    }
     if let Some(p) = inst.record("COMPOSITE_CURVE") {
         let segs = refs(inst, p.get(1), "segments")?;
         if segs.is_empty() {
@@ -433,7 +460,7 @@ pub(crate) fn bounded_segments(m: &Model<'_>, inst: &Instance) -> Result<Vec<(Nu
             })?;
             let same = boolean(seg, sp.get(1), "same_sense")?;
             let parent = m.param_ref(seg, sp, 2)?;
-            let pieces = bounded_segments(m, parent)
+            let pieces = segments_at(m, parent, depth + 1)
                 .map_err(|e| err(inst, format!("segment {} (#{sid}): {e}", k + 1)))?;
             if same {
                 out.extend(pieces);

@@ -469,7 +469,7 @@ fn bspline_surface(m: &Model<'_>, inst: &Instance) -> Result<NurbsSurface> {
         (b, inst.record("B_SPLINE_SURFACE_WITH_KNOTS"))
     } else {
         let k = m.rec(inst, "B_SPLINE_SURFACE_WITH_KNOTS")?;
-        (&k[1..], Some(&k[8..]))
+        (k.get(1..).unwrap_or(&[]), Some(k.get(8..).unwrap_or(&[])))
     };
     let krec = krec.ok_or_else(|| err(inst, "a B-spline surface without knots"))?;
     let du = int(inst, head.first(), "u_degree")?;
@@ -483,6 +483,9 @@ fn bspline_surface(m: &Model<'_>, inst: &Instance) -> Result<NurbsSurface> {
                 .map(|id| m.point(m.get(inst, id)?))
                 .collect::<Result<Vec<_>>>()?,
         );
+    }
+    if krec.len() < 4 {
+        return Err(err(inst, "expected u and v knot multiplicities and knots"));
     }
     let ku = expand_knots(inst, &[krec[0].clone(), krec[2].clone()])?;
     let kv = expand_knots(inst, &[krec[1].clone(), krec[3].clone()])?;

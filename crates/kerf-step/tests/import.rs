@@ -398,3 +398,42 @@ fn a_placed_assembly_part_is_refused_not_misplaced() {
         "identity accepted"
     );
 }
+
+#[test]
+fn hostile_files_give_errors_not_hangs_or_panics() {
+    let circle = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(0.,0.,1.));\n#3=DIRECTION('',(1.,0.,0.));\n\
+        #4=AXIS2_PLACEMENT_3D('',#1,#2,#3);\n#5=CIRCLE('',#4,2.);\n";
+    // A trim parameter far beyond 2 pi: one turn at most, computed without looping.
+    let huge = format!(
+        "{circle}#6=TRIMMED_CURVE('',#5,(PARAMETER_VALUE(1.E300)),(PARAMETER_VALUE(0.)),.T.,.PARAMETER.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n"
+    );
+    let im = import(&step(&huge), &ImportOptions::default()).expect("reads");
+    let c = curve(&im.file.curves[0]);
+    assert!(
+        samples(&c, 20)
+            .iter()
+            .all(|p| (p.coords.norm() - 2.0).abs() < 1e-9),
+        "on the circle"
+    );
+    // A surface curve that is its own 3D curve, and a composite that contains itself.
+    let cycle = "#1=SURFACE_CURVE('',#1,(),.CURVE_3D.);\n#2=GEOMETRIC_CURVE_SET('',(#3));\n\
+        #3=COMPOSITE_CURVE('',(#4),.F.);\n#4=COMPOSITE_CURVE_SEGMENT(.CONTINUOUS.,.T.,#3);\n";
+    let e = import(&step(cycle), &ImportOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("deep (a cycle?)"), "{e}");
+    let e = import(
+        &step("#1=SURFACE_CURVE('',#1,(),.CURVE_3D.);\n#2=TRIMMED_CURVE('',#1,(PARAMETER_VALUE(0.)),(PARAMETER_VALUE(1.)),.T.,.PARAMETER.);\n#3=GEOMETRIC_CURVE_SET('',(#2));\n"),
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("deep (a cycle?)"), "{e}");
+    // A B-spline record cut short.
+    let e = import(
+        &step("#1=B_SPLINE_CURVE_WITH_KNOTS('',3);\n#2=GEOMETRIC_CURVE_SET('',(#1));\n"),
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().starts_with("#1 B_SPLINE_CURVE_WITH_KNOTS: "),
+        "{e}"
+    );
+}

@@ -146,3 +146,28 @@ fn real_parts_import_with_edges_and_discretize_with_normals() {
         assert_eq!(code, 0, "{name}: {out}{err}");
     }
 }
+
+#[test]
+fn run_cuts_the_boundary_loops_of_chosen_faces() {
+    // In fixtures/step/faces.step (entity numbers as the fixture script wrote them): a box
+    // face, the cylinder's side, the cone's side, the extrusion and the B-spline surface face.
+    // Faces whose outward normal points down (the box's bottom) are out of the head's reach.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(fixture("step/faces.step"))
+        .args(["--edges", "--faces", "183,#412,529,754,953", "-m"])
+        .arg(fixture("machines/ac_head.json"))
+        .arg("--out")
+        .arg(&out));
+    assert_eq!(code, 0, "{err}");
+    let tp = kerf_format::toolpath::load(out.join("toolpath.json")).unwrap();
+    let ids: Vec<&str> = tp.paths.iter().map(|p| p.id.as_str()).collect();
+    for f in ["#183", "#412", "#529", "#754", "#953"] {
+        assert!(
+            ids.iter().any(|i| i.starts_with(&format!("face {f} "))),
+            "{f} cut: {ids:?}"
+        );
+    }
+}

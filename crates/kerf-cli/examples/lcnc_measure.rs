@@ -154,37 +154,36 @@ fn main() {
     // Paths run in cutting order (not the toolpath's): each with its lead-in, the cut from its
     // start point and its lead-out, against the lead polylines and the cutting points in the
     // same order.
-    let cuts: Vec<Cut> = axes
-        .paths
-        .iter()
-        .map(|a| {
-            let t = tp
-                .paths
-                .iter()
-                .find(|t| t.id == a.id)
-                .unwrap_or_else(|| fail(format!("path {:?} is not in toolpath.json", a.id)));
-            let (_, run) = a.run();
-            let tip = |p: &[f64; 6]| Point3::new(p[0], p[1], p[2]);
-            let poses: Vec<Point3<f64>> = run.iter().map(tip).collect();
-            let n = t.points.len();
-            let sp = a.start_point.unwrap_or(0).min(n.saturating_sub(1));
-            let order: Vec<usize> = if sp > 0 {
-                (sp..n).chain(1..=sp).collect()
-            } else {
-                (0..n).collect()
-            };
-            let mut pts: Vec<Point3<f64>> = Vec::new();
-            if let Some(m) = &a.lead_in {
-                pts.extend(m.poses.iter().map(tip));
-            }
-            pts.extend(order.iter().map(|&k| t.points.position(k)));
-            if let Some(m) = &a.lead_out {
-                pts.extend(m.poses.iter().map(tip));
-            }
-            let u = Vector3::new(run[0][3], run[0][4], run[0][5]).normalize();
-            (poses, pts, u)
-        })
-        .collect();
+    let cuts: Vec<Cut> =
+        axes.paths
+            .iter()
+            .map(|a| {
+                let t =
+                    tp.paths.iter().find(|t| t.id == a.id).unwrap_or_else(|| {
+                        fail(format!("path {:?} is not in toolpath.json", a.id))
+                    });
+                let (_, run) = a.run();
+                let tip = |p: &[f64; 6]| Point3::new(p[0], p[1], p[2]);
+                let poses: Vec<Point3<f64>> = run.iter().map(tip).collect();
+                let n = t.points.len();
+                let sp = a.start_point.unwrap_or(0).min(n.saturating_sub(1));
+                let order: Vec<usize> = if sp > 0 {
+                    (sp..n).chain(1..=sp).collect()
+                } else {
+                    (0..n).collect()
+                };
+                let mut pts: Vec<Point3<f64>> = Vec::new();
+                if let Some(m) = &a.lead_in {
+                    pts.extend(m.poses.iter().map(tip));
+                }
+                pts.extend(order.iter().map(|&k| t.points.position(k)));
+                if let Some(m) = &a.lead_out {
+                    pts.extend(m.poses.iter().map(tip));
+                }
+                let u = Vector3::new(run[0][3], run[0][4], run[0][5]).normalize();
+                (poses, pts, u)
+            })
+            .collect();
 
     let mut per_cut = Vec::new();
     let mut max_dev_union: f64 = 0.0;

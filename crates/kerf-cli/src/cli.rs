@@ -111,6 +111,18 @@ pub(crate) enum Command {
         after_help = "Examples:\n  kerf plot fixtures/mixed.json mixed.toolpath.json -o mixed.svg\n  kerf plot part.json part.toolpath.json --axes part.axes.json --machine fixtures/machines/ac_head.json -o part.svg"
     )]
     Plot(crate::plot::PlotArgs),
+
+    /// Read a STEP file's cut contours and the faces they lie on into kerf.curves/1.
+    ///
+    /// Takes the curves of the geometric sets (composite curves joined into one NURBS curve
+    /// each, C0 at every join, gaps up to --close-gaps closed, larger gaps opened), or with
+    /// --edges the boundary loops of faces; finds the faces each contour lies on by projection
+    /// and writes them as exact NURBS surfaces, `Su x Sv` outward. Lengths are converted to mm.
+    /// Says what it took and what it skipped; a file with no usable contour is an error.
+    #[command(
+        after_help = "Examples:\n  kerf import fixtures/step/composite_mm.step -o part.curves.json\n  kerf import bracket.stp --edges --faces 120 -o bracket.curves.json\n  kerf run part.step --machine fixtures/machines/ac_head.json --out part-out"
+    )]
+    Import(crate::import::ImportArgs),
 }
 
 /// Arguments of `kerf validate`.
@@ -375,9 +387,13 @@ impl From<DialectArg> for kerf_interp::Dialect {
 /// Arguments of `kerf run`.
 #[derive(Debug, Args)]
 pub(crate) struct RunArgs {
-    /// The kerf.curves/1 file.
+    /// The kerf.curves/1 file, or a STEP file (.step, .stp: imported as `kerf import` does).
     #[arg(value_name = "CURVES.json")]
     pub(crate) curves: PathBuf,
+
+    /// How contours and faces are taken from a STEP input.
+    #[command(flatten)]
+    pub(crate) step_args: crate::import::StepArgs,
 
     /// The kerf.machine/1 file.
     #[arg(short, long, value_name = "MACHINE.json")]

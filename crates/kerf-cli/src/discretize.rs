@@ -8,7 +8,9 @@ use std::time::Instant;
 use kerf_discretize::{minimum_count, Discretization, Options};
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_format::{curves, CurvesFile, SurfaceGeometry};
-use kerf_normals::{orient, MeshNormals, NormalOptions, NormalSource, NurbsNormals, Oriented};
+use kerf_normals::{
+    orient, Hint, MeshNormals, NormalOptions, NormalSource, NurbsNormals, Oriented, Projection,
+};
 use rayon::prelude::*;
 use serde_json::json;
 
@@ -264,7 +266,7 @@ fn normal_sources(
             let used = file
                 .curves
                 .iter()
-                .any(|c| c.surface.as_deref() == Some(&s.id));
+                .any(|c| c.surfaces.iter().any(|id| id == &s.id));
             if !used {
                 return Ok(None);
             }
@@ -336,12 +338,26 @@ pub(crate) fn normals_for_file(
                     place(i)
                 )));
             };
-            let si = file
+            let _ = sid;
+            let picked: Vec<&dyn NormalSource> = rec
                 .surfaces
                 .iter()
-                .position(|s| &s.id == sid)
-                .expect("the reader resolved every surface id");
-            let src = sources[si].as_deref().expect("a source exists for every used surface");
+                .map(|id| {
+                    let si = file
+                        .surfaces
+                        .iter()
+                        .position(|s| &s.id == id)
+                        .expect("the reader resolved every surface id");
+                    sources[si].as_deref().expect("a source exists for every used surface")
+                })
+                .collect();
+            let nearest;
+            let src: &dyn NormalSource = if picked.len() == 1 {
+                picked[0]
+            } else {
+                nearest = Nearest(picked);
+                &nearest
+            };
             orient(&rec.curve, &results[i], src, opts, &nopts).map_err(|error| CliError::Normals {
                 file: path.to_path_buf(),
                 place: place(i),
@@ -349,6 +365,26 @@ pub(crate) fn normals_for_file(
             })
         })
         .collect()
+}
+
+/// Several surfaces as one normal source: each query goes to every surface (cold-started, as
+/// their parameters are unrelated) and the nearest answers (the list form of a curve's
+/// `surface`; ties go to the first listed).
+struct Nearest<'a>(Vec<&'a dyn NormalSource>);
+
+impl NormalSource for Nearest<'_> {
+    fn project(&self, p: &nalgebra::Point3<f64>, _hint: Hint) -> Projection {
+        let mut best: Option<Projection> = None;
+        for s in &self.0 {
+            let pr = s.project(p, Hint::None);
+            if best.as_ref().is_none_or(|b| pr.distance < b.distance) {
+                best = Some(pr);
+            }
+        }
+        let mut b = best.expect("a list of surfaces is never empty");
+        b.hint = Hint::None;
+        b
+    }
 }
 
 /// A progress bar is worth showing for batches long enough to wait for, and only when

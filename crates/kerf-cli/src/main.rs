@@ -12,6 +12,7 @@ mod cuts;
 mod discretize;
 mod error;
 mod guard;
+mod import;
 mod motion;
 mod place;
 mod plot;
@@ -37,6 +38,7 @@ fn main() -> ExitCode {
         Command::Gcode(args) => motion::run_gcode(args),
         Command::Check(args) => check::run(args),
         Command::Plot(args) => plot::run(args),
+        Command::Import(args) => import::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

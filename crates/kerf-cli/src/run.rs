@@ -9,8 +9,7 @@ use kerf_discretize::Discretization;
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_interp::{
     gcode_motion, stations_from_solved, write_csv_to, AxisModel, Dialect, GcodeOptions,
-    MachineModel,
-    PathInput as InterpPath, PlanOptions,
+    MachineModel, PathInput as InterpPath, PlanOptions,
 };
 use kerf_io::DirEntry;
 use kerf_kinematics::{solve_paths, AxesFile, Machine, PathCurve, PathInput, PathOptions, Pose};
@@ -32,7 +31,15 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             &[path, args.machine.as_path()],
         )?;
     }
-    let file = load_curves(path)?;
+    let file = if crate::import::is_step(path) {
+        let (file, import) = crate::import::load_step(path, &args.step_args)?;
+        if !args.quiet && !args.json {
+            crate::import::print_account(path, &import);
+        }
+        file
+    } else {
+        load_curves(path)?
+    };
     let machine = Machine::read(&args.machine)?;
     let dopts = kerf_discretize::Options {
         max_segment_length: args.max_segment_length.unwrap_or(f64::INFINITY),

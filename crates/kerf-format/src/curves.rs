@@ -75,9 +75,68 @@ pub struct RawCurve {
     /// One weight per control point, finite and > 0; absent means all 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weights: Option<Vec<f64>>,
-    /// The id of the surface carrying the curve (which gives the tool axis), if any.
+    /// The surface carrying the curve (which gives the tool axis), if any: one id, or a list
+    /// of ids for a curve over several faces.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub surface: Option<String>,
+    pub surface: Option<SurfaceRef>,
+}
+
+/// The `surface` key of a curve: one surface id, or a list of them for a curve that runs over
+/// several faces (the normal at each point then comes from the nearest of them).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(untagged)]
+pub enum SurfaceRef {
+    /// `"surface": "panel"`.
+    One(String),
+    /// `"surface": ["panel", "flange"]`.
+    Many(Vec<String>),
+}
+
+impl SurfaceRef {
+    /// The ids, in the order written.
+    pub fn ids(&self) -> Vec<String> {
+        match self {
+            SurfaceRef::One(s) => vec![s.clone()],
+            SurfaceRef::Many(v) => v.clone(),
+        }
+    }
+}
+
+impl From<&str> for SurfaceRef {
+    fn from(id: &str) -> Self {
+        SurfaceRef::One(id.to_owned())
+    }
+}
+
+impl From<String> for SurfaceRef {
+    fn from(id: String) -> Self {
+        SurfaceRef::One(id)
+    }
+}
+
+impl<'de> Deserialize<'de> for SurfaceRef {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error;
+        match Value::deserialize(d)? {
+            Value::String(s) => Ok(SurfaceRef::One(s)),
+            Value::Array(items) => items
+                .into_iter()
+                .enumerate()
+                .map(|(k, v)| match v {
+                    Value::String(s) => Ok(s),
+                    other => Err(D::Error::custom(format!(
+                        "item {k}: expected a surface id (a string), got {}",
+                        json_type_name(&other)
+                    ))),
+                })
+                .collect::<std::result::Result<Vec<_>, _>>()
+                .map(SurfaceRef::Many),
+            other => Err(D::Error::custom(format!(
+                "expected a surface id or a list of ids, got {}",
+                json_type_name(&other)
+            ))),
+        }
+    }
 }
 
 /// One entry of `surfaces`, told apart by its `type` key.
@@ -164,8 +223,12 @@ pub struct CurveRecord {
     pub id: String,
     /// The curve.
     pub curve: NurbsCurve,
-    /// The id of the surface carrying it, guaranteed to exist in [`CurvesFile::surfaces`].
+    /// The id of the surface carrying it (the first, if the file names several), guaranteed to
+    /// exist in [`CurvesFile::surfaces`].
     pub surface: Option<String>,
+    /// Every surface id the curve names, in file order (empty without `surface`; one entry for
+    /// the string form). The normal at a point comes from the nearest of them.
+    pub surfaces: Vec<String>,
 }
 
 /// One surface.
@@ -362,10 +425,18 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
         let points = c.control_points.iter().map(|&p| Point3::from(p)).collect();
         let curve = NurbsCurve::try_new(c.degree, c.knots, points, c.weights)
             .map_err(|error| FormatError::Curve { index, error })?;
+        let named = c.surface.as_ref().map(SurfaceRef::ids).unwrap_or_default();
+        if matches!(&c.surface, Some(SurfaceRef::Many(v)) if v.is_empty()) {
+            return Err(FormatError::Shape {
+                path: format!("curves[{index}].surface"),
+                message: "an empty list of surface ids (omit the key for no surface)".into(),
+            });
+        }
         curves.push(CurveRecord {
             id: c.id,
             curve,
-            surface: c.surface,
+            surface: named.first().cloned(),
+            surfaces: named,
         });
     }
 
@@ -438,7 +509,7 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
     }
 
     for (index, c) in curves.iter().enumerate() {
-        if let Some(id) = &c.surface {
+        for id in &c.surfaces {
             if !surfaces.iter().any(|s| &s.id == id) {
                 return Err(FormatError::UnknownSurface {
                     index,
@@ -530,6 +601,26 @@ impl IdSet {
         self.seen.insert(id.to_owned(), index);
         Ok(())
     }
+}
+
+/// Writes a raw `kerf.curves/1` document as JSON to `dest` through the one writer
+/// ([`kerf_io::write_file`]: atomic for regular files, written through for devices, FIFOs and
+/// `-`). It does not check
+/// the content: pass it through [`from_raw`] first.
+///
+/// # Errors
+/// [`FormatError::Write`], wrapped in [`FormatError::File`] naming `dest`.
+pub fn write_raw(file: &RawCurvesFile, dest: impl AsRef<Path>) -> Result<()> {
+    use std::io::Write;
+    let dest = dest.as_ref();
+    let json = |w: &mut dyn Write| -> std::io::Result<()> {
+        serde_json::to_writer_pretty(&mut *w, file).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    };
+    let result = kerf_io::write_file(dest, json);
+    result
+        .map_err(|error| FormatError::Write { error })
+        .map_err(|e| e.in_file(dest))
 }
 
 #[cfg(test)]

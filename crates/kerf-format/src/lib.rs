@@ -30,7 +30,9 @@ mod json;
 pub mod stl;
 pub mod toolpath;
 
-pub use curves::{CurveRecord, CurvesFile, SurfaceGeometry, SurfaceRecord, SurfaceSource};
+pub use curves::{
+    CurveRecord, CurvesFile, SurfaceGeometry, SurfaceRecord, SurfaceRef, SurfaceSource,
+};
 pub use error::{FormatError, MeshDefect, Result, StlProblem};
 pub use toolpath::{ToolPath, ToolPathPoints, ToolpathFile};
 

@@ -626,3 +626,57 @@ fn load_names_the_file() {
     let e = load(dir.path()).expect_err("a directory");
     assert!(e.to_string().contains("cannot read"), "{e}");
 }
+
+#[test]
+fn surface_may_be_a_list_of_ids() {
+    let one = line("a").replace("\"degree\"", "\"surface\": [\"p\", \"q\"], \"degree\"");
+    let file = parse(&doc(&one, &format!("{}, {}", plane("p"), plane("q")))).unwrap();
+    assert_eq!(
+        file.curves[0].surfaces,
+        vec!["p".to_string(), "q".to_string()],
+        "both ids kept"
+    );
+    assert_eq!(
+        file.curves[0].surface.as_deref(),
+        Some("p"),
+        "the first as the single id"
+    );
+    // The string form gives a one-entry list.
+    let s = line("a").replace("\"degree\"", "\"surface\": \"q\", \"degree\"");
+    let file = parse(&doc(&s, &format!("{}, {}", plane("p"), plane("q")))).unwrap();
+    assert_eq!(
+        file.curves[0].surfaces,
+        vec!["q".to_string()],
+        "string form"
+    );
+    // Round trip of the raw list form.
+    let raw = raw_from_slice(doc(&one, &plane("p")).as_bytes()).unwrap();
+    let text = serde_json::to_string(&raw).unwrap();
+    assert!(text.contains(r#""surface":["p","q"]"#), "{text}");
+}
+
+#[test]
+fn bad_surface_lists_name_the_place() {
+    let unknown = line("a").replace("\"degree\"", "\"surface\": [\"p\", \"nope\"], \"degree\"");
+    assert_eq!(
+        error(&doc(&unknown, &plane("p"))),
+        "curves[0].surface: no surface with id \"nope\" (surfaces: \"p\")",
+        "unknown id in the list"
+    );
+    let empty = line("a").replace("\"degree\"", "\"surface\": [], \"degree\"");
+    assert_eq!(
+        error(&doc(&empty, &plane("p"))),
+        "curves[0].surface: an empty list of surface ids (omit the key for no surface)",
+        "empty list"
+    );
+    let number = line("a").replace("\"degree\"", "\"surface\": [\"p\", 3], \"degree\"");
+    let e = error(&doc(&number, &plane("p")));
+    assert!(
+        e.starts_with("curves[0].surface")
+            && e.contains("item 1: expected a surface id (a string), got"),
+        "{e}"
+    );
+    let object = line("a").replace("\"degree\"", "\"surface\": {}, \"degree\"");
+    let e = error(&doc(&object, &plane("p")));
+    assert!(e.contains("expected a surface id or a list of ids"), "{e}");
+}

@@ -1,0 +1,188 @@
+//! `kerf import`: a STEP file's cut contours and the faces they lie on, as `kerf.curves/1`.
+//! Also the loader that lets `kerf run` take a STEP file directly.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use kerf_format::{curves, CurvesFile};
+use kerf_step::{Import, ImportOptions};
+use serde_json::json;
+
+use crate::error::CliError;
+
+/// How contours and faces are taken from a STEP file (shared by `kerf import` and `kerf run`).
+#[derive(Debug, Clone, Args)]
+pub(crate) struct StepArgs {
+    /// STEP: cut the boundary loops of faces (sheet-metal holes and outlines) instead of the
+    /// curves of the geometric sets.
+    #[arg(long)]
+    pub(crate) edges: bool,
+
+    /// STEP, with --edges: only these faces, by entity number (`--faces 120,#388`).
+    #[arg(long, value_delimiter = ',', value_name = "ID,...", requires = "edges")]
+    pub(crate) faces: Vec<String>,
+
+    /// STEP: close gaps between a contour's segments up to this (mm) by moving the shared pole;
+    /// larger gaps open the contour.
+    #[arg(long, default_value_t = 0.1, value_name = "MM")]
+    pub(crate) close_gaps: f64,
+
+    /// STEP: a contour lies on the faces within this distance (mm) of every dense sample.
+    #[arg(long, default_value_t = 0.01, value_name = "MM")]
+    pub(crate) face_tolerance: f64,
+
+    /// STEP: write every face read as a surface, not only those a contour lies on.
+    #[arg(long)]
+    pub(crate) all_faces: bool,
+}
+
+/// Arguments of `kerf import`.
+#[derive(Debug, Args)]
+pub(crate) struct ImportArgs {
+    /// The STEP file (AP203, AP214, AP242; .step or .stp).
+    #[arg(value_name = "PART.step")]
+    pub(crate) step: PathBuf,
+
+    /// Output kerf.curves/1 file (`-` for standard output). Default: `<input stem>.curves.json`
+    /// in the current directory.
+    #[arg(short, long, value_name = "CURVES.json")]
+    pub(crate) output: Option<PathBuf>,
+
+    /// How contours and faces are taken.
+    #[command(flatten)]
+    pub(crate) step_args: StepArgs,
+
+    /// Print the summary as JSON on standard output.
+    #[arg(long)]
+    pub(crate) json: bool,
+
+    /// Print no summary.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
+}
+
+/// Whether `path` names a STEP file (by its extension).
+pub(crate) fn is_step(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "step" | "stp" | "p21"))
+}
+
+fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
+    let mut o = ImportOptions::default()
+        .with_close_gaps(a.close_gaps)
+        .with_face_tolerance(a.face_tolerance)
+        .with_all_faces(a.all_faces);
+    if a.edges {
+        let ids = a
+            .faces
+            .iter()
+            .map(|s| {
+                s.trim()
+                    .trim_start_matches('#')
+                    .parse::<u64>()
+                    .map_err(|_| {
+                        CliError::Input(format!(
+                            "--faces: {s:?} is not an entity number like 120 or #120"
+                        ))
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        o = o.with_edges((!ids.is_empty()).then_some(ids));
+    }
+    Ok(o)
+}
+
+/// Reads a STEP file into a checked curves file (and the import's account).
+pub(crate) fn load_step(path: &Path, a: &StepArgs) -> Result<(CurvesFile, Import), CliError> {
+    let opts = options(a)?;
+    let import = kerf_step::import_file(path, &opts).map_err(|e| CliError::Input(e.to_string()))?;
+    let file = curves::from_raw(import.file.clone(), Path::new(".")).map_err(|e| {
+        CliError::Input(format!(
+            "{}: the import is not valid kerf.curves/1: {e}",
+            path.display()
+        ))
+    })?;
+    Ok((file, import))
+}
+
+/// Prints what an import took and skipped, to standard error.
+pub(crate) fn print_account(path: &Path, import: &Import) {
+    let r = &import.report;
+    eprintln!(
+        "{}: {} ({}; lengths x{} to mm): {} contours on {} faces ({} faces read)",
+        path.display(),
+        r.schemas.join(", "),
+        r.units.length_name,
+        r.units.mm_per_length,
+        import.file.curves.len(),
+        import.file.surfaces.len(),
+        r.faces_read
+    );
+    for t in &r.taken {
+        eprintln!("  took {t}");
+    }
+    for s in &r.surfaces {
+        eprintln!("  surface {s}");
+    }
+    if r.gaps_closed > 0 {
+        eprintln!(
+            "  closed {} gaps between segments, largest pole move {:.3e} mm",
+            r.gaps_closed, r.largest_move
+        );
+    }
+    for o in &r.opened {
+        eprintln!("  opened {o}");
+    }
+    for s in &r.skipped {
+        eprintln!("  skipped {s}");
+    }
+}
+
+/// Runs `kerf import`.
+pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
+    let start = Instant::now();
+    let (_, import) = load_step(&args.step, &args.step_args)?;
+    let dest = args.output.clone().unwrap_or_else(|| {
+        let stem = args
+            .step
+            .file_stem()
+            .map_or_else(|| "part".to_string(), |s| s.to_string_lossy().into_owned());
+        format!("{stem}.curves.json").into()
+    });
+    curves::write_raw(&import.file, &dest)?;
+    let r = &import.report;
+    if args.json {
+        let summary = json!({
+            "file": args.step.display().to_string(),
+            "output": dest.display().to_string(),
+            "schemas": r.schemas,
+            "length_unit": r.units.length_name,
+            "mm_per_length_unit": r.units.mm_per_length,
+            "rad_per_angle_unit": r.units.rad_per_angle,
+            "curves": import.file.curves.len(),
+            "surfaces": import.file.surfaces.len(),
+            "faces_read": r.faces_read,
+            "taken": r.taken,
+            "skipped": r.skipped,
+            "gaps_closed": r.gaps_closed,
+            "largest_pole_move_mm": r.largest_move,
+            "opened": r.opened,
+            "seconds": start.elapsed().as_secs_f64(),
+        });
+        if dest == Path::new("-") {
+            eprintln!("{summary}");
+        } else {
+            println!("{summary}");
+        }
+    } else if !args.quiet {
+        print_account(&args.step, &import);
+        eprintln!(
+            "wrote {} in {:.3} s",
+            dest.display(),
+            start.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,173 @@
+//! `kerf import` and `kerf run PART.step` through the binary, on the STEP fixtures (made with
+//! Open CASCADE, checked against its reader by scripts/step_check.py) and the real parts.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn kerf() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_kerf"))
+}
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+fn run(c: &mut Command) -> (i32, String, String) {
+    let o = c.output().unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn import_writes_a_valid_curves_file_and_says_what_it_did() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("part.curves.json");
+    let (code, _, err) = run(kerf()
+        .arg("import")
+        .arg(fixture("step/composite_mm.step"))
+        .arg("-o")
+        .arg(&out));
+    assert_eq!(code, 0, "{err}");
+    let file = kerf_format::curves::load(&out).expect("valid kerf.curves/1");
+    assert_eq!(file.curves.len(), 5, "contours");
+    assert_eq!(file.surfaces.len(), 2, "the top and side faces");
+    assert!(err.contains("took contour 1 #"), "{err}");
+    assert!(
+        err.contains("closed 1 gaps between segments, largest pole move 2.000e-2 mm"),
+        "{err}"
+    );
+    assert!(
+        err.contains("opened #") && err.contains("(gap 0.300 mm)"),
+        "{err}"
+    );
+}
+
+#[test]
+fn no_usable_contour_exits_1_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.curves.json");
+    let step = dir.path().join("points.step");
+    std::fs::write(
+        &step,
+        "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=GEOMETRIC_CURVE_SET('',(#1));\nENDSEC;\nEND-ISO-10303-21;\n",
+    )
+    .unwrap();
+    let (code, _, err) = run(kerf().arg("import").arg(&step).arg("-o").arg(&out));
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("no usable contour"), "{err}");
+    assert!(!out.exists(), "nothing written");
+
+    std::fs::write(&step, "ISO-10303-21;\nDATA;\n#1=CIRCLE('',#2,3.;\n").unwrap();
+    let (code, _, err) = run(kerf().arg("import").arg(&step).arg("-o").arg(&out));
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("points.step: line 3:"), "{err}");
+    assert!(!out.exists(), "nothing written");
+
+    let (code, _, err) = run(kerf().arg("import").arg(&step).args(["--faces", "12"]));
+    assert_eq!(code, 2, "--faces without --edges is a usage error: {err}");
+}
+
+#[test]
+fn run_takes_a_step_file_and_normals_come_from_the_nearest_face() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(fixture("step/composite_mm.step"))
+        .arg("-m")
+        .arg(fixture("machines/ac_head.json"))
+        .arg("--out")
+        .arg(&out));
+    assert_eq!(code, 0, "{err}");
+    let tp = kerf_format::toolpath::load(out.join("toolpath.json")).unwrap();
+    assert_eq!(tp.paths.len(), 5, "every contour cut");
+    // The contour over two faces of the block 120 x 80 x 20: on the top (z = 20) the normal is
+    // +z, on the side face x = 120 it is +x (the block's outward normals).
+    let path = tp
+        .paths
+        .iter()
+        .find(|p| p.id.starts_with("contour 3"))
+        .expect("contour 3");
+    let mut top = 0;
+    let mut side = 0;
+    for n in 0..path.params.len() {
+        let p = path.points.position(n);
+        let nv = path.points.normal(n).expect("normals");
+        if p.z > 20.0 - 1e-9 && p.x < 120.0 - 1e-6 {
+            assert!(
+                (nv - nalgebra::Vector3::z()).norm() < 1e-9,
+                "top normal {nv:?} at {p:?}"
+            );
+            top += 1;
+        } else if p.x > 120.0 - 1e-9 && p.z < 20.0 - 1e-6 {
+            assert!(
+                (nv - nalgebra::Vector3::x()).norm() < 1e-9,
+                "side normal {nv:?} at {p:?}"
+            );
+            side += 1;
+        }
+    }
+    assert!(top > 0 && side > 0, "points on both faces ({top}, {side})");
+    for f in ["axes.json", "program.nc", "report.json"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+}
+
+#[test]
+fn real_parts_import_with_edges_and_discretize_with_normals() {
+    let dir_real = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
+    if !dir_real.is_dir() {
+        eprintln!("skipped: {} not present", dir_real.display());
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["S01094.stp", "S06298.stp"] {
+        let curves = dir.path().join(format!("{name}.json"));
+        let tp = dir.path().join(format!("{name}.tp.json"));
+        let (code, _, err) = run(kerf()
+            .arg("import")
+            .arg(dir_real.join(name))
+            .arg("--edges")
+            .arg("-o")
+            .arg(&curves));
+        assert_eq!(code, 0, "{name}: {err}");
+        let (code, _, err) = run(kerf()
+            .arg("discretize")
+            .arg(&curves)
+            .args(["-t", "0.01", "--normals", "-o"])
+            .arg(&tp));
+        assert_eq!(code, 0, "{name}: {err}");
+        let (code, out, err) = run(kerf().arg("check").arg(&curves).arg(&tp));
+        assert_eq!(code, 0, "{name}: {out}{err}");
+    }
+}
+
+#[test]
+fn run_cuts_the_boundary_loops_of_chosen_faces() {
+    // In fixtures/step/faces.step (entity numbers as the fixture script wrote them): a box
+    // face, the cylinder's side, the cone's side, the extrusion and the B-spline surface face.
+    // Faces whose outward normal points down (the box's bottom) are out of the head's reach.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(fixture("step/faces.step"))
+        .args(["--edges", "--faces", "183,#412,529,754,953", "-m"])
+        .arg(fixture("machines/ac_head.json"))
+        .arg("--out")
+        .arg(&out));
+    assert_eq!(code, 0, "{err}");
+    let tp = kerf_format::toolpath::load(out.join("toolpath.json")).unwrap();
+    let ids: Vec<&str> = tp.paths.iter().map(|p| p.id.as_str()).collect();
+    for f in ["#183", "#412", "#529", "#754", "#953"] {
+        assert!(
+            ids.iter().any(|i| i.starts_with(&format!("face {f} "))),
+            "{f} cut: {ids:?}"
+        );
+    }
+}

@@ -1,0 +1,341 @@
+//! B-rep faces: their boundary loops as NURBS curves, their surface as a NURBS surface cut to
+//! the face's parameter range and oriented so that `Su x Sv` is the face's outward normal,
+//! and the association of contours to faces by projection.
+
+use std::f64::consts::TAU;
+
+use kerf_nurbs::{NurbsCurve, NurbsSurface};
+use nalgebra::Point3;
+
+use crate::curves::{basis, oriented_piece, Basis};
+use crate::error::Result;
+use crate::model::{boolean, err, name_of, refs, Model};
+use crate::parser::{Instance, Value};
+use crate::surfaces::{angle_range, geometry, Geometry};
+
+/// Samples per edge for the parameter range (2 degrees apart on a full circle).
+pub(crate) const EDGE_SAMPLES: usize = 181;
+
+/// A gap between boundary angles below this (3 degrees) means the face turns all the way
+/// round (a full cylinder, a torus tube).
+pub(crate) const FULL_TURN_GAP: f64 = 3.0 * std::f64::consts::PI / 180.0;
+
+/// One face, converted.
+pub(crate) struct Face {
+    /// The `#id` of the `ADVANCED_FACE` (or `FACE_SURFACE`).
+    pub(crate) id: u64,
+    /// Its name attribute.
+    pub(crate) name: String,
+    /// The kind of its surface (`plane`, `cylinder`, ...).
+    pub(crate) kind: &'static str,
+    /// The surface over the face's parameter range, `Su x Sv` outward.
+    pub(crate) surface: NurbsSurface,
+    /// The boundary loops (outer first where marked), each as its edges in loop order.
+    pub(crate) loops: Vec<Vec<NurbsCurve>>,
+}
+
+/// The faces of the file, in file order; a face that cannot be converted is returned as an
+/// error message in the second list (it is skipped, not fatal).
+pub(crate) fn read_faces(m: &Model<'_>) -> (Vec<Face>, Vec<String>) {
+    let flipped = oriented_face_flips(m);
+    let mut faces = Vec::new();
+    let mut skipped = Vec::new();
+    for inst in m
+        .all("ADVANCED_FACE")
+        .into_iter()
+        .chain(m.all("FACE_SURFACE"))
+    {
+        let flip = flipped.contains(&inst.id);
+        match face(m, inst, flip) {
+            Ok(f) => faces.push(f),
+            Err(e) => skipped.push(e.to_string()),
+        }
+    }
+    (faces, skipped)
+}
+
+/// The faces a shell uses through an `ORIENTED_FACE` with orientation `.F.` (reversed).
+fn oriented_face_flips(m: &Model<'_>) -> Vec<u64> {
+    m.all("ORIENTED_FACE")
+        .into_iter()
+        .filter_map(|i| {
+            let p = i.record("ORIENTED_FACE")?;
+            match (p.get(2), p.get(3)) {
+                (Some(Value::Ref(f)), Some(Value::Enum(o))) if o == "F" => Some(*f),
+                _ => None,
+            }
+        })
+        .collect()
+}
+
+fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
+    let p = inst
+        .record("ADVANCED_FACE")
+        .or_else(|| inst.record("FACE_SURFACE"))
+        .ok_or_else(|| err(inst, "expected a face"))?;
+    let surf_inst = m.param_ref(inst, p, 2)?;
+    let same_sense = boolean(inst, p.get(3), "same_sense")?;
+    let g = geometry(m, surf_inst).map_err(|e| err(inst, format!("face_geometry: {e}")))?;
+    let mut loops = Vec::new();
+    let mut vertices: Vec<Point3<f64>> = Vec::new();
+    for bid in refs(inst, p.get(1), "bounds")? {
+        let b = m.get(inst, bid)?;
+        let bp = b
+            .record("FACE_OUTER_BOUND")
+            .or_else(|| b.record("FACE_BOUND"))
+            .ok_or_else(|| err(b, "expected a FACE_BOUND"))?;
+        let lp_inst = m.param_ref(b, bp, 1)?;
+        let orientation = boolean(b, bp.get(2), "orientation")?;
+        if let Some(vl) = lp_inst.record("VERTEX_LOOP") {
+            let v = m.param_ref(lp_inst, vl, 1)?;
+            vertices.push(vertex(m, v)?);
+            continue;
+        }
+        let mut edges = edge_loop(m, lp_inst)?;
+        if !orientation {
+            edges = edges.into_iter().rev().map(|c| c.reversed()).collect();
+        }
+        loops.push(edges);
+    }
+    // The parameter range: every boundary sample mapped to natural parameters.
+    let mut us = Vec::new();
+    let mut vs = Vec::new();
+    let mut add = |q: &Point3<f64>| {
+        let (u, v) = g.params_of(q);
+        us.push(u);
+        vs.push(v);
+    };
+    for l in &loops {
+        for e in l {
+            let (a, b) = e.domain();
+            for k in 0..EDGE_SAMPLES {
+                add(&e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64));
+            }
+        }
+    }
+    for q in &vertices {
+        add(q);
+    }
+    let (pu, pv) = g.periodic();
+    let whole = loops.is_empty();
+    if whole && !matches!(g, Geometry::Sphere(..) | Geometry::Torus(..)) {
+        return Err(err(inst, "a face without a boundary edge"));
+    }
+    let range = |x: &[f64], periodic: bool| {
+        if periodic {
+            angle_range(x, FULL_TURN_GAP)
+        } else {
+            let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            (lo, hi)
+        }
+    };
+    // A sphere or torus bounded by vertex loops only (as Open CASCADE writes a whole sphere)
+    // is the whole closed surface.
+    let mut u = if whole { (0.0, TAU) } else { range(&us, pu) };
+    let mut v = match (&g, whole) {
+        (Geometry::Sphere(..), true) => (-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2),
+        (_, true) => (0.0, TAU),
+        _ => range(&vs, pv),
+    };
+    if let Geometry::Nurbs(s) = &g {
+        // Parameters come from projection: keep them inside the domain.
+        let (a, b) = s.domain_u();
+        let (c, d) = s.domain_v();
+        u = (u.0.max(a), u.1.min(b));
+        v = (v.0.max(c), v.1.min(d));
+        // Within rounding of the whole domain: the whole domain (no knot insertion).
+        let near = |x: f64, y: f64, span: f64| (x - y).abs() <= 1e-9 * span.max(1.0);
+        if near(u.0, a, b - a) {
+            u.0 = a;
+        }
+        if near(u.1, b, b - a) {
+            u.1 = b;
+        }
+        if near(v.0, c, d - c) {
+            v.0 = c;
+        }
+        if near(v.1, d, d - c) {
+            v.1 = d;
+        }
+    }
+    if let Geometry::Sphere(..) = &g {
+        // A cap bounded by one circle has its pole inside: the boundary alone shows no v
+        // extent. Not resolved here.
+        if v.1 - v.0 < 1e-9 {
+            return Err(err(
+                inst,
+                "a spherical face whose boundary does not reach its pole is not supported",
+            ));
+        }
+    }
+    let mut surface = g.to_nurbs(inst, u, v)?;
+    if same_sense == flip {
+        surface = reverse_u(&surface);
+    }
+    Ok(Face {
+        id: inst.id,
+        name: name_of(inst),
+        kind: g.kind(),
+        surface,
+        loops,
+    })
+}
+
+/// The same surface with u reversed: `Su x Sv` flips.
+pub(crate) fn reverse_u(s: &NurbsSurface) -> NurbsSurface {
+    let (nu, nv) = s.net_size();
+    let (a, b) = s.domain_u();
+    let ku: Vec<f64> = s.knots_u().iter().rev().map(|k| a + b - k).collect();
+    let pts: Vec<Vec<Point3<f64>>> = s.control_points().into_iter().rev().collect();
+    let w: Vec<Vec<f64>> = s.weights().into_iter().rev().collect();
+    let _ = (nu, nv);
+    NurbsSurface::try_new(
+        s.degree_u(),
+        s.degree_v(),
+        ku,
+        s.knots_v().to_vec(),
+        pts,
+        Some(w),
+    )
+    .unwrap_or_else(|_| s.clone())
+}
+
+fn vertex(m: &Model<'_>, v: &Instance) -> Result<Point3<f64>> {
+    let p = m.rec(v, "VERTEX_POINT")?;
+    m.point(m.param_ref(v, p, 1)?)
+}
+
+/// The edges of an `EDGE_LOOP`, each as a NURBS curve running in loop order.
+fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<Vec<NurbsCurve>> {
+    let p = m.rec(inst, "EDGE_LOOP")?;
+    let mut out = Vec::new();
+    for oid in refs(inst, p.get(1), "edge_list")? {
+        let oe = m.get(inst, oid)?;
+        let op = m.rec(oe, "ORIENTED_EDGE")?;
+        let ec = m.param_ref(oe, op, 3)?;
+        let orientation = boolean(oe, op.get(4), "orientation")?;
+        let c = edge_curve(m, ec)?;
+        out.push(if orientation { c } else { c.reversed() });
+    }
+    Ok(out)
+}
+
+/// An `EDGE_CURVE` from its start vertex to its end vertex along its geometry.
+pub(crate) fn edge_curve(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
+    let p = m.rec(inst, "EDGE_CURVE")?;
+    let start = vertex(m, m.param_ref(inst, p, 1)?)?;
+    let end = vertex(m, m.param_ref(inst, p, 2)?)?;
+    let geom = m.param_ref(inst, p, 3)?;
+    let same = boolean(inst, p.get(4), "same_sense")?;
+    let c = if geom.is("TRIMMED_CURVE") {
+        crate::curves::trimmed(m, geom)?
+    } else {
+        let b = basis(m, geom).map_err(|e| err(inst, format!("edge_geometry: {e}")))?;
+        let (ts, te) = (b.param_of(&start), b.param_of(&end));
+        let closed = (start - end).norm() <= 1e-9 * (1.0 + start.coords.norm());
+        match &b {
+            Basis::Conic { .. } if closed => {
+                let c = b.piece(inst, ts, ts + TAU)?;
+                if same {
+                    c
+                } else {
+                    c.reversed()
+                }
+            }
+            Basis::Conic { .. } => {
+                if same {
+                    oriented_piece(inst, &b, ts, te, true)?
+                } else {
+                    oriented_piece(inst, &b, te, ts, true)?.reversed()
+                }
+            }
+            Basis::Nurbs(c) if closed => {
+                if same {
+                    c.clone()
+                } else {
+                    c.reversed()
+                }
+            }
+            _ => b.piece(inst, ts, te)?,
+        }
+    };
+    Ok(c)
+}
+
+/// Which faces a contour lies on: sample it densely, keep the faces within `tolerance` mm of
+/// some sample, and choose greedily the fewest faces that together are within tolerance of
+/// every sample. `None` if some sample is farther than `tolerance` from every face (the
+/// contour is not on the part), with the worst distance.
+pub(crate) fn associate(
+    curve: &NurbsCurve,
+    faces: &[Face],
+    tolerance: f64,
+) -> std::result::Result<Vec<usize>, f64> {
+    let samples = sample(curve);
+    // near[f][k]: face f is within tolerance of sample k.
+    let mut near: Vec<Vec<bool>> = Vec::with_capacity(faces.len());
+    let mut best = vec![f64::INFINITY; samples.len()];
+    for f in faces {
+        let (lo, hi) = f.surface.bounding_box();
+        let mut row = vec![false; samples.len()];
+        let mut warm = None;
+        for (k, p) in samples.iter().enumerate() {
+            let outside = (0..3).any(|i| p[i] < lo[i] - tolerance || p[i] > hi[i] + tolerance);
+            if outside {
+                warm = None;
+                continue;
+            }
+            let pr = f.surface.closest_point(p, warm);
+            warm = Some((pr.u, pr.v));
+            best[k] = best[k].min(pr.distance);
+            row[k] = pr.distance <= tolerance;
+        }
+        near.push(row);
+    }
+    let worst = best.iter().copied().fold(0.0, f64::max);
+    if worst > tolerance {
+        return Err(worst);
+    }
+    let mut covered = vec![false; samples.len()];
+    let mut chosen = Vec::new();
+    while covered.iter().any(|c| !c) {
+        let (f, gain) = near
+            .iter()
+            .enumerate()
+            .map(|(f, row)| {
+                (
+                    f,
+                    row.iter()
+                        .zip(&covered)
+                        .filter(|(n, c)| **n && !**c)
+                        .count(),
+                )
+            })
+            .max_by_key(|&(f, g)| (g, std::cmp::Reverse(f)))
+            .unwrap_or((0, 0));
+        if gain == 0 {
+            break;
+        }
+        chosen.push(f);
+        for (c, n) in covered.iter_mut().zip(&near[f]) {
+            *c |= *n;
+        }
+    }
+    chosen.sort_unstable();
+    Ok(chosen)
+}
+
+/// Dense samples of a curve: 16 per knot span and at least 200.
+pub(crate) fn sample(curve: &NurbsCurve) -> Vec<Point3<f64>> {
+    let spans = curve.spans();
+    let per = (200 / spans.len().max(1)).max(16);
+    let mut out = Vec::with_capacity(spans.len() * per + 1);
+    for (_, a, b) in &spans {
+        for k in 0..per {
+            out.push(curve.point(a + (b - a) * k as f64 / per as f64));
+        }
+    }
+    out.push(curve.point(curve.domain().1));
+    out
+}

@@ -1,0 +1,470 @@
+//! Reads cut contours and the faces they lie on from STEP (ISO 10303-21: AP203, AP214, AP242)
+//! into `kerf.curves/1`.
+//!
+//! - **Contours** are the curves of every `GEOMETRIC_SET` / `GEOMETRIC_CURVE_SET` (where CAD
+//!   systems put laser trim lines): composite curves of trimmed lines, circles, ellipses and
+//!   B-splines (rational or not), trimmed curves, polylines, B-splines, full circles. Each
+//!   composite becomes one NURBS curve with a C0 knot at every join and its segments' senses
+//!   applied; gaps up to [`ImportOptions::close_gaps`] are closed by moving the two end poles
+//!   to their midpoint (the largest move is reported), larger gaps open the contour (reported).
+//!   With [`ImportOptions::edges`], the boundary loops of the faces are the contours instead.
+//! - **Surfaces**: every face a contour lies on becomes a NURBS surface (exact for B-spline
+//!   surfaces, planes, cylinders, cones, spheres, tori, extrusions and revolutions), cut to the
+//!   face's parameter range and oriented so that `Su x Sv` is the face's outward normal. Faces
+//!   are found by projection: dense samples of the contour within
+//!   [`ImportOptions::face_tolerance`] of the face. A contour over several faces names them all
+//!   (the list form of `surface`).
+//! - **Units**: lengths to mm (inch, cm, m files), plane angles from degrees or radians.
+//! - **Errors** name the entity: `#23805 COMPOSITE_CURVE: segment 12 (#23790): ...`.
+//!
+//! The reader is kerf's own, on a Part 21 tokenizer (see `docs/step.md` for why not
+//! `step-io`).
+//!
+//! ```
+//! let step = r#"ISO-10303-21;
+//! HEADER; FILE_SCHEMA(('AUTOMOTIVE_DESIGN')); ENDSEC;
+//! DATA;
+//! #1=CARTESIAN_POINT('',(0.,0.,0.));
+//! #2=DIRECTION('',(0.,0.,1.));
+//! #3=DIRECTION('',(1.,0.,0.));
+//! #4=AXIS2_PLACEMENT_3D('',#1,#2,#3);
+//! #5=CIRCLE('hole',#4,5.);
+//! #6=GEOMETRIC_CURVE_SET('cut',(#5));
+//! ENDSEC;
+//! END-ISO-10303-21;"#;
+//! let import = kerf_step::import(step, &kerf_step::ImportOptions::default())?;
+//! let c = &import.file.curves[0];
+//! assert_eq!(c.id, "hole #5");
+//! assert_eq!(c.degree, 2);
+//! # Ok::<(), kerf_step::StepError>(())
+//! ```
+
+// `!(x > 0.0)` rejects NaN together with the out-of-range values in one test; every such
+// comparison in this crate guards file data that may be NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+mod contour;
+mod curves;
+mod error;
+mod faces;
+mod model;
+mod parser;
+mod surfaces;
+
+use std::path::Path;
+
+use kerf_format::curves::{RawCurve, RawCurvesFile, RawNurbsSurface, RawSurface, SurfaceRef};
+use kerf_nurbs::{NurbsCurve, NurbsSurface};
+
+pub use error::{FileError, Result, StepError};
+pub use model::Units;
+
+use crate::faces::Face;
+use crate::model::{name_of, refs, Model};
+
+/// Options of [`import`]. Defaults: gaps up to 0.1 mm closed, faces within 0.01 mm, contours
+/// from geometric sets.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct ImportOptions {
+    /// Gaps between consecutive segments up to this (mm) are closed by moving the shared pole;
+    /// larger gaps open the contour. Default 0.1 mm (the largest seen on automotive data).
+    pub close_gaps: f64,
+    /// A contour lies on a face where every dense sample is within this distance (mm) of one
+    /// of the faces named. Default 0.01 mm.
+    pub face_tolerance: f64,
+    /// Take the boundary loops of faces as the contours instead of the geometric sets.
+    pub edges: bool,
+    /// With `edges`: only the faces with these `#id`s (default: every face).
+    pub faces: Option<Vec<u64>>,
+    /// Write every face read as a surface, not only those a contour lies on.
+    pub all_faces: bool,
+}
+
+impl Default for ImportOptions {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+impl ImportOptions {
+    /// The defaults, as a constant.
+    pub const DEFAULT: Self = Self {
+        close_gaps: 0.1,
+        face_tolerance: 0.01,
+        edges: false,
+        faces: None,
+        all_faces: false,
+    };
+
+    /// With a gap threshold (mm).
+    pub fn with_close_gaps(mut self, mm: f64) -> Self {
+        self.close_gaps = mm;
+        self
+    }
+
+    /// With a face tolerance (mm).
+    pub fn with_face_tolerance(mut self, mm: f64) -> Self {
+        self.face_tolerance = mm;
+        self
+    }
+
+    /// Write every face read as a surface, used or not.
+    pub fn with_all_faces(mut self, all: bool) -> Self {
+        self.all_faces = all;
+        self
+    }
+
+    /// Contours from the boundary loops of these faces (`None`: every face).
+    pub fn with_edges(mut self, faces: Option<Vec<u64>>) -> Self {
+        self.edges = true;
+        self.faces = faces;
+        self
+    }
+}
+
+/// What [`import`] read.
+#[derive(Debug, Clone)]
+pub struct Import {
+    /// The `kerf.curves/1` document (valid: it passes `kerf_format::curves::from_raw`).
+    pub file: RawCurvesFile,
+    /// What was taken, skipped, closed and opened.
+    pub report: Report,
+}
+
+/// The account of an import.
+#[derive(Debug, Clone, Default)]
+pub struct Report {
+    /// The schemas of `FILE_SCHEMA` (AP203 `CONFIG_CONTROL_DESIGN`, AP214 `AUTOMOTIVE_DESIGN`, ...).
+    pub schemas: Vec<String>,
+    /// The file's units.
+    pub units: Units,
+    /// One line per contour written.
+    pub taken: Vec<String>,
+    /// One line per entity not used, with the reason.
+    pub skipped: Vec<String>,
+    /// Gaps closed (count) and the largest pole move, mm.
+    pub gaps_closed: usize,
+    /// The largest distance a pole was moved to close a gap, mm.
+    pub largest_move: f64,
+    /// One line per gap that opened a contour.
+    pub opened: Vec<String>,
+    /// Faces read (converted); those that failed are listed in `skipped`.
+    pub faces_read: usize,
+    /// One line per surface written: its id, kind and the face's name.
+    pub surfaces: Vec<String>,
+}
+
+/// Reads a STEP file from disk; see [`import`].
+///
+/// # Errors
+/// [`FileError`] naming the file around any [`StepError`].
+pub fn import_file(
+    path: impl AsRef<Path>,
+    opts: &ImportOptions,
+) -> std::result::Result<Import, FileError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|source| {
+        StepError::Read {
+            path: path.to_path_buf(),
+            source,
+        }
+        .in_file(path)
+    })?;
+    let text = String::from_utf8_lossy(&bytes);
+    import(&text, opts).map_err(|e| e.in_file(path))
+}
+
+/// Reads the text of a STEP file into a `kerf.curves/1` document.
+///
+/// # Errors
+/// [`StepError::Syntax`] for malformed Part 21, [`StepError::Entity`] naming the entity for a
+/// defect in one that is needed (a contour's segment; a face's geometry is skipped and
+/// reported instead), [`StepError::NoContour`] if nothing can be cut,
+/// [`StepError::Options`] for a non-positive or non-finite option.
+pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
+    for (name, v) in [
+        ("close_gaps", opts.close_gaps),
+        ("face_tolerance", opts.face_tolerance),
+    ] {
+        if !(v >= 0.0 && v.is_finite()) {
+            return Err(StepError::Options(format!(
+                "{name} must be a finite number >= 0 mm, got {v}"
+            )));
+        }
+    }
+    let ex = parser::parse(text)?;
+    let m = Model::new(&ex)?;
+    let mut report = Report {
+        schemas: ex.schemas.clone(),
+        units: m.units,
+        ..Report::default()
+    };
+    check_no_placed_parts(&m)?;
+    let (faces, face_errors) = faces::read_faces(&m);
+    report.faces_read = faces.len();
+    report
+        .skipped
+        .extend(face_errors.into_iter().map(|e| format!("face {e}")));
+
+    // (id, curve, faces named)
+    let mut contours: Vec<(String, NurbsCurve, Vec<usize>)> = Vec::new();
+    if opts.edges {
+        for (fi, f) in faces.iter().enumerate() {
+            if let Some(only) = &opts.faces {
+                if !only.contains(&f.id) {
+                    continue;
+                }
+            }
+            for (li, l) in f.loops.iter().enumerate() {
+                let j = contour::join(l, opts.close_gaps, true);
+                note_join(&mut report, &format!("#{} face loop {}", f.id, li + 1), &j);
+                let n = j.contours.len();
+                for (k, c) in j.contours.into_iter().enumerate() {
+                    let id = if n == 1 {
+                        format!("face #{} loop {}", f.id, li + 1)
+                    } else {
+                        format!("face #{} loop {}.{}", f.id, li + 1, k + 1)
+                    };
+                    contours.push((id, c.curve, vec![fi]));
+                }
+            }
+        }
+        if let Some(only) = &opts.faces {
+            for id in only {
+                if !faces.iter().any(|f| f.id == *id) {
+                    return Err(StepError::NoContour {
+                        reason: format!(
+                            "#{id} is not a face kerf could read ({} faces read)",
+                            faces.len()
+                        ),
+                    });
+                }
+            }
+        }
+    } else {
+        let mut sets = m.all("GEOMETRIC_SET");
+        for s in m.all("GEOMETRIC_CURVE_SET") {
+            if !sets.iter().any(|x| x.id == s.id) {
+                sets.push(s);
+            }
+        }
+        for set in sets {
+            let p = set
+                .record("GEOMETRIC_CURVE_SET")
+                .or_else(|| set.record("GEOMETRIC_SET"))
+                .unwrap_or(&[]);
+            for eid in refs(set, p.get(1), "elements")? {
+                let e = m.get(set, eid)?;
+                if e.is("CARTESIAN_POINT") || e.is("POINT_ON_CURVE") || e.is("POINT_ON_SURFACE") {
+                    report
+                        .skipped
+                        .push(format!("#{eid} {}: a point, not a contour", e.name()));
+                    continue;
+                }
+                if e.is("LINE") {
+                    report.skipped.push(format!("#{eid} LINE: unbounded"));
+                    continue;
+                }
+                let is_curve = [
+                    "COMPOSITE_CURVE",
+                    "TRIMMED_CURVE",
+                    "B_SPLINE_CURVE_WITH_KNOTS",
+                    "B_SPLINE_CURVE",
+                    "BEZIER_CURVE",
+                    "CIRCLE",
+                    "ELLIPSE",
+                    "POLYLINE",
+                ]
+                .iter()
+                .any(|n| e.is(n));
+                if !is_curve {
+                    report
+                        .skipped
+                        .push(format!("#{eid} {}: not a curve kerf cuts", e.name()));
+                    continue;
+                }
+                let segs = curves::bounded_segments(&m, e)?;
+                let curves_only: Vec<NurbsCurve> = segs.iter().map(|(c, _)| c.clone()).collect();
+                let closed_hint = {
+                    let a = &curves_only[0];
+                    let b = &curves_only[curves_only.len() - 1];
+                    (a.point(a.domain().0) - b.point(b.domain().1)).norm() <= opts.close_gaps
+                };
+                let j = contour::join(&curves_only, opts.close_gaps, closed_hint);
+                for (before, after, gap) in &j.opened {
+                    report.opened.push(format!(
+                        "#{eid} {}: segment {} (#{}) does not join segment {} (#{}) (gap {gap:.3} mm): opened there",
+                        e.name(),
+                        before + 1,
+                        segs[*before].1,
+                        after + 1,
+                        segs[*after].1
+                    ));
+                }
+                note_join(&mut report, &format!("#{eid} {}", e.name()), &j);
+                let name = name_of(e);
+                let base = if name.is_empty() {
+                    format!("#{eid}")
+                } else {
+                    format!("{name} #{eid}")
+                };
+                let n = j.contours.len();
+                if n == 0 {
+                    report.skipped.push(format!(
+                        "#{eid} {}: every segment has zero length",
+                        e.name()
+                    ));
+                }
+                for (k, c) in j.contours.into_iter().enumerate() {
+                    let id = if n == 1 {
+                        base.clone()
+                    } else {
+                        format!("{base}.{}", k + 1)
+                    };
+                    let named = match faces::associate(&c.curve, &faces, opts.face_tolerance) {
+                        Ok(f) => f,
+                        Err(worst) => {
+                            report.skipped.push(format!(
+                                "{id}: on no face (a sample is {worst:.3e} mm from every face, more than {} mm): cut without a surface",
+                                opts.face_tolerance
+                            ));
+                            Vec::new()
+                        }
+                    };
+                    contours.push((id, c.curve, named));
+                }
+            }
+        }
+    }
+    if contours.is_empty() {
+        let reason = if opts.edges {
+            format!(
+                "no face boundary loop ({} faces read, {} skipped)",
+                faces.len(),
+                report.skipped.len()
+            )
+        } else {
+            format!(
+                "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET ({} faces read; try --edges to cut their boundary loops)",
+                faces.len()
+            )
+        };
+        return Err(StepError::NoContour { reason });
+    }
+    // Surfaces: the faces named, in file order.
+    let mut used: Vec<usize> = contours.iter().flat_map(|c| c.2.iter().copied()).collect();
+    if opts.all_faces {
+        used = (0..faces.len()).collect();
+    }
+    used.sort_unstable();
+    used.dedup();
+    let face_id = |f: &Face| format!("face #{}", f.id);
+    for &fi in &used {
+        let f = &faces[fi];
+        report.surfaces.push(format!(
+            "{} ({}{})",
+            face_id(f),
+            f.kind,
+            if f.name.is_empty() {
+                String::new()
+            } else {
+                format!(", {:?}", f.name)
+            }
+        ));
+    }
+    let surfaces: Vec<RawSurface> = used
+        .iter()
+        .map(|&fi| RawSurface::Nurbs(raw_surface(&face_id(&faces[fi]), &faces[fi].surface)))
+        .collect();
+    let mut raw_curves = Vec::with_capacity(contours.len());
+    for (id, c, named) in contours {
+        let surface = match named.len() {
+            0 => None,
+            1 => Some(SurfaceRef::One(face_id(&faces[named[0]]))),
+            _ => Some(SurfaceRef::Many(
+                named.iter().map(|&f| face_id(&faces[f])).collect(),
+            )),
+        };
+        report.taken.push(format!(
+            "{id}: degree {}, {} control points, {:.3} mm{}",
+            c.degree(),
+            c.len(),
+            c.arc_length(),
+            match &surface {
+                None => " (no face)".to_string(),
+                Some(s) => format!(" on {}", s.ids().join(", ")),
+            }
+        ));
+        raw_curves.push(raw_curve(id, &c, surface));
+    }
+    let file = RawCurvesFile {
+        format: kerf_format::CURVES_FORMAT.into(),
+        units: "mm".into(),
+        curves: raw_curves,
+        surfaces,
+    };
+    Ok(Import { file, report })
+}
+
+/// Assembly placements are not applied: refuse a file that places a part anywhere but where
+/// its own coordinates put it, rather than write its geometry in the wrong place.
+fn check_no_placed_parts(m: &Model<'_>) -> Result<()> {
+    for inst in m.all("ITEM_DEFINED_TRANSFORMATION") {
+        let p = m.rec(inst, "ITEM_DEFINED_TRANSFORMATION")?;
+        let a = m.placement(m.param_ref(inst, p, 2)?)?;
+        let b = m.placement(m.param_ref(inst, p, 3)?)?;
+        let same = (a.origin - b.origin).norm() <= 1e-9 * (1.0 + a.origin.coords.norm())
+            && (a.x - b.x).norm() <= 1e-12
+            && (a.z - b.z).norm() <= 1e-12;
+        if !same {
+            return Err(model::err(
+                inst,
+                "places a part with a transformation that is not the identity; assemblies \
+                 are not supported (export the part alone, or as one body in its place)",
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn note_join(report: &mut Report, what: &str, j: &contour::JoinResult) {
+    for c in &j.contours {
+        report.gaps_closed += c.closed.len();
+        report.largest_move = report.largest_move.max(c.largest_move);
+    }
+    for d in &j.dropped {
+        report.skipped.push(format!(
+            "{what}: segment {} has zero length, dropped",
+            d + 1
+        ));
+    }
+}
+
+fn raw_curve(id: String, c: &NurbsCurve, surface: Option<SurfaceRef>) -> RawCurve {
+    RawCurve {
+        id,
+        degree: c.degree(),
+        knots: c.knots().to_vec(),
+        control_points: c.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+        weights: c.is_rational().then(|| c.weights()),
+        surface,
+    }
+}
+
+fn raw_surface(id: &str, s: &NurbsSurface) -> RawNurbsSurface {
+    RawNurbsSurface {
+        id: id.to_owned(),
+        degree_u: s.degree_u(),
+        degree_v: s.degree_v(),
+        knots_u: s.knots_u().to_vec(),
+        knots_v: s.knots_v().to_vec(),
+        control_points: s
+            .control_points()
+            .iter()
+            .map(|row| row.iter().map(|p| [p.x, p.y, p.z]).collect())
+            .collect(),
+        weights: s.is_rational().then(|| s.weights()),
+        flip: false,
+    }
+}

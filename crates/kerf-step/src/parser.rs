@@ -1,0 +1,589 @@
+//! The ISO 10303-21 ("Part 21") exchange structure: a tokenizer and a parser of the `DATA`
+//! section into an entity table keyed by `#id`.
+//!
+//! Only the syntax is handled here; what entities mean is for [`crate::model`]. The parser is
+//! linear in the file size and recursion is bounded ([`MAX_NESTING`]), so a hostile file can
+//! neither hang it nor overflow the stack.
+
+use std::collections::HashMap;
+
+use crate::error::{Result, StepError};
+
+/// The deepest nesting of parameter lists accepted (real files use 3 or 4: a B-spline
+/// surface's control net is a list of lists).
+pub(crate) const MAX_NESTING: usize = 32;
+
+/// One parameter value of an entity instance.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Value {
+    /// An integer.
+    Int(i64),
+    /// A real.
+    Real(f64),
+    /// A string, with `''` and the `\X2\...\X0\` escapes decoded.
+    Str(String),
+    /// An enumeration value without its dots (`.T.` is `Enum("T")`).
+    Enum(String),
+    /// A reference to another instance (`#23`).
+    Ref(u64),
+    /// A list `( ... )`.
+    List(Vec<Value>),
+    /// A typed parameter `LENGTH_MEASURE(1.E-07)`.
+    Typed(String, Box<Value>),
+    /// `$`: the value is absent.
+    Null,
+    /// `*`: derived.
+    Derived,
+    /// A binary `"..."` (kept as text).
+    Binary(String),
+}
+
+/// One entity instance: `#id=NAME(...)` has one record, a complex instance
+/// `#id=(A(...) B(...))` has one record per partial type, in file order.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Instance {
+    /// The `#id`.
+    pub(crate) id: u64,
+    /// `(NAME, parameters)` per record; names upper case.
+    pub(crate) records: Vec<(String, Vec<Value>)>,
+}
+
+impl Instance {
+    /// The record named `name`, if the instance has one.
+    pub(crate) fn record(&self, name: &str) -> Option<&[Value]> {
+        self.records
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, p)| p.as_slice())
+    }
+
+    /// The entity name for messages: the simple name, or the partial names joined by `+`.
+    pub(crate) fn name(&self) -> String {
+        self.records
+            .iter()
+            .map(|(n, _)| n.as_str())
+            .collect::<Vec<_>>()
+            .join("+")
+    }
+
+    /// `true` if the instance is (or, complex, contains) an entity called `name`.
+    pub(crate) fn is(&self, name: &str) -> bool {
+        self.records.iter().any(|(n, _)| n == name)
+    }
+}
+
+/// A parsed exchange structure.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Exchange {
+    /// The schema names of `FILE_SCHEMA`.
+    pub(crate) schemas: Vec<String>,
+    /// Every instance of the `DATA` sections, by id.
+    pub(crate) instances: HashMap<u64, Instance>,
+    /// The ids in file order.
+    pub(crate) order: Vec<u64>,
+}
+
+/// Parses a whole Part 21 file.
+///
+/// # Errors
+/// [`StepError::Syntax`] naming the line and what was expected; [`StepError::DuplicateId`].
+pub(crate) fn parse(text: &str) -> Result<Exchange> {
+    let mut p = Parser {
+        s: text.as_bytes(),
+        i: 0,
+    };
+    let mut ex = Exchange::default();
+    p.skip_ws()?;
+    p.expect_keyword("ISO-10303-21")?;
+    p.expect_byte(b';')?;
+    let mut in_data = false;
+    let mut seen_data = false;
+    loop {
+        p.skip_ws()?;
+        if p.at_end() {
+            return Err(p.error("the file ends before END-ISO-10303-21;"));
+        }
+        if p.peek() == Some(b'#') && in_data {
+            let inst = p.instance()?;
+            if ex.instances.contains_key(&inst.id) {
+                return Err(StepError::DuplicateId {
+                    id: inst.id,
+                    line: p.line(),
+                });
+            }
+            ex.order.push(inst.id);
+            ex.instances.insert(inst.id, inst);
+            continue;
+        }
+        let word = p.keyword()?;
+        match word.as_str() {
+            "END-ISO-10303-21" => {
+                p.skip_ws()?;
+                p.expect_byte(b';')?;
+                break;
+            }
+            "HEADER" => p.expect_byte(b';')?,
+            "DATA" => {
+                p.skip_ws()?;
+                if p.peek() == Some(b'(') {
+                    // DATA('name', (schemas)); of Part 21 edition 3.
+                    p.i += 1;
+                    p.params(0)?;
+                }
+                p.skip_ws()?;
+                p.expect_byte(b';')?;
+                in_data = true;
+                seen_data = true;
+            }
+            "ENDSEC" => {
+                p.skip_ws()?;
+                p.expect_byte(b';')?;
+                in_data = false;
+            }
+            _ if !in_data => {
+                // A header entity: FILE_DESCRIPTION(...); FILE_NAME(...); FILE_SCHEMA(...);
+                p.skip_ws()?;
+                p.expect_byte(b'(')?;
+                let params = p.params(0)?;
+                p.skip_ws()?;
+                p.expect_byte(b';')?;
+                if word == "FILE_SCHEMA" {
+                    if let Some(Value::List(l)) = params.first() {
+                        ex.schemas = l
+                            .iter()
+                            .filter_map(|v| match v {
+                                Value::Str(s) => Some(s.clone()),
+                                _ => None,
+                            })
+                            .collect();
+                    }
+                }
+            }
+            _ => return Err(p.error(&format!("expected #id=... or ENDSEC, found {word}"))),
+        }
+    }
+    if !seen_data {
+        return Err(StepError::Syntax {
+            line: p.line(),
+            message: "no DATA section".into(),
+        });
+    }
+    Ok(ex)
+}
+
+struct Parser<'a> {
+    s: &'a [u8],
+    i: usize,
+}
+
+impl Parser<'_> {
+    fn at_end(&self) -> bool {
+        self.i >= self.s.len()
+    }
+
+    fn peek(&self) -> Option<u8> {
+        self.s.get(self.i).copied()
+    }
+
+    fn line(&self) -> usize {
+        1 + self.s[..self.i.min(self.s.len())]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+    }
+
+    fn error(&self, message: &str) -> StepError {
+        StepError::Syntax {
+            line: self.line(),
+            message: message.to_owned(),
+        }
+    }
+
+    /// Skips white space and `/* ... */` comments.
+    fn skip_ws(&mut self) -> Result<()> {
+        loop {
+            while self.peek().is_some_and(|b| b.is_ascii_whitespace()) {
+                self.i += 1;
+            }
+            if self.s[self.i.min(self.s.len())..].starts_with(b"/*") {
+                let start = self.i;
+                match self.s[self.i + 2..].windows(2).position(|w| w == b"*/") {
+                    Some(k) => self.i += 2 + k + 2,
+                    None => {
+                        self.i = start;
+                        return Err(self.error("unterminated comment /* ..."));
+                    }
+                }
+            } else {
+                return Ok(());
+            }
+        }
+    }
+
+    fn expect_byte(&mut self, b: u8) -> Result<()> {
+        self.skip_ws()?;
+        if self.peek() == Some(b) {
+            self.i += 1;
+            Ok(())
+        } else {
+            let found = self.found();
+            Err(self.error(&format!("expected '{}', found {found}", b as char)))
+        }
+    }
+
+    fn found(&self) -> String {
+        match self.peek() {
+            None => "the end of the file".into(),
+            Some(b) if b.is_ascii_graphic() => format!("'{}'", b as char),
+            Some(b) => format!("byte 0x{b:02x}"),
+        }
+    }
+
+    /// A keyword: letters, digits, `_` and `-`, upper-cased.
+    fn keyword(&mut self) -> Result<String> {
+        self.skip_ws()?;
+        let start = self.i;
+        while self
+            .peek()
+            .is_some_and(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+        {
+            self.i += 1;
+        }
+        if start == self.i {
+            let found = self.found();
+            return Err(self.error(&format!("expected a keyword, found {found}")));
+        }
+        Ok(String::from_utf8_lossy(&self.s[start..self.i]).to_ascii_uppercase())
+    }
+
+    fn expect_keyword(&mut self, word: &str) -> Result<()> {
+        let k = self.keyword()?;
+        if k == word {
+            Ok(())
+        } else {
+            Err(self.error(&format!("expected {word}, found {k}")))
+        }
+    }
+
+    /// `#id = NAME(...);` or `#id = (A(...) B(...));`.
+    fn instance(&mut self) -> Result<Instance> {
+        self.i += 1; // '#'
+        let id = self.unsigned()?;
+        self.expect_byte(b'=')?;
+        self.skip_ws()?;
+        let mut records = Vec::new();
+        if self.peek() == Some(b'(') {
+            self.i += 1;
+            loop {
+                self.skip_ws()?;
+                if self.peek() == Some(b')') {
+                    self.i += 1;
+                    break;
+                }
+                let name = self.keyword()?;
+                self.expect_byte(b'(')?;
+                records.push((name, self.params(1)?));
+            }
+            if records.is_empty() {
+                return Err(self.error(&format!("#{id}: a complex instance with no record")));
+            }
+        } else {
+            let name = self.keyword()?;
+            self.expect_byte(b'(')?;
+            records.push((name, self.params(0)?));
+        }
+        self.expect_byte(b';')?;
+        Ok(Instance { id, records })
+    }
+
+    fn unsigned(&mut self) -> Result<u64> {
+        let start = self.i;
+        while self.peek().is_some_and(|b| b.is_ascii_digit()) {
+            self.i += 1;
+        }
+        std::str::from_utf8(&self.s[start..self.i])
+            .ok()
+            .and_then(|t| t.parse().ok())
+            .ok_or_else(|| self.error("expected an instance number after '#'"))
+    }
+
+    /// The parameters after an opening `(` up to and including the matching `)`.
+    fn params(&mut self, depth: usize) -> Result<Vec<Value>> {
+        if depth > MAX_NESTING {
+            return Err(self.error(&format!("lists nested deeper than {MAX_NESTING}")));
+        }
+        let mut out = Vec::new();
+        self.skip_ws()?;
+        if self.peek() == Some(b')') {
+            self.i += 1;
+            return Ok(out);
+        }
+        loop {
+            out.push(self.value(depth)?);
+            self.skip_ws()?;
+            match self.peek() {
+                Some(b',') => self.i += 1,
+                Some(b')') => {
+                    self.i += 1;
+                    return Ok(out);
+                }
+                _ => {
+                    let found = self.found();
+                    return Err(self.error(&format!("expected ',' or ')', found {found}")));
+                }
+            }
+        }
+    }
+
+    fn value(&mut self, depth: usize) -> Result<Value> {
+        self.skip_ws()?;
+        let Some(b) = self.peek() else {
+            return Err(self.error("the file ends inside a parameter list"));
+        };
+        match b {
+            b'#' => {
+                self.i += 1;
+                Ok(Value::Ref(self.unsigned()?))
+            }
+            b'$' => {
+                self.i += 1;
+                Ok(Value::Null)
+            }
+            b'*' => {
+                self.i += 1;
+                Ok(Value::Derived)
+            }
+            b'(' => {
+                self.i += 1;
+                Ok(Value::List(self.params(depth + 1)?))
+            }
+            b'\'' => self.string(),
+            b'"' => {
+                self.i += 1;
+                let start = self.i;
+                while self.peek().is_some_and(|b| b != b'"') {
+                    self.i += 1;
+                }
+                if self.at_end() {
+                    return Err(self.error("unterminated binary \"..."));
+                }
+                let text = String::from_utf8_lossy(&self.s[start..self.i]).into_owned();
+                self.i += 1;
+                Ok(Value::Binary(text))
+            }
+            b'.' if self
+                .s
+                .get(self.i + 1)
+                .is_some_and(|c| c.is_ascii_alphabetic()) =>
+            {
+                self.i += 1;
+                let start = self.i;
+                while self
+                    .peek()
+                    .is_some_and(|b| b.is_ascii_alphanumeric() || b == b'_')
+                {
+                    self.i += 1;
+                }
+                let name = String::from_utf8_lossy(&self.s[start..self.i]).to_ascii_uppercase();
+                if self.peek() != Some(b'.') {
+                    return Err(self.error("unterminated enumeration .NAME."));
+                }
+                self.i += 1;
+                Ok(Value::Enum(name))
+            }
+            b'+' | b'-' | b'.' | b'0'..=b'9' => self.number(),
+            b if b.is_ascii_alphabetic() || b == b'_' => {
+                let name = self.keyword()?;
+                self.expect_byte(b'(')?;
+                let mut inner = self.params(depth + 1)?;
+                let v = if inner.len() == 1 {
+                    inner.pop().unwrap_or(Value::Null)
+                } else {
+                    Value::List(inner)
+                };
+                Ok(Value::Typed(name, Box::new(v)))
+            }
+            _ => {
+                let found = self.found();
+                Err(self.error(&format!("expected a parameter, found {found}")))
+            }
+        }
+    }
+
+    fn number(&mut self) -> Result<Value> {
+        let start = self.i;
+        if matches!(self.peek(), Some(b'+' | b'-')) {
+            self.i += 1;
+        }
+        let mut real = false;
+        while let Some(b) = self.peek() {
+            match b {
+                b'0'..=b'9' => self.i += 1,
+                b'.' => {
+                    real = true;
+                    self.i += 1;
+                }
+                b'E' | b'e' => {
+                    real = true;
+                    self.i += 1;
+                    if matches!(self.peek(), Some(b'+' | b'-')) {
+                        self.i += 1;
+                    }
+                }
+                _ => break,
+            }
+        }
+        let text = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("");
+        let bad = || self.error(&format!("not a number: {text:?}"));
+        if real {
+            // Part 21 allows "1." and "1.E5"; Rust parses both.
+            let v: f64 = text.parse().map_err(|_| bad())?;
+            if !v.is_finite() {
+                return Err(bad());
+            }
+            Ok(Value::Real(v))
+        } else {
+            text.parse().map(Value::Int).map_err(|_| bad())
+        }
+    }
+
+    /// `'...'` with `''` for a quote and the `\X2\hhhh\X0\`, `\X\hh` and `\S\c` escapes.
+    fn string(&mut self) -> Result<Value> {
+        let start_line = self.line();
+        self.i += 1;
+        let mut raw = Vec::new();
+        loop {
+            match self.peek() {
+                None => {
+                    return Err(StepError::Syntax {
+                        line: start_line,
+                        message: "unterminated string '...".into(),
+                    })
+                }
+                Some(b'\'') if self.s.get(self.i + 1) == Some(&b'\'') => {
+                    raw.push(b'\'');
+                    self.i += 2;
+                }
+                Some(b'\'') => {
+                    self.i += 1;
+                    break;
+                }
+                Some(b) => {
+                    raw.push(b);
+                    self.i += 1;
+                }
+            }
+        }
+        Ok(Value::Str(decode_string(&String::from_utf8_lossy(&raw))))
+    }
+}
+
+/// Decodes the Part 21 string escapes; anything malformed is kept as written.
+fn decode_string(s: &str) -> String {
+    if !s.contains('\\') {
+        return s.to_owned();
+    }
+    let mut out = String::new();
+    let mut rest = s;
+    while let Some(k) = rest.find('\\') {
+        out.push_str(&rest[..k]);
+        rest = &rest[k..];
+        if let Some(body) = rest.strip_prefix("\\X2\\") {
+            if let Some(end) = body.find("\\X0\\") {
+                let hex = &body[..end];
+                let units: Vec<u16> = (0..hex.len() / 4)
+                    .filter_map(|j| u16::from_str_radix(hex.get(4 * j..4 * j + 4)?, 16).ok())
+                    .collect();
+                out.push_str(&String::from_utf16_lossy(&units));
+                rest = &body[end + 4..];
+                continue;
+            }
+        } else if let Some(body) = rest.strip_prefix("\\X\\") {
+            if let Some(c) = body.get(..2).and_then(|h| u8::from_str_radix(h, 16).ok()) {
+                out.push(char::from(c));
+                rest = &body[2..];
+                continue;
+            }
+        } else if rest.starts_with("\\\\") {
+            out.push('\\');
+            rest = &rest[2..];
+            continue;
+        }
+        out.push('\\');
+        rest = &rest[1..];
+    }
+    out.push_str(rest);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_simple_complex_and_typed_instances() {
+        let text = "ISO-10303-21;\nHEADER;\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\nDATA;\n\
+            #1=CARTESIAN_POINT('it''s',(0.,1.5E1,-2));\n/* comment */\n\
+            #2=(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT(.MILLI.,.METRE.));\n\
+            #3=UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-07),#2,'x','');\n\
+            ENDSEC;\nEND-ISO-10303-21;\n";
+        let ex = parse(text).expect("valid file");
+        assert_eq!(ex.schemas, vec!["AUTOMOTIVE_DESIGN".to_string()], "schema");
+        let p = &ex.instances[&1];
+        assert_eq!(
+            p.records[0].1,
+            vec![
+                Value::Str("it's".into()),
+                Value::List(vec![Value::Real(0.0), Value::Real(15.0), Value::Int(-2)])
+            ],
+            "point parameters"
+        );
+        assert_eq!(
+            ex.instances[&2].name(),
+            "LENGTH_UNIT+NAMED_UNIT+SI_UNIT",
+            "complex"
+        );
+        assert_eq!(
+            ex.instances[&3].records[0].1[0],
+            Value::Typed("LENGTH_MEASURE".into(), Box::new(Value::Real(1e-7))),
+            "typed"
+        );
+    }
+
+    #[test]
+    fn syntax_errors_name_the_line() {
+        let text = "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n#1=LINE('',#2,#3;\nENDSEC;\n";
+        let e = parse(text).unwrap_err().to_string();
+        assert!(e.contains("line 5"), "{e}");
+        let e = parse("ISO-10303-21;\nDATA;\n#1=A('x);\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unterminated string"), "{e}");
+        let e = parse("ISO-10303-21;\nDATA;\n#1=A(1);\n#1=A(2);\nENDSEC;\nEND-ISO-10303-21;")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("#1 is defined twice"), "{e}");
+    }
+
+    #[test]
+    fn deep_nesting_is_refused_not_overflowed() {
+        let text = format!(
+            "ISO-10303-21;\nDATA;\n#1=A({}{});\nENDSEC;\nEND-ISO-10303-21;",
+            "(".repeat(100_000),
+            ")".repeat(100_000)
+        );
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(e.contains("nested deeper"), "{e}");
+    }
+
+    #[test]
+    fn string_escapes() {
+        assert_eq!(decode_string("a\\X2\\00E9\\X0\\b"), "a\u{e9}b", "X2");
+        assert_eq!(decode_string("\\X\\E9"), "\u{e9}", "X");
+        assert_eq!(
+            decode_string("back\\\\slash"),
+            "back\\slash",
+            "double backslash"
+        );
+    }
+}

@@ -1,0 +1,439 @@
+//! The STEP reader on the shipped fixtures (made with Open CASCADE, `scripts/make_step_fixtures.py`)
+//! and on hand-written files, against independent truth: the geometry the fixture script put
+//! in (exact lines, circles and spheres), the mm file for the inch file, and the format's own
+//! validator. The full comparison with Open CASCADE's reader is `scripts/step_check.py` (CI).
+
+use std::path::{Path, PathBuf};
+
+use kerf_format::curves::{from_raw, RawCurve, RawSurface, SurfaceRef};
+use kerf_nurbs::{NurbsCurve, NurbsSurface};
+use kerf_step::{import, import_file, ImportOptions, StepError};
+use nalgebra::{Point3, Vector3};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/step")
+        .join(name)
+}
+
+fn curve(c: &RawCurve) -> NurbsCurve {
+    NurbsCurve::try_new(
+        c.degree,
+        c.knots.clone(),
+        c.control_points.iter().map(|&p| Point3::from(p)).collect(),
+        c.weights.clone(),
+    )
+    .expect("valid curve")
+}
+
+fn surface(s: &RawSurface) -> NurbsSurface {
+    let RawSurface::Nurbs(n) = s else {
+        panic!("the reader writes NURBS surfaces only")
+    };
+    NurbsSurface::try_new(
+        n.degree_u,
+        n.degree_v,
+        n.knots_u.clone(),
+        n.knots_v.clone(),
+        n.control_points
+            .iter()
+            .map(|r| r.iter().map(|&p| Point3::from(p)).collect())
+            .collect(),
+        n.weights.clone(),
+    )
+    .expect("valid surface")
+}
+
+fn samples(c: &NurbsCurve, n: usize) -> Vec<Point3<f64>> {
+    let (a, b) = c.domain();
+    (0..=n)
+        .map(|k| c.point(a + (b - a) * k as f64 / n as f64))
+        .collect()
+}
+
+#[test]
+fn composite_fixture_contours_are_what_the_script_built() {
+    let im = import_file(fixture("composite_mm.step"), &ImportOptions::default()).expect("reads");
+    // The document is valid kerf.curves/1.
+    from_raw(im.file.clone(), Path::new(".")).expect("valid kerf.curves/1");
+    let ids: Vec<&str> = im.file.curves.iter().map(|c| c.id.as_str()).collect();
+    assert_eq!(ids.len(), 5, "4 contours, one opened in two: {ids:?}");
+
+    // Contour 1: line (10,10)-(50,10), arc centre (50,30) r 20, rational spline to (10,50),
+    // line to (10,10.04): closed, the 0.04 mm gap closed by moving both poles 0.02 mm.
+    let c1 = curve(&im.file.curves[0]);
+    assert!(c1.is_closed(), "the 0.04 mm gap to the start is closed");
+    let (a, b) = c1.domain();
+    assert!(
+        (c1.point(a) - Point3::new(10.0, 10.02, 20.0)).norm() < 1e-12,
+        "start moved to the midpoint: {:?}",
+        c1.point(a)
+    );
+    assert!(
+        (im.report.largest_move - 0.02).abs() < 1e-12,
+        "largest move {}",
+        im.report.largest_move
+    );
+    assert_eq!(
+        im.report.gaps_closed, 1,
+        "one real gap closed (rounding gaps are not counted)"
+    );
+    // The arc: every point of the parameter stretch after the first line (20 mm) for the arc
+    // length (20 pi) is on the circle.
+    for k in 0..=100 {
+        let t = a + 40.0 + 20.0 * std::f64::consts::PI * k as f64 / 100.0;
+        let d = (c1.point(t) - Point3::new(50.0, 30.0, 20.0)).norm();
+        assert!((d - 20.0).abs() < 1e-9, "arc point at radius {d}");
+    }
+    // The segments run the way the composite says, although the spline was written reversed
+    // (same_sense .F.): after the arc the curve goes to (10, 50), not back to (50, 50).
+    let joins = c1.c0_breaks();
+    assert!(joins.len() >= 3, "C0 knots at the joins: {joins:?}");
+    assert!(
+        joins
+            .iter()
+            .any(|&t| (c1.point(t) - Point3::new(10.0, 50.0, 20.0)).norm() < 1e-9),
+        "a join at (10, 50)"
+    );
+    assert!(b > a, "domain");
+
+    // Contour 2 opened at the 0.3 mm gap, reported with both segments.
+    assert!(ids[1].ends_with(".1") && ids[2].ends_with(".2"), "{ids:?}");
+    assert_eq!(im.report.opened.len(), 1, "{:?}", im.report.opened);
+    assert!(
+        im.report.opened[0].contains("COMPOSITE_CURVE: segment 1 (#")
+            && im.report.opened[0].contains("(gap 0.300 mm)"),
+        "{}",
+        im.report.opened[0]
+    );
+
+    // Contour 3 runs over the top and the side face: both named, in the list form.
+    match &im.file.curves[3].surface {
+        Some(SurfaceRef::Many(v)) => assert_eq!(v.len(), 2, "{v:?}"),
+        other => panic!("expected two faces, got {other:?}"),
+    }
+    // The full circle on the side face x = 120: on the circle, in the plane, and starting where
+    // Open CASCADE's gp_Ax2 puts the x axis of a placement without reference direction whose
+    // axis is +X: (0, 0, 1), so at (120, 50, 15).
+    let circle = curve(&im.file.curves[4]);
+    for p in samples(&circle, 200) {
+        assert!((p.x - 120.0).abs() < 1e-12, "in the plane x = 120");
+        assert!(
+            ((p - Point3::new(120.0, 50.0, 10.0)).norm() - 5.0).abs() < 1e-12,
+            "radius 5"
+        );
+    }
+    let start = circle.point(circle.domain().0);
+    // (The file rounds 2 pi to 12 digits: closing that rounding gap moves the start ~1e-12.)
+    assert!(
+        (start - Point3::new(120.0, 50.0, 15.0)).norm() < 1e-9,
+        "start {start:?}"
+    );
+    assert!(
+        matches!(&im.file.curves[4].surface, Some(SurfaceRef::One(_))),
+        "one face"
+    );
+}
+
+#[test]
+fn inch_file_gives_the_mm_geometry() {
+    let mm = import_file(fixture("composite_mm.step"), &ImportOptions::default()).expect("mm");
+    let inch =
+        import_file(fixture("composite_inch.step"), &ImportOptions::default()).expect("inch");
+    assert_eq!(inch.report.units.length_name, "inch", "unit found");
+    assert_eq!(inch.report.units.mm_per_length, 25.4, "factor");
+    assert_eq!(
+        mm.file.curves.len(),
+        inch.file.curves.len(),
+        "same contours"
+    );
+    for (a, b) in mm.file.curves.iter().zip(&inch.file.curves) {
+        let (ca, cb) = (curve(a), curve(b));
+        for (p, q) in samples(&ca, 300).iter().zip(samples(&cb, 300)) {
+            // The inch file holds 12 significant digits of the inch values.
+            assert!((p - q).norm() < 1e-8, "{}: {p:?} vs {q:?}", a.id);
+        }
+    }
+}
+
+#[test]
+fn faces_of_every_kind_are_exact_and_outward() {
+    let opts = ImportOptions::default()
+        .with_edges(None)
+        .with_all_faces(true);
+    let im = import_file(fixture("faces.step"), &opts).expect("reads");
+    from_raw(im.file.clone(), Path::new(".")).expect("valid kerf.curves/1");
+    let kinds: Vec<&str> = im
+        .report
+        .surfaces
+        .iter()
+        .map(|s| s.split('(').nth(1).unwrap_or(""))
+        .collect();
+    for k in [
+        "plane",
+        "cylinder",
+        "cone",
+        "sphere",
+        "torus",
+        "extrusion",
+        "revolution",
+        "b-spline",
+    ] {
+        assert!(
+            kinds.iter().any(|s| s.starts_with(k)),
+            "a {k} face among {kinds:?}"
+        );
+    }
+    // Analytic truth for the cylinder (axis z through (-150, 0), r 10), sphere (centre
+    // (-50, 0, 0), r 9) and torus (centre 0, axis (1,0,1)/sqrt 2, R 15, r 4) of the script:
+    // every grid point on the surface, the normal pointing away from the solid's inside.
+    let mut seen = 0;
+    for (s, line) in im.file.surfaces.iter().zip(&im.report.surfaces) {
+        let ns = surface(s);
+        let (ua, ub) = ns.domain_u();
+        let (va, vb) = ns.domain_v();
+        for i in 0..=12 {
+            for j in 0..=12 {
+                let (u, v) = (
+                    ua + (ub - ua) * i as f64 / 12.0,
+                    va + (vb - va) * j as f64 / 12.0,
+                );
+                let p = ns.point(u, v);
+                let n = ns.normal(u, v);
+                let check = |dist: f64, outward: Vector3<f64>, what: &str| {
+                    assert!(dist.abs() < 1e-9, "{line}: {what} off by {dist}");
+                    if let Some(n) = n {
+                        assert!(
+                            n.dot(&outward.normalize()) > 0.999,
+                            "{line}: normal {n:?} not outward {outward:?}"
+                        );
+                    }
+                };
+                if line.contains("(cylinder") {
+                    let r = Vector3::new(p.x + 150.0, p.y, 0.0);
+                    check(r.norm() - 10.0, r, "cylinder");
+                } else if line.contains("(sphere") {
+                    let r = p - Point3::new(-50.0, 0.0, 0.0);
+                    check(r.norm() - 9.0, r, "sphere");
+                } else if line.contains("(torus") {
+                    let axis = Vector3::new(1.0, 0.0, 1.0).normalize();
+                    let d = p.coords;
+                    let radial = d - axis * d.dot(&axis);
+                    let centre = radial.normalize() * 15.0;
+                    let r = d - centre;
+                    check(r.norm() - 4.0, r, "torus");
+                } else {
+                    continue;
+                }
+            }
+        }
+        seen += usize::from(
+            line.contains("(cylinder") || line.contains("(sphere") || line.contains("(torus"),
+        );
+    }
+    assert_eq!(seen, 3, "cylinder, sphere and torus checked");
+}
+
+#[test]
+fn every_edge_loop_closes_and_lies_on_its_face() {
+    let opts = ImportOptions::default().with_edges(None);
+    let im = import_file(fixture("faces.step"), &opts).expect("reads");
+    let file = from_raw(im.file.clone(), Path::new(".")).expect("valid");
+    for c in &file.curves {
+        assert!(c.curve.is_closed(), "{}: a face loop is closed", c.id);
+        let s = file.surface_of(c).expect("the loop's face");
+        let kerf_format::SurfaceGeometry::Nurbs(ns) = &s.geometry else {
+            panic!("nurbs")
+        };
+        for p in samples(&c.curve, 60) {
+            let d = ns.closest_point(&p, None).distance;
+            assert!(d < 1e-7, "{}: {d} mm off its face", c.id);
+        }
+    }
+}
+
+const HEAD: &str = "ISO-10303-21;\nHEADER;\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\nDATA;\n";
+const TAIL: &str = "ENDSEC;\nEND-ISO-10303-21;\n";
+
+fn step(body: &str) -> String {
+    format!("{HEAD}{body}{TAIL}")
+}
+
+#[test]
+fn errors_name_the_entity() {
+    let e = import(
+        &step("#1=CIRCLE('',#9,5.);\n#2=GEOMETRIC_CURVE_SET('',(#1));\n"),
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "#1 CIRCLE: refers to #9, which the file does not define",
+        "dangling"
+    );
+
+    let body = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(1.,0.,0.));\n#3=VECTOR('',#2,1.);\n\
+        #4=LINE('',#1,#3);\n#5=TRIMMED_CURVE('',#4,(PARAMETER_VALUE(0.)),(PARAMETER_VALUE(10.)),.T.,.PARAMETER.);\n\
+        #6=COMPOSITE_CURVE_SEGMENT(.CONTINUOUS.,.T.,#5);\n#7=COMPOSITE_CURVE('c',(#6,#1),.F.);\n\
+        #8=GEOMETRIC_CURVE_SET('',(#7));\n";
+    let e = import(&step(body), &ImportOptions::default()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "#7 COMPOSITE_CURVE: segment 2 (#1) is not a COMPOSITE_CURVE_SEGMENT",
+        "bad segment"
+    );
+
+    let e = import(
+        &step("#1=CARTESIAN_POINT('',(0.,0.,0.));\n"),
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, StepError::NoContour { .. }), "{e}");
+    assert!(e.to_string().contains("try --edges"), "{e}");
+
+    let e = import(
+        "ISO-10303-21;\nDATA;\n#1=LINE('',#2,#3;\n",
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().starts_with("line 3:"), "{e}");
+
+    let e = import(
+        &step(""),
+        &ImportOptions::default().with_close_gaps(f64::NAN),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("close_gaps"), "{e}");
+}
+
+#[test]
+fn a_line_trim_and_degree_units_in_a_hand_written_file() {
+    // A circle trimmed from 0 to 90 in a file whose plane angles are degrees and lengths cm.
+    let body = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(0.,0.,1.));\n#3=DIRECTION('',(1.,0.,0.));\n\
+        #4=AXIS2_PLACEMENT_3D('',#1,#2,#3);\n#5=CIRCLE('',#4,2.);\n\
+        #6=TRIMMED_CURVE('q',#5,(PARAMETER_VALUE(0.)),(PARAMETER_VALUE(90.)),.T.,.PARAMETER.);\n\
+        #7=GEOMETRIC_CURVE_SET('',(#6));\n\
+        #10=(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT(.CENTI.,.METRE.));\n\
+        #11=(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.));\n\
+        #12=PLANE_ANGLE_MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(0.0174532925199433),#11);\n\
+        #13=(CONVERSION_BASED_UNIT('DEGREE',#12)NAMED_UNIT(*)PLANE_ANGLE_UNIT());\n\
+        #14=(GEOMETRIC_REPRESENTATION_CONTEXT(3)GLOBAL_UNIT_ASSIGNED_CONTEXT((#10,#13))REPRESENTATION_CONTEXT('',''));\n";
+    let im = import(&step(body), &ImportOptions::default()).expect("reads");
+    assert_eq!(im.report.units.length_name, "cm", "cm");
+    let c = curve(&im.file.curves[0]);
+    let (a, b) = c.domain();
+    assert!(
+        (c.point(a) - Point3::new(20.0, 0.0, 0.0)).norm() < 1e-12,
+        "starts at 20 mm on x"
+    );
+    assert!(
+        (c.point(b) - Point3::new(0.0, 20.0, 0.0)).norm() < 1e-9,
+        "a quarter turn: {:?}",
+        c.point(b)
+    );
+    for p in samples(&c, 50) {
+        assert!((p.coords.norm() - 20.0).abs() < 1e-12, "radius 20 mm");
+    }
+    assert!(im.file.curves[0].surface.is_none(), "no face in the file");
+}
+
+#[test]
+fn gaps_above_the_threshold_open_the_contour() {
+    let strict = ImportOptions::default().with_close_gaps(0.01);
+    let im = import_file(fixture("composite_mm.step"), &strict).expect("reads");
+    // The 0.04 mm gap between the end of contour 1 and its start is no longer closed: the
+    // contour stays open, its start where the file has it.
+    let c1 = curve(&im.file.curves[0]);
+    assert!(!c1.is_closed(), "left open");
+    assert!(
+        (c1.point(c1.domain().0) - Point3::new(10.0, 10.0, 20.0)).norm() < 1e-12,
+        "start unmoved"
+    );
+    assert_eq!(im.report.gaps_closed, 0, "nothing closed");
+    assert_eq!(im.report.opened.len(), 1, "{:?}", im.report.opened);
+}
+
+#[test]
+fn real_sheet_metal_parts_read_with_edges() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
+    if !dir.is_dir() {
+        eprintln!("skipped: {} not present", dir.display());
+        return;
+    }
+    for (name, faces) in [("S01094.stp", 24), ("S06298.stp", 75)] {
+        let im =
+            import_file(dir.join(name), &ImportOptions::default().with_edges(None)).expect(name);
+        assert_eq!(im.report.faces_read, faces, "{name}: every face read");
+        assert!(
+            im.report.skipped.is_empty(),
+            "{name}: {:?}",
+            im.report.skipped
+        );
+        let file = from_raw(im.file, Path::new(".")).expect("valid");
+        assert!(
+            file.curves.iter().all(|c| c.curve.is_closed()),
+            "{name}: loops closed"
+        );
+    }
+}
+
+#[test]
+fn a_placed_assembly_part_is_refused_not_misplaced() {
+    let body = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=CARTESIAN_POINT('',(100.,0.,0.));\n\
+        #3=AXIS2_PLACEMENT_3D('',#1,$,$);\n#4=AXIS2_PLACEMENT_3D('',#2,$,$);\n\
+        #5=ITEM_DEFINED_TRANSFORMATION('','',#3,#4);\n#6=CIRCLE('',#3,5.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n";
+    let e = import(&step(body), &ImportOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("#5 ITEM_DEFINED_TRANSFORMATION: places a part"),
+        "{e}"
+    );
+    // The identity (as Open CASCADE writes for parts in place) is fine.
+    let same = body.replace(
+        "#5=ITEM_DEFINED_TRANSFORMATION('','',#3,#4)",
+        "#5=ITEM_DEFINED_TRANSFORMATION('','',#3,#3)",
+    );
+    assert!(
+        import(&step(&same), &ImportOptions::default()).is_ok(),
+        "identity accepted"
+    );
+}
+
+#[test]
+fn hostile_files_give_errors_not_hangs_or_panics() {
+    let circle = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(0.,0.,1.));\n#3=DIRECTION('',(1.,0.,0.));\n\
+        #4=AXIS2_PLACEMENT_3D('',#1,#2,#3);\n#5=CIRCLE('',#4,2.);\n";
+    // A trim parameter far beyond 2 pi: one turn at most, computed without looping.
+    let huge = format!(
+        "{circle}#6=TRIMMED_CURVE('',#5,(PARAMETER_VALUE(1.E300)),(PARAMETER_VALUE(0.)),.T.,.PARAMETER.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n"
+    );
+    let im = import(&step(&huge), &ImportOptions::default()).expect("reads");
+    let c = curve(&im.file.curves[0]);
+    assert!(
+        samples(&c, 20)
+            .iter()
+            .all(|p| (p.coords.norm() - 2.0).abs() < 1e-9),
+        "on the circle"
+    );
+    // A surface curve that is its own 3D curve, and a composite that contains itself.
+    let cycle = "#1=SURFACE_CURVE('',#1,(),.CURVE_3D.);\n#2=GEOMETRIC_CURVE_SET('',(#3));\n\
+        #3=COMPOSITE_CURVE('',(#4),.F.);\n#4=COMPOSITE_CURVE_SEGMENT(.CONTINUOUS.,.T.,#3);\n";
+    let e = import(&step(cycle), &ImportOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("deep (a cycle?)"), "{e}");
+    let e = import(
+        &step("#1=SURFACE_CURVE('',#1,(),.CURVE_3D.);\n#2=TRIMMED_CURVE('',#1,(PARAMETER_VALUE(0.)),(PARAMETER_VALUE(1.)),.T.,.PARAMETER.);\n#3=GEOMETRIC_CURVE_SET('',(#2));\n"),
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("deep (a cycle?)"), "{e}");
+    // A B-spline record cut short.
+    let e = import(
+        &step("#1=B_SPLINE_CURVE_WITH_KNOTS('',3);\n#2=GEOMETRIC_CURVE_SET('',(#1));\n"),
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().starts_with("#1 B_SPLINE_CURVE_WITH_KNOTS: "),
+        "{e}"
+    );
+}

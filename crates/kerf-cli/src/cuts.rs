@@ -38,6 +38,9 @@ pub(crate) struct CutPath {
     pub(crate) start_point: usize,
 }
 
+/// The process plan of each set-up, with the curves (indices into the file) it was made for.
+pub(crate) type SetupPlans = Vec<(Vec<usize>, CutPlan)>;
+
 /// The cuts of every contour in cutting order (set-up by set-up), with the plans that made
 /// them.
 pub(crate) fn plan(
@@ -45,7 +48,7 @@ pub(crate) fn plan(
     oriented: &[Oriented],
     placed: &Placed,
     options: &LeadOptions,
-) -> Result<(Vec<CutPath>, Vec<(Vec<usize>, CutPlan)>), CliError> {
+) -> Result<(Vec<CutPath>, SetupPlans), CliError> {
     let poses: Vec<Vec<PoseArray>> = oriented.iter().map(Oriented::poses).collect();
     let mut cuts = Vec::new();
     let mut plans = Vec::new();
@@ -183,11 +186,7 @@ pub(crate) fn split_axes(
 }
 
 /// The `process` object of `report.json`: pierces, lengths, order and what each cut got.
-pub(crate) fn report(
-    file: &CurvesFile,
-    cuts: &[CutPath],
-    plans: &[(Vec<usize>, CutPlan)],
-) -> Value {
+pub(crate) fn report(file: &CurvesFile, cuts: &[CutPath], plans: &SetupPlans) -> Value {
     let len = |p: &[PoseArray]| -> f64 {
         p.windows(2)
             .map(|w| {

@@ -260,3 +260,49 @@ fn a_bad_place_is_a_usage_error_and_no_fit_is_named() {
         "nothing written"
     );
 }
+
+#[test]
+fn step_parts_run_with_place_auto() {
+    // The shipped STEP fixtures (composite contours over their faces) straight from STEP.
+    for f in ["step/composite_mm.step", "step/composite_inch.step"] {
+        run_placed(f, "gantry_ac.json", "auto");
+    }
+    // The real sheet-metal parts, their faces' boundary loops as contours, where the shared
+    // data is present (CI lays it beside the checkout).
+    let real = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
+    let Ok(dir) = std::fs::read_dir(&real) else {
+        eprintln!("{} not found: real STEP parts skipped", real.display());
+        return;
+    };
+    let mut files: Vec<PathBuf> = dir.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    files.retain(|p| p.extension().is_some_and(|x| x == "stp" || x == "step"));
+    files.sort();
+    assert!(!files.is_empty(), "no STEP file in {}", real.display());
+    for f in files {
+        let out = tempfile::tempdir().expect("temporary directory");
+        let r = kerf()
+            .arg("run")
+            .arg(&f)
+            .arg("--edges")
+            .arg("--machine")
+            .arg(fixture("machines/gantry_ac.json"))
+            .arg("--place")
+            .arg("auto")
+            .arg("--out")
+            .arg(out.path())
+            .arg("-q")
+            .output()
+            .expect("run kerf");
+        assert!(
+            r.status.success(),
+            "{}: {}",
+            f.display(),
+            String::from_utf8_lossy(&r.stderr)
+        );
+        assert!(
+            out.path().join("report.json").exists(),
+            "{}: report",
+            f.display()
+        );
+    }
+}

@@ -172,6 +172,9 @@ pub struct AutoPlaceOptions {
     pub flip: bool,
     /// Distance kept from every linear limit, mm. Default 1.
     pub margin_mm: f64,
+    /// Distance kept from the tilt axis' limits, degrees (the interpolator's smooth motion
+    /// between poses may swing slightly past a pose that sits on a limit). Default 0.5.
+    pub tilt_margin_deg: f64,
     /// The options the paths are solved with (the same as for the final solve).
     pub path_options: PathOptions,
 }
@@ -182,6 +185,7 @@ impl Default for AutoPlaceOptions {
             rotate: true,
             flip: true,
             margin_mm: 1.0,
+            tilt_margin_deg: 0.5,
             path_options: PathOptions::default(),
         }
     }
@@ -468,12 +472,21 @@ fn path_tilt_shortfall(machine: &Machine, poses: &[Pose]) -> f64 {
 }
 
 fn try_rotation(
-    machine: &Machine,
+    real: &Machine,
     paths: &[(&str, &[Pose])],
     owned: &[Vec<Pose>],
     rot: &Rotation3<f64>,
     options: &AutoPlaceOptions,
 ) -> std::result::Result<AutoPlacement, TryError> {
+    // The tilt range less its margin (when the range is wide enough to keep one).
+    let mut inset = real.clone();
+    if let Some(r) = inset.limits[3] {
+        let m = options.tilt_margin_deg.max(0.0);
+        if r.max - r.min > 4.0 * m {
+            inset.limits[3] = Some(Range::new(r.min + m, r.max - m));
+        }
+    }
+    let machine = &inset;
     let tilt_name = machine.kinematics.tilt_name();
     let rotation = Placement::from_rotation(Vector3::zeros(), rot);
     let rotated = place_paths(&rotation, &[], owned);

@@ -167,7 +167,8 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
 
 def main():
     args = sys.argv[1:]
-    outdir = Path(args[args.index("--out") + 1]) if "--out" in args else Path(tempfile.mkdtemp(prefix="kerf-lcnc-"))
+    # Absolute: rs274 and the simulator run in the configuration directory.
+    outdir = (Path(args[args.index("--out") + 1]) if "--out" in args else Path(tempfile.mkdtemp(prefix="kerf-lcnc-"))).resolve()
     outdir.mkdir(parents=True, exist_ok=True)
     sims = SIMS
     if "--sim" in args:

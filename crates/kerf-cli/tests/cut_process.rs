@@ -4,37 +4,12 @@
 //! its cut tangentially, every hole cut before the contour around it, and the order's traverse
 //! no longer than the file order's.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
 use nalgebra::{Vector2, Vector3};
 use serde_json::Value;
 
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
-
-fn read_json(path: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(path).expect("read")).expect("JSON")
-}
-
-fn rows(v: &Value) -> Vec<Vec<f64>> {
-    v.as_array()
-        .map(|a| {
-            a.iter()
-                .map(|r| {
-                    r.as_array()
-                        .expect("row")
-                        .iter()
-                        .map(|x| x.as_f64().expect("number"))
-                        .collect()
-                })
-                .collect()
-        })
-        .unwrap_or_default()
-}
+use common::{fixture, kerf, read_json, rows};
 
 /// A closed cut projected along its mean tool axis.
 struct Plane {
@@ -102,7 +77,7 @@ impl Plane {
 
 fn check(curves: &str, machine: &str, extra: &[&str]) -> Value {
     let dir = tempfile::tempdir().expect("temporary directory");
-    let out = Command::new(env!("CARGO_BIN_EXE_kerf"))
+    let out = kerf()
         .arg("run")
         .arg(fixture(curves))
         .arg("--machine")

@@ -4,26 +4,15 @@
 //! every path equal to the toolpath's cutting point moved by the placement the report states
 //! (the rotation rebuilt here from the reported angles, not by the library).
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use kerf_kinematics::{Axes, Machine};
 use nalgebra::{Matrix3, Vector3};
 use serde_json::Value;
 
-fn kerf() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_kerf"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
-
-fn read_json(path: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(path).expect("read")).expect("JSON")
-}
+use common::{fixture, kerf, read_json};
 
 fn rot_x(a: f64) -> Matrix3<f64> {
     let (s, c) = a.to_radians().sin_cos();

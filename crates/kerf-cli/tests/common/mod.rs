@@ -1,0 +1,43 @@
+//! Helpers shared by the tests that read `kerf run`'s output files (`placement.rs`,
+//! `cut_process.rs`).
+
+#![allow(dead_code)] // each test file uses its own subset
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::Value;
+
+/// The built `kerf` binary.
+pub(crate) fn kerf() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_kerf"))
+}
+
+/// A file under `fixtures/`.
+pub(crate) fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+/// A JSON file, parsed.
+pub(crate) fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).expect("read")).expect("JSON")
+}
+
+/// A JSON array of number arrays (points, poses, positions); empty if absent.
+pub(crate) fn rows(v: &Value) -> Vec<Vec<f64>> {
+    v.as_array()
+        .map(|a| {
+            a.iter()
+                .map(|r| {
+                    r.as_array()
+                        .expect("row")
+                        .iter()
+                        .map(|x| x.as_f64().expect("number"))
+                        .collect()
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}

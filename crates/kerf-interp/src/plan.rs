@@ -3,7 +3,10 @@
 //!
 //! 1. The smooth path (module `smooth`) cuts the program into *runs* at true corners (tangent turns of more
 //!    than 5 degrees, rapid moves, pure rotations, path changes) and lays a C2 spline through
-//!    the poses of each run: the path the machine follows, smooth between corners.
+//!    the poses of each run: the path the machine follows, smooth between corners. With jerk
+//!    limits the tip follows the spline's moving mean over a window within
+//!    [`PlanOptions::blend_tolerance`], which ramps every curvature jump (a clothoid-like
+//!    blend); the rotary axes never leave their ranges (soft-range coordinates).
 //! 2. Along a run the machine axes are `q(s)` of the tip's arc length `s`; with `x = (ds/dt)^2`
 //!    and `u = d2s/dt2` every axis must satisfy `-A_k <= q'_k(s) u + q''_k(s) x <= A_k` and
 //!    `|q'_k| sqrt(x) <= V_k`, the tip `|tip'| sqrt(x) <= F` (the programmed feed), the chord
@@ -11,9 +14,10 @@
 //!    time-optimal `x(s)` on a grid (the phase-plane formulation, rest to rest), using each
 //!    axis' whole acceleration: no fixed shares.
 //! 3. With jerk limits the run's `s(t)` is passed through a moving average of width
-//!    `tau = max_k A_k / J_k` (an S-curve: the path jerk is the difference of two accelerations
-//!    over `tau`), after the maximum velocity curve was lowered to its minimum over the filter's
-//!    reach so that the averaged speed stays under it; the run takes `tau` longer.
+//!    `tau = JERK_FILTER_WIDTH max_k A_k / J_k` (an S-curve: the path jerk is the difference of
+//!    two accelerations over `tau`), after the maximum velocity curve was lowered to its minimum
+//!    over the filter's reach (measured with the speed of the unfiltered optimum) so that the
+//!    averaged speed stays under it; the run takes `tau` longer.
 //! 4. The set-points are the plan sampled every cycle `T`. The plan is then **verified the way a
 //!    test would**: velocities `(q_i - q_{i-1}) / T`, accelerations
 //!    `(q_{i+1} - 2 q_i + q_{i-1}) / T^2` and jerks `(q_{i+1} - 3 q_i + 3 q_{i-1} - q_{i-2}) / T^3`

@@ -12,7 +12,14 @@
 //! the rotary axes are a second clamped C2 cubic spline through the stations (block ends and arc
 //! intermediate points). The linear axes follow from the machine model at every `s`. The ends
 //! are clamped to the tangent of the first and last block, and a run's ends, and every block's
-//! start, are returned exactly as the stations' axes. The math is in `docs/interpolation.md`.
+//! start, are returned exactly as the stations' axes.
+//!
+//! With a blend tolerance `e` (jerk-limited plans) the tip is the spline's mean over
+//! `[s - w(s), s + w(s)]`, `w <= W = sqrt(6 e / max |p''|)` (so within `e` of the spline), tapered
+//! to 0 at the run's ends: a curvature jump becomes a linear ramp over `2 W`. The rotary spline
+//! interpolates the stations in the coordinates of [`SoftRange`], a C2 map onto the axis range,
+//! so the rotary axes pass every station exactly and never leave their ranges. The math is in
+//! `docs/interpolation.md`.
 
 use crate::block::{Block, Geometry};
 use crate::model::AxisModel;
@@ -87,7 +94,10 @@ impl<const D: usize> Spline<D> {
     /// The index of the interval holding `s` (the end intervals extended beyond the ends).
     #[inline]
     fn index(&self, s: f64) -> usize {
-        self.s.partition_point(|&v| v <= s).clamp(1, self.s.len() - 1) - 1
+        self.s
+            .partition_point(|&v| v <= s)
+            .clamp(1, self.s.len() - 1)
+            - 1
     }
 
     /// The cubic's coefficients on the interval holding `s` (the end intervals extended beyond
@@ -295,7 +305,9 @@ impl Run {
             let h = 1e-3;
             let (a, b, c) = (self.tip_at(s - h), self.tip_at(s), self.tip_at(s + h));
             let d1 = Vector3::from(std::array::from_fn(|d| (c[d] - a[d]) / (2.0 * h)));
-            let d2 = Vector3::from(std::array::from_fn(|d| (c[d] - 2.0 * b[d] + a[d]) / (h * h)));
+            let d2 = Vector3::from(std::array::from_fn(|d| {
+                (c[d] - 2.0 * b[d] + a[d]) / (h * h)
+            }));
             return (d1, d2);
         }
         let d = self.tip.derivatives(s);
@@ -591,7 +603,13 @@ mod tests {
         let hi = 30.0;
         let s: Vec<f64> = (0..=40).map(|i| i as f64).collect();
         // Steeper up than down: the spline's slope at the peak is not 0.
-        let tent = |v: f64| hi - if v < 20.0 { 0.75 * (20.0 - v) } else { 0.25 * (v - 20.0) };
+        let tent = |v: f64| {
+            hi - if v < 20.0 {
+                0.75 * (20.0 - v)
+            } else {
+                0.25 * (v - 20.0)
+            }
+        };
         let y: Vec<[f64; 1]> = s.iter().map(|&v| [tent(v)]).collect();
         let plain = Spline::clamped(s.clone(), y.clone(), [0.75], [-0.25]);
         let over = (0..=4000)
@@ -614,8 +632,12 @@ mod tests {
         let m = ROTARY_SOFT_DEG;
         for y0 in [hi - m, hi] {
             let h = 1e-4;
-            let d2 = |y: f64| (soft.apply(y + h) - 2.0 * soft.apply(y) + soft.apply(y - h)) / (h * h);
-            assert!((d2(y0 - 2.0 * h) - d2(y0 + 2.0 * h)).abs() < 0.05, "y'' at {y0}");
+            let d2 =
+                |y: f64| (soft.apply(y + h) - 2.0 * soft.apply(y) + soft.apply(y - h)) / (h * h);
+            assert!(
+                (d2(y0 - 2.0 * h) - d2(y0 + 2.0 * h)).abs() < 0.05,
+                "y'' at {y0}"
+            );
         }
     }
 

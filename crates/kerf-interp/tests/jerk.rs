@@ -112,7 +112,10 @@ fn a_slot_is_blended_within_the_tolerance_and_planned_near_the_optimum() {
             "{feed}: the blend buys time"
         );
         assert!(jerk.blend_deviation() <= opts.blend_tolerance, "{feed}");
-        assert!(jerk.blend_deviation() > 0.2 * opts.blend_tolerance, "{feed}");
+        assert!(
+            jerk.blend_deviation() > 0.2 * opts.blend_tolerance,
+            "{feed}"
+        );
         assert_eq!(acc.blend_deviation(), 0.0, "no blend without jerk limits");
         // The set-points against the exact slot: the blend plus the spline's own few um.
         assert!(worst <= opts.blend_tolerance + 0.002, "{feed}: {worst}");
@@ -182,9 +185,11 @@ fn a_pose_exactly_on_the_tilt_limit_is_reached_and_never_passed() {
         for feed in [6000.0, 20000.0] {
             let motion = plan(&m, &blocks, &PlanOptions::new(feed, 0.001)).expect("planned");
             let rows = motion.setpoints(&m);
-            let (lo, hi) = rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
-                (l.min(q[3]), h.max(q[3]))
-            });
+            let (lo, hi) = rows
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+                    (l.min(q[3]), h.max(q[3]))
+                });
             let r = ratios(&m, &rows, 0.001);
             println!(
                 "jerk {jerk}, {feed}: tilt {lo:.6} .. {hi:.6} in [{:.6}, {:.6}], limits {r:?}",
@@ -195,7 +200,11 @@ fn a_pose_exactly_on_the_tilt_limit_is_reached_and_never_passed() {
                 "a set-point outside the tilt range"
             );
             // The peak is reached (within what one cycle at the feed moves the tilt).
-            let near = if peak > 0.0 { hi - range[1] } else { range[0] - lo };
+            let near = if peak > 0.0 {
+                hi - range[1]
+            } else {
+                range[0] - lo
+            };
             assert!(near.abs() < 0.01, "peak {peak}: {lo} .. {hi}");
             assert!(r.iter().all(|&x| x <= 1.0), "{r:?}");
         }

@@ -40,7 +40,7 @@ pub struct Motion {
     pub(super) block_times: Vec<[f64; 2]>,
     /// F word of each block, mm/s.
     pub(super) feeds: Vec<f64>,
-    /// With [`PlanOptions::block_ends_on_cycles`]: when each block runs.
+    /// With [`PlanOptions::block_ends_on_cycles`](super::PlanOptions::block_ends_on_cycles): when each block runs.
     pub(super) clock: Option<Vec<BlockClock>>,
     pub(super) total_cycles: usize,
     pub(super) stats: Vec<PathStats>,
@@ -146,7 +146,7 @@ impl Motion {
     }
 
     /// The block index and path parameter at time `t` (seconds from the start) of the planned
-    /// motion (with [`PlanOptions::block_ends_on_cycles`], before each block is slowed to whole
+    /// motion (with [`PlanOptions::block_ends_on_cycles`](super::PlanOptions::block_ends_on_cycles), before each block is slowed to whole
     /// cycles).
     pub fn locate(&self, t: f64) -> (usize, f64) {
         if self.runs.is_empty() {
@@ -225,7 +225,12 @@ impl Motion {
     }
 
     #[inline]
-    pub(super) fn axes_at_time<M: AxisModel + ?Sized>(&self, model: &M, t: f64, run: &mut usize) -> [f64; 5] {
+    pub(super) fn axes_at_time<M: AxisModel + ?Sized>(
+        &self,
+        model: &M,
+        t: f64,
+        run: &mut usize,
+    ) -> [f64; 5] {
         while *run + 1 < self.runs.len() && t >= self.starts[*run + 1] {
             *run += 1;
         }

@@ -158,7 +158,12 @@ impl Timed {
 /// The grid of one run: nodes subdivided to at most `step`, at least two intervals each, and
 /// at every grid point `q'`, `q''` (and `q'''` for the jerk cap) by central differences of the
 /// machine axes along the smooth path, with the static caps on `x`.
-pub(super) fn run_grid<M: AxisModel + ?Sized>(model: &M, run: &Run, step: f64, opts: &PlanOptions) -> RunGrid {
+pub(super) fn run_grid<M: AxisModel + ?Sized>(
+    model: &M,
+    run: &Run,
+    step: f64,
+    opts: &PlanOptions,
+) -> RunGrid {
     let lim = model.limits();
     let mut s = Vec::new();
     for w in run.nodes.windows(2) {

@@ -470,9 +470,19 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
     rs.push(s);
     ry.push([end.end_axes[3], end.end_axes[4]]);
     let (m0, m1) = if moves_tip {
-        // The curve's tangent where it can be estimated (circle through the neighbours).
-        let a = tangent(blocks, first, false).unwrap_or_else(Vector3::zeros);
-        let b = tangent(blocks, last, true).unwrap_or_else(Vector3::zeros);
+        // The curve's tangent where it can be estimated (circle through the neighbours), the
+        // neighbour taken inside the run only: a run of one block ends at corners on both
+        // sides, and the circle through the block and the next run's block (across the
+        // corner) tilted a 275 mm edge's end slopes enough to bulge it 35 mm off the contour.
+        let end_tangent = |b: usize, at_end: bool| {
+            if first == last {
+                own_tangent(&blocks[b], at_end)
+            } else {
+                tangent(blocks, b, at_end)
+            }
+        };
+        let a = end_tangent(first, false).unwrap_or_else(Vector3::zeros);
+        let b = end_tangent(last, true).unwrap_or_else(Vector3::zeros);
         ([a.x, a.y, a.z], [b.x, b.y, b.z])
     } else {
         ([0.0; 3], [0.0; 3])

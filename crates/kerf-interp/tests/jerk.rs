@@ -210,3 +210,55 @@ fn a_pose_exactly_on_the_tilt_limit_is_reached_and_never_passed() {
         }
     }
 }
+
+/// Distance of `p` from the polyline `poly`.
+fn polyline_distance(p: &Point3<f64>, poly: &[Point3<f64>]) -> f64 {
+    poly.windows(2)
+        .map(|w| {
+            let d = w[1] - w[0];
+            let t = ((p - w[0]).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+            (p - (w[0] + d * t)).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn a_long_edge_between_two_corners_stays_straight() {
+    // The corner of the fixtures' sheet outline: 160 mm up, 275 mm left, 105 mm down, square
+    // corners. Each edge is a run of its own; its end slopes must be its own direction (an
+    // estimate from the circle through the edge and the next edge across the corner bent the
+    // 275 mm edge 35 mm off the contour). Every set-point on the polyline, with and without jerk.
+    let mut m = gantry();
+    let tips = [
+        Point3::new(40.0, -15.0, 0.0),
+        Point3::new(40.0, 145.0, 0.0),
+        Point3::new(-235.0, 145.0, 0.0),
+        Point3::new(-235.0, 40.0, 0.0),
+    ];
+    let st = solve_stations(&m, &tips, None, None, None).expect("reachable");
+    let blocks = fit_blocks(
+        &m,
+        &st,
+        None,
+        0,
+        &FitOptions {
+            arcs: false,
+            merge_lines: false,
+            ..FitOptions::default()
+        },
+    )
+    .expect("fit");
+    for jerk in [true, false] {
+        if !jerk {
+            m.limits.max_jerk = None;
+        }
+        let motion = plan(&m, &blocks, &PlanOptions::new(20000.0, 0.001)).expect("plan");
+        assert_eq!(motion.runs(), 3, "three edges, three runs");
+        let worst = motion
+            .iter(&m)
+            .map(|q| polyline_distance(&Point3::new(q[0] + m.r_c, q[1], q[2] - m.r_a), &tips))
+            .fold(0.0, f64::max);
+        println!("jerk {jerk}: largest distance from the edges {worst:.2e} mm");
+        assert!(worst < 1e-6, "jerk {jerk}: {worst}");
+    }
+}

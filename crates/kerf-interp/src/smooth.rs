@@ -418,10 +418,25 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         Geometry::Arc(a) => (a.angle_end.to_degrees() / ARC_NODE_DEG).ceil().max(2.0) as usize,
         _ => 1,
     };
-    let spacing: Vec<f64> = run
+    // Node spacing of each block: an arc's own, a line's graded so that it is at most twice its
+    // neighbours' (a forward and a backward sweep; arcs stay as they are). A C2 interpolating
+    // spline rings where the node spacing jumps: a 10 mm edge next to 0.78 mm nodes of a
+    // rounded corner swung 0.11 mm off the contour.
+    let is_line = |b: &Block| matches!(b.geometry, Geometry::Line { .. });
+    let mut spacing: Vec<f64> = run
         .iter()
         .map(|b| b.length() / arc_parts(b) as f64)
         .collect();
+    for j in 1..run.len() {
+        if is_line(&run[j]) && spacing[j - 1] > 0.0 {
+            spacing[j] = spacing[j].min(2.0 * spacing[j - 1]);
+        }
+    }
+    for j in (0..run.len().saturating_sub(1)).rev() {
+        if is_line(&run[j]) && spacing[j + 1] > 0.0 {
+            spacing[j] = spacing[j].min(2.0 * spacing[j + 1]);
+        }
+    }
     let mut ts = Vec::new();
     let mut ty: Vec<[f64; 3]> = Vec::new();
     let mut rs = Vec::new();
@@ -433,20 +448,12 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         let s0 = starts[j];
         let parts = match &b.geometry {
             Geometry::Arc(_) => arc_parts(b),
-            Geometry::Line { .. } => {
-                // Lines much longer than their neighbours' node spacing get nodes on the line,
-                // so that the spline does not bulge between far-apart nodes.
-                let nb = [j.checked_sub(1), Some(j + 1).filter(|&n| n < run.len())]
-                    .into_iter()
-                    .flatten()
-                    .map(|n| spacing[n])
-                    .fold(0.0, f64::max);
-                if nb > 0.0 {
-                    ((b.length() / (2.0 * nb)).ceil() as usize).clamp(1, 4096)
-                } else {
-                    1
-                }
+            Geometry::Line { .. } if spacing[j] > 0.0 => {
+                // Lines longer than their graded spacing get nodes on the line, so that the
+                // spline does not bulge between far-apart nodes.
+                ((b.length() / spacing[j] * (1.0 - 1e-12)).ceil() as usize).clamp(1, 4096)
             }
+            Geometry::Line { .. } => 1,
             Geometry::Turn { .. } => 1,
         };
         for k in 0..parts {

@@ -262,3 +262,64 @@ fn a_long_edge_between_two_corners_stays_straight() {
         assert!(worst < 1e-6, "jerk {jerk}: {worst}");
     }
 }
+
+/// Distance of `p` from the contour of the 40 x 20 mm rectangle with 3 mm rounded corners
+/// centred on the origin (its signed distance function, in the plane).
+fn rounded_rectangle_distance(p: &Point3<f64>) -> f64 {
+    let (qx, qy) = (p.x.abs() - 17.0, p.y.abs() - 7.0);
+    let outside = (qx.max(0.0).powi(2) + qy.max(0.0).powi(2)).sqrt();
+    ((outside + qx.max(qy).min(0.0) - 3.0).powi(2) + p.z.powi(2)).sqrt()
+}
+
+#[test]
+fn long_edges_between_fine_corners_do_not_make_the_spline_ring() {
+    // A rounded rectangle cut as one line per chord: 10 degree chords on the 3 mm corners
+    // (0.52 mm), each straight edge two long chords (17 and 7 mm). Where the spline's node
+    // spacing jumps from 0.52 mm to 17 mm a C2 spline rings (0.14 mm off the contour here before
+    // the spacing was graded; the door trim's switch cut-out swung 0.11 mm off). The set-points
+    // must stay within the chords' own sagitta, 3 (1 - cos 5 deg) = 11 um, of the exact contour
+    // (plus the blend with jerk limits).
+    let mut m = gantry();
+    let mut tips = Vec::new();
+    let corners = [(17.0, -7.0), (17.0, 7.0), (-17.0, 7.0), (-17.0, -7.0)];
+    let mids = [(0.0, -10.0), (20.0, 0.0), (0.0, 10.0), (-20.0, 0.0)];
+    tips.push(Point3::new(-17.0, -10.0, 0.0));
+    for (k, ((cx, cy), (mx, my))) in corners.iter().zip(mids).enumerate() {
+        tips.push(Point3::new(mx, my, 0.0));
+        for i in 0..=9 {
+            let a = (-90.0 + 90.0 * k as f64 + 10.0 * i as f64).to_radians();
+            tips.push(Point3::new(cx + 3.0 * a.cos(), cy + 3.0 * a.sin(), 0.0));
+        }
+    }
+    let st = solve_stations(&m, &tips, None, None, None).expect("reachable");
+    let blocks = fit_blocks(
+        &m,
+        &st,
+        None,
+        0,
+        &FitOptions {
+            arcs: false,
+            merge_lines: false,
+            ..FitOptions::default()
+        },
+    )
+    .expect("fit");
+    for jerk in [false, true] {
+        if !jerk {
+            m.limits.max_jerk = None;
+        } else {
+            m = gantry();
+        }
+        let opts = PlanOptions::new(6000.0, 0.001);
+        let motion = plan(&m, &blocks, &opts).expect("plan");
+        println!("{} runs", motion.runs());
+        let worst = motion
+            .iter(&m)
+            .map(|q| rounded_rectangle_distance(&Point3::new(q[0] + m.r_c, q[1], q[2] - m.r_a)))
+            .fold(0.0, f64::max);
+        println!("jerk {jerk}: largest distance from the rounded rectangle {worst:.2e} mm");
+        let sagitta = 3.0 * (1.0 - 5f64.to_radians().cos());
+        let blend = if jerk { opts.blend_tolerance } else { 0.0 };
+        assert!(worst <= sagitta + blend + 1e-4, "jerk {jerk}: {worst}");
+    }
+}

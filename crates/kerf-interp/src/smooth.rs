@@ -418,23 +418,55 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         Geometry::Arc(a) => (a.angle_end.to_degrees() / ARC_NODE_DEG).ceil().max(2.0) as usize,
         _ => 1,
     };
-    // Node spacing of each block: an arc's own, a line's graded so that it is at most twice its
-    // neighbours' (a forward and a backward sweep; arcs stay as they are). A C2 interpolating
-    // spline rings where the node spacing jumps: a 10 mm edge next to 0.78 mm nodes of a
-    // rounded corner swung 0.11 mm off the contour.
+    // Node spacing of each block: an arc's own; a line's at most twice its neighbours' largest
+    // (a line much longer than both is an edge, not a chord of a curve), and graded where it is
+    // more than 4 times a neighbour's. A C2 interpolating
+    // spline rings where the node spacing jumps: a 10 mm edge next to 0.78 mm nodes of a rounded
+    // corner swung 0.11 mm off the contour. Chords of a smooth curve, whose lengths change by
+    // less than 4 times from one to the next, get no nodes on them (a node on a chord pulls the
+    // spline onto it, up to the chord's sagitta off the curve).
     let is_line = |b: &Block| matches!(b.geometry, Geometry::Line { .. });
-    let mut spacing: Vec<f64> = run
+    let own: Vec<f64> = run
         .iter()
         .map(|b| b.length() / arc_parts(b) as f64)
         .collect();
-    for j in 1..run.len() {
-        if is_line(&run[j]) && spacing[j - 1] > 0.0 {
-            spacing[j] = spacing[j].min(2.0 * spacing[j - 1]);
+    let mut spacing = own.clone();
+    for j in 0..run.len() {
+        if is_line(&run[j]) {
+            let nb = [j.checked_sub(1), Some(j + 1).filter(|&n| n < run.len())]
+                .into_iter()
+                .flatten()
+                .map(|n| own[n])
+                .fold(0.0, f64::max);
+            if nb > 0.0 {
+                spacing[j] = spacing[j].min(2.0 * nb);
+            }
         }
     }
-    for j in (0..run.len().saturating_sub(1)).rev() {
-        if is_line(&run[j]) && spacing[j + 1] > 0.0 {
-            spacing[j] = spacing[j].min(2.0 * spacing[j + 1]);
+    // A line is graded once it is more than 4 times a neighbour's spacing (or next to a graded
+    // one that is more than twice smaller); graded lines are kept within twice their
+    // neighbours'. Spacings only decrease, so the passes end; at most 64 of them.
+    let mut graded = vec![false; run.len()];
+    for _ in 0..64 {
+        let mut changed = false;
+        for j in 0..run.len() {
+            if !is_line(&run[j]) {
+                continue;
+            }
+            for n in [j.checked_sub(1), Some(j + 1).filter(|&n| n < run.len())]
+                .into_iter()
+                .flatten()
+            {
+                let h = spacing[n];
+                if h > 0.0 && spacing[j] > 2.0 * h && (graded[j] || own[j] > 4.0 * h) {
+                    spacing[j] = 2.0 * h;
+                    graded[j] = true;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
         }
     }
     let mut ts = Vec::new();

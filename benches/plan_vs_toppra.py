@@ -12,7 +12,9 @@ For every fixture path (`kerf discretize -t 0.01 --normals`, `kerf post`) and fe
     5 degrees), per-axis velocity and acceleration limits of the same machine file, the tip
     speed ds/dt <= F as one more constrained coordinate, rest to rest on every piece;
   * the CSV of every kerf run is checked independently: every cycle's velocity, acceleration and
-    (with jerk limits) jerk by finite differences, at rest before and after, against the limits.
+    (with jerk limits) jerk by finite differences, at rest before and after, against the limits;
+    and every set-point's tool tip (the A/C head's forward kinematics) against the polyline of
+    the certified cutting points (largest distance), with and without the jerk-limited blend.
 
 Usage: python3 benches/plan_vs_toppra.py [--kerf target/release/kerf] [--feeds 6000,20000,40000]
        [--only sheet_metal_holes] [--out bench-out]
@@ -138,6 +140,32 @@ def check_csv(path, vmax, amax, jmax, cycle):
     return over, worst
 
 
+def tips_of(q, kin):
+    """Tool tips of set-points [X, Y, Z, A, C] of an A/C head (paper 000 eq 16 inverted:
+    x = X - r_a sin A sin C + r_c cos C, y = Y + r_a sin A cos C + r_c sin C, z = Z - r_a cos A)."""
+    ra, rc = kin["r_a"], kin["r_c"]
+    a, c = np.radians(q[:, 3]), np.radians(q[:, 4])
+    return np.column_stack([
+        q[:, 0] - ra * np.sin(a) * np.sin(c) + rc * np.cos(c),
+        q[:, 1] + ra * np.sin(a) * np.cos(c) + rc * np.sin(c),
+        q[:, 2] - ra * np.cos(a),
+    ])
+
+
+def polyline_distance(points, poly):
+    """Largest distance of `points` from the polyline `poly` (brute force over its segments)."""
+    a, b = poly[:-1], poly[1:]
+    d = b - a
+    dd = np.maximum((d * d).sum(axis=1), 1e-300)
+    worst = 0.0
+    for chunk in np.array_split(points, max(1, len(points) // 2000)):
+        w = chunk[:, None, :] - a[None, :, :]
+        t = np.clip((w * d[None, :, :]).sum(axis=2) / dd[None, :], 0.0, 1.0)
+        r = w - t[:, :, None] * d[None, :, :]
+        worst = max(worst, float(np.sqrt((r * r).sum(axis=2).min(axis=1)).max()))
+    return worst
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--kerf", default="target/release/kerf")
@@ -192,20 +220,27 @@ def main():
                     summary = json.loads(out)
                     over, worst = check_csv(csv, vmax, amax, jl, args.cycle)
                     st = summary["paths"][0] if summary.get("paths") else {}
-                    res[label] = (summary["duration_s"], over, worst, st.get("length_share_at_feed", 0.0))
+                    # The set-points' tips against the certified polyline of cutting points.
+                    rows_q = np.loadtxt(csv, delimiter=",", skiprows=1)[:, 1:]
+                    dev = polyline_distance(tips_of(rows_q, machine["kinematics"]), tips)
+                    res[label] = (summary["duration_s"], over, worst, st.get("length_share_at_feed", 0.0),
+                                  dev, summary.get("blend_deviation_mm", 0.0))
                 a, fr = res["acc"], res["free"]
                 line = (f"{fixture:18s} {p['id']:18s} {length:7.1f} mm {feed:6.0f}  ref {ref:7.3f} s  "
                         f"kerf {fr[0]:7.3f} s = {fr[0] / ref:5.3f} x  over {fr[1]}  | chord 1 um {a[0]:7.3f} s = {a[0] / ref:5.3f} x"
                         f"  at feed {100 * a[3]:5.1f} %  over {a[1]}")
                 if "jerk" in res:
                     j = res["jerk"]
-                    line += f"  | jerk {j[0]:7.3f} s = {j[0] / a[0]:5.3f} x  at feed {100 * j[3]:5.1f} %  over {j[1]} (j {j[2][2]:.3f})"
+                    line += (f"  | jerk {j[0]:7.3f} s = {j[0] / a[0]:5.3f} x  at feed {100 * j[3]:5.1f} %  over {j[1]} (j {j[2][2]:.3f})"
+                             f"  | from polyline {1000 * a[4]:.1f} / {1000 * j[4]:.1f} um, blend {1000 * j[5]:.1f} um")
                 print(line, flush=True)
                 rows.append(dict(fixture=fixture, path=p["id"], length=length, feed=feed, ref=ref,
                                  free=fr[0], free_over=fr[1], acc=a[0], acc_over=a[1], acc_worst=a[2], acc_share=a[3],
                                  jerk=res.get("jerk", (None,))[0],
                                  jerk_over=res.get("jerk", (0, 0))[1],
-                                 jerk_share=res.get("jerk", (0, 0, 0, 0))[3]))
+                                 jerk_share=res.get("jerk", (0, 0, 0, 0))[3],
+                                 acc_dev=a[4], jerk_dev=res.get("jerk", (0,) * 6)[4],
+                                 jerk_blend=res.get("jerk", (0,) * 6)[5]))
     json.dump(rows, open(os.path.join(args.out, "plan_vs_toppra.json"), "w"), indent=1)
     worst_ratio = max(r["free"] / r["ref"] for r in rows)
     best_ratio = min(r["free"] / r["ref"] for r in rows)
@@ -216,6 +251,10 @@ def main():
     if long_jerk:
         print(f"jerk-limited / acceleration-limited on paths > 100 mm: up to {max(long_jerk):.3f}")
     print(f"cycles over a limit: {sum(r['free_over'] + r['acc_over'] + r['jerk_over'] for r in rows)}")
+    print(f"set-points from the polyline of cutting points: acceleration-limited up to "
+          f"{1000 * max(r['acc_dev'] for r in rows):.1f} um, jerk-limited (blended) up to "
+          f"{1000 * max(r['jerk_dev'] for r in rows):.1f} um; blend up to "
+          f"{1000 * max(r['jerk_blend'] for r in rows):.1f} um")
 
 
 if __name__ == "__main__":

@@ -12,7 +12,14 @@
 //! the rotary axes are a second clamped C2 cubic spline through the stations (block ends and arc
 //! intermediate points). The linear axes follow from the machine model at every `s`. The ends
 //! are clamped to the tangent of the first and last block, and a run's ends, and every block's
-//! start, are returned exactly as the stations' axes. The math is in `docs/interpolation.md`.
+//! start, are returned exactly as the stations' axes.
+//!
+//! With a blend tolerance `e` (jerk-limited plans) the tip is the spline's mean over
+//! `[s - w(s), s + w(s)]`, `w <= W = sqrt(6 e / max |p''|)` (so within `e` of the spline), tapered
+//! to 0 at the run's ends: a curvature jump becomes a linear ramp over `2 W`. The rotary spline
+//! interpolates the stations in the coordinates of [`SoftRange`], a C2 map onto the axis range,
+//! so the rotary axes pass every station exactly and never leave their ranges. The math is in
+//! `docs/interpolation.md`.
 
 use crate::block::{Block, Geometry};
 use crate::model::AxisModel;
@@ -84,12 +91,25 @@ impl<const D: usize> Spline<D> {
         Self { s, y, m }
     }
 
+    /// The index of the interval holding `s` (the end intervals extended beyond the ends).
+    #[inline]
+    fn index(&self, s: f64) -> usize {
+        self.s
+            .partition_point(|&v| v <= s)
+            .clamp(1, self.s.len() - 1)
+            - 1
+    }
+
     /// The cubic's coefficients on the interval holding `s` (the end intervals extended beyond
     /// the ends): `(t, h, [a, b, c, d])` with `p = a + b t + c t^2 + d t^3`, `t = (s - s_i) / h`.
     #[inline]
     fn piece(&self, s: f64) -> (f64, f64, [[f64; D]; 4]) {
-        let n = self.s.len();
-        let i = self.s.partition_point(|&v| v <= s).clamp(1, n - 1) - 1;
+        self.piece_at(self.index(s), s)
+    }
+
+    /// Like [`Spline::piece`], for the cubic of interval `i` (extrapolated outside it).
+    #[inline]
+    fn piece_at(&self, i: usize, s: f64) -> (f64, f64, [[f64; D]; 4]) {
         let h = self.s[i + 1] - self.s[i];
         let t = (s - self.s[i]) / h;
         let (y0, y1, m0, m1) = (&self.y[i], &self.y[i + 1], &self.m[i], &self.m[i + 1]);
@@ -108,6 +128,54 @@ impl<const D: usize> Spline<D> {
     pub(crate) fn at(&self, s: f64) -> [f64; D] {
         let (t, _, c) = self.piece(s);
         std::array::from_fn(|d| c[0][d] + t * (c[1][d] + t * (c[2][d] + t * c[3][d])))
+    }
+
+    /// The largest `|y''|` (Euclidean norm of the `D` components) anywhere: `y''` is linear on
+    /// each interval, so its norm is largest at an interval's end.
+    pub(crate) fn max_second_derivative(&self) -> f64 {
+        let mut m = 0.0f64;
+        for i in 0..self.s.len() - 1 {
+            let (_, h, c) = self.piece_at(i, self.s[i]);
+            for t in [0.0, 1.0] {
+                let n2: f64 = (0..D)
+                    .map(|d| ((2.0 * c[2][d] + 6.0 * t * c[3][d]) / (h * h)).powi(2))
+                    .sum();
+                m = m.max(n2.sqrt());
+            }
+        }
+        m
+    }
+
+    /// The mean of the spline over `[s - w, s + w]` (`w > 0`), computed as `y(s)` plus the
+    /// integral of `y(x) - y(s)` piece by piece, each piece expanded about `s` (so no large
+    /// values cancel, however small `w`).
+    pub(crate) fn box_mean(&self, s: f64, w: f64) -> [f64; D] {
+        let y = self.at(s);
+        let (a, b) = (s - w, s + w);
+        let (ia, ib) = (self.index(a), self.index(b));
+        let mut acc = [0.0; D];
+        for j in ia..=ib {
+            let lo = if j == ia { a } else { self.s[j] } - s;
+            let hi = if j == ib { b } else { self.s[j + 1] } - s;
+            if hi <= lo {
+                continue;
+            }
+            let (t, h, c) = self.piece_at(j, s);
+            let (l2, l3, l4) = (lo * lo, lo * lo * lo, lo * lo * lo * lo);
+            let (h2, h3, h4) = (hi * hi, hi * hi * hi, hi * hi * hi * hi);
+            for d in 0..D {
+                // Taylor coefficients of piece j about s.
+                let d0 = c[0][d] + t * (c[1][d] + t * (c[2][d] + t * c[3][d])) - y[d];
+                let d1 = (c[1][d] + t * (2.0 * c[2][d] + 3.0 * t * c[3][d])) / h;
+                let d2 = (2.0 * c[2][d] + 6.0 * t * c[3][d]) / (h * h);
+                let d3 = 6.0 * c[3][d] / (h * h * h);
+                acc[d] += d0 * (hi - lo)
+                    + d1 * (h2 - l2) / 2.0
+                    + d2 * (h3 - l3) / 6.0
+                    + d3 * (h4 - l4) / 24.0;
+            }
+        }
+        std::array::from_fn(|d| y[d] + acc[d] / (2.0 * w))
     }
 
     /// The first three derivatives with respect to `s` at `s`.
@@ -137,7 +205,12 @@ pub(crate) struct Run {
     /// The tip nodes' parameters (the planner's grid is refined from them).
     pub(crate) nodes: Vec<f64>,
     tip: Spline<3>,
+    /// The rotary axes' spline, in the soft-limit coordinates of [`SoftRange`].
     rot: Spline<2>,
+    /// The soft limits of the two rotary axes.
+    soft: [SoftRange; 2],
+    /// Half-width `W` of the blend (mm; 0: the tip follows its spline exactly).
+    blend: f64,
 }
 
 impl Run {
@@ -146,11 +219,53 @@ impl Run {
         self.starts[self.starts.len() - 1]
     }
 
+    /// Half-width of the blend's window at `s`: `W` in the middle, tapered to 0 at both ends
+    /// by a C2 smooth step over `2 W`, so that the window `[s - w, s + w]` never leaves the run
+    /// (`w(s) <= min(s, len - s)`) and the run's ends are exact.
+    #[inline]
+    pub(crate) fn blend_width(&self, s: f64) -> f64 {
+        if self.blend <= 0.0 {
+            return 0.0;
+        }
+        let step = |d: f64| {
+            let t = (d / (2.0 * self.blend)).clamp(0.0, 1.0);
+            t * t * t * (10.0 + t * (6.0 * t - 15.0))
+        };
+        self.blend * step(s) * step(self.len() - s)
+    }
+
+    /// The tip at `s`: the tip spline's mean over `[s - w(s), s + w(s)]` (the blend), or the
+    /// spline itself.
+    #[inline]
+    fn tip_at(&self, s: f64) -> [f64; 3] {
+        let w = self.blend_width(s);
+        if w > 0.0 {
+            self.tip.box_mean(s, w)
+        } else {
+            self.tip.at(s)
+        }
+    }
+
+    /// The tip on the unblended spline at `s` (what the blend is measured against).
+    pub(crate) fn spline_tip(&self, s: f64) -> Point3<f64> {
+        let p = self.tip.at(s);
+        Point3::new(p[0], p[1], p[2])
+    }
+
+    /// True when the tip is blended (block starts are then not passed exactly).
+    pub(crate) fn blended(&self) -> bool {
+        self.blend > 0.0
+    }
+
     /// Tip position and rotary axes `(tilt, C)` at `s`, the splines extended beyond the ends.
     #[inline]
     pub(crate) fn pose(&self, s: f64) -> (Point3<f64>, [f64; 2]) {
-        let p = self.tip.at(s);
-        (Point3::new(p[0], p[1], p[2]), self.rot.at(s))
+        let p = self.tip_at(s);
+        let r = self.rot.at(s);
+        (
+            Point3::new(p[0], p[1], p[2]),
+            [self.soft[0].apply(r[0]), self.soft[1].apply(r[1])],
+        )
     }
 
     /// Machine axes at `s` without clamping (for derivatives by differences).
@@ -177,14 +292,24 @@ impl Run {
             return blocks[self.first].start_axes;
         }
         let j = self.starts.partition_point(|&v| v < s);
-        if j < self.starts.len() && self.starts[j] == s {
+        if !self.blended() && j < self.starts.len() && self.starts[j] == s {
             return blocks[self.first + j].start_axes;
         }
         self.axes_raw(model, s)
     }
 
-    /// Tip derivatives `(t', t'')` with respect to `s`.
+    /// Tip derivatives `(t', t'')` with respect to `s` (of the blended tip by central
+    /// differences, step 1e-3 mm).
     pub(crate) fn tip_derivatives(&self, s: f64) -> (Vector3<f64>, Vector3<f64>) {
+        if self.blend_width(s) > 0.0 {
+            let h = 1e-3;
+            let (a, b, c) = (self.tip_at(s - h), self.tip_at(s), self.tip_at(s + h));
+            let d1 = Vector3::from(std::array::from_fn(|d| (c[d] - a[d]) / (2.0 * h)));
+            let d2 = Vector3::from(std::array::from_fn(|d| {
+                (c[d] - 2.0 * b[d] + a[d]) / (h * h)
+            }));
+            return (d1, d2);
+        }
         let d = self.tip.derivatives(s);
         (Vector3::from(d[0]), Vector3::from(d[1]))
     }
@@ -257,20 +382,29 @@ fn breaks(blocks: &[Block], a: usize) -> bool {
     t0.dot(&t1) < CORNER_DEG.to_radians().cos()
 }
 
+/// How the path is built: the rotary axes' ranges and the blend tolerance.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PathOptions {
+    /// Range of the tilt and the C axis (degrees), if limited.
+    pub(crate) rotary_ranges: [Option<[f64; 2]>; 2],
+    /// Largest distance of the blended tip from the tip spline, mm; 0 for no blend.
+    pub(crate) blend_tolerance: f64,
+}
+
 /// Cuts the blocks into runs and builds each run's splines.
-pub(crate) fn runs(blocks: &[Block]) -> Vec<Run> {
+pub(crate) fn runs(blocks: &[Block], opts: &PathOptions) -> Vec<Run> {
     let mut out = Vec::new();
     let mut first = 0;
     for b in 0..blocks.len() {
         if b + 1 == blocks.len() || breaks(blocks, b) {
-            out.push(build(blocks, first, b));
+            out.push(build(blocks, first, b, opts));
             first = b + 1;
         }
     }
     out
 }
 
-fn build(blocks: &[Block], first: usize, last: usize) -> Run {
+fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run {
     let run = &blocks[first..=last];
     let mut starts = Vec::with_capacity(run.len() + 1);
     let mut s = 0.0;
@@ -284,10 +418,57 @@ fn build(blocks: &[Block], first: usize, last: usize) -> Run {
         Geometry::Arc(a) => (a.angle_end.to_degrees() / ARC_NODE_DEG).ceil().max(2.0) as usize,
         _ => 1,
     };
-    let spacing: Vec<f64> = run
+    // Node spacing of each block: an arc's own; a line's at most twice its neighbours' largest
+    // (a line much longer than both is an edge, not a chord of a curve), and graded where it is
+    // more than 4 times a neighbour's. A C2 interpolating
+    // spline rings where the node spacing jumps: a 10 mm edge next to 0.78 mm nodes of a rounded
+    // corner swung 0.11 mm off the contour. Chords of a smooth curve, whose lengths change by
+    // less than 4 times from one to the next, get no nodes on them (a node on a chord pulls the
+    // spline onto it, up to the chord's sagitta off the curve).
+    let is_line = |b: &Block| matches!(b.geometry, Geometry::Line { .. });
+    let own: Vec<f64> = run
         .iter()
         .map(|b| b.length() / arc_parts(b) as f64)
         .collect();
+    let mut spacing = own.clone();
+    for j in 0..run.len() {
+        if is_line(&run[j]) {
+            let nb = [j.checked_sub(1), Some(j + 1).filter(|&n| n < run.len())]
+                .into_iter()
+                .flatten()
+                .map(|n| own[n])
+                .fold(0.0, f64::max);
+            if nb > 0.0 {
+                spacing[j] = spacing[j].min(2.0 * nb);
+            }
+        }
+    }
+    // A line is graded once it is more than 4 times a neighbour's spacing (or next to a graded
+    // one that is more than twice smaller); graded lines are kept within twice their
+    // neighbours'. Spacings only decrease, so the passes end; at most 64 of them.
+    let mut graded = vec![false; run.len()];
+    for _ in 0..64 {
+        let mut changed = false;
+        for j in 0..run.len() {
+            if !is_line(&run[j]) {
+                continue;
+            }
+            for n in [j.checked_sub(1), Some(j + 1).filter(|&n| n < run.len())]
+                .into_iter()
+                .flatten()
+            {
+                let h = spacing[n];
+                if h > 0.0 && spacing[j] > 2.0 * h && (graded[j] || own[j] > 4.0 * h) {
+                    spacing[j] = 2.0 * h;
+                    graded[j] = true;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
     let mut ts = Vec::new();
     let mut ty: Vec<[f64; 3]> = Vec::new();
     let mut rs = Vec::new();
@@ -299,20 +480,12 @@ fn build(blocks: &[Block], first: usize, last: usize) -> Run {
         let s0 = starts[j];
         let parts = match &b.geometry {
             Geometry::Arc(_) => arc_parts(b),
-            Geometry::Line { .. } => {
-                // Lines much longer than their neighbours' node spacing get nodes on the line,
-                // so that the spline does not bulge between far-apart nodes.
-                let nb = [j.checked_sub(1), Some(j + 1).filter(|&n| n < run.len())]
-                    .into_iter()
-                    .flatten()
-                    .map(|n| spacing[n])
-                    .fold(0.0, f64::max);
-                if nb > 0.0 {
-                    ((b.length() / (2.0 * nb)).ceil() as usize).clamp(1, 4096)
-                } else {
-                    1
-                }
+            Geometry::Line { .. } if spacing[j] > 0.0 => {
+                // Lines longer than their graded spacing get nodes on the line, so that the
+                // spline does not bulge between far-apart nodes.
+                ((b.length() / spacing[j] * (1.0 - 1e-12)).ceil() as usize).clamp(1, 4096)
             }
+            Geometry::Line { .. } => 1,
             Geometry::Turn { .. } => 1,
         };
         for k in 0..parts {
@@ -336,34 +509,201 @@ fn build(blocks: &[Block], first: usize, last: usize) -> Run {
     rs.push(s);
     ry.push([end.end_axes[3], end.end_axes[4]]);
     let (m0, m1) = if moves_tip {
-        // The curve's tangent where it can be estimated (circle through the neighbours).
-        let a = tangent(blocks, first, false).unwrap_or_else(Vector3::zeros);
-        let b = tangent(blocks, last, true).unwrap_or_else(Vector3::zeros);
+        // The curve's tangent where it can be estimated (circle through the neighbours), the
+        // neighbour taken inside the run only: a run of one block ends at corners on both
+        // sides, and the circle through the block and the next run's block (across the
+        // corner) tilted a 275 mm edge's end slopes enough to bulge it 35 mm off the contour.
+        let end_tangent = |b: usize, at_end: bool| {
+            if first == last {
+                own_tangent(&blocks[b], at_end)
+            } else {
+                tangent(blocks, b, at_end)
+            }
+        };
+        let a = end_tangent(first, false).unwrap_or_else(Vector3::zeros);
+        let b = end_tangent(last, true).unwrap_or_else(Vector3::zeros);
         ([a.x, a.y, a.z], [b.x, b.y, b.z])
     } else {
         ([0.0; 3], [0.0; 3])
     };
+    // The rotary spline runs through the stations' soft-limit coordinates.
+    let soft = opts.rotary_ranges.map(SoftRange::new);
+    for r in &mut ry {
+        *r = [soft[0].invert(r[0]), soft[1].invert(r[1])];
+    }
     let slope = |i: usize, j: usize| -> [f64; 2] {
         let h = rs[j] - rs[i];
         [(ry[j][0] - ry[i][0]) / h, (ry[j][1] - ry[i][1]) / h]
     };
     let n = rs.len();
     let (r0, r1) = (slope(0, 1), slope(n - 2, n - 1));
+    let tip = Spline::clamped(ts.clone(), ty, m0, m1);
+    // The blend's half-width: the mean over [s - w, s + w] is within w^2 / 6 max |p''| of p(s)
+    // (Taylor: |p(s + x) - p(s) - x p'(s)| <= x^2 / 2 max |p''|, the linear term averages out).
+    let blend = if moves_tip && opts.blend_tolerance > 0.0 {
+        let m = tip.max_second_derivative();
+        if m > 0.0 {
+            (6.0 * opts.blend_tolerance / m).sqrt().min(BLEND_MAX_MM)
+        } else {
+            BLEND_MAX_MM
+        }
+    } else {
+        0.0
+    };
     Run {
         first,
         last,
         cutting: !run[0].rapid,
         moves_tip,
-        nodes: ts.clone(),
-        tip: Spline::clamped(ts, ty, m0, m1),
+        nodes: ts,
+        tip,
         rot: Spline::clamped(rs, ry, r0, r1),
+        soft,
+        blend,
         starts,
+    }
+}
+
+/// Largest half-width of the blend, mm (bounds the pieces one mean spans).
+const BLEND_MAX_MM: f64 = 10.0;
+/// Width of the soft band inside a rotary axis' limits, degrees (at most a quarter of the range).
+pub(crate) const ROTARY_SOFT_DEG: f64 = 0.5;
+
+/// A C2, non-decreasing map `phi` of the real line onto an axis range `[lo, hi]`: the identity
+/// on `[lo + m, hi - m]`, on the upper band `phi(y) = hi - m + m psi((y - hi + m) / m)` with
+/// `psi(t) = t + 4 t^3 - 7 t^4 + 3 t^5` (`psi(0) = 0`, `psi'(0) = 1`, `psi''(0) = 0`,
+/// `psi(1) = 1`, `psi'(1) = psi''(1) = 0`, `psi' = (1 - t)^2 (15 t^2 + 2 t + 1) >= 0`), `hi`
+/// beyond, the lower band mirrored. The rotary spline interpolates `phi^-1` of the stations, so
+/// the axis passes every station exactly and, whatever the spline does between stations, never
+/// leaves `[lo, hi]`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SoftRange {
+    range: Option<[f64; 2]>,
+    band: f64,
+}
+
+impl SoftRange {
+    pub(crate) fn new(range: Option<[f64; 2]>) -> Self {
+        let band = range.map_or(0.0, |[lo, hi]| ROTARY_SOFT_DEG.min(0.25 * (hi - lo)));
+        Self {
+            range: range.filter(|[lo, hi]| hi > lo && lo.is_finite() && hi.is_finite()),
+            band,
+        }
+    }
+
+    /// `hi - m + m psi(t)` for `y` in the upper band of `hi` (identity below, `hi` above).
+    #[inline]
+    fn upper(y: f64, hi: f64, m: f64) -> f64 {
+        let t = (y - (hi - m)) / m;
+        if t <= 0.0 {
+            y
+        } else if t >= 1.0 {
+            hi
+        } else {
+            let psi = t + t * t * t * (4.0 + t * (3.0 * t - 7.0));
+            (hi - m + m * psi).min(hi)
+        }
+    }
+
+    /// `phi(y)`.
+    #[inline]
+    pub(crate) fn apply(&self, y: f64) -> f64 {
+        match self.range {
+            Some([lo, hi]) => -Self::upper(-Self::upper(y, hi, self.band), -lo, self.band),
+            None => y,
+        }
+    }
+
+    /// `phi^-1(y)` for `y` in `[lo, hi]` (by bisection: `phi` is increasing on the bands, with
+    /// `phi(y) >= y` on the upper band); `y` itself outside the range.
+    pub(crate) fn invert(&self, y: f64) -> f64 {
+        let Some([lo, hi]) = self.range else {
+            return y;
+        };
+        let m = self.band;
+        if !(y > lo && y < hi) || (y >= lo + m && y <= hi - m) {
+            return y;
+        }
+        // Upper band: phi^-1(y) in [hi - m, y]; lower band: in [y, lo + m].
+        let (mut a, mut b) = if y > hi - m { (hi - m, y) } else { (y, lo + m) };
+        for _ in 0..200 {
+            let mid = 0.5 * (a + b);
+            if mid <= a || mid >= b {
+                break;
+            }
+            if self.apply(mid) < y {
+                a = mid;
+            } else {
+                b = mid;
+            }
+        }
+        b
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_soft_range_keeps_a_swinging_spline_inside_and_passes_every_station() {
+        // A tent of tilts peaking exactly on the limit: the plain C2 spline swings past it, the
+        // spline of the soft-range coordinates mapped back does not, and hits every station.
+        let hi = 30.0;
+        let s: Vec<f64> = (0..=40).map(|i| i as f64).collect();
+        // Steeper up than down: the spline's slope at the peak is not 0.
+        let tent = |v: f64| {
+            hi - if v < 20.0 {
+                0.75 * (20.0 - v)
+            } else {
+                0.25 * (v - 20.0)
+            }
+        };
+        let y: Vec<[f64; 1]> = s.iter().map(|&v| [tent(v)]).collect();
+        let plain = Spline::clamped(s.clone(), y.clone(), [0.75], [-0.25]);
+        let over = (0..=4000)
+            .map(|i| plain.at(i as f64 * 0.01)[0])
+            .fold(f64::NEG_INFINITY, f64::max);
+        println!("plain spline peak {over}");
+        assert!(over > hi + 0.01, "the plain spline overshoots: {over}");
+        let soft = SoftRange::new(Some([-hi, hi]));
+        let z: Vec<[f64; 1]> = y.iter().map(|v| [soft.invert(v[0])]).collect();
+        let sp = Spline::clamped(s.clone(), z, [0.75], [-0.25]);
+        for i in 0..=4000 {
+            let v = soft.apply(sp.at(i as f64 * 0.01)[0]);
+            assert!(v <= hi && v >= -hi, "{v}");
+        }
+        for (si, yi) in s.iter().zip(&y) {
+            let v = soft.apply(sp.at(*si)[0]);
+            assert!((v - yi[0]).abs() < 1e-12, "station {si}: {v} vs {}", yi[0]);
+        }
+        // The map is C2 where its bands meet the identity and the limit.
+        let m = ROTARY_SOFT_DEG;
+        for y0 in [hi - m, hi] {
+            let h = 1e-4;
+            let d2 =
+                |y: f64| (soft.apply(y + h) - 2.0 * soft.apply(y) + soft.apply(y - h)) / (h * h);
+            assert!(
+                (d2(y0 - 2.0 * h) - d2(y0 + 2.0 * h)).abs() < 0.05,
+                "y'' at {y0}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_box_mean_of_a_cubic_is_exact() {
+        // The mean of p(x) = x^3 over [s - w, s + w] is s^3 + s w^2 (the odd moments vanish),
+        // across pieces and however small w.
+        let f = |s: f64| [s * s * s];
+        let s: Vec<f64> = vec![0.0, 0.3, 1.1, 1.5, 2.6, 3.0];
+        let y: Vec<[f64; 1]> = s.iter().map(|&v| f(v)).collect();
+        let sp = Spline::clamped(s, y, [0.0], [27.0]);
+        for (c, w) in [(1.0, 0.9), (1.4, 0.05), (2.0, 1e-9), (0.5, 0.49)] {
+            let got = sp.box_mean(c, w)[0];
+            let want = c * c * c + c * w * w;
+            assert!((got - want).abs() < 1e-12, "{c} {w}: {got} vs {want}");
+        }
+    }
 
     #[test]
     fn spline_reproduces_a_cubic_and_is_c2() {

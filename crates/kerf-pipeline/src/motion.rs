@@ -169,6 +169,7 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
                 "cycle": args.cycle,
                 "duration_s": p.motion.duration(),
                 "time_share_at_feed": p.motion.time_share_at_feed(),
+                "blend_deviation_mm": p.motion.blend_deviation(),
                 "paths": path_report(&p.motion, &p.ids),
                 "output": out.map(|o| o.display().to_string()),
         });

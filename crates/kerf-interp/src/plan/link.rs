@@ -1,0 +1,98 @@
+//! Joining the paths of a program with rapid (laser-off) moves.
+
+use crate::block::Block;
+use crate::model::AxisModel;
+
+/// Joins the blocks of several paths into one program: between the end of one path and the
+/// start of the next, a rapid (laser-off) line, planned at the axes' own limits.
+pub fn link_paths(paths: Vec<Vec<Block>>) -> Vec<Block> {
+    let mut out: Vec<Block> = Vec::new();
+    for blocks in paths {
+        let Some(first) = blocks.first() else {
+            continue;
+        };
+        if let Some(last) = out.last() {
+            if last.end_axes != first.start_axes {
+                let a = crate::block::Station {
+                    tip: last.end_tip(),
+                    axis: last.end_tool_axis,
+                    param: None,
+                    axes: last.end_axes,
+                };
+                let b = crate::block::Station {
+                    tip: first.start_tip(),
+                    axis: first.end_tool_axis,
+                    param: None,
+                    axes: first.start_axes,
+                };
+                let mut rapid = Block::line(&a, &b);
+                rapid.rapid = true;
+                rapid.path = first.path;
+                rapid.stations = [0, 0];
+                out.push(rapid);
+            }
+        }
+        out.extend(blocks);
+    }
+    out
+}
+
+/// Like [`link_paths`], but each rapid move backs off `retract` mm along the tool axis from
+/// the end of one path (rotary axes standing), traverses to `retract` mm above the next path's
+/// start along its tool axis, and approaches it along that axis, so the nozzle leaves and
+/// meets the part along the beam instead of crossing it at cutting height. The traverse between
+/// the two retract points is one straight move of the machine axes (the rotary axes turn during
+/// it): it clears the part only if the retract distance is large enough for the part's shape;
+/// nothing here checks the traverse against the part. With `retract <= 0` it is one straight rapid
+/// (as [`link_paths`], but arriving with the next path's start orientation).
+pub fn link_paths_with_retract<M: AxisModel + ?Sized>(
+    model: &M,
+    paths: Vec<Vec<Block>>,
+    retract: f64,
+) -> Vec<Block> {
+    // Without a retract: one straight rapid, with the tool axes of the model at both ends
+    // (the next path's start orientation, not its first block's end).
+    let retract = if retract.is_nan() {
+        0.0
+    } else {
+        retract.max(0.0)
+    };
+    let station = |tip: nalgebra::Point3<f64>, axes: [f64; 5]| {
+        let axis = model.tool_axis(axes[3], axes[4]);
+        let lin = model.linear_axes(&tip, axes[3], axes[4]);
+        crate::block::Station {
+            tip,
+            axis,
+            param: None,
+            axes: [lin[0], lin[1], lin[2], axes[3], axes[4]],
+        }
+    };
+    let mut out: Vec<Block> = Vec::new();
+    for blocks in paths {
+        let Some(first) = blocks.first() else {
+            continue;
+        };
+        if let Some(last) = out.last() {
+            if last.end_axes != first.start_axes {
+                let end = station(last.end_tip(), last.end_axes);
+                let start = station(first.start_tip(), first.start_axes);
+                let up = station(end.tip + end.axis * retract, end.axes);
+                let over = station(start.tip + start.axis * retract, start.axes);
+                let moves = if retract > 0.0 {
+                    vec![(&end, &up), (&up, &over), (&over, &start)]
+                } else {
+                    vec![(&end, &start)]
+                };
+                for (a, b) in moves {
+                    let mut rapid = Block::line(a, b);
+                    rapid.rapid = true;
+                    rapid.path = first.path;
+                    rapid.stations = [0, 0];
+                    out.push(rapid);
+                }
+            }
+        }
+        out.extend(blocks);
+    }
+    out
+}

@@ -1,0 +1,359 @@
+//! The planning grid of one run (its constraints, computed once) and the timed profile
+//! planned on it: the time-optimal `x(s)`, the time of every grid point, and the jerk filter.
+
+use super::{PlanOptions, ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_STATIC_SHARE};
+use crate::model::AxisModel;
+use crate::smooth::Run;
+use crate::topp;
+
+/// The grid of one run and its constraints, computed once.
+#[derive(Debug, Clone)]
+pub(super) struct RunGrid {
+    pub(super) s: Vec<f64>,
+    pub(super) d1: Vec<[f64; 5]>,
+    pub(super) d2: Vec<[f64; 5]>,
+    /// `|tip'(s)|`.
+    pub(super) tip_speed: Vec<f64>,
+    /// The static cap on `x` (velocity, feed, chord, jerk).
+    pub(super) cap: Vec<f64>,
+    /// `|q''|` of each axis (for the jerk budget of the path acceleration).
+    pub(super) d2_abs_max: Vec<[f64; 5]>,
+    /// The maximum velocity curve of the limits alone (no refinement): what the `F` words say.
+    pub(super) static_mv: Vec<f64>,
+    /// Caps on `x` set by refinements, and factors on the accelerations.
+    pub(super) xlim: Vec<f64>,
+    pub(super) mult_a: Vec<f64>,
+}
+
+/// The timed profile of one run: `x`, `u` and the time of each grid point, and the integral of
+/// `s dt` for the jerk filter.
+#[derive(Debug, Clone)]
+pub(super) struct Timed {
+    pub(super) s: Vec<f64>,
+    pub(super) x: Vec<f64>,
+    pub(super) u: Vec<f64>,
+    pub(super) t: Vec<f64>,
+    pub(super) area: Vec<f64>,
+    /// Filter width, s (0: acceleration-limited).
+    pub(super) tau: f64,
+    /// Run time, s (the grid's time plus `tau`).
+    pub(super) duration: f64,
+}
+
+impl Timed {
+    pub(super) fn len(&self) -> f64 {
+        self.s[self.s.len() - 1]
+    }
+
+    /// The interval holding time `t` (`0 <= t < t_N`).
+    #[inline]
+    pub(super) fn interval(&self, t: f64) -> usize {
+        self.t
+            .partition_point(|&v| v <= t)
+            .clamp(1, self.t.len() - 1)
+            - 1
+    }
+
+    /// `s` at time `t` of the unfiltered profile.
+    #[inline]
+    pub(super) fn s_raw(&self, t: f64) -> f64 {
+        let n = self.t.len() - 1;
+        if t <= 0.0 {
+            return 0.0;
+        }
+        if t >= self.t[n] {
+            return self.len();
+        }
+        let i = self.interval(t);
+        let h = t - self.t[i];
+        (self.s[i] + self.x[i].sqrt() * h + 0.5 * self.u[i] * h * h).clamp(self.s[i], self.s[i + 1])
+    }
+
+    /// `integral of s dt` from 0 to `t` of the unfiltered profile (`s = len` after the end).
+    #[inline]
+    pub(super) fn area_at(&self, t: f64) -> f64 {
+        let n = self.t.len() - 1;
+        if t <= 0.0 {
+            return 0.0;
+        }
+        if t >= self.t[n] {
+            return self.area[n] + self.len() * (t - self.t[n]);
+        }
+        let i = self.interval(t);
+        let h = t - self.t[i];
+        self.area[i] + h * (self.s[i] + h * (0.5 * self.x[i].sqrt() + h * self.u[i] / 6.0))
+    }
+
+    /// `s` at time `t` of the run (filtered when jerk-limited).
+    #[inline]
+    pub(super) fn s_at(&self, t: f64) -> f64 {
+        if t >= self.duration {
+            return self.len();
+        }
+        if self.tau > 0.0 {
+            ((self.area_at(t) - self.area_at(t - self.tau)) / self.tau).clamp(0.0, self.len())
+        } else {
+            self.s_raw(t)
+        }
+    }
+
+    /// `ds/dt` at time `t`.
+    pub(super) fn speed_at(&self, t: f64) -> f64 {
+        if t <= 0.0 || t >= self.duration {
+            return 0.0;
+        }
+        if self.tau > 0.0 {
+            (self.s_raw(t) - self.s_raw(t - self.tau)) / self.tau
+        } else {
+            let i = self.interval(t);
+            (self.x[i].sqrt() + self.u[i] * (t - self.t[i])).max(0.0)
+        }
+    }
+
+    /// The earliest time at which `s_at(t) >= s`: exact from the grid when unfiltered (block
+    /// starts are grid points), else by bisection in `[t_raw(s), t_raw(s) + tau]` (the average
+    /// of `s` over `[t - tau, t]` lies between `s(t - tau)` and `s(t)`).
+    pub(super) fn time_of(&self, s: f64) -> f64 {
+        if s <= 0.0 {
+            return 0.0;
+        }
+        if s >= self.len() {
+            return self.duration;
+        }
+        let i = self.s.partition_point(|&v| v < s).min(self.s.len() - 1);
+        let raw = if self.s[i] == s || i == 0 {
+            self.t[i]
+        } else {
+            // Inside interval i - 1: solve s_i + v tau + u tau^2 / 2 = s by bisection too.
+            let (mut lo, mut hi) = (self.t[i - 1], self.t[i]);
+            for _ in 0..50 {
+                let mid = 0.5 * (lo + hi);
+                if self.s_raw(mid) >= s {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            hi
+        };
+        if self.tau <= 0.0 {
+            return raw;
+        }
+        let (mut lo, mut hi) = (raw, (raw + self.tau).min(self.duration));
+        for _ in 0..50 {
+            let mid = 0.5 * (lo + hi);
+            if self.s_at(mid) >= s {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+            if hi - lo <= 1e-13 * self.duration {
+                break;
+            }
+        }
+        hi
+    }
+}
+
+/// The grid of one run: nodes subdivided to at most `step`, at least two intervals each, and
+/// at every grid point `q'`, `q''` (and `q'''` for the jerk cap) by central differences of the
+/// machine axes along the smooth path, with the static caps on `x`.
+pub(super) fn run_grid<M: AxisModel + ?Sized>(
+    model: &M,
+    run: &Run,
+    step: f64,
+    opts: &PlanOptions,
+) -> RunGrid {
+    let lim = model.limits();
+    let mut s = Vec::new();
+    for w in run.nodes.windows(2) {
+        let h = w[1] - w[0];
+        if h <= 0.0 {
+            continue;
+        }
+        let m = ((h / step).ceil() as usize).max(2);
+        for k in 0..m {
+            s.push(w[0] + h * k as f64 / m as f64);
+        }
+    }
+    s.push(run.len());
+    let h = 1e-3f64.min(run.len() * 1e-3);
+    let derivs = |si: f64| {
+        let q = |d: f64| run.axes_raw(model, si + d);
+        let (qm2, qm1, q0, qp1, qp2) = (q(-2.0 * h), q(-h), q(0.0), q(h), q(2.0 * h));
+        let a: [f64; 5] = std::array::from_fn(|k| (qp1[k] - qm1[k]) / (2.0 * h));
+        let b: [f64; 5] = std::array::from_fn(|k| (qp1[k] - 2.0 * q0[k] + qm1[k]) / (h * h));
+        let c: [f64; 5] = std::array::from_fn(|k| {
+            (qp2[k] - 2.0 * qp1[k] + 2.0 * qm1[k] - qm2[k]) / (2.0 * h * h * h)
+        });
+        (a, b, c)
+    };
+    let mut first: Vec<_> = s.iter().map(|&si| derivs(si)).collect();
+    // Where the axes' speeds per unit of s (in units of their limits) change by more than 2 %
+    // between grid points, refine: the constraints hold at grid points only.
+    let norm = |a: &[f64; 5]| -> [f64; 5] { std::array::from_fn(|k| a[k] / lim.max_velocity[k]) };
+    let mut fine_s = Vec::with_capacity(s.len());
+    let mut fine_d = Vec::with_capacity(s.len());
+    for i in 0..s.len() {
+        fine_s.push(s[i]);
+        fine_d.push(first[i]);
+        if i + 1 == s.len() {
+            break;
+        }
+        let (p, q) = (norm(&first[i].0), norm(&first[i + 1].0));
+        let scale = (0..5)
+            .map(|k| p[k].abs().max(q[k].abs()))
+            .fold(0.0, f64::max);
+        let change = (0..5).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max);
+        if scale > 0.0 && change > 0.02 * scale {
+            let m = ((change / (0.02 * scale)).ceil() as usize).min(64);
+            for k in 1..m {
+                let sk = s[i] + (s[i + 1] - s[i]) * k as f64 / m as f64;
+                fine_s.push(sk);
+                fine_d.push(derivs(sk));
+            }
+        }
+    }
+    first.clear();
+    let s = fine_s;
+    let n = s.len();
+    let mut d1 = Vec::with_capacity(n);
+    let mut d2 = Vec::with_capacity(n);
+    let mut tip_speed = Vec::with_capacity(n);
+    let mut cap = Vec::with_capacity(n);
+    let mut static_mv = Vec::with_capacity(n);
+    let feed = opts.feed / 60.0;
+    for (&si, &(a, b, c)) in s.iter().zip(&fine_d) {
+        let (t1, t2) = run.tip_derivatives(si);
+        let speed = t1.norm();
+        let mut x = f64::INFINITY;
+        for k in 0..5 {
+            if a[k] != 0.0 {
+                x = x.min((lim.max_velocity[k] * 0.999 / a[k].abs()).powi(2));
+            }
+            if let Some(j) = lim.max_jerk {
+                if c[k] != 0.0 {
+                    x = x.min((JERK_STATIC_SHARE * j[k] / c[k].abs()).powf(2.0 / 3.0));
+                }
+            }
+        }
+        if run.moves_tip && speed > 0.0 {
+            if run.cutting {
+                x = x.min((feed / speed).powi(2));
+            }
+            let kappa = t1.cross(&t2).norm() / speed.powi(3);
+            if kappa > 1e-12 {
+                let step = (8.0 * opts.chord_tolerance / kappa).sqrt();
+                x = x.min((step / opts.cycle / speed).powi(2));
+            }
+        }
+        let x = x.min(1e18);
+        static_mv.push(topp::xmax(&topp::Point {
+            d1: a,
+            d2: b,
+            acc: lim.max_acceleration.map(|v| v * ACCELERATION_MARGIN),
+            cap: x,
+            path_acc: f64::INFINITY,
+        }));
+        d1.push(a);
+        d2.push(b);
+        tip_speed.push(speed);
+        cap.push(x);
+    }
+    RunGrid {
+        xlim: vec![f64::INFINITY; n],
+        d2_abs_max: d2.iter().map(|b: &[f64; 5]| b.map(f64::abs)).collect(),
+        static_mv,
+        mult_a: vec![1.0; n],
+        s,
+        d1,
+        d2,
+        tip_speed,
+        cap,
+    }
+}
+
+/// Plans one run on its grid (rest to rest) and times it.
+pub(super) fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: f64) -> Timed {
+    let n = g.s.len();
+    let mut pts: Vec<topp::Point> = (0..n)
+        .map(|i| {
+            let cap = g.cap[i].min(g.xlim[i]);
+            let mut path_acc = f64::INFINITY;
+            if let Some(j) = jerk {
+                let v = cap.sqrt();
+                for k in 0..5 {
+                    let c = 3.0 * g.d2_abs_max[i][k] * v;
+                    if c > 0.0 {
+                        path_acc = path_acc.min(JERK_CROSS_SHARE * j[k] / c);
+                    }
+                }
+            }
+            topp::Point {
+                d1: g.d1[i],
+                d2: g.d2[i],
+                acc: acc.map(|a| a * ACCELERATION_MARGIN * g.mult_a[i]),
+                cap,
+                path_acc,
+            }
+        })
+        .collect();
+    let mv: Vec<f64> = pts.iter().map(topp::xmax).collect();
+    if tau > 0.0 {
+        // The moving average sees positions about v tau / 2 either side: lower the maximum
+        // velocity curve to its minimum over that reach, the reach measured with the speed of
+        // the unfiltered optimum (an upper bound of the final speed, so the reach is not too
+        // short; measured with the maximum velocity curve instead, a fast straight would drag
+        // the slow junction it leads to far back along itself).
+        let (first, _) = topp::solve(&g.s, &pts);
+        let raw = mv.clone();
+        let mut mv = mv;
+        for i in 0..n {
+            let w = 0.6 * first[i].sqrt() * tau;
+            let mut low = raw[i];
+            let mut j = i;
+            while j > 0 && g.s[i] - g.s[j - 1] <= w {
+                j -= 1;
+                low = low.min(raw[j]);
+            }
+            let mut j = i;
+            while j + 1 < n && g.s[j + 1] - g.s[i] <= w {
+                j += 1;
+                low = low.min(raw[j]);
+            }
+            mv[i] = low;
+        }
+        for (p, m) in pts.iter_mut().zip(&mv) {
+            p.cap = p.cap.min(*m);
+        }
+    }
+    let (x, u) = topp::solve(&g.s, &pts);
+    let mut t = Vec::with_capacity(n);
+    let mut area = Vec::with_capacity(n);
+    let (mut tt, mut aa) = (0.0, 0.0);
+    for i in 0..n {
+        t.push(tt);
+        area.push(aa);
+        if i + 1 < n {
+            let d = g.s[i + 1] - g.s[i];
+            let den = x[i].sqrt() + x[i + 1].sqrt();
+            let dt = if den > 0.0 {
+                2.0 * d / den
+            } else {
+                f64::INFINITY
+            };
+            let v = x[i].sqrt();
+            aa += dt * (g.s[i] + dt * (0.5 * v + dt * u[i] / 6.0));
+            tt += dt;
+        }
+    }
+    Timed {
+        s: g.s.clone(),
+        duration: tt + tau,
+        x,
+        u,
+        t,
+        area,
+        tau,
+    }
+}

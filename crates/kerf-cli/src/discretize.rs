@@ -113,11 +113,11 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             .zip(&results)
             .map(|(rec, d)| ToolPath {
                 id: rec.id.clone(),
-                params: d.params.clone(),
+                params: d.params().to_vec(),
                 points: ToolPathPoints::Positions(
-                    d.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                    d.points().iter().map(|p| [p.x, p.y, p.z]).collect(),
                 ),
-                max_chord_error: d.max_chord_error,
+                max_chord_error: d.max_chord_error(),
             })
             .collect(),
         Some(o) => file
@@ -167,7 +167,7 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             .sum()
     };
     let elapsed = start.elapsed().as_secs_f64();
-    let breaks: usize = results.iter().map(|d| d.c0_breaks.len()).sum();
+    let breaks: usize = results.iter().map(|d| d.c0_breaks().len()).sum();
     if args.json {
         let summary = json!({
             "file": path.display().to_string(),
@@ -325,10 +325,10 @@ pub(crate) fn normals_for_file(
                 if vertical_without_surface {
                     let d = &results[i];
                     return Ok(Oriented {
-                        params: d.params.clone(),
-                        points: d.points.clone(),
-                        normals: vec![nalgebra::Vector3::z(); d.points.len()],
-                        max_chord_error: d.max_chord_error,
+                        params: d.params().to_vec(),
+                        points: d.points().to_vec(),
+                        normals: vec![nalgebra::Vector3::z(); d.points().len()],
+                        max_chord_error: d.max_chord_error(),
                         ..Default::default()
                     });
                 }

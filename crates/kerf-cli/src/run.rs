@@ -218,7 +218,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "segments": segments,
             "n_star": nstar,
             "max_chord_error": tp.paths.iter().map(|p| p.max_chord_error).fold(0.0, f64::max),
-            "c0_breaks": discs.iter().map(|d| d.c0_breaks.len()).sum::<usize>(),
+            "c0_breaks": discs.iter().map(|d| d.c0_breaks().len()).sum::<usize>(),
         },
         "normals": {
             "points": oriented.iter().map(|o| o.points.len()).sum::<usize>(),

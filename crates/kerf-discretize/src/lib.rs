@@ -21,9 +21,9 @@
 //!     Some(vec![1.0, h, 1.0]),
 //! );
 //! let d = discretize(&quarter, &Options::with_tolerance(0.01))?;
-//! assert!(d.max_chord_error <= 0.01, "certified");
-//! assert_eq!(d.params[0], 0.0, "starts at the domain start");
-//! assert_eq!(*d.params.last().unwrap(), 1.0, "ends at the domain end");
+//! assert!(d.max_chord_error() <= 0.01, "certified");
+//! assert_eq!(d.params()[0], 0.0, "starts at the domain start");
+//! assert_eq!(*d.params().last().unwrap(), 1.0, "ends at the domain end");
 //! # Ok::<(), kerf_discretize::DiscretizeError>(())
 //! ```
 
@@ -44,26 +44,135 @@ use kerf_nurbs::NurbsCurve;
 use nalgebra::Point3;
 use rayon::prelude::*;
 
-/// The cutting points of one curve.
+/// The cutting points of one curve, with the certificate of their chord error.
+///
+/// The fields are private: a `Discretization` is made only by the discretizer
+/// ([`discretize`], [`discretize_range`]), or by [`Discretization::certify`], which proves the
+/// bound of every segment of given parameters itself. So [`Discretization::max_chord_error`] is
+/// always a certified bound, and later stages (the normals' `orient`) can rely on it. Points read
+/// back from a toolpath file are a claim, not a certificate: check them with `kerf-check`, or
+/// turn them into a `Discretization` with [`Discretization::certify`].
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Discretization {
-    /// Curve parameter of each cutting point; strictly increasing, first and last are the ends
-    /// of the domain.
-    pub params: Vec<f64>,
-    /// The cutting points `C(params[n])`.
-    pub points: Vec<Point3<f64>>,
-    /// Certified upper bound of the chord error over every segment (`<= tolerance`).
-    pub max_chord_error: f64,
-    /// The largest chord error actually observed (a lower bound of the true maximum).
-    pub estimated_chord_error: f64,
-    /// The C0 break parameters that were forced as cutting points.
-    pub c0_breaks: Vec<f64>,
+    params: Vec<f64>,
+    points: Vec<Point3<f64>>,
+    max_chord_error: f64,
+    estimated_chord_error: f64,
+    c0_breaks: Vec<f64>,
 }
 
 impl Discretization {
     /// Number of segments (points - 1).
     pub fn segments(&self) -> usize {
         self.points.len().saturating_sub(1)
+    }
+
+    /// Curve parameter of each cutting point; strictly increasing, first and last are the ends
+    /// of the discretized range.
+    pub fn params(&self) -> &[f64] {
+        &self.params
+    }
+
+    /// The cutting points `C(params[n])`, evaluated on the curve.
+    pub fn points(&self) -> &[Point3<f64>] {
+        &self.points
+    }
+
+    /// Certified upper bound (mm) of the chord error over every segment, rounding margin
+    /// included; `<=` the tolerance asked for.
+    pub fn max_chord_error(&self) -> f64 {
+        self.max_chord_error
+    }
+
+    /// The largest chord error actually observed (mm): a curve point's distance from its
+    /// chord, so a lower bound of the true maximum.
+    pub fn estimated_chord_error(&self) -> f64 {
+        self.estimated_chord_error
+    }
+
+    /// The C0 break parameters strictly inside the range, each of which is a cutting point.
+    pub fn c0_breaks(&self) -> &[f64] {
+        &self.c0_breaks
+    }
+
+    /// The parameters and the points, moved out (no copy).
+    pub fn into_parts(self) -> (Vec<f64>, Vec<Point3<f64>>) {
+        (self.params, self.points)
+    }
+
+    /// Certifies given cutting parameters of `curve` (for instance read back from a toolpath
+    /// file): checks that they are strictly increasing from one end of the domain to the other
+    /// and contain every C0 break, evaluates the points on the curve, and proves the chord
+    /// error of every segment `<= tolerance` with the same bound as the discretizer
+    /// (`docs/discretization.md`). The result is then as trustworthy as one from
+    /// [`discretize`].
+    ///
+    /// # Errors
+    /// [`DiscretizeError::BadOption`] for a tolerance that is not finite and positive,
+    /// [`DiscretizeError::ToleranceBelowMargin`] as in [`discretize`],
+    /// [`DiscretizeError::NotCertified`] naming the first parameter or segment that fails.
+    pub fn certify(curve: &NurbsCurve, params: &[f64], tolerance: f64) -> Result<Self> {
+        Options::with_tolerance(tolerance).validate()?;
+        let cert = Certifier::new(curve);
+        let margin = cert.max_margin() + cert.output_resolution();
+        if margin.is_nan() || margin > 0.5 * tolerance {
+            return Err(DiscretizeError::ToleranceBelowMargin { tolerance, margin });
+        }
+        let fail = |index: usize, reason: &'static str, bound: f64| {
+            Err(DiscretizeError::NotCertified {
+                index,
+                reason,
+                bound,
+            })
+        };
+        let (a, b) = curve.domain();
+        if params.len() < 2 {
+            return fail(0, "at least two parameters are needed", f64::NAN);
+        }
+        if params[0] != a || params[params.len() - 1] != b {
+            return fail(
+                0,
+                "the parameters must start and end at the domain's ends",
+                f64::NAN,
+            );
+        }
+        if let Some(i) = params.windows(2).position(|w| !(w[0] < w[1])) {
+            return fail(i + 1, "parameters must be strictly increasing", f64::NAN);
+        }
+        let c0_breaks = piece_ends(curve, tolerance)?;
+        let c0_breaks = c0_breaks[1..c0_breaks.len() - 1].to_vec();
+        if let Some(&t) = c0_breaks
+            .iter()
+            .find(|t| params.binary_search_by(|p| p.total_cmp(t)).is_err())
+        {
+            return fail(0, "a C0 break is not a cutting point", t);
+        }
+        let points: Vec<Point3<f64>> = params.iter().map(|&t| curve.point(t)).collect();
+        let mut scratch = bound::Scratch::default();
+        let (mut upper, mut lower) = (0.0f64, 0.0f64);
+        for i in 0..params.len() - 1 {
+            let bd = cert.chord_error(
+                &mut scratch,
+                params[i],
+                params[i + 1],
+                &points[i],
+                &points[i + 1],
+                tolerance,
+                tolerance,
+            );
+            if !(bd.upper <= tolerance) {
+                return fail(i, "the segment's chord error cannot be certified", bd.upper);
+            }
+            upper = upper.max(bd.upper);
+            lower = lower.max(bd.lower);
+        }
+        Ok(Self {
+            params: params.to_vec(),
+            points,
+            max_chord_error: upper,
+            estimated_chord_error: lower,
+            c0_breaks,
+        })
     }
 }
 

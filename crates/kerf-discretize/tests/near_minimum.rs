@@ -20,7 +20,7 @@ fn smooth_cubic_and_quintic_stay_within_five_percent_of_n_star() {
                 let d = discretize(c, &Options::with_tolerance(tol)).unwrap();
                 segs += d.segments();
                 nstar += minimum_count(c, tol);
-                pieces += 1 + d.c0_breaks.len();
+                pieces += 1 + d.c0_breaks().len();
             }
             let ratio = segs as f64 / nstar;
             eprintln!(

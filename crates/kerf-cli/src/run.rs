@@ -188,11 +188,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     }
     let duration: f64 = motions.iter().map(|m| m.duration()).sum();
     let cycles: usize = motions.iter().map(|m| m.cycles()).sum();
-    let nstar: f64 = file
-        .curves
-        .iter()
-        .map(|r| kerf_discretize::minimum_count(&r.curve, dopts.tolerance))
-        .sum();
+    let nstar: f64 = discs.iter().map(|d| d.n_star(dopts.tolerance)).sum();
     let segments: usize = discs.iter().map(Discretization::segments).sum();
     let report = json!({
         "input": path.display().to_string(),

@@ -3,7 +3,7 @@
 //! `benches/discretize_vs_occt.py` (issue 15) next to the whole `kerf discretize` process and
 //! Open CASCADE's `GCPnts_TangentialDeflection`.
 //!
-//! Run: `cargo run --release -p kerf-discretize --example time_file -- FILE TOLERANCE [REPS]`
+//! Run: `cargo run --release --example discretize_time -- FILE TOLERANCE [REPS]`
 //!
 //! The figure is the fastest of `REPS` (default 3) passes over the whole file. The CPU time of
 //! the thread is read from `/proc/thread-self/schedstat` (nanoseconds on a CPU), so other
@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use kerf_discretize::{discretize, minimum_count, Options};
+use kerf::discretize::{discretize, minimum_count, Options};
 
 /// CPU time of the calling thread in seconds, if the kernel exposes it.
 fn thread_cpu_seconds() -> Option<f64> {
@@ -25,14 +25,14 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let (Some(file), Some(tol)) = (args.next(), args.next().and_then(|s| s.parse::<f64>().ok()))
     else {
-        eprintln!("usage: time_file FILE TOLERANCE [REPS]");
+        eprintln!("usage: discretize_time FILE TOLERANCE [REPS]");
         std::process::exit(2);
     };
     let reps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(3).max(1);
-    let doc = match kerf_format::curves::load(&file) {
+    let doc = match kerf::format::curves::load(&file) {
         Ok(d) => d,
         Err(e) => {
-            eprintln!("time_file: {e}");
+            eprintln!("discretize_time: {e}");
             std::process::exit(1);
         }
     };
@@ -57,7 +57,7 @@ fn main() {
                     worst = worst.max(d.max_chord_error());
                 }
                 Err(e) => {
-                    eprintln!("time_file: curve {:?}: {e}", r.id);
+                    eprintln!("discretize_time: curve {:?}: {e}", r.id);
                     std::process::exit(1);
                 }
             }

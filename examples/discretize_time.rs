@@ -3,7 +3,7 @@
 //! `benches/discretize_vs_occt.py` (issue 15) next to the whole `kerf discretize` process and
 //! Open CASCADE's `GCPnts_TangentialDeflection`.
 //!
-//! Run: `cargo run --release --example discretize_time -- FILE TOLERANCE [REPS]`
+//! Run: `cargo run --release --example discretize_time -- FILE TOLERANCE [REPS [BAND]]`
 //!
 //! The figure is the fastest of `REPS` (default 3) passes over the whole file. The CPU time of
 //! the thread is read from `/proc/thread-self/schedstat` (nanoseconds on a CPU), so other
@@ -29,6 +29,11 @@ fn main() {
         std::process::exit(2);
     };
     let reps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(3).max(1);
+    let defaults = Options::with_tolerance(tol);
+    let band: f64 = args
+        .next()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(defaults.band);
     let doc = match kerf::format::curves::load(&file) {
         Ok(d) => d,
         Err(e) => {
@@ -36,7 +41,7 @@ fn main() {
             std::process::exit(1);
         }
     };
-    let opts = Options::with_tolerance(tol);
+    let opts = Options { band, ..defaults };
     let cpu = thread_cpu_seconds().is_some();
     let now = || thread_cpu_seconds().unwrap_or(0.0);
     let wall = Instant::now();
@@ -73,7 +78,7 @@ fn main() {
         .sum();
     let nstar_seconds = now() - c0;
     println!(
-        "{{\"file\": {file:?}, \"tolerance\": {tol}, \"curves\": {}, \"points\": {points}, \
+        "{{\"file\": {file:?}, \"tolerance\": {tol}, \"band\": {band}, \"curves\": {}, \"points\": {points}, \
          \"segments\": {segments}, \"max_chord_error\": {worst}, \"seconds\": {}, \
          \"clock\": \"{}\", \"wall_seconds\": {best_wall}, \"reps\": {reps}, \
          \"n_star\": {nstar}, \"n_star_quadrature_seconds\": {nstar_seconds}}}",

@@ -194,7 +194,7 @@ impl Walker<'_> {
                 match (good, bad) {
                     (Some(g), None) => {
                         let f = if g.bound.lower > 0.0 {
-                            (hp / g.bound.lower).sqrt().clamp(1.1, 4.0)
+                            (hp / g.bound.lower).sqrt().clamp(1.005, 4.0)
                         } else {
                             4.0
                         };
@@ -203,7 +203,7 @@ impl Walker<'_> {
                     }
                     (None, Some(bd)) => {
                         let f = if bd.bound.lower > 0.0 {
-                            (hp / bd.bound.lower).sqrt().clamp(0.05, 0.7)
+                            (hp / bd.bound.lower).sqrt().clamp(0.05, 0.995)
                         } else {
                             0.5
                         };

@@ -2,7 +2,8 @@
 
 mod common;
 
-use kerf_discretize::{discretize, minimum_count, Options};
+use kerf_discretize::bound::Scratch;
+use kerf_discretize::{discretize, minimum_count, Certifier, Options};
 use kerf_nurbs::NurbsCurve;
 
 /// Smooth random curves: clamped, uniform simple knots, unit weights, seeded.
@@ -52,5 +53,65 @@ fn the_walks_n_star_matches_the_adaptive_quadrature() {
                 );
             }
         }
+    }
+}
+
+/// The greedy certified minimum (test-only oracle, slow): from each point, the longest step
+/// whose certified chord error is `<= tol`, found by bisection on the end parameter to a
+/// relative 1e-7 of the step. Greedy longest steps are optimal for a monotone predicate (no
+/// other choice of points can be ahead after the same number of segments), so on smooth curves
+/// this is the fewest segments any certified discretization can have, up to the bisection's
+/// resolution.
+fn greedy_segments(c: &NurbsCurve, tol: f64) -> usize {
+    let cert = Certifier::new(c);
+    let mut scratch = Scratch::default();
+    let (a, b) = c.domain();
+    let ok = |scratch: &mut Scratch, t0: f64, t1: f64| {
+        let (p0, p1) = (c.point(t0), c.point(t1));
+        cert.chord_error(scratch, t0, t1, &p0, &p1, tol, tol).upper <= tol
+    };
+    let mut t0 = a;
+    let mut n = 0;
+    while t0 < b {
+        let t1 = if ok(&mut scratch, t0, b) {
+            b
+        } else {
+            let (mut lo, mut hi) = (t0, b);
+            while hi - lo > 1e-7 * (lo - t0).max(1e-9 * (b - a)) {
+                let mid = 0.5 * (lo + hi);
+                if ok(&mut scratch, t0, mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            lo
+        };
+        assert!(t1 > t0, "greedy progresses");
+        t0 = t1;
+        n += 1;
+    }
+    n
+}
+
+/// Segments of the default discretizer within 1 % of the greedy certified minimum on smooth
+/// curves (issue 15), degrees 2 to 7, at 0.01 and 0.001 mm.
+#[test]
+fn within_one_percent_of_the_greedy_certified_minimum() {
+    for tol in [0.01, 0.001] {
+        let (mut ours, mut greedy) = (0usize, 0usize);
+        for degree in 2..=7 {
+            for c in smooth_curves(degree, 3, 70 + degree as u64) {
+                let d = discretize(&c, &Options::with_tolerance(tol)).unwrap();
+                ours += d.segments();
+                greedy += greedy_segments(&c, tol);
+            }
+        }
+        let ratio = ours as f64 / greedy as f64;
+        eprintln!("tol {tol}: {ours} segments, greedy {greedy}, ratio {ratio:.4}");
+        assert!(
+            ratio <= 1.01,
+            "tol {tol}: {ours} segments vs the greedy minimum {greedy} ({ratio:.4})"
+        );
     }
 }

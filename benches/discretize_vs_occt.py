@@ -38,13 +38,26 @@ TIME_FILE = os.path.join(ROOT, "target", "release", "examples", "discretize_time
 
 
 def run_child(cmd, env=None):
-    """Runs cmd; returns (stdout, user+sys CPU seconds, peak RSS in MiB, exit code)."""
+    """Runs cmd; returns (stdout, user+sys CPU seconds, peak RSS in MiB, exit code).
+
+    CPU time comes from os.wait4 (the child's own rusage). Peak RSS comes from GNU time's %M
+    where /usr/bin/time exists: the rusage of a child forked from this (large) Python process
+    counts the pages it shared before exec, so ru_maxrss would report Python's size.
+    """
+    timed = os.path.exists("/usr/bin/time")
+    rss_file = os.path.join(os.environ.get("TMPDIR", "/tmp"), "kerf-bench-rss-%d" % os.getpid())
+    full = ["/usr/bin/time", "-f", "%M", "-o", rss_file] + cmd if timed else cmd
     with open(os.devnull, "wb") as null:
-        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=null, env=env)
+        p = subprocess.Popen(full, stdout=subprocess.PIPE, stderr=null, env=env)
         out = p.stdout.read()
         _, status, ru = os.wait4(p.pid, 0)
-        p.returncode = os.waitstatus_to_exitcode(status)
-    return out.decode(), ru.ru_utime + ru.ru_stime, ru.ru_maxrss / 1024.0, p.returncode
+        code = os.waitstatus_to_exitcode(status)
+    rss = ru.ru_maxrss / 1024.0
+    if timed:
+        with open(rss_file) as f:
+            rss = int(f.read().split()[-1]) / 1024.0
+        os.remove(rss_file)
+    return out.decode(), ru.ru_utime + ru.ru_stime, rss, code
 
 
 def occt_curves(doc):

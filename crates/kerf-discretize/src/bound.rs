@@ -91,22 +91,47 @@ struct Chord {
     a: Point3<f64>,
     ab: Vector3<f64>,
     ab2: f64,
+    /// `1 / ab2` where finite (else 0: the exact division is used).
+    inv_ab2: f64,
 }
 
 impl Chord {
+    fn new(a: Point3<f64>, b: Point3<f64>) -> Self {
+        let ab = b - a;
+        let ab2 = ab.norm_squared();
+        let inv = 1.0 / ab2;
+        Self {
+            a,
+            ab,
+            ab2,
+            inv_ab2: if inv.is_finite() { inv } else { 0.0 },
+        }
+    }
+
+    /// The distance from `q` to the chord. With the reciprocal, the foot parameter `s` is off
+    /// by a rounding, but it is clamped to `[0, 1]`, so the value is the distance to *a* point
+    /// of the segment: never below the true distance (up to the rounding of the norm).
     #[inline]
     fn dist(&self, q: &Point3<f64>) -> f64 {
-        dist_to_segment(q, &self.a, &self.ab, self.ab2)
+        if self.inv_ab2 == 0.0 {
+            return dist_to_segment(q, &self.a, &self.ab, self.ab2);
+        }
+        let aq = q - self.a;
+        let s = (aq.dot(&self.ab) * self.inv_ab2).clamp(0.0, 1.0);
+        (aq - self.ab * s).norm()
     }
 
     /// Upper bound over a piece's hull (the largest distance of a projected control point),
-    /// and the distance of its last control point (a curve point).
+    /// and the distance of its last control point (a curve point). The projection multiplies
+    /// by `1 / w` (one more rounding of size `eps |Q|` than a division, within the margin's
+    /// allowance for the projection).
     #[inline]
     fn piece(&self, h: &[Vector4<f64>]) -> (f64, f64) {
         let mut upper = 0.0f64;
         let mut end = 0.0;
         for c in h {
-            let q = Point3::new(c.x / c.w, c.y / c.w, c.z / c.w);
+            let inv = 1.0 / c.w;
+            let q = Point3::new(c.x * inv, c.y * inv, c.z * inv);
             end = self.dist(&q);
             upper = upper.max(end);
         }
@@ -327,11 +352,7 @@ impl<'a> Certifier<'a> {
         want_lower: f64,
     ) -> Bound {
         let (al, bl) = (a - self.origin, b - self.origin);
-        let chord = Chord {
-            a: al,
-            ab: bl - al,
-            ab2: (bl - al).norm_squared(),
-        };
+        let chord = Chord::new(al, bl);
         let f = self.factor();
         let p = self.curve.degree();
         let mut margin = 8.0 * f64::EPSILON * al.coords.amax().max(bl.coords.amax());

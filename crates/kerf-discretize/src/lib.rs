@@ -150,7 +150,10 @@ impl Discretization {
                 f64::NAN,
             );
         }
-        if let Some(i) = params.windows(2).position(|w| !(w[0] < w[1])) {
+        if let Some(i) = params
+            .windows(2)
+            .position(|w| w[0].partial_cmp(&w[1]) != Some(std::cmp::Ordering::Less))
+        {
             return fail(i + 1, "parameters must be strictly increasing", f64::NAN);
         }
         let c0_breaks = piece_ends(curve, tolerance)?;
@@ -174,7 +177,7 @@ impl Discretization {
                 tolerance,
                 tolerance,
             );
-            if !(bd.upper <= tolerance) {
+            if bd.upper.is_nan() || bd.upper > tolerance {
                 return fail(i, "the segment's chord error cannot be certified", bd.upper);
             }
             upper = upper.max(bd.upper);

@@ -202,12 +202,17 @@ impl Discretization {
 /// `df/dt` is NaN where it is not finite (`k = 0`, where `sqrt(k)` has no derivative).
 #[inline]
 pub(crate) fn sqrt_curvature_speed(d: &[nalgebra::Vector3<f64>; 4]) -> (f64, f64) {
-    let (d1, d2, d3) = (&d[1], &d[2], &d[3]);
-    let s = d1.norm();
-    let a = d1.cross(d2);
-    let an = a.norm();
-    let f = (an / s).sqrt();
-    let df = a.dot(&d1.cross(d3)) / (2.0 * an * (an * s).sqrt()) - 0.5 * f * d1.dot(d2) / (s * s);
+    let s = d[1].norm();
+    // Scaled by the speed first, as `curvature_of`: tiny parameter ranges (knots scaled by
+    // 1e-50) give `|C'| ~ 1e52`, `|C''| ~ 1e104`, and `C' x C''` would overflow. With
+    // `u_i = C^(i) / s`, `b = u1 x u2`, `c = u1 x u3`: `f = sqrt(|b| s)` and
+    // `df/dt = s^(1/2) (b . c) / (2 |b|^(3/2)) - f (u1 . u2) / 2`.
+    let inv = 1.0 / s;
+    let (u1, u2, u3) = (d[1] * inv, d[2] * inv, d[3] * inv);
+    let b = u1.cross(&u2);
+    let bn = b.norm();
+    let f = (bn * s).sqrt();
+    let df = s.sqrt() * b.dot(&u1.cross(&u3)) / (2.0 * bn * bn.sqrt()) - 0.5 * f * u1.dot(&u2);
     let f = if f.is_finite() { f } else { 0.0 };
     let df = if df.is_finite() { df } else { f64::NAN };
     (f, df)

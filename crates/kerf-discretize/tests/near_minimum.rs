@@ -115,3 +115,23 @@ fn within_one_percent_of_the_greedy_certified_minimum() {
         );
     }
 }
+
+/// The walk's `N*` does not depend on the parametrisation's scale: knots scaled by 1e-50 give
+/// speeds of 1e50 and second derivatives of 1e100, whose cross product must not overflow.
+#[test]
+fn the_walks_n_star_survives_tiny_knot_ranges() {
+    let c = &smooth_curves(3, 1, 5)[0];
+    let tiny = NurbsCurve::new(
+        3,
+        c.knots().iter().map(|k| k * 1e-50).collect(),
+        c.control_points(),
+        None,
+    );
+    let (d, e) = (
+        discretize(c, &Options::with_tolerance(0.001)).unwrap(),
+        discretize(&tiny, &Options::with_tolerance(0.001)).unwrap(),
+    );
+    let (a, b) = (d.n_star(0.001), e.n_star(0.001));
+    assert!(a > 100.0, "a curved curve: N* {a}");
+    assert!((a - b).abs() <= 1e-3 * a, "N* {a} vs {b} with tiny knots");
+}

@@ -20,14 +20,14 @@ fn bench(c: &mut Criterion) {
             let opts = Options::with_tolerance(tol);
             let points: usize = curves
                 .iter()
-                .map(|c| discretize(c, &opts).expect("discretizes").points.len())
+                .map(|c| discretize(c, &opts).expect("discretizes").points().len())
                 .sum();
             group.throughput(Throughput::Elements(points as u64));
             group.bench_with_input(BenchmarkId::new("single", tol), &opts, |b, o| {
                 b.iter(|| {
                     curves
                         .iter()
-                        .map(|c| discretize(c, o).expect("discretizes").points.len())
+                        .map(|c| discretize(c, o).expect("discretizes").points().len())
                         .sum::<usize>()
                 })
             });
@@ -48,14 +48,14 @@ fn bench(c: &mut Criterion) {
             let opts = Options::with_tolerance(tol);
             let points: usize = discretize_all(&curves, &opts)
                 .into_iter()
-                .map(|d| d.expect("discretizes").points.len())
+                .map(|d| d.expect("discretizes").points().len())
                 .sum();
             group.throughput(Throughput::Elements(points as u64));
             group.bench_with_input(BenchmarkId::new("single", tol), &opts, |b, o| {
                 b.iter(|| {
                     curves
                         .iter()
-                        .map(|c| discretize(c, o).expect("discretizes").points.len())
+                        .map(|c| discretize(c, o).expect("discretizes").points().len())
                         .sum::<usize>()
                 })
             });

@@ -184,11 +184,15 @@ pub fn discretize(case: &CurveCase) {
         return;
     };
     let (t0, t1) = curve.domain();
-    assert_eq!(d.params.first(), Some(&t0), "starts at the domain start");
-    assert_eq!(d.params.last(), Some(&t1), "ends at the domain end");
-    assert_eq!(d.params.len(), d.points.len(), "one point per parameter");
+    assert_eq!(d.params().first(), Some(&t0), "starts at the domain start");
+    assert_eq!(d.params().last(), Some(&t1), "ends at the domain end");
+    assert_eq!(
+        d.params().len(),
+        d.points().len(),
+        "one point per parameter"
+    );
     assert!(
-        d.max_chord_error <= case.tolerance,
+        d.max_chord_error() <= case.tolerance,
         "certified within the tolerance"
     );
     // Rounding in evaluating the samples themselves: a few ulps of the curve's size.
@@ -198,7 +202,7 @@ pub fn discretize(case: &CurveCase) {
         .map(|p| p.coords.amax())
         .fold(1.0, f64::max);
     let slack = 1e-9 * size;
-    for (i, w) in d.params.windows(2).enumerate() {
+    for (i, w) in d.params().windows(2).enumerate() {
         assert!(w[0] < w[1], "params[{i}..]: strictly increasing");
         let e = sampled_chord_error(curve, w[0], w[1]);
         assert!(
@@ -209,7 +213,7 @@ pub fn discretize(case: &CurveCase) {
             case.tolerance
         );
     }
-    for (t, p) in d.params.iter().zip(&d.points) {
+    for (t, p) in d.params().iter().zip(d.points()) {
         assert!(
             (curve.point(*t) - p).norm() <= slack,
             "point on the curve at {t}"

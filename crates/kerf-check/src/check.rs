@@ -788,9 +788,9 @@ mod tests {
                     let d = kerf_discretize::discretize(&c.curve, &opts).expect("discretizes");
                     PathRecord {
                         id: c.id.clone(),
-                        params: d.params,
-                        points: d.points.iter().map(|p| vec![p.x, p.y, p.z]).collect(),
-                        max_chord_error: Some(d.max_chord_error),
+                        params: d.params().to_vec(),
+                        points: d.points().iter().map(|p| vec![p.x, p.y, p.z]).collect(),
+                        max_chord_error: Some(d.max_chord_error()),
                         point_count: None,
                     }
                 })

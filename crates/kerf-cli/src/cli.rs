@@ -155,7 +155,7 @@ pub(crate) struct DiscretizeArgs {
     pub(crate) output: Option<PathBuf>,
 
     /// Lower edge of the accepted chord-error band, as a fraction of the tolerance (0 < band <
-    /// 1; default 0.9). Higher: fewer points, slower.
+    /// 1; default 0.97). Higher: fewer points, slower.
     #[arg(long, value_name = "FRACTION", value_parser = crate::guard::fraction)]
     pub(crate) band: Option<f64>,
 

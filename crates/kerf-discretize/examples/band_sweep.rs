@@ -34,7 +34,7 @@ fn main() {
                     for c in &curves {
                         let d = discretize(c, &opts).expect("discretizes");
                         segs += d.segments();
-                        pts += d.points.len();
+                        pts += d.points().len();
                     }
                 }
                 let rate = pts as f64 / start.elapsed().as_secs_f64();

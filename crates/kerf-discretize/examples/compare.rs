@@ -55,9 +55,9 @@ fn main() {
                     secs = secs.min(start.elapsed().as_secs_f64());
                 }
                 let d = d.expect("ran");
-                totals[i].0 += d.points.len();
+                totals[i].0 += d.points().len();
                 totals[i].1 += secs;
-                cells.push(format!("{} ({:.0} us)", d.points.len(), secs * 1e6));
+                cells.push(format!("{} ({:.0} us)", d.points().len(), secs * 1e6));
             }
             if per_curve {
                 println!(

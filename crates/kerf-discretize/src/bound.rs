@@ -9,7 +9,7 @@
 //! curve points found on the way (the pieces' end points) give a lower bound. The search stops
 //! as soon as the bounds decide the question asked. See `docs/discretization.md`.
 
-use kerf_nurbs::{NurbsCurve, RationalBezier};
+use kerf_nurbs::{NurbsCurve, RationalBezier, MAX_ORDER};
 use nalgebra::{Point3, Vector3, Vector4};
 
 /// The verdict on one segment.
@@ -43,16 +43,37 @@ pub fn dist_to_segment(q: &Point3<f64>, a: &Point3<f64>, ab: &Vector3<f64>, ab2:
 }
 
 /// Reusable work space of [`Certifier::chord_error`], so that a walk along a curve allocates once.
+/// Pieces are kept in arrays sized for the degree (4, 8 or `MAX_ORDER` control points), so a
+/// cubic's piece is 128 bytes to copy, not 800.
 #[derive(Debug, Default, Clone)]
 pub struct Scratch {
-    pieces: Vec<Piece>,
+    small: Vec<Piece<4>>,
+    medium: Vec<Piece<8>>,
+    large: Vec<Piece<MAX_ORDER>>,
 }
 
 #[derive(Debug, Clone, Copy)]
-struct Piece {
-    bez: RationalBezier,
+struct Piece<const M: usize> {
+    /// Homogeneous control points; entries beyond the degree are unused.
+    cpw: [Vector4<f64>; M],
     upper: f64,
     depth: u32,
+}
+
+impl<const M: usize> Piece<M> {
+    /// Splits at the middle in place: `self` becomes the left half and `right`, which must hold
+    /// a copy of `self` on entry, the right half (de Casteljau: `p` levels of convex
+    /// combinations with weights `1/2`, as `RationalBezier::subdivide_in_place`).
+    #[inline]
+    fn split(&mut self, right: &mut Self, p: usize) {
+        kerf_nurbs::work::tick();
+        for r in 1..=p {
+            for i in 0..=(p - r) {
+                right.cpw[i] = right.cpw[i] * 0.5 + right.cpw[i + 1] * 0.5;
+            }
+            self.cpw[r] = right.cpw[0];
+        }
+    }
 }
 
 /// Subdivisions of one Bezier piece beyond which it is not refined further: the rounding
@@ -70,29 +91,50 @@ struct Chord {
     a: Point3<f64>,
     ab: Vector3<f64>,
     ab2: f64,
+    /// `1 / ab2` where finite (else 0: the exact division is used).
+    inv_ab2: f64,
 }
 
 impl Chord {
-    #[inline]
-    fn dist(&self, q: &Point3<f64>) -> f64 {
-        dist_to_segment(q, &self.a, &self.ab, self.ab2)
+    fn new(a: Point3<f64>, b: Point3<f64>) -> Self {
+        let ab = b - a;
+        let ab2 = ab.norm_squared();
+        let inv = 1.0 / ab2;
+        Self {
+            a,
+            ab,
+            ab2,
+            inv_ab2: if inv.is_finite() { inv } else { 0.0 },
+        }
     }
 
-    /// Upper bound over a piece's hull, and the distances of its two end points (curve points).
+    /// The distance from `q` to the chord. With the reciprocal, the foot parameter `s` is off
+    /// by a rounding, but it is clamped to `[0, 1]`, so the value is the distance to *a* point
+    /// of the segment: never below the true distance (up to the rounding of the norm).
     #[inline]
-    fn piece(&self, bez: &RationalBezier) -> (f64, f64) {
-        let h = bez.homogeneous();
-        let mut upper = 0.0f64;
-        for c in h {
-            let q = Point3::new(c.x / c.w, c.y / c.w, c.z / c.w);
-            upper = upper.max(self.dist(&q));
+    fn dist(&self, q: &Point3<f64>) -> f64 {
+        if self.inv_ab2 == 0.0 {
+            return dist_to_segment(q, &self.a, &self.ab, self.ab2);
         }
-        let last = h[h.len() - 1];
-        let end = self.dist(&Point3::new(
-            last.x / last.w,
-            last.y / last.w,
-            last.z / last.w,
-        ));
+        let aq = q - self.a;
+        let s = (aq.dot(&self.ab) * self.inv_ab2).clamp(0.0, 1.0);
+        (aq - self.ab * s).norm()
+    }
+
+    /// Upper bound over a piece's hull (the largest distance of a projected control point),
+    /// and the distance of its last control point (a curve point). The projection multiplies
+    /// by `1 / w` (one more rounding of size `eps |Q|` than a division, within the margin's
+    /// allowance for the projection).
+    #[inline]
+    fn piece(&self, h: &[Vector4<f64>]) -> (f64, f64) {
+        let mut upper = 0.0f64;
+        let mut end = 0.0;
+        for c in h {
+            let inv = 1.0 / c.w;
+            let q = Point3::new(c.x * inv, c.y * inv, c.z * inv);
+            end = self.dist(&q);
+            upper = upper.max(end);
+        }
         (upper, end)
     }
 }
@@ -112,6 +154,11 @@ pub struct Certifier<'a> {
     origin: Vector3<f64>,
     /// Per knot span index: `L = max_i |P_i - O|_inf` over the span's `p + 1` control points.
     spans: Vec<f64>,
+    /// Per knot span index `i`: the homogeneous control points of the whole span's Bezier form
+    /// at `span_bezier[i * (p + 1)..(i + 1) * (p + 1)]` (zeros for empty spans). A segment's
+    /// piece in the span is cut from it by two de Casteljau splits (`docs/discretization.md`,
+    /// Step 1), instead of a blossom per trial.
+    span_bezier: Vec<Vector4<f64>>,
     /// `4 eps max |P_i|` for curves whose weights are not powers of two (the control points are
     /// recovered from `w P` by one division, within two ulps), else 0.
     representation: f64,
@@ -177,11 +224,17 @@ impl<'a> Certifier<'a> {
             let scale = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
             4.0 * f64::EPSILON * scale
         };
+        let local = NurbsCurve::from_homogeneous_unchecked(p, curve.knots().to_vec(), cpw);
+        let mut span_bezier = vec![Vector4::zeros(); curve.len() * (p + 1)];
+        for (i, a, b) in curve.spans() {
+            local.bezier_in_span_into(i, a, b, &mut span_bezier[i * (p + 1)..(i + 1) * (p + 1)]);
+        }
         Self {
             curve,
-            local: NurbsCurve::from_homogeneous_unchecked(p, curve.knots().to_vec(), cpw),
+            local,
             origin,
             spans,
+            span_bezier,
             representation,
         }
     }
@@ -194,6 +247,39 @@ impl<'a> Certifier<'a> {
     /// The local origin `O` the certificate computes in.
     pub fn origin(&self) -> Vector3<f64> {
         self.origin
+    }
+
+    /// The Bezier piece of the curve on `[lo, hi]` inside knot span `span`, cut from the span's
+    /// Bezier form by de Casteljau: first the left part at `u1 = (hi - k_lo) / (k_hi - k_lo)`,
+    /// then the right part of that at `v = (lo - k_lo) / (hi - k_lo)`. Both local parameters
+    /// lie in `[0, 1]` (clamped), so each level is a convex combination, like the blossom's de
+    /// Boor levels; their rounding (and that of `u1`, `v`) is covered by the margin (3 `p`
+    /// levels of extraction instead of `p`, Step 5). Counts as one evaluation.
+    #[inline]
+    fn piece_in_span(&self, span: usize, lo: f64, hi: f64, out: &mut [Vector4<f64>]) {
+        kerf_nurbs::work::tick();
+        let p = self.curve.degree();
+        let knots = self.local.knots();
+        let (klo, khi) = (knots[span], knots[span + 1]);
+        out.copy_from_slice(&self.span_bezier[span * (p + 1)..(span + 1) * (p + 1)]);
+        if hi < khi {
+            let u = ((hi - klo) / (khi - klo)).clamp(0.0, 1.0);
+            // Left part at u, in place: after level r, out[r] is the left piece's point r.
+            for r in 1..=p {
+                for i in (r..=p).rev() {
+                    out[i] = out[i - 1] * (1.0 - u) + out[i] * u;
+                }
+            }
+        }
+        if lo > klo {
+            let v = ((lo - klo) / (hi - klo)).clamp(0.0, 1.0);
+            // Right part at v, in place: after level r, out[p - r] is the right piece's point.
+            for r in 1..=p {
+                for i in 0..=(p - r) {
+                    out[i] = out[i] * (1.0 - v) + out[i + 1] * v;
+                }
+            }
+        }
     }
 
     fn factor(&self) -> f64 {
@@ -246,30 +332,59 @@ impl<'a> Certifier<'a> {
         limit: f64,
         want_lower: f64,
     ) -> Bound {
+        match self.curve.degree() {
+            0..=3 => self.chord_error_m(&mut scratch.small, t0, t1, a, b, limit, want_lower),
+            4..=7 => self.chord_error_m(&mut scratch.medium, t0, t1, a, b, limit, want_lower),
+            _ => self.chord_error_m(&mut scratch.large, t0, t1, a, b, limit, want_lower),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn chord_error_m<const M: usize>(
+        &self,
+        pieces: &mut Vec<Piece<M>>,
+        t0: f64,
+        t1: f64,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        limit: f64,
+        want_lower: f64,
+    ) -> Bound {
         let (al, bl) = (a - self.origin, b - self.origin);
-        let chord = Chord {
-            a: al,
-            ab: bl - al,
-            ab2: (bl - al).norm_squared(),
-        };
+        let chord = Chord::new(al, bl);
         let f = self.factor();
+        let p = self.curve.degree();
         let mut margin = 8.0 * f64::EPSILON * al.coords.amax().max(bl.coords.amax());
-        let pieces = &mut scratch.pieces;
         pieces.clear();
         let mut lower = 0.0f64;
-        let spans = &self.spans;
         let local = &self.local;
-        local.for_each_bezier_piece(t0, t1, |bez| {
-            let (upper, end) = chord.piece(bez);
-            let l = spans[local.span(bez.t0)];
-            margin = margin.max((2.0 * f + 8.0 * f64::EPSILON) * l);
-            lower = lower.max(end);
-            pieces.push(Piece {
-                bez: *bez,
-                upper,
-                depth: 0,
-            });
-        });
+        // The Bezier pieces of [t0, t1], one per knot span it meets (as
+        // `NurbsCurve::for_each_bezier_piece`), extracted straight into the work space.
+        let knots = local.knots();
+        let mut span = local.span(t0);
+        let mut lo = t0;
+        loop {
+            let hi = knots[span + 1].min(t1);
+            if hi > lo {
+                let mut pc = Piece {
+                    cpw: [Vector4::zeros(); M],
+                    upper: 0.0,
+                    depth: 0,
+                };
+                self.piece_in_span(span, lo, hi, &mut pc.cpw[..=p]);
+                let (upper, end) = chord.piece(&pc.cpw[..=p]);
+                pc.upper = upper;
+                margin = margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span]);
+                lower = lower.max(end);
+                pieces.push(pc);
+            }
+            if hi >= t1 || span + 1 >= local.len() {
+                break;
+            }
+            lo = hi;
+            span += 1;
+        }
         margin += self.representation;
         let budget = 48 + 4 * pieces.len();
         let mut steps = 0;
@@ -277,14 +392,16 @@ impl<'a> Certifier<'a> {
             // The piece with the largest bound decides the global bound.
             let mut worst = 0;
             let mut upper = 0.0f64;
-            for (i, p) in pieces.iter().enumerate() {
-                if p.upper > upper {
-                    upper = p.upper;
+            let mut nan = false;
+            for (i, pc) in pieces.iter().enumerate() {
+                nan |= pc.upper.is_nan();
+                if pc.upper > upper {
+                    upper = pc.upper;
                     worst = i;
                 }
             }
             // A NaN distance (overflowing homogeneous coordinates) must never look like 0.
-            if pieces.iter().any(|p| p.upper.is_nan()) || lower.is_nan() || margin.is_nan() {
+            if nan || lower.is_nan() || margin.is_nan() {
                 return Bound {
                     upper: f64::INFINITY,
                     lower: if lower.is_nan() { f64::INFINITY } else { lower },
@@ -304,7 +421,7 @@ impl<'a> Certifier<'a> {
             let exhausted = steps >= budget
                 || pieces
                     .get(worst)
-                    .is_none_or(|p| p.depth >= MAX_SUBDIVISION_DEPTH);
+                    .is_none_or(|pc| pc.depth >= MAX_SUBDIVISION_DEPTH);
             if decided || exhausted {
                 return Bound {
                     upper: upper_m,
@@ -318,9 +435,9 @@ impl<'a> Certifier<'a> {
             let last = pieces.len() - 1;
             let (head, tail) = pieces.split_at_mut(last);
             let (l, r) = (&mut head[worst], &mut tail[0]);
-            l.bez.subdivide_in_place(&mut r.bez, 0.5);
-            let (ul, el) = chord.piece(&l.bez);
-            let (ur, _) = chord.piece(&r.bez);
+            l.split(r, p);
+            let (ul, el) = chord.piece(&l.cpw[..=p]);
+            let (ur, _) = chord.piece(&r.cpw[..=p]);
             lower = lower.max(el);
             l.upper = ul;
             r.upper = ur;

@@ -79,6 +79,17 @@ pub enum DiscretizeError {
         /// The estimated count.
         estimate: f64,
     },
+    /// [`crate::Discretization::certify`] was given parameters that it cannot certify. Fix:
+    /// discretize the curve with [`crate::discretize`] instead, or correct the parameters.
+    #[error("cutting parameter or segment {index} cannot be certified: {reason} (bound {})", Readable(*.bound))]
+    NotCertified {
+        /// Index of the parameter (or of the segment, which starts at that parameter).
+        index: usize,
+        /// What is wrong.
+        reason: &'static str,
+        /// The certified bound reached (mm), or the parameter of a missing C0 break, or NaN.
+        bound: f64,
+    },
 }
 
 /// `Result` with [`DiscretizeError`].

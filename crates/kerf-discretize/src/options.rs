@@ -27,7 +27,7 @@ pub struct Options {
     pub tolerance: f64,
     /// The lower edge of the band as a fraction of the tolerance: `E_min = band * tolerance`.
     /// A step whose estimated chord error lies in `[E_min, E_max]` is accepted at once; a
-    /// shorter one is lengthened. In `(0, 1)`; default 0.9 (measured: see
+    /// shorter one is lengthened. In `(0, 1)`; default 0.97 (measured: see
     /// `docs/discretization.md`).
     pub band: f64,
     /// The longest chord allowed (machines limit block length). `f64::INFINITY` for none.
@@ -50,7 +50,7 @@ impl Default for Options {
     fn default() -> Self {
         Self {
             tolerance: 0.01,
-            band: 0.9,
+            band: 0.97,
             max_segment_length: f64::INFINITY,
             min_segment_length: 0.0,
             max_turn: f64::INFINITY,

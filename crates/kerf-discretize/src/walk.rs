@@ -38,6 +38,9 @@ pub(crate) struct Walker<'a> {
     /// The band's lower edge `E_min`: `band * (tolerance - margin)`, so that the band stays
     /// reachable when the rounding margin is a visible part of the tolerance.
     pub emin: f64,
+    /// `integral sqrt(k) |C'| dt` so far, by the trapezoid rule on the cutting points (the
+    /// curvature at each point is evaluated anyway, to predict the step): `N*` for free.
+    pub sqrt_curvature: f64,
 }
 
 /// Why the last trial of a point failed.
@@ -86,9 +89,17 @@ impl Walker<'_> {
         // walk learns the systematic error of the osculating-circle model (warm start).
         let mut bias = 1.0f64;
         let mut last_dt = (b - a) / 8.0;
+        // sqrt(k) |C'| at the previous cutting point.
+        let mut prev_f = None;
         while t0 < b {
-            let (_, d1, d2) = self.curve.eval_d2(t0);
+            let d = self.curve.eval_d3(t0);
+            let (d1, d2) = (d[1], d[2]);
             let k = curvature_of(&d1, &d2);
+            let f0 = crate::sqrt_curvature_speed(&d);
+            if let Some(fp) = prev_f {
+                self.sqrt_curvature += crate::trapezoid_step(self.curve, t0 - last_dt, t0, fp, f0);
+            }
+            prev_f = Some(f0);
             let speed0 = d1.norm();
             let remaining = (pb - p0).norm();
             // Paper 004 eq 4-5: the chord of the osculating circle with sagitta H_p.
@@ -183,7 +194,7 @@ impl Walker<'_> {
                 match (good, bad) {
                     (Some(g), None) => {
                         let f = if g.bound.lower > 0.0 {
-                            (hp / g.bound.lower).sqrt().clamp(1.1, 4.0)
+                            (hp / g.bound.lower).sqrt().clamp(1.005, 4.0)
                         } else {
                             4.0
                         };
@@ -192,7 +203,7 @@ impl Walker<'_> {
                     }
                     (None, Some(bd)) => {
                         let f = if bd.bound.lower > 0.0 {
-                            (hp / bd.bound.lower).sqrt().clamp(0.05, 0.7)
+                            (hp / bd.bound.lower).sqrt().clamp(0.05, 0.995)
                         } else {
                             0.5
                         };
@@ -260,6 +271,11 @@ impl Walker<'_> {
             } else {
                 (g.hit.t, g.hit.p)
             };
+            if t1 >= b {
+                // The piece's last segment: the value at its start (the value at `b` would
+                // cost an evaluation, and at a C0 break it belongs to the next piece).
+                self.sqrt_curvature += f0.0 * (t1 - t0);
+            }
             out.params.push(t1);
             out.points.push(p1);
             if out.points.len() > self.opts.max_points {

@@ -69,7 +69,7 @@ fn a_straight_line_is_one_segment_or_what_max_length_demands() {
         (len / 7.0).ceil() as usize,
         "max segment length"
     );
-    for w in d.points.windows(2) {
+    for w in d.points().windows(2) {
         assert!(
             (w[1] - w[0]).norm() <= 7.0 + 1e-9,
             "segment longer than the maximum"
@@ -96,7 +96,7 @@ fn c0_corners_are_cutting_points() {
     );
     let d = discretize(&c, &Options::with_tolerance(0.01)).unwrap();
     check(&c, &d, 0.01);
-    assert!(d.params.contains(&0.5), "the corner is a cutting point");
+    assert!(d.params().contains(&0.5), "the corner is a cutting point");
 }
 
 fn full_circle(r: f64) -> NurbsCurve {
@@ -304,20 +304,20 @@ fn a_range_keeps_its_ends_inner_breaks_and_the_guarantee() {
     let c = full_circle(30.0);
     let d =
         kerf_discretize::discretize_range(&c, 0.1, 0.6, &Options::with_tolerance(0.001)).unwrap();
-    assert_eq!(d.params[0], 0.1, "starts at a");
-    assert_eq!(*d.params.last().unwrap(), 0.6, "ends at b");
+    assert_eq!(d.params()[0], 0.1, "starts at a");
+    assert_eq!(*d.params().last().unwrap(), 0.6, "ends at b");
     assert!(
-        d.params.contains(&0.25) && d.params.contains(&0.5),
+        d.params().contains(&0.25) && d.params().contains(&0.5),
         "inner breaks kept"
     );
-    assert!(!d.params.contains(&0.75), "outer break not added");
-    for i in 1..d.params.len() {
+    assert!(!d.params().contains(&0.75), "outer break not added");
+    for i in 1..d.params().len() {
         let e = brute_chord_error(
             &c,
-            d.params[i - 1],
-            d.params[i],
-            &d.points[i - 1],
-            &d.points[i],
+            d.params()[i - 1],
+            d.params()[i],
+            &d.points()[i - 1],
+            &d.points()[i],
         );
         assert!(e <= 0.001, "segment {i}: {e}");
     }

@@ -76,7 +76,7 @@ fn max_turn_limits_the_tangent_turn_per_segment() {
     };
     let d = discretize(&c, &opts).unwrap();
     check(&c, &d, 0.1);
-    for w in d.params.windows(2) {
+    for w in d.params().windows(2) {
         // The turn between the end tangents of each segment.
         let u = c.tangent(w[0]).unwrap();
         let v = c.tangent(w[1]).unwrap();

@@ -297,36 +297,40 @@ fn write_path(path: &ToolPath, w: &mut impl Write) -> io::Result<()> {
     write!(w, "      \"max_chord_error\": ")?;
     number(w, path.max_chord_error)?;
     writeln!(w, ",\n      \"params\": [")?;
+    // The numbers go straight from the formatter into `w` (a buffered writer): no string per
+    // number, no serializer per number.
+    let mut fmt = zmij::Buffer::new();
     for (i, chunk) in path.params.chunks(8).enumerate() {
-        write!(w, "        ")?;
+        w.write_all(b"        ")?;
         for (k, &t) in chunk.iter().enumerate() {
             if k > 0 {
-                write!(w, ", ")?;
+                w.write_all(b", ")?;
             }
-            number(w, t)?;
+            w.write_all(fmt.format_finite(t).as_bytes())?;
         }
         let last = (i + 1) * 8 >= path.params.len();
-        writeln!(w, "{}", if last { "" } else { "," })?;
+        w.write_all(if last { b"\n" } else { b",\n" })?;
     }
-    writeln!(w, "      ],\n      \"points\": [")?;
+    w.write_all(b"      ],\n      \"points\": [\n")?;
     let n = path.points.len();
     for (i, point) in path.points.iter().enumerate() {
-        write!(w, "        [")?;
+        w.write_all(b"        [")?;
         for (k, &x) in point.iter().enumerate() {
             if k > 0 {
-                write!(w, ", ")?;
+                w.write_all(b", ")?;
             }
-            number(w, x)?;
+            w.write_all(fmt.format_finite(x).as_bytes())?;
         }
-        writeln!(w, "]{}", if i + 1 < n { "," } else { "" })?;
+        w.write_all(if i + 1 < n { b"],\n" } else { b"]\n" })?;
     }
     write!(w, "      ]\n    }}")
 }
 
-/// Writes a finite number in the shortest form that reads back to the same double.
+/// Writes a finite number in the shortest form that reads back to the same double (the
+/// formatter serde_json uses, so the bytes are those serde_json would write).
 fn number(w: &mut impl Write, x: f64) -> io::Result<()> {
     debug_assert!(x.is_finite(), "validated before writing");
-    serde_json::to_writer(&mut *w, &x).map_err(io::Error::from)
+    w.write_all(zmij::Buffer::new().format_finite(x).as_bytes())
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -436,6 +440,22 @@ fn points_from_rows(index: usize, rows: Vec<Vec<f64>>) -> Result<ToolPathPoints>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    proptest::proptest! {
+        /// The writer formats numbers itself (zmij, no serializer per number): the bytes must
+        /// be serde_json's, and read back to the same double.
+        #[test]
+        fn numbers_are_serde_jsons_and_round_trip(bits in proptest::num::u64::ANY) {
+            let x = f64::from_bits(bits);
+            proptest::prop_assume!(x.is_finite());
+            let mut ours = Vec::new();
+            number(&mut ours, x).unwrap();
+            let theirs = serde_json::to_string(&x).unwrap();
+            proptest::prop_assert_eq!(std::str::from_utf8(&ours).unwrap(), theirs.as_str());
+            let back: f64 = serde_json::from_slice(&ours).unwrap();
+            proptest::prop_assert_eq!(back.to_bits(), x.to_bits());
+        }
+    }
 
     fn sample() -> ToolpathFile {
         let h = std::f64::consts::FRAC_1_SQRT_2;

@@ -240,14 +240,14 @@ impl Ctx<'_> {
             if bound.upper > tol {
                 let d = discretize_range(self.curve, a.t, b.t, self.dopts)?;
                 let mut prev = a;
-                let last = d.params.len() - 1;
+                let last = d.params().len() - 1;
                 for i in 1..last {
-                    let s = self.sample(d.params[i], d.points[i], prev.hint)?;
+                    let s = self.sample(d.params()[i], d.points()[i], prev.hint)?;
                     self.out.inserted += 1;
                     self.segment(prev, s, true)?;
                     prev = s;
                 }
-                self.out.max_chord_error = self.out.max_chord_error.max(d.max_chord_error);
+                self.out.max_chord_error = self.out.max_chord_error.max(d.max_chord_error());
                 return self.segment(prev, b, true);
             }
             self.out.max_chord_error = self.out.max_chord_error.max(bound.upper);
@@ -285,20 +285,20 @@ pub fn orient(
         nopts,
         min_dt: (1e-9 * (db - da)).max(8.0 * f64::EPSILON * da.abs().max(db.abs())),
         out: Oriented {
-            max_chord_error: disc.max_chord_error,
-            params: Vec::with_capacity(disc.params.len()),
-            points: Vec::with_capacity(disc.params.len()),
-            normals: Vec::with_capacity(disc.params.len()),
+            max_chord_error: disc.max_chord_error(),
+            params: Vec::with_capacity(disc.params().len()),
+            points: Vec::with_capacity(disc.params().len()),
+            normals: Vec::with_capacity(disc.params().len()),
             ..Default::default()
         },
     };
-    let Some((&t0, &p0)) = disc.params.first().zip(disc.points.first()) else {
+    let Some((&t0, &p0)) = disc.params().first().zip(disc.points().first()) else {
         return Ok(ctx.out);
     };
     let mut prev = ctx.sample(t0, p0, Hint::None)?;
     ctx.push(&prev);
-    for i in 1..disc.params.len() {
-        let s = ctx.sample(disc.params[i], disc.points[i], prev.hint)?;
+    for i in 1..disc.params().len() {
+        let s = ctx.sample(disc.params()[i], disc.points()[i], prev.hint)?;
         ctx.segment(prev, s, true)?;
         if s.n.angle(&s.n_after) > ctx.nopts.max_normal_step {
             // The normal jumps at a degenerate point of the surface (a cone's apex): the head

@@ -111,19 +111,40 @@ impl NurbsCurve {
     /// each level. For arguments inside the span every de Boor step is a convex combination,
     /// so the Bezier weights stay positive.
     pub fn bezier_in_span(&self, span: usize, t0: f64, t1: f64) -> RationalBezier {
-        crate::work::tick();
-        let p = self.degree();
-        let knots = self.knots();
-        let cpw = self.homogeneous_points();
         let mut out = RationalBezier {
-            degree: p,
+            degree: self.degree(),
             t0,
             t1,
             cpw: [Vector4::zeros(); MAX_ORDER],
         };
+        self.bezier_in_span_into(span, t0, t1, &mut out.cpw);
+        out
+    }
+
+    /// [`NurbsCurve::bezier_in_span`] written to `out[..=degree]` (homogeneous control points),
+    /// without building a [`RationalBezier`]: hot loops keep their pieces in arrays sized for
+    /// the degree instead of copying `MAX_ORDER` entries. `out` must hold at least
+    /// `degree + 1` entries.
+    #[inline]
+    pub fn bezier_in_span_into(&self, span: usize, t0: f64, t1: f64, out: &mut [Vector4<f64>]) {
+        // Scratch arrays sized for the degree: clearing 25-entry arrays costs more than the
+        // arithmetic for the common degrees.
+        match self.degree() {
+            0..=3 => self.blossom_m::<4>(span, t0, t1, out),
+            4..=7 => self.blossom_m::<8>(span, t0, t1, out),
+            _ => self.blossom_m::<MAX_ORDER>(span, t0, t1, out),
+        }
+    }
+
+    #[inline]
+    fn blossom_m<const M: usize>(&self, span: usize, t0: f64, t1: f64, out: &mut [Vector4<f64>]) {
+        crate::work::tick();
+        let p = self.degree();
+        let knots = self.knots();
+        let cpw = self.homogeneous_points();
         // Control point j applies t0 at p - j de Boor levels and t1 at j levels. The t0 levels
         // are shared: `pre` holds the state after `p - j` levels of t0, for j = p down to 0.
-        let level = |d: &mut [Vector4<f64>; MAX_ORDER], r: usize, x: f64| {
+        let level = |d: &mut [Vector4<f64>; M], r: usize, x: f64| {
             for k in (r..=p).rev() {
                 let lo = knots[span - p + k];
                 let hi = knots[span + 1 + k - r];
@@ -131,9 +152,9 @@ impl NurbsCurve {
                 d[k] = d[k - 1] * (1.0 - alpha) + d[k] * alpha;
             }
         };
-        let mut pre = [Vector4::zeros(); MAX_ORDER];
+        let mut pre = [Vector4::zeros(); M];
         pre[..=p].copy_from_slice(&cpw[span - p..=span]);
-        let mut d = pre;
+        let mut d = [Vector4::zeros(); M];
         for j in (0..=p).rev() {
             if j < p {
                 // One more level of t0: level p - j.
@@ -143,9 +164,8 @@ impl NurbsCurve {
             for r in (p - j + 1)..=p {
                 level(&mut d, r, t1);
             }
-            out.cpw[j] = d[p];
+            out[j] = d[p];
         }
-        out
     }
 
     /// The rational Bezier pieces of the curve on `[t0, t1]`: one per knot span the interval

@@ -5,7 +5,7 @@ use std::io;
 use std::path::Path;
 use std::time::Instant;
 
-use kerf_discretize::{minimum_count, Discretization, Options};
+use kerf_discretize::{Discretization, Options};
 use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
 use kerf_format::{curves, CurvesFile, SurfaceGeometry};
 use kerf_normals::{
@@ -113,11 +113,11 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             .zip(&results)
             .map(|(rec, d)| ToolPath {
                 id: rec.id.clone(),
-                params: d.params.clone(),
+                params: d.params().to_vec(),
                 points: ToolPathPoints::Positions(
-                    d.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                    d.points().iter().map(|p| [p.x, p.y, p.z]).collect(),
                 ),
-                max_chord_error: d.max_chord_error,
+                max_chord_error: d.max_chord_error(),
             })
             .collect(),
         Some(o) => file
@@ -153,21 +153,11 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             o.iter().map(|o| o.jumps.len()).sum::<usize>(),
         )
     });
-    // N* (a diagnostic) costs an adaptive quadrature per curve, with a work budget linear in
-    // the curve's spans: in parallel, inside the reported time, and skipped when nothing
-    // would print it.
-    let nstar: f64 = if args.quiet && !args.json {
-        0.0
-    } else {
-        file.curves
-            .par_iter()
-            .map(|r| minimum_count(&r.curve, opts.tolerance))
-            .collect::<Vec<f64>>()
-            .iter()
-            .sum()
-    };
+    // N* (a diagnostic) comes from the curvature the walk evaluated at its points (no
+    // quadrature of its own; `Discretization::n_star`).
+    let nstar: f64 = results.iter().map(|d| d.n_star(opts.tolerance)).sum();
     let elapsed = start.elapsed().as_secs_f64();
-    let breaks: usize = results.iter().map(|d| d.c0_breaks.len()).sum();
+    let breaks: usize = results.iter().map(|d| d.c0_breaks().len()).sum();
     if args.json {
         let summary = json!({
             "file": path.display().to_string(),
@@ -325,10 +315,10 @@ pub(crate) fn normals_for_file(
                 if vertical_without_surface {
                     let d = &results[i];
                     return Ok(Oriented {
-                        params: d.params.clone(),
-                        points: d.points.clone(),
-                        normals: vec![nalgebra::Vector3::z(); d.points.len()],
-                        max_chord_error: d.max_chord_error,
+                        params: d.params().to_vec(),
+                        points: d.points().to_vec(),
+                        normals: vec![nalgebra::Vector3::z(); d.points().len()],
+                        max_chord_error: d.max_chord_error(),
                         ..Default::default()
                     });
                 }

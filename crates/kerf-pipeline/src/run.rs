@@ -188,11 +188,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     }
     let duration: f64 = motions.iter().map(|m| m.duration()).sum();
     let cycles: usize = motions.iter().map(|m| m.cycles()).sum();
-    let nstar: f64 = file
-        .curves
-        .iter()
-        .map(|r| kerf_discretize::minimum_count(&r.curve, dopts.tolerance))
-        .sum();
+    let nstar: f64 = discs.iter().map(|d| d.n_star(dopts.tolerance)).sum();
     let segments: usize = discs.iter().map(Discretization::segments).sum();
     let report = json!({
         "input": path.display().to_string(),
@@ -218,7 +214,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "segments": segments,
             "n_star": nstar,
             "max_chord_error": tp.paths.iter().map(|p| p.max_chord_error).fold(0.0, f64::max),
-            "c0_breaks": discs.iter().map(|d| d.c0_breaks.len()).sum::<usize>(),
+            "c0_breaks": discs.iter().map(|d| d.c0_breaks().len()).sum::<usize>(),
         },
         "normals": {
             "points": oriented.iter().map(|o| o.points.len()).sum::<usize>(),

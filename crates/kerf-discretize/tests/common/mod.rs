@@ -75,15 +75,19 @@ pub fn brute_chord_error(
 /// worst true chord error.
 pub fn check(c: &NurbsCurve, d: &Discretization, tol: f64) -> f64 {
     let (a, b) = c.domain();
-    assert_eq!(d.params.len(), d.points.len(), "one point per parameter");
-    assert!(d.params.len() >= 2, "at least one segment");
-    assert_eq!(d.params[0], a, "first parameter is the domain start");
     assert_eq!(
-        *d.params.last().unwrap(),
+        d.params().len(),
+        d.points().len(),
+        "one point per parameter"
+    );
+    assert!(d.params().len() >= 2, "at least one segment");
+    assert_eq!(d.params()[0], a, "first parameter is the domain start");
+    assert_eq!(
+        *d.params().last().unwrap(),
         b,
         "last parameter is the domain end"
     );
-    for w in d.params.windows(2) {
+    for w in d.params().windows(2) {
         assert!(
             w[1] > w[0],
             "parameters strictly increase: {} then {}",
@@ -99,7 +103,7 @@ pub fn check(c: &NurbsCurve, d: &Discretization, tol: f64) -> f64 {
         .map(|p| p.coords.amax())
         .fold(0.0, f64::max);
     let size = c.size().max(1e-300) + 1e4 * far;
-    for (t, p) in d.params.iter().zip(&d.points) {
+    for (t, p) in d.params().iter().zip(d.points()) {
         let q = c.point(*t);
         assert!(
             (q - p).norm() <= 1e-12 * size,
@@ -108,32 +112,32 @@ pub fn check(c: &NurbsCurve, d: &Discretization, tol: f64) -> f64 {
         );
     }
     for br in c.c0_breaks() {
-        assert!(d.params.contains(&br), "C0 break {br} is a cutting point");
+        assert!(d.params().contains(&br), "C0 break {br} is a cutting point");
     }
     assert!(
-        d.max_chord_error <= tol,
+        d.max_chord_error() <= tol,
         "certified bound {} <= tol {tol}",
-        d.max_chord_error
+        d.max_chord_error()
     );
     let mut worst = 0.0f64;
-    for i in 1..d.params.len() {
+    for i in 1..d.params().len() {
         let e = brute_chord_error(
             c,
-            d.params[i - 1],
-            d.params[i],
-            &d.points[i - 1],
-            &d.points[i],
+            d.params()[i - 1],
+            d.params()[i],
+            &d.points()[i - 1],
+            &d.points()[i],
         );
         assert!(
             e <= tol * (1.0 + 1e-9) + 1e-12 * size,
             "segment {i} [{}, {}]: brute-force chord error {e} > tol {tol}",
-            d.params[i - 1],
-            d.params[i]
+            d.params()[i - 1],
+            d.params()[i]
         );
         assert!(
-            e <= d.max_chord_error * (1.0 + 1e-9) + 1e-12 * size,
+            e <= d.max_chord_error() * (1.0 + 1e-9) + 1e-12 * size,
             "segment {i}: brute-force error {e} above the certified bound {}",
-            d.max_chord_error
+            d.max_chord_error()
         );
         worst = worst.max(e);
     }

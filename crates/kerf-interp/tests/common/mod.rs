@@ -57,7 +57,7 @@ pub fn freeform() -> NurbsCurve {
 /// Cutting points of `curve` at chord tolerance `tol`: (params, points).
 pub fn cut(curve: &NurbsCurve, tol: f64) -> (Vec<f64>, Vec<Point3<f64>>) {
     let d = discretize(curve, &Options::with_tolerance(tol)).expect("discretize");
-    (d.params, d.points)
+    d.into_parts()
 }
 
 /// Stations of a curve with tool axes from `axis_of(point)`.

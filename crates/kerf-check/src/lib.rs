@@ -38,12 +38,14 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod check;
-pub mod error;
-pub mod input;
-pub mod measure;
+mod check;
+mod error;
+mod input;
+mod measure;
 
-pub use check::{check, CheckOptions, Defect, PathReport, Report, Violation, WorstSegment};
+pub use check::{check, CheckOptions, ROUNDING_ALLOWANCE, Defect, PathReport, Report, Violation, WorstSegment};
 pub use error::{CheckError, Result};
 pub use input::{PathRecord, Toolpath};
-pub use measure::{distance_to_segment, segment_chord_error, SegmentError};
+/// The point-to-segment distance of the checker's dense sampling (the one implementation, in `kerf-nurbs`).
+pub use kerf_nurbs::distance_to_segment;
+pub use measure::{segment_chord_error, SegmentError};

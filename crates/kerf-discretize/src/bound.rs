@@ -9,7 +9,7 @@
 //! curve points found on the way (the pieces' end points) give a lower bound. The search stops
 //! as soon as the bounds decide the question asked. See `docs/discretization.md`.
 
-use kerf_nurbs::{NurbsCurve, RationalBezier};
+use kerf_nurbs::{NurbsCurve, RationalBezier, Segment};
 use nalgebra::{Point3, Vector3, Vector4};
 
 /// The verdict on one segment.
@@ -29,17 +29,6 @@ impl Bound {
     pub fn certified(&self, tolerance: f64) -> bool {
         self.upper <= tolerance
     }
-}
-
-/// Distance from `q` to the segment `[a, b]` (to the point `a` when `a == b`).
-#[inline]
-pub fn dist_to_segment(q: &Point3<f64>, a: &Point3<f64>, ab: &Vector3<f64>, ab2: f64) -> f64 {
-    let aq = q - a;
-    if ab2 == 0.0 {
-        return aq.norm();
-    }
-    let s = (aq.dot(ab) / ab2).clamp(0.0, 1.0);
-    (aq - ab * s).norm()
 }
 
 /// Reusable work space of [`Certifier::chord_error`], so that a walk along a curve allocates once.
@@ -66,16 +55,13 @@ pub const MAX_SUBDIVISION_DEPTH: u32 = 48;
 /// convex combination (`docs/discretization.md`, Step 5).
 pub const MARGIN_FACTOR: f64 = 128.0;
 
-struct Chord {
-    a: Point3<f64>,
-    ab: Vector3<f64>,
-    ab2: f64,
-}
+/// The chord, as the segment of the one point-to-segment distance (`kerf_nurbs::Segment`).
+struct Chord(Segment<3>);
 
 impl Chord {
     #[inline]
     fn dist(&self, q: &Point3<f64>) -> f64 {
-        dist_to_segment(q, &self.a, &self.ab, self.ab2)
+        self.0.distance_to(q)
     }
 
     /// Upper bound over a piece's hull, and the distances of its two end points (curve points).
@@ -247,11 +233,7 @@ impl<'a> Certifier<'a> {
         want_lower: f64,
     ) -> Bound {
         let (al, bl) = (a - self.origin, b - self.origin);
-        let chord = Chord {
-            a: al,
-            ab: bl - al,
-            ab2: (bl - al).norm_squared(),
-        };
+        let chord = Chord(Segment::between(&al, &bl));
         let f = self.factor();
         let mut margin = 8.0 * f64::EPSILON * al.coords.amax().max(bl.coords.amax());
         let pieces = &mut scratch.pieces;

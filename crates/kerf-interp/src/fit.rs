@@ -29,7 +29,8 @@ use nalgebra::Point3;
 
 use crate::block::{Block, Station, MIN_TRAVEL};
 use crate::error::{positive, InterpError, Result};
-use crate::geometry::{segment_distance, Arc};
+use crate::geometry::Arc;
+use kerf_nurbs::nearest_on_segment;
 use crate::model::AxisModel;
 
 /// Options of [`fit_blocks`].
@@ -272,7 +273,7 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
         }
         let mut last_t = 0.0;
         for k in i + 1..j {
-            let (d, t) = segment_distance(&self.st[k].tip, &a.tip, &b.tip);
+            let (d, t) = nearest_on_segment(&self.st[k].tip, &a.tip, &b.tip);
             if d > tol || t <= last_t || t >= 1.0 {
                 return false;
             }
@@ -286,7 +287,7 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
         for seg in self.samples[i..j].iter().flatten() {
             if seg
                 .iter()
-                .any(|p| segment_distance(p, &a.tip, &b.tip).0 > tol)
+                .any(|p| nearest_on_segment(p, &a.tip, &b.tip).0 > tol)
             {
                 return false;
             }

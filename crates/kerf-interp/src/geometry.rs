@@ -151,18 +151,6 @@ impl Arc {
     }
 }
 
-/// Distance from `p` to the segment `[a, b]`, and the parameter in `[0, 1]` of the nearest point.
-pub fn segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> (f64, f64) {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    ((p - (a + ab * t)).norm(), t)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -20,8 +20,9 @@
 //! (all four types, from `kerf-kinematics`; [`stations_from_solved`] takes its solved paths),
 //! [`AcHead`] as a small self-contained reference (paper 000's head).
 //!
-//! [`Block::constant_feed`] is paper 000's interpolator of one block at constant feed, and
-//! [`recursive`] is paper 001's recursive spline interpolator. The maths, the tolerance budget
+//! [`Block::constant_feed`] is paper 000's interpolator of one block at constant feed. Paper
+//! 001's recursive spline interpolator (`NewBasisSegment`, `spline_setpoints`) and paper 000's
+//! eq 19 (`paper_eq19`) are research code behind the cargo feature `research`. The maths, the tolerance budget
 //! and the measured figures are in `docs/interpolation.md`.
 //!
 //! ```
@@ -46,20 +47,24 @@
 //! # Ok::<(), kerf_interp::InterpError>(())
 //! ```
 
-pub mod block;
-pub mod chord;
-pub mod error;
-pub mod fit;
-pub mod geometry;
-pub mod machine;
-pub mod model;
-pub mod output;
-pub mod plan;
-pub mod recursive;
+mod block;
+mod chord;
+mod error;
+mod fit;
+mod geometry;
+mod machine;
+mod model;
+mod output;
+mod plan;
+#[cfg(feature = "research")]
+mod recursive;
 pub(crate) mod smooth;
 pub(crate) mod topp;
 
-pub use block::{increments, solve_stations, Block, Geometry, Station};
+pub use block::{increments, solve_stations, Block, Geometry, Station, MIN_TRAVEL};
+#[cfg(feature = "research")]
+pub use chord::paper_eq19;
+pub use chord::{chord_error, max_feed, max_step};
 pub use error::{InterpError, Result};
 pub use fit::{fit_blocks, BlockCounts, CurveFn, FitOptions};
 pub use geometry::Arc;
@@ -69,7 +74,14 @@ pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_csv_to, write_gcode, Dialect,
     GcodeOptions, ProcessCodes,
 };
+pub use output::{comment_text, write_atomic, DEFAULT_BLEND_TOLERANCE, MAX_COMMENT};
+pub use plan::{ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_STATIC_SHARE};
 pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PathStats, PlanOptions};
+#[cfg(feature = "research")]
+pub use recursive::{
+    max_deviation, new_basis_coefficients, spline_setpoints, spline_through, CubicHermite,
+    ForwardDifferences, NewBasisSegment, Recurrence, RecurrenceSteps, OMEGA,
+};
 
 /// One path of a program: its id (the source curve's), its stations and, when known, the
 /// curve itself.

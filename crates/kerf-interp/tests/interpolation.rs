@@ -1,6 +1,7 @@
 //! Paper 000's interpolators against analytic positions, eq 19, and the error paths.
 
-use kerf_interp::chord::{chord_error, max_feed, paper_eq19};
+#[cfg(feature = "research")]
+use kerf_interp::{chord_error, max_feed, paper_eq19};
 use kerf_interp::{increments, AcHead, AxisModel, Block, InterpError, Station};
 use nalgebra::{Point3, Vector3};
 
@@ -136,6 +137,7 @@ fn long_block_does_not_drift() {
 }
 
 #[test]
+#[cfg(feature = "research")]
 fn eq19_numbers() {
     // F <= sqrt(225000 (2R - 0.001)) mm/min for T = 8 ms, delta = 1 um (eq 19 with the
     // unit slip corrected), and it equals the general bound 60 * 2 sqrt(d (2R - d)) / T.

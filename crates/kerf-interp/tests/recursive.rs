@@ -1,7 +1,7 @@
 //! Paper 001's recursive interpolator: its table of coefficients, the accumulated-error claims
 //! (600 and 5,000 steps; the 1,000,000-step row is in the example), and the spline mode.
 
-use kerf_interp::recursive::{
+use kerf_interp::{
     max_deviation, new_basis_coefficients, spline_setpoints, spline_through, CubicHermite,
     NewBasisSegment, Recurrence,
 };

@@ -32,21 +32,21 @@
 //! # Ok::<(), kerf_kinematics::KinematicsError>(())
 //! ```
 
-pub mod ac_head;
-pub mod axes_file;
-pub mod error;
-pub mod fork_head;
-pub mod head_table;
+mod ac_head;
+mod axes_file;
+mod error;
+mod fork_head;
+mod head_table;
 mod json;
-pub mod kinematics;
-pub mod machine;
-pub mod nonlinear;
-pub mod path;
-pub mod placement;
-pub mod pose;
+mod kinematics;
+mod machine;
+mod nonlinear;
+mod path;
+mod placement;
+mod pose;
 mod registry;
 mod rotation;
-pub mod table_table;
+mod table_table;
 
 pub use ac_head::AcHead;
 pub use axes_file::{AxesFile, AxesMove, AxesPath, AXES_FORMAT};
@@ -55,7 +55,8 @@ pub use fork_head::{ForkHead, ForkTilt};
 pub use head_table::HeadTable;
 pub use kinematics::Kinematics;
 pub use machine::{Machine, Process, Range, MACHINE_FORMAT};
-pub use nonlinear::{linearization_error, Deviation};
+pub use nonlinear::{interpolate, linearization_error, slerp, Deviation};
+pub use path::{nearest_turn, LIMIT_SLACK, UNIT_AXIS_TOLERANCE};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
 pub use placement::{
     auto_place, auto_setups, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement,

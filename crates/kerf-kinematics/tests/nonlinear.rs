@@ -5,7 +5,8 @@ mod common;
 use std::sync::Arc;
 
 use common::{fixture, polar, unlimited};
-use kerf_kinematics::nonlinear::{distance_to_segment, linearization_error};
+use kerf_kinematics::linearization_error;
+use kerf_nurbs::distance_to_segment;
 use kerf_kinematics::{
     solve_path, ForkHead, ForkTilt, KinematicsError, Machine, PathCurve, PathInput, PathOptions,
     Pose, SolvedPath,

@@ -251,7 +251,7 @@ pub(crate) fn write_program(p: &Program, dest: &Path, opts: &GcodeOptions) -> Re
         std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes())?;
         return Ok(());
     }
-    kerf_interp::output::write_atomic(dest, text.as_bytes()).map_err(interp_err(dest))
+    kerf_interp::write_atomic(dest, text.as_bytes()).map_err(interp_err(dest))
 }
 
 /// Runs `kerf gcode`.

@@ -11,9 +11,9 @@ use common::{brute_chord_error, check, seg_dist};
 use kerf_discretize::{
     discretize, minimum_count_quadrature, Discretization, DiscretizeError, Options, Strategy,
 };
-use kerf_nurbs::SPLITS_PER_SPAN;
 use kerf_nurbs::counted;
 use kerf_nurbs::NurbsCurve;
+use kerf_nurbs::SPLITS_PER_SPAN;
 
 fn fixture(name: &str) -> Vec<(String, NurbsCurve)> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -29,9 +29,9 @@ use nalgebra::Point3;
 
 use crate::block::{Block, Station, MIN_TRAVEL};
 use crate::error::{positive, InterpError, Result};
-use crate::geometry::Arc;
-use kerf_nurbs::nearest_on_segment;
+use crate::geometry::SpaceArc;
 use crate::model::AxisModel;
+use kerf_nurbs::nearest_on_segment;
 
 /// Options of [`fit_blocks`].
 #[derive(Debug, Clone, PartialEq)]
@@ -298,7 +298,7 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
     fn arc_fits(&self, i: usize, j: usize) -> bool {
         let m = (i + j) / 2;
         let (a, mid, b) = (&self.st[i], &self.st[m], &self.st[j]);
-        let Ok(arc) = Arc::through(a.tip, mid.tip, b.tip) else {
+        let Ok(arc) = SpaceArc::through(a.tip, mid.tip, b.tip) else {
             return false;
         };
         if arc.radius > self.opts.max_radius || arc.angle_end > self.opts.max_sweep {

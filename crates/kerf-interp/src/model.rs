@@ -9,7 +9,7 @@
 //!
 //! kerf's machines (`kerf.machine/1`, four types) live in `kerf-kinematics`;
 //! [`crate::MachineModel`] adapts them. The trait keeps the interpolator's needs in one small
-//! place (and lets a controller plug in its own kinematics); [`AcHead`], the head of paper 000,
+//! place (and lets a controller plug in its own kinematics); [`PaperAcHead`], the head of paper 000,
 //! is a self-contained reference implementation for tests, examples and benches.
 
 use nalgebra::{Point3, Vector3};
@@ -128,7 +128,7 @@ pub trait AxisModel {
 /// A reference implementation for tests, examples and benches; kerf's machines, all four
 /// types, come from `kerf-kinematics`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct AcHead {
+pub struct PaperAcHead {
     /// Machine name.
     pub name: String,
     /// Rotation radius of A, mm.
@@ -142,7 +142,7 @@ pub struct AcHead {
     pub pole_tolerance: f64,
 }
 
-impl AcHead {
+impl PaperAcHead {
     /// The example machine of `formats.md` ("paper-000 laser head": `r_a` 180, `r_c` 95,
     /// X +-1500, Y +-800, Z -100..600, A +-135, C continuous; 60/60/30 m/min, 36000 deg/min;
     /// 10/10/8 m/s^2, 20000 deg/s^2).
@@ -181,7 +181,7 @@ pub(crate) fn nearest_turn(value: f64, reference: f64) -> f64 {
     value + 360.0 * ((reference - value) / 360.0).round()
 }
 
-impl AxisModel for AcHead {
+impl AxisModel for PaperAcHead {
     fn name(&self) -> &str {
         &self.name
     }
@@ -260,7 +260,7 @@ mod tests {
 
     #[test]
     fn paper_eq16_and_inverse_round_trip() {
-        let m = AcHead::paper_000();
+        let m = PaperAcHead::paper_000();
         let tip = Point3::new(10.0, -20.0, 5.0);
         let u = m.tool_axis(30.0, 40.0);
         let q = m.inverse(&tip, &u, None).expect("reachable");
@@ -276,7 +276,7 @@ mod tests {
 
     #[test]
     fn continuity_picks_second_solution_and_turn() {
-        let m = AcHead::paper_000();
+        let m = PaperAcHead::paper_000();
         let tip = Point3::origin();
         let u = m.tool_axis(-20.0, 370.0 + 180.0);
         let prev = [0.0, 0.0, 0.0, -19.0, 545.0];
@@ -292,7 +292,7 @@ mod tests {
     fn bad_limits_and_axes_are_errors() {
         assert!(AxisLimits::from_machine_units([None; 5], [f64::NAN; 5], [1.0; 5]).is_err());
         assert!(AxisLimits::from_machine_units([None; 5], [1.0; 5], [0.0; 5]).is_err());
-        let m = AcHead::paper_000();
+        let m = PaperAcHead::paper_000();
         let e = m.inverse(&Point3::origin(), &Vector3::new(0.0, 0.0, 2.0), None);
         assert!(matches!(e, Err(InterpError::Kinematics { .. })), "{e:?}");
     }

@@ -162,5 +162,4 @@ mod tests {
             "antipodal midpoint is perpendicular"
         );
     }
-
 }

@@ -21,8 +21,8 @@ pub use error::{NormalsError, Result};
 pub use mesh::{MeshNormals, DEFAULT_CREASE_ANGLE_DEG};
 pub use surface::{Hint, NormalSource, NurbsNormals, Projection};
 
-use kerf_discretize::{Certifier, Scratch};
 use kerf_discretize::{discretize_range, Discretization, Options};
+use kerf_discretize::{Certifier, Scratch};
 use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3};
 

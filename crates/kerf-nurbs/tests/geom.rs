@@ -19,13 +19,29 @@ fn exact_cases_clamp_to_the_ends() {
     let a = Point3::new(0.0, 0.0, 0.0);
     let b = Point3::new(4.0, 0.0, 0.0);
     // Beside the middle: the perpendicular distance.
-    assert_eq!(nearest_on_segment(&Point3::new(1.0, 3.0, 0.0), &a, &b), (3.0, 0.25), "inside");
+    assert_eq!(
+        nearest_on_segment(&Point3::new(1.0, 3.0, 0.0), &a, &b),
+        (3.0, 0.25),
+        "inside"
+    );
     // Beyond b: the distance to b (3-4-5), at s = 1.
-    assert_eq!(nearest_on_segment(&Point3::new(7.0, 4.0, 0.0), &a, &b), (5.0, 1.0), "past b");
+    assert_eq!(
+        nearest_on_segment(&Point3::new(7.0, 4.0, 0.0), &a, &b),
+        (5.0, 1.0),
+        "past b"
+    );
     // Before a: the distance to a, at s = 0.
-    assert_eq!(nearest_on_segment(&Point3::new(-3.0, 0.0, 4.0), &a, &b), (5.0, 0.0), "before a");
+    assert_eq!(
+        nearest_on_segment(&Point3::new(-3.0, 0.0, 4.0), &a, &b),
+        (5.0, 0.0),
+        "before a"
+    );
     // A segment of no length is its point.
-    assert_eq!(distance_to_segment(&Point3::new(0.0, 1.0, 0.0), &a, &a), 1.0, "point segment");
+    assert_eq!(
+        distance_to_segment(&Point3::new(0.0, 1.0, 0.0), &a, &a),
+        1.0,
+        "point segment"
+    );
     // The ends of the segment are at distance exactly 0.
     assert_eq!(distance_to_segment(&b, &a, &b), 0.0, "end");
     assert_eq!(distance_to_segment(&a, &a, &b), 0.0, "start");

@@ -276,7 +276,7 @@ mod tests {
 
     /// 21 equally spaced params per curve, points on the curve.
     fn toolpath(file: &CurvesFile) -> ToolpathFile {
-        use kerf_format::{ToolPath, ToolPathPoints};
+        use kerf_format::{ToolpathPoints, ToolpathRecord};
         ToolpathFile {
             units: kerf_format::Units::Millimetres,
             tolerance: 0.5,
@@ -292,10 +292,10 @@ mod tests {
                         .iter()
                         .map(|&t| c.curve.point(t).coords.into())
                         .collect();
-                    ToolPath {
+                    ToolpathRecord {
                         id: c.id.clone(),
                         params,
-                        points: ToolPathPoints::Positions(points),
+                        points: ToolpathPoints::Positions(points),
                         max_chord_error: 0.0,
                     }
                 })

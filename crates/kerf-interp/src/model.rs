@@ -12,6 +12,7 @@
 //! place (and lets a controller plug in its own kinematics); [`PaperAcHead`], the head of paper 000,
 //! is a self-contained reference implementation for tests, examples and benches.
 
+use kerf_kinematics::{nearest_solution, Axes};
 use nalgebra::{Point3, Vector3};
 
 use crate::error::{positive, InterpError, Result};
@@ -176,11 +177,6 @@ impl PaperAcHead {
     }
 }
 
-/// `value` plus the multiple of 360 that brings it nearest `reference`.
-pub(crate) fn nearest_turn(value: f64, reference: f64) -> f64 {
-    value + 360.0 * ((reference - value) / 360.0).round()
-}
-
 impl AxisModel for PaperAcHead {
     fn name(&self) -> &str {
         &self.name
@@ -218,21 +214,19 @@ impl AxisModel for PaperAcHead {
                 let c = u.x.atan2(-u.y).to_degrees();
                 vec![(a, c), (-a, c + 180.0)]
             };
-        let mut best: Option<([f64; 5], f64)> = None;
-        for (a, c) in candidates {
-            let c = nearest_turn(c, prev_c);
-            let xyz = self.linear_axes(tip, a, c);
-            let q = [xyz[0], xyz[1], xyz[2], a, c];
-            if !(0..5).all(|k| self.in_range(k, q[k])) {
-                continue;
-            }
-            let travel = (a - prev_a).abs().max((c - prev_c).abs());
-            if best.as_ref().is_none_or(|(_, t)| travel < *t) {
-                best = Some((q, travel));
-            }
-        }
-        best.map(|(q, _)| q)
-            .ok_or_else(|| kin("no solution within the axis ranges".to_string()))
+        // X, Y, Z do not depend on whole turns of A or C: placed once per solution, the turns
+        // chosen by kerf-kinematics' one rule.
+        let solutions = candidates.into_iter().map(|(a, c)| {
+            let [x, y, z] = self.linear_axes(tip, a, c);
+            Axes::new(x, y, z, a, c)
+        });
+        let previous = Axes::new(0.0, 0.0, 0.0, prev_a, prev_c);
+        nearest_solution(solutions, &previous, |q| {
+            let q = q.to_array();
+            (0..5).all(|k| self.in_range(k, q[k]))
+        })
+        .map(|q| q.to_array())
+        .ok_or_else(|| kin("no solution within the axis ranges".to_string()))
     }
 
     #[inline]

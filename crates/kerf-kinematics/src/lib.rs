@@ -34,6 +34,7 @@
 
 mod ac_head;
 mod axes_file;
+mod choice;
 mod error;
 mod fork_head;
 mod head_table;
@@ -41,6 +42,7 @@ mod json;
 mod kinematics;
 mod machine;
 mod nonlinear;
+mod params;
 mod path;
 mod placement;
 mod pose;
@@ -50,14 +52,15 @@ mod table_table;
 
 pub use ac_head::AcHead;
 pub use axes_file::{AxesFile, AxesMove, AxesPath, AXES_FORMAT};
+pub use choice::{nearest_solution, nearest_turn, turns_near};
 pub use error::{KinematicsError, Result};
 pub use fork_head::{ForkHead, ForkTilt};
 pub use head_table::HeadTable;
 pub use kinematics::Kinematics;
 pub use machine::{Machine, Process, Range, MACHINE_FORMAT};
 pub use nonlinear::{interpolate, linearization_error, slerp, Deviation};
-pub use path::{nearest_turn, LIMIT_SLACK, UNIT_AXIS_TOLERANCE};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
+pub use path::{LIMIT_SLACK, UNIT_AXIS_TOLERANCE};
 pub use placement::{
     auto_place, auto_setups, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement,
     Placement, Setup, SetupPlan,

@@ -40,6 +40,7 @@
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
+use crate::choice::{nearest_solution, nearest_turn};
 use crate::error::{KinematicsError, Result};
 use crate::kinematics::Kinematics;
 use crate::machine::Machine;
@@ -288,11 +289,6 @@ fn checked_poses(input: &PathInput<'_>) -> Result<Vec<Pose>> {
     Ok(out)
 }
 
-/// `value + 360 k` nearest `reference`.
-pub fn nearest_turn(value: f64, reference: f64) -> f64 {
-    value + 360.0 * ((reference - value) / 360.0).round()
-}
-
 /// Why the preferred solution of a pose cannot be used.
 #[derive(Debug, Clone)]
 struct Refusal {
@@ -453,8 +449,11 @@ impl Ctx<'_> {
             q.c = nearest_turn(q.c, prev.c);
             q
         });
-        let travel = |q: &Axes| prev.rotary_travel(q);
-        let (pref, other) = if travel(&sols[1]) < travel(&sols[0]) {
+        // The preferred solution by the one choice rule, limits aside (they are checked next,
+        // so that a refusal can say which axis and what the other solution would do).
+        let second =
+            nearest_solution(sols, prev, |_| true).is_some_and(|q| q == sols[1] && q != sols[0]);
+        let (pref, other) = if second {
             (sols[1], sols[0])
         } else {
             (sols[0], sols[1])

@@ -26,7 +26,7 @@ pub struct MachineModel {
     /// A tool axis within this angle (radians) of the C axis is at the pole, where C keeps its
     /// previous value ([`AxisModel::inverse`] only; kerf-kinematics' `solve_path` has its own
     /// option). Default 1e-6, as `formats.md`.
-    pub pole_tolerance: f64,
+    pub pole_tolerance_rad: f64,
     limits: AxisLimits,
 }
 
@@ -44,7 +44,7 @@ impl MachineModel {
         limits.validate()?;
         Ok(Self {
             machine,
-            pole_tolerance: 1e-6,
+            pole_tolerance_rad: 1e-6,
             limits,
         })
     }
@@ -93,7 +93,7 @@ impl AxisModel for MachineModel {
             axis: *axis,
         };
         let (prev_t, prev_c) = previous.map_or((0.0, 0.0), |p| (p[3], p[4]));
-        let candidates: Vec<Axes> = if k.pole_angle(axis) <= self.pole_tolerance {
+        let candidates: Vec<Axes> = if k.pole_angle(axis) <= self.pole_tolerance_rad {
             vec![k.inverse_with_c(&pose, prev_c)]
         } else {
             k.inverse(&pose).to_vec()

@@ -276,17 +276,13 @@ fn normal_sources(
                     vertices,
                     triangles,
                 } => Box::new(
-                    MeshNormals::new(
-                        vertices.clone(),
-                        triangles.clone(),
-                        crease.to_radians(),
-                        s.flip,
-                    )
-                    .map_err(|error| CliError::Normals {
-                        file: path.to_path_buf(),
-                        place: format!("surfaces[{i}] ({:?})", s.id),
-                        error,
-                    })?,
+                    MeshNormals::new(vertices.clone(), triangles.clone(), crease, s.flip).map_err(
+                        |error| CliError::Normals {
+                            file: path.to_path_buf(),
+                            place: format!("surfaces[{i}] ({:?})", s.id),
+                            error,
+                        },
+                    )?,
                 ),
             };
             Ok(Some(src))

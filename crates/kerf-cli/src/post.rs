@@ -18,8 +18,8 @@ pub(crate) fn options(args: &PostArgs) -> PathOptions {
         linearization_tolerance: args
             .linearization_tolerance
             .unwrap_or(d.linearization_tolerance),
-        max_rotary_step: args.max_rotary_step.unwrap_or(d.max_rotary_step),
-        pole_tolerance: args.pole_tolerance.unwrap_or(d.pole_tolerance),
+        max_rotary_step_deg: args.max_rotary_step.unwrap_or(d.max_rotary_step_deg),
+        pole_tolerance_rad: args.pole_tolerance.unwrap_or(d.pole_tolerance_rad),
         ..d
     }
 }

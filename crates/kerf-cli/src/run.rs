@@ -73,7 +73,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         linearization_tolerance: args
             .linearization_tolerance
             .unwrap_or(PathOptions::default().linearization_tolerance),
-        max_rotary_step: args.max_rotary_step.unwrap_or(f64::INFINITY),
+        max_rotary_step_deg: args.max_rotary_step.unwrap_or(f64::INFINITY),
         ..PathOptions::default()
     };
     let poses: Vec<Vec<Pose>> = oriented

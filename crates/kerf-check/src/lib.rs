@@ -3,7 +3,7 @@
 //! The discretizer (crate `kerf-discretize`) proves a chord-error bound for every segment it
 //! writes. This crate does not trust that proof, nor any other tool's: it reads a toolpath
 //! leniently ([`RawToolpath`], so that a file kerf would refuse still gets every defect listed),
-//! and [`check()`] measures every segment's chord error by brute force ([`measure`]: dense
+//! and [`check()`] measures every segment's chord error by brute force ([`segment_chord_error`]: dense
 //! sampling between the two params including every knot inside, then golden-section
 //! refinement of each local maximum), and checks every rule of the format
 //! (`shared/formats.md`): same ids in the same order, params strictly increasing from one end

@@ -5,7 +5,7 @@
 //! inverse kinematics, and [`solve_path`] does so along a whole path, keeping the axes
 //! continuous and within their limits, handling the pole, and inserting poses where the
 //! controller's linear axis interpolation would take the tool tip off the path
-//! ([`nonlinear`], paper 002). [`AxesFile`] writes the result as `kerf.axes/1`.
+//! ([`linearization_error`], paper 002). [`AxesFile`] writes the result as `kerf.axes/1`.
 //!
 //! Four kinematic types, one file each: [`AcHead`] (the laser head of paper 000),
 //! [`ForkHead`] (a double swing head), [`TableTable`] (LinuxCNC's `xyzac-trt`) and

@@ -105,7 +105,7 @@ impl NurbsSurface {
     ///   its minimum lies on one edge, a rational Bezier curve, whose closest point
     ///   [`NurbsCurve::closest_point`] finds exactly. (These coefficients are those of
     ///   `B . (B_u w - B w_u)` with `B = A - p w`, which has the sign of `(S - p) . Su`; see
-    ///   the [`closest`](crate::closest) module.) This also settles whole families of
+    ///   the curves' `closest.rs`.) This also settles whole families of
     ///   equidistant points, such as `p` on the axis of a surface of revolution;
     /// - a *leaf* once it is at least two halvings deep and simple — rows and columns of its
     ///   net turning by at most 22.5 degrees and a regular parametrisation (the cross products

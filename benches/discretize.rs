@@ -8,7 +8,7 @@ use kerf::discretize::{discretize, discretize_all, Options};
 use kerf::nurbs::NurbsCurve;
 
 fn smooth_curves(degree: usize, count: usize, seed: u64) -> Vec<NurbsCurve> {
-    kerf::nurbs::samples::smooth_random_curves(degree, count, seed)
+    kerf::nurbs::smooth_random_curves(degree, count, seed)
 }
 
 fn bench(c: &mut Criterion) {

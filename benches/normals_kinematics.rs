@@ -76,7 +76,7 @@ fn bench(c: &mut Criterion) {
         })
     });
     let (v, t) = sphere_mesh(100.0, 316);
-    let mesh = MeshNormals::new(v, t, 30f64.to_radians(), false).expect("mesh builds");
+    let mesh = MeshNormals::new(v, t, 30.0, false).expect("mesh builds");
     g.bench_function(
         BenchmarkId::new("mesh_sphere", mesh.triangle_count()),
         |b| {

@@ -27,7 +27,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use kerf::format::curves::{self, RawCurve, RawCurvesFile, RawNurbsSurface, RawStl, RawSurface};
-use kerf::nurbs::{basis, knots, NurbsSurface, MAX_ORDER};
+use kerf::nurbs::{basis_funs, find_span, NurbsSurface, MAX_ORDER};
 use nalgebra::{DMatrix, Matrix3x2, Point2, Point3, Vector2, Vector3};
 
 /// The largest curve-to-surface distance the generator accepts, mm (kerf's default on-surface
@@ -398,9 +398,9 @@ fn complete_cubic(
     a[(1, 1)] = s0;
     set(&mut b, 1, d0);
     for k in 1..n {
-        let span = knots::find_span(3, &kn, m, t[k]);
+        let span = find_span(3, &kn, m, t[k]);
         let mut nb = [0.0; MAX_ORDER];
-        basis::basis_funs(span, t[k], 3, &kn, &mut nb);
+        basis_funs(span, t[k], 3, &kn, &mut nb);
         for j in 0..4 {
             a[(k + 1, span - 3 + j)] = nb[j];
         }

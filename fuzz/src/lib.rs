@@ -48,7 +48,7 @@ pub fn read_toolpath(data: &[u8]) {
         assert_eq!(again, file, "toolpath round trip");
     }
     // The checker's independent loose reader must not panic either.
-    let _ = kerf_check::Toolpath::from_slice(data);
+    let _ = kerf_check::RawToolpath::from_slice(data);
 }
 
 pub fn read_axes(data: &[u8]) {

@@ -10,7 +10,7 @@ use nalgebra::Point3;
 use serde::Serialize;
 use serde_json::{json, Value};
 
-use crate::input::{PathRecord, Toolpath};
+use crate::input::{RawPathRecord, RawToolpath};
 use crate::measure::segment_chord_error;
 
 /// Floating-point allowance of the chord-error comparisons, relative to the curve size: a
@@ -65,10 +65,10 @@ impl Report {
     }
 
     /// The largest measured chord error over all paths, in mm (0 for no segments).
-    pub fn max_chord_error(&self) -> f64 {
+    pub fn measured_chord_error(&self) -> f64 {
         self.paths
             .iter()
-            .map(|p| p.max_chord_error)
+            .map(|p| p.measured_chord_error)
             .fold(0.0, f64::max)
     }
 
@@ -84,7 +84,7 @@ impl Report {
         json!({
             "passed": self.passed(),
             "tolerance": self.tolerance,
-            "max_chord_error": self.max_chord_error(),
+            "max_chord_error": self.measured_chord_error(),
             "segments": self.segments(),
             "paths": serde_json::to_value(&self.paths).unwrap_or(Value::Null),
             "violations": self.violations.iter().map(Violation::to_json).collect::<Vec<_>>(),
@@ -104,8 +104,9 @@ pub struct PathReport {
     /// The number of segments whose chord error was measured (those with increasing, finite
     /// params and points); `points - 1` for a sound path.
     pub segments: usize,
-    /// The largest measured chord error, in mm.
-    pub max_chord_error: f64,
+    /// The largest measured chord error, in mm (the key `max_chord_error` of the JSON report).
+    #[serde(rename = "max_chord_error")]
+    pub measured_chord_error: f64,
     /// The segment where it occurs, if any segment was measured.
     pub worst: Option<WorstSegment>,
     /// The `max_chord_error` the file claims, if present.
@@ -464,7 +465,7 @@ impl fmt::Display for Defect {
 ///
 /// Never fails: everything wrong is a [`Violation`] in the report, and every path that can be
 /// measured is.
-pub fn check(curves: &[CurveRecord], toolpath: &Toolpath, opts: &CheckOptions) -> Report {
+pub fn check(curves: &[CurveRecord], toolpath: &RawToolpath, opts: &CheckOptions) -> Report {
     let mut violations = Vec::new();
     let file_level = |defect| Violation {
         path: None,
@@ -542,7 +543,7 @@ pub fn check(curves: &[CurveRecord], toolpath: &Toolpath, opts: &CheckOptions) -
 /// Checks one path; pushes its defects to `found`.
 fn check_path(
     index: usize,
-    path: &PathRecord,
+    path: &RawPathRecord,
     curve: Option<&NurbsCurve>,
     tolerance: Option<f64>,
     opts: &CheckOptions,
@@ -554,9 +555,9 @@ fn check_path(
         id: path.id.clone(),
         points: n,
         segments: 0,
-        max_chord_error: 0.0,
+        measured_chord_error: 0.0,
         worst: None,
-        claimed: path.max_chord_error,
+        claimed: path.claimed_chord_error,
         claim_holds: None,
         c0_breaks: curve.map_or(0, |c| c.c0_breaks().len()),
         max_point_distance: 0.0,
@@ -623,7 +624,7 @@ fn check_path(
         }
     }
     let increasing = path.params.windows(2).all(|w| w[1] > w[0]);
-    if let Some(claimed) = path.max_chord_error {
+    if let Some(claimed) = path.claimed_chord_error {
         if let Some(tol) = tolerance {
             if claimed > tol {
                 found.push(Defect::ClaimAboveTolerance {
@@ -736,7 +737,7 @@ fn check_path(
                 at: e.at,
                 error: e.error,
             });
-            report.max_chord_error = e.error;
+            report.measured_chord_error = e.error;
         }
         if let Some(tol) = tolerance {
             if e.error > tol + allowance {
@@ -752,13 +753,13 @@ fn check_path(
         }
     }
     found.extend(exceeding);
-    if let (Some(claimed), true) = (path.max_chord_error, report.measured) {
-        let holds = claimed >= report.max_chord_error - allowance;
+    if let (Some(claimed), true) = (path.claimed_chord_error, report.measured) {
+        let holds = claimed >= report.measured_chord_error - allowance;
         report.claim_holds = Some(holds);
         if !holds {
             found.push(Defect::ClaimUnderstated {
                 claimed,
-                measured: report.max_chord_error,
+                measured: report.measured_chord_error,
             });
         }
     }
@@ -776,9 +777,9 @@ mod tests {
     }
 
     /// The discretizer's toolpath of every curve at `tol`.
-    fn toolpath(file: &CurvesFile, tol: f64) -> Toolpath {
+    fn toolpath(file: &CurvesFile, tol: f64) -> RawToolpath {
         let opts = kerf_discretize::Options::with_tolerance(tol);
-        Toolpath {
+        RawToolpath {
             units: Some("mm".into()),
             tolerance: tol,
             paths: file
@@ -786,11 +787,11 @@ mod tests {
                 .iter()
                 .map(|c| {
                     let d = kerf_discretize::discretize(&c.curve, &opts).expect("discretizes");
-                    PathRecord {
+                    RawPathRecord {
                         id: c.id.clone(),
                         params: d.params().to_vec(),
                         points: d.points().iter().map(|p| vec![p.x, p.y, p.z]).collect(),
-                        max_chord_error: Some(d.max_chord_error()),
+                        claimed_chord_error: Some(d.max_chord_error()),
                         point_count: None,
                     }
                 })
@@ -832,7 +833,7 @@ mod tests {
                 "{}: the certified bound holds",
                 p.id
             );
-            assert!(p.max_chord_error <= 0.01, "{}: within tolerance", p.id);
+            assert!(p.measured_chord_error <= 0.01, "{}: within tolerance", p.id);
             assert!(
                 p.max_point_distance <= 1e-12,
                 "{}: points on the curve",
@@ -841,7 +842,7 @@ mod tests {
         }
         // The discretizer fills the band [0.9, 1] of the tolerance on curved paths.
         let quintic = &report.paths[index_of(&file, "freeform-quintic")];
-        assert!(quintic.max_chord_error > 0.008, "{quintic:?}");
+        assert!(quintic.measured_chord_error > 0.008, "{quintic:?}");
         assert_eq!(
             report.paths[index_of(&file, "v-corner")].c0_breaks,
             1,
@@ -1062,8 +1063,8 @@ mod tests {
         }
         p.points[1][5] = 0.5;
         p.points[2].truncate(3);
-        tp.paths[1].max_chord_error = None;
-        tp.paths[3].max_chord_error = Some(0.02);
+        tp.paths[1].claimed_chord_error = None;
+        tp.paths[3].claimed_chord_error = Some(0.02);
         tp.paths[0].params.pop();
         let report = check(&file.curves, &tp, &CheckOptions::default());
         let found: Vec<_> = report
@@ -1175,7 +1176,7 @@ mod tests {
         let mut tp = toolpath(&file, 0.01);
         tp.tolerance = 0.001;
         for p in &mut tp.paths {
-            p.max_chord_error = Some(0.0);
+            p.claimed_chord_error = Some(0.0);
         }
         let report = check(&file.curves, &tp, &CheckOptions::default());
         let chord = report

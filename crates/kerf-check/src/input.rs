@@ -9,7 +9,8 @@
 
 use std::path::Path;
 
-use kerf_format::{ToolPathPoints, ToolpathFile, TOOLPATH_FORMAT};
+use kerf_format::{ToolpathFile, ToolpathPoints, TOOLPATH_FORMAT};
+use kerf_io::{JsonProblem, ShapeError};
 use serde::Deserialize;
 use serde_json::Value;
 
@@ -17,18 +18,18 @@ use crate::error::{CheckError, Result};
 
 /// A toolpath document as written, before any rule about its values is checked.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Toolpath {
+pub struct RawToolpath {
     /// The `units` value, if present (the format requires `"mm"`).
     pub units: Option<String>,
     /// The chord tolerance the file claims, in mm.
     pub tolerance: f64,
     /// The paths, in file order.
-    pub paths: Vec<PathRecord>,
+    pub paths: Vec<RawPathRecord>,
 }
 
-/// One path of a [`Toolpath`], as written.
+/// One path of a [`RawToolpath`], as written.
 #[derive(Debug, Clone, PartialEq)]
-pub struct PathRecord {
+pub struct RawPathRecord {
     /// The id of the curve the path claims to discretize.
     pub id: String,
     /// The curve parameter of each point.
@@ -36,7 +37,7 @@ pub struct PathRecord {
     /// Each point as written: 3 numbers, or 6 with the normal.
     pub points: Vec<Vec<f64>>,
     /// The `max_chord_error` the file claims, if present.
-    pub max_chord_error: Option<f64>,
+    pub claimed_chord_error: Option<f64>,
     /// The optional `point_count` the file claims (kerf's writer adds it), if present.
     pub point_count: Option<usize>,
 }
@@ -60,19 +61,19 @@ struct RawPath {
     point_count: Option<usize>,
 }
 
-impl Toolpath {
+impl RawToolpath {
     /// Reads a toolpath file leniently (see the module documentation).
     ///
     /// # Errors
     /// [`CheckError::Read`] if the file cannot be read, else any error of
-    /// [`Toolpath::from_slice`], wrapped in [`CheckError::File`].
-    pub fn load(path: impl AsRef<Path>) -> Result<Toolpath> {
+    /// [`RawToolpath::from_slice`], wrapped in [`CheckError::File`].
+    pub fn load(path: impl AsRef<Path>) -> Result<RawToolpath> {
         let path = path.as_ref();
         let bytes = kerf_io::read_file(path).map_err(|error| CheckError::Read {
             path: path.to_path_buf(),
             error,
         })?;
-        Toolpath::from_slice(&bytes).map_err(|e| e.in_file(path))
+        RawToolpath::from_slice(&bytes).map_err(|e| e.in_file(path))
     }
 
     /// Reads a toolpath document held in memory leniently.
@@ -81,32 +82,20 @@ impl Toolpath {
     /// [`CheckError::Syntax`] for text that is not JSON, [`CheckError::Format`] if `format` is
     /// not `kerf.toolpath/1`, [`CheckError::Shape`] naming the JSON path of a value of the
     /// wrong type or a missing key.
-    pub fn from_slice(bytes: &[u8]) -> Result<Toolpath> {
+    pub fn from_slice(bytes: &[u8]) -> Result<RawToolpath> {
         // The shared front end: BOM skipped, a key given twice refused (a checker must not
         // read a different document than the pipeline did).
-        let value: Value = kerf_io::parse_json(bytes).map_err(|e| match e {
-            kerf_io::JsonError::Empty => CheckError::Shape {
-                path: "top level".to_owned(),
-                message: "the file is empty".to_owned(),
-            },
-            kerf_io::JsonError::Syntax {
+        let value: Value = kerf_io::parse_json(bytes).map_err(|e| match JsonProblem::from(e) {
+            JsonProblem::Syntax {
                 line,
                 column,
-                path,
                 message,
             } => CheckError::Syntax {
                 line,
                 column,
-                message: if path.is_empty() {
-                    message
-                } else {
-                    format!("{message} (in {path})")
-                },
+                message,
             },
-            kerf_io::JsonError::DuplicateKey { path, line } => CheckError::Shape {
-                path,
-                message: format!("key given twice in one object (line {line})"),
-            },
+            JsonProblem::Shape(ShapeError { path, message }) => CheckError::Shape { path, message },
         })?;
         match value.get("format") {
             Some(Value::String(s)) if s == TOOLPATH_FORMAT => {}
@@ -116,42 +105,19 @@ impl Toolpath {
                 })
             }
         }
-        let raw: RawFile = serde_path_to_error::deserialize(value).map_err(|e| {
-            let mut path = e.path().to_string();
-            let mut message = e
-                .into_inner()
-                .to_string()
-                .replace("expected f64", "expected a number")
-                .replace("a sequence", "an array")
-                .replace("invalid type: map", "invalid type: object")
-                .replace("invalid type: sequence", "invalid type: array");
-            if let Some(field) = message
-                .strip_prefix("missing field `")
-                .and_then(|rest| rest.strip_suffix('`'))
-            {
-                path = if path == "." {
-                    field.to_owned()
-                } else {
-                    format!("{path}.{field}")
-                };
-                message = "required key is missing".to_owned();
-            }
-            if path == "." {
-                path = "top level".to_owned();
-            }
-            CheckError::Shape { path, message }
-        })?;
-        Ok(Toolpath {
+        let raw: RawFile = kerf_io::deserialize_at(value, "")
+            .map_err(|ShapeError { path, message }| CheckError::Shape { path, message })?;
+        Ok(RawToolpath {
             units: raw.units,
             tolerance: raw.tolerance,
             paths: raw
                 .paths
                 .into_iter()
-                .map(|p| PathRecord {
+                .map(|p| RawPathRecord {
                     id: p.id,
                     params: p.params,
                     points: p.points,
-                    max_chord_error: p.max_chord_error,
+                    claimed_chord_error: p.max_chord_error,
                     point_count: p.point_count,
                 })
                 .collect(),
@@ -159,22 +125,22 @@ impl Toolpath {
     }
 }
 
-impl From<&ToolpathFile> for Toolpath {
+impl From<&ToolpathFile> for RawToolpath {
     fn from(file: &ToolpathFile) -> Self {
-        Toolpath {
+        RawToolpath {
             units: Some(file.units.name().to_owned()),
             tolerance: file.tolerance,
             paths: file
                 .paths
                 .iter()
-                .map(|p| PathRecord {
+                .map(|p| RawPathRecord {
                     id: p.id.clone(),
                     params: p.params.clone(),
                     points: match &p.points {
-                        ToolPathPoints::Positions(v) => v.iter().map(|q| q.to_vec()).collect(),
-                        ToolPathPoints::Poses(v) => v.iter().map(|q| q.to_vec()).collect(),
+                        ToolpathPoints::Positions(v) => v.iter().map(|q| q.to_vec()).collect(),
+                        ToolpathPoints::Poses(v) => v.iter().map(|q| q.to_vec()).collect(),
                     },
-                    max_chord_error: Some(p.max_chord_error),
+                    claimed_chord_error: Some(p.max_chord_error),
                     point_count: None,
                 })
                 .collect(),
@@ -191,17 +157,17 @@ mod tests {
         let text = r#"{"format": "kerf.toolpath/1", "units": "mm", "tolerance": 0.1,
             "paths": [{"id": "a", "params": [1, 0], "points": [[0,0,0],[1,0,0,0]],
                        "max_chord_error": 5, "extra": true}]}"#;
-        let tp = Toolpath::from_slice(text.as_bytes()).unwrap();
+        let tp = RawToolpath::from_slice(text.as_bytes()).unwrap();
         assert_eq!(tp.paths[0].params, vec![1.0, 0.0], "reversed params kept");
         assert_eq!(tp.paths[0].points[1].len(), 4, "odd point length kept");
-        assert_eq!(tp.paths[0].max_chord_error, Some(5.0), "claim kept");
+        assert_eq!(tp.paths[0].claimed_chord_error, Some(5.0), "claim kept");
     }
 
     #[test]
     fn errors_name_the_json_path() {
         let bad = r#"{"format": "kerf.toolpath/1", "tolerance": 0.1,
             "paths": [{"id": "a", "params": [0, "x"], "points": []}]}"#;
-        let e = Toolpath::from_slice(bad.as_bytes())
+        let e = RawToolpath::from_slice(bad.as_bytes())
             .unwrap_err()
             .to_string();
         assert!(
@@ -209,21 +175,21 @@ mod tests {
             "{e}"
         );
         let missing = r#"{"format": "kerf.toolpath/1", "paths": []}"#;
-        let e = Toolpath::from_slice(missing.as_bytes())
+        let e = RawToolpath::from_slice(missing.as_bytes())
             .unwrap_err()
             .to_string();
         assert_eq!(e, "tolerance: required key is missing", "{e}");
         let curves = r#"{"format": "kerf.curves/1", "curves": []}"#;
-        let e = Toolpath::from_slice(curves.as_bytes())
+        let e = RawToolpath::from_slice(curves.as_bytes())
             .unwrap_err()
             .to_string();
         assert!(
             e.contains("expected \"kerf.toolpath/1\", found \"kerf.curves/1\""),
             "{e}"
         );
-        let e = Toolpath::from_slice(b"{").unwrap_err().to_string();
+        let e = RawToolpath::from_slice(b"{").unwrap_err().to_string();
         assert!(e.starts_with("invalid JSON at line 1"), "{e}");
-        let e = Toolpath::load("/nonexistent/x.json")
+        let e = RawToolpath::load("/nonexistent/x.json")
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("/nonexistent/x.json: cannot read"), "{e}");

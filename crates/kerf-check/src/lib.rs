@@ -2,8 +2,8 @@
 //!
 //! The discretizer (crate `kerf-discretize`) proves a chord-error bound for every segment it
 //! writes. This crate does not trust that proof, nor any other tool's: it reads a toolpath
-//! leniently ([`Toolpath`], so that a file kerf would refuse still gets every defect listed),
-//! and [`check()`] measures every segment's chord error by brute force ([`measure`]: dense
+//! leniently ([`RawToolpath`], so that a file kerf would refuse still gets every defect listed),
+//! and [`check()`] measures every segment's chord error by brute force ([`segment_chord_error`]: dense
 //! sampling between the two params including every knot inside, then golden-section
 //! refinement of each local maximum), and checks every rule of the format
 //! (`shared/formats.md`): same ids in the same order, params strictly increasing from one end
@@ -17,7 +17,7 @@
 //! guarantee.
 //!
 //! ```
-//! use kerf_check::{check, CheckOptions, Toolpath};
+//! use kerf_check::{check, CheckOptions, RawToolpath};
 //!
 //! let curves = kerf_format::curves::from_str(
 //!     r#"{"format": "kerf.curves/1", "units": "mm", "curves": [{"id": "arc", "degree": 2,
@@ -25,25 +25,29 @@
 //!     std::path::Path::new("."),
 //! )?;
 //! // Two points only: the chord misses the arc's apex (5 mm away) by far.
-//! let toolpath = Toolpath::from_slice(
+//! let toolpath = RawToolpath::from_slice(
 //!     br#"{"format": "kerf.toolpath/1", "units": "mm", "tolerance": 0.01, "paths": [
 //!         {"id": "arc", "params": [0, 1], "points": [[0, 0, 0], [20, 0, 0]], "max_chord_error": 0}]}"#,
 //! )?;
 //! let report = check(&curves.curves, &toolpath, &CheckOptions::default());
 //! assert!(!report.passed(), "one segment cannot follow the arc");
-//! assert!((report.paths[0].max_chord_error - 5.0).abs() < 1e-12, "the apex is 5 mm off the chord");
+//! assert!((report.paths[0].measured_chord_error - 5.0).abs() < 1e-12, "the apex is 5 mm off the chord");
 //! for v in &report.violations {
 //!     println!("{v}"); // paths[0] ("arc"): segment 0 (t 0 .. 1): chord error 5.000000e0 mm > ...
 //! }
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod check;
-pub mod error;
-pub mod input;
-pub mod measure;
+mod check;
+mod error;
+mod input;
+mod measure;
 
-pub use check::{check, CheckOptions, Defect, PathReport, Report, Violation, WorstSegment};
+pub use check::{
+    check, CheckOptions, Defect, PathReport, Report, Violation, WorstSegment, ROUNDING_ALLOWANCE,
+};
 pub use error::{CheckError, Result};
-pub use input::{PathRecord, Toolpath};
-pub use measure::{distance_to_segment, segment_chord_error, SegmentError};
+pub use input::{RawPathRecord, RawToolpath};
+/// The point-to-segment distance of the checker's dense sampling (the one implementation, in `kerf-nurbs`).
+pub use kerf_nurbs::distance_to_segment;
+pub use measure::{segment_chord_error, SegmentError};

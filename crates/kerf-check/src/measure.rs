@@ -17,7 +17,7 @@
 //! agrees with the true one to about `1e-12` of the curve size; the unit tests compare it
 //! with closed forms (a circle's sagitta).
 
-use kerf_nurbs::NurbsCurve;
+use kerf_nurbs::{distance_to_segment, NurbsCurve};
 use nalgebra::Point3;
 
 /// Golden-section steps: the bracket shrinks by `0.618^60 ~ 3e-13`.
@@ -30,17 +30,6 @@ pub struct SegmentError {
     pub error: f64,
     /// The parameter where it occurs.
     pub at: f64,
-}
-
-/// The distance from `q` to the segment `a b` (to `a` if the segment has zero length).
-pub fn distance_to_segment(q: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    if len2.is_nan() || len2 <= 0.0 {
-        return (q - a).norm();
-    }
-    let s = ((q - a).dot(&ab) / len2).clamp(0.0, 1.0);
-    (q - (a + ab * s)).norm()
 }
 
 /// The chord error of the segment from `p0` (at `t0`) to `p1` (at `t1`) of `curve`, measured
@@ -171,26 +160,6 @@ mod tests {
             Some(vec![1.0, h, 1.0, h, 1.0, h, 1.0, h, 1.0]),
         )
         .unwrap()
-    }
-
-    #[test]
-    fn distance_to_a_segment_clamps_to_its_ends() {
-        let (a, b) = (Point3::new(0.0, 0.0, 0.0), Point3::new(2.0, 0.0, 0.0));
-        assert_eq!(
-            distance_to_segment(&Point3::new(1.0, 3.0, 0.0), &a, &b),
-            3.0,
-            "inside"
-        );
-        assert_eq!(
-            distance_to_segment(&Point3::new(5.0, 4.0, 0.0), &a, &b),
-            5.0,
-            "past b"
-        );
-        assert_eq!(
-            distance_to_segment(&Point3::new(0.0, 1.0, 0.0), &a, &a),
-            1.0,
-            "degenerate"
-        );
     }
 
     #[test]

@@ -14,6 +14,7 @@
 use std::path::Path;
 
 use kerf_kinematics::{Axes, AxesFile, Machine};
+use kerf_nurbs::{distance_to_segment as seg_dist, nearest_on_segment};
 use nalgebra::{Point3, Vector3};
 use serde_json::{json, Value};
 
@@ -25,18 +26,6 @@ fn fail(msg: String) -> ! {
 /// One cut: the tips of its poses (axes file), its cutting points (toolpath) and the tool axis
 /// at its start.
 type Cut = (Vec<Point3<f64>>, Vec<Point3<f64>>, Vector3<f64>);
-
-/// Distance from `p` to the segment `a b`.
-fn seg_dist(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    let d = b - a;
-    let l2 = d.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + d * t)).norm()
-}
 
 /// Distance from `p` to the polyline `pts`, over all its segments (exact, no search window).
 fn poly_dist(p: &Point3<f64>, pts: &[Point3<f64>]) -> f64 {
@@ -52,14 +41,7 @@ fn poly_dist(p: &Point3<f64>, pts: &[Point3<f64>]) -> f64 {
 fn nearest_segment(p: &Point3<f64>, pts: &[Point3<f64>]) -> (usize, f64) {
     let mut best = (0, 0.0, f64::INFINITY);
     for (j, w) in pts.windows(2).enumerate() {
-        let d = w[1] - w[0];
-        let l2 = d.norm_squared();
-        let f = if l2 > 0.0 {
-            ((p - w[0]).dot(&d) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let dist = (p - (w[0] + d * f)).norm();
+        let (dist, f) = nearest_on_segment(p, &w[0], &w[1]);
         if dist < best.2 {
             best = (j, f, dist);
         }

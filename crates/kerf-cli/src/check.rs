@@ -7,7 +7,7 @@ use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use kerf_check::{check, CheckOptions, Report, Toolpath, Violation};
+use kerf_check::{check, CheckOptions, RawToolpath, Report, Violation};
 
 use crate::error::CliError;
 
@@ -55,9 +55,9 @@ pub(crate) fn run(args: &CheckArgs) -> Result<(), CliError> {
                 error,
             },
         )?;
-        Toolpath::from_slice(&bytes).map_err(|e| e.in_file("<stdin>"))?
+        RawToolpath::from_slice(&bytes).map_err(|e| e.in_file("<stdin>"))?
     } else {
-        Toolpath::load(&args.toolpath)?
+        RawToolpath::load(&args.toolpath)?
     };
     let defaults = CheckOptions::default();
     let opts = CheckOptions {
@@ -139,7 +139,7 @@ fn print_text(out: &mut impl Write, args: &CheckArgs, report: &Report) -> io::Re
             (None, _) => "missing".to_owned(),
         };
         let error = if p.measured {
-            format!("{:.4e} mm", p.max_chord_error)
+            format!("{:.4e} mm", p.measured_chord_error)
         } else {
             "not measured".to_owned()
         };
@@ -155,7 +155,7 @@ fn print_text(out: &mut impl Write, args: &CheckArgs, report: &Report) -> io::Re
             "passed: every segment's chord error <= {} mm (largest measured {:.4e} mm), every \
              point on its curve at its param, every C0 corner a cutting point, every claim holds",
             report.tolerance,
-            report.max_chord_error()
+            report.measured_chord_error()
         )?;
         return Ok(());
     }

@@ -351,7 +351,7 @@ pub(crate) struct GcodeArgs {
 
     /// The controller's blending tolerance, mm: a term of the tolerance budget (LinuxCNC
     /// `G64 P`, Sinumerik `CTOL`/`OTOL`).
-    #[arg(long, default_value_t = kerf_interp::output::DEFAULT_BLEND_TOLERANCE, value_name = "MM")]
+    #[arg(long, default_value_t = kerf_interp::DEFAULT_BLEND_TOLERANCE, value_name = "MM")]
     pub(crate) blend_tolerance: f64,
 
     /// Print the summary as one JSON object.
@@ -421,7 +421,7 @@ pub(crate) struct RunArgs {
 
     /// The controller's blending tolerance, mm: a term of the tolerance budget (LinuxCNC
     /// `G64 P`, Sinumerik `CTOL`/`OTOL`).
-    #[arg(long, default_value_t = kerf_interp::output::DEFAULT_BLEND_TOLERANCE, value_name = "MM")]
+    #[arg(long, default_value_t = kerf_interp::DEFAULT_BLEND_TOLERANCE, value_name = "MM")]
     pub(crate) blend_tolerance: f64,
 
     /// Longest chord allowed, in mm.

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use kerf_format::{curves, toolpath, ToolPath, ToolPathPoints, ToolpathFile};
+use kerf_format::{curves, toolpath, ToolpathFile, ToolpathPoints, ToolpathRecord};
 use kerf_kinematics::{AxesFile, Machine};
 use kerf_plot::{render, write_svg, AxesChart, Scene, SceneOptions};
 
@@ -59,7 +59,7 @@ pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
         // params out of order, ...) is still drawn if it has a usable shape: the picture is
         // how one looks at what is wrong.
         Err(strict) => {
-            let loose = kerf_check::Toolpath::load(&args.toolpath).ok();
+            let loose = kerf_check::RawToolpath::load(&args.toolpath).ok();
             match loose.as_ref().and_then(drawable) {
                 Some(tp) => {
                     eprintln!(
@@ -126,7 +126,7 @@ pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
 
 /// A toolpath read leniently, as a [`ToolpathFile`] for drawing, if its points are all 3 or all
 /// 6 numbers and its tolerance is positive.
-fn drawable(loose: &kerf_check::Toolpath) -> Option<ToolpathFile> {
+fn drawable(loose: &kerf_check::RawToolpath) -> Option<ToolpathFile> {
     if !(loose.tolerance.is_finite() && loose.tolerance > 0.0) {
         return None;
     }
@@ -135,9 +135,9 @@ fn drawable(loose: &kerf_check::Toolpath) -> Option<ToolpathFile> {
         .iter()
         .map(|p| {
             let points = if p.points.iter().all(|q| q.len() == 3) {
-                ToolPathPoints::Positions(p.points.iter().map(|q| [q[0], q[1], q[2]]).collect())
+                ToolpathPoints::Positions(p.points.iter().map(|q| [q[0], q[1], q[2]]).collect())
             } else if p.points.iter().all(|q| q.len() == 6) {
-                ToolPathPoints::Poses(
+                ToolpathPoints::Poses(
                     p.points
                         .iter()
                         .map(|q| [q[0], q[1], q[2], q[3], q[4], q[5]])
@@ -146,11 +146,11 @@ fn drawable(loose: &kerf_check::Toolpath) -> Option<ToolpathFile> {
             } else {
                 return None;
             };
-            Some(ToolPath {
+            Some(ToolpathRecord {
                 id: p.id.clone(),
                 params: p.params.clone(),
                 points,
-                max_chord_error: p.max_chord_error.unwrap_or(0.0),
+                max_chord_error: p.claimed_chord_error.unwrap_or(0.0),
             })
         })
         .collect::<Option<Vec<_>>>()?;

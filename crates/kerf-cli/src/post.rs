@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use kerf_format::toolpath::{self, ToolPathPoints};
+use kerf_format::toolpath::{self, ToolpathPoints};
 use kerf_kinematics::{solve_paths, AxesFile, Machine, PathInput, PathOptions, Pose};
 use serde_json::json;
 
@@ -18,8 +18,8 @@ pub(crate) fn options(args: &PostArgs) -> PathOptions {
         linearization_tolerance: args
             .linearization_tolerance
             .unwrap_or(d.linearization_tolerance),
-        max_rotary_step: args.max_rotary_step.unwrap_or(d.max_rotary_step),
-        pole_tolerance: args.pole_tolerance.unwrap_or(d.pole_tolerance),
+        max_rotary_step_deg: args.max_rotary_step.unwrap_or(d.max_rotary_step_deg),
+        pole_tolerance_rad: args.pole_tolerance.unwrap_or(d.pole_tolerance_rad),
         ..d
     }
 }
@@ -37,10 +37,10 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
     let mut poses = Vec::with_capacity(tp.paths.len());
     for (i, p) in tp.paths.iter().enumerate() {
         match &p.points {
-            ToolPathPoints::Poses(v) => {
+            ToolpathPoints::Poses(v) => {
                 poses.push(v.iter().copied().map(Pose::from_array).collect::<Vec<_>>())
             }
-            ToolPathPoints::Positions(_) => {
+            ToolpathPoints::Positions(_) => {
                 return Err(CliError::Input(format!(
                 "{}: paths[{i}] ({:?}): points have no normals; run `kerf discretize --normals` \
                      on curves that name their surface",

@@ -10,7 +10,7 @@ use kerf_discretize::{discretize, minimum_count, Options};
 use kerf_nurbs::NurbsCurve;
 
 fn smooth_curves(degree: usize, count: usize, seed: u64) -> Vec<NurbsCurve> {
-    kerf_nurbs::samples::smooth_random_curves(degree, count, seed)
+    kerf_nurbs::smooth_random_curves(degree, count, seed)
 }
 
 fn main() {

@@ -31,17 +31,6 @@ impl Bound {
     }
 }
 
-/// Distance from `q` to the segment `[a, b]` (to the point `a` when `a == b`).
-#[inline]
-pub fn dist_to_segment(q: &Point3<f64>, a: &Point3<f64>, ab: &Vector3<f64>, ab2: f64) -> f64 {
-    let aq = q - a;
-    if ab2 == 0.0 {
-        return aq.norm();
-    }
-    let s = (aq.dot(ab) / ab2).clamp(0.0, 1.0);
-    (aq - ab * s).norm()
-}
-
 /// Reusable work space of [`Certifier::chord_error`], so that a walk along a curve allocates once.
 /// Pieces are kept in arrays sized for the degree (4, 8 or `MAX_ORDER` control points), so a
 /// cubic's piece is 128 bytes to copy, not 800.
@@ -114,7 +103,7 @@ impl Chord {
     #[inline]
     fn dist(&self, q: &Point3<f64>) -> f64 {
         if self.inv_ab2 == 0.0 {
-            return dist_to_segment(q, &self.a, &self.ab, self.ab2);
+            return kerf_nurbs::distance_to_segment(q, &self.a, &(self.a + self.ab));
         }
         let aq = q - self.a;
         let s = (aq.dot(&self.ab) * self.inv_ab2).clamp(0.0, 1.0);

@@ -27,17 +27,21 @@
 //! # Ok::<(), kerf_discretize::DiscretizeError>(())
 //! ```
 
-pub mod bound;
+mod bound;
 mod classic;
-pub mod error;
-pub mod minimum;
-pub mod options;
+mod error;
+mod minimum;
+mod options;
 mod sphere;
 mod walk;
 
-pub use bound::{chord_error, Bound, Certifier};
+pub use bound::{chord_error, Bound, Certifier, Scratch, MARGIN_FACTOR, MAX_SUBDIVISION_DEPTH};
 pub use error::{DiscretizeError, Result};
-pub use minimum::{estimate_count, minimum_count, minimum_count_quadrature};
+pub use minimum::{
+    estimate_count, estimate_turning, minimum_count, minimum_count_quadrature,
+    sqrt_curvature_integral, sqrt_curvature_quadrature, NSTAR_ABSOLUTE_ACCURACY,
+    NSTAR_RELATIVE_ACCURACY, NSTAR_SPLITS_PER_SPAN,
+};
 pub use options::{Options, Strategy};
 
 use kerf_nurbs::NurbsCurve;
@@ -280,7 +284,7 @@ pub fn piece_ends(curve: &NurbsCurve, tolerance: f64) -> Result<Vec<f64>> {
     let breaks = curve.c0_breaks();
     let p = curve.degree();
     for &u in &breaks {
-        if kerf_nurbs::knots::multiplicity(curve.knots(), u) > p {
+        if kerf_nurbs::multiplicity(curve.knots(), u) > p {
             let span = curve.span(u);
             // The span ending at u, to its left.
             let left_span = (p..span)

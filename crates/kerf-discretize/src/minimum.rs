@@ -5,8 +5,8 @@
 //! length is `sqrt(k / (8 tol))`. Integrating along the curve gives the asymptotic minimum
 //! (`docs/discretization.md` derives it).
 
-use kerf_nurbs::arclength::integrate;
-use kerf_nurbs::curve::curvature_of;
+use kerf_nurbs::curvature_of;
+use kerf_nurbs::integrate;
 use kerf_nurbs::{NurbsCurve, Quadrature};
 
 fn integrand(curve: &NurbsCurve, t: f64) -> f64 {

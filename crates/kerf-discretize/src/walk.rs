@@ -1,7 +1,7 @@
 //! The reference-sphere walk of paper 004 (and the parameter-bisection walk of the classic
 //! "equal error" method), with every accepted segment certified by [`crate::bound`].
 
-use kerf_nurbs::curve::curvature_of;
+use kerf_nurbs::curvature_of;
 use kerf_nurbs::NurbsCurve;
 use nalgebra::Point3;
 

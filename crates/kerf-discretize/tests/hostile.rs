@@ -11,9 +11,9 @@ use common::{brute_chord_error, check, seg_dist};
 use kerf_discretize::{
     discretize, minimum_count_quadrature, Discretization, DiscretizeError, Options, Strategy,
 };
-use kerf_nurbs::arclength::SPLITS_PER_SPAN;
-use kerf_nurbs::work::counted;
+use kerf_nurbs::counted;
 use kerf_nurbs::NurbsCurve;
+use kerf_nurbs::SPLITS_PER_SPAN;
 
 fn fixture(name: &str) -> Vec<(String, NurbsCurve)> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -79,7 +79,7 @@ fn certified_within_budget(name: &str, tol: f64) {
         let (q, work) = counted(|| minimum_count_quadrature(&c, tol));
         let work = work.expect("counted");
         assert!(
-            work <= (30 + 40 * kerf_discretize::minimum::NSTAR_SPLITS_PER_SPAN as u64) * spans(&c),
+            work <= (30 + 40 * kerf_discretize::NSTAR_SPLITS_PER_SPAN as u64) * spans(&c),
             "{name} {id}: N* took {work} evaluations"
         );
         assert!(

@@ -8,7 +8,7 @@ use kerf_nurbs::NurbsCurve;
 
 /// Smooth random curves: clamped, uniform simple knots, unit weights, seeded.
 fn smooth_curves(degree: usize, count: usize, seed: u64) -> Vec<NurbsCurve> {
-    kerf_nurbs::samples::smooth_random_curves(degree, count, seed)
+    kerf_nurbs::smooth_random_curves(degree, count, seed)
 }
 
 #[test]

@@ -8,7 +8,7 @@
 //!    reported as `curves[0].knots[3]: invalid JSON at line 5, column 31: number out of range`;
 //! 2. check `format` and `units` before anything else, so that a toolpath handed to the curves
 //!    reader says so instead of complaining about a missing `curves` key;
-//! 3. deserialize the typed structs through `serde_path_to_error`, so that a control point with
+//! 3. deserialize the typed structs through [`kerf_io::deserialize_at`], so that a control point with
 //!    two coordinates is reported as `curves[0].control_points[2]: invalid length 2, ...`.
 //!
 //! Step 1 is [`kerf_io::parse_json`], the front end every kerf reader shares: a byte-order mark
@@ -54,10 +54,7 @@ pub(crate) fn parse_document(bytes: &[u8], expected: &'static str) -> Result<Map
         },
         JsonError::DuplicateKey { path, line } => FormatError::Shape {
             path,
-            message: format!(
-                "key given twice in one object (line {line}); readers disagree on which one \
-                 counts, so remove one of them"
-            ),
+            message: kerf_io::duplicate_key_message(line),
         },
     })?;
     let Value::Object(map) = value else {
@@ -99,48 +96,10 @@ pub(crate) fn check_header(format: &str, units: &str, expected: &'static str) ->
 }
 
 /// Deserializes `value` into `T`; errors carry the JSON path, starting with `prefix` (the path
-/// of `value` itself in the document, empty for the top level).
+/// of `value` itself in the document, empty for the top level): [`kerf_io::deserialize_at`].
 pub(crate) fn deserialize<T: DeserializeOwned>(value: Value, prefix: &str) -> Result<T> {
-    serde_path_to_error::deserialize(value).map_err(|e| {
-        let inner = e.path().to_string();
-        let mut path = if inner == "." {
-            prefix.to_owned()
-        } else if prefix.is_empty() {
-            inner
-        } else if inner.starts_with('[') {
-            format!("{prefix}{inner}")
-        } else {
-            format!("{prefix}.{inner}")
-        };
-        let mut message = tidy_message(&e.into_inner().to_string());
-        // "curves[0]: missing field `knots`" reads better as "curves[0].knots: missing".
-        if let Some(field) = message
-            .strip_prefix("missing field `")
-            .and_then(|rest| rest.strip_suffix('`'))
-        {
-            path = if path.is_empty() {
-                field.to_owned()
-            } else {
-                format!("{path}.{field}")
-            };
-            message = "required key is missing".to_owned();
-        }
-        if path.is_empty() {
-            path = "top level".to_owned();
-        }
-        FormatError::Shape { path, message }
-    })
-}
-
-/// Replaces Rust type names in serde's messages with words a user of the format knows.
-fn tidy_message(message: &str) -> String {
-    message
-        .replace("expected usize", "expected a non-negative integer")
-        .replace("expected u32", "expected a non-negative integer")
-        .replace("expected f64", "expected a number")
-        .replace("a sequence", "an array")
-        .replace("invalid type: map", "invalid type: object")
-        .replace("invalid type: sequence", "invalid type: array")
+    kerf_io::deserialize_at(value, prefix)
+        .map_err(|kerf_io::ShapeError { path, message }| FormatError::Shape { path, message })
 }
 
 #[cfg(test)]

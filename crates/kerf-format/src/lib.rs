@@ -34,7 +34,7 @@ pub use curves::{
     CurveRecord, CurvesFile, SurfaceGeometry, SurfaceRecord, SurfaceRef, SurfaceSource,
 };
 pub use error::{FormatError, MeshDefect, Result, StlProblem};
-pub use toolpath::{ToolPath, ToolPathPoints, ToolpathFile};
+pub use toolpath::{ToolpathFile, ToolpathPoints, ToolpathRecord};
 
 /// The `format` string of curve files.
 pub const CURVES_FORMAT: &str = "kerf.curves/1";

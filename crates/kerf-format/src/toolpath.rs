@@ -11,15 +11,15 @@
 //! half-written toolpath behind.
 //!
 //! ```
-//! use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
+//! use kerf_format::toolpath::{self, ToolpathRecord, ToolpathPoints, ToolpathFile};
 //!
 //! let file = ToolpathFile {
 //!     units: kerf_format::Units::Millimetres,
 //!     tolerance: 0.01,
-//!     paths: vec![ToolPath {
+//!     paths: vec![ToolpathRecord {
 //!         id: "line".into(),
 //!         params: vec![0.0, 1.0],
-//!         points: ToolPathPoints::Positions(vec![[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]]),
+//!         points: ToolpathPoints::Positions(vec![[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]]),
 //!         max_chord_error: 0.0,
 //!     }],
 //! };
@@ -51,19 +51,19 @@ pub struct ToolpathFile {
     /// The chord tolerance the points were computed for, in mm; > 0.
     pub tolerance: f64,
     /// One path per input curve, same ids, same order.
-    pub paths: Vec<ToolPath>,
+    pub paths: Vec<ToolpathRecord>,
 }
 
 /// The cutting points of one curve.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ToolPath {
+pub struct ToolpathRecord {
     /// The id of the curve.
     pub id: String,
     /// `params[n]` is the curve parameter of point `n`; strictly increasing, first and last
     /// the ends of the curve's domain.
     pub params: Vec<f64>,
     /// The points, with or without normals.
-    pub points: ToolPathPoints,
+    pub points: ToolpathPoints,
     /// The largest distance, over every segment, from the curve to the chord; <= the file's
     /// tolerance.
     pub max_chord_error: f64,
@@ -71,19 +71,19 @@ pub struct ToolPath {
 
 /// The points of a toolpath: all positions, or all positions with unit normals.
 #[derive(Debug, Clone, PartialEq)]
-pub enum ToolPathPoints {
+pub enum ToolpathPoints {
     /// `[x, y, z]`.
     Positions(Vec<[f64; 3]>),
     /// `[x, y, z, i, j, k]`, `(i, j, k)` the unit normal (tool axis).
     Poses(Vec<[f64; 6]>),
 }
 
-impl ToolPathPoints {
+impl ToolpathPoints {
     /// The number of points.
     pub fn len(&self) -> usize {
         match self {
-            ToolPathPoints::Positions(p) => p.len(),
-            ToolPathPoints::Poses(p) => p.len(),
+            ToolpathPoints::Positions(p) => p.len(),
+            ToolpathPoints::Poses(p) => p.len(),
         }
     }
 
@@ -94,7 +94,7 @@ impl ToolPathPoints {
 
     /// True if the points carry normals.
     pub fn has_normals(&self) -> bool {
-        matches!(self, ToolPathPoints::Poses(_))
+        matches!(self, ToolpathPoints::Poses(_))
     }
 
     /// The position of point `n`.
@@ -103,8 +103,8 @@ impl ToolPathPoints {
     /// If `n >= self.len()`.
     pub fn position(&self, n: usize) -> Point3<f64> {
         match self {
-            ToolPathPoints::Positions(p) => Point3::from(p[n]),
-            ToolPathPoints::Poses(p) => Point3::new(p[n][0], p[n][1], p[n][2]),
+            ToolpathPoints::Positions(p) => Point3::from(p[n]),
+            ToolpathPoints::Poses(p) => Point3::new(p[n][0], p[n][1], p[n][2]),
         }
     }
 
@@ -114,16 +114,16 @@ impl ToolPathPoints {
     /// If `n >= self.len()`.
     pub fn normal(&self, n: usize) -> Option<Vector3<f64>> {
         match self {
-            ToolPathPoints::Positions(_) => None,
-            ToolPathPoints::Poses(p) => Some(Vector3::new(p[n][3], p[n][4], p[n][5])),
+            ToolpathPoints::Positions(_) => None,
+            ToolpathPoints::Poses(p) => Some(Vector3::new(p[n][3], p[n][4], p[n][5])),
         }
     }
 
     /// Each point as a slice of 3 or 6 numbers, as written in the file.
     pub fn iter(&self) -> Box<dyn Iterator<Item = &[f64]> + '_> {
         match self {
-            ToolPathPoints::Positions(p) => Box::new(p.iter().map(|q| q.as_slice())),
-            ToolPathPoints::Poses(p) => Box::new(p.iter().map(|q| q.as_slice())),
+            ToolpathPoints::Positions(p) => Box::new(p.iter().map(|q| q.as_slice())),
+            ToolpathPoints::Poses(p) => Box::new(p.iter().map(|q| q.as_slice())),
         }
     }
 }
@@ -153,7 +153,7 @@ impl ToolpathFile {
     }
 }
 
-fn validate_path(index: usize, path: &ToolPath, tolerance: f64) -> Result<()> {
+fn validate_path(index: usize, path: &ToolpathRecord, tolerance: f64) -> Result<()> {
     let (n, m) = (path.points.len(), path.params.len());
     if n != m {
         return Err(FormatError::PathCount {
@@ -289,7 +289,7 @@ fn write_json(file: &ToolpathFile, w: &mut impl Write) -> io::Result<()> {
     writeln!(w, "}}")
 }
 
-fn write_path(path: &ToolPath, w: &mut impl Write) -> io::Result<()> {
+fn write_path(path: &ToolpathRecord, w: &mut impl Write) -> io::Result<()> {
     writeln!(w, "    {{")?;
     write!(w, "      \"id\": ")?;
     serde_json::to_writer(&mut *w, &path.id)?;
@@ -396,7 +396,7 @@ fn from_slice(bytes: &[u8]) -> Result<ToolpathFile> {
                 });
             }
         }
-        paths.push(ToolPath {
+        paths.push(ToolpathRecord {
             points: points_from_rows(index, p.points)?,
             id: p.id,
             params: p.params,
@@ -412,8 +412,8 @@ fn from_slice(bytes: &[u8]) -> Result<ToolpathFile> {
     Ok(file)
 }
 
-/// Turns the rows of `points` into [`ToolPathPoints`], checking their lengths.
-fn points_from_rows(index: usize, rows: Vec<Vec<f64>>) -> Result<ToolPathPoints> {
+/// Turns the rows of `points` into [`ToolpathPoints`], checking their lengths.
+fn points_from_rows(index: usize, rows: Vec<Vec<f64>>) -> Result<ToolpathPoints> {
     let first = rows.first().map_or(3, Vec::len);
     let bad_length = |i: usize, got: usize| FormatError::PointLength {
         path: format!("paths[{index}].points[{i}]"),
@@ -426,13 +426,13 @@ fn points_from_rows(index: usize, rows: Vec<Vec<f64>>) -> Result<ToolPathPoints>
             .enumerate()
             .map(|(i, r)| <[f64; 3]>::try_from(r).map_err(|r| bad_length(i, r.len())))
             .collect::<Result<_>>()
-            .map(ToolPathPoints::Positions),
+            .map(ToolpathPoints::Positions),
         6 => rows
             .into_iter()
             .enumerate()
             .map(|(i, r)| <[f64; 6]>::try_from(r).map_err(|r| bad_length(i, r.len())))
             .collect::<Result<_>>()
-            .map(ToolPathPoints::Poses),
+            .map(ToolpathPoints::Poses),
         got => Err(bad_length(0, got)),
     }
 }
@@ -463,10 +463,10 @@ mod tests {
             units: Units::Millimetres,
             tolerance: 0.001,
             paths: vec![
-                ToolPath {
+                ToolpathRecord {
                     id: "arc \"1\"".into(),
                     params: (0..=9).map(|i| f64::from(i) / 9.0).collect(),
-                    points: ToolPathPoints::Poses(
+                    points: ToolpathPoints::Poses(
                         (0..=9)
                             .map(|i| {
                                 let a = f64::from(i) * 0.1;
@@ -476,10 +476,10 @@ mod tests {
                     ),
                     max_chord_error: 0.00097,
                 },
-                ToolPath {
+                ToolpathRecord {
                     id: "line".into(),
                     params: vec![-1.0, 2.5],
-                    points: ToolPathPoints::Positions(vec![[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]),
+                    points: ToolpathPoints::Positions(vec![[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]),
                     max_chord_error: 0.0,
                 },
             ],
@@ -552,7 +552,7 @@ mod tests {
     #[test]
     fn the_writer_refuses_what_the_reader_would() {
         let mut f = sample();
-        f.paths[1].points = ToolPathPoints::Positions(vec![[0.0, f64::NAN, 0.0], [1.0, 2.0, 3.0]]);
+        f.paths[1].points = ToolpathPoints::Positions(vec![[0.0, f64::NAN, 0.0], [1.0, 2.0, 3.0]]);
         assert_eq!(
             to_string(&f).expect_err("NaN").to_string(),
             "paths[1].points[0][1]: must be finite (got NaN)",

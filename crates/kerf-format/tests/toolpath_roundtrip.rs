@@ -1,6 +1,6 @@
 //! Property: any valid toolpath, written and read back, is bit-for-bit the same.
 
-use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
+use kerf_format::toolpath::{self, ToolpathFile, ToolpathPoints, ToolpathRecord};
 use kerf_format::Units;
 use proptest::prelude::*;
 
@@ -12,7 +12,7 @@ fn finite() -> impl Strategy<Value = f64> {
     ]
 }
 
-fn path(index: usize, normals: bool) -> impl Strategy<Value = ToolPath> {
+fn path(index: usize, normals: bool) -> impl Strategy<Value = ToolpathRecord> {
     (2usize..40)
         .prop_flat_map(move |n| {
             (
@@ -38,11 +38,11 @@ fn path(index: usize, normals: bool) -> impl Strategy<Value = ToolPath> {
                     }
                     poses.push([p[0], p[1], p[2], d[0] / norm, d[1] / norm, d[2] / norm]);
                 }
-                ToolPathPoints::Poses(poses)
+                ToolpathPoints::Poses(poses)
             } else {
-                ToolPathPoints::Positions(xyz[..n].to_vec())
+                ToolpathPoints::Positions(xyz[..n].to_vec())
             };
-            Some(ToolPath {
+            Some(ToolpathRecord {
                 id: format!("path-{index}"),
                 params,
                 points,

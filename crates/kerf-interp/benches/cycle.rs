@@ -9,17 +9,17 @@
 //!   and Reinsch form), and of forward differences of a cubic, for comparison.
 //!
 //! Throughput is in cycles, so criterion reports the time per cycle.
-//! Run: `cargo bench -p kerf-interp --bench cycle -- --warm-up-time 1 --measurement-time 2`
+//! Run: `cargo bench -p kerf-interp --features research --bench cycle -- --warm-up-time 1 --measurement-time 2`
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use kerf_interp::recursive::{CubicHermite, NewBasisSegment, Recurrence};
-use kerf_interp::{fit_blocks, plan, solve_stations, AcHead, FitOptions, PlanOptions};
+use kerf_interp::{fit_blocks, plan, solve_stations, FitOptions, PaperAcHead, PlanOptions};
+use kerf_interp::{CubicHermite, NewBasisSegment, Recurrence};
 use nalgebra::{Point3, Vector3};
 
 fn program(c: &mut Criterion) {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     // A 3D wave with a varying tool axis: 2001 cutting points over about 400 mm.
     let tips: Vec<Point3<f64>> = (0..=2000)
         .map(|i| {

@@ -4,7 +4,9 @@
 //! Run: `cargo run --release -p kerf-interp --example program`
 
 use kerf_discretize::{discretize, Options};
-use kerf_interp::{fit_blocks, plan, solve_stations, AcHead, BlockCounts, FitOptions, PlanOptions};
+use kerf_interp::{
+    fit_blocks, plan, solve_stations, BlockCounts, FitOptions, PaperAcHead, PlanOptions,
+};
 use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3};
 
@@ -56,7 +58,7 @@ fn freeform() -> NurbsCurve {
 type AxisOf = fn(&Point3<f64>) -> Vector3<f64>;
 
 fn main() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let up: AxisOf = |_| Vector3::z();
     let tilted: AxisOf =
         |p| Vector3::new(0.4 * (p.x / 40.0).sin(), 0.3 * (p.y / 25.0).cos(), 1.0).normalize();

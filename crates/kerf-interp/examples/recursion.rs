@@ -8,7 +8,7 @@
 //!
 //! Run: `cargo run --release -p kerf-interp --example recursion`
 
-use kerf_interp::recursive::{max_deviation, CubicHermite, NewBasisSegment, Recurrence};
+use kerf_interp::{max_deviation, CubicHermite, NewBasisSegment, Recurrence};
 
 /// A small deterministic generator (64-bit LCG, top 53 bits).
 struct Lcg(u64);

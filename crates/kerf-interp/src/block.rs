@@ -4,7 +4,7 @@
 use nalgebra::{Point3, Vector3};
 
 use crate::error::{positive, InterpError, Result};
-use crate::geometry::Arc;
+use crate::geometry::SpaceArc;
 use crate::model::AxisModel;
 
 /// Below this tip travel (mm) a block is a pure rotation ([`Geometry::Turn`]).
@@ -98,7 +98,7 @@ pub enum Geometry {
         end: Point3<f64>,
     },
     /// Space arc through three points (paper 000 eq 5-12).
-    Arc(Arc),
+    Arc(SpaceArc),
     /// The tip stands still while the rotary axes turn (two poses at the same point). The
     /// block's path parameter is then the larger rotary travel in degrees.
     Turn {
@@ -176,9 +176,9 @@ impl Block {
     /// `a -> m -> b`.
     ///
     /// # Errors
-    /// [`InterpError::CollinearArc`] as [`Arc::through`].
+    /// [`InterpError::CollinearArc`] as [`SpaceArc::through`].
     pub fn arc(a: &Station, m: &Station, b: &Station) -> Result<Self> {
-        let arc = Arc::through(a.tip, m.tip, b.tip)?;
+        let arc = SpaceArc::through(a.tip, m.tip, b.tip)?;
         let mut block = Self::line(a, b);
         block.geometry = Geometry::Arc(arc);
         block.mid_axes = m.axes;

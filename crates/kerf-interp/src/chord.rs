@@ -35,7 +35,8 @@ pub fn max_feed(radius: f64, delta: f64, cycle: f64) -> f64 {
 
 /// Paper 000 eq 19 with its unit slip corrected: `sqrt(225000 (2 R - 0.001))` mm/min, the
 /// feed limit for `T = 8 ms`, `delta = 1 um`, `R` in mm. Equal to
-/// `max_feed(radius, 0.001, 0.008)`.
+/// `max_feed(radius, 0.001, 0.008)`. Research code (feature `research`).
+#[cfg(feature = "research")]
 pub fn paper_eq19(radius: f64) -> f64 {
     (225000.0 * (2.0 * radius - 0.001)).sqrt()
 }

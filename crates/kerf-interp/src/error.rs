@@ -27,7 +27,7 @@ pub enum InterpError {
     },
     /// The three points of a space arc are collinear or two of them coincide, so no circle
     /// passes through them. [`crate::Block::arc_or_line`] falls back to a line instead; fix for
-    /// [`crate::Arc::through`]: give three distinct, non-collinear points.
+    /// [`crate::SpaceArc::through`]: give three distinct, non-collinear points.
     #[error("arc points are collinear or coincide (|P1P2 x P2P3| = {cross:e} mm^2)")]
     CollinearArc {
         /// Norm of the cross product of the two chords.

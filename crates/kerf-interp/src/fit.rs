@@ -10,7 +10,7 @@
 //! - every point in between lies within `tolerance` of the block and the points follow each
 //!   other along it (no back-tracking);
 //! - the tool axis interpolated at each point (rotary axes in proportion to the distance, or
-//!   to the swept angle piecewise `i -> m -> j` on arcs) is within `orientation_tolerance` of
+//!   to the swept angle piecewise `i -> m -> j` on arcs) is within `orientation_tolerance_deg` of
 //!   the point's own tool axis;
 //! - **the curve**: where the curve is known (a closure giving the curve point at a parameter,
 //!   and both neighbouring points carry their parameters), `curve_samples` points of the curve
@@ -29,8 +29,9 @@ use nalgebra::Point3;
 
 use crate::block::{Block, Station, MIN_TRAVEL};
 use crate::error::{positive, InterpError, Result};
-use crate::geometry::{segment_distance, Arc};
+use crate::geometry::SpaceArc;
 use crate::model::AxisModel;
+use kerf_nurbs::nearest_on_segment;
 
 /// Options of [`fit_blocks`].
 #[derive(Debug, Clone, PartialEq)]
@@ -40,16 +41,16 @@ pub struct FitOptions {
     pub tolerance: f64,
     /// Largest angle (degrees) between the interpolated and the given tool axis at a point.
     /// Default 0.1.
-    pub orientation_tolerance: f64,
+    pub orientation_tolerance_deg: f64,
     /// Fit arcs (default true); false gives lines only (still merged when collinear).
     pub arcs: bool,
     /// Merge runs of collinear points into one line (default true).
     pub merge_lines: bool,
     /// Most cutting points one block may span (bounds the fitting cost). Default 1024.
     pub max_points: usize,
-    /// Largest swept angle of an arc, radians. Default 1.5 pi (a three-point arc cannot make a
-    /// full turn; G-code `CIP` needs less than 2 pi).
-    pub max_sweep: f64,
+    /// Largest swept angle of an arc, degrees. Default 270 (a three-point arc cannot make a
+    /// full turn; G-code `CIP` needs less than 360).
+    pub max_sweep_deg: f64,
     /// Largest arc radius, mm; flatter runs are lines. Default 1e5.
     pub max_radius: f64,
     /// Curve points tested between two neighbouring cutting points when the curve is known.
@@ -65,11 +66,11 @@ impl Default for FitOptions {
     fn default() -> Self {
         Self {
             tolerance: 0.001,
-            orientation_tolerance: 0.1,
+            orientation_tolerance_deg: 0.1,
             arcs: true,
             merge_lines: true,
             max_points: 1024,
-            max_sweep: 1.5 * std::f64::consts::PI,
+            max_sweep_deg: 270.0,
             max_radius: 1e5,
             curve_samples: 4,
             retract: 10.0,
@@ -88,8 +89,8 @@ impl FitOptions {
 
     fn validate(&self) -> Result<()> {
         positive("tolerance", self.tolerance)?;
-        positive("orientation_tolerance", self.orientation_tolerance)?;
-        positive("max_sweep", self.max_sweep)?;
+        positive("orientation_tolerance_deg", self.orientation_tolerance_deg)?;
+        positive("max_sweep_deg", self.max_sweep_deg)?;
         positive("max_radius", self.max_radius)?;
         Ok(())
     }
@@ -254,7 +255,7 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
     fn orientation_ok(&self, k: usize, tilt: f64, c: f64) -> bool {
         let u = self.model.tool_axis(tilt, c);
         let cos = u.dot(&self.st[k].axis).clamp(-1.0, 1.0);
-        cos.acos().to_degrees() <= self.opts.orientation_tolerance
+        cos.acos().to_degrees() <= self.opts.orientation_tolerance_deg
     }
 
     fn distinct_tips(&self, i: usize, j: usize) -> bool {
@@ -272,7 +273,7 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
         }
         let mut last_t = 0.0;
         for k in i + 1..j {
-            let (d, t) = segment_distance(&self.st[k].tip, &a.tip, &b.tip);
+            let (d, t) = nearest_on_segment(&self.st[k].tip, &a.tip, &b.tip);
             if d > tol || t <= last_t || t >= 1.0 {
                 return false;
             }
@@ -286,7 +287,7 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
         for seg in self.samples[i..j].iter().flatten() {
             if seg
                 .iter()
-                .any(|p| segment_distance(p, &a.tip, &b.tip).0 > tol)
+                .any(|p| nearest_on_segment(p, &a.tip, &b.tip).0 > tol)
             {
                 return false;
             }
@@ -297,10 +298,11 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
     fn arc_fits(&self, i: usize, j: usize) -> bool {
         let m = (i + j) / 2;
         let (a, mid, b) = (&self.st[i], &self.st[m], &self.st[j]);
-        let Ok(arc) = Arc::through(a.tip, mid.tip, b.tip) else {
+        let Ok(arc) = SpaceArc::through(a.tip, mid.tip, b.tip) else {
             return false;
         };
-        if arc.radius > self.opts.max_radius || arc.angle_end > self.opts.max_sweep {
+        if arc.radius > self.opts.max_radius || arc.angle_end.to_degrees() > self.opts.max_sweep_deg
+        {
             return false;
         }
         if !self.distinct_tips(i, j) {

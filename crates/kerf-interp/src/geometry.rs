@@ -12,7 +12,7 @@ use crate::error::{InterpError, Result};
 /// In that frame the arc runs counter-clockwise from angle 0 (at `P1`) through `angle_mid`
 /// (at `P2`) to `angle_end` (at `P3`), all in `(0, 2 pi)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Arc {
+pub struct SpaceArc {
     /// Start point `P1`.
     pub start: Point3<f64>,
     /// Intermediate point `P2`.
@@ -35,7 +35,7 @@ pub struct Arc {
     pub angle_end: f64,
 }
 
-impl Arc {
+impl SpaceArc {
     /// The arc through `p1`, `p2`, `p3`, in that order.
     ///
     /// # Errors
@@ -151,18 +151,6 @@ impl Arc {
     }
 }
 
-/// Distance from `p` to the segment `[a, b]`, and the parameter in `[0, 1]` of the nearest point.
-pub fn segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> (f64, f64) {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    ((p - (a + ab * t)).norm(), t)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -175,7 +163,7 @@ mod tests {
         let a = Vector3::new(1.0, 1.0, 0.0).normalize();
         let b = Vector3::new(-1.0, 1.0, 1.0).normalize();
         let at = |t: f64| c + (a * t.cos() + b * t.sin()) * 5.0;
-        let arc = Arc::through(at(0.2), at(1.0), at(2.5)).expect("arc");
+        let arc = SpaceArc::through(at(0.2), at(1.0), at(2.5)).expect("arc");
         assert_relative_eq!(arc.radius, 5.0, epsilon = 1e-12);
         assert_relative_eq!((arc.centre - c).norm(), 0.0, epsilon = 1e-12);
         assert_relative_eq!(arc.angle_mid, 0.8, epsilon = 1e-12);
@@ -187,7 +175,7 @@ mod tests {
         );
         assert_eq!(arc.point_at_angle(arc.angle_end), at(2.5), "end exact");
         // Reverse direction: e3 flips, angles are the same.
-        let rev = Arc::through(at(2.5), at(1.0), at(0.2)).expect("arc");
+        let rev = SpaceArc::through(at(2.5), at(1.0), at(0.2)).expect("arc");
         assert_relative_eq!(rev.angle_end, 2.3, epsilon = 1e-12);
         assert_relative_eq!(rev.e3.dot(&arc.e3), -1.0, epsilon = 1e-12);
     }
@@ -195,7 +183,7 @@ mod tests {
     #[test]
     fn arc_over_half_a_turn() {
         let at = |t: f64| Point3::new(t.cos(), t.sin(), 0.0);
-        let arc = Arc::through(at(0.0), at(2.0), at(5.0)).expect("arc");
+        let arc = SpaceArc::through(at(0.0), at(2.0), at(5.0)).expect("arc");
         assert_relative_eq!(arc.angle_end, 5.0, epsilon = 1e-12);
         assert_relative_eq!(arc.e3.z, 1.0, epsilon = 1e-12);
         let (d, t) = arc.distance(&Point3::new(2.0 * 4f64.cos(), 2.0 * 4f64.sin(), 0.5));
@@ -207,16 +195,16 @@ mod tests {
     fn collinear_and_coincident_points_are_errors() {
         let p = |x: f64| Point3::new(x, 2.0 * x, 0.0);
         assert!(matches!(
-            Arc::through(p(0.0), p(1.0), p(3.0)),
+            SpaceArc::through(p(0.0), p(1.0), p(3.0)),
             Err(InterpError::CollinearArc { .. })
         ));
         assert!(matches!(
-            Arc::through(p(0.0), p(0.0), p(3.0)),
+            SpaceArc::through(p(0.0), p(0.0), p(3.0)),
             Err(InterpError::CollinearArc { .. })
         ));
         let nan = Point3::new(f64::NAN, 0.0, 0.0);
         assert!(matches!(
-            Arc::through(p(0.0), nan, p(3.0)),
+            SpaceArc::through(p(0.0), nan, p(3.0)),
             Err(InterpError::NonFinite { index: 1 })
         ));
     }

@@ -14,21 +14,22 @@
 //!    machine is at rest), the linear axes from the machine model (eq 16 for paper 000's head,
 //!    [`AxisModel`] in general). [`Block::constant_feed`] keeps paper 000's own interpolation
 //!    of one block (eq 3-12).
-//! 4. [`output`]: the set-points CSV of `formats.md`, generic and Sinumerik-style G-code.
+//! 4. [`write_csv`], [`gcode`]: the set-points CSV of `formats.md`, generic and Sinumerik-style G-code.
 //!
 //! The machine is any [`AxisModel`]: [`MachineModel`] for kerf's `kerf.machine/1` machines
 //! (all four types, from `kerf-kinematics`; [`stations_from_solved`] takes its solved paths),
-//! [`AcHead`] as a small self-contained reference (paper 000's head).
+//! [`PaperAcHead`] as a small self-contained reference (paper 000's head).
 //!
-//! [`Block::constant_feed`] is paper 000's interpolator of one block at constant feed, and
-//! [`recursive`] is paper 001's recursive spline interpolator. The maths, the tolerance budget
+//! [`Block::constant_feed`] is paper 000's interpolator of one block at constant feed. Paper
+//! 001's recursive spline interpolator (`NewBasisSegment`, `spline_setpoints`) and paper 000's
+//! eq 19 (`paper_eq19`) are research code behind the cargo feature `research`. The maths, the tolerance budget
 //! and the measured figures are in `docs/interpolation.md`.
 //!
 //! ```
-//! use kerf_interp::{fit_blocks, plan, solve_stations, AcHead, FitOptions, PlanOptions};
+//! use kerf_interp::{fit_blocks, plan, solve_stations, PaperAcHead, FitOptions, PlanOptions};
 //! use nalgebra::{Point3, Vector3};
 //!
-//! let machine = AcHead::paper_000();
+//! let machine = PaperAcHead::paper_000();
 //! // A half circle of radius 20 mm, tool vertical, 41 cutting points (chord error 0.0154 mm).
 //! let tips: Vec<Point3<f64>> = (0..=40)
 //!     .map(|i| {
@@ -46,34 +47,46 @@
 //! # Ok::<(), kerf_interp::InterpError>(())
 //! ```
 
-pub mod block;
-pub mod chord;
-pub mod error;
-pub mod fit;
-pub mod geometry;
-pub mod machine;
-pub mod model;
-pub mod output;
-pub mod plan;
-pub mod recursive;
+mod block;
+mod chord;
+mod error;
+mod fit;
+mod geometry;
+mod machine;
+mod model;
+mod output;
+mod plan;
+#[cfg(feature = "research")]
+mod recursive;
 pub(crate) mod smooth;
 pub(crate) mod topp;
 
-pub use block::{increments, solve_stations, Block, Geometry, Station};
+pub use block::{increments, solve_stations, Block, Geometry, Station, MIN_TRAVEL};
+#[cfg(feature = "research")]
+pub use chord::paper_eq19;
+pub use chord::{chord_error, max_feed, max_step};
 pub use error::{InterpError, Result};
 pub use fit::{fit_blocks, BlockCounts, CurveFn, FitOptions};
-pub use geometry::Arc;
+pub use geometry::SpaceArc;
 pub use machine::{stations_from_axes, stations_from_solved, MachineModel};
-pub use model::{AcHead, AxisLimits, AxisModel};
+pub use model::{AxisLimits, AxisModel, PaperAcHead};
+pub use output::{comment_text, write_atomic, DEFAULT_BLEND_TOLERANCE, MAX_COMMENT};
 pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_csv_to, write_gcode, Dialect,
     GcodeOptions, ProcessCodes,
 };
 pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PathStats, PlanOptions};
+pub use plan::{ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_STATIC_SHARE};
+#[cfg(feature = "research")]
+pub use recursive::{
+    max_deviation, new_basis_coefficients, spline_setpoints, spline_through, CubicHermite,
+    ForwardDifferences, NewBasisSegment, Recurrence, RecurrenceSteps, OMEGA,
+};
 
-/// One path of a program: its id (the source curve's), its stations and, when known, the
+/// One path of a program (the interpolator's input; `kerf_kinematics::PathInput` is the inverse
+/// solver's): its id (the source curve's), its stations and, when known, the
 /// curve itself.
-pub struct PathInput<'a> {
+pub struct ProgramPath<'a> {
     /// The id of the source curve (written in G-code comments).
     pub id: String,
     /// The cutting points with their machine axes.
@@ -83,9 +96,9 @@ pub struct PathInput<'a> {
     pub curve: Option<CurveFn<'a>>,
 }
 
-impl std::fmt::Debug for PathInput<'_> {
+impl std::fmt::Debug for ProgramPath<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("PathInput")
+        f.debug_struct("ProgramPath")
             .field("id", &self.id)
             .field("stations", &self.stations.len())
             .field("curve", &self.curve.is_some())
@@ -101,7 +114,7 @@ impl std::fmt::Debug for PathInput<'_> {
 /// As [`fit_blocks`].
 pub fn fit_program<M: AxisModel + ?Sized>(
     model: &M,
-    paths: &[PathInput<'_>],
+    paths: &[ProgramPath<'_>],
     opts: &FitOptions,
 ) -> Result<Vec<Block>> {
     let mut all = Vec::with_capacity(paths.len());
@@ -119,7 +132,7 @@ pub fn fit_program<M: AxisModel + ?Sized>(
 /// As [`fit_blocks`] and [`plan()`].
 pub fn interpolate<M: AxisModel + ?Sized>(
     model: &M,
-    paths: &[PathInput<'_>],
+    paths: &[ProgramPath<'_>],
     fit: &FitOptions,
     plan_options: &PlanOptions,
 ) -> Result<Motion> {

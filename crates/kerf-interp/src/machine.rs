@@ -2,7 +2,7 @@
 //! [`Station`]s from kerf-kinematics' solved paths.
 //!
 //! ```
-//! use kerf_interp::{machine::MachineModel, AxisModel};
+//! use kerf_interp::{AxisModel, MachineModel};
 //!
 //! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/machines/ac_head.json");
 //! let model = MachineModel::new(kerf_kinematics::Machine::read(path).unwrap())?;
@@ -11,12 +11,12 @@
 //! # Ok::<(), kerf_interp::InterpError>(())
 //! ```
 
-use kerf_kinematics::{Axes, Machine, Pose, SolvedPath};
+use kerf_kinematics::{nearest_solution, Axes, Machine, Pose, SolvedPath};
 use nalgebra::{Point3, Vector3};
 
 use crate::block::Station;
 use crate::error::{InterpError, Result};
-use crate::model::{nearest_turn, AxisLimits, AxisModel};
+use crate::model::{AxisLimits, AxisModel};
 
 /// A `kerf.machine/1` machine (any of the four kinematic types) as the interpolator sees it.
 #[derive(Debug, Clone)]
@@ -26,7 +26,7 @@ pub struct MachineModel {
     /// A tool axis within this angle (radians) of the C axis is at the pole, where C keeps its
     /// previous value ([`AxisModel::inverse`] only; kerf-kinematics' `solve_path` has its own
     /// option). Default 1e-6, as `formats.md`.
-    pub pole_tolerance: f64,
+    pub pole_tolerance_rad: f64,
     limits: AxisLimits,
 }
 
@@ -44,7 +44,7 @@ impl MachineModel {
         limits.validate()?;
         Ok(Self {
             machine,
-            pole_tolerance: 1e-6,
+            pole_tolerance_rad: 1e-6,
             limits,
         })
     }
@@ -69,9 +69,9 @@ impl AxisModel for MachineModel {
         &self.limits
     }
 
-    /// Both solutions of the kinematics (at the pole: the one keeping the previous C), C
-    /// turned by whole turns to the one nearest the previous C (and its neighbours, for a
-    /// limited C), the least rotary travel within the ranges. kerf-kinematics' `solve_path`
+    /// Both solutions of the kinematics (at the pole: the one keeping the previous C), chosen
+    /// by kerf-kinematics' one rule ([`kerf_kinematics::nearest_solution`]: the turns nearest
+    /// the previous axes, the least rotary travel within the ranges). kerf-kinematics' `solve_path`
     /// does this along a whole path with more care (look-ahead at the ranges, inserted points);
     /// prefer its output with [`stations_from_solved`].
     fn inverse(
@@ -93,30 +93,18 @@ impl AxisModel for MachineModel {
             axis: *axis,
         };
         let (prev_t, prev_c) = previous.map_or((0.0, 0.0), |p| (p[3], p[4]));
-        let candidates: Vec<Axes> = if k.pole_angle(axis) <= self.pole_tolerance {
+        let candidates: Vec<Axes> = if k.pole_angle(axis) <= self.pole_tolerance_rad {
             vec![k.inverse_with_c(&pose, prev_c)]
         } else {
             k.inverse(&pose).to_vec()
         };
-        let mut best: Option<([f64; 5], f64)> = None;
-        for a in candidates {
-            let near = nearest_turn(a.c, prev_c);
-            for c in [near, near - 360.0, near + 360.0] {
-                // X, Y, Z do not depend on whole turns of C.
-                let q = [a.x, a.y, a.z, a.tilt, c];
-                if !self.in_range(&q) {
-                    continue;
-                }
-                let travel = (a.tilt - prev_t).abs().max((c - prev_c).abs());
-                if best.as_ref().is_none_or(|(_, t)| travel < *t) {
-                    best = Some((q, travel));
-                }
-            }
-        }
-        best.map(|(q, _)| q).ok_or_else(|| InterpError::Kinematics {
-            index: 0,
-            message: "no solution within the axis ranges".into(),
-        })
+        let previous = Axes::new(0.0, 0.0, 0.0, prev_t, prev_c);
+        nearest_solution(candidates, &previous, |q| self.in_range(&q.to_array()))
+            .map(|q| q.to_array())
+            .ok_or_else(|| InterpError::Kinematics {
+                index: 0,
+                message: "no solution within the axis ranges".into(),
+            })
     }
 
     /// The forward kinematics give the tool axis of `(tilt, c)`; `inverse_with_c` at that C

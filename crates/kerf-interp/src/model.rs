@@ -9,9 +9,10 @@
 //!
 //! kerf's machines (`kerf.machine/1`, four types) live in `kerf-kinematics`;
 //! [`crate::MachineModel`] adapts them. The trait keeps the interpolator's needs in one small
-//! place (and lets a controller plug in its own kinematics); [`AcHead`], the head of paper 000,
+//! place (and lets a controller plug in its own kinematics); [`PaperAcHead`], the head of paper 000,
 //! is a self-contained reference implementation for tests, examples and benches.
 
+use kerf_kinematics::{nearest_solution, Axes};
 use nalgebra::{Point3, Vector3};
 
 use crate::error::{positive, InterpError, Result};
@@ -128,7 +129,7 @@ pub trait AxisModel {
 /// A reference implementation for tests, examples and benches; kerf's machines, all four
 /// types, come from `kerf-kinematics`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct AcHead {
+pub struct PaperAcHead {
     /// Machine name.
     pub name: String,
     /// Rotation radius of A, mm.
@@ -138,11 +139,11 @@ pub struct AcHead {
     /// Limits (per second).
     pub limits: AxisLimits,
     /// A pose whose tool axis is within this angle (radians) of +z counts as at the pole, where
-    /// C keeps its previous value (`formats.md`: `pole_tolerance`, default 1e-6).
-    pub pole_tolerance: f64,
+    /// C keeps its previous value (`formats.md`: `pole_tolerance`, default 1e-6 rad).
+    pub pole_tolerance_rad: f64,
 }
 
-impl AcHead {
+impl PaperAcHead {
     /// The example machine of `formats.md` ("paper-000 laser head": `r_a` 180, `r_c` 95,
     /// X +-1500, Y +-800, Z -100..600, A +-135, C continuous; 60/60/30 m/min, 36000 deg/min;
     /// 10/10/8 m/s^2, 20000 deg/s^2).
@@ -164,7 +165,7 @@ impl AcHead {
             r_a: 180.0,
             r_c: 95.0,
             limits,
-            pole_tolerance: 1e-6,
+            pole_tolerance_rad: 1e-6,
         }
     }
 
@@ -176,12 +177,7 @@ impl AcHead {
     }
 }
 
-/// `value` plus the multiple of 360 that brings it nearest `reference`.
-pub(crate) fn nearest_turn(value: f64, reference: f64) -> f64 {
-    value + 360.0 * ((reference - value) / 360.0).round()
-}
-
-impl AxisModel for AcHead {
+impl AxisModel for PaperAcHead {
     fn name(&self) -> &str {
         &self.name
     }
@@ -212,27 +208,25 @@ impl AxisModel for AcHead {
         let a = u.z.clamp(-1.0, 1.0).acos().to_degrees();
         let sin_a = (u.x * u.x + u.y * u.y).sqrt();
         let candidates: Vec<(f64, f64)> =
-            if sin_a.atan2(u.z.abs()) < self.pole_tolerance && u.z > 0.0 {
+            if sin_a.atan2(u.z.abs()) < self.pole_tolerance_rad && u.z > 0.0 {
                 vec![(0.0, prev_c)]
             } else {
                 let c = u.x.atan2(-u.y).to_degrees();
                 vec![(a, c), (-a, c + 180.0)]
             };
-        let mut best: Option<([f64; 5], f64)> = None;
-        for (a, c) in candidates {
-            let c = nearest_turn(c, prev_c);
-            let xyz = self.linear_axes(tip, a, c);
-            let q = [xyz[0], xyz[1], xyz[2], a, c];
-            if !(0..5).all(|k| self.in_range(k, q[k])) {
-                continue;
-            }
-            let travel = (a - prev_a).abs().max((c - prev_c).abs());
-            if best.as_ref().is_none_or(|(_, t)| travel < *t) {
-                best = Some((q, travel));
-            }
-        }
-        best.map(|(q, _)| q)
-            .ok_or_else(|| kin("no solution within the axis ranges".to_string()))
+        // X, Y, Z do not depend on whole turns of A or C: placed once per solution, the turns
+        // chosen by kerf-kinematics' one rule.
+        let solutions = candidates.into_iter().map(|(a, c)| {
+            let [x, y, z] = self.linear_axes(tip, a, c);
+            Axes::new(x, y, z, a, c)
+        });
+        let previous = Axes::new(0.0, 0.0, 0.0, prev_a, prev_c);
+        nearest_solution(solutions, &previous, |q| {
+            let q = q.to_array();
+            (0..5).all(|k| self.in_range(k, q[k]))
+        })
+        .map(|q| q.to_array())
+        .ok_or_else(|| kin("no solution within the axis ranges".to_string()))
     }
 
     #[inline]
@@ -260,7 +254,7 @@ mod tests {
 
     #[test]
     fn paper_eq16_and_inverse_round_trip() {
-        let m = AcHead::paper_000();
+        let m = PaperAcHead::paper_000();
         let tip = Point3::new(10.0, -20.0, 5.0);
         let u = m.tool_axis(30.0, 40.0);
         let q = m.inverse(&tip, &u, None).expect("reachable");
@@ -276,7 +270,7 @@ mod tests {
 
     #[test]
     fn continuity_picks_second_solution_and_turn() {
-        let m = AcHead::paper_000();
+        let m = PaperAcHead::paper_000();
         let tip = Point3::origin();
         let u = m.tool_axis(-20.0, 370.0 + 180.0);
         let prev = [0.0, 0.0, 0.0, -19.0, 545.0];
@@ -292,7 +286,7 @@ mod tests {
     fn bad_limits_and_axes_are_errors() {
         assert!(AxisLimits::from_machine_units([None; 5], [f64::NAN; 5], [1.0; 5]).is_err());
         assert!(AxisLimits::from_machine_units([None; 5], [1.0; 5], [0.0; 5]).is_err());
-        let m = AcHead::paper_000();
+        let m = PaperAcHead::paper_000();
         let e = m.inverse(&Point3::origin(), &Vector3::new(0.0, 0.0, 2.0), None);
         assert!(matches!(e, Err(InterpError::Kinematics { .. })), "{e:?}");
     }

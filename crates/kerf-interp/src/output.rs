@@ -233,7 +233,7 @@ pub const MAX_COMMENT: usize = 160;
 /// [`MAX_COMMENT`] bytes.
 ///
 /// ```
-/// use kerf_interp::output::comment_text;
+/// use kerf_interp::comment_text;
 /// assert_eq!(comment_text("hole\nG0 X1400\nM30"), "hole\\u{a}G0 X1400\\u{a}M30");
 /// assert_eq!(comment_text(")G0X1("), "]G0X1[");
 /// assert_eq!(comment_text("Stoßblech"), "Sto\\u{df}blech");

@@ -364,7 +364,7 @@ fn tangent(blocks: &[Block], b: usize, at_end: bool) -> Option<Vector3<f64>> {
     } else {
         (blk.start_tip(), blk.end_tip(), n.end_tip())
     };
-    match crate::geometry::Arc::through(p, q, r) {
+    match crate::geometry::SpaceArc::through(p, q, r) {
         Ok(a) => Some(a.tangent_at_angle(if at_end { a.angle_end } else { 0.0 })),
         Err(_) => Some(own),
     }

@@ -6,8 +6,8 @@ mod common;
 
 use common::{circle, stations};
 use kerf_interp::{
-    gcode_motion, interpolate, AcHead, AxisModel, Dialect, FitOptions, GcodeOptions, Motion,
-    PathInput, PlanOptions,
+    gcode_motion, interpolate, AxisModel, Dialect, FitOptions, GcodeOptions, Motion, PaperAcHead,
+    PlanOptions, ProgramPath,
 };
 use kerf_kinematics::Process;
 use nalgebra::{Point3, Vector3};
@@ -15,18 +15,18 @@ use nalgebra::{Point3, Vector3};
 const DIALECTS: [Dialect; 3] = [Dialect::Generic, Dialect::Sinumerik, Dialect::Linuxcnc];
 
 /// Two closed contours, the second with a tilted tool, linked by rapids with a 10 mm retract.
-fn program(m: &AcHead, dialect: Dialect) -> Motion {
+fn program(m: &PaperAcHead, dialect: Dialect) -> Motion {
     let a = stations(m, &circle(20.0, 0.0, 0.0, 0.0), 0.005, |_| Vector3::z());
     let b = stations(m, &circle(15.0, 80.0, 10.0, 5.0), 0.005, |p| {
         Vector3::new((p.x - 80.0) / 60.0, (p.y - 10.0) / 60.0, 1.0).normalize()
     });
     let paths = vec![
-        PathInput {
+        ProgramPath {
             id: "a".into(),
             stations: a,
             curve: None,
         },
-        PathInput {
+        ProgramPath {
             id: "b".into(),
             stations: b,
             curve: None,
@@ -70,13 +70,13 @@ fn word(code: &str, key: &str) -> Option<f64> {
     })
 }
 
-fn u_of(m: &AcHead, q: &[f64; 5]) -> Vector3<f64> {
+fn u_of(m: &PaperAcHead, q: &[f64; 5]) -> Vector3<f64> {
     // u = Rz(C) Rx(A) ez, written out (formats.md), not the model's own function.
     let (a, c) = (q[3].to_radians(), q[4].to_radians());
     Vector3::new(a.sin() * c.sin(), -a.sin() * c.cos(), a.cos()) + 0.0 * m.tool_axis(0.0, 0.0)
 }
 
-fn tip_of(m: &AcHead, q: &[f64; 5]) -> Point3<f64> {
+fn tip_of(m: &PaperAcHead, q: &[f64; 5]) -> Point3<f64> {
     // Paper 000 eq 16 solved for the tip.
     let u = u_of(m, q);
     let c = q[4].to_radians();
@@ -89,7 +89,7 @@ fn tip_of(m: &AcHead, q: &[f64; 5]) -> Point3<f64> {
 
 #[test]
 fn every_cut_is_framed_and_no_beam_during_rapids() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     for dialect in DIALECTS {
         let motion = program(&m, dialect);
         let opts = GcodeOptions::new(dialect, 6000.0);
@@ -201,7 +201,7 @@ fn every_cut_is_framed_and_no_beam_during_rapids() {
 
 #[test]
 fn headers_state_units_feed_budget_machine_and_process() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     for dialect in DIALECTS {
         let motion = program(&m, dialect);
         let opts = GcodeOptions {
@@ -260,7 +260,7 @@ fn headers_state_units_feed_budget_machine_and_process() {
 /// per block), the RS274/NGC G94 rule on the machine axes (generic), the tip (Sinumerik).
 #[test]
 fn feed_words_reproduce_the_planned_block_times() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     for dialect in DIALECTS {
         let motion = program(&m, dialect);
         let opts = GcodeOptions {
@@ -325,9 +325,9 @@ fn feed_words_reproduce_the_planned_block_times() {
 
 #[test]
 fn hostile_ids_and_names_never_make_a_block() {
-    let m = AcHead {
+    let m = PaperAcHead {
         name: "evil\nG0 X1400 Y700 Z-90 A0 C0\nM30 (".into(),
-        ..AcHead::paper_000()
+        ..PaperAcHead::paper_000()
     };
     let hostile: Vec<String> = [
         "hole\nG0 X1400 Y700 Z-90 A0 C0\nM30",
@@ -394,7 +394,7 @@ fn hostile_ids_and_names_never_make_a_block() {
 
 #[test]
 fn bad_process_codes_are_named_errors() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let motion = program(&m, Dialect::Linuxcnc);
     for (p, want) in [
         (Process { pierce_dwell_s: Some(-1.0), ..Process::default() }, "process.pierce_dwell_s: must be finite and >= 0 (got -1)"),

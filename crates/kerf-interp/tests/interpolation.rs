@@ -1,11 +1,12 @@
 //! Paper 000's interpolators against analytic positions, eq 19, and the error paths.
 
-use kerf_interp::chord::{chord_error, max_feed, paper_eq19};
-use kerf_interp::{increments, AcHead, AxisModel, Block, InterpError, Station};
+#[cfg(feature = "research")]
+use kerf_interp::{chord_error, max_feed, paper_eq19};
+use kerf_interp::{increments, AxisModel, Block, InterpError, PaperAcHead, Station};
 use nalgebra::{Point3, Vector3};
 
 /// Paper 000 eq 16, written out independently of the crate.
-fn eq16(m: &AcHead, p: Point3<f64>, a_deg: f64, c_deg: f64) -> [f64; 5] {
+fn eq16(m: &PaperAcHead, p: Point3<f64>, a_deg: f64, c_deg: f64) -> [f64; 5] {
     let (a, c) = (a_deg.to_radians(), c_deg.to_radians());
     [
         p.x + m.r_a * a.sin() * c.sin() - m.r_c * c.cos(),
@@ -16,7 +17,7 @@ fn eq16(m: &AcHead, p: Point3<f64>, a_deg: f64, c_deg: f64) -> [f64; 5] {
     ]
 }
 
-fn station(m: &AcHead, p: Point3<f64>, a: f64, c: f64) -> Station {
+fn station(m: &PaperAcHead, p: Point3<f64>, a: f64, c: f64) -> Station {
     Station {
         tip: p,
         axis: m.tool_axis(a, c),
@@ -38,7 +39,7 @@ fn assert_close(got: &[f64; 5], want: &[f64; 5], tol: f64, what: &str) {
 
 #[test]
 fn space_line_lands_on_the_analytic_positions() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let (p1, p2) = (
         Point3::new(10.0, -20.0, 30.0),
         Point3::new(73.0, 15.0, -12.0),
@@ -74,7 +75,7 @@ fn space_line_lands_on_the_analytic_positions() {
 
 #[test]
 fn space_arc_lands_on_the_analytic_positions() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     // Circle of radius 25 about o in a tilted plane (orthonormal e, f).
     let o = Point3::new(5.0, 8.0, -3.0);
     let e = Vector3::new(2.0, 1.0, 2.0) / 3.0;
@@ -120,7 +121,7 @@ fn space_arc_lands_on_the_analytic_positions() {
 #[test]
 fn long_block_does_not_drift() {
     // 2 m at 10 um per cycle: 200,000 cycles; positions from the start, not summed.
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let (p1, p2) = (
         Point3::new(-1000.0, -300.0, 50.0),
         Point3::new(1000.0, 300.0, 50.0),
@@ -136,6 +137,7 @@ fn long_block_does_not_drift() {
 }
 
 #[test]
+#[cfg(feature = "research")]
 fn eq19_numbers() {
     // F <= sqrt(225000 (2R - 0.001)) mm/min for T = 8 ms, delta = 1 um (eq 19 with the
     // unit slip corrected), and it equals the general bound 60 * 2 sqrt(d (2R - d)) / T.
@@ -173,7 +175,7 @@ fn eq19_numbers() {
 
 #[test]
 fn bad_feed_and_cycle_are_errors() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let b = Block::line(
         &station(&m, Point3::origin(), 0.0, 0.0),
         &station(&m, Point3::new(1.0, 0.0, 0.0), 0.0, 0.0),
@@ -196,7 +198,7 @@ fn bad_feed_and_cycle_are_errors() {
 
 #[test]
 fn collinear_arc_falls_back_to_a_line() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let s = |x: f64| station(&m, Point3::new(x, 2.0 * x, 0.0), 0.0, 0.0);
     let e = Block::arc(&s(0.0), &s(1.0), &s(2.0));
     assert!(matches!(e, Err(InterpError::CollinearArc { .. })), "{e:?}");
@@ -207,7 +209,7 @@ fn collinear_arc_falls_back_to_a_line() {
 
 #[test]
 fn pure_rotation_is_a_turn_block() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let p = Point3::new(3.0, 4.0, 5.0);
     let b = Block::line(&station(&m, p, 0.0, 0.0), &station(&m, p, 30.0, -60.0));
     assert!(
@@ -229,7 +231,7 @@ fn pure_rotation_is_a_turn_block() {
 #[test]
 fn station_and_fit_errors() {
     use kerf_interp::{fit_blocks, solve_stations, FitOptions};
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let tips = [Point3::origin(), Point3::new(1.0, 0.0, 0.0)];
     let e = solve_stations(&m, &[], None, None, None);
     assert!(
@@ -296,7 +298,7 @@ mod prop {
             tilt in -1.0f64..1.0, spin in 0.0f64..6.3,
             feed in 100.0f64..30000.0, cycle in 0.0005f64..0.01,
         ) {
-            let m = AcHead::paper_000();
+            let m = PaperAcHead::paper_000();
             let e = Vector3::new(spin.cos(), spin.sin(), 0.0);
             let f = Vector3::new(-spin.sin() * tilt.cos(), spin.cos() * tilt.cos(), tilt.sin());
             let o = Point3::new(3.0, -7.0, 11.0);

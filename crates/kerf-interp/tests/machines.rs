@@ -2,8 +2,8 @@
 //! by kerf-kinematics, planned within the limits.
 
 use kerf_interp::{
-    fit_blocks, plan, stations_from_axes, stations_from_solved, AcHead, AxisModel, FitOptions,
-    MachineModel, PlanOptions,
+    fit_blocks, plan, stations_from_axes, stations_from_solved, AxisModel, FitOptions,
+    MachineModel, PaperAcHead, PlanOptions,
 };
 use kerf_kinematics::{solve_path, Machine, PathInput, PathOptions, Pose};
 use nalgebra::{Point3, Vector3};
@@ -19,7 +19,7 @@ fn load(name: &str) -> MachineModel {
 #[test]
 fn ac_head_file_agrees_with_the_reference_head() {
     let m = load("ac_head");
-    let r = AcHead::paper_000();
+    let r = PaperAcHead::paper_000();
     for (t, c) in [(0.0, 0.0), (30.0, 40.0), (-20.0, 200.0), (100.0, -75.0)] {
         let tip = Point3::new(12.0, -34.0, 56.0);
         let (a, b) = (m.linear_axes(&tip, t, c), r.linear_axes(&tip, t, c));

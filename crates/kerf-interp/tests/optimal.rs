@@ -8,7 +8,7 @@
 mod common;
 
 use common::{circle, stations};
-use kerf_interp::{fit_blocks, plan, AcHead, AxisModel, FitOptions, PlanOptions, Station};
+use kerf_interp::{fit_blocks, plan, AxisModel, FitOptions, PaperAcHead, PlanOptions, Station};
 use nalgebra::{Point3, Vector3};
 
 /// Largest ratio of finite-difference velocity, acceleration and jerk to the limits over every
@@ -35,8 +35,8 @@ fn ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> [f64; 3] {
 }
 
 /// The large gantry of `fixtures/machines/gantry_ac.json`: 6 m/s^2 on X and Y, 40 m/min.
-fn gantry() -> AcHead {
-    let mut m = AcHead::paper_000();
+fn gantry() -> PaperAcHead {
+    let mut m = PaperAcHead::paper_000();
     m.limits.max_velocity = [40000.0 / 60.0, 40000.0 / 60.0, 20000.0 / 60.0, 600.0, 600.0];
     m.limits.max_acceleration = [6000.0, 6000.0, 5000.0, 20000.0, 20000.0];
     m
@@ -204,7 +204,7 @@ fn the_70_mm_hole_runs_at_the_programmed_feed_with_one_modal_f_word() {
     assert!((st.length_at_feed / st.cutting_length - share).abs() < 0.01);
 }
 
-fn line_stations(m: &AcHead, len: f64) -> Vec<Station> {
+fn line_stations(m: &PaperAcHead, len: f64) -> Vec<Station> {
     let tips: Vec<Point3<f64>> = (0..=100)
         .map(|i| Point3::new(len * i as f64 / 100.0 - 0.5 * len, 20.0, 0.0))
         .collect();
@@ -216,7 +216,7 @@ fn a_straight_line_is_the_analytic_trapezoid_and_s_curve() {
     // Along X only: the optimum is the trapezoid L / v + v / a, and with jerk j the S-curve
     // L / v + v / a + a / j (both limits reached); the planner's filter is JERK_FILTER_WIDTH
     // jerk times wide, so it takes L / v + v / a + 1.25 a / j (each ramp at 80 % of the jerk).
-    let mut m = AcHead::paper_000();
+    let mut m = PaperAcHead::paper_000();
     let (len, feed) = (400.0, 20000.0);
     let blocks =
         fit_blocks(&m, &line_stations(&m, len), None, 0, &FitOptions::default()).expect("fit");
@@ -249,7 +249,7 @@ fn jerk_limited_plans_stay_within_every_limit_and_near_the_optimum() {
     // limits of fixtures/machines/ac_head.json (10 ms jerk time, 1000 m/s^3 on X and Y): every
     // cycle within the jerk limit, and the target, 1.25 x the acceleration-limited plan
     // on paths over 100 mm. (With 20 ms jerk times the free-form curve takes 1.26 x at 40 m/min.)
-    let mut m = AcHead::paper_000();
+    let mut m = PaperAcHead::paper_000();
     let free = common::freeform();
     let cases = [
         (circle(35.0, 0.0, 0.0, 0.0), false),
@@ -293,7 +293,7 @@ fn jerk_limited_plans_stay_within_every_limit_and_near_the_optimum() {
 #[test]
 fn planning_work_is_bounded_on_a_long_path() {
     // 10,000 poses along a wavy line: the grid grows linearly with the path, not more.
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let tips: Vec<Point3<f64>> = (0..10_000)
         .map(|i| {
             let x = i as f64 * 0.25;
@@ -330,7 +330,7 @@ fn the_smooth_path_stays_on_the_curve() {
     // line per chord (the generic fit): the set-points follow the spline through the points,
     // whose distance from the true curve (closest point on the NURBS) is far below the chord
     // error of the polyline. Tool vertical: the tip is XYZ - (-r_c, 0, r_a).
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     for (name, c) in [
         ("free-form", common::freeform()),
         ("hole", circle(5.0, 0.0, 0.0, 0.0)),

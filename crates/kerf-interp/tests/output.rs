@@ -7,8 +7,8 @@ use std::collections::HashMap;
 
 use common::{circle, freeform, stations};
 use kerf_interp::{
-    csv_string, fit_blocks, gcode, plan, write_csv, write_gcode, AcHead, AxisModel, Dialect,
-    FitOptions, GcodeOptions, Geometry, PlanOptions,
+    csv_string, fit_blocks, gcode, plan, write_csv, write_gcode, AxisModel, Dialect, FitOptions,
+    GcodeOptions, Geometry, PaperAcHead, PlanOptions,
 };
 use nalgebra::Vector3;
 
@@ -40,7 +40,7 @@ fn words(line: &str) -> (String, HashMap<String, f64>) {
 
 #[test]
 fn csv_header_and_rows() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let st = stations(&m, &circle(10.0, 0.0, 0.0, 0.0), 0.001, |_| Vector3::z());
     let blocks = fit_blocks(&m, &st, None, 0, &FitOptions::default()).expect("fit");
     let motion = plan(&m, &blocks, &PlanOptions::new(3000.0, 0.004)).expect("plan");
@@ -88,7 +88,7 @@ fn csv_header_and_rows() {
 
 #[test]
 fn generic_gcode_parses_back_to_the_machine_axes() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let c = freeform();
     let st = stations(&m, &c, 0.001, |p| {
         Vector3::new(0.3 * (p.x / 50.0).sin(), 0.2, 1.0).normalize()
@@ -158,7 +158,7 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
 
 #[test]
 fn sinumerik_gcode_parses_back_to_tips_orientations_and_arcs() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let c = circle(40.0, 10.0, -5.0, 3.0);
     let st = stations(&m, &c, 0.001, |p| {
         Vector3::new((p.x - 10.0) / 120.0, (p.y + 5.0) / 120.0, 1.0).normalize()

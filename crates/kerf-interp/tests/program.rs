@@ -5,13 +5,13 @@ mod common;
 
 use common::{circle, freeform, limit_ratios, stations};
 use kerf_interp::{
-    fit_blocks, fit_program, plan, AcHead, AxisModel, FitOptions, PathInput, PlanOptions,
+    fit_blocks, fit_program, plan, AxisModel, FitOptions, PaperAcHead, PlanOptions, ProgramPath,
 };
 use nalgebra::{Point3, Vector3};
 
 fn check_program(
     name: &str,
-    m: &AcHead,
+    m: &PaperAcHead,
     blocks: &[kerf_interp::Block],
     feed: f64,
     cycle: f64,
@@ -21,7 +21,7 @@ fn check_program(
 
 fn check_with(
     name: &str,
-    m: &AcHead,
+    m: &PaperAcHead,
     blocks: &[kerf_interp::Block],
     opts: &PlanOptions,
 ) -> kerf_interp::Motion {
@@ -55,7 +55,7 @@ fn check_with(
 
 #[test]
 fn circle_becomes_few_arcs_and_stays_within_limits() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let c = circle(50.0, 100.0, 50.0, 20.0);
     // Tool tilted 30 degrees outward all around: A constant, C turning once.
     let st = stations(&m, &c, 0.001, |p| {
@@ -79,7 +79,7 @@ fn circle_becomes_few_arcs_and_stays_within_limits() {
 
 #[test]
 fn freeform_with_varying_tool_axis_stays_within_limits() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let c = freeform();
     let st = stations(&m, &c, 0.001, |p| {
         Vector3::new(0.4 * (p.x / 40.0).sin(), 0.3 * (p.y / 25.0).cos(), 1.0).normalize()
@@ -125,7 +125,7 @@ fn freeform_with_varying_tool_axis_stays_within_limits() {
 fn path_near_the_pole_limits_the_rotary_axes() {
     // The tool axis passes 0.06 degrees from +z: C swings through about 180 degrees within a
     // few millimetres while A stays tiny. The plan must slow down for C.
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let tips: Vec<Point3<f64>> = (0..=200)
         .map(|i| Point3::new(-50.0 + 0.5 * i as f64, 10.0, 0.0))
         .collect();
@@ -148,19 +148,19 @@ fn path_near_the_pole_limits_the_rotary_axes() {
 
 #[test]
 fn two_paths_are_linked_by_a_rapid_move() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let c1 = circle(20.0, 0.0, 0.0, 0.0);
     let c2 = circle(10.0, 80.0, 30.0, 5.0);
     let up = |_: &Point3<f64>| Vector3::z();
     let f1 = |t: f64| c1.point(t);
     let f2 = |t: f64| c2.point(t);
     let paths = [
-        PathInput {
+        ProgramPath {
             id: "ring-20".into(),
             stations: stations(&m, &c1, 0.001, up),
             curve: Some(&f1),
         },
-        PathInput {
+        ProgramPath {
             id: "ring-10".into(),
             stations: stations(&m, &c2, 0.001, up),
             curve: Some(&f2),
@@ -212,7 +212,7 @@ fn two_paths_are_linked_by_a_rapid_move() {
 
 #[test]
 fn plan_refuses_bad_options() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let st = stations(&m, &circle(5.0, 0.0, 0.0, 0.0), 0.01, |_| Vector3::z());
     let blocks = fit_blocks(&m, &st, None, 0, &FitOptions::with_tolerance(0.01)).expect("fit");
     for o in [
@@ -250,7 +250,7 @@ fn plan_refuses_bad_options() {
 #[test]
 fn block_ends_on_cycles() {
     // Paper 000's block-by-block mode: every block end is a set-point, exactly.
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let c = freeform();
     let st = stations(&m, &c, 0.001, |p| {
         Vector3::new(0.4 * (p.x / 40.0).sin(), 0.3 * (p.y / 25.0).cos(), 1.0).normalize()
@@ -288,7 +288,7 @@ fn block_ends_on_cycles() {
 
 #[test]
 fn plan_error_variants() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let c = freeform();
     let st = stations(&m, &c, 0.001, |_| Vector3::z());
     let lines = fit_blocks(
@@ -323,7 +323,7 @@ fn plan_error_variants() {
         "{e:?}"
     );
     // An arc bulging past an axis range is reported.
-    let mut small = AcHead::paper_000();
+    let mut small = PaperAcHead::paper_000();
     small.limits.range[1] = Some([-10.0, 10.0]);
     let ring = stations(&m, &circle(20.0, 0.0, 30.0, 0.0), 0.001, |_| Vector3::z());
     let blocks = fit_blocks(&m, &ring, None, 0, &FitOptions::default()).expect("fit");

@@ -1,11 +1,11 @@
 //! Paper 001's recursive interpolator: its table of coefficients, the accumulated-error claims
 //! (600 and 5,000 steps; the 1,000,000-step row is in the example), and the spline mode.
 
-use kerf_interp::recursive::{
+use kerf_interp::{
     max_deviation, new_basis_coefficients, spline_setpoints, spline_through, CubicHermite,
     NewBasisSegment, Recurrence,
 };
-use kerf_interp::{solve_stations, AcHead};
+use kerf_interp::{solve_stations, PaperAcHead};
 use nalgebra::{Point3, Vector3};
 
 #[test]
@@ -130,7 +130,7 @@ fn accumulated_error_claims() {
 
 #[test]
 fn spline_mode_passes_through_the_points_c2() {
-    let m = AcHead::paper_000();
+    let m = PaperAcHead::paper_000();
     let tips: Vec<Point3<f64>> = (0..12)
         .map(|i| {
             let a = i as f64 * 0.4;

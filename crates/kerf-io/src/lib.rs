@@ -32,10 +32,12 @@
 
 mod json;
 mod read;
+mod shape;
 mod text;
 mod write;
 
 pub use json::{parse_json, path_at, JsonError};
 pub use read::{read_file, read_to_end, strip_bom, MAX_INPUT_BYTES};
+pub use shape::{deserialize_at, duplicate_key_message, JsonProblem, ShapeError};
 pub use text::{check_text, TextDefect};
 pub use write::{same_file, write_dir_all_or_nothing, write_file, Contents, DirEntry, DirError};

@@ -17,8 +17,8 @@ use serde_json::Value;
 
 use crate::error::Result;
 use crate::kinematics::Kinematics;
+use crate::params::{non_negative, KinematicsType};
 use crate::pose::{Axes, Pose};
-use crate::registry::{non_negative, KinematicsType};
 use crate::rotation::{Angles, Orientation, TiltAbout};
 
 /// The registry entry.
@@ -86,13 +86,11 @@ impl Kinematics for AcHead {
     }
 
     fn inverse(&self, pose: &Pose) -> [Axes; 2] {
-        ORIENTATION
-            .solve(&pose.axis)
-            .map(|s| self.place(&pose.position, &s))
+        ORIENTATION.inverse(pose, |p, s| self.place(p, s))
     }
 
     fn inverse_with_c(&self, pose: &Pose, c: f64) -> Axes {
-        self.place(&pose.position, &ORIENTATION.tilt_for_c(&pose.axis, c))
+        ORIENTATION.inverse_with_c(pose, c, |p, s| self.place(p, s))
     }
 
     fn pivot_length(&self) -> f64 {

@@ -15,8 +15,8 @@ use serde_json::Value;
 
 use crate::error::{KinematicsError, Result};
 use crate::kinematics::Kinematics;
+use crate::params::{finite, non_negative, KinematicsType, Params};
 use crate::pose::{Axes, Pose};
-use crate::registry::{finite, non_negative, KinematicsType, Params};
 use crate::rotation::{rot_z, Angles, Orientation, TiltAbout};
 
 /// The registry entry.
@@ -134,13 +134,12 @@ impl Kinematics for ForkHead {
     }
 
     fn inverse(&self, pose: &Pose) -> [Axes; 2] {
-        self.orientation
-            .solve(&pose.axis)
-            .map(|s| self.place(&pose.position, &s))
+        self.orientation.inverse(pose, |p, s| self.place(p, s))
     }
 
     fn inverse_with_c(&self, pose: &Pose, c: f64) -> Axes {
-        self.place(&pose.position, &self.orientation.tilt_for_c(&pose.axis, c))
+        self.orientation
+            .inverse_with_c(pose, c, |p, s| self.place(p, s))
     }
 
     fn pivot_length(&self) -> f64 {

@@ -13,8 +13,8 @@ use serde_json::Value;
 
 use crate::error::Result;
 use crate::kinematics::Kinematics;
+use crate::params::{finite, non_negative, sign, KinematicsType, Params};
 use crate::pose::{Axes, Pose};
-use crate::registry::{finite, non_negative, sign, KinematicsType, Params};
 use crate::rotation::{inv, rot_y, rot_z, Angles, Orientation, TiltAbout};
 
 /// The registry entry.
@@ -106,13 +106,12 @@ impl Kinematics for HeadTable {
     }
 
     fn inverse(&self, pose: &Pose) -> [Axes; 2] {
-        self.orientation
-            .solve(&pose.axis)
-            .map(|s| self.place(&pose.position, &s))
+        self.orientation.inverse(pose, |p, s| self.place(p, s))
     }
 
     fn inverse_with_c(&self, pose: &Pose, c: f64) -> Axes {
-        self.place(&pose.position, &self.orientation.tilt_for_c(&pose.axis, c))
+        self.orientation
+            .inverse_with_c(pose, c, |p, s| self.place(p, s))
     }
 
     fn pivot_length(&self) -> f64 {

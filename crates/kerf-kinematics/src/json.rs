@@ -3,36 +3,25 @@
 
 use std::path::Path;
 
-use kerf_io::JsonError;
+use kerf_io::{JsonProblem, ShapeError};
 use serde_json::Value;
 
 use crate::error::{KinematicsError, Result};
 
-/// Parses JSON bytes into a value.
+/// Parses JSON bytes into a value (kerf-io's front end, its problems as kerf-kinematics'
+/// errors).
 pub(crate) fn parse(bytes: &[u8]) -> Result<Value> {
-    kerf_io::parse_json(bytes).map_err(|e| match e {
-        JsonError::Empty => KinematicsError::doc("top level", "the file is empty"),
-        JsonError::Syntax {
+    kerf_io::parse_json(bytes).map_err(|e| match JsonProblem::from(e) {
+        JsonProblem::Syntax {
             line,
             column,
-            path,
             message,
         } => KinematicsError::Syntax {
             line,
             column,
-            message: if path.is_empty() {
-                message
-            } else {
-                format!("{message} (in {path})")
-            },
+            message,
         },
-        JsonError::DuplicateKey { path, line } => KinematicsError::doc(
-            path,
-            format!(
-                "key given twice in one object (line {line}); readers disagree on which one \
-                 counts, so remove one of them"
-            ),
-        ),
+        JsonProblem::Shape(ShapeError { path, message }) => KinematicsError::doc(path, message),
     })
 }
 

@@ -5,7 +5,7 @@
 //! inverse kinematics, and [`solve_path`] does so along a whole path, keeping the axes
 //! continuous and within their limits, handling the pole, and inserting poses where the
 //! controller's linear axis interpolation would take the tool tip off the path
-//! ([`nonlinear`], paper 002). [`AxesFile`] writes the result as `kerf.axes/1`.
+//! ([`linearization_error`], paper 002). [`AxesFile`] writes the result as `kerf.axes/1`.
 //!
 //! Four kinematic types, one file each: [`AcHead`] (the laser head of paper 000),
 //! [`ForkHead`] (a double swing head), [`TableTable`] (LinuxCNC's `xyzac-trt`) and
@@ -32,31 +32,35 @@
 //! # Ok::<(), kerf_kinematics::KinematicsError>(())
 //! ```
 
-pub mod ac_head;
-pub mod axes_file;
-pub mod error;
-pub mod fork_head;
-pub mod head_table;
+mod ac_head;
+mod axes_file;
+mod choice;
+mod error;
+mod fork_head;
+mod head_table;
 mod json;
-pub mod kinematics;
-pub mod machine;
-pub mod nonlinear;
-pub mod path;
-pub mod placement;
-pub mod pose;
+mod kinematics;
+mod machine;
+mod nonlinear;
+mod params;
+mod path;
+mod placement;
+mod pose;
 mod registry;
 mod rotation;
-pub mod table_table;
+mod table_table;
 
 pub use ac_head::AcHead;
 pub use axes_file::{AxesFile, AxesMove, AxesPath, AXES_FORMAT};
+pub use choice::{nearest_solution, nearest_turn, turns_near};
 pub use error::{KinematicsError, Result};
 pub use fork_head::{ForkHead, ForkTilt};
 pub use head_table::HeadTable;
 pub use kinematics::Kinematics;
 pub use machine::{Machine, Process, Range, MACHINE_FORMAT};
-pub use nonlinear::{linearization_error, Deviation};
+pub use nonlinear::{interpolate, linearization_error, slerp, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
+pub use path::{LIMIT_SLACK, UNIT_AXIS_TOLERANCE};
 pub use placement::{
     auto_place, auto_setups, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement,
     Placement, Setup, SetupPlan,

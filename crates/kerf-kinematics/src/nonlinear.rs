@@ -18,7 +18,8 @@
 //! default 0.005 mm of linearization tolerance should expect up to 0.015 mm. The interpolator's
 //! own chord error, if any, adds to that.
 
-use nalgebra::{Point3, Vector3};
+use kerf_nurbs::distance_to_segment;
+use nalgebra::Vector3;
 
 use crate::kinematics::Kinematics;
 use crate::pose::{Axes, Pose};
@@ -32,18 +33,6 @@ pub struct Deviation {
     /// Where along the move it occurs, as the fraction `s` in `[0, 1]` of the axis
     /// interpolation.
     pub at: f64,
-}
-
-/// The distance of `p` from the segment `[a, b]`.
-pub fn distance_to_segment(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + t * ab)).norm()
 }
 
 /// The number of samples for a move: 16, plus one per degree of rotary step, at most 512.
@@ -171,26 +160,6 @@ mod tests {
         assert!(
             anti.dot(&a).abs() < 1e-15,
             "antipodal midpoint is perpendicular"
-        );
-    }
-
-    #[test]
-    fn distance_to_segment_clamps_to_the_ends() {
-        let (a, b) = (Point3::origin(), Point3::new(1.0, 0.0, 0.0));
-        assert_eq!(
-            distance_to_segment(&Point3::new(0.5, 2.0, 0.0), &a, &b),
-            2.0,
-            "inside"
-        );
-        assert_eq!(
-            distance_to_segment(&Point3::new(4.0, 0.0, 0.0), &a, &b),
-            3.0,
-            "beyond b"
-        );
-        assert_eq!(
-            distance_to_segment(&Point3::new(0.0, 0.0, 1.0), &a, &a),
-            1.0,
-            "degenerate"
         );
     }
 }

@@ -20,9 +20,9 @@
 //! whose A only goes to -10 degrees turns C by 180 at the pole instead of tilting the wrong
 //! way. A path that starts at the pole starts with the C it leaves the pole with.
 //!
-//! **The pole.** A pose whose tool axis is within `pole_tolerance` of the C axis keeps the
+//! **The pole.** A pose whose tool axis is within `pole_tolerance_rad` of the C axis keeps the
 //! previous C; its tilt is the one bringing the tool axis closest to the pose's, and X, Y, Z
-//! put the tip exactly on the point. The tool axis is then off by at most `pole_tolerance`;
+//! put the tip exactly on the point. The tool axis is then off by at most `pole_tolerance_rad`;
 //! [`SolvedPath::pole_tip_error`] reports `pivot_length * angle`: the tip error that angle
 //! would cause had X, Y, Z been computed for the requested tool axis instead (kerf re-places
 //! the tip, so what remains is the orientation error `angle`). Leaving the pole in a direction other than the kept C needs C to
@@ -30,7 +30,7 @@
 //! move), so that the tool axis never swings off the path.
 //!
 //! **Rotary steps.** Near the pole C moves as `1/sin(tilt)` for a given change of the tool
-//! axis. Every move whose rotary step `max(|d tilt|, |d C|)` exceeds `max_rotary_step`, and
+//! axis. Every move whose rotary step `max(|d tilt|, |d C|)` exceeds `max_rotary_step_deg`, and
 //! every move whose non-linearity error ([`crate::nonlinear`]) exceeds
 //! `linearization_tolerance`, is split by inserting poses: the position on the curve when the
 //! path has one ([`PathCurve`]), else on the straight segment; the tool axis on the great
@@ -40,6 +40,7 @@
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
+use crate::choice::{nearest_solution, nearest_turn};
 use crate::error::{KinematicsError, Result};
 use crate::kinematics::Kinematics;
 use crate::machine::Machine;
@@ -63,10 +64,10 @@ const MAX_PIECES: f64 = 1024.0;
 pub struct PathOptions {
     /// A pose whose tool axis is within this angle (radians) of the C axis is at the pole: C
     /// keeps its previous value. Finite and >= 0; default 1e-6.
-    pub pole_tolerance: f64,
+    pub pole_tolerance_rad: f64,
     /// The largest move of a rotary axis between two points (degrees); longer moves are
     /// split. > 0; default `f64::INFINITY` (no limit).
-    pub max_rotary_step: f64,
+    pub max_rotary_step_deg: f64,
     /// The largest non-linearity error (mm) of a move; moves with more are split. > 0;
     /// `f64::INFINITY` turns the insertion off. Default 0.005.
     pub linearization_tolerance: f64,
@@ -78,8 +79,8 @@ pub struct PathOptions {
 impl Default for PathOptions {
     fn default() -> Self {
         Self {
-            pole_tolerance: 1e-6,
-            max_rotary_step: f64::INFINITY,
+            pole_tolerance_rad: 1e-6,
+            max_rotary_step_deg: f64::INFINITY,
             linearization_tolerance: 0.005,
             max_inserted: 1_000_000,
         }
@@ -99,17 +100,17 @@ impl PathOptions {
                 reason,
             })
         };
-        if !(self.pole_tolerance.is_finite() && self.pole_tolerance >= 0.0) {
+        if !(self.pole_tolerance_rad.is_finite() && self.pole_tolerance_rad >= 0.0) {
             return bad(
-                "pole_tolerance",
-                self.pole_tolerance,
+                "pole_tolerance_rad",
+                self.pole_tolerance_rad,
                 "must be finite and >= 0 (radians)",
             );
         }
-        if self.max_rotary_step.is_nan() || self.max_rotary_step <= 0.0 {
+        if self.max_rotary_step_deg.is_nan() || self.max_rotary_step_deg <= 0.0 {
             return bad(
-                "max_rotary_step",
-                self.max_rotary_step,
+                "max_rotary_step_deg",
+                self.max_rotary_step_deg,
                 "must be > 0 (degrees; infinity for no limit)",
             );
         }
@@ -168,7 +169,7 @@ pub struct SolvedPath {
     pub source: Vec<Option<usize>>,
     /// The number of inserted points (`poses.len()` minus the cutting points).
     pub inserted: usize,
-    /// How many of them were inserted to keep rotary steps within `max_rotary_step`
+    /// How many of them were inserted to keep rotary steps within `max_rotary_step_deg`
     /// (including the C turns at the pole).
     pub inserted_for_rotary_step: usize,
     /// How many were inserted against the non-linearity error.
@@ -288,11 +289,6 @@ fn checked_poses(input: &PathInput<'_>) -> Result<Vec<Pose>> {
     Ok(out)
 }
 
-/// `value + 360 k` nearest `reference`.
-pub fn nearest_turn(value: f64, reference: f64) -> f64 {
-    value + 360.0 * ((reference - value) / 360.0).round()
-}
-
 /// Why the preferred solution of a pose cannot be used.
 #[derive(Debug, Clone)]
 struct Refusal {
@@ -359,7 +355,7 @@ impl Ctx<'_> {
     }
 
     fn is_pole(&self, pose: &Pose) -> bool {
-        self.kin.pole_angle(&pose.axis) <= self.options.pole_tolerance
+        self.kin.pole_angle(&pose.axis) <= self.options.pole_tolerance_rad
     }
 
     fn cutting(&self, n: usize) -> Node {
@@ -453,8 +449,11 @@ impl Ctx<'_> {
             q.c = nearest_turn(q.c, prev.c);
             q
         });
-        let travel = |q: &Axes| prev.rotary_travel(q);
-        let (pref, other) = if travel(&sols[1]) < travel(&sols[0]) {
+        // The preferred solution by the one choice rule, limits aside (they are checked next,
+        // so that a refusal can say which axis and what the other solution would do).
+        let second =
+            nearest_solution(sols, prev, |_| true).is_some_and(|q| q == sols[1] && q != sols[0]);
+        let (pref, other) = if second {
             (sols[1], sols[0])
         } else {
             (sols[0], sols[1])
@@ -619,7 +618,7 @@ impl Ctx<'_> {
         let mid = self.kin.forward(&prev.lerp(q, 0.5)).axis;
         let great = slerp(ua, ub, 0.5);
         angle_between(&mid, &great)
-            <= angle_between(ua, ub).max(self.options.pole_tolerance) + 1e-12
+            <= angle_between(ua, ub).max(self.options.pole_tolerance_rad) + 1e-12
     }
 
     /// The node a fraction `s` of the way from `a` to `b`.
@@ -676,7 +675,7 @@ impl Ctx<'_> {
                 let q = self.choose(&prev, &node, n)?;
                 let step = prev.axes.rotary_step(&q);
                 let dev = linearization_error(self.kin, &prev.axes, &q).distance;
-                let rotary_ok = step <= opts.max_rotary_step + LIMIT_SLACK;
+                let rotary_ok = step <= opts.max_rotary_step_deg + LIMIT_SLACK;
                 let linear_ok = dev <= opts.linearization_tolerance;
                 if rotary_ok && linear_ok {
                     max_dev = max_dev.max(dev);
@@ -713,7 +712,7 @@ impl Ctx<'_> {
                 };
                 let mut pieces: f64 = 2.0;
                 if !rotary_ok {
-                    pieces = pieces.max((step / opts.max_rotary_step).ceil());
+                    pieces = pieces.max((step / opts.max_rotary_step_deg).ceil());
                 }
                 if !linear_ok {
                     pieces = pieces.max((dev / opts.linearization_tolerance).sqrt().ceil());

@@ -6,7 +6,9 @@
 //! with `sc = c_sign`, `st = b_sign`. [`Orientation`] solves that for `(t, C)` once for all of
 //! them; a fifth type with another structure implements its own orientation.
 
-use nalgebra::Vector3;
+use nalgebra::{Point3, Vector3};
+
+use crate::pose::{Axes, Pose};
 
 /// `(sin, cos)` of an angle in degrees.
 #[inline]
@@ -168,6 +170,29 @@ impl Orientation {
             a,
             g,
         }
+    }
+
+    /// The one body of every type's [`crate::Kinematics::inverse`]: both solutions of the
+    /// tool axis ([`Orientation::solve`]), each placed at the tip by the type's `place`.
+    #[inline]
+    pub(crate) fn inverse(
+        &self,
+        pose: &Pose,
+        place: impl Fn(&Point3<f64>, &Angles) -> Axes,
+    ) -> [Axes; 2] {
+        self.solve(&pose.axis).map(|s| place(&pose.position, &s))
+    }
+
+    /// The one body of every type's [`crate::Kinematics::inverse_with_c`]: the tilt for C
+    /// fixed at `c` degrees ([`Orientation::tilt_for_c`]), placed at the tip by `place`.
+    #[inline]
+    pub(crate) fn inverse_with_c(
+        &self,
+        pose: &Pose,
+        c: f64,
+        place: impl Fn(&Point3<f64>, &Angles) -> Axes,
+    ) -> Axes {
+        place(&pose.position, &self.tilt_for_c(&pose.axis, c))
     }
 }
 

@@ -16,8 +16,8 @@ use serde_json::Value;
 
 use crate::error::Result;
 use crate::kinematics::Kinematics;
+use crate::params::{finite, KinematicsType, Params};
 use crate::pose::{Axes, Pose};
-use crate::registry::{finite, KinematicsType, Params};
 use crate::rotation::{inv, rot_x, rot_z, sin_cos_deg, Angles, Orientation, TiltAbout};
 
 /// The registry entry.
@@ -144,13 +144,12 @@ impl Kinematics for TableTable {
     }
 
     fn inverse(&self, pose: &Pose) -> [Axes; 2] {
-        self.orientation
-            .solve(&pose.axis)
-            .map(|s| self.place(&pose.position, &s))
+        self.orientation.inverse(pose, |p, s| self.place(p, s))
     }
 
     fn inverse_with_c(&self, pose: &Pose, c: f64) -> Axes {
-        self.place(&pose.position, &self.orientation.tilt_for_c(&pose.axis, c))
+        self.orientation
+            .inverse_with_c(pose, c, |p, s| self.place(p, s))
     }
 
     fn pivot_length(&self) -> f64 {

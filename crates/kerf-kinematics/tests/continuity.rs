@@ -40,7 +40,7 @@ fn assert_exact(machine: &Machine, path: &SolvedPath, options: &PathOptions) {
             .norm()
             .atan2(back.axis.dot(&pose.axis));
         assert!(
-            angle <= options.pole_tolerance + 1e-12,
+            angle <= options.pole_tolerance_rad + 1e-12,
             "point {n}: axis off by {angle:e}"
         );
     }
@@ -216,7 +216,7 @@ fn passing_just_outside_the_pole_tolerance_stays_continuous() {
     // 1e-4 rad beside the pole, sideways: C must turn by about 90 degrees within one step.
     let machine = fixture("ac_head.json");
     let options = PathOptions {
-        max_rotary_step: 5.0,
+        max_rotary_step_deg: 5.0,
         ..PathOptions::default()
     };
     let poses = through_the_pole(Some(polar(1e-4, 30f64.to_radians())));
@@ -246,7 +246,7 @@ fn leaving_the_pole_sideways_turns_c_at_the_pole() {
     // Tilt down to the pole along C = 0, stay there, leave along C = 90.
     let machine = fixture("ac_head.json");
     let options = PathOptions {
-        max_rotary_step: 5.0,
+        max_rotary_step_deg: 5.0,
         ..PathOptions::default()
     };
     let mut poses = Vec::new();
@@ -300,7 +300,7 @@ fn a_trunnion_turns_c_at_the_pole_rather_than_tilt_below_its_limit() {
     // -30; C turns 180 at the pole instead and A stays positive.
     let machine = fixture("table_table.json");
     let options = PathOptions {
-        max_rotary_step: 10.0,
+        max_rotary_step_deg: 10.0,
         ..PathOptions::default()
     };
     let poses: Vec<Pose> = (0..=60)
@@ -389,7 +389,7 @@ fn first_point_out_of_reach_is_point_0() {
 fn long_rotary_moves_are_split() {
     let machine = unlimited(Arc::new(AcHead::try_new(180.0, 95.0).unwrap()));
     let options = PathOptions {
-        max_rotary_step: 10.0,
+        max_rotary_step_deg: 10.0,
         linearization_tolerance: f64::INFINITY,
         ..PathOptions::default()
     };

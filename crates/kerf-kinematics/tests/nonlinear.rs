@@ -5,11 +5,12 @@ mod common;
 use std::sync::Arc;
 
 use common::{fixture, polar, unlimited};
-use kerf_kinematics::nonlinear::{distance_to_segment, linearization_error};
+use kerf_kinematics::linearization_error;
 use kerf_kinematics::{
     solve_path, ForkHead, ForkTilt, KinematicsError, Machine, PathCurve, PathInput, PathOptions,
     Pose, SolvedPath,
 };
+use kerf_nurbs::distance_to_segment;
 use nalgebra::{Point3, Vector3};
 
 /// A fork head tilting A with a 200 mm pivot and no offsets: XYZ = P + 200 u.

@@ -27,24 +27,24 @@ fn bad_options_are_named() {
     for (options, name) in [
         (
             PathOptions {
-                pole_tolerance: f64::NAN,
+                pole_tolerance_rad: f64::NAN,
                 ..PathOptions::default()
             },
-            "pole_tolerance",
+            "pole_tolerance_rad",
         ),
         (
             PathOptions {
-                pole_tolerance: -1.0,
+                pole_tolerance_rad: -1.0,
                 ..PathOptions::default()
             },
-            "pole_tolerance",
+            "pole_tolerance_rad",
         ),
         (
             PathOptions {
-                max_rotary_step: 0.0,
+                max_rotary_step_deg: 0.0,
                 ..PathOptions::default()
             },
-            "max_rotary_step",
+            "max_rotary_step_deg",
         ),
         (
             PathOptions {

@@ -13,16 +13,16 @@
 //!
 //! `docs/normals.md` has the details.
 
-pub mod error;
-pub mod mesh;
-pub mod surface;
+mod error;
+mod mesh;
+mod surface;
 
 pub use error::{NormalsError, Result};
 pub use mesh::{MeshNormals, DEFAULT_CREASE_ANGLE_DEG};
 pub use surface::{Hint, NormalSource, NurbsNormals, Projection};
 
-use kerf_discretize::bound::{Certifier, Scratch};
 use kerf_discretize::{discretize_range, Discretization, Options};
+use kerf_discretize::{Certifier, Scratch};
 use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3};
 

@@ -30,21 +30,21 @@ pub const DEFAULT_CREASE_ANGLE_DEG: f64 = 30.0;
 impl MeshNormals {
     /// Builds the mesh (duplicate vertices merged, degenerate triangles removed) and its corner
     /// normals. The normal follows the winding (counter-clockwise = outward), reversed if
-    /// `flip`. `crease_angle` in radians.
+    /// `flip`. `crease_angle_deg` in degrees (like [`DEFAULT_CREASE_ANGLE_DEG`]).
     ///
     /// # Errors
     /// [`NormalsError::BadMesh`] for non-finite vertices, bad indices or no usable triangle;
-    /// [`NormalsError::BadOption`] for a crease angle outside `[0, pi]`.
+    /// [`NormalsError::BadOption`] for a crease angle outside `[0, 180]` degrees.
     pub fn new(
         vertices: Vec<Point3<f64>>,
         triangles: Vec<[u32; 3]>,
-        crease_angle: f64,
+        crease_angle_deg: f64,
         flip: bool,
     ) -> Result<Self> {
-        if !(0.0..=std::f64::consts::PI).contains(&crease_angle) {
+        if !(0.0..=180.0).contains(&crease_angle_deg) {
             return Err(NormalsError::BadOption {
-                name: "crease_angle",
-                value: crease_angle,
+                name: "crease_angle_deg",
+                value: crease_angle_deg,
                 reason: "must lie in [0, 180] degrees",
             });
         }
@@ -64,7 +64,11 @@ impl MeshNormals {
             TriMeshFlags::MERGE_DUPLICATE_VERTICES | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES;
         let mesh = TriMesh::with_flags(vertices, triangles, flags)
             .map_err(|e| NormalsError::BadMesh(format!("{e:?}")))?;
-        let corner = corner_normals(mesh.vertices(), mesh.indices(), crease_angle);
+        let corner = corner_normals(
+            mesh.vertices(),
+            mesh.indices(),
+            crease_angle_deg.to_radians(),
+        );
         if corner.iter().all(|c| c.norm() == 0.0) {
             return Err(NormalsError::BadMesh(
                 "no triangle with a non-zero area".into(),

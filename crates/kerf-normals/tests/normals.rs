@@ -252,7 +252,7 @@ fn cylinder_mesh(r: f64, h: f64, n: usize, flip: bool) -> (Vec<Point3<f64>>, Vec
 fn cylinder_mesh_normals_within_the_facet_bound() {
     let n = 72;
     let (v, t) = cylinder_mesh(20.0, 100.0, n, false);
-    let mesh = MeshNormals::new(v, t, 30f64.to_radians(), false).unwrap();
+    let mesh = MeshNormals::new(v, t, 30.0, false).unwrap();
     assert_eq!(mesh.triangle_count(), 2 * n, "facet count");
     // The circle at mid height lies inside the facets (the mesh is inscribed): use one on it
     // by projecting, with a generous on-surface tolerance for the facet sagitta.
@@ -282,7 +282,7 @@ fn cylinder_mesh_normals_within_the_facet_bound() {
     assert!(o.jumps.is_empty(), "no jumps on a smooth mesh");
     // Reversed winding flips every normal.
     let (v, t) = cylinder_mesh(20.0, 100.0, n, true);
-    let flipped = MeshNormals::new(v, t, 30f64.to_radians(), false).unwrap();
+    let flipped = MeshNormals::new(v, t, 30.0, false).unwrap();
     let of = orient(&curve, &d, &flipped, &opts, &nopts).unwrap();
     assert_eq!(o.params, of.params, "same points");
     // (Exactly, except where a point is equidistant from two facets and the two meshes pick
@@ -328,7 +328,7 @@ fn box_mesh() -> (Vec<Point3<f64>>, Vec<[u32; 3]>) {
 #[test]
 fn box_mesh_edges_are_not_blended() {
     let (v, t) = box_mesh();
-    let mesh = MeshNormals::new(v, t, 30f64.to_radians(), false).unwrap();
+    let mesh = MeshNormals::new(v, t, 30.0, false).unwrap();
     // A line on the top face, then down the side: a polyline with a corner on the 90 degree edge.
     let curve = NurbsCurve::new(
         1,
@@ -371,7 +371,7 @@ fn an_inconsistently_oriented_mesh_is_an_error() {
         Point3::new(20.0, 10.0, 0.0),
     ];
     let t = vec![[0, 1, 2], [0, 2, 3], [1, 2, 5], [1, 5, 4]];
-    let strip = MeshNormals::new(v, t, 30f64.to_radians(), false).unwrap();
+    let strip = MeshNormals::new(v, t, 30.0, false).unwrap();
     let across = NurbsCurve::new(
         1,
         vec![0.0, 0.0, 1.0, 1.0],
@@ -422,7 +422,7 @@ fn large_parameter_values_do_not_recurse_forever_at_a_jump() {
     // Parameters near 1e7 are 1.9e-9 apart, coarser than 1e-9 of the domain: the split must
     // stop when the midpoint is no longer strictly inside, and report the jump.
     let (v, t) = box_mesh();
-    let mesh = MeshNormals::new(v, t, 30f64.to_radians(), false).unwrap();
+    let mesh = MeshNormals::new(v, t, 30.0, false).unwrap();
     let base = 1e7;
     let curve = NurbsCurve::new(
         1,

@@ -137,7 +137,7 @@ impl NurbsCurve {
     /// distance from `p` to the bounding box of each piece's control points, a lower bound on
     /// the distance to the piece (convex hull property). The piece with the smallest bound is
     /// taken next; once that bound is not below the best distance found, the search ends. The
-    /// Bernstein coefficients of `g = B . (B' w - B w')` (see the [module](self) docs) classify
+    /// Bernstein coefficients of `g = B . (B' w - B w')` (see the docs of `closest.rs`) classify
     /// the piece: no sign change leaves its ends as candidates; one change from `-` to `+`
     /// brackets the single interior minimum, found by Newton's method on
     /// `(C - p) . C'` safeguarded by bisection; more changes split the piece in half (its

@@ -24,23 +24,37 @@
 //! # Ok::<(), kerf_nurbs::NurbsError>(())
 //! ```
 
-pub mod arclength;
-pub mod basis;
-pub mod bezier;
-pub mod closest;
-pub mod curve;
-pub mod error;
-pub mod knots;
-pub mod samples;
-pub mod surface;
-pub mod work;
+mod arclength;
+mod basis;
+mod bezier;
+mod closest;
+mod curve;
+mod error;
+mod geom;
+mod knots;
+#[cfg(feature = "samples")]
+mod samples;
+mod surface;
+mod work;
 
-pub use arclength::Quadrature;
+pub use arclength::{
+    gauss10, integrate, Bracket, Quadrature, GL10_NODES, GL10_WEIGHTS, LENGTH_RELATIVE_ACCURACY,
+    SPLITS_PER_SPAN,
+};
+pub use basis::{basis_funs, basis_funs_m, binomial, ders_basis_funs, ders_basis_funs_m};
 pub use bezier::RationalBezier;
-pub use closest::CurveProjection;
-pub use curve::{FrenetFrame, NurbsCurve};
+pub use closest::{CurveProjection, CLOSEST_POPS_PER_PIECE};
+pub use curve::{
+    curvature_of, hull_box, normalized_weights, project, rational_from_homogeneous, scale_pow2,
+    FrenetFrame, NurbsCurve, MIN_NORMALISED_WEIGHT,
+};
 pub use error::{NurbsError, Readable, Result};
+pub use geom::{distance_to_segment, nearest_on_segment, Segment};
+pub use knots::{find_span, interior_knots, multiplicity, validate as validate_knots};
+#[cfg(feature = "samples")]
+pub use samples::{smooth_random_curves, Lcg};
 pub use surface::{NurbsSurface, SurfaceProjection};
+pub use work::{counted, evaluations, tick};
 
 /// The largest degree kerf accepts. CAD systems use degree <= 11 in practice; the fixed-size
 /// scratch arrays of the evaluator are sized by this constant.

@@ -30,8 +30,8 @@ impl Lcg {
 /// so each is about 200 mm long and curved like a free-form cut contour.
 ///
 /// ```
-/// let a = kerf_nurbs::samples::smooth_random_curves(3, 4, 7);
-/// let b = kerf_nurbs::samples::smooth_random_curves(3, 4, 7);
+/// let a = kerf_nurbs::smooth_random_curves(3, 4, 7);
+/// let b = kerf_nurbs::smooth_random_curves(3, 4, 7);
 /// assert_eq!(a, b, "seeded: the same curves every time");
 /// ```
 pub fn smooth_random_curves(degree: usize, count: usize, seed: u64) -> Vec<NurbsCurve> {

@@ -1650,7 +1650,7 @@ fn arc_length_of_extreme_weights_and_far_small_circles_is_budgeted() {
             Some(vec![1.0, w, 1.0]),
         )
     };
-    let budget = 30 + 40 * kerf_nurbs::arclength::SPLITS_PER_SPAN;
+    let budget = 30 + 40 * kerf_nurbs::SPLITS_PER_SPAN;
     // Weight 1e12: the curve is the control polygon's two legs (length 100 to 1e-10), traced
     // within 1e-11 of the parameter's ends, where no Gauss node of a coarse panel looks.
     let q = arc(1e12).arc_length_quadrature(0.0, 1.0);
@@ -1696,7 +1696,7 @@ fn arc_length_of_extreme_weights_and_far_small_circles_is_budgeted() {
 /// The quadrature never exceeds its budget, whatever the integrand does.
 #[test]
 fn integrate_stops_at_its_budget_on_a_hostile_integrand() {
-    use kerf_nurbs::arclength::integrate;
+    use kerf_nurbs::integrate;
     // Rough everywhere: no accuracy is reachable.
     let q = integrate(
         |t| (1e6 * t).sin().abs() * 1e3,

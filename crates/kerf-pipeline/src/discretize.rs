@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use kerf_discretize::{Discretization, Options};
-use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
+use kerf_format::toolpath::{self, ToolpathFile, ToolpathPoints, ToolpathRecord};
 use kerf_format::{curves, CurvesFile, SurfaceGeometry};
 use kerf_normals::{
     orient, Hint, MeshNormals, NormalOptions, NormalSource, NurbsNormals, Oriented, Projection,
@@ -111,10 +111,10 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             .curves
             .iter()
             .zip(&results)
-            .map(|(rec, d)| ToolPath {
+            .map(|(rec, d)| ToolpathRecord {
                 id: rec.id.clone(),
                 params: d.params().to_vec(),
-                points: ToolPathPoints::Positions(
+                points: ToolpathPoints::Positions(
                     d.points().iter().map(|p| [p.x, p.y, p.z]).collect(),
                 ),
                 max_chord_error: d.max_chord_error(),
@@ -124,10 +124,10 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             .curves
             .iter()
             .zip(o)
-            .map(|(rec, o)| ToolPath {
+            .map(|(rec, o)| ToolpathRecord {
                 id: rec.id.clone(),
                 params: o.params.clone(),
-                points: ToolPathPoints::Poses(o.poses()),
+                points: ToolpathPoints::Poses(o.poses()),
                 max_chord_error: o.max_chord_error,
             })
             .collect(),
@@ -266,17 +266,13 @@ fn normal_sources(
                     vertices,
                     triangles,
                 } => Box::new(
-                    MeshNormals::new(
-                        vertices.clone(),
-                        triangles.clone(),
-                        crease.to_radians(),
-                        s.flip,
-                    )
-                    .map_err(|error| CliError::Normals {
-                        file: path.to_path_buf(),
-                        place: format!("surfaces[{i}] ({:?})", s.id),
-                        error,
-                    })?,
+                    MeshNormals::new(vertices.clone(), triangles.clone(), crease, s.flip).map_err(
+                        |error| CliError::Normals {
+                            file: path.to_path_buf(),
+                            place: format!("surfaces[{i}] ({:?})", s.id),
+                            error,
+                        },
+                    )?,
                 ),
             };
             Ok(Some(src))

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use kerf_format::toolpath;
 use kerf_interp::{
     gcode_motion, stations_from_axes, stations_from_solved, write_csv, AxisModel, Dialect,
-    FitOptions, GcodeOptions, MachineModel, Motion, PathInput, PlanOptions,
+    FitOptions, GcodeOptions, MachineModel, Motion, PlanOptions, ProgramPath,
 };
 use kerf_kinematics::{solve_path, AxesFile, Machine, PathOptions, Pose};
 use nalgebra::Vector3;
@@ -66,7 +66,7 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
             .map_err(|e| CliError::Kinematics(Box::new(e), Some(input.clone())))?;
         let mut paths = Vec::new();
         for p in &axes.paths {
-            paths.push(PathInput {
+            paths.push(ProgramPath {
                 id: p.id.clone(),
                 stations: {
                     // Lead-in, cut and lead-out, as the machine runs them.
@@ -103,7 +103,7 @@ pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliEr
                 &PathOptions::default(),
             )
             .map_err(|e| CliError::Kinematics(Box::new(e), Some(input.clone())))?;
-            paths.push(PathInput {
+            paths.push(ProgramPath {
                 id: p.id.clone(),
                 stations: stations_from_solved(&solved, Some(&p.params))
                     .map_err(interp_err(input))?,
@@ -252,7 +252,7 @@ pub(crate) fn write_program(p: &Program, dest: &Path, opts: &GcodeOptions) -> Re
         std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes())?;
         return Ok(());
     }
-    kerf_interp::output::write_atomic(dest, text.as_bytes()).map_err(interp_err(dest))
+    kerf_interp::write_atomic(dest, text.as_bytes()).map_err(interp_err(dest))
 }
 
 /// Runs `kerf gcode`.

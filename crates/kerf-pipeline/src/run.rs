@@ -6,10 +6,10 @@ use std::path::Path;
 use std::time::Instant;
 
 use kerf_discretize::Discretization;
-use kerf_format::toolpath::{self, ToolPath, ToolPathPoints, ToolpathFile};
+use kerf_format::toolpath::{self, ToolpathFile, ToolpathPoints, ToolpathRecord};
 use kerf_interp::{
     gcode_motion, stations_from_solved, write_csv_to, AxisModel, Dialect, GcodeOptions,
-    MachineModel, PathInput as InterpPath, PlanOptions,
+    MachineModel, PlanOptions, ProgramPath as InterpPath,
 };
 use kerf_io::DirEntry;
 use kerf_kinematics::{solve_paths, AxesFile, Machine, PathCurve, PathInput, PathOptions, Pose};
@@ -60,10 +60,10 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             .curves
             .iter()
             .zip(&oriented)
-            .map(|(rec, o)| ToolPath {
+            .map(|(rec, o)| ToolpathRecord {
                 id: rec.id.clone(),
                 params: o.params.clone(),
-                points: ToolPathPoints::Poses(o.poses()),
+                points: ToolpathPoints::Poses(o.poses()),
                 max_chord_error: o.max_chord_error,
             })
             .collect(),
@@ -73,7 +73,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         linearization_tolerance: args
             .linearization_tolerance
             .unwrap_or(PathOptions::default().linearization_tolerance),
-        max_rotary_step: args.max_rotary_step.unwrap_or(f64::INFINITY),
+        max_rotary_step_deg: args.max_rotary_step.unwrap_or(f64::INFINITY),
         ..PathOptions::default()
     };
     let poses: Vec<Vec<Pose>> = oriented

@@ -53,7 +53,7 @@ use std::path::Path;
 mod charts;
 mod layout;
 mod scale;
-pub mod scene;
+mod scene;
 mod svg;
 mod views;
 

@@ -4,7 +4,7 @@
 
 use kerf_format::{CurvesFile, ToolpathFile};
 use kerf_kinematics::{AxesFile, Machine};
-use kerf_nurbs::NurbsCurve;
+use kerf_nurbs::{NurbsCurve, Segment};
 use nalgebra::{Point3, Vector3};
 
 use crate::PlotError;
@@ -219,18 +219,9 @@ pub fn sampled_chord_error(
     samples: usize,
 ) -> f64 {
     let n = samples.max(2);
-    let ab = p1 - p0;
-    let len2 = ab.norm_squared();
+    let chord = Segment::between(p0, p1);
     (0..=n)
-        .map(|k| {
-            let q = curve.point(t0 + (t1 - t0) * (k as f64 / n as f64));
-            let s = if len2 > 0.0 {
-                ((q - p0).dot(&ab) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (q - (p0 + ab * s)).norm()
-        })
+        .map(|k| chord.distance_to(&curve.point(t0 + (t1 - t0) * (k as f64 / n as f64))))
         .fold(0.0, f64::max)
 }
 
@@ -285,7 +276,7 @@ mod tests {
 
     /// 21 equally spaced params per curve, points on the curve.
     fn toolpath(file: &CurvesFile) -> ToolpathFile {
-        use kerf_format::{ToolPath, ToolPathPoints};
+        use kerf_format::{ToolpathPoints, ToolpathRecord};
         ToolpathFile {
             units: kerf_format::Units::Millimetres,
             tolerance: 0.5,
@@ -301,10 +292,10 @@ mod tests {
                         .iter()
                         .map(|&t| c.curve.point(t).coords.into())
                         .collect();
-                    ToolPath {
+                    ToolpathRecord {
                         id: c.id.clone(),
                         params,
-                        points: ToolPathPoints::Positions(points),
+                        points: ToolpathPoints::Positions(points),
                         max_chord_error: 0.0,
                     }
                 })

@@ -2,6 +2,7 @@
 //! when it runs counter-clockwise seen from the normal), winding-number containment and
 //! segment crossings.
 
+use kerf_nurbs::Segment;
 use nalgebra::{Point3, Vector2, Vector3};
 
 use crate::PoseArray;
@@ -135,7 +136,7 @@ impl Projected {
         let q = self.project(p);
         let n = self.poly.len();
         (0..n)
-            .map(|i| segment_distance(q, self.poly[i], self.poly[(i + 1) % n]))
+            .map(|i| Segment::new(self.poly[i], self.poly[(i + 1) % n]).distance(&q))
             .fold(f64::INFINITY, f64::min)
     }
 }
@@ -147,16 +148,4 @@ fn segments_cross(p: Vector2<f64>, q: Vector2<f64>, a: Vector2<f64>, b: Vector2<
     let d3 = (b - a).perp(&(p - a));
     let d4 = (b - a).perp(&(q - a));
     (d1 * d2 <= 0.0) && (d3 * d4 <= 0.0) && !(d1 == 0.0 && d2 == 0.0)
-}
-
-/// The distance from `q` to the segment `a b`.
-fn segment_distance(q: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((q - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (q - (a + ab * t)).norm()
 }

@@ -3,19 +3,10 @@
 
 use kerf_discretize::Discretization;
 use kerf_nurbs::NurbsCurve;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 use proptest::prelude::*;
 
-/// Distance from q to segment [a, b].
-pub fn seg_dist(q: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    let ab: Vector3<f64> = b - a;
-    let l2 = ab.norm_squared();
-    if l2 == 0.0 {
-        return (q - a).norm();
-    }
-    let s = ((q - a).dot(&ab) / l2).clamp(0.0, 1.0);
-    (q - (a + ab * s)).norm()
-}
+pub use kerf_nurbs::distance_to_segment as seg_dist;
 
 /// True chord error of [t0, t1] by dense sampling (per knot span) and golden-section refinement
 /// around the best samples. Independent of the discretizer's Bezier bound.

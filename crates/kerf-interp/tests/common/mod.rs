@@ -3,7 +3,7 @@
 #![allow(dead_code, unreachable_pub)]
 
 use kerf_discretize::{discretize, Options};
-use kerf_interp::{solve_stations, AcHead, AxisModel, Station};
+use kerf_interp::{solve_stations, AxisModel, PaperAcHead, Station};
 use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3};
 
@@ -62,7 +62,7 @@ pub fn cut(curve: &NurbsCurve, tol: f64) -> (Vec<f64>, Vec<Point3<f64>>) {
 
 /// Stations of a curve with tool axes from `axis_of(point)`.
 pub fn stations(
-    m: &AcHead,
+    m: &PaperAcHead,
     curve: &NurbsCurve,
     tol: f64,
     axis_of: impl Fn(&Point3<f64>) -> Vector3<f64>,

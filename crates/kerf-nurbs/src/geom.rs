@@ -1,0 +1,80 @@
+//! Point-to-segment distance: the one implementation every kerf crate calls (the discretizer's
+//! certified bound, the arc fitter, the linearization error of the kinematics, the checker's
+//! dense sampling, the cut-order geometry of the process crate).
+//!
+//! The nearest point of the segment `a + s (b - a)`, `s` in `[0, 1]`, to `q` is at
+//! `s = clamp((q - a).(b - a) / |b - a|^2, 0, 1)`; a segment of zero length (or one whose
+//! squared length is not a positive number) is the point `a`, at `s = 0`. The difference
+//! `q - a` is formed once and the distance taken as `|(q - a) - s (b - a)|`, so a point on the
+//! segment gives exactly 0 at its ends.
+
+use nalgebra::{Point3, SVector};
+
+/// A segment from `start` to `start + direction` in `D` dimensions, prepared for many distance
+/// queries (its squared length is computed once).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Segment<const D: usize> {
+    start: SVector<f64, D>,
+    direction: SVector<f64, D>,
+    length_squared: f64,
+}
+
+impl<const D: usize> Segment<D> {
+    /// The segment from `a` to `b`.
+    #[inline]
+    pub fn new(a: SVector<f64, D>, b: SVector<f64, D>) -> Self {
+        let direction = b - a;
+        Self {
+            start: a,
+            direction,
+            length_squared: direction.norm_squared(),
+        }
+    }
+
+    /// The nearest point of the segment to `q`: its distance (in the units of the coordinates,
+    /// mm in kerf) and its parameter `s` in `[0, 1]` (0 at the start, 1 at the end; 0 when the
+    /// segment has no length).
+    #[inline]
+    pub fn nearest(&self, q: &SVector<f64, D>) -> (f64, f64) {
+        let aq = q - self.start;
+        let s = if self.length_squared > 0.0 {
+            (aq.dot(&self.direction) / self.length_squared).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        ((aq - self.direction * s).norm(), s)
+    }
+
+    /// The distance from `q` to the nearest point of the segment.
+    #[inline]
+    pub fn distance(&self, q: &SVector<f64, D>) -> f64 {
+        self.nearest(q).0
+    }
+}
+
+impl Segment<3> {
+    /// The segment between two points of space.
+    #[inline]
+    pub fn between(a: &Point3<f64>, b: &Point3<f64>) -> Self {
+        Self::new(a.coords, b.coords)
+    }
+
+    /// The distance from the point `q` to the segment.
+    #[inline]
+    pub fn distance_to(&self, q: &Point3<f64>) -> f64 {
+        self.distance(&q.coords)
+    }
+}
+
+/// The distance from `q` to the segment `a b` (to `a` when the segment has zero length).
+#[inline]
+pub fn distance_to_segment(q: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
+    Segment::between(a, b).distance_to(q)
+}
+
+/// The nearest point of the segment `a b` to `q`: its distance and its parameter `s` in
+/// `[0, 1]` along `a -> b`.
+#[inline]
+pub fn nearest_on_segment(q: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> (f64, f64) {
+    Segment::between(a, b).nearest(&q.coords)
+}

@@ -99,7 +99,10 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
     let opts = GcodeOptions::new(Dialect::Generic, 6000.0);
     let refused = gcode(&m, &arcs, &["door-trim-1".to_string()], None, &opts);
     assert!(
-        matches!(refused, Err(kerf_interp::InterpError::UncheckedBlock { .. })),
+        matches!(
+            refused,
+            Err(kerf_interp::InterpError::UncheckedBlock { .. })
+        ),
         "arcs or merged lines in a generic program are refused: {refused:?}"
     );
     let lines_only = FitOptions {

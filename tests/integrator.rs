@@ -45,7 +45,9 @@ fn the_integrator_program_cuts_the_circle_within_the_tolerance() {
     let tol = 0.01;
     let digits = 1e-3; // the program's rounding, generously
     let codes = |key: &str| -> Vec<String> {
-        let list = out.report["program"][key].as_array().expect("process codes");
+        let list = out.report["program"][key]
+            .as_array()
+            .expect("process codes");
         list.iter()
             .map(|c| c.as_str().expect("a code").to_string())
             .collect()

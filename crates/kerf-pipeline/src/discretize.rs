@@ -65,23 +65,18 @@ pub fn toolpath_of_points(
     tolerance_mm: f64,
     discs: &[Discretization],
 ) -> ToolpathFile {
-    ToolpathFile {
-        units: file.units,
-        tolerance: tolerance_mm,
-        paths: file
-            .curves
-            .iter()
-            .zip(discs)
-            .map(|(rec, d)| ToolPath {
-                id: rec.id.clone(),
-                params: d.params.clone(),
-                points: ToolPathPoints::Positions(
-                    d.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
-                ),
-                max_chord_error: d.max_chord_error,
-            })
-            .collect(),
-    }
+    toolpath(
+        file,
+        tolerance_mm,
+        discs.iter().map(|d| {
+            let points = d.points.iter().map(|p| [p.x, p.y, p.z]).collect();
+            (
+                &d.params,
+                ToolPathPoints::Positions(points),
+                d.max_chord_error,
+            )
+        }),
+    )
 }
 
 /// The `kerf.toolpath/1` document of `oriented` (`[x, y, z, i, j, k]` points): one path per
@@ -91,18 +86,37 @@ pub fn toolpath_of_poses(
     tolerance_mm: f64,
     oriented: &[Oriented],
 ) -> ToolpathFile {
+    toolpath(
+        file,
+        tolerance_mm,
+        oriented.iter().map(|o| {
+            (
+                &o.params,
+                ToolPathPoints::Poses(o.poses()),
+                o.max_chord_error,
+            )
+        }),
+    )
+}
+
+/// One path per curve: its id, then the params, points and chord error given.
+fn toolpath<'a>(
+    file: &CurvesFile,
+    tolerance_mm: f64,
+    paths: impl Iterator<Item = (&'a Vec<f64>, ToolPathPoints, f64)>,
+) -> ToolpathFile {
     ToolpathFile {
         units: file.units,
         tolerance: tolerance_mm,
         paths: file
             .curves
             .iter()
-            .zip(oriented)
-            .map(|(rec, o)| ToolPath {
+            .zip(paths)
+            .map(|(rec, (params, points, max_chord_error))| ToolPath {
                 id: rec.id.clone(),
-                params: o.params.clone(),
-                points: ToolPathPoints::Poses(o.poses()),
-                max_chord_error: o.max_chord_error,
+                params: params.clone(),
+                points,
+                max_chord_error,
             })
             .collect(),
     }

@@ -47,9 +47,8 @@ pub use discretize::{discretize_curves, orient_curves, toolpath_of_points, toolp
 pub use error::{Error, Result};
 pub use job::{Job, JobOptions, MissingSurface, OrientOptions};
 pub use motion::{fit_options, path_report, plan_program, MotionInput, MotionOptions, Program};
-pub use output::{Output, SetupProgram};
+pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};
 pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};
-pub use run::{csv_names, program_names, OUTPUTS};
 
 /// A stage of a job, as [`Progress`] reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

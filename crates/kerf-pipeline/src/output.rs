@@ -13,7 +13,6 @@ use kerf_normals::Oriented;
 
 use crate::error::{Error, Result};
 use crate::place::Placed;
-use crate::run::OUTPUTS;
 
 /// One set-up's program: the part is clamped anew between set-ups, so each is a job of its
 /// own for the machine.
@@ -33,7 +32,32 @@ pub struct SetupProgram {
     pub text: String,
 }
 
-/// Every stage's result of a [`Job::run`].
+impl SetupProgram {
+    /// The programs of the set-ups in order, named `program.nc` or `program-1.nc`, ...
+    pub(crate) fn numbered(
+        motions: Vec<Motion>,
+        texts: Vec<String>,
+        ids: Vec<Vec<String>>,
+    ) -> Vec<SetupProgram> {
+        let names = program_names(motions.len());
+        let csv_names = csv_names(motions.len());
+        motions
+            .into_iter()
+            .zip(texts)
+            .zip(ids)
+            .enumerate()
+            .map(|(k, ((motion, text), ids))| SetupProgram {
+                name: names[k].clone(),
+                setpoints_name: csv_names[k].clone(),
+                ids,
+                motion,
+                text,
+            })
+            .collect()
+    }
+}
+
+/// Every stage's result of a [`Job::run`](crate::Job::run).
 #[derive(Debug)]
 #[non_exhaustive]
 pub struct Output {
@@ -171,3 +195,34 @@ impl Output {
         })
     }
 }
+
+/// `program.nc` for one set-up; `program-1.nc`, `program-2.nc`, ... for several (each set-up is
+/// a job of its own: the part is clamped anew between them).
+pub fn program_names(setups: usize) -> Vec<String> {
+    if setups == 1 {
+        vec!["program.nc".to_string()]
+    } else {
+        (1..=setups).map(|k| format!("program-{k}.nc")).collect()
+    }
+}
+
+/// The set-point files matching [`program_names`].
+pub fn csv_names(setups: usize) -> Vec<String> {
+    if setups == 1 {
+        vec!["setpoints.csv".to_string()]
+    } else {
+        (1..=setups).map(|k| format!("setpoints-{k}.csv")).collect()
+    }
+}
+
+/// The files `kerf run` writes into its output directory for one set-up, all or nothing
+/// (through [`kerf_io::write_dir_all_or_nothing`]); several set-ups number the program and
+/// set-point files ([`program_names`], [`csv_names`]).
+pub const OUTPUTS: [&str; 6] = [
+    "toolpath.json",
+    "axes.json",
+    "program.nc",
+    "setpoints.csv",
+    "report.json",
+    "plot.svg",
+];

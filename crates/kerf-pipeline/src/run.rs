@@ -17,14 +17,14 @@ use serde_json::json;
 use crate::discretize::{discretize_curves, orient_curves, toolpath_of_poses};
 use crate::error::{interp, kin, Result};
 use crate::job::Job;
-use crate::output::{Output, SetupProgram};
+use crate::output::{program_names, Output, SetupProgram};
 use crate::{Progress, Stage};
 
 impl Job {
     /// Runs every stage in memory.
     ///
     /// # Errors
-    /// The first stage's [`Error`], naming the file (see [`Job::with_source`]) and the curve.
+    /// The first stage's [`Error`](crate::Error), naming the file (see [`Job::with_source`]) and the curve.
     pub fn run(&self) -> Result<Output> {
         self.run_with_progress(&|_| {})
     }
@@ -252,21 +252,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         },
         "seconds": start.elapsed().as_secs_f64(),
     });
-    let names = program_names(motions.len());
-    let csv_names = csv_names(motions.len());
-    let programs = motions
-        .into_iter()
-        .zip(programs)
-        .zip(setup_ids)
-        .enumerate()
-        .map(|(k, ((motion, text), ids))| SetupProgram {
-            name: names[k].clone(),
-            setpoints_name: csv_names[k].clone(),
-            ids,
-            motion,
-            text,
-        })
-        .collect();
+    let programs = SetupProgram::numbered(motions, programs, setup_ids);
     Ok(Output {
         discretizations: discs,
         oriented,
@@ -281,34 +267,3 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         cycle_s: o.cycle_s,
     })
 }
-
-/// `program.nc` for one set-up; `program-1.nc`, `program-2.nc`, ... for several (each set-up is
-/// a job of its own: the part is clamped anew between them).
-pub fn program_names(setups: usize) -> Vec<String> {
-    if setups == 1 {
-        vec!["program.nc".to_string()]
-    } else {
-        (1..=setups).map(|k| format!("program-{k}.nc")).collect()
-    }
-}
-
-/// The set-point files matching [`program_names`].
-pub fn csv_names(setups: usize) -> Vec<String> {
-    if setups == 1 {
-        vec!["setpoints.csv".to_string()]
-    } else {
-        (1..=setups).map(|k| format!("setpoints-{k}.csv")).collect()
-    }
-}
-
-/// The files `kerf run` writes into its output directory for one set-up, all or nothing
-/// (through [`kerf_io::write_dir_all_or_nothing`]); several set-ups number the program and
-/// set-point files ([`program_names`], [`csv_names`]).
-pub const OUTPUTS: [&str; 6] = [
-    "toolpath.json",
-    "axes.json",
-    "program.nc",
-    "setpoints.csv",
-    "report.json",
-    "plot.svg",
-];

@@ -120,13 +120,7 @@ impl Output {
     /// # Errors
     /// [`Error::Write`] if `w` fails or there is no such set-up.
     pub fn write_setpoints(&self, setup: usize, mut w: impl Write) -> Result<()> {
-        let p = self.programs.get(setup).ok_or_else(|| Error::Write {
-            path: None,
-            source: std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                format!("no set-up {setup} (there are {})", self.programs.len()),
-            ),
-        })?;
+        let p = self.setup(setup)?;
         write_csv_to(
             &mut w,
             self.model.axis_names(),
@@ -134,6 +128,44 @@ impl Output {
             p.motion.iter(&self.model),
         )
         .map_err(|source| Error::Write { path: None, source })
+    }
+
+    /// Writes the G-code program of set-up `setup` to `w`.
+    ///
+    /// # Errors
+    /// [`Error::Write`] if `w` fails or there is no such set-up.
+    pub fn write_program(&self, setup: usize, mut w: impl Write) -> Result<()> {
+        let p = self.setup(setup)?;
+        w.write_all(p.text.as_bytes())
+            .map_err(|source| Error::Write { path: None, source })
+    }
+
+    /// Writes the report (pretty JSON) to `w`.
+    ///
+    /// # Errors
+    /// [`Error::Write`] if `w` fails.
+    pub fn write_report(&self, mut w: impl Write) -> Result<()> {
+        w.write_all(self.report_text().as_bytes())
+            .map_err(|source| Error::Write { path: None, source })
+    }
+
+    /// Writes the picture (SVG) to `w`.
+    ///
+    /// # Errors
+    /// [`Error::Write`] if `w` fails.
+    pub fn write_plot(&self, mut w: impl Write) -> Result<()> {
+        w.write_all(self.plot_svg.as_bytes())
+            .map_err(|source| Error::Write { path: None, source })
+    }
+
+    fn setup(&self, setup: usize) -> Result<&SetupProgram> {
+        self.programs.get(setup).ok_or_else(|| Error::Write {
+            path: None,
+            source: std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("no set-up {setup} (there are {})", self.programs.len()),
+            ),
+        })
     }
 
     /// The report as pretty JSON text.

@@ -47,7 +47,7 @@ pub(crate) fn run(args: &CheckArgs) -> Result<(), CliError> {
             message: "only one of CURVES.json and TOOLPATH.json can be `-` (standard input)".into(),
         }));
     }
-    let curves = crate::discretize::load_curves(&args.curves)?;
+    let curves = crate::input::load_curves(&args.curves)?;
     let toolpath = if args.toolpath == Path::new("-") {
         let bytes = kerf_io::read_to_end(io::stdin().lock(), kerf_io::MAX_INPUT_BYTES).map_err(
             |error| kerf_check::CheckError::Read {

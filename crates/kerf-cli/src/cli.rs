@@ -263,8 +263,8 @@ pub(crate) struct PostArgs {
     /// motion centred in the travel, contours turned to the side the head can reach, the part
     /// turned by quarter turns if it does not fit as modelled) or `X,Y,Z[,RX,RY,RZ]` (mm,
     /// degrees; `p' = Rz Ry Rx p + t`). Default: where the CAD model put it.
-    #[arg(long, value_name = "auto|X,Y,Z[,RX,RY,RZ]", value_parser = crate::place::parse_place, allow_hyphen_values = true)]
-    pub(crate) place: Option<crate::place::PlaceArg>,
+    #[arg(long, value_name = "auto|X,Y,Z[,RX,RY,RZ]", value_parser = kerf_pipeline::PlaceMode::parse, allow_hyphen_values = true)]
+    pub(crate) place: Option<kerf_pipeline::PlaceMode>,
 
     /// Tool axes within this angle of the C axis count as the pole, in radians (default 1e-6).
     #[arg(long, value_name = "RAD", value_parser = crate::guard::small_angle_rad)]
@@ -444,8 +444,8 @@ pub(crate) struct RunArgs {
     /// motion centred in the travel, contours turned to the side the head can reach, the part
     /// turned by quarter turns if it does not fit as modelled) or `X,Y,Z[,RX,RY,RZ]` (mm,
     /// degrees; `p' = Rz Ry Rx p + t`). Default: where the CAD model put it.
-    #[arg(long, value_name = "auto|X,Y,Z[,RX,RY,RZ]", value_parser = crate::place::parse_place, allow_hyphen_values = true)]
-    pub(crate) place: Option<crate::place::PlaceArg>,
+    #[arg(long, value_name = "auto|X,Y,Z[,RX,RY,RZ]", value_parser = kerf_pipeline::PlaceMode::parse, allow_hyphen_values = true)]
+    pub(crate) place: Option<kerf_pipeline::PlaceMode>,
 
     /// Between two contours the head backs off this far along the tool axis, traverses, and
     /// approaches the next start along its tool axis (mm; 0 = one straight rapid at cutting

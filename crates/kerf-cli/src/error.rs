@@ -1,4 +1,8 @@
 //! The errors a command can end with; `main` prints them as `error: <message>`.
+//!
+//! Everything the pipeline can fail with is one [`kerf_pipeline::Error`] (which keeps the
+//! stage's error as its source and names the file and the curve); the variants here add what
+//! only a command line has: usage errors, standard output, the checker's verdict.
 
 use std::fmt;
 use std::io;
@@ -8,33 +12,15 @@ use kerf_format::FormatError;
 /// Why a command failed.
 #[derive(Debug)]
 pub(crate) enum CliError {
-    /// An input file is unreadable or invalid; the message starts with the file's path.
-    Format(FormatError),
+    /// A stage of the pipeline failed (the message names the file and the curve).
+    Pipeline(kerf_pipeline::Error),
     /// Writing to standard output failed.
     Output(io::Error),
-    /// The machine file is invalid, or a path cannot be solved on the machine. The optional
-    /// path names the toolpath file the path came from.
-    Kinematics(
-        Box<kerf_kinematics::KinematicsError>,
-        Option<std::path::PathBuf>,
-    ),
     /// An input is unusable for this command (the message names file and place).
     Input(String),
     /// The command line asks for something that cannot be done (an output that is also an
     /// input); exit status 2 like clap's own usage errors.
     Usage(String),
-    /// A command-line option is out of range.
-    Options(kerf_discretize::DiscretizeError),
-    /// A curve's normals could not be found (off its surface, reversed orientation, ...), or
-    /// a surface cannot give normals.
-    Normals {
-        /// The input file.
-        file: std::path::PathBuf,
-        /// Where: `curves[3] ("id")` or `surfaces[1] ("id")`.
-        place: String,
-        /// What went wrong.
-        error: kerf_normals::NormalsError,
-    },
     /// A toolpath could not be read by `kerf check` (not JSON, not kerf.toolpath/1, wrong
     /// shape); the message names the file and the JSON path.
     Check(kerf_check::CheckError),
@@ -47,30 +33,19 @@ pub(crate) enum CliError {
     },
     /// `kerf plot` could not make its picture (the message names the file).
     Plot(String),
-    /// A curve could not be discretized.
-    Discretize {
-        /// The input file.
-        file: std::path::PathBuf,
-        /// Index of the curve in `curves`.
-        index: usize,
-        /// Its id.
-        id: String,
-        /// What went wrong.
-        error: kerf_discretize::DiscretizeError,
-    },
 }
 
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CliError::Format(e) => write!(f, "{e}"),
-            CliError::Output(e) => write!(f, "cannot write to standard output: {e}"),
-            CliError::Options(e) => write!(f, "{e}"),
-            CliError::Normals { file, place, error } => {
-                write!(f, "{}: {place}: {error}", file.display())
+            CliError::Pipeline(e) => {
+                write!(f, "{e}")?;
+                if let Some(hint) = hint(e) {
+                    write!(f, " [{hint}]")?;
+                }
+                Ok(())
             }
-            CliError::Kinematics(e, Some(file)) => write!(f, "{}: {e}", file.display()),
-            CliError::Kinematics(e, None) => write!(f, "{e}"),
+            CliError::Output(e) => write!(f, "cannot write to standard output: {e}"),
             CliError::Input(m) | CliError::Usage(m) => write!(f, "{m}"),
             CliError::Check(e) => write!(f, "{e}"),
             CliError::CheckFailed {
@@ -83,37 +58,43 @@ impl fmt::Display for CliError {
                 if *violations == 1 { "" } else { "s" }
             ),
             CliError::Plot(m) => write!(f, "{m}"),
-            CliError::Discretize {
-                file,
-                index,
-                id,
-                error,
-            } => {
-                write!(f, "{}: curves[{index}] ({id:?}): {error}", file.display())?;
-                if let Some(hint) = discretize_hint(error) {
-                    write!(f, " [{hint}]")?;
-                }
-                Ok(())
-            }
         }
     }
 }
 
-impl std::error::Error for CliError {}
+impl std::error::Error for CliError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            CliError::Pipeline(e) => Some(e),
+            CliError::Output(e) => Some(e),
+            CliError::Check(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 /// The command-line options that change the outcome of a discretizer error.
-fn discretize_hint(e: &kerf_discretize::DiscretizeError) -> Option<&'static str> {
+fn hint(e: &kerf_pipeline::Error) -> Option<&'static str> {
     use kerf_discretize::DiscretizeError as E;
     match e {
-        E::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-points"),
-        E::ToleranceBelowPrecision { .. } => Some("option: a larger --tolerance"),
+        kerf_pipeline::Error::Discretize { source, .. } => match source {
+            E::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-points"),
+            E::ToleranceBelowPrecision { .. } => Some("option: a larger --tolerance"),
+            _ => None,
+        },
         _ => None,
+    }
+}
+
+impl From<kerf_pipeline::Error> for CliError {
+    fn from(e: kerf_pipeline::Error) -> Self {
+        CliError::Pipeline(e)
     }
 }
 
 impl From<FormatError> for CliError {
     fn from(e: FormatError) -> Self {
-        CliError::Format(e)
+        CliError::Pipeline(e.into())
     }
 }
 
@@ -125,7 +106,7 @@ impl From<io::Error> for CliError {
 
 impl From<kerf_kinematics::KinematicsError> for CliError {
     fn from(e: kerf_kinematics::KinematicsError) -> Self {
-        CliError::Kinematics(Box::new(e), None)
+        CliError::Pipeline(e.into())
     }
 }
 

@@ -1,23 +1,23 @@
 //! The `kerf` command-line tool.
 //!
 //! Layout: [`cli`] holds the clap definitions of every subcommand, one module per subcommand
-//! does its work (`validate`), and `main` dispatches and turns errors into messages and exit
+//! reads the inputs, calls the library and prints (`validate`, `discretize_cmd`, `run_cmd`,
+//! ...; the stages themselves are `kerf-pipeline`), and `main` dispatches and turns errors into messages and exit
 //! codes: 0 success, 1 a failure (invalid or unreadable input, unwritable output), 2 a usage
 //! error (reported by clap). To add a subcommand, add its arguments and a variant to
 //! [`cli::Command`], a module with a `run` function, and a line to the `match` below.
 
 mod check;
 mod cli;
-mod cuts;
-mod discretize;
+mod discretize_cmd;
 mod error;
 mod guard;
 mod import;
-mod motion;
-mod place;
+mod input;
+mod motion_cmd;
 mod plot;
 mod post;
-mod run;
+mod run_cmd;
 mod validate;
 
 use std::process::ExitCode;
@@ -31,11 +31,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Validate(args) => validate::run(args),
-        Command::Discretize(args) => discretize::run(args),
+        Command::Discretize(args) => discretize_cmd::run(args),
         Command::Post(args) => post::run(args),
-        Command::Run(args) => run::run(args),
-        Command::Interpolate(args) => motion::run_interpolate(args),
-        Command::Gcode(args) => motion::run_gcode(args),
+        Command::Run(args) => run_cmd::run(args),
+        Command::Interpolate(args) => motion_cmd::run_interpolate(args),
+        Command::Gcode(args) => motion_cmd::run_gcode(args),
         Command::Check(args) => check::run(args),
         Command::Plot(args) => plot::run(args),
         Command::Import(args) => import::run(args),

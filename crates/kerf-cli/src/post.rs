@@ -41,25 +41,25 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
                 poses.push(v.iter().copied().map(Pose::from_array).collect::<Vec<_>>())
             }
             ToolpathPoints::Positions(_) => {
-                return Err(CliError::Input(format!(
-                "{}: paths[{i}] ({:?}): points have no normals; run `kerf discretize --normals` \
-                     on curves that name their surface",
-                args.toolpath.display(),
-                p.id
-            )))
+                return Err(kerf_pipeline::Error::NoNormals {
+                    file: Some(args.toolpath.clone()),
+                    index: i,
+                    id: p.id.clone(),
+                }
+                .into())
             }
         }
     }
     let opts = options(args);
     let ids: Vec<&str> = tp.paths.iter().map(|p| p.id.as_str()).collect();
-    let placed = crate::place::place(
+    let placed = kerf_pipeline::place(
         &machine,
         &ids,
         &poses,
-        args.place.as_ref(),
+        args.place.unwrap_or_default(),
         &opts,
-        crate::place::AUTO_CLEARANCE_MM,
-        &args.toolpath,
+        kerf_pipeline::AUTO_CLEARANCE_MM,
+        Some(&args.toolpath),
     )?;
     let poses = placed.apply(&poses);
     let inputs: Vec<PathInput<'_>> = tp
@@ -73,7 +73,7 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
         })
         .collect();
     let solved = solve_paths(&machine, &inputs, &opts)
-        .map_err(|e| CliError::Kinematics(Box::new(e), Some(args.toolpath.clone())))?;
+        .map_err(|e| kerf_pipeline::Error::from(e).in_file(&args.toolpath))?;
     let file = AxesFile::new(&machine, &solved);
     file.write(&dest)?;
     let inserted: usize = solved.iter().map(|s| s.inserted).sum();

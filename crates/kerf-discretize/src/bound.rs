@@ -55,7 +55,7 @@ impl<const M: usize> Piece<M> {
     /// combinations with weights `1/2`, as `RationalBezier::subdivide_in_place`).
     #[inline]
     fn split(&mut self, right: &mut Self, p: usize) {
-        kerf_nurbs::work::tick();
+        kerf_nurbs::tick();
         for r in 1..=p {
             for i in 0..=(p - r) {
                 right.cpw[i] = right.cpw[i] * 0.5 + right.cpw[i + 1] * 0.5;
@@ -79,7 +79,6 @@ pub const MARGIN_FACTOR: f64 = 128.0;
 struct Chord {
     a: Point3<f64>,
     ab: Vector3<f64>,
-    ab2: f64,
     /// `1 / ab2` where finite (else 0: the exact division is used).
     inv_ab2: f64,
 }
@@ -92,7 +91,6 @@ impl Chord {
         Self {
             a,
             ab,
-            ab2,
             inv_ab2: if inv.is_finite() { inv } else { 0.0 },
         }
     }
@@ -246,7 +244,7 @@ impl<'a> Certifier<'a> {
     /// levels of extraction instead of `p`, Step 5). Counts as one evaluation.
     #[inline]
     fn piece_in_span(&self, span: usize, lo: f64, hi: f64, out: &mut [Vector4<f64>]) {
-        kerf_nurbs::work::tick();
+        kerf_nurbs::tick();
         let p = self.curve.degree();
         let knots = self.local.knots();
         let (klo, khi) = (knots[span], knots[span + 1]);

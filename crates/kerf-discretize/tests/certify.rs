@@ -31,7 +31,7 @@ fn circle(r: f64) -> NurbsCurve {
 
 #[test]
 fn the_discretizers_own_parameters_certify_and_the_bound_holds_by_brute_force() {
-    for c in kerf_nurbs::samples::smooth_random_curves(4, 6, 3) {
+    for c in kerf_nurbs::smooth_random_curves(4, 6, 3) {
         let d = discretize(&c, &Options::with_tolerance(0.01)).expect("discretizes");
         let again = Discretization::certify(&c, d.params(), 0.01).expect("certifies");
         assert_eq!(again.params(), d.params(), "same parameters");

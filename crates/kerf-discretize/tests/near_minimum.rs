@@ -2,7 +2,7 @@
 
 mod common;
 
-use kerf_discretize::bound::Scratch;
+use kerf_discretize::Scratch;
 use kerf_discretize::{discretize, minimum_count, Certifier, Options};
 use kerf_nurbs::NurbsCurve;
 

@@ -118,6 +118,23 @@ pub enum InterpError {
     /// the machine file.
     #[error("{0}")]
     Process(String),
+    /// A program for a dialect that gives the raw machine axes (`generic`, `linuxcnc`: the
+    /// controller interpolates every axis linearly between blocks) holds an arc or a line merged
+    /// over several poses: its chords would move the rotary axes in steps the kinematics never
+    /// checked against the linearization tolerance. Fix: fit the blocks with `arcs` and
+    /// `merge_lines` off for such dialects (`kerf_pipeline::fit_options` does), or use a
+    /// dialect with tool-tip control (Sinumerik TRAORI).
+    #[error(
+        "{dialect} programs give raw machine axes, but block {block} is {what}: fit the motion with arcs and merged lines off for this dialect"
+    )]
+    UncheckedBlock {
+        /// The dialect's name.
+        dialect: &'static str,
+        /// Index of the block.
+        block: usize,
+        /// `an arc` or `a line merged over N poses`.
+        what: String,
+    },
 }
 
 /// `Result` with [`InterpError`].

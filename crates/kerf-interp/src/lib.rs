@@ -76,7 +76,7 @@ pub use output::{
     GcodeOptions, ProcessCodes,
 };
 pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PathStats, PlanOptions};
-pub use plan::{ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_STATIC_SHARE};
+pub use plan::{ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_FILTER_WIDTH, JERK_STATIC_SHARE};
 #[cfg(feature = "research")]
 pub use recursive::{
     max_deviation, new_basis_coefficients, spline_setpoints, spline_through, CubicHermite,

@@ -379,13 +379,43 @@ pub fn gcode_motion<M: AxisModel + ?Sized>(
     gcode_timed(model, motion.blocks(), path_ids, &times, opts)
 }
 
+/// The generic-dialect rule: a dialect that programs the raw machine axes runs only blocks
+/// between neighbouring poses of the kinematics (whose non-linearity error was checked), never
+/// an arc nor a line merged over several poses.
+fn refuse_unchecked_blocks(blocks: &[Block], dialect: Dialect) -> Result<()> {
+    if !dialect.raw_axes() {
+        return Ok(());
+    }
+    for (k, b) in blocks.iter().enumerate() {
+        if b.rapid {
+            continue;
+        }
+        let what = match b.geometry {
+            Geometry::Arc(_) => "an arc".to_string(),
+            _ if b.stations[1] > b.stations[0] + 1 => format!(
+                "a line merged over {} poses",
+                b.stations[1] - b.stations[0] + 1
+            ),
+            _ => continue,
+        };
+        return Err(InterpError::UncheckedBlock {
+            dialect: dialect.name(),
+            block: k,
+            what,
+        });
+    }
+    Ok(())
+}
+
 /// The G-code program of `blocks`, cutting block `b` taking `block_times[b]` seconds (a
 /// missing, zero or non-finite time falls back to `length / opts.feed`); rapid blocks are
 /// `G0` at the controller's rapid rate.
 ///
 /// # Errors
 /// [`InterpError::BadParameter`] for a feed, chord or blending tolerance that is not finite
-/// and > 0; [`InterpError::Process`] for unusable process codes.
+/// and > 0; [`InterpError::Process`] for unusable process codes;
+/// [`InterpError::UncheckedBlock`] for an arc or a merged line in a program for a dialect that
+/// gives the raw machine axes ([`Dialect::raw_axes`]).
 pub fn gcode_timed<M: AxisModel + ?Sized>(
     model: &M,
     blocks: &[Block],
@@ -396,6 +426,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     positive("feed", opts.feed)?;
     positive("chord_tolerance", opts.chord_tolerance)?;
     positive("blend_tolerance", opts.blend_tolerance)?;
+    refuse_unchecked_blocks(blocks, opts.dialect)?;
     let process = ProcessCodes::resolve(opts.dialect, &opts.process)?;
     let mut w = Writer {
         model,

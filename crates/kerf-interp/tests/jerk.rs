@@ -4,7 +4,7 @@
 //! axis ranges, and the set-points' own finite differences against every limit.
 
 use kerf_interp::{
-    fit_blocks, plan, solve_stations, AcHead, AxisModel, FitOptions, InterpError, PlanOptions,
+    fit_blocks, plan, solve_stations, AxisModel, FitOptions, InterpError, PaperAcHead, PlanOptions,
 };
 use nalgebra::{Point3, Vector3};
 
@@ -33,8 +33,8 @@ fn ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> [f64; 3] {
 
 /// The large gantry of `fixtures/machines/gantry_ac.json`, with its shipped jerk limits
 /// (10 ms jerk time: 600 m/s^3 on X and Y).
-fn gantry() -> AcHead {
-    let mut m = AcHead::paper_000();
+fn gantry() -> PaperAcHead {
+    let mut m = PaperAcHead::paper_000();
     m.limits.max_velocity = [40000.0 / 60.0, 40000.0 / 60.0, 20000.0 / 60.0, 600.0, 600.0];
     m.limits.max_acceleration = [6000.0, 6000.0, 5000.0, 20000.0, 20000.0];
     m.limits.max_jerk = Some([600_000.0, 600_000.0, 500_000.0, 2_000_000.0, 2_000_000.0]);

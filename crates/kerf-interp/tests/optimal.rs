@@ -231,7 +231,7 @@ fn a_straight_line_is_the_analytic_trapezoid_and_s_curve() {
     assert!((0.999..=1.011).contains(&ratio), "trapezoid: {ratio}");
     let j = 500_000.0;
     m.limits.max_jerk = Some([j, j, 400_000.0, 1_000_000.0, 1_000_000.0]);
-    let s_curve = trapezoid + kerf_interp::plan::JERK_FILTER_WIDTH * a / j;
+    let s_curve = trapezoid + kerf_interp::JERK_FILTER_WIDTH * a / j;
     let jerked = plan(&m, &blocks, &PlanOptions::new(feed, 0.001)).expect("plan");
     let r = ratios(&m, &jerked.setpoints(&m), 0.001);
     let ratio = jerked.duration() / s_curve;

@@ -94,8 +94,24 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
         Vector3::new(0.3 * (p.x / 50.0).sin(), 0.2, 1.0).normalize()
     });
     let curve = |t: f64| c.point(t);
-    let blocks = fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::default()).expect("fit");
+    // Generic programs give raw machine axes: one line per pose, no arcs, no merged lines.
+    let arcs = fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::default()).expect("fit");
     let opts = GcodeOptions::new(Dialect::Generic, 6000.0);
+    let refused = gcode(&m, &arcs, &["door-trim-1".to_string()], None, &opts);
+    assert!(
+        matches!(
+            refused,
+            Err(kerf_interp::InterpError::UncheckedBlock { .. })
+        ),
+        "arcs or merged lines in a generic program are refused: {refused:?}"
+    );
+    let lines_only = FitOptions {
+        arcs: false,
+        merge_lines: false,
+        ..FitOptions::default()
+    };
+    let blocks = fit_blocks(&m, &st, Some(&curve), 0, &lines_only).expect("fit");
+    assert_eq!(blocks.len(), st.len() - 1, "one block per pose step");
     let text = gcode(&m, &blocks, &["door-trim-1".to_string()], None, &opts).expect("gcode");
     assert!(
         text.contains("; curve door-trim-1"),

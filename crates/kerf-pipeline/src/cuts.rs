@@ -1,4 +1,4 @@
-//! The cuts of `kerf run`: each contour with its start point, lead-in and lead-out
+//! The cuts of a job (`kerf run`): each contour with its start point, lead-in and lead-out
 //! ([`kerf_process`]), in cutting order within each set-up, as one path of poses with a
 //! parameter and a point function for the kinematics and the interpolator.
 //!
@@ -15,7 +15,7 @@ use kerf_process::{plan_cuts, Contour, CutPlan, LeadOptions, PoseArray};
 use nalgebra::Point3;
 use serde_json::{json, Value};
 
-use crate::error::CliError;
+use crate::error::Error;
 use crate::place::Placed;
 
 /// A point function of a cut path (part coordinates).
@@ -48,7 +48,8 @@ pub(crate) fn plan(
     oriented: &[Oriented],
     placed: &Placed,
     options: &LeadOptions,
-) -> Result<(Vec<CutPath>, SetupPlans), CliError> {
+    source: Option<&std::path::Path>,
+) -> Result<(Vec<CutPath>, SetupPlans), Error> {
     let poses: Vec<Vec<PoseArray>> = oriented.iter().map(Oriented::poses).collect();
     let mut cuts = Vec::new();
     let mut plans = Vec::new();
@@ -63,7 +64,10 @@ pub(crate) fn plan(
                 start: None,
             })
             .collect();
-        let plan = plan_cuts(&contours, options).map_err(|e| CliError::Input(e.to_string()))?;
+        let plan = plan_cuts(&contours, options).map_err(|e| Error::Process {
+            file: source.map(std::path::Path::to_path_buf),
+            source: e,
+        })?;
         for &k in &plan.order {
             let i = setup.paths[k];
             cuts.push(cut_path(file, &oriented[i], &poses[i], i, &plan, k));

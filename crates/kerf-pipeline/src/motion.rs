@@ -1,22 +1,171 @@
-//! `kerf interpolate` and `kerf gcode`: the interpolator on a `kerf.axes/1` or
-//! `kerf.toolpath/1` file.
+//! The motion stage on files: a `kerf.axes/1` or `kerf.toolpath/1` document (format detected
+//! from its `format` key), solved on the machine if needed, fitted and planned ([`Program`]);
+//! G-code and set-points written to any [`std::io::Write`].
+//!
+//! The generic-dialect rule lives here and in [`fit_options`], and nowhere can a caller set it
+//! aside: a program for a controller that interpolates the machine axes linearly (`generic`,
+//! `linuxcnc`) gets one G1 per pose of the kinematics, whose non-linearity error is within the
+//! linearization tolerance, and no arcs (their chords would move the rotary axes in steps
+//! nobody checked) nor merged lines. With tool-tip control (Sinumerik TRAORI) arcs and merges
+//! are safe: the controller keeps the tip on the programmed path. (`kerf-interp`'s G-code
+//! writer refuses such blocks for those dialects too.)
 
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::Path;
 
-use kerf_format::toolpath;
+use kerf_format::toolpath::{self, ToolpathFile};
 use kerf_interp::{
-    gcode_motion, stations_from_axes, stations_from_solved, write_csv, AxisModel, Dialect,
+    gcode_motion, stations_from_axes, stations_from_solved, write_csv_to, AxisModel, Dialect,
     FitOptions, GcodeOptions, MachineModel, Motion, PlanOptions, ProgramPath,
 };
 use kerf_kinematics::{solve_path, AxesFile, Machine, PathOptions, Pose};
 use nalgebra::Vector3;
 use serde_json::json;
 
-use crate::cli::{GcodeArgs, InterpolateArgs, MotionArgs};
-use crate::error::CliError;
+use crate::error::{interp, kin, Error, Result};
 
-/// A program ready to be written: the machine model, the path ids and the planned motion.
-pub(crate) struct Program {
+/// The fit of a program for `dialect` (`None`: set-points only, run with tool-tip control):
+/// the tolerance and retract given, arcs and merged lines only where the controller keeps the
+/// tool tip on the programmed path (see the module documentation).
+pub fn fit_options(tolerance_mm: f64, dialect: Option<Dialect>, retract_mm: f64) -> FitOptions {
+    let raw_axes = dialect.is_some_and(Dialect::raw_axes);
+    FitOptions {
+        arcs: !raw_axes,
+        merge_lines: !raw_axes,
+        retract: retract_mm,
+        ..FitOptions::with_tolerance(tolerance_mm)
+    }
+}
+
+/// What the motion stage reads: machine axes (`kerf.axes/1`, from `kerf post` or any tool), or
+/// cutting points (`kerf.toolpath/1`), solved on the machine first.
+#[derive(Debug, Clone)]
+pub enum MotionInput {
+    /// Machine axes, with the lead-ins and lead-outs the file records.
+    Axes(AxesFile),
+    /// Cutting points; points without normals get the tool axis +z.
+    Toolpath(ToolpathFile),
+}
+
+impl MotionInput {
+    /// Reads either document, choosing by its `format` key (anything but `kerf.axes/1` is read
+    /// as a toolpath, whose reader then names what is wrong). `source` names the file in
+    /// errors.
+    ///
+    /// # Errors
+    /// [`Error::Format`] or [`Error::Kinematics`] naming the file and the defect.
+    pub fn from_slice(bytes: &[u8], source: Option<&Path>) -> Result<Self> {
+        let format = kerf_io::parse_json(bytes)
+            .ok()
+            .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_owned))
+            .unwrap_or_default();
+        if format == kerf_kinematics::AXES_FORMAT {
+            Ok(Self::Axes(
+                AxesFile::from_slice(bytes).map_err(kin(source))?,
+            ))
+        } else {
+            let tp = toolpath::from_reader(bytes);
+            Ok(Self::Toolpath(match source {
+                Some(f) => tp.map_err(|e| e.in_file(f))?,
+                None => tp?,
+            }))
+        }
+    }
+
+    /// Reads the file at `path`.
+    ///
+    /// # Errors
+    /// [`Error::Read`], then as [`MotionInput::from_slice`].
+    pub fn read(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let bytes = kerf_io::read_file(path).map_err(|source| Error::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_slice(&bytes, Some(path))
+    }
+}
+
+/// The options of [`plan_program`], with the defaults of `kerf gcode`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct MotionOptions {
+    /// Programmed cutting feed, mm/min. Default 6000.
+    pub feed_mm_per_min: f64,
+    /// Interpolation cycle, s. Default 0.001.
+    pub cycle_s: f64,
+    /// The dialect the program is for; `None` plans for set-points only (tool-tip control:
+    /// arcs allowed) and [`Program::gcode`] then refuses. The fit follows from it (see the
+    /// module documentation). Default `Some(Dialect::Generic)`.
+    pub dialect: Option<Dialect>,
+    /// Arc-fit tolerance, mm. Default `None`: the toolpath's tolerance, else 0.001.
+    pub fit_tolerance_mm: Option<f64>,
+    /// Chord error allowed between two set-points on an arc, mm. Default `None`: the
+    /// planner's (0.001).
+    pub chord_tolerance_mm: Option<f64>,
+    /// Retract between contours along the tool axis, mm. Default 10.
+    pub retract_mm: f64,
+    /// The controller's blending tolerance, mm. Default
+    /// [`kerf_interp::DEFAULT_BLEND_TOLERANCE`].
+    pub blend_tolerance_mm: f64,
+}
+
+impl Default for MotionOptions {
+    fn default() -> Self {
+        Self {
+            feed_mm_per_min: 6000.0,
+            cycle_s: 0.001,
+            dialect: Some(Dialect::Generic),
+            fit_tolerance_mm: None,
+            chord_tolerance_mm: None,
+            retract_mm: 10.0,
+            blend_tolerance_mm: kerf_interp::DEFAULT_BLEND_TOLERANCE,
+        }
+    }
+}
+
+impl MotionOptions {
+    /// With this feed, mm/min.
+    pub fn with_feed_mm_per_min(mut self, feed: f64) -> Self {
+        self.feed_mm_per_min = feed;
+        self
+    }
+    /// With this cycle, s.
+    pub fn with_cycle_s(mut self, cycle: f64) -> Self {
+        self.cycle_s = cycle;
+        self
+    }
+    /// For this dialect (`None`: set-points only).
+    pub fn with_dialect(mut self, dialect: Option<Dialect>) -> Self {
+        self.dialect = dialect;
+        self
+    }
+    /// With this arc-fit tolerance, mm.
+    pub fn with_fit_tolerance_mm(mut self, mm: Option<f64>) -> Self {
+        self.fit_tolerance_mm = mm;
+        self
+    }
+    /// With this set-point chord tolerance, mm.
+    pub fn with_chord_tolerance_mm(mut self, mm: Option<f64>) -> Self {
+        self.chord_tolerance_mm = mm;
+        self
+    }
+    /// With this retract, mm.
+    pub fn with_retract_mm(mut self, mm: f64) -> Self {
+        self.retract_mm = mm;
+        self
+    }
+    /// With this blending tolerance, mm.
+    pub fn with_blend_tolerance_mm(mut self, mm: f64) -> Self {
+        self.blend_tolerance_mm = mm;
+        self
+    }
+}
+
+/// A planned program: the machine model, the path ids and the motion, with what it was
+/// planned with.
+#[derive(Debug)]
+pub struct Program {
     /// The machine.
     pub model: MachineModel,
     /// The source curve of each path.
@@ -24,121 +173,171 @@ pub(crate) struct Program {
     /// The planned motion.
     pub motion: Motion,
     /// The tolerance the blocks were fitted with, mm.
-    pub fit_tolerance: f64,
+    pub fit_tolerance_mm: f64,
     /// The linearization tolerance the axes were solved with, mm (`None` for an axes file,
     /// which does not record it).
-    pub linearization_tolerance: Option<f64>,
+    pub linearization_tolerance_mm: Option<f64>,
+    options: MotionOptions,
+    source: Option<String>,
 }
 
-fn interp_err(file: &Path) -> impl Fn(kerf_interp::InterpError) -> CliError + '_ {
-    move |e| CliError::Input(format!("{}: {e}", file.display()))
-}
-
-/// The fit for a program run by a controller that interpolates the machine axes linearly
-/// (`generic`): one G1 per pose of the kinematics, whose non-linearity error is within the
-/// linearization tolerance; no arcs (their chords would move the rotary axes in steps nobody
-/// checked) and no merged lines. With tool-tip control (Sinumerik TRAORI) arcs and merges are
-/// safe: the controller keeps the tip on the programmed path.
-pub(crate) fn fit_options(tolerance: f64, generic: bool, retract: f64) -> FitOptions {
-    FitOptions {
-        arcs: !generic,
-        merge_lines: !generic,
-        retract,
-        ..FitOptions::with_tolerance(tolerance)
-    }
-}
-
-/// Reads the input (axes or toolpath), solves it on the machine if needed, fits blocks and
-/// plans the motion.
-pub(crate) fn program(args: &MotionArgs, generic: bool) -> Result<Program, CliError> {
-    let machine = Machine::read(&args.machine)?;
-    let model = MachineModel::new(machine.clone()).map_err(interp_err(&args.machine))?;
-    let input = &args.input;
-    let bytes = kerf_io::read_file(input)
-        .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", input.display())))?;
-    let format = kerf_io::parse_json(&bytes)
-        .ok()
-        .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_owned))
-        .unwrap_or_default();
+/// Solves (for a toolpath), fits and plans `input` on `machine`; `source` names the input
+/// file in errors and in the program's comments.
+///
+/// # Errors
+/// [`Error::Kinematics`] for a machine or path that cannot be solved, [`Error::Interp`] for
+/// options out of range or a path the interpolator refuses.
+pub fn plan_program(
+    machine: &Machine,
+    input: &MotionInput,
+    options: &MotionOptions,
+    source: Option<&Path>,
+) -> Result<Program> {
+    let model = MachineModel::new(machine.clone()).map_err(interp(source))?;
     let mut linearization = None;
-    let (ids, paths, file_tol) = if format == kerf_kinematics::AXES_FORMAT {
-        let axes = AxesFile::from_slice(&bytes)
-            .map_err(|e| CliError::Kinematics(Box::new(e), Some(input.clone())))?;
-        let mut paths = Vec::new();
-        for p in &axes.paths {
-            paths.push(ProgramPath {
-                id: p.id.clone(),
-                stations: {
-                    // Lead-in, cut and lead-out, as the machine runs them.
-                    let (positions, poses) = p.run();
-                    stations_from_axes(&positions, &poses).map_err(interp_err(input))?
-                },
-                curve: None,
-            });
-        }
-        (
-            axes.paths.iter().map(|p| p.id.clone()).collect(),
-            paths,
-            None,
-        )
-    } else {
-        let tp = toolpath::from_reader(&bytes[..]).map_err(|e| e.in_file(input))?;
-        linearization = Some(PathOptions::default().linearization_tolerance);
-        let mut paths = Vec::new();
-        for p in &tp.paths {
-            let poses: Vec<Pose> = (0..p.points.len())
-                .map(|n| {
-                    let q = p.points.position(n);
-                    let a = p.points.normal(n).unwrap_or_else(Vector3::z);
-                    Pose::new(q.x, q.y, q.z, a.x, a.y, a.z)
-                })
-                .collect();
-            let solved = solve_path(
-                &machine,
-                &kerf_kinematics::PathInput {
-                    id: &p.id,
-                    poses: &poses,
+    let (ids, paths, file_tol) = match input {
+        MotionInput::Axes(axes) => {
+            let mut paths = Vec::new();
+            for p in &axes.paths {
+                paths.push(ProgramPath {
+                    id: p.id.clone(),
+                    stations: {
+                        // Lead-in, cut and lead-out, as the machine runs them.
+                        let (positions, poses) = p.run();
+                        stations_from_axes(&positions, &poses).map_err(interp(source))?
+                    },
                     curve: None,
-                },
-                &PathOptions::default(),
+                });
+            }
+            (
+                axes.paths.iter().map(|p| p.id.clone()).collect::<Vec<_>>(),
+                paths,
+                None,
             )
-            .map_err(|e| CliError::Kinematics(Box::new(e), Some(input.clone())))?;
-            paths.push(ProgramPath {
-                id: p.id.clone(),
-                stations: stations_from_solved(&solved, Some(&p.params))
-                    .map_err(interp_err(input))?,
-                curve: None,
-            });
         }
-        (
-            tp.paths.iter().map(|p| p.id.clone()).collect(),
-            paths,
-            Some(tp.tolerance),
-        )
+        MotionInput::Toolpath(tp) => {
+            linearization = Some(PathOptions::default().linearization_tolerance);
+            let mut paths = Vec::new();
+            for p in &tp.paths {
+                let poses: Vec<Pose> = (0..p.points.len())
+                    .map(|n| {
+                        let q = p.points.position(n);
+                        let a = p.points.normal(n).unwrap_or_else(Vector3::z);
+                        Pose::new(q.x, q.y, q.z, a.x, a.y, a.z)
+                    })
+                    .collect();
+                let solved = solve_path(
+                    machine,
+                    &kerf_kinematics::PathInput {
+                        id: &p.id,
+                        poses: &poses,
+                        curve: None,
+                    },
+                    &PathOptions::default(),
+                )
+                .map_err(kin(source))?;
+                paths.push(ProgramPath {
+                    id: p.id.clone(),
+                    stations: stations_from_solved(&solved, Some(&p.params))
+                        .map_err(interp(source))?,
+                    curve: None,
+                });
+            }
+            (
+                tp.paths.iter().map(|p| p.id.clone()).collect(),
+                paths,
+                Some(tp.tolerance),
+            )
+        }
     };
-    let fit_tolerance = args.fit_tolerance.or(file_tol).unwrap_or(0.001);
-    let mut plan = PlanOptions::new(args.feed, args.cycle);
-    if let Some(c) = args.chord_tolerance {
+    let fit_tolerance = options.fit_tolerance_mm.or(file_tol).unwrap_or(0.001);
+    let mut plan = PlanOptions::new(options.feed_mm_per_min, options.cycle_s);
+    if let Some(c) = options.chord_tolerance_mm {
         plan.chord_tolerance = c;
     }
     let motion = kerf_interp::interpolate(
         &model,
         &paths,
-        &fit_options(fit_tolerance, generic, args.retract),
+        &fit_options(fit_tolerance, options.dialect, options.retract_mm),
         &plan,
     )
-    .map_err(interp_err(input))?;
+    .map_err(interp(source))?;
     Ok(Program {
         model,
         ids,
         motion,
-        fit_tolerance,
-        linearization_tolerance: linearization,
+        fit_tolerance_mm: fit_tolerance,
+        linearization_tolerance_mm: linearization,
+        options: *options,
+        source: source.map(|s| s.display().to_string()),
     })
 }
 
+impl Program {
+    /// The G-code options of the program: its dialect, the budget terms, the machine's process
+    /// codes and pivot length, the source file's name.
+    ///
+    /// # Errors
+    /// [`Error::NoDialect`] for a program planned for set-points only.
+    pub fn gcode_options(&self) -> Result<GcodeOptions> {
+        let dialect = self.options.dialect.ok_or(Error::NoDialect)?;
+        Ok(GcodeOptions {
+            fit_tolerance: self.fit_tolerance_mm,
+            chord_tolerance: self.options.chord_tolerance_mm.unwrap_or(0.001),
+            linearization_tolerance: self.linearization_tolerance_mm,
+            ..gcode_options(
+                &self.model,
+                dialect,
+                self.options.feed_mm_per_min,
+                self.options.blend_tolerance_mm,
+                self.source.as_deref(),
+            )
+        })
+    }
+
+    /// The program text in its dialect.
+    ///
+    /// # Errors
+    /// [`Error::NoDialect`]; [`Error::Interp`] for unusable process codes.
+    pub fn gcode(&self) -> Result<String> {
+        let opts = self.gcode_options()?;
+        gcode_motion(&self.model, &self.motion, &self.ids, &opts)
+            .map_err(interp(self.source.as_deref().map(Path::new)))
+    }
+
+    /// Writes the program text to `w`.
+    ///
+    /// # Errors
+    /// As [`Program::gcode`]; [`Error::Write`] if `w` fails.
+    pub fn write_gcode(&self, mut w: impl Write) -> Result<()> {
+        let text = self.gcode()?;
+        w.write_all(text.as_bytes())
+            .map_err(|source| Error::Write { path: None, source })
+    }
+
+    /// Streams the set-points CSV (one row per cycle, `t,X,Y,Z,<tilt>,C`) to `w`: memory stays
+    /// bounded however long the program runs.
+    ///
+    /// # Errors
+    /// [`Error::Write`] if `w` fails.
+    pub fn write_setpoints(&self, mut w: impl Write) -> Result<()> {
+        write_csv_to(
+            &mut w,
+            self.model.axis_names(),
+            self.options.cycle_s,
+            self.motion.iter(&self.model),
+        )
+        .map_err(|source| Error::Write { path: None, source })
+    }
+
+    /// The options it was planned with.
+    pub fn options(&self) -> &MotionOptions {
+        &self.options
+    }
+}
+
 /// The planned time of every path and the share at the programmed feed, for the summaries.
-pub(crate) fn path_report(motion: &Motion, ids: &[String]) -> serde_json::Value {
+pub fn path_report(motion: &Motion, ids: &[String]) -> serde_json::Value {
     let paths: Vec<serde_json::Value> = motion
         .path_stats()
         .iter()
@@ -156,77 +355,6 @@ pub(crate) fn path_report(motion: &Motion, ids: &[String]) -> serde_json::Value 
     json!(paths)
 }
 
-fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, quiet: bool) {
-    let c = p.motion.counts();
-    if json {
-        let text = json!({
-                "input": args.input.display().to_string(),
-                "machine": p.model.name(),
-                "lines": c.lines,
-                "arcs": c.arcs,
-                "turns": c.turns,
-                "cycles": p.motion.cycles(),
-                "cycle": args.cycle,
-                "duration_s": p.motion.duration(),
-                "time_share_at_feed": p.motion.time_share_at_feed(),
-                "blend_deviation_mm": p.motion.blend_deviation(),
-                "paths": path_report(&p.motion, &p.ids),
-                "output": out.map(|o| o.display().to_string()),
-        });
-        // The summary goes to standard output unless the program or CSV itself does.
-        if out.is_some_and(|o| o == Path::new("-")) {
-            eprintln!("{text}");
-        } else {
-            println!("{text}");
-        }
-    } else if !quiet {
-        eprintln!(
-            "{}: {} lines, {} arcs, {} turns; {} cycles of {} s = {:.3} s of motion, {:.1} % of the cutting time at the programmed feed{}",
-            args.input.display(),
-            c.lines,
-            c.arcs,
-            c.turns,
-            p.motion.cycles(),
-            args.cycle,
-            p.motion.duration(),
-            100.0 * p.motion.time_share_at_feed(),
-            out.map_or(String::new(), |o| format!(" -> {}", o.display()))
-        );
-        for st in p.motion.path_stats() {
-            let id = p.ids.get(st.path).map_or("?", String::as_str);
-            eprintln!(
-                "  {id}: {:.3} s ({:.3} s cutting {:.1} mm, {:.1} % of its length at the programmed feed)",
-                st.duration,
-                st.cutting_time,
-                st.cutting_length,
-                if st.cutting_length > 0.0 { 100.0 * st.length_at_feed / st.cutting_length } else { 0.0 }
-            );
-        }
-    }
-}
-
-/// Runs `kerf interpolate`.
-pub(crate) fn run_interpolate(args: &InterpolateArgs) -> Result<(), CliError> {
-    if let Some(csv) = &args.csv {
-        crate::guard::refuse_overwrite("--csv", csv, &[&args.motion.input, &args.motion.machine])?;
-    }
-    // Set-points are computed with tool-tip control: arcs are safe.
-    let p = program(&args.motion, false)?;
-    if let Some(csv) = &args.csv {
-        // Streamed cycle by cycle from the plan into the file (or standard output): memory
-        // stays bounded however long the program runs.
-        write_csv(
-            csv,
-            p.model.axis_names(),
-            args.motion.cycle,
-            p.motion.iter(&p.model),
-        )
-        .map_err(interp_err(csv))?;
-    }
-    summary(&args.motion, &p, args.csv.as_ref(), args.json, args.quiet);
-    Ok(())
-}
-
 /// The G-code options of a program for `dialect`: the budget terms, the machine's process
 /// codes and pivot length, the source file's name.
 pub(crate) fn gcode_options(
@@ -234,49 +362,13 @@ pub(crate) fn gcode_options(
     dialect: Dialect,
     feed: f64,
     blend_tolerance: f64,
-    source: &Path,
+    source: Option<&str>,
 ) -> GcodeOptions {
     GcodeOptions {
         blend_tolerance,
         pivot_length: Some(model.machine.kinematics.pivot_length()),
         process: model.machine.process.clone(),
-        source: Some(source.display().to_string()),
+        source: source.map(str::to_owned),
         ..GcodeOptions::new(dialect, feed)
     }
-}
-
-/// Writes the G-code of a program.
-pub(crate) fn write_program(p: &Program, dest: &Path, opts: &GcodeOptions) -> Result<(), CliError> {
-    let text = gcode_motion(&p.model, &p.motion, &p.ids, opts).map_err(interp_err(dest))?;
-    if dest == Path::new("-") {
-        std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes())?;
-        return Ok(());
-    }
-    kerf_interp::write_atomic(dest, text.as_bytes()).map_err(interp_err(dest))
-}
-
-/// Runs `kerf gcode`.
-pub(crate) fn run_gcode(args: &GcodeArgs) -> Result<(), CliError> {
-    crate::guard::refuse_overwrite(
-        "--output",
-        &args.output,
-        &[&args.motion.input, &args.motion.machine],
-    )?;
-    let dialect: Dialect = args.dialect.into();
-    let p = program(&args.motion, dialect.raw_axes())?;
-    let opts = GcodeOptions {
-        fit_tolerance: p.fit_tolerance,
-        chord_tolerance: args.motion.chord_tolerance.unwrap_or(0.001),
-        linearization_tolerance: p.linearization_tolerance,
-        ..gcode_options(
-            &p.model,
-            dialect,
-            args.motion.feed,
-            args.blend_tolerance,
-            &args.motion.input,
-        )
-    };
-    write_program(&p, &args.output, &opts)?;
-    summary(&args.motion, &p, Some(&args.output), args.json, args.quiet);
-    Ok(())
 }

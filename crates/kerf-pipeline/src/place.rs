@@ -1,7 +1,7 @@
-//! `--place`: where the part goes on the machine (`kerf run` and `kerf post`).
+//! Where the part goes on the machine ([`PlaceMode`]; `--place` of `kerf run` and `kerf post`).
 //!
-//! `--place X,Y,Z[,RX,RY,RZ]` applies a fixed part-to-workpiece transform (mm, degrees,
-//! `Rz Ry Rx`); `--place auto` asks [`kerf_kinematics::auto_place`] for one that puts every pose
+//! [`PlaceMode::Fixed`] (`--place X,Y,Z[,RX,RY,RZ]`) applies a fixed part-to-workpiece
+//! transform (mm, degrees, `Rz Ry Rx`); [`PlaceMode::Auto`] (`--place auto`) asks [`kerf_kinematics::auto_place`] for one that puts every pose
 //! within the axis limits (turning contours whose side the head cannot reach, and rotating the
 //! part by quarter turns if it does not fit as modelled). The toolpath stays in part
 //! coordinates; the axes file, the program and the report are in workpiece coordinates, and
@@ -12,47 +12,58 @@ use kerf_kinematics::{
 };
 use serde_json::{json, Value};
 
-use crate::error::CliError;
+use crate::error::{kin, Error};
 
 /// The clearance `kerf post --place auto` keeps from the linear limits, mm: room for the
 /// default 10 mm retract of `kerf gcode` plus 1 mm.
-pub(crate) const AUTO_CLEARANCE_MM: f64 = 11.0;
+pub const AUTO_CLEARANCE_MM: f64 = 11.0;
 
-/// The `--place` argument.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum PlaceArg {
-    /// Search for a placement that fits.
-    Auto,
+/// Where the part goes on the machine.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
+pub enum PlaceMode {
+    /// Where the CAD model put it (the identity placement).
+    #[default]
+    AsModelled,
     /// This placement.
     Fixed(Placement),
+    /// Search for a placement that puts every pose within the axis limits, the motion centred
+    /// in the travel, contours turned to the side the head can reach, the part turned by
+    /// quarter turns if it does not fit as modelled, and several set-ups if one does not fit.
+    Auto,
 }
 
-/// clap's value parser for `--place` (a bad value is a usage error, exit 2).
-pub(crate) fn parse_place(text: &str) -> Result<PlaceArg, String> {
-    if text.trim().eq_ignore_ascii_case("auto") {
-        Ok(PlaceArg::Auto)
-    } else {
-        Placement::parse(text).map(PlaceArg::Fixed)
+impl PlaceMode {
+    /// Reads `auto` or `X,Y,Z[,RX,RY,RZ]` (mm, degrees; `p' = Rz Ry Rx p + t`).
+    ///
+    /// # Errors
+    /// A message saying what is wrong with the text.
+    pub fn parse(text: &str) -> Result<PlaceMode, String> {
+        if text.trim().eq_ignore_ascii_case("auto") {
+            Ok(PlaceMode::Auto)
+        } else {
+            Placement::parse(text).map(PlaceMode::Fixed)
+        }
     }
 }
 
-/// The placement used, with what `auto` decided.
+/// The placement used, with what [`PlaceMode::Auto`] decided.
 #[derive(Debug, Clone)]
-pub(crate) struct Placed {
+pub struct Placed {
     /// The set-ups (one unless `auto` had to place parts or contours separately).
-    pub(crate) plan: SetupPlan,
-    /// Chosen by `--place auto`.
-    pub(crate) auto: bool,
+    pub plan: SetupPlan,
+    /// Chosen by [`PlaceMode::Auto`].
+    pub auto: bool,
 }
 
 impl Placed {
     /// The poses of every path in workpiece coordinates.
-    pub(crate) fn apply(&self, poses: &[Vec<Pose>]) -> Vec<Vec<Pose>> {
+    pub fn apply(&self, poses: &[Vec<Pose>]) -> Vec<Vec<Pose>> {
         self.plan.apply(poses)
     }
 
     /// The poses of path `i` (any sequence of its poses) in workpiece coordinates.
-    pub(crate) fn apply_one(&self, i: usize, poses: &[Pose]) -> Vec<Pose> {
+    pub fn apply_one(&self, i: usize, poses: &[Pose]) -> Vec<Pose> {
         let flip = self.plan.flipped.get(i).copied().unwrap_or(false);
         kerf_kinematics::place_paths(&self.placement_of(i), &[flip], &[poses.to_vec()])
             .pop()
@@ -60,18 +71,18 @@ impl Placed {
     }
 
     /// The placement of path `i`.
-    pub(crate) fn placement_of(&self, i: usize) -> Placement {
+    pub fn placement_of(&self, i: usize) -> Placement {
         self.plan.placement_of(i)
     }
 
     /// True if nothing was moved or turned.
-    pub(crate) fn is_identity(&self) -> bool {
+    pub fn is_identity(&self) -> bool {
         self.plan.setups.iter().all(|s| s.placement.is_identity())
             && !self.plan.flipped.contains(&true)
     }
 
     /// The `placement` object of `report.json`.
-    pub(crate) fn json(&self, ids: &[&str]) -> Value {
+    pub fn json(&self, ids: &[&str]) -> Value {
         let setups: Vec<Value> = self
             .plan
             .setups
@@ -95,7 +106,7 @@ impl Placed {
     }
 
     /// One line for the summary.
-    pub(crate) fn summary(&self) -> String {
+    pub fn summary(&self) -> String {
         let flips = self.plan.flipped.iter().filter(|f| **f).count();
         let flips = if flips > 0 {
             format!(", {flips} contours cut from the other side of the sheet")
@@ -116,21 +127,22 @@ impl Placed {
     }
 }
 
-/// The placement for `--place` (identity without it). `auto` keeps `clearance_mm` from every
-/// linear limit (the retract between contours moves the head that far along the tool axis).
+/// The placement of the paths `ids` with `poses` for `mode`. [`PlaceMode::Auto`] keeps
+/// `clearance_mm` from every linear limit (the retract between contours moves the head that
+/// far along the tool axis); `file` is named in errors.
 ///
 /// # Errors
-/// [`CliError::Kinematics`] when `auto` finds nothing that fits (the message names the axis and
+/// [`Error::Kinematics`] when `auto` finds nothing that fits (the message names the axis and
 /// how much travel is missing).
-pub(crate) fn place(
+pub fn place(
     machine: &Machine,
     ids: &[&str],
     poses: &[Vec<Pose>],
-    arg: Option<&PlaceArg>,
+    mode: PlaceMode,
     path_options: &PathOptions,
     clearance_mm: f64,
-    file: &std::path::Path,
-) -> Result<Placed, CliError> {
+    file: Option<&std::path::Path>,
+) -> Result<Placed, Error> {
     let single = |placement: Placement| Placed {
         plan: SetupPlan {
             setups: vec![Setup {
@@ -143,10 +155,10 @@ pub(crate) fn place(
         },
         auto: false,
     };
-    match arg {
-        None => Ok(single(Placement::IDENTITY)),
-        Some(PlaceArg::Fixed(p)) => Ok(single(*p)),
-        Some(PlaceArg::Auto) => {
+    match mode {
+        PlaceMode::AsModelled => Ok(single(Placement::IDENTITY)),
+        PlaceMode::Fixed(p) => Ok(single(p)),
+        PlaceMode::Auto => {
             let refs: Vec<(&str, &[Pose])> = ids
                 .iter()
                 .copied()
@@ -159,7 +171,7 @@ pub(crate) fn place(
                     .with_path_options(*path_options)
                     .with_margin_mm(clearance_mm),
             )
-            .map_err(|e| CliError::Kinematics(Box::new(e), Some(file.to_path_buf())))?;
+            .map_err(kin(file))?;
             Ok(Placed { plan, auto: true })
         }
     }

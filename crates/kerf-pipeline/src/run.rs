@@ -1,81 +1,62 @@
-//! `kerf run`: the whole pipeline in one command. Discretize (certified chord error), normals,
-//! machine axes, interpolation and G-code, with a report and a picture, all written into one
-//! output directory only once every stage has succeeded.
+//! [`Job::run`]: the whole pipeline in memory. Discretize (certified chord error), normals,
+//! placement, cuts, machine axes, interpolation and G-code, with a report and a picture
+//! ([`Output`]); [`Output::write_dir`] writes them all into one directory only once every
+//! stage has succeeded.
 
-use std::path::Path;
 use std::time::Instant;
 
 use kerf_discretize::Discretization;
-use kerf_format::toolpath::{self, ToolpathFile, ToolpathPoints, ToolpathRecord};
 use kerf_interp::{
-    gcode_motion, stations_from_solved, write_csv_to, AxisModel, Dialect, GcodeOptions,
-    MachineModel, PlanOptions, ProgramPath as InterpPath,
+    gcode_motion, stations_from_solved, GcodeOptions, MachineModel, PlanOptions,
+    ProgramPath as InterpPath,
 };
-use kerf_io::DirEntry;
-use kerf_kinematics::{solve_paths, AxesFile, Machine, PathCurve, PathInput, PathOptions, Pose};
+use kerf_kinematics::{solve_paths, AxesFile, PathCurve, PathInput, Pose};
 use kerf_normals::Oriented;
 use serde_json::json;
 
-use crate::cli::RunArgs;
-use crate::discretize::{discretize_file, load_curves, normals_for_file, NormalArgs};
-use crate::error::CliError;
+use crate::discretize::{discretize_curves, orient_curves, toolpath_of_poses};
+use crate::error::{interp, kin, Result};
+use crate::job::Job;
+use crate::output::{program_names, Output, SetupProgram};
+use crate::{Progress, Stage};
 
-/// Runs `kerf run`.
-pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
-    let start = Instant::now();
-    let path = args.curves.as_path();
-    for name in OUTPUTS {
-        crate::guard::refuse_overwrite(
-            "--out",
-            &args.out.join(name),
-            &[path, args.machine.as_path()],
-        )?;
+impl Job {
+    /// Runs every stage in memory.
+    ///
+    /// # Errors
+    /// The first stage's [`Error`](crate::Error), naming the file (see [`Job::with_source`]) and the curve.
+    pub fn run(&self) -> Result<Output> {
+        self.run_with_progress(&|_| {})
     }
-    let file = if crate::import::is_step(path) {
-        let (file, import) = crate::import::load_step(path, &args.step_args)?;
-        if !args.quiet && !args.json {
-            crate::import::print_account(path, &import);
-        }
-        file
-    } else {
-        load_curves(path)?
-    };
-    let machine = Machine::read(&args.machine)?;
-    let dopts = kerf_discretize::Options {
-        max_segment_length: args.max_segment_length.unwrap_or(f64::INFINITY),
-        ..kerf_discretize::Options::with_tolerance(args.tolerance)
-    };
+
+    /// [`Job::run`], calling `progress` as the stages advance (from several threads in the
+    /// parallel stages: per curve in [`Stage::Discretize`] and [`Stage::Normals`], once per
+    /// stage elsewhere).
+    ///
+    /// # Errors
+    /// As [`Job::run`].
+    pub fn run_with_progress(&self, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
+        run(self, progress)
+    }
+}
+
+/// The stages of [`Job::run_with_progress`], in order.
+fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
+    let start = Instant::now();
+    let path = job.source.as_deref();
+    let file = &job.curves;
+    let machine = &job.machine;
+    let o = &job.options;
+    job.validate()?;
+    let dopts = o.discretize;
     // 1. Cutting points with a certified chord error.
-    let discs: Vec<Discretization> = discretize_file(path, &file, &dopts)?;
-    // 2. Normals (+z for curves that name no surface).
-    let nargs = NormalArgs {
-        max_normal_step: args.max_normal_step,
-        ..NormalArgs::default()
-    };
-    let oriented: Vec<Oriented> = normals_for_file(path, &file, &discs, &dopts, &nargs, true)?;
-    let tp = ToolpathFile {
-        units: file.units,
-        tolerance: dopts.tolerance,
-        paths: file
-            .curves
-            .iter()
-            .zip(&oriented)
-            .map(|(rec, o)| ToolpathRecord {
-                id: rec.id.clone(),
-                params: o.params.clone(),
-                points: ToolpathPoints::Poses(o.poses()),
-                max_chord_error: o.max_chord_error,
-            })
-            .collect(),
-    };
+    let discs: Vec<Discretization> = discretize_curves(file, &dopts, path, progress)?;
+    // 2. Normals (+z for curves that name no surface, unless the options refuse them).
+    let oriented: Vec<Oriented> = orient_curves(file, &discs, &dopts, &o.orient, path, progress)?;
+    let tp = toolpath_of_poses(file, dopts.tolerance, &oriented);
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
-    let popts = PathOptions {
-        linearization_tolerance: args
-            .linearization_tolerance
-            .unwrap_or(PathOptions::default().linearization_tolerance),
-        max_rotary_step_deg: args.max_rotary_step.unwrap_or(f64::INFINITY),
-        ..PathOptions::default()
-    };
+    let popts = o.path;
+    progress(Progress::new(Stage::Kinematics, 0, 1));
     let poses: Vec<Vec<Pose>> = oriented
         .iter()
         .map(|o| o.poses().into_iter().map(Pose::from_array).collect())
@@ -83,17 +64,17 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     // 3a. Where the part goes on the machine; from here on, workpiece coordinates.
     let id_refs: Vec<&str> = file.curves.iter().map(|c| c.id.as_str()).collect();
     let placed = crate::place::place(
-        &machine,
+        machine,
         &id_refs,
         &poses,
-        args.place.as_ref(),
+        o.place,
         &popts,
-        args.retract.max(0.0) + 1.0,
+        o.retract_mm.max(0.0) + 1.0,
         path,
     )?;
     // 3b. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
     // outlines, the shortest traverse; in part coordinates, then placed.
-    let (cuts, cut_plans) = crate::cuts::plan(&file, &oriented, &placed, &args.lead_options())?;
+    let (cuts, cut_plans) = crate::cuts::plan(file, &oriented, &placed, &o.leads, path)?;
     let cut_poses: Vec<Vec<Pose>> = cuts
         .iter()
         .map(|c| {
@@ -122,20 +103,28 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             }),
         })
         .collect();
-    let solved = solve_paths(&machine, &inputs, &popts)
-        .map_err(|e| CliError::Kinematics(Box::new(e), Some(args.curves.clone())))?;
-    let mut axes = AxesFile::new(&machine, &solved);
+    let solved = solve_paths(machine, &inputs, &popts).map_err(kin(path))?;
+    let mut axes = AxesFile::new(machine, &solved);
     crate::cuts::split_axes(&mut axes, &cuts, &solved);
     // 4. Interpolation and G-code, one program per set-up.
+    progress(Progress::new(Stage::Interpolate, 0, 1));
     let model = MachineModel::new(machine.clone()).map_err(interp(path))?;
-    let dialect: Dialect = args.dialect.into();
-    let fit = crate::motion::fit_options(dopts.tolerance, dialect.raw_axes(), args.retract);
-    let plan = PlanOptions::new(args.feed, args.cycle);
+    let dialect = o.dialect;
+    // The generic-dialect rule: the fit follows from the dialect, no option can change it.
+    let fit = crate::motion::fit_options(dopts.tolerance, Some(dialect), o.retract_mm);
+    let plan = PlanOptions::new(o.feed_mm_per_min, o.cycle_s);
+    let source_name = path.map(|p| p.display().to_string());
     let gopts = GcodeOptions {
         fit_tolerance: dopts.tolerance,
         chord_tolerance: plan.chord_tolerance,
         linearization_tolerance: Some(popts.linearization_tolerance),
-        ..crate::motion::gcode_options(&model, dialect, args.feed, args.blend_tolerance, path)
+        ..crate::motion::gcode_options(
+            &model,
+            dialect,
+            o.feed_mm_per_min,
+            o.blend_tolerance_mm,
+            source_name.as_deref(),
+        )
     };
     let mut motions = Vec::new();
     let mut programs = Vec::new();
@@ -164,20 +153,20 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     let process =
         kerf_interp::ProcessCodes::resolve(dialect, &machine.process).map_err(interp(path))?;
     // 5. Picture and report.
-    let mut scene = kerf_plot::Scene::new(&file, &tp, &kerf_plot::SceneOptions::default())
-        .map_err(|e| CliError::Plot(e.to_string()))?;
+    progress(Progress::new(Stage::Report, 0, 1));
+    let mut scene = kerf_plot::Scene::new(file, &tp, &kerf_plot::SceneOptions::default())?;
     scene.title = format!(
         "kerf run \u{2014} {} on {}",
-        path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned()
+        path.map_or_else(
+            || "curves".to_string(),
+            |path| path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned()
+            )
         ),
         machine.name
     );
-    scene.axes = Some(
-        kerf_plot::AxesChart::new(&axes, Some(&machine))
-            .map_err(|e| CliError::Plot(e.to_string()))?,
-    );
+    scene.axes = Some(kerf_plot::AxesChart::new(&axes, Some(machine))?);
     let svg = kerf_plot::render(&scene);
     let mut counts = motions[0].counts();
     for m in &motions[1..] {
@@ -188,10 +177,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     }
     let duration: f64 = motions.iter().map(|m| m.duration()).sum();
     let cycles: usize = motions.iter().map(|m| m.cycles()).sum();
+    // N* from the curvature the walk evaluated at its points (`Discretization::n_star`).
     let nstar: f64 = discs.iter().map(|d| d.n_star(dopts.tolerance)).sum();
     let segments: usize = discs.iter().map(Discretization::segments).sum();
     let report = json!({
-        "input": path.display().to_string(),
+        "input": source_name,
         "machine": machine.name,
         "tolerance_budget_mm": {
             "chord": dopts.tolerance,
@@ -232,10 +222,10 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             "pole_tip_error": solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
         },
         "placement": placed.json(&id_refs),
-        "process": crate::cuts::report(&file, &cuts, &cut_plans),
+        "process": crate::cuts::report(file, &cuts, &cut_plans),
         "interpolation": {
-            "feed_mm_per_min": args.feed,
-            "cycle_s": args.cycle,
+            "feed_mm_per_min": o.feed_mm_per_min,
+            "cycle_s": o.cycle_s,
             "lines": counts.lines,
             "arcs": counts.arcs,
             "turns": counts.turns,
@@ -259,116 +249,18 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         },
         "seconds": start.elapsed().as_secs_f64(),
     });
-    // 6. Write everything at once; the set-points are streamed from the plan into the file.
-    let names = program_names(programs.len());
-    let csv_names = csv_names(programs.len());
-    for name in names.iter().chain(&csv_names) {
-        crate::guard::refuse_overwrite(
-            "--out",
-            &args.out.join(name),
-            &[path, args.machine.as_path()],
-        )?;
-    }
-    let toolpath_text = toolpath::to_string(&tp)?;
-    let axes_text = axes
-        .to_json()
-        .map_err(|e| CliError::Kinematics(Box::new(e), None))?;
-    let report_text = serde_json::to_string_pretty(&report).unwrap_or_else(|_| report.to_string());
-    let text = |s: &str| {
-        let bytes = s.as_bytes().to_vec();
-        Box::new(move |w: &mut dyn std::io::Write| w.write_all(&bytes)) as kerf_io::Contents<'_>
-    };
-    let axis_names = model.axis_names();
-    let mut entries = vec![
-        DirEntry {
-            name: OUTPUTS[0],
-            contents: text(&toolpath_text),
-        },
-        DirEntry {
-            name: OUTPUTS[1],
-            contents: text(&axes_text),
-        },
-    ];
-    for (k, (program, motion)) in programs.iter().zip(&motions).enumerate() {
-        entries.push(DirEntry {
-            name: names[k].as_str(),
-            contents: text(program),
-        });
-        let model = &model;
-        entries.push(DirEntry {
-            name: csv_names[k].as_str(),
-            contents: Box::new(move |w| {
-                write_csv_to(w, axis_names, args.cycle, motion.iter(model))
-            }),
-        });
-    }
-    entries.push(DirEntry {
-        name: OUTPUTS[4],
-        contents: text(&report_text),
-    });
-    entries.push(DirEntry {
-        name: OUTPUTS[5],
-        contents: text(&svg),
-    });
-    kerf_io::write_dir_all_or_nothing(&args.out, entries)
-        .map_err(|e| CliError::Input(e.to_string()))?;
-    if args.json {
-        println!("{report}");
-    } else if !args.quiet {
-        eprintln!(
-            "{}: {} curves -> {} cutting points (N* {nstar:.1}), {} poses on {:?}, {} lines + {} arcs, \
-             {:.2} s of motion at {} mm/min; wrote {} in {:.2} s{}",
-            path.display(),
-            file.curves.len(),
-            tp.paths.iter().map(|p| p.params.len()).sum::<usize>(),
-            solved.iter().map(|s| s.poses.len()).sum::<usize>(),
-            machine.name,
-            counts.lines,
-            counts.arcs,
-            duration,
-            args.feed,
-            args.out.display(),
-            start.elapsed().as_secs_f64(),
-            if placed.is_identity() {
-                String::new()
-            } else {
-                format!("; {}", placed.summary())
-            }
-        );
-    }
-    Ok(())
+    let programs = SetupProgram::numbered(motions, programs, setup_ids);
+    Ok(Output {
+        discretizations: discs,
+        oriented,
+        toolpath: tp,
+        placement: placed,
+        solved,
+        axes,
+        programs,
+        report,
+        plot_svg: svg,
+        model,
+        cycle_s: o.cycle_s,
+    })
 }
-
-/// `program.nc` for one set-up; `program-1.nc`, `program-2.nc`, ... for several (each set-up is
-/// a job of its own: the part is clamped anew between them).
-fn program_names(setups: usize) -> Vec<String> {
-    if setups == 1 {
-        vec!["program.nc".to_string()]
-    } else {
-        (1..=setups).map(|k| format!("program-{k}.nc")).collect()
-    }
-}
-
-/// The set-point files matching [`program_names`].
-fn csv_names(setups: usize) -> Vec<String> {
-    if setups == 1 {
-        vec!["setpoints.csv".to_string()]
-    } else {
-        (1..=setups).map(|k| format!("setpoints-{k}.csv")).collect()
-    }
-}
-
-fn interp(file: &Path) -> impl Fn(kerf_interp::InterpError) -> CliError + '_ {
-    move |e| CliError::Input(format!("{}: {e}", file.display()))
-}
-
-/// The files `kerf run` writes into its output directory, all or nothing (through
-/// [`kerf_io::write_dir_all_or_nothing`]).
-const OUTPUTS: [&str; 6] = [
-    "toolpath.json",
-    "axes.json",
-    "program.nc",
-    "setpoints.csv",
-    "report.json",
-    "plot.svg",
-];

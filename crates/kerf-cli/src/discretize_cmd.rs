@@ -1,0 +1,170 @@
+//! `kerf discretize`: cutting points with a certified chord error for every curve of a
+//! `kerf.curves/1` file, written as `kerf.toolpath/1` (the pipeline's first two stages).
+
+use std::path::Path;
+use std::time::Instant;
+
+use kerf_discretize::{Discretization, Options};
+use kerf_format::toolpath;
+use kerf_normals::NormalOptions;
+use kerf_pipeline::{
+    discretize_curves, orient_curves, toolpath_of_points, toolpath_of_poses, MissingSurface,
+    OrientOptions,
+};
+use serde_json::json;
+
+use crate::cli::DiscretizeArgs;
+use crate::error::CliError;
+use crate::input::{load_curves, ProgressBar};
+
+/// The discretizer options the arguments ask for.
+// `..d` keeps the defaults of options added to `Options` later (every field is set today).
+#[allow(clippy::needless_update)]
+pub(crate) fn options(args: &DiscretizeArgs) -> Options {
+    let d = Options::default();
+    Options {
+        tolerance: args.tolerance,
+        band: args.band.unwrap_or(d.band),
+        max_segment_length: args.max_segment_length.unwrap_or(d.max_segment_length),
+        min_segment_length: args.min_segment_length.unwrap_or(d.min_segment_length),
+        max_turn: args.max_turn.map_or(d.max_turn, f64::to_radians),
+        strategy: args.strategy.into(),
+        max_points: args
+            .max_points
+            .map_or(d.max_points, |n| usize::try_from(n).unwrap_or(usize::MAX)),
+        ..d
+    }
+}
+
+/// The normals-stage options the arguments ask for (`--normals` refuses curves without a
+/// surface).
+fn orient_options(args: &DiscretizeArgs) -> OrientOptions {
+    let d = NormalOptions::default();
+    let normals = NormalOptions {
+        on_surface_tolerance: args.on_surface_tolerance.unwrap_or(d.on_surface_tolerance),
+        max_normal_step: args
+            .max_normal_step
+            .map_or(d.max_normal_step, f64::to_radians),
+        ..d
+    };
+    let o = OrientOptions::default()
+        .with_normals(normals)
+        .with_missing_surface(MissingSurface::Error);
+    match args.crease_angle {
+        Some(deg) => o.with_crease_angle_deg(deg),
+        None => o,
+    }
+}
+
+/// Runs `kerf discretize`.
+pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
+    let start = Instant::now();
+    let path = args.curves.as_path();
+    let dest = args.output.clone().unwrap_or_else(|| default_output(path));
+    crate::guard::refuse_overwrite("--output", &dest, &[path])?;
+    let file = load_curves(path)?;
+    let opts = options(args);
+    let bar = ProgressBar::new(file.curves.len());
+    let progress = |p| bar.update(p);
+    let results = discretize_curves(&file, &opts, Some(path), &progress);
+    bar.finish();
+    let results = results?;
+    let oriented = if args.normals {
+        Some(orient_curves(
+            &file,
+            &results,
+            &opts,
+            &orient_options(args),
+            Some(path),
+            &|_| {},
+        )?)
+    } else {
+        None
+    };
+    let out = match &oriented {
+        None => toolpath_of_points(&file, opts.tolerance, &results),
+        Some(o) => toolpath_of_poses(&file, opts.tolerance, o),
+    };
+    // `-` is standard output; kerf_io also writes devices and FIFOs through.
+    toolpath::write(&out, &dest)?;
+    let segments: usize = results.iter().map(Discretization::segments).sum();
+    let points: usize = out.paths.iter().map(|p| p.params.len()).sum();
+    let worst = out
+        .paths
+        .iter()
+        .map(|p| p.max_chord_error)
+        .fold(0.0, f64::max);
+    let (added, surface_dist, jumps) = oriented.as_ref().map_or((0, 0.0, 0), |o| {
+        (
+            o.iter().map(|o| o.inserted).sum::<usize>(),
+            o.iter().map(|o| o.max_surface_distance).fold(0.0, f64::max),
+            o.iter().map(|o| o.jumps.len()).sum::<usize>(),
+        )
+    });
+    // N* (a diagnostic) comes from the curvature the walk evaluated at its points (no
+    // quadrature of its own; `Discretization::n_star`).
+    let nstar: f64 = results.iter().map(|d| d.n_star(opts.tolerance)).sum();
+    let elapsed = start.elapsed().as_secs_f64();
+    let breaks: usize = results.iter().map(|d| d.c0_breaks().len()).sum();
+    if args.json {
+        let summary = json!({
+            "file": path.display().to_string(),
+            "output": dest.display().to_string(),
+            "curves": file.curves.len(),
+            "points": points,
+            "segments": segments,
+            "c0_breaks": breaks,
+            "tolerance": opts.tolerance,
+            "max_chord_error": worst,
+            "n_star": nstar,
+            "segments_over_n_star": if nstar > 0.0 { segments as f64 / nstar } else { f64::NAN },
+            "seconds": elapsed,
+            "normals": args.normals,
+            "normal_points_added": added,
+            "max_surface_distance": surface_dist,
+            "normal_jumps": jumps,
+        });
+        // The summary goes to standard output unless the toolpath itself does.
+        if dest == Path::new("-") {
+            eprintln!("{summary}");
+        } else {
+            println!("{summary}");
+        }
+    } else if !args.quiet {
+        if args.normals {
+            eprintln!(
+                "normals: {added} points added for the normal step, worst curve-to-surface \
+                 distance {surface_dist:.2e} mm, {jumps} normal jumps at sharp edges"
+            );
+        }
+        eprintln!(
+            "{}: {} curves, {points} points ({segments} segments from the discretizer, {breaks} C0 corners kept), \
+             worst certified chord error {worst:.3e} mm <= {} mm, N* {nstar:.1} \
+             (segments / N* = {:.3}), {:.3} s -> {}",
+            path.display(),
+            file.curves.len(),
+            opts.tolerance,
+            if nstar > 0.0 {
+                segments as f64 / nstar
+            } else {
+                f64::NAN
+            },
+            elapsed,
+            dest.display()
+        );
+    }
+    Ok(())
+}
+
+/// `dir/part.json` -> `part.toolpath.json` in the current directory (the input's folder may be
+/// read-only).
+fn default_output(input: &Path) -> std::path::PathBuf {
+    if input == Path::new("-") {
+        return "-".into();
+    }
+    let stem = input.file_stem().map_or_else(
+        || "curves".to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    format!("{stem}.toolpath.json").into()
+}

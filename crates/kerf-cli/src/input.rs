@@ -1,0 +1,72 @@
+//! Reading the command's inputs (a file or standard input) and showing progress on a
+//! terminal.
+
+use std::io;
+use std::path::Path;
+
+use kerf_format::{curves, CurvesFile};
+use kerf_pipeline::{Progress, Stage};
+
+use crate::error::CliError;
+
+/// Loads a curves file, or standard input for `-`.
+pub(crate) fn load_curves(path: &Path) -> Result<CurvesFile, CliError> {
+    let loaded = if path == Path::new("-") {
+        curves::from_reader(io::stdin().lock(), Path::new(".")).map_err(|e| e.in_file("<stdin>"))
+    } else {
+        curves::load(path)
+    };
+    Ok(loaded?)
+}
+
+/// The job's progress as a bar on standard error, for batches long enough to wait for and
+/// only when standard error is a terminal (never in pipes, logs or CI): the per-curve stages
+/// of `items` curves get a bar each.
+pub(crate) struct ProgressBar {
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl ProgressBar {
+    /// A bar for a job on `items` curves (hidden unless it is worth showing).
+    pub(crate) fn new(items: usize) -> Self {
+        use std::io::IsTerminal;
+        let show = items >= 200 && io::stderr().is_terminal();
+        let bar = show.then(|| {
+            let bar = indicatif::ProgressBar::new(items as u64);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{msg} {bar:40} {pos}/{len} curves, {eta} left",
+            ) {
+                bar.set_style(style);
+            }
+            bar
+        });
+        Self { bar }
+    }
+
+    /// Shows `p`.
+    pub(crate) fn update(&self, p: Progress) {
+        let Some(bar) = &self.bar else { return };
+        match p.stage {
+            Stage::Discretize | Stage::Normals => {
+                if p.done == 0 {
+                    bar.reset();
+                    bar.set_length(p.total as u64);
+                    bar.set_message(if p.stage == Stage::Discretize {
+                        "discretizing"
+                    } else {
+                        "normals"
+                    });
+                }
+                bar.set_position(p.done as u64);
+            }
+            _ => bar.finish_and_clear(),
+        }
+    }
+
+    /// Removes the bar.
+    pub(crate) fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}

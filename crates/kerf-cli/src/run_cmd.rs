@@ -1,0 +1,110 @@
+//! `kerf run`: the whole pipeline in one command ([`kerf_pipeline::Job::run`]), all files
+//! written into one output directory only once every stage has succeeded.
+
+use std::time::Instant;
+
+use kerf_kinematics::{Machine, PathOptions};
+use kerf_normals::NormalOptions;
+use kerf_pipeline::{Job, JobOptions, OrientOptions};
+
+use crate::cli::RunArgs;
+use crate::error::CliError;
+use crate::input::{load_curves, ProgressBar};
+
+/// The job options the arguments ask for.
+fn job_options(args: &RunArgs) -> JobOptions {
+    let mut discretize = kerf_discretize::Options::with_tolerance(args.tolerance);
+    discretize.max_segment_length = args.max_segment_length.unwrap_or(f64::INFINITY);
+    let mut normals = NormalOptions::default();
+    if let Some(deg) = args.max_normal_step {
+        normals.max_normal_step = deg.to_radians();
+    }
+    let d = PathOptions::default();
+    let path = PathOptions {
+        linearization_tolerance: args
+            .linearization_tolerance
+            .unwrap_or(d.linearization_tolerance),
+        max_rotary_step_deg: args.max_rotary_step.unwrap_or(f64::INFINITY),
+        ..d
+    };
+    JobOptions::default()
+        .with_discretize(discretize)
+        .with_orient(OrientOptions::default().with_normals(normals))
+        .with_path(path)
+        .with_place(args.place.unwrap_or_default())
+        .with_leads(args.lead_options())
+        .with_feed_mm_per_min(args.feed)
+        .with_cycle_s(args.cycle)
+        .with_dialect(args.dialect.into())
+        .with_blend_tolerance_mm(args.blend_tolerance)
+        .with_retract_mm(args.retract)
+}
+
+/// Runs `kerf run`.
+pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
+    let start = Instant::now();
+    let path = args.curves.as_path();
+    let refuse = |names: &[String]| {
+        names.iter().try_for_each(|name| {
+            crate::guard::refuse_overwrite(
+                "--out",
+                &args.out.join(name),
+                &[path, args.machine.as_path()],
+            )
+        })
+    };
+    refuse(&kerf_pipeline::OUTPUTS.map(str::to_owned))?;
+    let file = if crate::import::is_step(path) {
+        let (file, import) = crate::import::load_step(path, &args.step_args)?;
+        if !args.quiet && !args.json {
+            crate::import::print_account(path, &import);
+        }
+        file
+    } else {
+        load_curves(path)?
+    };
+    let machine = Machine::read(&args.machine)?;
+    let job = Job::new(file, machine)
+        .with_source(path)
+        .with_options(job_options(args));
+    let bar = ProgressBar::new(job.curves().curves.len());
+    let out = job.run_with_progress(&|p| bar.update(p));
+    bar.finish();
+    let out = out?;
+    // Several set-ups number their programs: check those names too.
+    refuse(&out.file_names())?;
+    out.write_dir(&args.out)?;
+    let r = &out.report;
+    if args.json {
+        println!("{r}");
+    } else if !args.quiet {
+        let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+        let int = |v: &serde_json::Value| v.as_u64().unwrap_or(0);
+        eprintln!(
+            "{}: {} curves -> {} cutting points (N* {:.1}), {} poses on {:?}, {} lines + {} arcs, \
+             {:.2} s of motion at {} mm/min; wrote {} in {:.2} s{}",
+            path.display(),
+            job.curves().curves.len(),
+            out.toolpath
+                .paths
+                .iter()
+                .map(|p| p.params.len())
+                .sum::<usize>(),
+            num(&r["discretize"]["n_star"]),
+            out.solved.iter().map(|s| s.poses.len()).sum::<usize>(),
+            job.machine().name,
+            int(&r["interpolation"]["lines"]),
+            int(&r["interpolation"]["arcs"]),
+            num(&r["interpolation"]["duration_s"]),
+            args.feed,
+            args.out.display(),
+            start.elapsed().as_secs_f64(),
+            if out.placement.is_identity() {
+                String::new()
+            } else {
+                format!("; {}", out.placement.summary())
+            }
+        );
+    }
+    Ok(())
+}

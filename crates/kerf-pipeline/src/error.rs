@@ -1,0 +1,234 @@
+//! [`Error`]: the one error type of a job, every stage's error with the place it happened.
+
+use std::path::{Path, PathBuf};
+
+/// Why a job (or one of its stages) failed.
+///
+/// Every variant keeps the stage crate's own error as its [`source`](std::error::Error::source)
+/// and says where it happened: the input file (when the job was given one, see
+/// [`crate::Job::with_source`]) and the curve's index and id in the form
+/// `part.json: curves[3] ("outline"): ...`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// An input file is unreadable or invalid; the message names the file and the JSON path of
+    /// the defect. Fix: the file (see `shared/formats.md`).
+    #[error(transparent)]
+    Format(#[from] kerf_format::FormatError),
+    /// A discretizer option is out of range; nothing was computed. Fix: the option named.
+    #[error(transparent)]
+    Options(kerf_discretize::DiscretizeError),
+    /// A curve could not be discretized (too many points for the tolerance, a tolerance below
+    /// the precision of the curve's coordinates, the work budget). Fix: the tolerance or
+    /// `max_points`.
+    #[error("{}curves[{index}] ({id:?}): {source}", at(file))]
+    Discretize {
+        /// The curves file, when known.
+        file: Option<PathBuf>,
+        /// Index of the curve in `curves`.
+        index: usize,
+        /// Its id.
+        id: String,
+        /// What went wrong.
+        #[source]
+        source: kerf_discretize::DiscretizeError,
+    },
+    /// A curve's normals could not be found (a point off its surface, a reversed surface, ...),
+    /// or a surface cannot give normals (a degenerate mesh). Fix: the surface or the curve.
+    #[error("{}{place}: {source}", at(file))]
+    Normals {
+        /// The curves file, when known.
+        file: Option<PathBuf>,
+        /// Where: `curves[3] ("id")` or `surfaces[1] ("id")`.
+        place: String,
+        /// What went wrong.
+        #[source]
+        source: kerf_normals::NormalsError,
+    },
+    /// Normals were asked for a curve that names no surface
+    /// ([`crate::MissingSurface::Error`]). Fix: add `"surface": "<id>"` to the curve, or cut it
+    /// with a vertical beam ([`crate::MissingSurface::Vertical`]).
+    #[error(
+        "{}curves[{index}] ({id:?}): --normals needs a surface, but the curve names none (add \"surface\": \"<id>\")",
+        at(file)
+    )]
+    MissingSurface {
+        /// The curves file, when known.
+        file: Option<PathBuf>,
+        /// Index of the curve in `curves`.
+        index: usize,
+        /// Its id.
+        id: String,
+    },
+    /// A curve or surface built in code is invalid (the reader refuses files with these
+    /// defects): a NURBS defect, or a duplicate id or one with a control character (ids go
+    /// into programs). Fix: the value named.
+    #[error("{}{place}: {message}", at(file))]
+    Invalid {
+        /// The curves file, when known.
+        file: Option<PathBuf>,
+        /// Where: `curves[3] ("id")` or `surfaces[1] ("id")`.
+        place: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A curve or surface could not be built (a NURBS defect). Fix: the value the message
+    /// names.
+    #[error(transparent)]
+    Nurbs(#[from] kerf_nurbs::NurbsError),
+    /// A curve names a surface the file does not have (possible only in a
+    /// [`kerf_format::CurvesFile`] built in code: the reader refuses such files). Fix: add the
+    /// surface to `surfaces` or correct the id.
+    #[error("{}curves[{index}] ({id:?}): no surface with id {surface:?}", at(file))]
+    UnknownSurface {
+        /// The curves file, when known.
+        file: Option<PathBuf>,
+        /// Index of the curve in `curves`.
+        index: usize,
+        /// Its id.
+        id: String,
+        /// The surface id it names.
+        surface: String,
+    },
+    /// A toolpath's points have no normals, so they cannot be put on a 5-axis machine. Fix:
+    /// discretize with normals (`kerf discretize --normals`) on curves that name their surface.
+    #[error(
+        "{}paths[{index}] ({id:?}): points have no normals; run `kerf discretize --normals` on curves that name their surface",
+        at(file)
+    )]
+    NoNormals {
+        /// The toolpath file, when known.
+        file: Option<PathBuf>,
+        /// Index of the path in `paths`.
+        index: usize,
+        /// Its id.
+        id: String,
+    },
+    /// The machine file is invalid, a path cannot be solved on the machine (a pose out of
+    /// reach, an axis limit), or no placement fits. Fix: as the message says.
+    #[error("{}{source}", at(file))]
+    Kinematics {
+        /// The input file the path came from, when known.
+        file: Option<PathBuf>,
+        /// What went wrong.
+        #[source]
+        source: Box<kerf_kinematics::KinematicsError>,
+    },
+    /// The interpolator or the G-code writer refused (an option out of range, unusable process
+    /// codes, a program the dialect cannot run). Fix: as the message says.
+    #[error("{}{source}", at(file))]
+    Interp {
+        /// The input file, when known.
+        file: Option<PathBuf>,
+        /// What went wrong.
+        #[source]
+        source: kerf_interp::InterpError,
+    },
+    /// The cut planner refused (lead options out of range, a contour too short). Fix: the lead
+    /// options or the contour.
+    #[error("{}{source}", at(file))]
+    Process {
+        /// The curves file, when known.
+        file: Option<PathBuf>,
+        /// What went wrong.
+        #[source]
+        source: kerf_process::ProcessError,
+    },
+    /// The picture could not be made.
+    #[error(transparent)]
+    Plot(#[from] kerf_plot::PlotError),
+    /// G-code was asked of a program planned for set-points only
+    /// ([`crate::MotionOptions::dialect`] `None`). Fix: plan it with the dialect.
+    #[error("this program was planned for set-points only (no dialect); plan it with a dialect to write G-code")]
+    NoDialect,
+    /// A job has no curve to cut. Fix: give it at least one curve.
+    #[error("{}the job has no curve to cut", at(file))]
+    NoCurves {
+        /// The curves file, when known.
+        file: Option<PathBuf>,
+    },
+    /// Stage results given to a later stage do not belong to its input (one discretization
+    /// per curve, one cut per path). Fix: pass the results computed from the same input.
+    #[error("inconsistent stage input: {0}")]
+    Inconsistent(String),
+    /// A file could not be read. Fix: the path or its permissions.
+    #[error("{}: cannot read: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        #[source]
+        source: std::io::Error,
+    },
+    /// An output could not be written (a writer failed, or the all-or-nothing write of an
+    /// output directory; the directory is then left as it was).
+    #[error("{}cannot write: {source}", at(path))]
+    Write {
+        /// The file or directory, when known.
+        path: Option<PathBuf>,
+        /// What went wrong.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// `file: ` or nothing.
+fn at(file: &Option<PathBuf>) -> String {
+    file.as_deref()
+        .map_or_else(String::new, |f| format!("{}: ", f.display()))
+}
+
+impl Error {
+    /// The error with `file` as the input it is about, where it names no file yet (a stage
+    /// error from a job built in code, reported for a file the caller read).
+    pub fn in_file(mut self, path: impl AsRef<Path>) -> Self {
+        let path = path.as_ref().to_path_buf();
+        match &mut self {
+            Error::Discretize { file, .. }
+            | Error::Normals { file, .. }
+            | Error::MissingSurface { file, .. }
+            | Error::UnknownSurface { file, .. }
+            | Error::NoNormals { file, .. }
+            | Error::Kinematics { file, .. }
+            | Error::Interp { file, .. }
+            | Error::Process { file, .. }
+            | Error::NoCurves { file }
+            | Error::Invalid { file, .. } => {
+                file.get_or_insert(path);
+            }
+            Error::Write { path: p, .. } => {
+                p.get_or_insert(path);
+            }
+            _ => {}
+        }
+        self
+    }
+}
+
+impl From<kerf_kinematics::KinematicsError> for Error {
+    fn from(e: kerf_kinematics::KinematicsError) -> Self {
+        Error::Kinematics {
+            file: None,
+            source: Box::new(e),
+        }
+    }
+}
+
+/// The result of a job or a stage.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Maps a stage error to [`Error`] naming `file`.
+pub(crate) fn kin(file: Option<&Path>) -> impl Fn(kerf_kinematics::KinematicsError) -> Error + '_ {
+    move |e| Error::Kinematics {
+        file: file.map(Path::to_path_buf),
+        source: Box::new(e),
+    }
+}
+
+/// Maps an interpolator error to [`Error`] naming `file`.
+pub(crate) fn interp(file: Option<&Path>) -> impl Fn(kerf_interp::InterpError) -> Error + '_ {
+    move |e| Error::Interp {
+        file: file.map(Path::to_path_buf),
+        source: e,
+    }
+}

@@ -1,0 +1,367 @@
+//! [`Job`] and [`JobOptions`]: what a run of the whole pipeline takes.
+
+use std::path::{Path, PathBuf};
+
+use kerf_discretize::Options;
+use kerf_format::{CurveRecord, CurvesFile, SurfaceGeometry, SurfaceRecord, SurfaceSource};
+use kerf_interp::Dialect;
+use kerf_kinematics::{Machine, PathOptions};
+use kerf_normals::NormalOptions;
+use kerf_nurbs::{NurbsCurve, NurbsSurface};
+use kerf_process::LeadOptions;
+
+use crate::error::{Error, Result};
+use crate::place::PlaceMode;
+
+/// What the normals stage does with a curve that names no surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum MissingSurface {
+    /// The tool axis is +z at every point: flat 2D cutting with a vertical beam (the default
+    /// of a [`Job`]).
+    #[default]
+    Vertical,
+    /// The curve is refused with [`crate::Error::MissingSurface`] (what `kerf discretize
+    /// --normals` does: a 3D part whose contour lost its surface must not be cut vertically).
+    Error,
+}
+
+/// The options of the normals stage: the stage's own [`NormalOptions`], the crease angle of
+/// mesh surfaces and what to do with curves without a surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct OrientOptions {
+    /// The normals stage (on-surface tolerance, normal step, work budget). Default
+    /// [`NormalOptions::default`].
+    pub normals: NormalOptions,
+    /// Mesh faces meeting at more than this angle form a sharp edge whose normals are not
+    /// blended, degrees. Default [`kerf_normals::DEFAULT_CREASE_ANGLE_DEG`] (30).
+    pub crease_angle_deg: f64,
+    /// Curves without a surface. Default [`MissingSurface::Vertical`].
+    pub missing_surface: MissingSurface,
+}
+
+impl Default for OrientOptions {
+    fn default() -> Self {
+        Self {
+            normals: NormalOptions::default(),
+            crease_angle_deg: kerf_normals::DEFAULT_CREASE_ANGLE_DEG,
+            missing_surface: MissingSurface::Vertical,
+        }
+    }
+}
+
+impl OrientOptions {
+    /// With these options of the normals stage.
+    pub fn with_normals(mut self, normals: NormalOptions) -> Self {
+        self.normals = normals;
+        self
+    }
+
+    /// With this crease angle for mesh surfaces, degrees.
+    pub fn with_crease_angle_deg(mut self, deg: f64) -> Self {
+        self.crease_angle_deg = deg;
+        self
+    }
+
+    /// With this rule for curves without a surface.
+    pub fn with_missing_surface(mut self, rule: MissingSurface) -> Self {
+        self.missing_surface = rule;
+        self
+    }
+}
+
+/// The options of every stage of a [`Job`], with documented defaults (those of `kerf run`).
+///
+/// Build with [`JobOptions::default`] and the `with_*` setters; new options may be added
+/// without breaking callers. Units are in the names: `_mm`, `_s`, `_deg`, `_mm_per_min`; the
+/// stage option structs document their own units.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct JobOptions {
+    /// The discretizer. Default [`Options::default`]: chord tolerance 0.01 mm, no longest
+    /// segment.
+    pub discretize: Options,
+    /// The normals stage. Default [`OrientOptions::default`] (vertical beam for curves without
+    /// a surface).
+    pub orient: OrientOptions,
+    /// The kinematics. Default [`PathOptions::default`]: linearization tolerance 0.005 mm, no
+    /// rotary step limit.
+    pub path: PathOptions,
+    /// Where the part goes on the machine. Default [`PlaceMode::AsModelled`].
+    pub place: PlaceMode,
+    /// Lead-ins and lead-outs of every cut. Default [`LeadOptions::default`] (2 mm line and
+    /// 1 mm arc in, 0.5 mm overcut and 1 mm exit).
+    pub leads: LeadOptions,
+    /// Programmed cutting feed, mm/min. Default 6000.
+    pub feed_mm_per_min: f64,
+    /// Interpolation cycle, s. Default 0.001.
+    pub cycle_s: f64,
+    /// The G-code dialect. Default [`Dialect::Generic`]. The fit of the motion follows from it
+    /// (see [`crate::MotionOptions`]): a dialect that programs raw machine axes gets neither
+    /// arcs nor merged lines, whatever else is set.
+    pub dialect: Dialect,
+    /// The controller's blending tolerance, mm: a term of the tolerance budget. Default
+    /// [`kerf_interp::DEFAULT_BLEND_TOLERANCE`].
+    pub blend_tolerance_mm: f64,
+    /// Between two contours the head backs off this far along the tool axis, traverses and
+    /// approaches the next start along its tool axis, mm (0: one straight rapid). Default 10.
+    pub retract_mm: f64,
+}
+
+impl Default for JobOptions {
+    fn default() -> Self {
+        Self {
+            discretize: Options::default(),
+            orient: OrientOptions::default(),
+            path: PathOptions::default(),
+            place: PlaceMode::AsModelled,
+            leads: LeadOptions::default(),
+            feed_mm_per_min: 6000.0,
+            cycle_s: 0.001,
+            dialect: Dialect::Generic,
+            blend_tolerance_mm: kerf_interp::DEFAULT_BLEND_TOLERANCE,
+            retract_mm: 10.0,
+        }
+    }
+}
+
+impl JobOptions {
+    /// With this chord tolerance, mm: every segment's chord error is at most this (certified).
+    pub fn with_tolerance_mm(mut self, mm: f64) -> Self {
+        self.discretize.tolerance = mm;
+        self
+    }
+
+    /// With these discretizer options.
+    pub fn with_discretize(mut self, options: Options) -> Self {
+        self.discretize = options;
+        self
+    }
+
+    /// With these normals-stage options.
+    pub fn with_orient(mut self, options: OrientOptions) -> Self {
+        self.orient = options;
+        self
+    }
+
+    /// With these kinematics options.
+    pub fn with_path(mut self, options: PathOptions) -> Self {
+        self.path = options;
+        self
+    }
+
+    /// With this placement of the part on the machine.
+    pub fn with_place(mut self, place: PlaceMode) -> Self {
+        self.place = place;
+        self
+    }
+
+    /// With these lead-in and lead-out options.
+    pub fn with_leads(mut self, leads: LeadOptions) -> Self {
+        self.leads = leads;
+        self
+    }
+
+    /// With this programmed feed, mm/min.
+    pub fn with_feed_mm_per_min(mut self, feed: f64) -> Self {
+        self.feed_mm_per_min = feed;
+        self
+    }
+
+    /// With this interpolation cycle, s.
+    pub fn with_cycle_s(mut self, cycle: f64) -> Self {
+        self.cycle_s = cycle;
+        self
+    }
+
+    /// With this G-code dialect.
+    pub fn with_dialect(mut self, dialect: Dialect) -> Self {
+        self.dialect = dialect;
+        self
+    }
+
+    /// With this controller blending tolerance, mm.
+    pub fn with_blend_tolerance_mm(mut self, mm: f64) -> Self {
+        self.blend_tolerance_mm = mm;
+        self
+    }
+
+    /// With this retract between contours, mm.
+    pub fn with_retract_mm(mut self, mm: f64) -> Self {
+        self.retract_mm = mm;
+        self
+    }
+}
+
+/// A job: the curves (with their surfaces), the machine and the options of every stage.
+/// [`Job::run`] runs the whole pipeline in memory and returns every stage's result
+/// ([`crate::Output`]).
+#[derive(Debug, Clone)]
+pub struct Job {
+    pub(crate) curves: CurvesFile,
+    pub(crate) machine: Machine,
+    pub(crate) options: JobOptions,
+    pub(crate) source: Option<PathBuf>,
+}
+
+impl Job {
+    /// A job with the default options on `curves` (read from a file or built in code) and
+    /// `machine`.
+    pub fn new(curves: CurvesFile, machine: Machine) -> Self {
+        Self {
+            curves,
+            machine,
+            options: JobOptions::default(),
+            source: None,
+        }
+    }
+
+    /// A job on a `kerf.curves/1` file and a `kerf.machine/1` file; errors name the curves
+    /// file.
+    ///
+    /// # Errors
+    /// [`crate::Error::Format`] for an unreadable or invalid curves file,
+    /// [`crate::Error::Kinematics`] for the machine file.
+    pub fn from_files(curves: impl AsRef<Path>, machine: impl AsRef<Path>) -> Result<Self> {
+        let path = curves.as_ref();
+        let file = kerf_format::curves::load(path)?;
+        let machine = Machine::read(machine)?;
+        Ok(Self::new(file, machine).with_source(path))
+    }
+
+    /// A job on `machine` with no curves yet: add them with [`Job::with_surface`] and
+    /// [`Job::with_curve`] (geometry built in code).
+    pub fn on_machine(machine: Machine) -> Self {
+        Self::new(
+            CurvesFile {
+                units: kerf_format::Units::Millimetres,
+                curves: Vec::new(),
+                surfaces: Vec::new(),
+            },
+            machine,
+        )
+    }
+
+    /// With one more surface (coordinates in mm; the normal is `Su x Sv`, `flip` reverses it).
+    pub fn with_surface(
+        mut self,
+        id: impl Into<String>,
+        surface: NurbsSurface,
+        flip: bool,
+    ) -> Self {
+        self.curves.surfaces.push(SurfaceRecord {
+            id: id.into(),
+            geometry: SurfaceGeometry::Nurbs(surface),
+            source: SurfaceSource::Inline,
+            flip,
+        });
+        self
+    }
+
+    /// With one more cut contour (coordinates in mm) on the surface with id `surface` (`None`:
+    /// cut with a vertical beam, see [`MissingSurface`]).
+    pub fn with_curve(
+        mut self,
+        id: impl Into<String>,
+        curve: NurbsCurve,
+        surface: Option<&str>,
+    ) -> Self {
+        let surface = surface.map(str::to_owned);
+        self.curves.curves.push(CurveRecord {
+            id: id.into(),
+            curve,
+            surfaces: surface.iter().cloned().collect(),
+            surface,
+        });
+        self
+    }
+
+    /// Checks what the reader checks of a file but a model built in code may lack: at least
+    /// one curve, unique ids without control characters, every surface named present.
+    ///
+    /// # Errors
+    /// [`Error::NoCurves`], [`Error::Invalid`], [`Error::UnknownSurface`].
+    pub fn validate(&self) -> Result<()> {
+        let file = || self.source.clone();
+        if self.curves.curves.is_empty() {
+            return Err(Error::NoCurves { file: file() });
+        }
+        let ids = self
+            .curves
+            .curves
+            .iter()
+            .map(|c| ("curves", &c.id))
+            .enumerate()
+            .chain(
+                self.curves
+                    .surfaces
+                    .iter()
+                    .map(|s| ("surfaces", &s.id))
+                    .enumerate(),
+            );
+        let mut seen = std::collections::HashSet::new();
+        for (i, (list, id)) in ids {
+            let invalid = |message: String| Error::Invalid {
+                file: file(),
+                place: format!("{list}[{i}] ({id:?})"),
+                message,
+            };
+            if let Err(d) = kerf_io::check_text(id) {
+                return Err(invalid(format!("the id {d}")));
+            }
+            if !seen.insert((list, id)) {
+                return Err(invalid(format!(
+                    "a second {} with this id",
+                    &list[..list.len() - 1]
+                )));
+            }
+        }
+        for (i, c) in self.curves.curves.iter().enumerate() {
+            for sid in c.surface.iter().chain(&c.surfaces) {
+                if self.curves.surface(sid).is_none() {
+                    return Err(Error::UnknownSurface {
+                        file: file(),
+                        index: i,
+                        id: c.id.clone(),
+                        surface: sid.clone(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// With these options.
+    pub fn with_options(mut self, options: JobOptions) -> Self {
+        self.options = options;
+        self
+    }
+
+    /// With `path` named as the curves' file: in every error, in the report and in the
+    /// program's comments.
+    pub fn with_source(mut self, path: impl AsRef<Path>) -> Self {
+        self.source = Some(path.as_ref().to_path_buf());
+        self
+    }
+
+    /// The curves and surfaces.
+    pub fn curves(&self) -> &CurvesFile {
+        &self.curves
+    }
+
+    /// The machine.
+    pub fn machine(&self) -> &Machine {
+        &self.machine
+    }
+
+    /// The options.
+    pub fn options(&self) -> &JobOptions {
+        &self.options
+    }
+
+    /// The file named by [`Job::with_source`].
+    pub fn source(&self) -> Option<&Path> {
+        self.source.as_deref()
+    }
+}

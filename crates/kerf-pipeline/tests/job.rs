@@ -1,0 +1,302 @@
+//! The pipeline as a library: a job from files and from code, every stage's result, the
+//! error type, the generic-dialect rule and the outputs, checked against independent truth
+//! (`kerf-check`'s brute-force measurement, the exact circle, forward kinematics).
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use kerf_check::{check, CheckOptions, RawToolpath};
+use kerf_interp::{Dialect, Geometry};
+use kerf_kinematics::Machine;
+use kerf_nurbs::NurbsCurve;
+use kerf_pipeline::{
+    plan_program, Error, Job, JobOptions, MissingSurface, MotionInput, MotionOptions,
+    OrientOptions, Progress, Stage,
+};
+use nalgebra::Point3;
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+fn machine() -> Machine {
+    Machine::read(fixture("machines/ac_head.json")).expect("machine")
+}
+
+/// A straight line from `a` to `b` (degree 1).
+fn line(a: [f64; 3], b: [f64; 3]) -> NurbsCurve {
+    NurbsCurve::try_new(
+        1,
+        vec![0.0, 0.0, 1.0, 1.0],
+        vec![Point3::from(a), Point3::from(b)],
+        None,
+    )
+    .expect("line")
+}
+
+#[test]
+fn a_job_from_files_gives_every_stage_and_its_toolpath_passes_the_independent_check() {
+    let job = Job::from_files(fixture("mixed.json"), fixture("machines/ac_head.json"))
+        .expect("inputs")
+        .with_options(JobOptions::default().with_tolerance_mm(0.01));
+    let out = job.run().expect("run");
+    let n = job.curves().curves.len();
+    assert_eq!(out.discretizations.len(), n, "one discretization per curve");
+    assert_eq!(out.oriented.len(), n, "one oriented path per curve");
+    assert_eq!(out.toolpath.paths.len(), n, "one toolpath path per curve");
+    assert_eq!(out.solved.len(), n, "one cut per curve");
+    assert_eq!(out.axes.paths.len(), n, "one axes path per cut");
+    assert_eq!(out.programs.len(), 1, "one set-up");
+    // The toolpath, as text, measured by the checker (dense sampling, not the certificate).
+    let mut text = Vec::new();
+    out.write_toolpath(&mut text).expect("toolpath to memory");
+    let tp = RawToolpath::from_slice(&text).expect("toolpath reads back");
+    let report = check(&job.curves().curves, &tp, &CheckOptions::default());
+    assert!(report.passed(), "{:?}", report.violations);
+    assert!(
+        report.measured_chord_error() <= 0.01,
+        "{}",
+        report.measured_chord_error()
+    );
+    // Curves without a surface get the vertical beam.
+    for (rec, o) in job.curves().curves.iter().zip(&out.oriented) {
+        if rec.surface.is_none() {
+            assert!(
+                o.normals.iter().all(|v| (v.z - 1.0).abs() < 1e-15),
+                "{}",
+                rec.id
+            );
+        }
+    }
+    // Forward kinematics after the pipeline's inverse, on every pose of every cut.
+    for p in &out.axes.paths {
+        let (axes, poses) = p.run();
+        for (q, pose) in axes.iter().zip(&poses) {
+            let back = job
+                .machine()
+                .kinematics
+                .forward(&kerf_kinematics::Axes::from_array(*q))
+                .to_array();
+            for k in 0..6 {
+                assert!(
+                    (back[k] - pose[k]).abs() < 1e-9,
+                    "{}: {back:?} vs {pose:?}",
+                    p.id
+                );
+            }
+        }
+    }
+    assert_eq!(
+        out.report["discretize"]["curves"].as_u64(),
+        Some(n as u64),
+        "the report counts the curves"
+    );
+}
+
+#[test]
+fn generic_programs_get_neither_arcs_nor_merged_lines_whatever_the_caller_sets() {
+    // A dome has long circular contours: with tool-tip control they become arcs.
+    let base =
+        Job::from_files(fixture("dome.json"), fixture("machines/ac_head.json")).expect("inputs");
+    let sinumerik = base
+        .clone()
+        .with_options(JobOptions::default().with_dialect(Dialect::Sinumerik))
+        .run()
+        .expect("sinumerik");
+    assert!(
+        sinumerik.programs[0].motion.counts().arcs > 0,
+        "arcs where the controller keeps the tip on the path"
+    );
+    for dialect in [Dialect::Generic, Dialect::Linuxcnc] {
+        let out = base
+            .clone()
+            .with_options(JobOptions::default().with_dialect(dialect))
+            .run()
+            .expect("raw axes");
+        for b in out.programs[0].motion.blocks().iter().filter(|b| !b.rapid) {
+            assert!(
+                !matches!(b.geometry, Geometry::Arc(_)),
+                "{dialect:?}: an arc"
+            );
+            assert_eq!(
+                b.stations[1],
+                b.stations[0] + 1,
+                "{dialect:?}: a merged line"
+            );
+        }
+    }
+    // The motion stage alone: the same rule from the dialect, and no G-code without one.
+    let input = MotionInput::Toolpath(sinumerik.toolpath.clone());
+    let generic = plan_program(&machine(), &input, &MotionOptions::default(), None).expect("plan");
+    assert_eq!(generic.motion.counts().arcs, 0, "generic: no arcs");
+    assert!(
+        generic.gcode().expect("gcode").contains("G1 X"),
+        "axis words"
+    );
+    let setpoints = MotionOptions::default().with_dialect(None);
+    let p = plan_program(&machine(), &input, &setpoints, None).expect("plan");
+    assert!(p.motion.counts().arcs > 0, "set-points follow arcs");
+    assert!(
+        matches!(p.gcode(), Err(Error::NoDialect)),
+        "no program without a dialect"
+    );
+    let mut csv = Vec::new();
+    p.write_setpoints(&mut csv).expect("set-points to memory");
+    let rows = String::from_utf8(csv).expect("utf-8").lines().count();
+    assert_eq!(
+        rows,
+        p.motion.cycles() + 2,
+        "a header and one row per cycle end"
+    );
+}
+
+#[test]
+fn errors_name_the_file_the_curve_and_keep_the_stage_error() {
+    let path = fixture("mixed.json");
+    let mut opts = JobOptions::default();
+    opts.discretize.max_points = 3;
+    let e = Job::from_files(&path, fixture("machines/ac_head.json"))
+        .expect("inputs")
+        .with_options(opts)
+        .run()
+        .expect_err("three points cannot certify these curves");
+    let Error::Discretize {
+        file, index, id, ..
+    } = &e
+    else {
+        panic!("a discretizer error: {e:?}");
+    };
+    assert_eq!(file.as_deref(), Some(path.as_path()), "the file");
+    let text = e.to_string();
+    assert!(
+        text.starts_with(&format!("{}: curves[{index}] ({id:?}): ", path.display())),
+        "{text}"
+    );
+    let source = std::error::Error::source(&e).expect("the stage error is kept");
+    assert!(
+        source
+            .downcast_ref::<kerf_discretize::DiscretizeError>()
+            .is_some(),
+        "{source:?}"
+    );
+    // Normals refused for a curve without a surface, when asked to.
+    let e = Job::from_files(&path, fixture("machines/ac_head.json"))
+        .expect("inputs")
+        .with_options(
+            JobOptions::default()
+                .with_orient(OrientOptions::default().with_missing_surface(MissingSurface::Error)),
+        )
+        .run()
+        .expect_err("mixed.json has curves without a surface");
+    assert!(
+        matches!(&e, Error::MissingSurface { index: 0, id, .. } if id == "v-corner"),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn a_model_built_in_code_is_checked_as_a_file_would_be() {
+    let l = || line([100.0, 100.0, 0.0], [140.0, 100.0, 0.0]);
+    let e = Job::on_machine(machine())
+        .run()
+        .expect_err("nothing to cut");
+    assert!(matches!(e, Error::NoCurves { .. }), "{e:?}");
+    let e = Job::on_machine(machine())
+        .with_curve("a", l(), Some("nowhere"))
+        .run()
+        .expect_err("unknown surface");
+    assert!(
+        matches!(&e, Error::UnknownSurface { index: 0, surface, .. } if surface == "nowhere"),
+        "{e:?}"
+    );
+    let e = Job::on_machine(machine())
+        .with_curve("a", l(), None)
+        .with_curve("a", l(), None)
+        .run()
+        .expect_err("duplicate id");
+    assert!(e.to_string().contains("curves[1] (\"a\")"), "{e}");
+    let e = Job::on_machine(machine())
+        .with_curve("a\nM30", l(), None)
+        .run()
+        .expect_err("an id that would add a block");
+    assert!(matches!(e, Error::Invalid { .. }), "{e:?}");
+    // A valid one: a 40 mm straight cut with a vertical beam; the cutting points are the
+    // line's ends and the certified chord error is the rounding margin only.
+    let out = Job::on_machine(machine())
+        .with_curve("slit", l(), None)
+        .run()
+        .expect("run");
+    let p = &out.toolpath.paths[0];
+    assert_eq!(p.points.len(), 2, "a line needs its two ends");
+    assert!(
+        p.max_chord_error < 1e-9,
+        "a chord of a line: {}",
+        p.max_chord_error
+    );
+}
+
+#[test]
+fn progress_reports_every_stage_and_every_curve() {
+    let seen = Mutex::new(Vec::<Progress>::new());
+    let job =
+        Job::from_files(fixture("mixed.json"), fixture("machines/ac_head.json")).expect("inputs");
+    job.run_with_progress(&|p| seen.lock().expect("lock").push(p))
+        .expect("run");
+    let seen = seen.into_inner().expect("lock");
+    let n = job.curves().curves.len();
+    for stage in [Stage::Discretize, Stage::Normals] {
+        let done: Vec<usize> = seen
+            .iter()
+            .filter(|p| p.stage == stage)
+            .map(|p| p.done)
+            .collect();
+        assert_eq!(
+            done.len(),
+            n + 1,
+            "{stage:?}: a start and one report per curve"
+        );
+        assert_eq!(done.iter().max(), Some(&n), "{stage:?}: all curves");
+    }
+    for stage in [Stage::Kinematics, Stage::Interpolate, Stage::Report] {
+        assert!(seen.iter().any(|p| p.stage == stage), "{stage:?} reported");
+    }
+}
+
+#[test]
+fn the_output_directory_is_written_all_or_nothing() {
+    let out = Job::from_files(fixture("dome.json"), fixture("machines/ac_head.json"))
+        .expect("inputs")
+        .run()
+        .expect("run");
+    let dir = tempfile::tempdir().expect("temp dir");
+    out.write_dir(dir.path()).expect("write");
+    for name in out.file_names() {
+        assert!(dir.path().join(&name).is_file(), "{name} written");
+    }
+    let program = std::fs::read_to_string(dir.path().join("program.nc")).expect("program");
+    assert_eq!(
+        program, out.programs[0].text,
+        "the program in memory is the file"
+    );
+    // A directory where a file must go: refused before anything is written, nothing changed.
+    let dir2 = tempfile::tempdir().expect("temp dir");
+    std::fs::create_dir(dir2.path().join("report.json")).expect("mkdir");
+    let e = out
+        .write_dir(dir2.path())
+        .expect_err("report.json is a directory");
+    assert!(
+        matches!(&e, Error::Write { path: Some(p), .. } if p.ends_with("report.json")),
+        "{e:?}"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir2.path())
+        .expect("list")
+        .map(|e| e.expect("entry").file_name())
+        .collect();
+    assert_eq!(
+        left,
+        vec![std::ffi::OsString::from("report.json")],
+        "nothing else written"
+    );
+}

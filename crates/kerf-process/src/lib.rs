@@ -26,10 +26,12 @@
 mod geometry;
 mod lead;
 mod order;
+mod rapid;
 mod traverse;
 
 pub use lead::{LeadIn, LeadOptions};
 pub use order::CutPlan;
+pub use rapid::{rapid_moves, RapidMoves};
 pub use traverse::{check_move, plan_traverse, Obstacles, Route, Traverse, TraverseOptions};
 
 use geometry::Projected;

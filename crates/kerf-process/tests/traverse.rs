@@ -288,3 +288,72 @@ fn far_surfaces_are_not_queried() {
         t.route
     );
 }
+
+/// The machine's rapid moves over the arch on heads with long pivots: where the rotary axes
+/// turn between waypoints, the tip swings off the straight line when every axis moves
+/// linearly. Each returned move is sampled densely as the machine runs it (all axes linear,
+/// forward kinematics) and checked against the exact cylinder distance.
+#[test]
+fn the_machines_rapid_moves_clear_the_arch_as_the_machine_runs_them() {
+    use kerf_kinematics::{AcHead, Axes, Kinematics, Pose};
+    use kerf_process::rapid_moves;
+    let mut splits = 0;
+    for (pivot, a, b, clearance) in [
+        (150.0, 20.0, 160.0, 5.0),
+        (400.0, 60.0, 120.0, 3.0),
+        (400.0, 50.0, 100.0, 2.0),
+        (800.0, 70.0, 110.0, 2.0),
+    ] {
+        let kin = AcHead::try_new(pivot, 0.0).expect("head");
+        let obs = obstacles();
+        let opts = TraverseOptions::default().with_clearance(clearance);
+        let (from, to) = (on_arch(a, 30.0), on_arch(b, 50.0));
+        let solve = |p: &PoseArray| {
+            let a = kin.inverse(&Pose::new(p[0], p[1], p[2], p[3], p[4], p[5]))[0];
+            [a.x, a.y, a.z, a.tilt, a.c]
+        };
+        let (end, start) = (solve(&from), solve(&to));
+        let t = plan_traverse(&obs, &from, &to, &opts).expect("route");
+        let r = rapid_moves(&kin, &obs, end, start, &t, &opts).expect("rapids");
+        splits += r.split_moves;
+        assert_eq!(r.axes.len(), r.poses.len(), "one pose per waypoint");
+        let forward = |v: &[f64; 5]| kin.forward(&Axes::new(v[0], v[1], v[2], v[3], v[4]));
+        let mut least = f64::INFINITY;
+        let mut all = vec![end];
+        all.extend_from_slice(&r.axes);
+        all.push(start);
+        for w in all[1..all.len() - 1].windows(2) {
+            for j in 0..=1000 {
+                let f = j as f64 / 1000.0;
+                let v: [f64; 5] = std::array::from_fn(|k| w[0][k] + (w[1][k] - w[0][k]) * f);
+                let p = forward(&v);
+                for s in 0..=20 {
+                    let q = p.position + p.axis * (opts.nozzle_mm * s as f64 / 20.0);
+                    least = least.min(arch_distance(&q));
+                }
+            }
+        }
+        assert!(
+            least >= clearance - 1e-3,
+            "pivot {pivot}, {a} -> {b}: dense machine-move check {least} mm ({} split)",
+            r.split_moves
+        );
+        // The first waypoint keeps the exit's rotaries, the last the next start's.
+        assert_eq!(&r.axes[0][3..], &end[3..], "rotaries stand on the retract");
+        assert_eq!(
+            &r.axes[r.axes.len() - 1][3..],
+            &start[3..],
+            "and on the approach"
+        );
+        let tip = forward(&r.axes[0]).position;
+        let want = t.waypoints[0];
+        assert!(
+            (tip - Point3::new(want[0], want[1], want[2])).norm() < 1e-9,
+            "first waypoint"
+        );
+    }
+    assert!(
+        splits > 0,
+        "at least one swing needed splitting (the split path is exercised)"
+    );
+}

@@ -1,0 +1,194 @@
+//! The machine's rapid moves through a traverse's waypoints, checked as the machine runs
+//! them: a rapid (G0) moves every axis linearly from one waypoint to the next, so where the
+//! rotary axes turn, the tip does not follow the straight line between the waypoints but
+//! swings; each move is sampled through the forward kinematics and checked, and a move that
+//! comes too close is split into shorter ones along the straight line until it clears.
+
+use kerf_kinematics::{Axes, Kinematics, Pose};
+use nalgebra::Point3;
+
+use crate::traverse::{check_move, Obstacles, Traverse, TraverseOptions};
+use crate::{PoseArray, ProcessError, Result};
+
+/// Most pieces one rapid move between two waypoints is split into.
+const MAX_SPLIT: usize = 64;
+
+/// The machine axes of a traverse's rapid moves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidMoves {
+    /// `[X, Y, Z, tilt, C]` (mm, degrees) of every rapid waypoint, from the retract point to
+    /// the point above the pierce (the cut's end and the next pierce not included).
+    pub axes: Vec<[f64; 5]>,
+    /// The tip and tool axis at each of those (workpiece frame).
+    pub poses: Vec<PoseArray>,
+    /// The smallest surface distance measured over the sampled machine moves, mm.
+    pub min_distance_mm: f64,
+    /// How many moves had to be split so that their swing clears the part.
+    pub split_moves: usize,
+}
+
+fn pose_array(p: &Pose) -> PoseArray {
+    [
+        p.position.x,
+        p.position.y,
+        p.position.z,
+        p.axis.x,
+        p.axis.y,
+        p.axis.z,
+    ]
+}
+
+/// The axes that put the tip at `tip` with the rotary axes at `tilt`, `c` (degrees).
+fn linear_at(kin: &dyn Kinematics, tip: &Point3<f64>, tilt: f64, c: f64) -> [f64; 5] {
+    let axis = kin.forward(&Axes::new(0.0, 0.0, 0.0, tilt, c)).axis;
+    let q = kin.inverse_with_c(
+        &Pose {
+            position: *tip,
+            axis,
+        },
+        c,
+    );
+    [q.x, q.y, q.z, tilt, c]
+}
+
+/// The poses of the joint-linear move `a -> b`, sampled so that the tip moves at most
+/// `step` between samples (doubling the count until it does, at most 2^16 samples).
+fn joint_samples(kin: &dyn Kinematics, a: &[f64; 5], b: &[f64; 5], step: f64) -> Vec<PoseArray> {
+    let at = |f: f64| {
+        let v: [f64; 5] = std::array::from_fn(|k| a[k] + (b[k] - a[k]) * f);
+        pose_array(&kin.forward(&Axes::new(v[0], v[1], v[2], v[3], v[4])))
+    };
+    let mut k = 8usize;
+    loop {
+        let poses: Vec<PoseArray> = (0..=k).map(|j| at(j as f64 / k as f64)).collect();
+        let widest = poses
+            .windows(2)
+            .map(|w| {
+                ((w[1][0] - w[0][0]).powi(2)
+                    + (w[1][1] - w[0][1]).powi(2)
+                    + (w[1][2] - w[0][2]).powi(2))
+                .sqrt()
+            })
+            .fold(0.0, f64::max);
+        if widest <= step || k >= 1 << 16 {
+            return poses;
+        }
+        k *= 2;
+    }
+}
+
+/// The machine's rapid moves for `traverse`, from the axes where the last cut ended
+/// (`end_axes`) to those where the next one starts (`start_axes`), `[X, Y, Z, tilt, C]`.
+///
+/// The rotary axes stand while the head backs off and rises (the waypoints with the exit's
+/// tool axis keep `end_axes`' rotaries), and turn on the move to the first waypoint with the
+/// next tool axis; the linear axes of each waypoint put the tip on it. Every move between
+/// waypoints is then run as the machine runs a rapid, all axes linear, sampled through the
+/// forward kinematics (the tip at most an eighth of the clearance between samples), and
+/// checked like the traverse (tip and nozzle keep the clearance); a move that does not is
+/// split into 2, 4, ... 64 moves along the straight line between its waypoints, the rotary
+/// axes shared out evenly, until each clears.
+///
+/// # Errors
+/// [`ProcessError::TraverseBlocked`] if a move still comes too close when split 64 times.
+pub fn rapid_moves(
+    kin: &dyn Kinematics,
+    obs: &Obstacles,
+    end_axes: [f64; 5],
+    start_axes: [f64; 5],
+    traverse: &Traverse,
+    opts: &TraverseOptions,
+) -> Result<RapidMoves> {
+    let n = traverse.waypoints.len();
+    let c = opts.clearance_mm;
+    let step = c / 8.0;
+    let waypoint_axes: Vec<[f64; 5]> = traverse
+        .waypoints
+        .iter()
+        .enumerate()
+        .map(|(i, w)| {
+            let r = if i < n / 2 { &end_axes } else { &start_axes };
+            linear_at(kin, &Point3::new(w[0], w[1], w[2]), r[3], r[4])
+        })
+        .collect();
+    let mut axes = Vec::new();
+    let mut least = f64::INFINITY;
+    let mut split_moves = 0;
+    for (i, w) in waypoint_axes.iter().enumerate() {
+        if i == 0 {
+            axes.push(*w);
+            continue;
+        }
+        let a = waypoint_axes[i - 1];
+        let b = *w;
+        let mut pieces = 1;
+        loop {
+            // The pieces' ends: on the straight line between the waypoints' tips.
+            let ta = kin
+                .forward(&Axes::new(a[0], a[1], a[2], a[3], a[4]))
+                .position;
+            let tb = kin
+                .forward(&Axes::new(b[0], b[1], b[2], b[3], b[4]))
+                .position;
+            let ends: Vec<[f64; 5]> = (0..=pieces)
+                .map(|j| {
+                    let f = j as f64 / pieces as f64;
+                    if j == 0 {
+                        a
+                    } else if j == pieces {
+                        b
+                    } else {
+                        linear_at(
+                            kin,
+                            &(ta + (tb - ta) * f),
+                            a[3] + (b[3] - a[3]) * f,
+                            a[4] + (b[4] - a[4]) * f,
+                        )
+                    }
+                })
+                .collect();
+            let mut worst: Option<(Point3<f64>, f64)> = None;
+            let mut here = f64::INFINITY;
+            for e in ends.windows(2) {
+                let samples = joint_samples(kin, &e[0], &e[1], step);
+                match check_move(obs, &samples, c, opts.nozzle_mm) {
+                    Ok(d) => here = here.min(d),
+                    Err(bad) => {
+                        worst = Some(bad);
+                        break;
+                    }
+                }
+            }
+            match worst {
+                None => {
+                    least = least.min(here);
+                    if pieces > 1 {
+                        split_moves += 1;
+                    }
+                    axes.extend_from_slice(&ends[1..]);
+                    break;
+                }
+                Some((at, d)) if pieces >= MAX_SPLIT => {
+                    return Err(ProcessError::TraverseBlocked {
+                        from: [ta.x, ta.y, ta.z],
+                        to: [tb.x, tb.y, tb.z],
+                        at: [at.x, at.y, at.z],
+                        distance_mm: d,
+                        clearance_mm: c,
+                    });
+                }
+                Some(_) => pieces *= 2,
+            }
+        }
+    }
+    let poses = axes
+        .iter()
+        .map(|a| pose_array(&kin.forward(&Axes::new(a[0], a[1], a[2], a[3], a[4]))))
+        .collect();
+    Ok(RapidMoves {
+        axes,
+        poses,
+        min_distance_mm: least,
+        split_moves,
+    })
+}

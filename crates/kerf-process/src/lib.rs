@@ -31,7 +31,7 @@ mod traverse;
 
 pub use lead::{LeadIn, LeadOptions};
 pub use order::CutPlan;
-pub use rapid::{rapid_moves, RapidMoves};
+pub use rapid::{plan_rapids, rapid_moves, Gap, RapidMoves};
 pub use traverse::{check_move, plan_traverse, Obstacles, Route, Traverse, TraverseOptions};
 
 use geometry::Projected;

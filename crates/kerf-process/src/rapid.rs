@@ -192,3 +192,71 @@ pub fn rapid_moves(
         split_moves,
     })
 }
+
+/// One gap between two cuts: where the last ended and where the next starts, each as the tip
+/// with its tool axis (workpiece frame) and the machine axes `[X, Y, Z, tilt, C]` there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gap {
+    /// The end of the last cut (its lead-out's end).
+    pub from: PoseArray,
+    /// The machine axes there.
+    pub from_axes: [f64; 5],
+    /// The next pierce point.
+    pub to: PoseArray,
+    /// The machine axes there.
+    pub to_axes: [f64; 5],
+    /// The last cutting point of the last cut on its contour (before the lead-out), mm.
+    pub from_contour: [f64; 3],
+    /// The first cutting point of the next cut on its contour (after the lead-in), mm.
+    pub to_contour: [f64; 3],
+    /// The surfaces the last cut's curve names (ids as in [`Obstacles::from_file`]).
+    pub from_surfaces: Vec<String>,
+    /// The surfaces the next cut's curve names.
+    pub to_surfaces: Vec<String>,
+}
+
+/// Plans and checks the traverse of every gap ([`crate::plan_traverse`], then
+/// [`rapid_moves`]), in order.
+///
+/// Which surfaces are checked: all of `obs`, except, for one gap, a surface that the cut's
+/// curve does not name and that comes within half the clearance of the line along the tool
+/// axis at the last cut's contour end or the next cut's contour start (from the contour up to
+/// the retract plus the nozzle). The head is on that line while it cuts: such a surface is
+/// either not there while that contour is cut (a file holding two workpieces in the same
+/// place, as a tube joint's hole in the main tube and the end of the branch tube, lists both,
+/// and each contour passes through the other workpiece) or in the way of the cut itself, which
+/// no traverse can mend; the ids are returned with the gap so that they can be reported.
+///
+/// # Errors
+/// The first gap's error, as [`crate::plan_traverse`] and [`rapid_moves`].
+pub fn plan_rapids(
+    kin: &dyn Kinematics,
+    obs: &Obstacles,
+    gaps: &[Gap],
+    opts: &TraverseOptions,
+) -> Result<Vec<(Traverse, RapidMoves, Vec<String>)>> {
+    gaps.iter()
+        .map(|g| {
+            let mut absent: Vec<String> = Vec::new();
+            for (p, axis, named) in [
+                (&g.from_contour, &g.from, &g.from_surfaces),
+                (&g.to_contour, &g.to, &g.to_surfaces),
+            ] {
+                let at = Point3::new(p[0], p[1], p[2]);
+                let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
+                    .try_normalize(1e-12)
+                    .unwrap_or_else(nalgebra::Vector3::z);
+                let top = at + n * (opts.retract_mm + opts.nozzle_mm);
+                for id in obs.near_segment(&at, &top, 0.5 * opts.clearance_mm) {
+                    if !named.contains(&id) && !absent.contains(&id) {
+                        absent.push(id);
+                    }
+                }
+            }
+            let here = obs.without(&absent);
+            let t = crate::plan_traverse(&here, &g.from, &g.to, opts)?;
+            let r = rapid_moves(kin, &here, g.from_axes, g.to_axes, &t, opts)?;
+            Ok((t, r, absent))
+        })
+        .collect()
+}

@@ -22,14 +22,23 @@ use crate::{PoseArray, ProcessError, Result};
 /// One surface of the part, placed in the workpiece frame.
 #[derive(Debug, Clone)]
 enum Obstacle {
-    Nurbs(Box<NurbsSurface>),
-    Mesh(Box<TriMesh>),
+    Nurbs(NurbsSurface),
+    Mesh(TriMesh),
+}
+
+/// One surface with its bounding box and its name.
+#[derive(Debug)]
+struct Item {
+    shape: std::sync::Arc<Obstacle>,
+    lo: Point3<f64>,
+    hi: Point3<f64>,
+    id: String,
 }
 
 /// The part's surfaces in the workpiece frame, for distance queries.
 #[derive(Debug, Default)]
 pub struct Obstacles {
-    items: Vec<(Obstacle, Point3<f64>, Point3<f64>)>,
+    items: Vec<Item>,
     /// How many exact distance queries have been made (the work the checks cost).
     queries: std::sync::atomic::AtomicUsize,
 }
@@ -42,9 +51,65 @@ impl Obstacles {
 
     /// Adds a NURBS surface (already placed in the workpiece frame).
     pub fn add_nurbs(&mut self, surface: NurbsSurface) {
+        let id = format!("#{}", self.items.len());
+        self.add_nurbs_named(surface, id);
+    }
+
+    fn add_nurbs_named(&mut self, surface: NurbsSurface, id: String) {
         let (lo, hi) = surface.bounding_box();
+        self.items.push(Item {
+            shape: std::sync::Arc::new(Obstacle::Nurbs(surface)),
+            lo,
+            hi,
+            id,
+        });
+    }
+
+    /// The same surfaces without those named in `ids` (shared, not copied).
+    pub fn without(&self, ids: &[String]) -> Obstacles {
+        Obstacles {
+            items: self
+                .items
+                .iter()
+                .filter(|i| !ids.contains(&i.id))
+                .map(|i| Item {
+                    shape: i.shape.clone(),
+                    lo: i.lo,
+                    hi: i.hi,
+                    id: i.id.clone(),
+                })
+                .collect(),
+            queries: Default::default(),
+        }
+    }
+
+    /// The names of the surfaces that come within `distance_mm` of the segment `a b` (sampled
+    /// at most `distance_mm / 2` apart, so a surface within half of it anywhere on the
+    /// segment is found).
+    pub fn near_segment(&self, a: &Point3<f64>, b: &Point3<f64>, distance_mm: f64) -> Vec<String> {
+        let k = (((b - a).norm() / (0.5 * distance_mm)).ceil() as usize).clamp(1, 100_000);
         self.items
-            .push((Obstacle::Nurbs(Box::new(surface)), lo, hi));
+            .iter()
+            .filter(|i| {
+                (0..=k).any(|j| {
+                    let p = a + (b - a) * (j as f64 / k as f64);
+                    box_distance(&p, &i.lo, &i.hi) < distance_mm
+                        && shape_distance(&i.shape, &p) < distance_mm
+                })
+            })
+            .map(|i| i.id.clone())
+            .collect()
+    }
+
+    /// The names of the surfaces within `tolerance_mm` of `p` (from [`Obstacles::from_file`]:
+    /// the surface ids; otherwise `#0`, `#1`, ... in the order added).
+    pub fn touching(&self, p: &Point3<f64>, tolerance_mm: f64) -> Vec<String> {
+        self.items
+            .iter()
+            .filter(|i| box_distance(p, &i.lo, &i.hi) <= tolerance_mm)
+            .filter(|i| shape_distance(&i.shape, p) <= tolerance_mm)
+            .map(|i| i.id.clone())
+            .collect()
     }
 
     /// Adds a triangle mesh (vertices in the workpiece frame, mm).
@@ -53,6 +118,16 @@ impl Obstacles {
     /// [`ProcessError::BadSurface`] if a vertex is not finite, an index is out of range or no
     /// triangle remains.
     pub fn add_mesh(&mut self, vertices: Vec<Point3<f64>>, triangles: Vec<[u32; 3]>) -> Result<()> {
+        let id = format!("#{}", self.items.len());
+        self.add_mesh_named(vertices, triangles, id)
+    }
+
+    fn add_mesh_named(
+        &mut self,
+        vertices: Vec<Point3<f64>>,
+        triangles: Vec<[u32; 3]>,
+        id: String,
+    ) -> Result<()> {
         let bad = |reason: String| ProcessError::BadSurface { reason };
         if let Some(i) = vertices
             .iter()
@@ -79,8 +154,96 @@ impl Obstacles {
         if mesh.indices().is_empty() {
             return Err(bad("mesh: no triangle with a non-zero area".into()));
         }
-        self.items.push((Obstacle::Mesh(Box::new(mesh)), lo, hi));
+        self.items.push(Item {
+            shape: std::sync::Arc::new(Obstacle::Mesh(mesh)),
+            lo,
+            hi,
+            id,
+        });
         Ok(())
+    }
+
+    /// Adds a NURBS surface moved by the rigid motion `map` (the placement of the part): the
+    /// control points are mapped, the knots and weights kept, which moves the surface exactly.
+    ///
+    /// # Errors
+    /// [`ProcessError::BadSurface`] if the mapped control net is not valid (a non-finite
+    /// point).
+    pub fn add_nurbs_mapped(
+        &mut self,
+        surface: &NurbsSurface,
+        map: impl Fn(&Point3<f64>) -> Point3<f64>,
+    ) -> Result<()> {
+        let cps = surface
+            .control_points()
+            .iter()
+            .map(|row| row.iter().map(&map).collect())
+            .collect();
+        let moved = NurbsSurface::try_new(
+            surface.degree_u(),
+            surface.degree_v(),
+            surface.knots_u().to_vec(),
+            surface.knots_v().to_vec(),
+            cps,
+            surface.is_rational().then(|| surface.weights()),
+        )
+        .map_err(|e| ProcessError::BadSurface {
+            reason: e.to_string(),
+        })?;
+        self.add_nurbs(moved);
+        Ok(())
+    }
+
+    fn add_nurbs_mapped_named(
+        &mut self,
+        surface: &NurbsSurface,
+        map: impl Fn(&Point3<f64>) -> Point3<f64>,
+        id: &str,
+    ) -> Result<()> {
+        self.add_nurbs_mapped(surface, map)?;
+        if let Some(last) = self.items.last_mut() {
+            last.id = id.to_string();
+        }
+        Ok(())
+    }
+
+    /// The surfaces that carry the curves `curves` (indices into `file.curves`), each once,
+    /// moved by the rigid motion `map` (the part's placement on the machine), named by their
+    /// ids.
+    ///
+    /// # Errors
+    /// [`ProcessError::BadSurface`] as [`Obstacles::add_mesh`] and
+    /// [`Obstacles::add_nurbs_mapped`].
+    pub fn from_file(
+        file: &kerf_format::CurvesFile,
+        curves: &[usize],
+        map: impl Fn(&Point3<f64>) -> Point3<f64>,
+    ) -> Result<Self> {
+        let mut obs = Self::new();
+        let mut seen: Vec<&str> = Vec::new();
+        for &i in curves {
+            for id in &file.curves[i].surfaces {
+                if seen.contains(&id.as_str()) {
+                    continue;
+                }
+                seen.push(id);
+                let Some(s) = file.surface(id) else { continue };
+                match &s.geometry {
+                    kerf_format::SurfaceGeometry::Nurbs(n) => {
+                        obs.add_nurbs_mapped_named(n, &map, id)?
+                    }
+                    kerf_format::SurfaceGeometry::Mesh {
+                        vertices,
+                        triangles,
+                    } => obs.add_mesh_named(
+                        vertices.iter().map(&map).collect(),
+                        triangles.clone(),
+                        id.clone(),
+                    )?,
+                }
+            }
+        }
+        Ok(obs)
     }
 
     /// True if there are no surfaces.
@@ -91,8 +254,10 @@ impl Obstacles {
     /// The axis-aligned box `(min, max)` that contains every surface, or `None` without any.
     pub fn bounding_box(&self) -> Option<(Point3<f64>, Point3<f64>)> {
         let mut it = self.items.iter();
-        let (_, lo, hi) = it.next()?;
-        Some(it.fold((*lo, *hi), |(a, b), (_, l, h)| (a.inf(l), b.sup(h))))
+        let first = it.next()?;
+        Some(it.fold((first.lo, first.hi), |(a, b), i| {
+            (a.inf(&i.lo), b.sup(&i.hi))
+        }))
     }
 
     /// How many exact distance queries (one surface, one point) the checks have made so far.
@@ -112,21 +277,25 @@ impl Obstacles {
         // `limit` and a lower bound of the distance (itself >= limit) above it.
         let mut best = f64::INFINITY;
         let mut floor = f64::INFINITY;
-        for (o, lo, hi) in &self.items {
-            let gap = box_distance(p, lo, hi);
+        for item in &self.items {
+            let gap = box_distance(p, &item.lo, &item.hi);
             if gap >= limit.min(best) {
                 floor = floor.min(gap);
                 continue;
             }
             self.queries
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let d = match o {
-                Obstacle::Nurbs(s) => s.closest_point(p, None).distance,
-                Obstacle::Mesh(m) => m.distance_to_local_point(p, false),
-            };
+            let d = shape_distance(&item.shape, p);
             best = best.min(d);
         }
         best.min(floor)
+    }
+}
+
+fn shape_distance(o: &Obstacle, p: &Point3<f64>) -> f64 {
+    match o {
+        Obstacle::Nurbs(s) => s.closest_point(p, None).distance,
+        Obstacle::Mesh(m) => m.distance_to_local_point(p, false),
     }
 }
 

@@ -140,9 +140,69 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     let mut motions = Vec::new();
     let mut programs = Vec::new();
     let mut setup_ids: Vec<Vec<String>> = Vec::new();
+    let topts = args.traverse_options();
+    let mut rapid_report = Vec::new();
     for setup in 0..placed.plan.setups.len() {
         let mut ipaths = Vec::new();
         let mut ids: Vec<String> = Vec::new();
+        let in_setup: Vec<usize> = (0..solved.len())
+            .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
+            .collect();
+        // Traverses that clear the part's surfaces, placed with this set-up.
+        let mut traverses = Vec::new();
+        if let (Some(topts), Some(&first)) = (&topts, in_setup.first()) {
+            let placement = placed.placement_of(cuts[first].curve);
+            let obs =
+                kerf_process::Obstacles::from_file(&file, &placed.plan.setups[setup].paths, |p| {
+                    placement.apply_point(p)
+                })
+                .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+            let gaps: Vec<kerf_process::Gap> = in_setup
+                .windows(2)
+                .map(|w| {
+                    let (a, b) = (&solved[w[0]], &solved[w[1]]);
+                    let ax = |q: &kerf_kinematics::Axes| [q.x, q.y, q.z, q.tilt, q.c];
+                    // The solved pose of a cut's k-th pose (lead-in, contour, lead-out).
+                    let at = |s: &kerf_kinematics::SolvedPath, k: usize| {
+                        let j = s.source.iter().position(|v| *v == Some(k)).unwrap_or(0);
+                        let p = s.poses[j].position;
+                        [p.x, p.y, p.z]
+                    };
+                    let [m, c, _] = cuts[w[0]].counts;
+                    kerf_process::Gap {
+                        from: a.poses[a.poses.len() - 1].to_array(),
+                        from_axes: ax(&a.axes[a.axes.len() - 1]),
+                        to: b.poses[0].to_array(),
+                        to_axes: ax(&b.axes[0]),
+                        from_contour: at(a, m + c - 1),
+                        to_contour: at(b, cuts[w[1]].counts[0]),
+                        from_surfaces: file.curves[cuts[w[0]].curve].surfaces.clone(),
+                        to_surfaces: file.curves[cuts[w[1]].curve].surfaces.clone(),
+                    }
+                })
+                .collect();
+            let rapids = kerf_process::plan_rapids(machine.kinematics.as_ref(), &obs, &gaps, topts)
+                .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+            for (w, (t, r, absent)) in in_setup.windows(2).zip(&rapids) {
+                axes.paths[w[1]].traverse = Some(kerf_kinematics::AxesMove {
+                    positions: r.axes.clone(),
+                    poses: r.poses.clone(),
+                });
+                traverses.push(
+                    r.axes
+                        .iter()
+                        .zip(&r.poses)
+                        .map(|(a, p)| kerf_interp::Station {
+                            tip: nalgebra::Point3::new(p[0], p[1], p[2]),
+                            axis: nalgebra::Vector3::new(p[3], p[4], p[5]),
+                            param: None,
+                            axes: *a,
+                        })
+                        .collect::<Vec<_>>(),
+                );
+                rapid_report.push((t.clone(), r.clone(), absent.clone()));
+            }
+        }
         for (k, s) in solved.iter().enumerate() {
             if placed.plan.setup_of(cuts[k].curve) != setup {
                 continue;
@@ -155,8 +215,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             });
             ids.push(s.id.clone());
         }
-        let motion =
-            kerf_interp::interpolate(&model, &ipaths, &fit, &plan).map_err(interp(path))?;
+        let motion = kerf_interp::interpolate_through(&model, &ipaths, &traverses, &fit, &plan)
+            .map_err(interp(path))?;
         programs.push(gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?);
         setup_ids.push(ids);
         motions.push(motion);
@@ -237,6 +297,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         },
         "placement": placed.json(&id_refs),
         "process": crate::cuts::report(&file, &cuts, &cut_plans),
+        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report),
         "interpolation": {
             "feed_mm_per_min": args.feed,
             "cycle_s": args.cycle,

@@ -24,12 +24,23 @@ fn read(text: &str) -> Result<curves::CurvesFile, String> {
 
 #[test]
 fn start_and_scrap_are_read_into_the_record() {
-    let f = read(&doc(r#", "start": 2.5, "scrap": "left""#, r#", "scrap": "right""#))
-        .expect("valid keys");
+    let f = read(&doc(
+        r#", "start": 2.5, "scrap": "left""#,
+        r#", "scrap": "right""#,
+    ))
+    .expect("valid keys");
     assert_eq!(f.curves[1].start, Some(2.5), "the square's start parameter");
-    assert_eq!(f.curves[1].scrap, Some(ScrapSide::Left), "the square's scrap side");
+    assert_eq!(
+        f.curves[1].scrap,
+        Some(ScrapSide::Left),
+        "the square's scrap side"
+    );
     assert_eq!(f.curves[0].start, None, "no start on the line");
-    assert_eq!(f.curves[0].scrap, Some(ScrapSide::Right), "an open curve may name its scrap");
+    assert_eq!(
+        f.curves[0].scrap,
+        Some(ScrapSide::Right),
+        "an open curve may name its scrap"
+    );
     let plain = read(&doc("", "")).expect("no keys");
     assert_eq!(
         (plain.curves[1].start, plain.curves[1].scrap),
@@ -49,9 +60,15 @@ fn a_start_at_either_end_of_the_domain_is_accepted() {
 #[test]
 fn a_start_outside_the_domain_is_named() {
     let e = read(&doc(r#", "start": 7.5"#, "")).unwrap_err();
-    assert_eq!(e, "curves[1].start: 7.5 is outside the domain [0, 4]", "message");
+    assert_eq!(
+        e, "curves[1].start: 7.5 is outside the domain [0, 4]",
+        "message"
+    );
     let e = read(&doc(r#", "start": -0.25"#, "")).unwrap_err();
-    assert_eq!(e, "curves[1].start: -0.25 is outside the domain [0, 4]", "message");
+    assert_eq!(
+        e, "curves[1].start: -0.25 is outside the domain [0, 4]",
+        "message"
+    );
 }
 
 #[test]
@@ -74,9 +91,15 @@ fn a_bad_scrap_is_named() {
     let e = read(&doc(r#", "scrap": "in\nside""#, "")).unwrap_err();
     assert!(e.ends_with(r#"got "in\nside""#), "escaped: {e}");
     let e = read(&doc(r#", "scrap": 1"#, "")).unwrap_err();
-    assert!(e.starts_with("curves[1].scrap"), "wrong type named by path: {e}");
+    assert!(
+        e.starts_with("curves[1].scrap"),
+        "wrong type named by path: {e}"
+    );
     let e = read(&doc(r#", "start": "2""#, "")).unwrap_err();
-    assert!(e.starts_with("curves[1].start"), "wrong type named by path: {e}");
+    assert!(
+        e.starts_with("curves[1].start"),
+        "wrong type named by path: {e}"
+    );
 }
 
 #[test]
@@ -87,5 +110,8 @@ fn the_keys_survive_a_raw_round_trip() {
     let f = read(&text).expect("re-read");
     assert_eq!(f.curves[1].start, Some(1.5), "start kept");
     assert_eq!(f.curves[1].scrap, Some(ScrapSide::Right), "scrap kept");
-    assert!(!text.contains("\"start\":null"), "absent keys are not written: {text}");
+    assert!(
+        !text.contains("\"start\":null"),
+        "absent keys are not written: {text}"
+    );
 }

@@ -27,12 +27,16 @@ mod geometry;
 mod lead;
 mod order;
 mod rapid;
+mod start;
 mod traverse;
 
 pub use lead::{LeadIn, LeadOptions};
 pub use order::CutPlan;
 pub use rapid::{plan_rapids, rapid_moves, Gap, RapidMoves};
-pub use traverse::{check_move, plan_traverse, Obstacles, Route, Traverse, TraverseOptions};
+pub use start::{index_of_param, prepare_start};
+pub use traverse::{
+    check_move, plan_traverse, plan_traverse_within, Obstacles, Route, Traverse, TraverseOptions,
+};
 
 use geometry::Projected;
 use thiserror::Error;

@@ -215,8 +215,10 @@ pub struct Gap {
     pub to_surfaces: Vec<String>,
 }
 
-/// Plans and checks the traverse of every gap ([`crate::plan_traverse`], then
-/// [`rapid_moves`]), in order.
+/// Plans and checks the traverse of every gap ([`crate::plan_traverse_within`] among the
+/// routes whose waypoints lie within `limits`, `(min, max)` of `[X, Y, Z, tilt, C]` or `None`
+/// for an unlimited axis, then [`rapid_moves`]), in order; one result per gap (a blocked gap does not stop the others:
+/// the caller decides, e.g. to fall back to an unchecked traverse and say so).
 ///
 /// Which surfaces are checked: all of `obs`, except, for one gap, a surface that the cut's
 /// curve does not name and that comes within half the clearance of the line along the tool
@@ -227,15 +229,16 @@ pub struct Gap {
 /// and each contour passes through the other workpiece) or in the way of the cut itself, which
 /// no traverse can mend; the ids are returned with the gap so that they can be reported.
 ///
-/// # Errors
-/// The first gap's error, as [`crate::plan_traverse`] and [`rapid_moves`].
+/// Each result's error is as [`crate::plan_traverse`] and [`rapid_moves`].
 pub fn plan_rapids(
     kin: &dyn Kinematics,
+    limits: &[Option<(f64, f64)>; 5],
     obs: &Obstacles,
     gaps: &[Gap],
     opts: &TraverseOptions,
-) -> Result<Vec<(Traverse, RapidMoves, Vec<String>)>> {
-    gaps.iter()
+) -> Vec<Result<(Traverse, RapidMoves, Vec<String>)>> {
+    use rayon::prelude::*;
+    gaps.par_iter()
         .map(|g| {
             let mut absent: Vec<String> = Vec::new();
             for (p, axis, named) in [
@@ -254,7 +257,47 @@ pub fn plan_rapids(
                 }
             }
             let here = obs.without(&absent);
-            let t = crate::plan_traverse(&here, &g.from, &g.to, opts)?;
+            // A route is tried only if the machine reaches its waypoints (with the rotary
+            // axes as [`rapid_moves`] sets them).
+            let reachable = |way: &[PoseArray]| {
+                let n = way.len();
+                let rot = |i: usize| if i < n / 2 { g.from_axes } else { g.to_axes };
+                let inside = |q: &[f64; 5]| {
+                    q.iter().zip(limits).all(|(v, l)| {
+                        l.is_none_or(|(lo, hi)| {
+                            let m = 1e-3 * (hi - lo);
+                            *v >= lo + m && *v <= hi - m
+                        })
+                    })
+                };
+                // Each move as the interpolator runs it (tip straight, rotaries linear),
+                // sampled: where the rotaries turn, the linear axes swing past the ends.
+                (0..n).all(|i| {
+                    let (a, ra) = (way[i], rot(i));
+                    let (b, rb) = if i + 1 < n {
+                        (way[i + 1], rot(i + 1))
+                    } else {
+                        (a, ra)
+                    };
+                    let k = if i + 1 < n && ra != rb { 32 } else { 1 };
+                    (0..=k).all(|j| {
+                        let f = j as f64 / k as f64;
+                        let tip = Point3::new(
+                            a[0] + (b[0] - a[0]) * f,
+                            a[1] + (b[1] - a[1]) * f,
+                            a[2] + (b[2] - a[2]) * f,
+                        );
+                        let q = linear_at(
+                            kin,
+                            &tip,
+                            ra[3] + (rb[3] - ra[3]) * f,
+                            ra[4] + (rb[4] - ra[4]) * f,
+                        );
+                        inside(&q)
+                    })
+                })
+            };
+            let t = crate::plan_traverse_within(&here, &g.from, &g.to, opts, &reachable)?;
             let r = rapid_moves(kin, &here, g.from_axes, g.to_axes, &t, opts)?;
             Ok((t, r, absent))
         })

@@ -11,7 +11,7 @@
 //! are not queried. The derivation and the routes are in `docs/process.md`.
 
 use nalgebra::{Point3, Vector3};
-use parry3d_f64::query::PointQuery;
+use parry3d_f64::query::{PointQuery, PointQueryWithLocation};
 use parry3d_f64::shape::{TriMesh, TriMeshFlags};
 
 use kerf_nurbs::NurbsSurface;
@@ -20,10 +20,124 @@ use crate::geometry::{normal, position};
 use crate::{PoseArray, ProcessError, Result};
 
 /// One surface of the part, placed in the workpiece frame.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 enum Obstacle {
-    Nurbs(NurbsSurface),
-    Mesh(TriMesh),
+    Nurbs(Box<Tessellated>),
+    Mesh(Box<TriMesh>),
+}
+
+/// A NURBS surface with a triangle mesh through points of it: the mesh finds, fast, which
+/// surfaces are far (its distance less the estimated deviation `sag`) and where on the surface
+/// the nearest point lies (the start of the exact closest-point search).
+#[derive(Debug)]
+struct Tessellated {
+    surface: NurbsSurface,
+    mesh: Option<TriMesh>,
+    /// `(u, v)` of each mesh vertex.
+    uv: Vec<(f64, f64)>,
+    /// Twice the largest distance found between the surface (cell centres and edge
+    /// middles) and the mesh, plus a small floor: an estimate of the deviation, mm.
+    sag: f64,
+}
+
+/// Cells per knot span in each direction of a tessellation (at least 12 over the domain).
+const CELLS_PER_SPAN: usize = 6;
+
+impl Tessellated {
+    fn new(surface: NurbsSurface) -> Self {
+        let grid = |spans: Vec<(usize, f64, f64)>| {
+            let per = CELLS_PER_SPAN.max(12usize.div_ceil(spans.len().max(1)));
+            let mut g = Vec::new();
+            for (k, &(_, a, b)) in spans.iter().enumerate() {
+                for j in 0..per {
+                    g.push(a + (b - a) * j as f64 / per as f64);
+                }
+                if k + 1 == spans.len() {
+                    g.push(b);
+                }
+            }
+            g
+        };
+        let us = grid(surface.spans_u());
+        let vs = grid(surface.spans_v());
+        let (nu, nv) = (us.len(), vs.len());
+        let mut vertices = Vec::with_capacity(nu * nv);
+        let mut uv = Vec::with_capacity(nu * nv);
+        for &u in &us {
+            for &v in &vs {
+                vertices.push(surface.point(u, v));
+                uv.push((u, v));
+            }
+        }
+        let mut triangles = Vec::new();
+        for i in 0..nu.saturating_sub(1) {
+            for j in 0..nv.saturating_sub(1) {
+                let a = (i * nv + j) as u32;
+                let b = a + 1;
+                let c = a + nv as u32;
+                let d = c + 1;
+                triangles.push([a, c, b]);
+                triangles.push([b, c, d]);
+            }
+        }
+        let finite = vertices
+            .iter()
+            .all(|p| p.coords.iter().all(|x| x.is_finite()));
+        let mesh = if finite && !triangles.is_empty() {
+            TriMesh::with_flags(vertices, triangles, TriMeshFlags::empty()).ok()
+        } else {
+            None
+        };
+        let mut sag = 0.0_f64;
+        if let Some(m) = &mesh {
+            for i in 0..nu - 1 {
+                for j in 0..nv - 1 {
+                    let (u0, u1, v0, v1) = (us[i], us[i + 1], vs[j], vs[j + 1]);
+                    for (u, v) in [
+                        (0.5 * (u0 + u1), 0.5 * (v0 + v1)),
+                        (0.5 * (u0 + u1), v0),
+                        (u0, 0.5 * (v0 + v1)),
+                        (0.25 * (3.0 * u0 + u1), 0.25 * (3.0 * v0 + v1)),
+                        (0.25 * (u0 + 3.0 * u1), 0.25 * (v0 + 3.0 * v1)),
+                    ] {
+                        let q = surface.point(u, v);
+                        sag = sag.max(m.distance_to_local_point(&q, false));
+                    }
+                }
+            }
+        }
+        let sag = 2.0 * sag + 1e-6 * surface.size() + 1e-9;
+        Self {
+            surface,
+            mesh,
+            uv,
+            sag,
+        }
+    }
+
+    /// The exact distance from `p` where it may be below `limit`; else a value `>= limit`
+    /// (the mesh's distance less the deviation estimate).
+    fn distance(&self, p: &Point3<f64>, limit: f64) -> f64 {
+        let Some(m) = &self.mesh else {
+            return self.surface.closest_point(p, None).distance;
+        };
+        let (proj, (tri, _)) = m.project_local_point_and_get_location(p, false);
+        let dm = (proj.point - p).norm();
+        if dm - self.sag >= limit {
+            return dm - self.sag;
+        }
+        let corner = m.indices()[tri as usize][0] as usize;
+        let warm = self
+            .surface
+            .closest_point(p, Some(self.uv[corner]))
+            .distance;
+        if warm <= dm + self.sag {
+            warm
+        } else {
+            // The local search found a farther point than the mesh promises: the global one.
+            self.surface.closest_point(p, None).distance
+        }
+    }
 }
 
 /// One surface with its bounding box and its name.
@@ -58,7 +172,7 @@ impl Obstacles {
     fn add_nurbs_named(&mut self, surface: NurbsSurface, id: String) {
         let (lo, hi) = surface.bounding_box();
         self.items.push(Item {
-            shape: std::sync::Arc::new(Obstacle::Nurbs(surface)),
+            shape: std::sync::Arc::new(Obstacle::Nurbs(Box::new(Tessellated::new(surface)))),
             lo,
             hi,
             id,
@@ -155,7 +269,7 @@ impl Obstacles {
             return Err(bad("mesh: no triangle with a non-zero area".into()));
         }
         self.items.push(Item {
-            shape: std::sync::Arc::new(Obstacle::Mesh(mesh)),
+            shape: std::sync::Arc::new(Obstacle::Mesh(Box::new(mesh))),
             lo,
             hi,
             id,
@@ -285,7 +399,7 @@ impl Obstacles {
             }
             self.queries
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let d = shape_distance(&item.shape, p);
+            let d = shape_distance_below(&item.shape, p, limit.min(best));
             best = best.min(d);
         }
         best.min(floor)
@@ -293,8 +407,12 @@ impl Obstacles {
 }
 
 fn shape_distance(o: &Obstacle, p: &Point3<f64>) -> f64 {
+    shape_distance_below(o, p, f64::INFINITY)
+}
+
+fn shape_distance_below(o: &Obstacle, p: &Point3<f64>, limit: f64) -> f64 {
     match o {
-        Obstacle::Nurbs(s) => s.closest_point(p, None).distance,
+        Obstacle::Nurbs(s) => s.distance(p, limit),
         Obstacle::Mesh(m) => m.distance_to_local_point(p, false),
     }
 }
@@ -446,7 +564,7 @@ fn certify(
     let (na, nb) = (normal(a).normalize(), normal(b).normalize());
     let half_cos = (0.5 * (1.0 + na.dot(&nb))).max(0.0).sqrt().max(0.05);
     let speed = (pb - pa).norm() + nozzle * (nb - na).norm() / half_cos;
-    let limit = 4.0 * (need + nozzle) + 10.0 * floor;
+    let limit = need + 2.0 * floor.max(need / 4.0) + 0.25 * nozzle;
     let mut least = f64::INFINITY;
     let mut f = 0.0_f64;
     loop {
@@ -536,6 +654,21 @@ pub fn plan_traverse(
     to: &PoseArray,
     opts: &TraverseOptions,
 ) -> Result<Traverse> {
+    plan_traverse_within(obs, from, to, opts, &|_| true)
+}
+
+/// [`plan_traverse`] among the routes whose waypoints `reachable` accepts (e.g. within the
+/// machine's axis limits); the others are not tried.
+///
+/// # Errors
+/// As [`plan_traverse`].
+pub fn plan_traverse_within(
+    obs: &Obstacles,
+    from: &PoseArray,
+    to: &PoseArray,
+    opts: &TraverseOptions,
+    reachable: &dyn Fn(&[PoseArray]) -> bool,
+) -> Result<Traverse> {
     opts.validate()?;
     for (name, p) in [("from", from), ("to", to)] {
         let axis_ok = normal(p).norm() > 1e-9;
@@ -564,43 +697,40 @@ pub fn plan_traverse(
         Ok(high)
     };
     let mut blocked: Option<Blocked> = None;
-    let mut height = opts.retract_mm;
-    while height <= 16.0 * c.max(opts.retract_mm) {
-        let (a, b) = match (axial(&from, height), axial(&to, height)) {
-            (Ok(a), Ok(b)) => (a, b),
-            (Err(e), _) | (_, Err(e)) => {
-                blocked = Some(e);
-                height *= 2.0;
-                continue;
-            }
-        };
-        let length_of = |way: &[PoseArray]| {
-            let mut pts = vec![position(&from)];
-            pts.extend(way.iter().map(position));
-            pts.push(position(&to));
-            path_length(&pts)
-        };
-        // Straight.
-        let tip_ends = |w: &[PoseArray]| -> std::result::Result<f64, Blocked> {
-            let mut least = f64::INFINITY;
-            for s in w.windows(2) {
-                least = least.min(certify(obs, &s[0], &s[1], c, opts.nozzle_mm, h)?);
-            }
-            Ok(least)
-        };
-        let straight = vec![a, b];
-        if let Ok(least) = tip_ends(&straight) {
-            return Ok(Traverse {
-                length_mm: length_of(&straight),
-                waypoints: straight,
-                route: Route::Straight,
-                min_distance_mm: least,
-            });
+    let length_of = |way: &[PoseArray]| {
+        let mut pts = vec![position(&from)];
+        pts.extend(way.iter().map(position));
+        pts.push(position(&to));
+        path_length(&pts)
+    };
+    let tip_ends = |w: &[PoseArray]| -> std::result::Result<f64, Blocked> {
+        let mut least = f64::INFINITY;
+        for s in w.windows(2) {
+            least = least.min(certify(obs, &s[0], &s[1], c, opts.nozzle_mm, h)?);
         }
-        // The safe plane above every surface.
-        let Some((lo, hi)) = obs.bounding_box() else {
-            unreachable!("a straight travel is only blocked by a surface")
-        };
+        Ok(least)
+    };
+    // The retract heights tried at each end (doubling), those whose axial move is clear.
+    let heights: Vec<f64> = (0..5)
+        .map(|k| opts.retract_mm * f64::from(1 << k))
+        .collect();
+    let mut ends = |p: &PoseArray| -> Vec<PoseArray> {
+        heights
+            .iter()
+            .filter_map(|&hh| match axial(p, hh) {
+                Ok(q) => Some(q),
+                Err(e) => {
+                    blocked = Some(e);
+                    None
+                }
+            })
+            .collect()
+    };
+    let (ends_a, ends_b) = (ends(&from), ends(&to));
+    // Every route: straight between any two retract points, or over the safe plane above
+    // every surface (risen along `up` from them); checked shortest first.
+    let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::new();
+    let lift = obs.bounding_box().map(|(lo, hi)| {
         let top = (0..8)
             .map(|k| {
                 let corner = Point3::new(
@@ -613,26 +743,43 @@ pub fn plan_traverse(
             .fold(f64::NEG_INFINITY, f64::max)
             + c
             + 2.0 * h;
-        let lift = |p: &PoseArray| {
+        move |p: &PoseArray| {
             let q = position(p);
             let rise = (top - q.coords.dot(&up)).max(0.0);
             with_axis(q + up * rise, normal(p))
-        };
-        let plane = vec![a, lift(&a), lift(&b), b];
-        match tip_ends(&plane) {
+        }
+    });
+    for a in &ends_a {
+        for b in &ends_b {
+            let straight = vec![*a, *b];
+            routes.push((length_of(&straight), Route::Straight, straight));
+            if let Some(lift) = &lift {
+                let plane = vec![*a, lift(a), lift(b), *b];
+                routes.push((length_of(&plane), Route::SafePlane, plane));
+            }
+        }
+    }
+    routes.sort_by(|x, y| x.0.total_cmp(&y.0));
+    for (length_mm, route, waypoints) in routes {
+        if !reachable(&waypoints) {
+            continue;
+        }
+        match tip_ends(&waypoints) {
             Ok(least) => {
                 return Ok(Traverse {
-                    length_mm: length_of(&plane),
-                    waypoints: plane,
-                    route: Route::SafePlane,
+                    length_mm,
+                    waypoints,
+                    route,
                     min_distance_mm: least,
                 })
             }
             Err(e) => blocked = Some(e),
         }
-        height *= 2.0;
     }
-    let b = blocked.expect("the loop runs at least once");
+    let b = blocked.unwrap_or(Blocked {
+        at: position(&from),
+        distance: 0.0,
+    });
     Err(ProcessError::TraverseBlocked {
         from: [from[0], from[1], from[2]],
         to: [to[0], to[1], to[2]],

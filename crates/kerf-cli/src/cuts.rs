@@ -250,6 +250,7 @@ pub(crate) fn traverse_report(
         kerf_process::RapidMoves,
         Vec<String>,
     )],
+    blocked: Vec<Value>,
 ) -> Value {
     let mut unchecked: Vec<&str> = Vec::new();
     for (_, _, absent) in rapids {
@@ -267,7 +268,9 @@ pub(crate) fn traverse_report(
         "clearance_mm": o.clearance_mm,
         "retract_mm": o.retract_mm,
         "nozzle_mm": o.nozzle_mm,
-        "count": rapids.len(),
+        "count": rapids.len() + blocked.len(),
+        "checked_count": rapids.len(),
+        "unchecked": blocked,
         "lifted": rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count(),
         "split_moves": rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>(),
         "length_mm": rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>(),

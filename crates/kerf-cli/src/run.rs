@@ -141,7 +141,9 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     let mut programs = Vec::new();
     let mut setup_ids: Vec<Vec<String>> = Vec::new();
     let topts = args.traverse_options();
+    let limits = machine.limits.map(|r| r.map(|r| (r.min, r.max)));
     let mut rapid_report = Vec::new();
+    let mut blocked_report = Vec::new();
     for setup in 0..placed.plan.setups.len() {
         let mut ipaths = Vec::new();
         let mut ids: Vec<String> = Vec::new();
@@ -181,9 +183,28 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
                     }
                 })
                 .collect();
-            let rapids = kerf_process::plan_rapids(machine.kinematics.as_ref(), &obs, &gaps, topts)
-                .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
-            for (w, (t, r, absent)) in in_setup.windows(2).zip(&rapids) {
+            let rapids =
+                kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, &obs, &gaps, topts);
+            for (w, planned) in in_setup.windows(2).zip(&rapids) {
+                let (t, r, absent) = match planned {
+                    Ok(p) => p,
+                    Err(e) => {
+                        // No checked route: the unchecked retract traverse, said loudly.
+                        if !args.quiet {
+                            eprintln!(
+                                "warning: {}: {e}; this traverse is NOT checked",
+                                path.display()
+                            );
+                        }
+                        blocked_report.push(json!({
+                            "after": solved[w[0]].id,
+                            "before": solved[w[1]].id,
+                            "reason": e.to_string(),
+                        }));
+                        traverses.push(Vec::new());
+                        continue;
+                    }
+                };
                 axes.paths[w[1]].traverse = Some(kerf_kinematics::AxesMove {
                     positions: r.axes.clone(),
                     poses: r.poses.clone(),
@@ -297,7 +318,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         },
         "placement": placed.json(&id_refs),
         "process": crate::cuts::report(&file, &cuts, &cut_plans),
-        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report),
+        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report),
         "interpolation": {
             "feed_mm_per_min": args.feed,
             "cycle_s": args.cycle,

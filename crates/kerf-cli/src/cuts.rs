@@ -47,6 +47,7 @@ pub(crate) fn plan(
     file: &CurvesFile,
     oriented: &[Oriented],
     placed: &Placed,
+    starts: &[Option<f64>],
     options: &LeadOptions,
 ) -> Result<(Vec<CutPath>, SetupPlans), CliError> {
     let poses: Vec<Vec<PoseArray>> = oriented.iter().map(Oriented::poses).collect();
@@ -59,8 +60,11 @@ pub(crate) fn plan(
             .map(|&i| Contour {
                 id: &file.curves[i].id,
                 poses: &poses[i],
-                scrap: None,
-                start: None,
+                scrap: file.curves[i].scrap.map(|s| match s {
+                    kerf_format::ScrapSide::Left => kerf_process::Side::Left,
+                    kerf_format::ScrapSide::Right => kerf_process::Side::Right,
+                }),
+                start: starts[i].map(|t| kerf_process::index_of_param(&oriented[i].params, t)),
             })
             .collect();
         let plan = plan_cuts(&contours, options).map_err(|e| CliError::Input(e.to_string()))?;

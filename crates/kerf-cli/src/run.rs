@@ -46,7 +46,14 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         ..kerf_discretize::Options::with_tolerance(args.tolerance)
     };
     // 1. Cutting points with a certified chord error.
-    let discs: Vec<Discretization> = discretize_file(path, &file, &dopts)?;
+    let mut discs: Vec<Discretization> = discretize_file(path, &file, &dopts)?;
+    // 1b. Where closed cuts start when the file pins it (`start`) or only corners offer it (a
+    // polygon: the middle of its longest edge), made a cutting point.
+    let starts: Vec<Option<f64>> = discs
+        .iter_mut()
+        .zip(&file.curves)
+        .map(|(d, r)| kerf_process::prepare_start(&r.curve, d, r.start, &args.lead_options()))
+        .collect();
     // 2. Normals (+z for curves that name no surface).
     let nargs = NormalArgs {
         max_normal_step: args.max_normal_step,
@@ -93,7 +100,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     )?;
     // 3b. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
     // outlines, the shortest traverse; in part coordinates, then placed.
-    let (cuts, cut_plans) = crate::cuts::plan(&file, &oriented, &placed, &args.lead_options())?;
+    let (cuts, cut_plans) =
+        crate::cuts::plan(&file, &oriented, &placed, &starts, &args.lead_options())?;
     let cut_poses: Vec<Vec<Pose>> = cuts
         .iter()
         .map(|c| {

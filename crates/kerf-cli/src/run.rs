@@ -246,7 +246,18 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         }
         let motion = kerf_interp::interpolate_through(&model, &ipaths, &traverses, &fit, &plan)
             .map_err(interp(path))?;
-        programs.push(gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?);
+        let mut gopts_k = gopts.clone();
+        gopts_k.header = vec![
+            format!(
+                "set-up {} of {}: {} contours; placement (part to workpiece): {}",
+                setup + 1,
+                placed.plan.setups.len(),
+                ids.len(),
+                placed.plan.setups[setup].placement
+            ),
+            "work offset: none; every coordinate is in the machine's workpiece frame with the placement applied: clamp the part there".to_string(),
+        ];
+        programs.push(gcode_motion(&model, &motion, &ids, &gopts_k).map_err(interp(path))?);
         setup_ids.push(ids);
         motions.push(motion);
     }

@@ -275,15 +275,28 @@ fn closed_leads(
         // Arc points closer to the start than half the neighbouring chords lie between the
         // contour's tangent and the contour itself, where the chord polygon (within the chord
         // tolerance of the curve) cannot tell the sides apart: the crossing test covers them.
-        let ok_in = pts
-            .iter()
-            .filter(|p| (*p - start).norm() > near)
-            .all(&in_scrap)
-            && pts.windows(2).all(|w| !poly.crosses(&w[0], &w[1], s))
-            && pts
-                .last()
-                .is_none_or(|p| !poly.crosses(p, &(start + (p - start) * 0.999), s));
-        let ok_out = opts.lead_out_mm == 0.0 || (in_scrap(&exit) && poly.distance(&exit) > 0.0);
+        let (ok_in, ok_out) = if poly.wraps {
+            // A loop around a tube: the projection folds the sides onto the contour, so the
+            // side is judged in 3D, against the nearest cutting point's own `n x t`.
+            let side3d = |p: &Point3<f64>| side_in_3d(poses, p, side);
+            (
+                pts.iter()
+                    .filter(|p| (*p - start).norm() > near)
+                    .all(side3d),
+                opts.lead_out_mm == 0.0 || side3d(&exit),
+            )
+        } else {
+            (
+                pts.iter()
+                    .filter(|p| (*p - start).norm() > near)
+                    .all(&in_scrap)
+                    && pts.windows(2).all(|w| !poly.crosses(&w[0], &w[1], s))
+                    && pts
+                        .last()
+                        .is_none_or(|p| !poly.crosses(p, &(start + (p - start) * 0.999), s)),
+                opts.lead_out_mm == 0.0 || (in_scrap(&exit) && poly.distance(&exit) > 0.0),
+            )
+        };
         if ok_in && ok_out || full * scale < opts.min_lead_mm {
             let fits = ok_in && ok_out;
             if !fits {
@@ -302,6 +315,22 @@ fn closed_leads(
         }
         scale *= 0.5;
     }
+}
+
+/// True if `p` lies on the `side` of a closed contour in 3D: on the side of `n x t` (times the
+/// side's sign) at the contour's nearest cutting point, and off the contour.
+fn side_in_3d(poses: &[PoseArray], p: &Point3<f64>, side: Side) -> bool {
+    let m = poses.len() - 1;
+    let Some(i) = (0..m).min_by(|&a, &b| {
+        (position(&poses[a]) - p)
+            .norm_squared()
+            .total_cmp(&(position(&poses[b]) - p).norm_squared())
+    }) else {
+        return false;
+    };
+    let (t, n) = closed_tangent(poses, i);
+    let v = (p - position(&poses[i])).dot(&(n.cross(&t) * side.sign()));
+    v > 1e-9
 }
 
 /// The cutting points past `s` up to `length` mm along the contour (the last one interpolated

@@ -43,10 +43,12 @@ impl Projected {
         if (first - last).norm() > tol {
             return None;
         }
-        // The closing point repeats the first: counted once.
-        let mut n: Vector3<f64> = poses[..poses.len() - 1].iter().map(normal).sum();
-        let wraps = n.norm() < 1e-6 * poses.len() as f64;
-        if wraps {
+        // Whether the normals cancel over the distinct points (the closing point repeats the
+        // first); the projection keeps the sum over all points.
+        let distinct: Vector3<f64> = poses[..poses.len() - 1].iter().map(normal).sum();
+        let wraps = distinct.norm() < 1e-6 * poses.len() as f64;
+        let mut n: Vector3<f64> = poses.iter().map(normal).sum();
+        if n.norm() < 1e-6 * poses.len() as f64 {
             // Normals cancel (a loop around a tube): use the polygon's own plane (Newell).
             n = Vector3::zeros();
             for w in poses.windows(2) {

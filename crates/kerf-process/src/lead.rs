@@ -157,7 +157,17 @@ impl Leads {
         };
         let options = starts
             .into_iter()
-            .map(|s| closed_leads(c.poses, s, poly, side, scrap_inside, opts))
+            .map(|s| {
+                closed_leads(
+                    c.poses,
+                    s,
+                    poly,
+                    side,
+                    scrap_inside,
+                    c.scrap.is_some(),
+                    opts,
+                )
+            })
             .collect();
         Self {
             closed: true,
@@ -238,6 +248,7 @@ fn closed_leads(
     poly: &Projected,
     side: Side,
     scrap_inside: bool,
+    explicit: bool,
     opts: &LeadOptions,
 ) -> LeadIn {
     let (t, n) = closed_tangent(poses, s);
@@ -275,9 +286,20 @@ fn closed_leads(
         // Arc points closer to the start than half the neighbouring chords lie between the
         // contour's tangent and the contour itself, where the chord polygon (within the chord
         // tolerance of the curve) cannot tell the sides apart: the crossing test covers them.
-        let (ok_in, ok_out) = if poly.wraps {
+        let planar_in = pts
+            .iter()
+            .filter(|p| (*p - start).norm() > near)
+            .all(&in_scrap)
+            && pts.windows(2).all(|w| !poly.crosses(&w[0], &w[1], s))
+            && pts
+                .last()
+                .is_none_or(|p| !poly.crosses(p, &(start + (p - start) * 0.999), s));
+        let planar_out = opts.lead_out_mm == 0.0 || (in_scrap(&exit) && poly.distance(&exit) > 0.0);
+        let (ok_in, ok_out) = if poly.wraps && explicit && !(planar_in && planar_out) {
             // A loop around a tube: the projection folds the sides onto the contour, so the
-            // side is judged in 3D, against the nearest cutting point's own `n x t`.
+            // side is judged in 3D, against the nearest cutting point's own `n x t`. Only for
+            // a side the file gives: the projected area's sign says nothing about which end
+            // of a tube is waste.
             let side3d = |p: &Point3<f64>| side_in_3d(poses, p, side);
             (
                 pts.iter()
@@ -286,16 +308,7 @@ fn closed_leads(
                 opts.lead_out_mm == 0.0 || side3d(&exit),
             )
         } else {
-            (
-                pts.iter()
-                    .filter(|p| (*p - start).norm() > near)
-                    .all(&in_scrap)
-                    && pts.windows(2).all(|w| !poly.crosses(&w[0], &w[1], s))
-                    && pts
-                        .last()
-                        .is_none_or(|p| !poly.crosses(p, &(start + (p - start) * 0.999), s)),
-                opts.lead_out_mm == 0.0 || (in_scrap(&exit) && poly.distance(&exit) > 0.0),
-            )
+            (planar_in, planar_out)
         };
         if ok_in && ok_out || full * scale < opts.min_lead_mm {
             let fits = ok_in && ok_out;

@@ -163,6 +163,8 @@ fn curve(
         control_points: cps,
         weights: w,
         surface: Some(surface.into()),
+        start: None,
+        scrap: None,
     }
 }
 

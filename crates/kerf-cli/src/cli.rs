@@ -453,6 +453,13 @@ pub(crate) struct RunArgs {
     #[arg(long, default_value_t = 10.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
     pub(crate) retract: f64,
 
+    /// No traverse between cuts comes closer than this to the part's surfaces (the tool tip
+    /// and a 20 mm nozzle along the tool axis, checked against the NURBS and mesh surfaces
+    /// as the machine runs its rapids); the travel is lifted over the part where the straight
+    /// one is not clear (mm; 0 = the unchecked retract and straight traverse).
+    #[arg(long, default_value_t = 5.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
+    pub(crate) clearance: f64,
+
     /// Lead-in of every cut: the straight part from the pierce point, then the radius of the
     /// quarter arc that joins the contour tangentially on the scrap side, mm (`0,0` pierces on
     /// the contour). Shrunk where the scrap is smaller (small holes).
@@ -496,5 +503,14 @@ impl RunArgs {
         kerf_process::LeadOptions::default()
             .with_lead_in(self.lead_in.0, self.lead_in.1)
             .with_lead_out(self.lead_out.0, self.lead_out.1)
+    }
+
+    /// The traverse options these arguments ask for (`None`: unchecked traverses).
+    pub(crate) fn traverse_options(&self) -> Option<kerf_process::TraverseOptions> {
+        (self.clearance > 0.0).then(|| {
+            let mut t = kerf_process::TraverseOptions::default().with_clearance(self.clearance);
+            t.retract_mm = t.retract_mm.max(self.retract);
+            t
+        })
     }
 }

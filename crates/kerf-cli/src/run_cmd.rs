@@ -38,6 +38,7 @@ fn job_options(args: &RunArgs) -> JobOptions {
         .with_dialect(args.dialect.into())
         .with_blend_tolerance_mm(args.blend_tolerance)
         .with_retract_mm(args.retract)
+        .with_traverse(args.traverse_options())
 }
 
 /// Runs `kerf run`.
@@ -71,6 +72,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     let out = job.run_with_progress(&|p| bar.update(p));
     bar.finish();
     let out = out?;
+    if !args.quiet {
+        for w in &out.warnings {
+            eprintln!("warning: {}: {w}", path.display());
+        }
+    }
     // Several set-ups number their programs: check those names too.
     refuse(&out.file_names())?;
     out.write_dir(&args.out)?;

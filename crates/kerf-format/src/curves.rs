@@ -79,6 +79,14 @@ pub struct RawCurve {
     /// of ids for a curve over several faces.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surface: Option<SurfaceRef>,
+    /// For a closed curve, the parameter where its cut begins (optional `start` key); checked
+    /// by [`from_raw`] to lie inside the curve's domain.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<f64>,
+    /// The side of the curve that is waste, `"left"` or `"right"` (optional `scrap` key);
+    /// checked by [`from_raw`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scrap: Option<String>,
 }
 
 /// The `surface` key of a curve: one surface id, or a list of them for a curve that runs over
@@ -229,6 +237,78 @@ pub struct CurveRecord {
     /// Every surface id the curve names, in file order (empty without `surface`; one entry for
     /// the string form). The normal at a point comes from the nearest of them.
     pub surfaces: Vec<String>,
+    /// The parameter where the cut of this closed curve begins (the `start` key), inside the
+    /// curve's domain; `None` lets kerf choose.
+    pub start: Option<f64>,
+    /// The side that is waste (the `scrap` key); `None` lets kerf decide.
+    pub scrap: Option<ScrapSide>,
+}
+
+/// The side of a curve that is waste, seen along the curve's direction with the normal toward
+/// the viewer: `Left` is the side of `normal x tangent` (the `scrap` key of `kerf.curves/1`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScrapSide {
+    /// `"left"`: the side of `normal x tangent`.
+    Left,
+    /// `"right"`: the other side.
+    Right,
+}
+
+impl ScrapSide {
+    /// `"left"` or `"right"`, as the file writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ScrapSide::Left => "left",
+            ScrapSide::Right => "right",
+        }
+    }
+}
+
+/// Ends of a curve closer than this are one point: the curve is closed and may carry `start`
+/// (mm; the closure tolerance of the cut planning).
+const CLOSED_TOLERANCE_MM: f64 = 1e-6;
+
+/// Checks a curve's `start` and `scrap` keys against the built curve.
+fn start_and_scrap(
+    index: usize,
+    curve: &NurbsCurve,
+    start: Option<f64>,
+    scrap: Option<&str>,
+) -> Result<(Option<f64>, Option<ScrapSide>)> {
+    if let Some(t) = start {
+        let path = format!("curves[{index}].start");
+        let (a, b) = curve.domain();
+        if !t.is_finite() || t < a || t > b {
+            return Err(FormatError::Shape {
+                path,
+                message: format!("{t} is outside the domain [{a}, {b}]"),
+            });
+        }
+        let gap = (curve.point(a) - curve.point(b)).norm();
+        if gap > CLOSED_TOLERANCE_MM {
+            return Err(FormatError::Shape {
+                path,
+                message: format!(
+                    "the curve is open (its ends are {gap:.6} mm apart); only a closed curve takes a start"
+                ),
+            });
+        }
+    }
+    let side = match scrap {
+        None => None,
+        Some("left") => Some(ScrapSide::Left),
+        Some("right") => Some(ScrapSide::Right),
+        Some(other) => {
+            return Err(FormatError::Shape {
+                path: format!("curves[{index}].scrap"),
+                message: format!(
+                    "expected \"left\" or \"right\", got {}",
+                    Value::String(other.to_owned())
+                ),
+            })
+        }
+    };
+    Ok((start, side))
 }
 
 /// One surface.
@@ -432,11 +512,14 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
                 message: "an empty list of surface ids (omit the key for no surface)".into(),
             });
         }
+        let (start, scrap) = start_and_scrap(index, &curve, c.start, c.scrap.as_deref())?;
         curves.push(CurveRecord {
             id: c.id,
             curve,
             surface: named.first().cloned(),
             surfaces: named,
+            start,
+            scrap,
         });
     }
 

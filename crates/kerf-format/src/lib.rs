@@ -31,7 +31,7 @@ pub mod stl;
 pub mod toolpath;
 
 pub use curves::{
-    CurveRecord, CurvesFile, SurfaceGeometry, SurfaceRecord, SurfaceRef, SurfaceSource,
+    CurveRecord, CurvesFile, ScrapSide, SurfaceGeometry, SurfaceRecord, SurfaceRef, SurfaceSource,
 };
 pub use error::{FormatError, MeshDefect, Result, StlProblem};
 pub use toolpath::{ToolpathFile, ToolpathPoints, ToolpathRecord};

@@ -75,7 +75,10 @@ pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_csv_to, write_gcode, Dialect,
     GcodeOptions, ProcessCodes,
 };
-pub use plan::{link_paths, link_paths_with_retract, plan, Cycles, Motion, PathStats, PlanOptions};
+pub use plan::{
+    link_paths, link_paths_through, link_paths_with_retract, plan, Cycles, Motion, PathStats,
+    PlanOptions,
+};
 pub use plan::{ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_FILTER_WIDTH, JERK_STATIC_SHARE};
 #[cfg(feature = "research")]
 pub use recursive::{
@@ -122,6 +125,27 @@ pub fn fit_program<M: AxisModel + ?Sized>(
         all.push(fit_blocks(model, &p.stations, p.curve, n, opts)?);
     }
     Ok(plan::link_paths_with_retract(model, all, opts.retract))
+}
+
+/// [`interpolate`] with the rapid moves between consecutive paths running through the given
+/// waypoints ([`link_paths_through`]; `traverses[k]` lies between `paths[k]` and
+/// `paths[k + 1]`).
+///
+/// # Errors
+/// As [`interpolate`].
+pub fn interpolate_through<M: AxisModel + ?Sized>(
+    model: &M,
+    paths: &[ProgramPath<'_>],
+    traverses: &[Vec<Station>],
+    fit: &FitOptions,
+    plan_options: &PlanOptions,
+) -> Result<Motion> {
+    let mut all = Vec::with_capacity(paths.len());
+    for (n, p) in paths.iter().enumerate() {
+        all.push(fit_blocks(model, &p.stations, p.curve, n, fit)?);
+    }
+    let blocks = plan::link_paths_through(model, all, traverses, fit.retract);
+    plan(model, &blocks, plan_options)
 }
 
 /// What `kerf interpolate` does once its inputs are read: [`fit_program`] then [`plan()`].

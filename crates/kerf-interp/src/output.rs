@@ -294,6 +294,9 @@ pub struct GcodeOptions {
     pub source: Option<String>,
     /// Decimals of coordinates (default 6).
     pub decimals: usize,
+    /// More header comment lines, written after the source (each through the same comment
+    /// sanitizer), e.g. the placement of the part and its set-up (default none).
+    pub header: Vec<String>,
 }
 
 impl GcodeOptions {
@@ -311,6 +314,7 @@ impl GcodeOptions {
             process: kerf_kinematics::Process::default(),
             source: None,
             decimals: 6,
+            header: Vec::new(),
         }
     }
 
@@ -599,6 +603,9 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         self.comment(&machine);
         if let Some(src) = &o.source {
             self.comment(&format!("source: {}", comment_text(src)));
+        }
+        for line in &o.header {
+            self.comment(&comment_text(line));
         }
         let unit = if o.dialect == Dialect::Sinumerik {
             "G71"

@@ -34,7 +34,7 @@ mod motion;
 mod profile;
 mod verify;
 
-pub use link::{link_paths, link_paths_with_retract};
+pub use link::{link_paths, link_paths_through, link_paths_with_retract};
 pub use motion::{Cycles, Motion, PathStats};
 
 use assemble::assemble;

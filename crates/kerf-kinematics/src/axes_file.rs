@@ -79,6 +79,11 @@ pub struct AxesPath {
     /// Optional: the move off the curve after the cut (overcut and exit).
     #[serde(default)]
     pub lead_out: Option<AxesMove>,
+    /// Optional: the rapid waypoints of the traverse before this path (from the retract
+    /// above the previous path's end to the point above this path's pierce), checked to clear
+    /// the part (`kerf-process`); the head runs each as a rapid, all axes linear.
+    #[serde(default)]
+    pub traverse: Option<AxesMove>,
 }
 
 /// A lead-in or lead-out of a path in `kerf.axes/1`: axis vectors and the poses they give.
@@ -136,6 +141,7 @@ impl AxesFile {
                     start_point: None,
                     lead_in: None,
                     lead_out: None,
+                    traverse: None,
                 })
                 .collect(),
         }
@@ -167,7 +173,11 @@ impl AxesFile {
         for (n, p) in self.paths.iter().enumerate() {
             let at = |key: &str| format!("paths[{n}].{key}");
             crate::json::check_text(&at("id"), &p.id)?;
-            for (key, m) in [("lead_in", &p.lead_in), ("lead_out", &p.lead_out)] {
+            for (key, m) in [
+                ("lead_in", &p.lead_in),
+                ("lead_out", &p.lead_out),
+                ("traverse", &p.traverse),
+            ] {
                 if let Some(m) = m {
                     if m.positions.len() != m.poses.len() {
                         return Err(KinematicsError::doc(
@@ -357,7 +367,11 @@ impl AxesFile {
             if let Some(sp) = p.start_point {
                 write!(w, ",\n      \"start_point\": {sp}")?;
             }
-            for (key, m) in [("lead_in", &p.lead_in), ("lead_out", &p.lead_out)] {
+            for (key, m) in [
+                ("lead_in", &p.lead_in),
+                ("lead_out", &p.lead_out),
+                ("traverse", &p.traverse),
+            ] {
                 if let Some(m) = m {
                     writeln!(w, ",\n      \"{key}\": {{")?;
                     write_rows(w, "positions", m.positions.iter().map(|r| r.as_slice()))?;

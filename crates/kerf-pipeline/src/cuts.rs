@@ -47,6 +47,7 @@ pub(crate) fn plan(
     file: &CurvesFile,
     oriented: &[Oriented],
     placed: &Placed,
+    starts: &[Option<f64>],
     options: &LeadOptions,
     source: Option<&std::path::Path>,
 ) -> Result<(Vec<CutPath>, SetupPlans), Error> {
@@ -60,8 +61,11 @@ pub(crate) fn plan(
             .map(|&i| Contour {
                 id: &file.curves[i].id,
                 poses: &poses[i],
-                scrap: None,
-                start: None,
+                scrap: file.curves[i].scrap.map(|s| match s {
+                    kerf_format::ScrapSide::Left => kerf_process::Side::Left,
+                    kerf_format::ScrapSide::Right => kerf_process::Side::Right,
+                }),
+                start: starts[i].map(|t| kerf_process::index_of_param(&oriented[i].params, t)),
             })
             .collect();
         let plan = plan_cuts(&contours, options).map_err(|e| Error::Process {
@@ -242,5 +246,44 @@ pub(crate) fn report(file: &CurvesFile, cuts: &[CutPath], plans: &SetupPlans) ->
         "lead_ins_shortened": shortened,
         "pierce_on_contour": on_contour,
         "traverse_note": "straight distances from each cut's exit to the next pierce point, in part coordinates, within each set-up; the program adds the retract and approach along the tool axes",
+    })
+}
+
+/// The `traverses` object of `report.json`: how the traverses between cuts were checked
+/// against the part and what they came to.
+pub(crate) fn traverse_report(
+    opts: Option<&kerf_process::TraverseOptions>,
+    rapids: &[(
+        kerf_process::Traverse,
+        kerf_process::RapidMoves,
+        Vec<String>,
+    )],
+    blocked: Vec<Value>,
+) -> Value {
+    let mut unchecked: Vec<&str> = Vec::new();
+    for (_, _, absent) in rapids {
+        for id in absent {
+            if !unchecked.contains(&id.as_str()) {
+                unchecked.push(id);
+            }
+        }
+    }
+    let Some(o) = opts else {
+        return json!({ "checked": false, "note": "--clearance 0: retract along the tool axis, one straight move, approach; not checked against the part" });
+    };
+    json!({
+        "checked": true,
+        "clearance_mm": o.clearance_mm,
+        "retract_mm": o.retract_mm,
+        "nozzle_mm": o.nozzle_mm,
+        "count": rapids.len() + blocked.len(),
+        "checked_count": rapids.len(),
+        "unchecked": blocked,
+        "lifted": rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count(),
+        "split_moves": rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>(),
+        "length_mm": rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>(),
+        "min_distance_mm": rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min),
+        "surfaces_in_the_cuts_way": unchecked,
+        "surfaces_note": "surfaces a cut's curve does not name that lie on the tool axis line at that cut (another workpiece in the same place, or in the way of the cut itself) are not checked for the traverses next to it",
     })
 }

@@ -107,6 +107,11 @@ pub struct JobOptions {
     /// Between two contours the head backs off this far along the tool axis, traverses and
     /// approaches the next start along its tool axis, mm (0: one straight rapid). Default 10.
     pub retract_mm: f64,
+    /// Traverses between cuts checked against the part's surfaces (retract along the tool
+    /// axis, travel at a clearance, approach; `kerf-process`), or `None` for the unchecked
+    /// retract and straight traverse. Default `Some(TraverseOptions::default())`: 5 mm
+    /// clearance, 20 mm nozzle; the retract is never shorter than `retract_mm`.
+    pub traverse: Option<kerf_process::TraverseOptions>,
 }
 
 impl Default for JobOptions {
@@ -122,6 +127,7 @@ impl Default for JobOptions {
             dialect: Dialect::Generic,
             blend_tolerance_mm: kerf_interp::DEFAULT_BLEND_TOLERANCE,
             retract_mm: 10.0,
+            traverse: Some(kerf_process::TraverseOptions::default()),
         }
     }
 }
@@ -190,6 +196,12 @@ impl JobOptions {
     /// With this retract between contours, mm.
     pub fn with_retract_mm(mut self, mm: f64) -> Self {
         self.retract_mm = mm;
+        self
+    }
+
+    /// With these traverse checks (`None`: unchecked traverses).
+    pub fn with_traverse(mut self, traverse: Option<kerf_process::TraverseOptions>) -> Self {
+        self.traverse = traverse;
         self
     }
 }
@@ -273,6 +285,8 @@ impl Job {
             curve,
             surfaces: surface.iter().cloned().collect(),
             surface,
+            start: None,
+            scrap: None,
         });
         self
     }

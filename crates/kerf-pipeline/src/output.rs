@@ -82,6 +82,9 @@ pub struct Output {
     /// The picture (`plot.svg`): the curves, points and tool axes, chord errors and the axes
     /// against the machine's limits.
     pub plot_svg: String,
+    /// What the caller should be told: traverses that could not be checked against the part
+    /// (they fall back to the unchecked retract traverse; `traverses.unchecked` in the report).
+    pub warnings: Vec<String>,
     pub(crate) model: MachineModel,
     pub(crate) cycle_s: f64,
 }

@@ -3,6 +3,7 @@
 //! ([`Output`]); [`Output::write_dir`] writes them all into one directory only once every
 //! stage has succeeded.
 
+use std::path::Path;
 use std::time::Instant;
 
 use kerf_discretize::Discretization;
@@ -50,7 +51,14 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     job.validate()?;
     let dopts = o.discretize;
     // 1. Cutting points with a certified chord error.
-    let discs: Vec<Discretization> = discretize_curves(file, &dopts, path, progress)?;
+    let mut discs: Vec<Discretization> = discretize_curves(file, &dopts, path, progress)?;
+    // 1b. Where closed cuts start when the file pins it (`start`) or only corners offer it (a
+    // polygon: the middle of its longest edge), made a (certified) cutting point.
+    let starts: Vec<Option<f64>> = discs
+        .iter_mut()
+        .zip(&file.curves)
+        .map(|(d, r)| kerf_process::prepare_start(&r.curve, d, r.start, &o.leads, dopts.tolerance))
+        .collect();
     // 2. Normals (+z for curves that name no surface, unless the options refuse them).
     let oriented: Vec<Oriented> = orient_curves(file, &discs, &dopts, &o.orient, path, progress)?;
     let tp = toolpath_of_poses(file, dopts.tolerance, &oriented);
@@ -74,7 +82,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     )?;
     // 3b. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
     // outlines, the shortest traverse; in part coordinates, then placed.
-    let (cuts, cut_plans) = crate::cuts::plan(file, &oriented, &placed, &o.leads, path)?;
+    let (cuts, cut_plans) = crate::cuts::plan(file, &oriented, &placed, &starts, &o.leads, path)?;
     let cut_poses: Vec<Vec<Pose>> = cuts
         .iter()
         .map(|c| {
@@ -129,9 +137,94 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let mut motions = Vec::new();
     let mut programs = Vec::new();
     let mut setup_ids: Vec<Vec<String>> = Vec::new();
+    // Checked traverses (None: the unchecked retract); never a shorter retract than asked.
+    let topts = o.traverse.map(|mut t| {
+        t.retract_mm = t.retract_mm.max(o.retract_mm);
+        t
+    });
+    let limits = machine.limits.map(|r| r.map(|r| (r.min, r.max)));
+    let mut rapid_report = Vec::new();
+    let mut blocked_report = Vec::new();
+    let mut warnings: Vec<String> = Vec::new();
     for setup in 0..placed.plan.setups.len() {
         let mut ipaths = Vec::new();
         let mut ids: Vec<String> = Vec::new();
+        let in_setup: Vec<usize> = (0..solved.len())
+            .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
+            .collect();
+        // Traverses that clear the part's surfaces, placed with this set-up.
+        let mut traverses = Vec::new();
+        if let (Some(topts), Some(&first)) = (&topts, in_setup.first()) {
+            let placement = placed.placement_of(cuts[first].curve);
+            let obs =
+                kerf_process::Obstacles::from_file(file, &placed.plan.setups[setup].paths, |p| {
+                    placement.apply_point(p)
+                })
+                .map_err(|source| crate::Error::Process {
+                    file: path.map(Path::to_path_buf),
+                    source,
+                })?;
+            let gaps: Vec<kerf_process::Gap> = in_setup
+                .windows(2)
+                .map(|w| {
+                    let (a, b) = (&solved[w[0]], &solved[w[1]]);
+                    let ax = |q: &kerf_kinematics::Axes| [q.x, q.y, q.z, q.tilt, q.c];
+                    // The solved pose of a cut's k-th pose (lead-in, contour, lead-out).
+                    let at = |s: &kerf_kinematics::SolvedPath, k: usize| {
+                        let j = s.source.iter().position(|v| *v == Some(k)).unwrap_or(0);
+                        let p = s.poses[j].position;
+                        [p.x, p.y, p.z]
+                    };
+                    let [m, c, _] = cuts[w[0]].counts;
+                    kerf_process::Gap {
+                        from: a.poses[a.poses.len() - 1].to_array(),
+                        from_axes: ax(&a.axes[a.axes.len() - 1]),
+                        to: b.poses[0].to_array(),
+                        to_axes: ax(&b.axes[0]),
+                        from_contour: at(a, m + c - 1),
+                        to_contour: at(b, cuts[w[1]].counts[0]),
+                        from_surfaces: file.curves[cuts[w[0]].curve].surfaces.clone(),
+                        to_surfaces: file.curves[cuts[w[1]].curve].surfaces.clone(),
+                    }
+                })
+                .collect();
+            let rapids =
+                kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, &obs, &gaps, topts);
+            for (w, planned) in in_setup.windows(2).zip(&rapids) {
+                let (t, r, absent) = match planned {
+                    Ok(p) => p,
+                    Err(e) => {
+                        // No checked route: the unchecked retract traverse, said loudly
+                        // (`Output::warnings`, and `traverses.unchecked` in the report).
+                        warnings.push(format!("{e}; this traverse is NOT checked"));
+                        blocked_report.push(json!({
+                            "after": solved[w[0]].id,
+                            "before": solved[w[1]].id,
+                            "reason": e.to_string(),
+                        }));
+                        traverses.push(Vec::new());
+                        continue;
+                    }
+                };
+                axes.paths[w[1]].traverse = Some(kerf_kinematics::AxesMove {
+                    positions: r.axes.clone(),
+                    poses: r.poses.clone(),
+                });
+                traverses.push(
+                    r.axes
+                        .iter()
+                        .zip(&r.poses)
+                        .map(|(a, p)| kerf_interp::Station {
+                            tip: nalgebra::Point3::new(p[0], p[1], p[2]),
+                            axis: nalgebra::Vector3::new(p[3], p[4], p[5]),
+                            param: None,
+                            axes: *a,
+                        })
+                        .collect::<Vec<_>>(),
+                );
+                rapid_report.push((t.clone(), r.clone(), absent.clone()));
+            }
+        }
         for (k, s) in solved.iter().enumerate() {
             if placed.plan.setup_of(cuts[k].curve) != setup {
                 continue;
@@ -144,9 +237,20 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
             });
             ids.push(s.id.clone());
         }
-        let motion =
-            kerf_interp::interpolate(&model, &ipaths, &fit, &plan).map_err(interp(path))?;
-        programs.push(gcode_motion(&model, &motion, &ids, &gopts).map_err(interp(path))?);
+        let motion = kerf_interp::interpolate_through(&model, &ipaths, &traverses, &fit, &plan)
+            .map_err(interp(path))?;
+        let mut gopts_k = gopts.clone();
+        gopts_k.header = vec![
+            format!(
+                "set-up {} of {}: {} contours; placement (part to workpiece): {}",
+                setup + 1,
+                placed.plan.setups.len(),
+                ids.len(),
+                placed.plan.setups[setup].placement
+            ),
+            "work offset: none; every coordinate is in the machine's workpiece frame with the placement applied: clamp the part there".to_string(),
+        ];
+        programs.push(gcode_motion(&model, &motion, &ids, &gopts_k).map_err(interp(path))?);
         setup_ids.push(ids);
         motions.push(motion);
     }
@@ -223,6 +327,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         },
         "placement": placed.json(&id_refs),
         "process": crate::cuts::report(file, &cuts, &cut_plans),
+        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report),
         "interpolation": {
             "feed_mm_per_min": o.feed_mm_per_min,
             "cycle_s": o.cycle_s,
@@ -260,6 +365,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         programs,
         report,
         plot_svg: svg,
+        warnings,
         model,
         cycle_s: o.cycle_s,
     })

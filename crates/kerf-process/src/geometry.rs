@@ -27,6 +27,9 @@ pub(crate) struct Projected {
     poly: Vec<Vector2<f64>>,
     /// Signed area (mm^2): > 0 counter-clockwise seen from the mean normal.
     pub(crate) area: f64,
+    /// True if the normals cancel (a loop whose tool axes turn all the way round, e.g. around
+    /// a tube): the projection then folds the two sides onto the contour.
+    pub(crate) wraps: bool,
 }
 
 impl Projected {
@@ -41,6 +44,10 @@ impl Projected {
         if (first - last).norm() > tol {
             return None;
         }
+        // Whether the normals cancel over the distinct points (the closing point repeats the
+        // first); the projection keeps the sum over all points.
+        let distinct: Vector3<f64> = poses[..poses.len() - 1].iter().map(normal).sum();
+        let wraps = distinct.norm() < 1e-6 * poses.len() as f64;
         let mut n: Vector3<f64> = poses.iter().map(normal).sum();
         if n.norm() < 1e-6 * poses.len() as f64 {
             // Normals cancel (a loop around a tube): use the polygon's own plane (Newell).
@@ -76,6 +83,7 @@ impl Projected {
             e2,
             poly,
             area: 0.5 * area,
+            wraps,
         })
     }
 

@@ -157,7 +157,17 @@ impl Leads {
         };
         let options = starts
             .into_iter()
-            .map(|s| closed_leads(c.poses, s, poly, side, scrap_inside, opts))
+            .map(|s| {
+                closed_leads(
+                    c.poses,
+                    s,
+                    poly,
+                    side,
+                    scrap_inside,
+                    c.scrap.is_some(),
+                    opts,
+                )
+            })
             .collect();
         Self {
             closed: true,
@@ -238,6 +248,7 @@ fn closed_leads(
     poly: &Projected,
     side: Side,
     scrap_inside: bool,
+    explicit: bool,
     opts: &LeadOptions,
 ) -> LeadIn {
     let (t, n) = closed_tangent(poses, s);
@@ -275,7 +286,7 @@ fn closed_leads(
         // Arc points closer to the start than half the neighbouring chords lie between the
         // contour's tangent and the contour itself, where the chord polygon (within the chord
         // tolerance of the curve) cannot tell the sides apart: the crossing test covers them.
-        let ok_in = pts
+        let planar_in = pts
             .iter()
             .filter(|p| (*p - start).norm() > near)
             .all(&in_scrap)
@@ -283,7 +294,22 @@ fn closed_leads(
             && pts
                 .last()
                 .is_none_or(|p| !poly.crosses(p, &(start + (p - start) * 0.999), s));
-        let ok_out = opts.lead_out_mm == 0.0 || (in_scrap(&exit) && poly.distance(&exit) > 0.0);
+        let planar_out = opts.lead_out_mm == 0.0 || (in_scrap(&exit) && poly.distance(&exit) > 0.0);
+        let (ok_in, ok_out) = if poly.wraps && explicit && !(planar_in && planar_out) {
+            // A loop around a tube: the projection folds the sides onto the contour, so the
+            // side is judged in 3D, against the nearest cutting point's own `n x t`. Only for
+            // a side the file gives: the projected area's sign says nothing about which end
+            // of a tube is waste.
+            let side3d = |p: &Point3<f64>| side_in_3d(poses, p, side);
+            (
+                pts.iter()
+                    .filter(|p| (*p - start).norm() > near)
+                    .all(side3d),
+                opts.lead_out_mm == 0.0 || side3d(&exit),
+            )
+        } else {
+            (planar_in, planar_out)
+        };
         if ok_in && ok_out || full * scale < opts.min_lead_mm {
             let fits = ok_in && ok_out;
             if !fits {
@@ -302,6 +328,22 @@ fn closed_leads(
         }
         scale *= 0.5;
     }
+}
+
+/// True if `p` lies on the `side` of a closed contour in 3D: on the side of `n x t` (times the
+/// side's sign) at the contour's nearest cutting point, and off the contour.
+fn side_in_3d(poses: &[PoseArray], p: &Point3<f64>, side: Side) -> bool {
+    let m = poses.len() - 1;
+    let Some(i) = (0..m).min_by(|&a, &b| {
+        (position(&poses[a]) - p)
+            .norm_squared()
+            .total_cmp(&(position(&poses[b]) - p).norm_squared())
+    }) else {
+        return false;
+    };
+    let (t, n) = closed_tangent(poses, i);
+    let v = (p - position(&poses[i])).dot(&(n.cross(&t) * side.sign()));
+    v > 1e-9
 }
 
 /// The cutting points past `s` up to `length` mm along the contour (the last one interpolated

@@ -26,9 +26,17 @@
 mod geometry;
 mod lead;
 mod order;
+mod rapid;
+mod start;
+mod traverse;
 
 pub use lead::{LeadIn, LeadOptions};
 pub use order::CutPlan;
+pub use rapid::{plan_rapids, rapid_moves, Gap, RapidMoves};
+pub use start::{index_of_param, prepare_start};
+pub use traverse::{
+    check_move, plan_traverse, plan_traverse_within, Obstacles, Route, Traverse, TraverseOptions,
+};
 
 use geometry::Projected;
 use thiserror::Error;
@@ -110,6 +118,33 @@ pub enum ProcessError {
         value: f64,
         /// What is wrong.
         reason: &'static str,
+    },
+    /// A surface given for the traverse checks is not usable (non-finite vertex, index out of
+    /// range, no triangle). Fix: check the surface in the curves file.
+    #[error("traverse surface: {reason}")]
+    BadSurface {
+        /// What is wrong.
+        reason: String,
+    },
+    /// No traverse route between two cuts keeps the clearance: the retract along the tool
+    /// axis, the straight travel and the travel over the safe plane all come too close.
+    /// Fix: a smaller clearance, another placement, or check the tool axes (one pointing into
+    /// a pocket).
+    #[error(
+        "traverse from ({:.3}, {:.3}, {:.3}) to ({:.3}, {:.3}, {:.3}): no route keeps the {clearance_mm} mm clearance; ({:.3}, {:.3}, {:.3}) is {distance_mm:.3} mm from the part",
+        from[0], from[1], from[2], to[0], to[1], to[2], at[0], at[1], at[2]
+    )]
+    TraverseBlocked {
+        /// Where the last cut ends, mm.
+        from: [f64; 3],
+        /// The next pierce point, mm.
+        to: [f64; 3],
+        /// The first point too close on the last route tried, mm.
+        at: [f64; 3],
+        /// Its distance from the part, mm.
+        distance_mm: f64,
+        /// The clearance asked for, mm.
+        clearance_mm: f64,
     },
 }
 

@@ -277,3 +277,38 @@ fn island_in_a_hole_and_a_shorter_order_than_the_file() {
         plan.file_order_traverse_mm
     );
 }
+
+/// A loop around a tube (radius 20 about the z axis, normals radial): the tool axes turn all
+/// the way round, so the projection along the (Newell) normal folds the sides onto the loop.
+/// With `scrap` on either side, the lead-in and lead-out lie on that side along the tube
+/// (`n x t` is +z for this loop, so left is +z), not on the contour.
+#[test]
+fn a_loop_around_a_tube_leads_in_on_its_scrap_side() {
+    let n = 96;
+    let ring: Vec<PoseArray> = (0..=n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+            [20.0 * a.cos(), 20.0 * a.sin(), 0.0, a.cos(), a.sin(), 0.0]
+        })
+        .collect();
+    for (side, sign) in [(Side::Left, 1.0), (Side::Right, -1.0)] {
+        let c = Contour {
+            id: "cut-off",
+            poses: &ring,
+            scrap: Some(side),
+            start: None,
+        };
+        let plan = plan_cuts(&[c], &LeadOptions::default()).expect("plan");
+        let l = &plan.leads[0];
+        assert!(!l.pierce_on_contour, "{side:?}: a lead-in fits: {l:?}");
+        assert!((l.scale - 1.0).abs() < 1e-12, "{side:?}: full size");
+        let pierce = l.lead_in[0];
+        assert!(
+            pierce[2] * sign > 2.0,
+            "{side:?}: the pierce is up/down the tube: {pierce:?}"
+        );
+        for q in l.lead_in.iter().chain(&l.lead_out) {
+            assert!(q[2] * sign >= -1e-9, "{side:?}: on the scrap side: {q:?}");
+        }
+    }
+}

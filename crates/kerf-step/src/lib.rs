@@ -449,6 +449,8 @@ fn raw_curve(id: String, c: &NurbsCurve, surface: Option<SurfaceRef>) -> RawCurv
         control_points: c.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
         weights: c.is_rational().then(|| c.weights()),
         surface,
+        start: None,
+        scrap: None,
     }
 }
 

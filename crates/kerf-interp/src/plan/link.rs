@@ -96,3 +96,66 @@ pub fn link_paths_with_retract<M: AxisModel + ?Sized>(
     }
     out
 }
+
+/// Like [`link_paths_with_retract`], but the rapid moves between path `k` and path `k + 1` run
+/// through the given waypoints `traverses[k]` (tip, tool axis and axes `[X, Y, Z, tilt, C]`
+/// of each, e.g. a traverse checked against the part by `kerf-process`): from the end of
+/// path `k` to the first waypoint, from one waypoint to the next, and from the last to the
+/// start of path `k + 1`, each one rapid line. A gap without waypoints (a missing or empty
+/// entry) falls back to the retract of [`link_paths_with_retract`].
+pub fn link_paths_through<M: AxisModel + ?Sized>(
+    model: &M,
+    paths: Vec<Vec<Block>>,
+    traverses: &[Vec<crate::block::Station>],
+    retract: f64,
+) -> Vec<Block> {
+    let mut out: Vec<Block> = Vec::new();
+    let mut k = 0usize;
+    for blocks in paths {
+        let Some(first) = blocks.first() else {
+            continue;
+        };
+        if let Some(last) = out.last() {
+            let way = traverses.get(k).filter(|w| !w.is_empty());
+            k += 1;
+            match way {
+                Some(way) => {
+                    let end = crate::block::Station {
+                        tip: last.end_tip(),
+                        axis: last.end_tool_axis,
+                        param: None,
+                        axes: last.end_axes,
+                    };
+                    let start = crate::block::Station {
+                        tip: first.start_tip(),
+                        axis: model.tool_axis(first.start_axes[3], first.start_axes[4]),
+                        param: None,
+                        axes: first.start_axes,
+                    };
+                    let mut stops = vec![end];
+                    stops.extend(
+                        way.iter()
+                            .map(|s| crate::block::Station { param: None, ..*s }),
+                    );
+                    stops.push(start);
+                    for w in stops.windows(2) {
+                        let mut rapid = Block::line(&w[0], &w[1]);
+                        rapid.rapid = true;
+                        rapid.path = first.path;
+                        rapid.stations = [0, 0];
+                        out.push(rapid);
+                    }
+                }
+                None => {
+                    let mut linked =
+                        link_paths_with_retract(model, vec![vec![*last], vec![*first]], retract);
+                    linked.pop();
+                    linked.remove(0);
+                    out.extend(linked);
+                }
+            }
+        }
+        out.extend(blocks);
+    }
+    out
+}

@@ -1,0 +1,271 @@
+//! Set-ups: groups of contours placed separately when the part does not fit in one.
+
+use super::*;
+/// One set-up: contours cut with the part clamped in one placement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setup {
+    /// The indices of the paths cut in this set-up, in input order.
+    pub paths: Vec<usize>,
+    /// The placement of the part for these paths.
+    pub placement: Placement,
+    /// The smallest distance of any of its poses to a linear limit, mm.
+    pub clearance_mm: f64,
+}
+
+/// The set-ups [`auto_setups`] chose: one when the whole part fits in one placement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetupPlan {
+    /// The set-ups, in cutting order.
+    pub setups: Vec<Setup>,
+    /// For each path, true if its tool axes were turned to the other side of the sheet.
+    pub flipped: Vec<bool>,
+    /// How many orientations were tried in all.
+    pub rotations_tried: usize,
+}
+
+impl SetupPlan {
+    /// The set-up that cuts path `path`.
+    pub fn setup_of(&self, path: usize) -> usize {
+        self.setups
+            .iter()
+            .position(|s| s.paths.contains(&path))
+            .unwrap_or(0)
+    }
+
+    /// The placement of path `path`.
+    pub fn placement_of(&self, path: usize) -> Placement {
+        self.setups
+            .get(self.setup_of(path))
+            .map_or(Placement::IDENTITY, |s| s.placement)
+    }
+
+    /// The placed poses of every path (each with its set-up's placement, flips applied).
+    pub fn apply(&self, paths: &[Vec<Pose>]) -> Vec<Vec<Pose>> {
+        paths
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let placed = place_paths(
+                    &self.placement_of(i),
+                    &[self.flipped.get(i).copied().unwrap_or(false)],
+                    std::slice::from_ref(p),
+                );
+                placed.into_iter().next().unwrap_or_default()
+            })
+            .collect()
+    }
+}
+
+/// Places the part in as few set-ups as it takes: the whole part in one placement if any fits
+/// ([`auto_place`]); else the contours are grouped by the orientation that serves them (greedily:
+/// the up direction that brings the most remaining contours within the tilt range takes them),
+/// and a group that does not fit the travel in one placement is halved at the median of its
+/// contours' centres along its longest extent, recursively, down to single contours.
+///
+/// # Errors
+/// [`KinematicsError::NoPlacement`] for a single contour that fits in no placement (naming the
+/// contour, the axis and the shortfall), and the errors of [`auto_place`].
+pub fn auto_setups(
+    machine: &Machine,
+    paths: &[(&str, &[Pose])],
+    options: &AutoPlaceOptions,
+) -> Result<SetupPlan> {
+    let mut plan = SetupPlan {
+        setups: Vec::new(),
+        flipped: vec![false; paths.len()],
+        rotations_tried: 0,
+    };
+    let all: Vec<usize> = (0..paths.len()).collect();
+    if place_group(machine, paths, &all, options, &mut plan)? {
+        return Ok(plan);
+    }
+    if paths.len() <= 1 {
+        // The whole part's error.
+        auto_place(machine, paths, options)?;
+        return Ok(plan);
+    }
+    let owned: Vec<Vec<Pose>> = paths.iter().map(|(_, p)| p.to_vec()).collect();
+    for group in orientation_groups(machine, &owned, options.flip) {
+        bisect(machine, paths, &group, options, &mut plan)?;
+    }
+    Ok(plan)
+}
+
+/// Places `group` as one set-up if it fits (true), else false; other errors pass through.
+pub(super) fn place_group(
+    machine: &Machine,
+    paths: &[(&str, &[Pose])],
+    group: &[usize],
+    options: &AutoPlaceOptions,
+    plan: &mut SetupPlan,
+) -> Result<bool> {
+    let sub: Vec<(&str, &[Pose])> = group.iter().map(|&i| paths[i]).collect();
+    match auto_place(machine, &sub, options) {
+        Ok(found) => {
+            plan.rotations_tried += found.rotations_tried;
+            for (k, &i) in group.iter().enumerate() {
+                plan.flipped[i] = found.flipped[k];
+            }
+            plan.setups.push(Setup {
+                paths: group.to_vec(),
+                placement: found.placement,
+                clearance_mm: found.clearance_mm,
+            });
+            Ok(true)
+        }
+        Err(KinematicsError::NoPlacement {
+            rotations_tried, ..
+        }) => {
+            plan.rotations_tried += rotations_tried;
+            Ok(false)
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Places `group`, halving it spatially until every piece fits (see [`auto_setups`]).
+pub(super) fn bisect(
+    machine: &Machine,
+    paths: &[(&str, &[Pose])],
+    group: &[usize],
+    options: &AutoPlaceOptions,
+    plan: &mut SetupPlan,
+) -> Result<()> {
+    if place_group(machine, paths, group, options, plan)? {
+        return Ok(());
+    }
+    if group.len() == 1 {
+        // The reason, for this contour alone.
+        auto_place(machine, &[paths[group[0]]], options)?;
+        return Ok(());
+    }
+    let centre = |i: usize| {
+        let mut lo = Vector3::repeat(f64::INFINITY);
+        let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+        for q in paths[i].1 {
+            lo = lo.inf(&q.position.coords);
+            hi = hi.sup(&q.position.coords);
+        }
+        0.5 * (lo + hi)
+    };
+    let centres: Vec<Vector3<f64>> = group.iter().map(|&i| centre(i)).collect();
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    for c in &centres {
+        lo = lo.inf(c);
+        hi = hi.sup(c);
+    }
+    let axis = (hi - lo).imax();
+    let mut order: Vec<usize> = (0..group.len()).collect();
+    order.sort_by(|&a, &b| {
+        centres[a][axis]
+            .total_cmp(&centres[b][axis])
+            .then(a.cmp(&b))
+    });
+    let half = group.len() / 2;
+    let mut first: Vec<usize> = order[..half].iter().map(|&k| group[k]).collect();
+    let mut second: Vec<usize> = order[half..].iter().map(|&k| group[k]).collect();
+    first.sort_unstable();
+    second.sort_unstable();
+    bisect(machine, paths, &first, options, plan)?;
+    bisect(machine, paths, &second, options, plan)
+}
+
+/// The directions of the part that may be turned to point up: a Fibonacci lattice of 2,048
+/// unit vectors, evenly spread over the sphere (neighbours about 4.5 degrees apart).
+pub(super) fn up_directions() -> Vec<Vector3<f64>> {
+    const DIRECTIONS: usize = 2048;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..DIRECTIONS)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / DIRECTIONS as f64;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Vector3::new(
+                r * (golden * i as f64).cos(),
+                r * (golden * i as f64).sin(),
+                z,
+            )
+        })
+        .collect()
+}
+
+/// The rotation that turns direction `d` of the part to +z (a half turn about x for -z).
+pub(super) fn turn_up(d: &Vector3<f64>) -> Rotation3<f64> {
+    Rotation3::rotation_between(d, &Vector3::z())
+        .unwrap_or_else(|| Rotation3::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI))
+}
+
+/// For each path and each lattice direction: can the tilt axis reach every tool axis of the
+/// path (on one side of the sheet, or the other with `flip`) once that direction points up?
+/// Checked on up to 256 poses per path, 1 degree inside the limits so that the tool axes
+/// between the samples are covered too (the final solve checks them all).
+pub(super) fn reachable_directions(
+    machine: &Machine,
+    paths: &[Vec<Pose>],
+    flip: bool,
+    lattice: &[Vector3<f64>],
+) -> Vec<Vec<bool>> {
+    const PER_PATH: usize = 256;
+    const INSET_DEG: f64 = 1.0;
+    let turns: Vec<Rotation3<f64>> = lattice.iter().map(turn_up).collect();
+    paths
+        .iter()
+        .map(|p| {
+            let step = p.len().div_ceil(PER_PATH).max(1);
+            let axes: Vec<Vector3<f64>> = p.iter().step_by(step).map(|q| q.axis).collect();
+            turns
+                .iter()
+                .map(|up| {
+                    let side = |sign: f64| {
+                        axes.iter().all(|a| {
+                            let pose = Pose {
+                                position: Point3::origin(),
+                                axis: up * (a * sign),
+                            };
+                            tilt_reachable_within(machine, &pose, INSET_DEG).is_ok()
+                        })
+                    };
+                    side(1.0) || (flip && side(-1.0))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Groups of paths that one orientation serves: greedily, the lattice direction that brings the
+/// most of the remaining paths within the tilt range (ties: the one nearest the modelled up
+/// direction) takes them. Paths no direction serves come last, one group each (their
+/// placement then fails with the reason).
+pub(super) fn orientation_groups(
+    machine: &Machine,
+    paths: &[Vec<Pose>],
+    flip: bool,
+) -> Vec<Vec<usize>> {
+    let lattice = up_directions();
+    let fits = reachable_directions(machine, paths, flip, &lattice);
+    let mut left: Vec<usize> = (0..paths.len()).collect();
+    let mut out = Vec::new();
+    while !left.is_empty() {
+        let mut best: Option<(usize, usize, f64)> = None;
+        for (d, dir) in lattice.iter().enumerate() {
+            let n = left.iter().filter(|&&i| fits[i][d]).count();
+            let angle = dir.angle(&Vector3::z());
+            if n > 0 && best.is_none_or(|(bn, _, ba)| n > bn || (n == bn && angle < ba - 1e-12)) {
+                best = Some((n, d, angle));
+            }
+        }
+        match best {
+            Some((_, d, _)) => {
+                let (take, rest): (Vec<usize>, Vec<usize>) =
+                    left.iter().partition(|&&i| fits[i][d]);
+                out.push(take);
+                left = rest;
+            }
+            None => {
+                out.extend(left.iter().map(|&i| vec![i]));
+                left.clear();
+            }
+        }
+    }
+    out
+}

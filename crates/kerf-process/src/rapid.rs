@@ -1,0 +1,305 @@
+//! The machine's rapid moves through a traverse's waypoints, checked as the machine runs
+//! them: a rapid (G0) moves every axis linearly from one waypoint to the next, so where the
+//! rotary axes turn, the tip does not follow the straight line between the waypoints but
+//! swings; each move is sampled through the forward kinematics and checked, and a move that
+//! comes too close is split into shorter ones along the straight line until it clears.
+
+use kerf_kinematics::{Axes, Kinematics, Pose};
+use nalgebra::Point3;
+
+use crate::traverse::{check_move, Obstacles, Traverse, TraverseOptions};
+use crate::{PoseArray, ProcessError, Result};
+
+/// Most pieces one rapid move between two waypoints is split into.
+const MAX_SPLIT: usize = 64;
+
+/// The machine axes of a traverse's rapid moves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidMoves {
+    /// `[X, Y, Z, tilt, C]` (mm, degrees) of every rapid waypoint, from the retract point to
+    /// the point above the pierce (the cut's end and the next pierce not included).
+    pub axes: Vec<[f64; 5]>,
+    /// The tip and tool axis at each of those (workpiece frame).
+    pub poses: Vec<PoseArray>,
+    /// The smallest surface distance measured over the sampled machine moves, mm.
+    pub min_distance_mm: f64,
+    /// How many moves had to be split so that their swing clears the part.
+    pub split_moves: usize,
+}
+
+fn pose_array(p: &Pose) -> PoseArray {
+    [
+        p.position.x,
+        p.position.y,
+        p.position.z,
+        p.axis.x,
+        p.axis.y,
+        p.axis.z,
+    ]
+}
+
+/// The axes that put the tip at `tip` with the rotary axes at `tilt`, `c` (degrees).
+fn linear_at(kin: &dyn Kinematics, tip: &Point3<f64>, tilt: f64, c: f64) -> [f64; 5] {
+    let axis = kin.forward(&Axes::new(0.0, 0.0, 0.0, tilt, c)).axis;
+    let q = kin.inverse_with_c(
+        &Pose {
+            position: *tip,
+            axis,
+        },
+        c,
+    );
+    [q.x, q.y, q.z, tilt, c]
+}
+
+/// The poses of the joint-linear move `a -> b`, sampled so that the tip moves at most
+/// `step` between samples (doubling the count until it does, at most 2^16 samples).
+fn joint_samples(kin: &dyn Kinematics, a: &[f64; 5], b: &[f64; 5], step: f64) -> Vec<PoseArray> {
+    let at = |f: f64| {
+        let v: [f64; 5] = std::array::from_fn(|k| a[k] + (b[k] - a[k]) * f);
+        pose_array(&kin.forward(&Axes::new(v[0], v[1], v[2], v[3], v[4])))
+    };
+    let mut k = 8usize;
+    loop {
+        let poses: Vec<PoseArray> = (0..=k).map(|j| at(j as f64 / k as f64)).collect();
+        let widest = poses
+            .windows(2)
+            .map(|w| {
+                ((w[1][0] - w[0][0]).powi(2)
+                    + (w[1][1] - w[0][1]).powi(2)
+                    + (w[1][2] - w[0][2]).powi(2))
+                .sqrt()
+            })
+            .fold(0.0, f64::max);
+        if widest <= step || k >= 1 << 16 {
+            return poses;
+        }
+        k *= 2;
+    }
+}
+
+/// The machine's rapid moves for `traverse`, from the axes where the last cut ended
+/// (`end_axes`) to those where the next one starts (`start_axes`), `[X, Y, Z, tilt, C]`.
+///
+/// The rotary axes stand while the head backs off and rises (the waypoints with the exit's
+/// tool axis keep `end_axes`' rotaries), and turn on the move to the first waypoint with the
+/// next tool axis; the linear axes of each waypoint put the tip on it. Every move between
+/// waypoints is then run as the machine runs a rapid, all axes linear, sampled through the
+/// forward kinematics (the tip at most an eighth of the clearance between samples), and
+/// checked like the traverse (tip and nozzle keep the clearance); a move that does not is
+/// split into 2, 4, ... 64 moves along the straight line between its waypoints, the rotary
+/// axes shared out evenly, until each clears.
+///
+/// # Errors
+/// [`ProcessError::TraverseBlocked`] if a move still comes too close when split 64 times.
+pub fn rapid_moves(
+    kin: &dyn Kinematics,
+    obs: &Obstacles,
+    end_axes: [f64; 5],
+    start_axes: [f64; 5],
+    traverse: &Traverse,
+    opts: &TraverseOptions,
+) -> Result<RapidMoves> {
+    let n = traverse.waypoints.len();
+    let c = opts.clearance_mm;
+    let step = c / 8.0;
+    let waypoint_axes: Vec<[f64; 5]> = traverse
+        .waypoints
+        .iter()
+        .enumerate()
+        .map(|(i, w)| {
+            let r = if i < n / 2 { &end_axes } else { &start_axes };
+            linear_at(kin, &Point3::new(w[0], w[1], w[2]), r[3], r[4])
+        })
+        .collect();
+    let mut axes = Vec::new();
+    let mut least = f64::INFINITY;
+    let mut split_moves = 0;
+    for (i, w) in waypoint_axes.iter().enumerate() {
+        if i == 0 {
+            axes.push(*w);
+            continue;
+        }
+        let a = waypoint_axes[i - 1];
+        let b = *w;
+        let mut pieces = 1;
+        loop {
+            // The pieces' ends: on the straight line between the waypoints' tips.
+            let ta = kin
+                .forward(&Axes::new(a[0], a[1], a[2], a[3], a[4]))
+                .position;
+            let tb = kin
+                .forward(&Axes::new(b[0], b[1], b[2], b[3], b[4]))
+                .position;
+            let ends: Vec<[f64; 5]> = (0..=pieces)
+                .map(|j| {
+                    let f = j as f64 / pieces as f64;
+                    if j == 0 {
+                        a
+                    } else if j == pieces {
+                        b
+                    } else {
+                        linear_at(
+                            kin,
+                            &(ta + (tb - ta) * f),
+                            a[3] + (b[3] - a[3]) * f,
+                            a[4] + (b[4] - a[4]) * f,
+                        )
+                    }
+                })
+                .collect();
+            let mut worst: Option<(Point3<f64>, f64)> = None;
+            let mut here = f64::INFINITY;
+            for e in ends.windows(2) {
+                let samples = joint_samples(kin, &e[0], &e[1], step);
+                match check_move(obs, &samples, c, opts.nozzle_mm) {
+                    Ok(d) => here = here.min(d),
+                    Err(bad) => {
+                        worst = Some(bad);
+                        break;
+                    }
+                }
+            }
+            match worst {
+                None => {
+                    least = least.min(here);
+                    if pieces > 1 {
+                        split_moves += 1;
+                    }
+                    axes.extend_from_slice(&ends[1..]);
+                    break;
+                }
+                Some((at, d)) if pieces >= MAX_SPLIT => {
+                    return Err(ProcessError::TraverseBlocked {
+                        from: [ta.x, ta.y, ta.z],
+                        to: [tb.x, tb.y, tb.z],
+                        at: [at.x, at.y, at.z],
+                        distance_mm: d,
+                        clearance_mm: c,
+                    });
+                }
+                Some(_) => pieces *= 2,
+            }
+        }
+    }
+    let poses = axes
+        .iter()
+        .map(|a| pose_array(&kin.forward(&Axes::new(a[0], a[1], a[2], a[3], a[4]))))
+        .collect();
+    Ok(RapidMoves {
+        axes,
+        poses,
+        min_distance_mm: least,
+        split_moves,
+    })
+}
+
+/// One gap between two cuts: where the last ended and where the next starts, each as the tip
+/// with its tool axis (workpiece frame) and the machine axes `[X, Y, Z, tilt, C]` there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gap {
+    /// The end of the last cut (its lead-out's end).
+    pub from: PoseArray,
+    /// The machine axes there.
+    pub from_axes: [f64; 5],
+    /// The next pierce point.
+    pub to: PoseArray,
+    /// The machine axes there.
+    pub to_axes: [f64; 5],
+    /// The last cutting point of the last cut on its contour (before the lead-out), mm.
+    pub from_contour: [f64; 3],
+    /// The first cutting point of the next cut on its contour (after the lead-in), mm.
+    pub to_contour: [f64; 3],
+    /// The surfaces the last cut's curve names (ids as in [`Obstacles::from_file`]).
+    pub from_surfaces: Vec<String>,
+    /// The surfaces the next cut's curve names.
+    pub to_surfaces: Vec<String>,
+}
+
+/// Plans and checks the traverse of every gap ([`crate::plan_traverse_within`] among the
+/// routes whose waypoints lie within `limits`, `(min, max)` of `[X, Y, Z, tilt, C]` or `None`
+/// for an unlimited axis, then [`rapid_moves`]), in order; one result per gap (a blocked gap does not stop the others:
+/// the caller decides, e.g. to fall back to an unchecked traverse and say so).
+///
+/// Which surfaces are checked: all of `obs`, except, for one gap, a surface that the cut's
+/// curve does not name and that comes within half the clearance of the line along the tool
+/// axis at the last cut's contour end or the next cut's contour start (from the contour up to
+/// the retract plus the nozzle). The head is on that line while it cuts: such a surface is
+/// either not there while that contour is cut (a file holding two workpieces in the same
+/// place, as a tube joint's hole in the main tube and the end of the branch tube, lists both,
+/// and each contour passes through the other workpiece) or in the way of the cut itself, which
+/// no traverse can mend; the ids are returned with the gap so that they can be reported.
+///
+/// Each result's error is as [`crate::plan_traverse`] and [`rapid_moves`].
+pub fn plan_rapids(
+    kin: &dyn Kinematics,
+    limits: &[Option<(f64, f64)>; 5],
+    obs: &Obstacles,
+    gaps: &[Gap],
+    opts: &TraverseOptions,
+) -> Vec<Result<(Traverse, RapidMoves, Vec<String>)>> {
+    use rayon::prelude::*;
+    gaps.par_iter()
+        .map(|g| {
+            let mut absent: Vec<String> = Vec::new();
+            for (p, axis, named) in [
+                (&g.from_contour, &g.from, &g.from_surfaces),
+                (&g.to_contour, &g.to, &g.to_surfaces),
+            ] {
+                let at = Point3::new(p[0], p[1], p[2]);
+                let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
+                    .try_normalize(1e-12)
+                    .unwrap_or_else(nalgebra::Vector3::z);
+                let top = at + n * (opts.retract_mm + opts.nozzle_mm);
+                for id in obs.near_segment(&at, &top, 0.5 * opts.clearance_mm) {
+                    if !named.contains(&id) && !absent.contains(&id) {
+                        absent.push(id);
+                    }
+                }
+            }
+            let here = obs.without(&absent);
+            // A route is tried only if the machine reaches its waypoints (with the rotary
+            // axes as [`rapid_moves`] sets them).
+            let reachable = |way: &[PoseArray]| {
+                let n = way.len();
+                let rot = |i: usize| if i < n / 2 { g.from_axes } else { g.to_axes };
+                let inside = |q: &[f64; 5]| {
+                    q.iter().zip(limits).all(|(v, l)| {
+                        l.is_none_or(|(lo, hi)| {
+                            let m = 1e-3 * (hi - lo);
+                            *v >= lo + m && *v <= hi - m
+                        })
+                    })
+                };
+                // Each move as the interpolator runs it (tip straight, rotaries linear),
+                // sampled: where the rotaries turn, the linear axes swing past the ends.
+                (0..n).all(|i| {
+                    let (a, ra) = (way[i], rot(i));
+                    let (b, rb) = if i + 1 < n {
+                        (way[i + 1], rot(i + 1))
+                    } else {
+                        (a, ra)
+                    };
+                    let k = if i + 1 < n && ra != rb { 32 } else { 1 };
+                    (0..=k).all(|j| {
+                        let f = j as f64 / k as f64;
+                        let tip = Point3::new(
+                            a[0] + (b[0] - a[0]) * f,
+                            a[1] + (b[1] - a[1]) * f,
+                            a[2] + (b[2] - a[2]) * f,
+                        );
+                        let q = linear_at(
+                            kin,
+                            &tip,
+                            ra[3] + (rb[3] - ra[3]) * f,
+                            ra[4] + (rb[4] - ra[4]) * f,
+                        );
+                        inside(&q)
+                    })
+                })
+            };
+            let t = crate::plan_traverse_within(&here, &g.from, &g.to, opts, &reachable)?;
+            let r = rapid_moves(kin, &here, g.from_axes, g.to_axes, &t, opts)?;
+            Ok((t, r, absent))
+        })
+        .collect()
+}

@@ -1,0 +1,359 @@
+//! Traverses against exact geometry: a half cylinder (an arch) with cuts on both flanks, where
+//! the straight traverse between the retract points runs through the part, checked by an
+//! independent dense distance computation from the analytic cylinder.
+
+use kerf_nurbs::NurbsSurface;
+use kerf_process::{plan_traverse, Obstacles, PoseArray, ProcessError, Route, TraverseOptions};
+use nalgebra::{Point3, Vector3};
+
+const R: f64 = 50.0;
+const L: f64 = 80.0;
+
+/// The upper half of the cylinder `x^2 + z^2 = R^2`, `0 <= y <= L`, as an exact rational
+/// NURBS surface (u along the half circle from +x over +z to -x, v along y).
+fn arch() -> NurbsSurface {
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    let ring = [(R, 0.0), (R, R), (0.0, R), (-R, R), (-R, 0.0)];
+    let cps = ring
+        .iter()
+        .map(|&(x, z)| vec![Point3::new(x, 0.0, z), Point3::new(x, L, z)])
+        .collect();
+    let ws = [1.0, w, 1.0, w, 1.0].iter().map(|&v| vec![v, v]).collect();
+    NurbsSurface::try_new(
+        2,
+        1,
+        vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0],
+        vec![0.0, 0.0, 1.0, 1.0],
+        cps,
+        Some(ws),
+    )
+    .expect("valid arch")
+}
+
+/// The exact distance from `p` to the arch (independent of kerf: the nearest point of the
+/// half circle in the x-z plane, and the clamped y).
+fn arch_distance(p: &Point3<f64>) -> f64 {
+    let phi = p.z.atan2(p.x); // (-pi, pi]
+    let phi = if (0.0..=std::f64::consts::PI).contains(&phi) {
+        phi
+    } else if phi > -std::f64::consts::FRAC_PI_2 {
+        0.0
+    } else {
+        std::f64::consts::PI
+    };
+    let y = p.y.clamp(0.0, L);
+    let q = Point3::new(R * phi.cos(), y, R * phi.sin());
+    (p - q).norm()
+}
+
+/// A cutting pose on the arch's outer face at angle `deg` (from +x) and height `y`.
+fn on_arch(deg: f64, y: f64) -> PoseArray {
+    let a = deg.to_radians();
+    [R * a.cos(), y, R * a.sin(), a.cos(), 0.0, a.sin()]
+}
+
+/// The smallest exact distance over a dense sampling (0.05 mm) of the tip's polyline through
+/// the waypoints and of the nozzle along the interpolated axis.
+fn dense_min(way: &[PoseArray], nozzle: f64) -> f64 {
+    let mut least = f64::INFINITY;
+    for w in way.windows(2) {
+        let (a, b) = (
+            Point3::new(w[0][0], w[0][1], w[0][2]),
+            Point3::new(w[1][0], w[1][1], w[1][2]),
+        );
+        let (na, nb) = (
+            Vector3::new(w[0][3], w[0][4], w[0][5]),
+            Vector3::new(w[1][3], w[1][4], w[1][5]),
+        );
+        let k = ((b - a).norm() / 0.05).ceil().max(1.0) as usize;
+        for j in 0..=k {
+            let f = j as f64 / k as f64;
+            let p = a + (b - a) * f;
+            let n = (na * (1.0 - f) + nb * f).normalize();
+            for s in 0..=40 {
+                let q = p + n * (nozzle * s as f64 / 40.0);
+                least = least.min(arch_distance(&q));
+            }
+        }
+    }
+    least
+}
+
+fn obstacles() -> Obstacles {
+    let mut o = Obstacles::new();
+    o.add_nurbs(arch());
+    o
+}
+
+#[test]
+fn the_straight_traverse_over_an_arch_cuts_through_it_and_the_planned_one_clears_it() {
+    let obs = obstacles();
+    let opts = TraverseOptions::default();
+    let (from, to) = (on_arch(20.0, 30.0), on_arch(160.0, 50.0));
+    // Today's traverse: the retract points joined straight. It runs through the arch.
+    let lift = |p: &PoseArray| {
+        let mut q = *p;
+        for k in 0..3 {
+            q[k] += p[k + 3] * opts.retract_mm;
+        }
+        q
+    };
+    let (a, b) = (lift(&from), lift(&to));
+    let inside = (0..=1000).any(|j| {
+        let f = j as f64 / 1000.0;
+        let (x, z) = (a[0] + (b[0] - a[0]) * f, a[2] + (b[2] - a[2]) * f);
+        x.hypot(z) < R - 10.0 && z > 0.0
+    });
+    assert!(
+        inside,
+        "the straight retract-to-retract move runs through the arch"
+    );
+    let t = plan_traverse(&obs, &from, &to, &opts).expect("a clear route");
+    assert_eq!(t.route, Route::SafePlane, "the arch is in the way");
+    let exact = dense_min(&t.waypoints, opts.nozzle_mm);
+    assert!(
+        exact >= opts.clearance_mm - 1e-9,
+        "dense exact check: {exact} mm against the {} mm clearance",
+        opts.clearance_mm
+    );
+    // It leaves and meets the part along the tool axes.
+    let first = t.waypoints[0];
+    let last = t.waypoints[t.waypoints.len() - 1];
+    for (w, p) in [(first, from), (last, to)] {
+        let d = Vector3::new(w[0] - p[0], w[1] - p[1], w[2] - p[2]);
+        let n = Vector3::new(p[3], p[4], p[5]);
+        assert!(
+            d.cross(&n).norm() < 1e-9 && d.dot(&n) > 0.0,
+            "retract along the axis: {d:?}"
+        );
+    }
+    // The travel is not absurdly high: the safe plane is just above the arch.
+    let top = t.waypoints.iter().map(|w| w[2]).fold(f64::MIN, f64::max);
+    assert!(top < R + opts.clearance_mm + 2.0, "safe plane at z = {top}");
+    assert!(
+        t.min_distance_mm >= opts.clearance_mm,
+        "reported {}",
+        t.min_distance_mm
+    );
+    let len: f64 = std::iter::once(from)
+        .chain(t.waypoints.iter().copied())
+        .chain(std::iter::once(to))
+        .collect::<Vec<_>>()
+        .windows(2)
+        .map(|w| {
+            ((w[1][0] - w[0][0]).powi(2)
+                + (w[1][1] - w[0][1]).powi(2)
+                + (w[1][2] - w[0][2]).powi(2))
+            .sqrt()
+        })
+        .sum();
+    assert!(
+        (t.length_mm - len).abs() < 1e-9,
+        "length {} against {len}",
+        t.length_mm
+    );
+}
+
+#[test]
+fn cuts_on_one_flank_traverse_straight_and_clear() {
+    let obs = obstacles();
+    let opts = TraverseOptions::default();
+    let t = plan_traverse(&obs, &on_arch(80.0, 10.0), &on_arch(100.0, 70.0), &opts).expect("clear");
+    assert_eq!(
+        t.route,
+        Route::Straight,
+        "near the crown nothing is in the way"
+    );
+    let exact = dense_min(&t.waypoints, opts.nozzle_mm);
+    assert!(
+        exact >= opts.clearance_mm - 1e-9,
+        "dense exact check: {exact}"
+    );
+}
+
+#[test]
+fn many_pairs_around_the_arch_keep_the_clearance_by_the_dense_check() {
+    let obs = obstacles();
+    let opts = TraverseOptions::default().with_clearance(3.0);
+    let angles = [5.0, 30.0, 60.0, 90.0, 120.0, 150.0, 175.0];
+    for &a in &angles {
+        for &b in &angles {
+            let t = plan_traverse(&obs, &on_arch(a, 5.0), &on_arch(b, 75.0), &opts)
+                .unwrap_or_else(|e| panic!("{a} -> {b}: {e}"));
+            let exact = dense_min(&t.waypoints, opts.nozzle_mm);
+            assert!(exact >= 3.0 - 1e-9, "{a} -> {b} ({:?}): {exact}", t.route);
+        }
+    }
+}
+
+#[test]
+fn a_mesh_half_cylinder_is_checked_like_the_nurbs_one() {
+    // The arch as a triangle mesh inscribed in the cylinder (vertices on it): the exact
+    // distance to the mesh is at most the sag more than to the cylinder, so the dense check
+    // against the cylinder allows the sag.
+    let n = 64;
+    let mut vertices = Vec::new();
+    for i in 0..=n {
+        let a = std::f64::consts::PI * i as f64 / n as f64;
+        vertices.push(Point3::new(R * a.cos(), 0.0, R * a.sin()));
+        vertices.push(Point3::new(R * a.cos(), L, R * a.sin()));
+    }
+    let mut triangles = Vec::new();
+    for i in 0..n as u32 {
+        let (a, b, c, d) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+        triangles.push([a, c, b]);
+        triangles.push([b, c, d]);
+    }
+    let sag = R * (1.0 - (std::f64::consts::PI / n as f64 / 2.0).cos());
+    let mut obs = Obstacles::new();
+    obs.add_mesh(vertices, triangles).expect("valid mesh");
+    let opts = TraverseOptions::default();
+    let t = plan_traverse(&obs, &on_arch(15.0, 40.0), &on_arch(165.0, 40.0), &opts).expect("clear");
+    assert_eq!(t.route, Route::SafePlane, "the arch is in the way");
+    let exact = dense_min(&t.waypoints, opts.nozzle_mm);
+    assert!(
+        exact >= opts.clearance_mm - sag - 1e-9,
+        "dense check: {exact}, sag {sag}"
+    );
+}
+
+#[test]
+fn a_head_under_a_roof_it_cannot_leave_is_refused_with_the_place() {
+    // A cut on the inside of the arch with the tool axis pointing down toward the floor is
+    // fine; one pointing up into the crown from just below it cannot back off 5 mm clear.
+    let obs = obstacles();
+    let opts = TraverseOptions::default();
+    let inside = [0.0, 40.0, R - 6.0, 0.0, 0.0, 1.0];
+    let e = plan_traverse(&obs, &inside, &on_arch(90.0, 40.0), &opts).unwrap_err();
+    assert!(matches!(e, ProcessError::TraverseBlocked { .. }), "{e}");
+    assert!(
+        e.to_string().contains("no route keeps the 5 mm clearance"),
+        "{e}"
+    );
+}
+
+#[test]
+fn bad_options_and_poses_are_errors() {
+    let obs = obstacles();
+    let p = on_arch(90.0, 10.0);
+    let mut bad = TraverseOptions::default();
+    bad.retract_mm = 1.0;
+    assert!(
+        matches!(
+            plan_traverse(&obs, &p, &p, &bad),
+            Err(ProcessError::BadOption {
+                name: "retract_mm",
+                ..
+            })
+        ),
+        "retract below the clearance"
+    );
+    let mut nan = p;
+    nan[1] = f64::NAN;
+    assert!(
+        matches!(
+            plan_traverse(&obs, &nan, &p, &TraverseOptions::default()),
+            Err(ProcessError::BadContour { .. })
+        ),
+        "non-finite pose"
+    );
+    let mut o = Obstacles::new();
+    assert!(
+        o.add_mesh(vec![Point3::origin()], vec![[0, 0, 1]]).is_err(),
+        "index out of range"
+    );
+}
+
+#[test]
+fn far_surfaces_are_not_queried() {
+    // Boxes farther than the need are skipped: a traverse 10 m away from the arch costs no
+    // exact query of it.
+    let obs = obstacles();
+    let before = obs.queries();
+    let p = [0.0, 1e4, 0.0, 0.0, 0.0, 1.0];
+    let q = [10.0, 1e4, 0.0, 0.0, 0.0, 1.0];
+    let t = plan_traverse(&obs, &p, &q, &TraverseOptions::default()).expect("clear");
+    assert_eq!(t.route, Route::Straight, "nothing near");
+    assert_eq!(obs.queries(), before, "no exact query");
+    let t = plan_traverse(
+        &obs,
+        &on_arch(20.0, 30.0),
+        &on_arch(160.0, 50.0),
+        &TraverseOptions::default(),
+    )
+    .expect("clear");
+    assert!(
+        obs.queries() > before,
+        "near the arch it is queried ({:?})",
+        t.route
+    );
+}
+
+/// The machine's rapid moves over the arch on heads with long pivots: where the rotary axes
+/// turn between waypoints, the tip swings off the straight line when every axis moves
+/// linearly. Each returned move is sampled densely as the machine runs it (all axes linear,
+/// forward kinematics) and checked against the exact cylinder distance.
+#[test]
+fn the_machines_rapid_moves_clear_the_arch_as_the_machine_runs_them() {
+    use kerf_kinematics::{AcHead, Axes, Kinematics, Pose};
+    use kerf_process::rapid_moves;
+    let mut splits = 0;
+    for (pivot, a, b, clearance) in [
+        (150.0, 20.0, 160.0, 5.0),
+        (400.0, 60.0, 120.0, 3.0),
+        (400.0, 50.0, 100.0, 2.0),
+        (800.0, 70.0, 110.0, 2.0),
+    ] {
+        let kin = AcHead::try_new(pivot, 0.0).expect("head");
+        let obs = obstacles();
+        let opts = TraverseOptions::default().with_clearance(clearance);
+        let (from, to) = (on_arch(a, 30.0), on_arch(b, 50.0));
+        let solve = |p: &PoseArray| {
+            let a = kin.inverse(&Pose::new(p[0], p[1], p[2], p[3], p[4], p[5]))[0];
+            [a.x, a.y, a.z, a.tilt, a.c]
+        };
+        let (end, start) = (solve(&from), solve(&to));
+        let t = plan_traverse(&obs, &from, &to, &opts).expect("route");
+        let r = rapid_moves(&kin, &obs, end, start, &t, &opts).expect("rapids");
+        splits += r.split_moves;
+        assert_eq!(r.axes.len(), r.poses.len(), "one pose per waypoint");
+        let forward = |v: &[f64; 5]| kin.forward(&Axes::new(v[0], v[1], v[2], v[3], v[4]));
+        let mut least = f64::INFINITY;
+        let mut all = vec![end];
+        all.extend_from_slice(&r.axes);
+        all.push(start);
+        for w in all[1..all.len() - 1].windows(2) {
+            for j in 0..=1000 {
+                let f = j as f64 / 1000.0;
+                let v: [f64; 5] = std::array::from_fn(|k| w[0][k] + (w[1][k] - w[0][k]) * f);
+                let p = forward(&v);
+                for s in 0..=20 {
+                    let q = p.position + p.axis * (opts.nozzle_mm * s as f64 / 20.0);
+                    least = least.min(arch_distance(&q));
+                }
+            }
+        }
+        assert!(
+            least >= clearance - 1e-3,
+            "pivot {pivot}, {a} -> {b}: dense machine-move check {least} mm ({} split)",
+            r.split_moves
+        );
+        // The first waypoint keeps the exit's rotaries, the last the next start's.
+        assert_eq!(&r.axes[0][3..], &end[3..], "rotaries stand on the retract");
+        assert_eq!(
+            &r.axes[r.axes.len() - 1][3..],
+            &start[3..],
+            "and on the approach"
+        );
+        let tip = forward(&r.axes[0]).position;
+        let want = t.waypoints[0];
+        assert!(
+            (tip - Point3::new(want[0], want[1], want[2])).norm() < 1e-9,
+            "first waypoint"
+        );
+    }
+    assert!(
+        splits > 0,
+        "at least one swing needed splitting (the split path is exercised)"
+    );
+}

@@ -79,8 +79,8 @@ fn main() {
     for (name, c, axis_of) in cases {
         let d = discretize(&c, &Options::with_tolerance(tol)).expect("discretize");
         let axes: Vec<Vector3<f64>> = d.points().iter().map(axis_of).collect();
-        let st = solve_stations(&m, &d.points(), Some(&axes), Some(&d.params()), None)
-            .expect("reachable");
+        let st =
+            solve_stations(&m, d.points(), Some(&axes), Some(d.params()), None).expect("reachable");
         let curve = |t: f64| c.point(t);
         let fits = [
             (

@@ -43,7 +43,7 @@ fn a_polygon_of_corners_starts_in_the_middle_of_its_longest_edge() {
         d.points()[i]
     );
     // The plan starts there, off every corner, with its lead-in outside the rectangle.
-    let p = poses(&d.points());
+    let p = poses(d.points());
     let contour = Contour {
         id: "rect",
         poses: &p,

@@ -197,6 +197,16 @@ pub enum NurbsError {
         /// The degree.
         degree: usize,
     },
+    /// A shape constructor (`NurbsCurve::circle`, `NurbsSurface::cylinder`, ...) was given a
+    /// non-finite value, a zero radius or length, a zero or parallel axis, or a sweep outside
+    /// `0 < |sweep| <= 2 pi`. Fix: the message names the argument and what it must be.
+    #[error("{field}: {reason}")]
+    BadShape {
+        /// The argument: `radius`, `axis_dir`, `points[3]`, ...
+        field: &'static str,
+        /// What is wrong with it, with the value found.
+        reason: String,
+    },
     /// A parameter interval `[t0, t1]` is empty or reversed.
     #[error("interval [{}, {}] is empty or reversed", Readable(*.t0), Readable(*.t1))]
     BadInterval {

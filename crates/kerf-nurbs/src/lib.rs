@@ -34,6 +34,7 @@ mod geom;
 mod knots;
 #[cfg(feature = "samples")]
 mod samples;
+mod shapes;
 mod surface;
 mod work;
 

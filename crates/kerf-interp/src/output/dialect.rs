@@ -1,0 +1,155 @@
+//! The G-code dialects, the laser process codes and the escaping of comment text.
+
+use crate::error::{InterpError, Result};
+
+/// G-code dialect.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dialect {
+    /// `G1 X Y Z A C F` with machine axis values, `G94` feed of the machine axes
+    /// (RS274/NGC rule), `;` comments, `M30`.
+    Generic,
+    /// Sinumerik-style `TRAORI`: tool tip, orientation vector, `CIP` arcs, `G54`, `SOFT`,
+    /// `G642` with `CTOL`/`OTOL`, `;` comments, `M30`.
+    Sinumerik,
+    /// LinuxCNC (trivkins, the machine's axis letters): inverse-time feed `G93`, `G64 P` on
+    /// cuts and `G61` on rapids, `( ... )` comments, `M2`.
+    Linuxcnc,
+}
+
+impl Dialect {
+    /// The dialect's name as the CLI spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Dialect::Generic => "generic",
+            Dialect::Sinumerik => "sinumerik",
+            Dialect::Linuxcnc => "linuxcnc",
+        }
+    }
+
+    /// True for the dialects that program the raw machine axes (a controller that interpolates
+    /// the axes linearly between blocks: no arcs may be fitted for them).
+    pub fn raw_axes(self) -> bool {
+        !matches!(self, Dialect::Sinumerik)
+    }
+
+    /// The process codes used when the machine file's `process` object lacks a key:
+    ///
+    /// | dialect | beam on | beam off | dwell | standoff |
+    /// |---|---|---|---|---|
+    /// | linuxcnc | `M64 P0` | `M65 P0` | 0.2 s | 1.5 mm |
+    /// | generic | `M3` | `M5` | 0.2 s | 1.5 mm |
+    /// | sinumerik | `M3` | `M5` | 0.2 s | 1.5 mm |
+    ///
+    /// LinuxCNC's `M64`/`M65` switch the output when every motion queued before them has
+    /// finished (they break blending): the dwell after `M64` runs with the beam on and the
+    /// beam goes off where the cut ends. (`M62`/`M63` would act at the start of the *next*
+    /// motion: the dwell would run with the beam off, and a last `M63` would never fire.)
+    pub fn default_process(self) -> ProcessCodes {
+        let (on, off) = match self {
+            Dialect::Linuxcnc => ("M64 P0", "M65 P0"),
+            Dialect::Generic | Dialect::Sinumerik => ("M3", "M5"),
+        };
+        ProcessCodes {
+            beam_on: vec![on.to_string()],
+            beam_off: vec![off.to_string()],
+            pierce_dwell_s: 0.2,
+            pierce_standoff: 1.5,
+        }
+    }
+
+    /// One whole-line comment in the dialect's syntax, its text escaped as by
+    /// [`comment_text`] but not cut (text from the input must already have been through
+    /// [`comment_text`], which cuts it).
+    pub(super) fn comment(self, text: &str) -> String {
+        let text = escape(text, usize::MAX);
+        match self {
+            Dialect::Linuxcnc => format!("({text})"),
+            Dialect::Generic | Dialect::Sinumerik => format!("; {text}"),
+        }
+    }
+}
+
+/// The process codes of a program, every value resolved (the machine file's `process` keys
+/// over the dialect's [`Dialect::default_process`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProcessCodes {
+    /// Lines that switch the beam on, written as given.
+    pub beam_on: Vec<String>,
+    /// Lines that switch the beam off.
+    pub beam_off: Vec<String>,
+    /// Dwell at the pierce point with the beam on, seconds.
+    pub pierce_dwell_s: f64,
+    /// Height of the pierce point above the cut's start along the tool axis, mm.
+    pub pierce_standoff: f64,
+}
+
+impl ProcessCodes {
+    /// `process` over the defaults of `dialect`, checked as the machine reader checks a file
+    /// (a library caller may have built `process` by hand).
+    ///
+    /// # Errors
+    /// [`InterpError::Process`] naming the key, as
+    /// `process.pierce_dwell_s: must be finite and >= 0 (got -1)`.
+    pub fn resolve(dialect: Dialect, process: &kerf_kinematics::Process) -> Result<Self> {
+        process
+            .validate()
+            .map_err(|e| InterpError::Process(e.to_string()))?;
+        let d = dialect.default_process();
+        Ok(Self {
+            beam_on: process.beam_on.clone().unwrap_or(d.beam_on),
+            beam_off: process.beam_off.clone().unwrap_or(d.beam_off),
+            pierce_dwell_s: process.pierce_dwell_s.unwrap_or(d.pierce_dwell_s),
+            pierce_standoff: process.pierce_standoff.unwrap_or(d.pierce_standoff),
+        })
+    }
+
+    /// Time of the descent from the pierce point to the cut's start, seconds, at `feed`
+    /// mm/min (the writer programs the descent at the cutting feed).
+    pub fn descent_s(&self, feed: f64) -> f64 {
+        if self.pierce_standoff > 0.0 && feed > 0.0 {
+            self.pierce_standoff / (feed / 60.0)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The longest comment text [`comment_text`] returns, in bytes (the rest is cut and `...`
+/// appended): LinuxCNC refuses lines over 255 characters.
+pub const MAX_COMMENT: usize = 160;
+
+/// Text made safe for a comment in every dialect: printable ASCII is kept except `(` and `)`,
+/// which become `[` and `]` (a parenthesis would close or nest a LinuxCNC comment); every
+/// other character (line feed, carriage return, NUL, tab, other control characters, Unicode
+/// line separators, any non-ASCII) becomes the visible escape `\u{hex}`. The result has no
+/// character that can end a line or a comment, so it can never start a new block; it is cut to
+/// [`MAX_COMMENT`] bytes.
+///
+/// ```
+/// use kerf_interp::comment_text;
+/// assert_eq!(comment_text("hole\nG0 X1400\nM30"), "hole\\u{a}G0 X1400\\u{a}M30");
+/// assert_eq!(comment_text(")G0X1("), "]G0X1[");
+/// assert_eq!(comment_text("Stoßblech"), "Sto\\u{df}blech");
+/// ```
+pub fn comment_text(text: &str) -> String {
+    escape(text, MAX_COMMENT)
+}
+
+/// The escaping of [`comment_text`], cut at `max` bytes.
+fn escape(text: &str, max: usize) -> String {
+    let mut out = String::with_capacity(text.len().min(max) + 8);
+    for c in text.chars() {
+        let piece = match c {
+            '(' => "[".to_string(),
+            ')' => "]".to_string(),
+            ' '..='~' => c.to_string(),
+            _ => format!("\\u{{{:x}}}", c as u32),
+        };
+        if out.len() + piece.len() > max {
+            out.push_str("...");
+            break;
+        }
+        out.push_str(&piece);
+    }
+    out
+}

@@ -1,0 +1,294 @@
+//! Outputs: the set-points CSV of `formats.md` and G-code in three dialects, written atomically.
+//!
+//! - **CSV**: header `t,X,Y,Z,<tilt>,C`, one row per cycle, `t` in seconds, axes in mm and
+//!   degrees; values are written in Rust's shortest round-trip form, so they read back exactly.
+//! - **LinuxCNC** ([`Dialect::Linuxcnc`]): raw machine axes for a trivkins machine, cutting
+//!   blocks in inverse-time feed (`G93`, an `F` on every block, `F = 60 / t` with `t` the
+//!   block's planned time in seconds), `G64 P<q> Q0` with `q` the budget's controller-blending
+//!   term on cuts, exact path (`G61`) on rapids, the safe preamble `G17 G21 G40 G49 G54 G80 G90`,
+//!   `( ... )` comments, `M2` at the end.
+//! - **Generic** ([`Dialect::Generic`]): raw machine axes, `G94` feed in the RS274/NGC sense:
+//!   `F` is mm/min of the combined X Y Z machine-axis motion (deg/min of the combined rotary
+//!   motion on blocks without X Y Z motion), chosen so that each block takes its planned time.
+//!   It is *not* the tool tip's speed.
+//! - **Sinumerik-style** ([`Dialect::Sinumerik`]): `G54` frame, `SOFT`, `G642` with `CTOL`/`OTOL`
+//!   from the blending term, `TRAORI` with the tool tip and the orientation vector
+//!   (`A3= B3= C3=`) in workpiece coordinates, arcs as `CIP X Y Z I1= J1= K1=` through the
+//!   intermediate point; `F` is the tool tip's mean planned speed of the block (TRAORI applies
+//!   it to the tip).
+//!
+//! Every program starts with a header (machine, source, units, feed semantics, the tolerance
+//! budget term by term, the process codes) and names the source curve in a comment where each
+//! path starts. Every cut (a maximal run of cutting blocks) is framed the same way: a rapid to
+//! the pierce point `pierce_standoff` mm above the cut's start along the tool axis, the beam-on
+//! lines, a dwell of `pierce_dwell_s`, the descent to the start with the beam on, the cut, and
+//! the beam-off lines before the next rapid. No text of the input (curve ids, machine names,
+//! file names) reaches a program except through [`comment_text`], which cannot open a new block
+//! in any dialect.
+
+use std::path::Path;
+
+use crate::block::{Block, Geometry};
+use crate::error::{positive, InterpError, Result};
+use crate::model::AxisModel;
+
+mod csv;
+mod dialect;
+mod writer;
+
+pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};
+pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
+use writer::Writer;
+
+/// The default controller-blending term of the tolerance budget, mm: LinuxCNC's `G64 P`,
+/// Sinumerik's `CTOL` plus the tip error of `OTOL`.
+pub const DEFAULT_BLEND_TOLERANCE: f64 = 0.005;
+
+/// What goes into a program besides the blocks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GcodeOptions {
+    /// Dialect.
+    pub dialect: Dialect,
+    /// Programmed cutting feed, mm/min of the tool tip: the descent after the pierce, and the
+    /// blocks' speed when no planned times are given.
+    pub feed: f64,
+    /// The discretizer's chord tolerance (also the arc-fit tolerance), mm: the budget's
+    /// `chord` term.
+    pub fit_tolerance: f64,
+    /// Chord tolerance of arcs, mm: raw-axis programs write arcs as chords within it (the
+    /// budget's `interpolation_chord` term).
+    pub chord_tolerance: f64,
+    /// The kinematics' linearization tolerance the axes were solved with, mm, if known (the
+    /// budget's `linearization` term).
+    pub linearization_tolerance: Option<f64>,
+    /// The controller's blending tolerance, mm (the budget's `controller_blending` term):
+    /// `G64 P` on LinuxCNC, split half into `CTOL` and half into `OTOL` on Sinumerik.
+    pub blend_tolerance: f64,
+    /// The machine's pivot length, mm (tip to tilt axis): turns the orientation half of the
+    /// blending term into Sinumerik's `OTOL` in degrees. Without it `OTOL` is not written.
+    pub pivot_length: Option<f64>,
+    /// The machine file's `process` object (absent keys take the dialect's defaults).
+    pub process: kerf_kinematics::Process,
+    /// The input file the program was made from (header only, escaped).
+    pub source: Option<String>,
+    /// Decimals of coordinates (default 6).
+    pub decimals: usize,
+    /// More header comment lines, written after the source (each through the same comment
+    /// sanitizer), e.g. the placement of the part and its set-up (default none).
+    pub header: Vec<String>,
+}
+
+impl GcodeOptions {
+    /// Options for `dialect` at `feed` mm/min, with 0.001 mm tolerances, the default blending
+    /// term, the dialect's default process codes and 6 decimals.
+    pub fn new(dialect: Dialect, feed: f64) -> Self {
+        Self {
+            dialect,
+            feed,
+            fit_tolerance: 0.001,
+            chord_tolerance: 0.001,
+            linearization_tolerance: None,
+            blend_tolerance: DEFAULT_BLEND_TOLERANCE,
+            pivot_length: None,
+            process: kerf_kinematics::Process::default(),
+            source: None,
+            decimals: 6,
+            header: Vec::new(),
+        }
+    }
+
+    /// The tolerance budget term by term, mm, named as in `report.json`: `chord`,
+    /// `linearization` (`None` when unknown), `interpolation_chord`, `controller_blending`.
+    pub fn budget(&self) -> [(&'static str, Option<f64>); 4] {
+        [
+            ("chord", Some(self.fit_tolerance)),
+            ("linearization", self.linearization_tolerance),
+            ("interpolation_chord", Some(self.chord_tolerance)),
+            ("controller_blending", Some(self.blend_tolerance)),
+        ]
+    }
+
+    /// The sum of the known budget terms, mm.
+    pub fn budget_total(&self) -> f64 {
+        self.budget().iter().filter_map(|(_, v)| *v).sum()
+    }
+}
+
+/// The G-code program of `blocks`.
+///
+/// `path_ids[b.path]` names the source curve of block `b` (missing ids are written as
+/// `path <n>`); `block_feeds`, if given, is the planned tip speed (mm/min) of each block, from
+/// which its time is `length / feed`; otherwise every cutting block runs at `opts.feed`. For
+/// the planned block times of a [`crate::Motion`] use [`gcode_motion`].
+///
+/// # Errors
+/// As [`gcode_timed`].
+pub fn gcode<M: AxisModel + ?Sized>(
+    model: &M,
+    blocks: &[Block],
+    path_ids: &[String],
+    block_feeds: Option<&[f64]>,
+    opts: &GcodeOptions,
+) -> Result<String> {
+    positive("feed", opts.feed)?;
+    let times: Vec<f64> = blocks
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let f = block_feeds
+                .and_then(|f| f.get(i).copied())
+                .filter(|f| f.is_finite() && *f > 0.0)
+                .unwrap_or(opts.feed);
+            b.length() / (f / 60.0)
+        })
+        .collect();
+    gcode_timed(model, blocks, path_ids, &times, opts)
+}
+
+/// The G-code program of a planned motion: every cutting block takes the time the plan gives
+/// it ([`crate::Motion::block_duration`]).
+///
+/// # Errors
+/// As [`gcode_timed`].
+pub fn gcode_motion<M: AxisModel + ?Sized>(
+    model: &M,
+    motion: &crate::Motion,
+    path_ids: &[String],
+    opts: &GcodeOptions,
+) -> Result<String> {
+    let times: Vec<f64> = (0..motion.blocks().len())
+        .map(|b| motion.block_duration(b))
+        .collect();
+    gcode_timed(model, motion.blocks(), path_ids, &times, opts)
+}
+
+/// The generic-dialect rule: a dialect that programs the raw machine axes runs only blocks
+/// between neighbouring poses of the kinematics (whose non-linearity error was checked), never
+/// an arc nor a line merged over several poses.
+fn refuse_unchecked_blocks(blocks: &[Block], dialect: Dialect) -> Result<()> {
+    if !dialect.raw_axes() {
+        return Ok(());
+    }
+    for (k, b) in blocks.iter().enumerate() {
+        if b.rapid {
+            continue;
+        }
+        let what = match b.geometry {
+            Geometry::Arc(_) => "an arc".to_string(),
+            _ if b.stations[1] > b.stations[0] + 1 => format!(
+                "a line merged over {} poses",
+                b.stations[1] - b.stations[0] + 1
+            ),
+            _ => continue,
+        };
+        return Err(InterpError::UncheckedBlock {
+            dialect: dialect.name(),
+            block: k,
+            what,
+        });
+    }
+    Ok(())
+}
+
+/// The G-code program of `blocks`, cutting block `b` taking `block_times[b]` seconds (a
+/// missing, zero or non-finite time falls back to `length / opts.feed`); rapid blocks are
+/// `G0` at the controller's rapid rate.
+///
+/// # Errors
+/// [`InterpError::BadParameter`] for a feed, chord or blending tolerance that is not finite
+/// and > 0; [`InterpError::Process`] for unusable process codes;
+/// [`InterpError::UncheckedBlock`] for an arc or a merged line in a program for a dialect that
+/// gives the raw machine axes ([`Dialect::raw_axes`]).
+pub fn gcode_timed<M: AxisModel + ?Sized>(
+    model: &M,
+    blocks: &[Block],
+    path_ids: &[String],
+    block_times: &[f64],
+    opts: &GcodeOptions,
+) -> Result<String> {
+    positive("feed", opts.feed)?;
+    positive("chord_tolerance", opts.chord_tolerance)?;
+    positive("blend_tolerance", opts.blend_tolerance)?;
+    refuse_unchecked_blocks(blocks, opts.dialect)?;
+    let process = ProcessCodes::resolve(opts.dialect, &opts.process)?;
+    let mut w = Writer {
+        model,
+        opts,
+        process,
+        names: model.axis_names(),
+        d: opts.decimals.min(12),
+        s: String::new(),
+        last: None,
+        in_cut: false,
+        last_f: None,
+    };
+    w.header(blocks);
+    let mut last_path = usize::MAX;
+    for (bi, b) in blocks.iter().enumerate() {
+        if b.rapid && w.in_cut {
+            w.end_cut();
+        }
+        if b.path != last_path {
+            last_path = b.path;
+            let id = path_ids
+                .get(b.path)
+                .cloned()
+                .unwrap_or_else(|| format!("path {}", b.path));
+            let span = b
+                .params
+                .map_or(String::new(), |p| format!(", t = {}", p[0]));
+            let line = opts.dialect.comment(&format!(
+                "curve {}, from cutting point {}{span}",
+                comment_text(&id),
+                b.stations[0]
+            ));
+            w.line(&line);
+        }
+        if b.rapid {
+            // The approach that ends where a cut starts is replaced by the rapid to that
+            // cut's pierce point (on the approach line, `pierce_standoff` above the start).
+            let approach = blocks.get(bi + 1).is_some_and(|n| !n.rapid);
+            if !approach {
+                w.rapid(b.end_tip(), b.end_axes, b.end_tool_axis);
+            }
+            continue;
+        }
+        if !w.in_cut {
+            w.start_cut(b);
+        }
+        let t = block_times
+            .get(bi)
+            .copied()
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .unwrap_or_else(|| b.length() / (opts.feed / 60.0));
+        w.cut(b, t);
+    }
+    if w.in_cut {
+        w.end_cut();
+    }
+    match opts.dialect {
+        Dialect::Linuxcnc => w.line("M2"),
+        Dialect::Generic => w.line("M30"),
+        Dialect::Sinumerik => {
+            w.line("TRAFOOF");
+            w.line("M30");
+        }
+    }
+    Ok(w.s)
+}
+
+/// Writes [`gcode`] to `path` atomically.
+///
+/// # Errors
+/// As [`gcode`], plus [`InterpError::Io`].
+pub fn write_gcode<M: AxisModel + ?Sized>(
+    path: impl AsRef<Path>,
+    model: &M,
+    blocks: &[Block],
+    path_ids: &[String],
+    block_feeds: Option<&[f64]>,
+    opts: &GcodeOptions,
+) -> Result<()> {
+    let text = gcode(model, blocks, path_ids, block_feeds, opts)?;
+    write_atomic(path.as_ref(), text.as_bytes())
+}

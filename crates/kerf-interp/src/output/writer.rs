@@ -1,0 +1,363 @@
+//! The writer of one program: blocks, cut framing and feeds, dialect by dialect.
+
+use crate::block::{Block, Geometry};
+use crate::chord::max_step;
+use crate::model::AxisModel;
+
+use super::{comment_text, Dialect, GcodeOptions, ProcessCodes};
+
+/// The state of one program being written.
+pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
+    pub(super) model: &'a M,
+    pub(super) opts: &'a GcodeOptions,
+    pub(super) process: ProcessCodes,
+    pub(super) names: [&'a str; 5],
+    pub(super) d: usize,
+    pub(super) s: String,
+    /// The axis words last written (raw-axis dialects), as printed, for feed and zero-move
+    /// decisions on the values the controller reads.
+    pub(super) last: Option<[f64; 5]>,
+    pub(super) in_cut: bool,
+    /// The last `F` written (Sinumerik, modal).
+    pub(super) last_f: Option<String>,
+}
+
+impl<M: AxisModel + ?Sized> Writer<'_, M> {
+    pub(super) fn line(&mut self, l: &str) {
+        self.s.push_str(l.trim_end());
+        self.s.push('\n');
+    }
+
+    pub(super) fn comment(&mut self, text: &str) {
+        let l = self.opts.dialect.comment(text);
+        self.line(&l);
+    }
+
+    /// A coordinate as written (no `-0`).
+    pub(super) fn num(&self, v: f64) -> String {
+        let t = format!("{:.*}", self.d, v);
+        match t.strip_prefix('-') {
+            Some(rest) if rest.bytes().all(|c| c == b'0' || c == b'.') => rest.to_string(),
+            _ => t,
+        }
+    }
+
+    /// Axis values rounded as the program writes them.
+    pub(super) fn printed(&self, q: &[f64; 5]) -> [f64; 5] {
+        q.map(|v| self.num(v).parse().unwrap_or(v))
+    }
+
+    pub(super) fn axis_words(&self, q: &[f64; 5]) -> String {
+        let n = &self.names;
+        format!(
+            "{}{} {}{} {}{} {}{} {}{}",
+            n[0],
+            self.num(q[0]),
+            n[1],
+            self.num(q[1]),
+            n[2],
+            self.num(q[2]),
+            n[3],
+            self.num(q[3]),
+            n[4],
+            self.num(q[4])
+        )
+    }
+
+    pub(super) fn tip_words(
+        &self,
+        p: &nalgebra::Point3<f64>,
+        u: &nalgebra::Vector3<f64>,
+    ) -> String {
+        format!(
+            "X{} Y{} Z{} A3={} B3={} C3={}",
+            self.num(p.x),
+            self.num(p.y),
+            self.num(p.z),
+            self.num(u.x),
+            self.num(u.y),
+            self.num(u.z)
+        )
+    }
+
+    pub(super) fn header(&mut self, blocks: &[Block]) {
+        let o = self.opts;
+        let n = self.names;
+        let counts = crate::fit::BlockCounts::of(blocks);
+        let (title, feed, arcs_as) = match o.dialect {
+            Dialect::Linuxcnc => (
+                format!(
+                    "kerf LinuxCNC program: trivkins machine axes {} {} {} {} {}, no tool-tip control",
+                    n[0], n[1], n[2], n[3], n[4]
+                ),
+                "feed: G93 inverse time on every cutting block, F = 60 / planned block time in s,\nfeed: so the tool tip moves at kerf's planned speed; rapids G0 in exact path G61".to_string(),
+                "arcs written as G1 chords",
+            ),
+            Dialect::Generic => (
+                format!(
+                    "kerf generic 5-axis program: machine axes {} {} {} {} {}, no tool-tip control",
+                    n[0], n[1], n[2], n[3], n[4]
+                ),
+                format!(
+                    "feed: G94, F in mm/min of the combined {} {} {} machine-axis motion, NOT of the tool tip;\nfeed: on blocks without {} {} {} motion F is deg/min of the combined rotary motion (RS274/NGC rule);\nfeed: each F makes its block take kerf's planned time",
+                    n[0], n[1], n[2], n[0], n[1], n[2]
+                ),
+                "arcs written as G1 chords",
+            ),
+            Dialect::Sinumerik => (
+                "kerf Sinumerik-style program: TRAORI, tool tip X Y Z and orientation vector A3 B3 C3 in workpiece coordinates".to_string(),
+                "feed: G94, F in mm/min of the tool tip (TRAORI), the block's mean planned speed".to_string(),
+                "arcs as CIP through the intermediate point",
+            ),
+        };
+        self.comment(&title);
+        let machine = format!("machine: {}", comment_text(self.model.name()));
+        self.comment(&machine);
+        if let Some(src) = &o.source {
+            self.comment(&format!("source: {}", comment_text(src)));
+        }
+        for line in &o.header {
+            self.comment(&comment_text(line));
+        }
+        let unit = if o.dialect == Dialect::Sinumerik {
+            "G71"
+        } else {
+            "G21"
+        };
+        self.comment(&format!("units: mm ({unit}), degrees, seconds"));
+        for part in feed.split('\n') {
+            self.comment(part);
+        }
+        let terms: Vec<String> = o
+            .budget()
+            .iter()
+            .map(|(k, v)| match v {
+                Some(v) => format!("{k} {v}"),
+                None => format!("{k} unknown"),
+            })
+            .collect();
+        let unknown = if o.linearization_tolerance.is_none() {
+            " (the known terms; the axes file does not record the linearization tolerance)"
+        } else {
+            ""
+        };
+        self.comment(&format!(
+            "tolerance budget mm: {} = {}{unknown}",
+            terms.join(" + "),
+            o.budget_total()
+        ));
+        self.comment(&format!(
+            "blocks: {} lines, {} arcs, {} turns, {arcs_as}",
+            counts.lines, counts.arcs, counts.turns
+        ));
+        let p = self.process.clone();
+        let pm = format!(
+            "process: beam on {}; beam off {};",
+            comment_text(&p.beam_on.join(" / ")),
+            comment_text(&p.beam_off.join(" / ")),
+        );
+        self.comment(&pm);
+        let pm = format!(
+            "process: pierce {} mm above the cut start along the tool axis, dwell {} s, descent at {} mm/min",
+            p.pierce_standoff, p.pierce_dwell_s, o.feed
+        );
+        self.comment(&pm);
+        match o.dialect {
+            Dialect::Linuxcnc => {
+                self.line("G17 G21 G40 G49 G54 G80 G90 G94");
+                self.line("G93");
+                self.line("G61");
+            }
+            Dialect::Generic => self.line("G17 G21 G40 G90 G94"),
+            Dialect::Sinumerik => {
+                self.line("G17 G71 G90 G94 G40");
+                self.line("G54");
+                self.line("SOFT");
+                let ctol = o.blend_tolerance / 2.0;
+                match o.pivot_length.filter(|l| l.is_finite() && *l > 0.0) {
+                    Some(l) => {
+                        let otol = (ctol / l).to_degrees();
+                        self.line(&format!("CTOL={ctol} OTOL={otol:.6}"));
+                    }
+                    None => self.line(&format!("CTOL={}", o.blend_tolerance)),
+                }
+                self.line("TRAORI");
+                self.line("ORIWKS");
+                self.line("ORIVECT");
+                self.line("G60");
+            }
+        }
+        // The beam is off before the first move, whatever state the controller was left in.
+        for l in self.process.beam_off.clone() {
+            self.line(&l);
+        }
+    }
+
+    /// A rapid to the axes `q` (tip `p`, tool axis `u`).
+    pub(super) fn rapid(
+        &mut self,
+        p: nalgebra::Point3<f64>,
+        q: [f64; 5],
+        u: nalgebra::Vector3<f64>,
+    ) {
+        let l = match self.opts.dialect {
+            Dialect::Sinumerik => format!("G0 {}", self.tip_words(&p, &u)),
+            _ => format!("G0 {}", self.axis_words(&q)),
+        };
+        self.line(&l);
+        self.last = Some(self.printed(&q));
+    }
+
+    /// Rapid to the pierce point of the cut starting with `b`, beam on, dwell, descent.
+    pub(super) fn start_cut(&mut self, b: &Block) {
+        let (tilt, c) = (b.start_axes[3], b.start_axes[4]);
+        let start = b.start_tip();
+        let u = self.model.tool_axis(tilt, c);
+        let h = self.process.pierce_standoff;
+        let pierce = start + u * h;
+        let lin = self.model.linear_axes(&pierce, tilt, c);
+        let qp = if h > 0.0 {
+            [lin[0], lin[1], lin[2], tilt, c]
+        } else {
+            b.start_axes
+        };
+        self.rapid(pierce, qp, u);
+        for l in self.process.beam_on.clone() {
+            self.line(&l);
+        }
+        let dwell = self.process.pierce_dwell_s;
+        if dwell > 0.0 {
+            let l = match self.opts.dialect {
+                Dialect::Sinumerik => format!("G4 F{dwell}"),
+                _ => format!("G4 P{dwell}"),
+            };
+            self.line(&l);
+        }
+        match self.opts.dialect {
+            Dialect::Linuxcnc => {
+                let l = format!("G64 P{} Q0", self.opts.blend_tolerance);
+                self.line(&l);
+            }
+            Dialect::Sinumerik => self.line("G642"),
+            Dialect::Generic => {}
+        }
+        self.in_cut = true;
+        if h > 0.0 {
+            let t = self.process.descent_s(self.opts.feed);
+            match self.opts.dialect {
+                Dialect::Sinumerik => {
+                    let f = format!("{:.1}", self.opts.feed);
+                    let l = format!("G1 {} F{f}", self.tip_words(&start, &u));
+                    self.line(&l);
+                    self.last_f = Some(f);
+                }
+                _ => self.raw_move(b.start_axes, t),
+            }
+        }
+    }
+
+    pub(super) fn end_cut(&mut self) {
+        for l in self.process.beam_off.clone() {
+            self.line(&l);
+        }
+        match self.opts.dialect {
+            Dialect::Linuxcnc => self.line("G61"),
+            Dialect::Sinumerik => self.line("G60"),
+            Dialect::Generic => {}
+        }
+        self.in_cut = false;
+    }
+
+    /// One `G1` of a raw-axis dialect to `q`, taking `t` seconds; nothing if the printed axes
+    /// do not change.
+    pub(super) fn raw_move(&mut self, q: [f64; 5], t: f64) {
+        let qp = self.printed(&q);
+        let prev = self.last.unwrap_or(qp);
+        if prev == qp {
+            return;
+        }
+        let f = match self.opts.dialect {
+            Dialect::Linuxcnc => 60.0 / t,
+            _ => {
+                let lin = ((qp[0] - prev[0]).powi(2)
+                    + (qp[1] - prev[1]).powi(2)
+                    + (qp[2] - prev[2]).powi(2))
+                .sqrt();
+                let rot = ((qp[3] - prev[3]).powi(2) + (qp[4] - prev[4]).powi(2)).sqrt();
+                let len = if lin > 0.0 { lin } else { rot };
+                len / t * 60.0
+            }
+        };
+        let l = format!("G1 {} F{}", self.axis_words(&q), feed_number(f));
+        self.line(&l);
+        self.last = Some(qp);
+    }
+
+    /// The cutting block `b`, taking `t` seconds.
+    pub(super) fn cut(&mut self, b: &Block, t: f64) {
+        match self.opts.dialect {
+            Dialect::Generic | Dialect::Linuxcnc => {
+                // Arcs become chords within the chord tolerance (eq 18), the block's time
+                // shared in proportion to the path parameter.
+                let mut ends = Vec::new();
+                if let Geometry::Arc(a) = &b.geometry {
+                    let k = (b.length() / max_step(a.radius, self.opts.chord_tolerance))
+                        .ceil()
+                        .max(1.0) as usize;
+                    for i in 1..k {
+                        let s = b.length() * i as f64 / k as f64;
+                        ends.push((s, b.axes_at(self.model, s)));
+                    }
+                }
+                ends.push((b.length(), b.end_axes));
+                let mut s0 = 0.0;
+                for (s, q) in ends {
+                    let share = if b.length() > 0.0 {
+                        (s - s0) / b.length()
+                    } else {
+                        1.0
+                    };
+                    self.raw_move(q, t * share);
+                    s0 = s;
+                }
+            }
+            Dialect::Sinumerik => {
+                let p = b.end_tip();
+                let u = b.end_tool_axis;
+                let mut l = match &b.geometry {
+                    Geometry::Arc(a) => format!(
+                        "CIP X{} Y{} Z{} I1={} J1={} K1={} A3={} B3={} C3={}",
+                        self.num(p.x),
+                        self.num(p.y),
+                        self.num(p.z),
+                        self.num(a.mid.x),
+                        self.num(a.mid.y),
+                        self.num(a.mid.z),
+                        self.num(u.x),
+                        self.num(u.y),
+                        self.num(u.z)
+                    ),
+                    _ => format!("G1 {}", self.tip_words(&p, &u)),
+                };
+                if !matches!(b.geometry, Geometry::Turn { .. }) {
+                    let f = format!("{:.1}", b.length() / t * 60.0);
+                    if self.last_f.as_deref() != Some(f.as_str()) {
+                        l.push_str(" F");
+                        l.push_str(&f);
+                        self.last_f = Some(f);
+                    }
+                }
+                self.line(&l);
+            }
+        }
+    }
+}
+
+/// A feed value with six significant digits in plain decimal notation (controllers read no
+/// exponents), never written as 0.
+fn feed_number(f: f64) -> String {
+    let f = if f.is_finite() { f.max(1e-9) } else { 1e9 };
+    let mag = f.log10().floor() as i32;
+    let decimals = (5 - mag).clamp(0, 12) as usize;
+    format!("{f:.decimals$}")
+}

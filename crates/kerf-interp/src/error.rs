@@ -54,15 +54,13 @@ pub enum InterpError {
         expected: usize,
     },
     /// The machine model could not reach a pose (inverse kinematics failed: outside the axis
-    /// ranges, or not a unit tool axis). The kinematics' error is kept as the
-    /// [`std::error::Error::source`]. Fix: see the kinematics' error.
-    #[error("point {index}: kinematics: {source}")]
+    /// ranges, or not a unit tool axis). Fix: see the message from the kinematics.
+    #[error("point {index}: kinematics: {message}")]
     Kinematics {
         /// Index of the pose within its path.
         index: usize,
-        /// The kinematics' own error.
-        #[source]
-        source: kerf_kinematics::KinematicsError,
+        /// The kinematics' own message.
+        message: String,
     },
     /// An interpolated set-point leaves an axis range of the machine (an arc bulging past a
     /// limit between two reachable points). Fix: move the part, or interpolate lines only

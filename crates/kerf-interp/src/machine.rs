@@ -11,7 +11,7 @@
 //! # Ok::<(), kerf_interp::InterpError>(())
 //! ```
 
-use kerf_kinematics::{nearest_solution, Axes, KinematicsError, Machine, Pose, SolvedPath};
+use kerf_kinematics::{nearest_solution, Axes, Machine, Pose, SolvedPath};
 use nalgebra::{Point3, Vector3};
 
 use crate::block::Station;
@@ -85,9 +85,7 @@ impl AxisModel for MachineModel {
         if !(n.is_finite() && (n - 1.0).abs() < 1e-6 && tip.coords.iter().all(|v| v.is_finite())) {
             return Err(InterpError::Kinematics {
                 index: 0,
-                source: KinematicsError::Unreachable {
-                    reason: format!("tool axis must be a unit vector (norm {n})"),
-                },
+                message: format!("tool axis must be a unit vector (norm {n})"),
             });
         }
         let pose = Pose {
@@ -105,9 +103,7 @@ impl AxisModel for MachineModel {
             .map(|q| q.to_array())
             .ok_or_else(|| InterpError::Kinematics {
                 index: 0,
-                source: KinematicsError::Unreachable {
-                    reason: "no solution within the axis ranges".into(),
-                },
+                message: "no solution within the axis ranges".into(),
             })
     }
 

@@ -12,7 +12,7 @@
 //! place (and lets a controller plug in its own kinematics); [`PaperAcHead`], the head of paper 000,
 //! is a self-contained reference implementation for tests, examples and benches.
 
-use kerf_kinematics::{nearest_solution, Axes, KinematicsError};
+use kerf_kinematics::{nearest_solution, Axes};
 use nalgebra::{Point3, Vector3};
 
 use crate::error::{positive, InterpError, Result};
@@ -196,10 +196,7 @@ impl AxisModel for PaperAcHead {
         axis: &Vector3<f64>,
         previous: Option<&[f64; 5]>,
     ) -> Result<[f64; 5]> {
-        let kin = |reason: String| InterpError::Kinematics {
-            index: 0,
-            source: KinematicsError::Unreachable { reason },
-        };
+        let kin = |message: String| InterpError::Kinematics { index: 0, message };
         let n = axis.norm();
         if !(n.is_finite() && (n - 1.0).abs() < 1e-6 && tip.coords.iter().all(|v| v.is_finite())) {
             return Err(kin(format!("tool axis must be a unit vector (norm {n})")));

@@ -138,15 +138,6 @@ pub enum KinematicsError {
         /// The limit.
         limit: usize,
     },
-    /// One pose has no inverse solution (the tool axis is not a unit vector, or no solution
-    /// lies within the axis ranges), from a single-pose inverse such as the interpolator's
-    /// machine models (`kerf_interp::MachineModel::inverse`), which know no path id; the
-    /// caller adds the index of the pose. Fix: see `reason`.
-    #[error("{reason}")]
-    Unreachable {
-        /// Why the pose cannot be reached.
-        reason: String,
-    },
 }
 
 impl KinematicsError {

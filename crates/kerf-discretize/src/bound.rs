@@ -9,7 +9,7 @@
 //! curve points found on the way (the pieces' end points) give a lower bound. The search stops
 //! as soon as the bounds decide the question asked. See `docs/discretization.md`.
 
-use kerf_nurbs::{NurbsCurve, RationalBezier, MAX_ORDER};
+use kerf_nurbs::{NurbsCurve, RationalBezier, Segment, MAX_ORDER};
 use nalgebra::{Point3, Vector3, Vector4};
 
 /// The verdict on one segment.
@@ -39,6 +39,9 @@ pub struct Scratch {
     small: Vec<Piece<4>>,
     medium: Vec<Piece<8>>,
     large: Vec<Piece<MAX_ORDER>>,
+    /// The homogeneous curve point at the last segment start seen by the interpolation
+    /// certificate (`t0`, its span, the point): the walk tries several ends from one start.
+    start: Option<(f64, usize, Vector4<f64>)>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -76,54 +79,106 @@ pub const MAX_SUBDIVISION_DEPTH: u32 = 48;
 /// convex combination (`docs/discretization.md`, Step 5).
 pub const MARGIN_FACTOR: f64 = 128.0;
 
-struct Chord {
-    a: Point3<f64>,
-    ab: Vector3<f64>,
-    /// `1 / ab2` where finite (else 0: the exact division is used).
-    inv_ab2: f64,
+/// Upper bound over a piece's hull (the largest distance of a projected control point to the
+/// chord), and the distance of its last control point (a curve point). The projection
+/// multiplies by `1 / w` (one more rounding of size `eps |Q|` than a division, within the
+/// margin's allowance for the projection); the distance is [`Segment::distance_upper`], the
+/// distance to *a* point of the segment, so never below the true distance (up to the rounding
+/// of the norm).
+#[inline]
+fn hull_distance(chord: &Segment<3>, h: &[Vector4<f64>]) -> (f64, f64) {
+    let mut upper = 0.0f64;
+    let mut end = 0.0;
+    for c in h {
+        let inv = 1.0 / c.w;
+        let q = Vector3::new(c.x * inv, c.y * inv, c.z * inv);
+        end = chord.distance_upper(&q);
+        upper = upper.max(end);
+    }
+    (upper, end)
 }
 
-impl Chord {
-    fn new(a: Point3<f64>, b: Point3<f64>) -> Self {
-        let ab = b - a;
-        let ab2 = ab.norm_squared();
-        let inv = 1.0 / ab2;
-        Self {
-            a,
-            ab,
-            inv_ab2: if inv.is_finite() { inv } else { 0.0 },
-        }
-    }
+/// Per knot span, the bounds the interpolation certificate needs, from the span's Bezier form
+/// (all derivatives with respect to the span's local parameter `u` in `[0, 1]`).
+#[derive(Debug, Clone, Copy, Default)]
+struct SpanBounds {
+    /// The largest Bezier weight (a bound of `w` on the span: convex hull).
+    w_max: f64,
+    /// Bounds of `|w'|`, `|w''|`, `|w'''|` (first, second, third hodograph of the weights),
+    /// each raised by `slack`.
+    w1: f64,
+    w2: f64,
+    w3: f64,
+    /// A bound of `|C'|` on the span (a rounding of the local parameter moves a point by
+    /// `eps` times it).
+    d1: f64,
+    /// Added to the third-derivative bounds: the rounding of the Bezier points, amplified by
+    /// the third differences (`64 p^4 eps w_max (L + |A|)`, the part in `L` stored here).
+    slack: f64,
+}
 
-    /// The distance from `q` to the chord. With the reciprocal, the foot parameter `s` is off
-    /// by a rounding, but it is clamped to `[0, 1]`, so the value is the distance to *a* point
-    /// of the segment: never below the true distance (up to the rounding of the norm).
-    #[inline]
-    fn dist(&self, q: &Point3<f64>) -> f64 {
-        if self.inv_ab2 == 0.0 {
-            return kerf_nurbs::distance_to_segment(q, &self.a, &(self.a + self.ab));
+/// The third hodographs and the derivative bounds of every span's Bezier form (see
+/// [`SpanBounds`]); spans of zero length get zeros and are never asked for.
+fn span_derivative_bounds(
+    p: usize,
+    span_bezier: &[Vector4<f64>],
+    spans: &[f64],
+) -> (Vec<Vector4<f64>>, Vec<Vector4<f64>>, Vec<SpanBounds>) {
+    let n = spans.len();
+    let mut h3 = vec![Vector4::zeros(); n * (p + 1)];
+    let mut h4 = vec![Vector4::zeros(); n * (p + 1)];
+    let mut out = vec![SpanBounds::default(); n];
+    let eps = f64::EPSILON;
+    let pf = p as f64;
+    for i in 0..n {
+        let b = &span_bezier[i * (p + 1)..(i + 1) * (p + 1)];
+        if b[0].w == 0.0 {
+            continue; // an empty span: never certified by this route
         }
-        let aq = q - self.a;
-        let s = (aq.dot(&self.ab) * self.inv_ab2).clamp(0.0, 1.0);
-        (aq - self.ab * s).norm()
-    }
-
-    /// Upper bound over a piece's hull (the largest distance of a projected control point),
-    /// and the distance of its last control point (a curve point). The projection multiplies
-    /// by `1 / w` (one more rounding of size `eps |Q|` than a division, within the margin's
-    /// allowance for the projection).
-    #[inline]
-    fn piece(&self, h: &[Vector4<f64>]) -> (f64, f64) {
-        let mut upper = 0.0f64;
-        let mut end = 0.0;
-        for c in h {
-            let inv = 1.0 / c.w;
-            let q = Point3::new(c.x * inv, c.y * inv, c.z * inv);
-            end = self.dist(&q);
-            upper = upper.max(end);
+        let w_min = b.iter().map(|v| v.w).fold(f64::INFINITY, f64::min);
+        let w_max = b.iter().map(|v| v.w).fold(0.0, f64::max);
+        let slack = 64.0 * pf.powi(4) * eps * w_max * spans[i].max(f64::MIN_POSITIVE);
+        let wslack = 64.0 * pf.powi(4) * eps * w_max;
+        let mut d1 = [Vector4::zeros(); MAX_ORDER];
+        let mut d2 = [Vector4::zeros(); MAX_ORDER];
+        for j in 0..p {
+            d1[j] = b[j + 1] - b[j];
         }
-        (upper, end)
+        for j in 0..p.saturating_sub(1) {
+            d2[j] = d1[j + 1] - d1[j];
+        }
+        let c3 = pf * (pf - 1.0) * (pf - 2.0);
+        let mut w3 = 0.0f64;
+        for j in 0..p.saturating_sub(2) {
+            let v = (d2[j + 1] - d2[j]) * c3;
+            h3[i * (p + 1) + j] = v;
+            w3 = w3.max(v.w.abs());
+        }
+        let c4 = c3 * (pf - 3.0);
+        for j in 0..p.saturating_sub(3) {
+            h4[i * (p + 1) + j] = ((d2[j + 2] - d2[j + 1]) - (d2[j + 1] - d2[j])) * c4;
+        }
+        let w1 = pf * d1[..p].iter().map(|v| v.w.abs()).fold(0.0, f64::max);
+        let w2 = pf
+            * (pf - 1.0)
+            * d2[..p.saturating_sub(1)]
+                .iter()
+                .map(|v| v.w.abs())
+                .fold(0.0, f64::max);
+        // |C'| = |P' - C w'| / w <= (|P'| + |C| |w'|) / w_min, |C| <= the largest projected
+        // control point (convex hull).
+        let pmax = pf * d1[..p].iter().map(|v| v.xyz().norm()).fold(0.0, f64::max);
+        let cmax = b.iter().map(|v| v.xyz().norm() / v.w).fold(0.0, f64::max);
+        out[i] = SpanBounds {
+            w_max,
+            w1: w1 + wslack,
+            w2: w2 + wslack,
+            w3: w3 + wslack,
+            d1: 2.0 * (pmax + cmax * (w1 + wslack)) / w_min,
+            slack,
+        };
     }
+    (h3, h4, out)
 }
 
 /// The curve prepared for certification: a copy translated to a local origin (so that rounding
@@ -146,6 +201,16 @@ pub struct Certifier<'a> {
     /// piece in the span is cut from it by two de Casteljau splits (`docs/discretization.md`,
     /// Step 1), instead of a blossom per trial.
     span_bezier: Vec<Vector4<f64>>,
+    /// Per knot span index `i`: the third hodograph of the span's homogeneous Bezier form,
+    /// `p (p - 1) (p - 2) Delta^3 Q^w_j` for `j <= p - 3`, at `span_h3[i * (p + 1)..]` (the
+    /// control points of the third derivatives of `(P, w)` in the local parameter).
+    span_h3: Vec<Vector4<f64>>,
+    /// The fourth hodographs likewise (`j <= p - 4`): a bound of how fast the third
+    /// derivative changes, so that the third derivative near a step is bounded from its value
+    /// at the step's middle rather than over the whole span.
+    span_h4: Vec<Vector4<f64>>,
+    /// Per knot span index: the bounds of the interpolation certificate.
+    span_bounds: Vec<SpanBounds>,
     /// `4 eps max |P_i|` for curves whose weights are not powers of two (the control points are
     /// recovered from `w P` by one division, within two ulps), else 0.
     representation: f64,
@@ -216,12 +281,16 @@ impl<'a> Certifier<'a> {
         for (i, a, b) in curve.spans() {
             local.bezier_in_span_into(i, a, b, &mut span_bezier[i * (p + 1)..(i + 1) * (p + 1)]);
         }
+        let (span_h3, span_h4, span_bounds) = span_derivative_bounds(p, &span_bezier, &spans);
         Self {
             curve,
             local,
             origin,
             spans,
             span_bezier,
+            span_h3,
+            span_h4,
+            span_bounds,
             representation,
         }
     }
@@ -267,6 +336,263 @@ impl<'a> Certifier<'a> {
                 }
             }
         }
+    }
+
+    /// The homogeneous point of span `span`'s Bezier form at the local parameter `u` in
+    /// `[0, 1]`, by de Casteljau (`p` levels of convex combinations, like the splits of Step
+    /// 1). Counts as one evaluation.
+    #[inline]
+    fn span_point<const M: usize>(&self, span: usize, u: f64) -> Vector4<f64> {
+        kerf_nurbs::tick();
+        let p = self.curve.degree();
+        let mut d = [Vector4::zeros(); M];
+        d[..=p].copy_from_slice(&self.span_bezier[span * (p + 1)..(span + 1) * (p + 1)]);
+        let v = 1.0 - u;
+        for r in 1..=p {
+            for i in 0..=(p - r) {
+                d[i] = d[i] * v + d[i + 1] * u;
+            }
+        }
+        d[0]
+    }
+
+    /// The interpolation certificate of a segment `[t0, t1]` inside one knot span
+    /// (`docs/discretization.md`, "The interpolation certificate"): from the curve points at
+    /// both ends and at the middle and the span's third-derivative bounds, an upper bound of
+    /// the chord error (margin included) and the middle point's distance (a lower bound).
+    /// `None` where its conditions fail (the weight changes too much over the step, or a
+    /// curve point's foot might fall outside the chord): then only the hull certificate
+    /// applies. Costs two evaluations (three for a new start).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn interpolation_bound<const M: usize>(
+        &self,
+        start: &mut Option<(f64, usize, Vector4<f64>)>,
+        span: usize,
+        t0: f64,
+        t1: f64,
+        chord: &Segment<3>,
+        al: &Vector3<f64>,
+        bl: &Vector3<f64>,
+        margin: f64,
+    ) -> Option<Bound> {
+        let p = self.curve.degree();
+        let sb = &self.span_bounds[span];
+        let knots = self.local.knots();
+        let (klo, khi) = (knots[span], knots[span + 1]);
+        let dk = khi - klo;
+        let u0 = ((t0 - klo) / dk).clamp(0.0, 1.0);
+        let u1 = ((t1 - klo) / dk).clamp(0.0, 1.0);
+        let h = u1 - u0;
+        if !(h > 0.0) {
+            return None;
+        }
+        let um = 0.5 * (u0 + u1);
+        let h0 = match *start {
+            Some((t, s, v)) if t == t0 && s == span => v,
+            _ => {
+                let v = self.span_point::<M>(span, u0);
+                *start = Some((t0, span, v));
+                v
+            }
+        };
+        let h1 = self.span_point::<M>(span, u1);
+        let hm = self.span_point::<M>(span, um);
+        let proj = |v: &Vector4<f64>| v.xyz() / v.w;
+        let (c0, c1, cm) = (proj(&h0), proj(&h1), proj(&hm));
+        // How far the given chord ends are from the curve's ends.
+        let e = (c0 - al).norm().max((c1 - bl).norm());
+        let ab = chord.direction();
+        let l = ab.norm();
+        let wm = hm.w;
+        if !(l > 0.0 && wm > 0.0 && e.is_finite()) {
+            return None;
+        }
+        let dir = ab / l;
+        let xm = cm - al;
+        let par = xm.dot(&dir);
+        // The middle point's distance to the chord's line, and to the chord itself.
+        let dm = (xm - dir * par).norm();
+        let lower = chord.distance_upper(&cm);
+        // w(u) >= w_m (1 - a |s - 1/2|) on the step.
+        let a = h * sb.w1 / wm;
+        if !(a <= 0.5) {
+            return None;
+        }
+        let w_lo = wm * (1.0 - 0.5 * a);
+        let w_hi = wm * (1.0 + 0.5 * a);
+        // Bounds of the third derivatives of the numerator N = P - w L across and along the
+        // chord: the hodograph's control points of P''' - w''' A (a convex hull).
+        let slack = sb.slack + 64.0 * (p as f64).powi(4) * f64::EPSILON * sb.w_max * al.amax();
+        let (mut m3_perp, mut m3_par) = (0.0f64, 0.0f64);
+        let h3s = &self.span_h3[span * (p + 1)..span * (p + 1) + p.saturating_sub(2)];
+        for v in h3s {
+            let g = v.xyz() - al * v.w;
+            let gp = g.dot(&dir);
+            m3_par = m3_par.max(gp.abs());
+            m3_perp = m3_perp.max((g - dir * gp).norm());
+        }
+        if p >= 4 {
+            // Across the chord, the third derivative at the middle (de Casteljau on the third
+            // hodograph) plus half the step times the fourth derivative's bound, if smaller.
+            let mut d = [Vector4::zeros(); M];
+            let q = p - 3;
+            d[..=q].copy_from_slice(h3s);
+            for r in 1..=q {
+                for i in 0..=(q - r) {
+                    d[i] = d[i] * (1.0 - um) + d[i + 1] * um;
+                }
+            }
+            let g = d[0].xyz() - al * d[0].w;
+            let mid = (g - dir * g.dot(&dir)).norm();
+            let mut m4 = 0.0f64;
+            for v in &self.span_h4[span * (p + 1)..span * (p + 1) + p - 3] {
+                let g = v.xyz() - al * v.w;
+                m4 = m4.max((g - dir * g.dot(&dir)).norm());
+            }
+            // The de Casteljau value is off by the rounding of q levels (within `slack`).
+            m3_perp = m3_perp.min(mid + 0.5 * h * (m4 + (p as f64 - 3.0) * slack) + slack);
+        }
+        m3_perp += slack;
+        m3_par += slack + l * (sb.w3 + 3.0 * sb.w2 / h);
+        let h3 = h * h * h;
+        // Every curve point's foot on the chord's line lies in the chord (up to the ends'
+        // offset `e`): then the distance to the chord is that to its line.
+        let along = 4.0 * ((wm * (par - 0.5 * l)).abs() + w_hi * e) + h3 * m3_par / 12.0;
+        if !(along <= 0.5 * l * w_lo) {
+            return None;
+        }
+        // |N_perp(u)| <= e_w + (1/4 - x^2) (4 n + c x) at x = |s - 1/2|, and w(u) >= w_m (1 - a x),
+        // 1 / (1 - a x) <= 1 + a' x: the maximum over x of (1/4 - x^2) (4 n + c' x) with
+        // c' = c + 4 n a' + c a' / 2 bounds it (x <= 1/2), in closed form.
+        let e_w = w_hi * e;
+        let n = wm * dm + e_w;
+        let c = h3 * m3_perp / 6.0;
+        let a2 = a / (1.0 - 0.5 * a);
+        let c2 = c + 4.0 * n * a2 + 0.5 * c * a2;
+        let root = (64.0 * n * n + 3.0 * c2 * c2).sqrt() + 8.0 * n;
+        let x = if root > 0.0 { c2 / (2.0 * root) } else { 0.0 };
+        let phi = (0.25 - x * x) * (4.0 * n + c2 * x);
+        let upper = (phi / wm + 2.0 * e_w / w_lo + 4.0 * f64::EPSILON * sb.d1)
+            * (1.0 + 64.0 * f64::EPSILON)
+            + margin;
+        if !upper.is_finite() {
+            return None;
+        }
+        Some(Bound {
+            upper,
+            lower: lower.min(upper),
+        })
+    }
+
+    /// The curve point at `t`, evaluated on the span's cached Bezier form by de Casteljau (`p`
+    /// levels of convex combinations in the local frame, then translated back): the walk's
+    /// cutting points. Within a few `eps` of the local magnitude of the curve's value (the
+    /// rounding is measured by the interpolation certificate, which evaluates the same way),
+    /// and far cheaper than a basis-function evaluation. Counts as one evaluation.
+    pub(crate) fn point(&self, t: f64) -> Point3<f64> {
+        match self.curve.degree() {
+            0..=3 => self.local_derivs::<4>(t, 0)[0],
+            4..=7 => self.local_derivs::<8>(t, 0)[0],
+            _ => self.local_derivs::<MAX_ORDER>(t, 0)[0],
+        }
+        .into()
+    }
+
+    /// The point (global frame) and first derivative at `t`, as [`Certifier::point`].
+    pub(crate) fn eval_d1(&self, t: f64) -> (Point3<f64>, Vector3<f64>) {
+        let d = match self.curve.degree() {
+            0..=3 => self.local_derivs::<4>(t, 1),
+            4..=7 => self.local_derivs::<8>(t, 1),
+            _ => self.local_derivs::<MAX_ORDER>(t, 1),
+        };
+        (d[0].into(), d[1])
+    }
+
+    /// The point (global frame) and the first three derivatives at `t`, as
+    /// [`Certifier::point`].
+    pub(crate) fn eval_d3(&self, t: f64) -> [Vector3<f64>; 4] {
+        match self.curve.degree() {
+            0..=3 => self.local_derivs::<4>(t, 3),
+            4..=7 => self.local_derivs::<8>(t, 3),
+            _ => self.local_derivs::<MAX_ORDER>(t, 3),
+        }
+    }
+
+    /// The point (translated back to the global frame) and the derivatives up to order `n`
+    /// (`n <= 3`; higher entries zero) with respect to `t`, from the span's Bezier form: de
+    /// Casteljau down to level `p - n`, whose forward differences give the homogeneous
+    /// derivatives (`p! / (p - k)! Delta^k`), then the quotient rule.
+    #[inline]
+    fn local_derivs<const M: usize>(&self, t: f64, n: usize) -> [Vector3<f64>; 4] {
+        kerf_nurbs::tick();
+        let p = self.curve.degree();
+        let span = self.local.span(t);
+        let knots = self.local.knots();
+        let (klo, khi) = (knots[span], knots[span + 1]);
+        let dk = khi - klo;
+        let u = if dk > 0.0 {
+            ((t - klo) / dk).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let mut d = [Vector4::zeros(); M];
+        d[..=p].copy_from_slice(&self.span_bezier[span * (p + 1)..(span + 1) * (p + 1)]);
+        let v = 1.0 - u;
+        let m = n.min(p);
+        for r in 1..=(p - m) {
+            for i in 0..=(p - r) {
+                d[i] = d[i] * v + d[i + 1] * u;
+            }
+        }
+        // Homogeneous derivatives from the level p - m points d[0..=m].
+        let mut hd = [Vector4::zeros(); 4];
+        let pf = p as f64;
+        let inv = 1.0 / dk;
+        if m >= 3 {
+            let c = pf * (pf - 1.0) * (pf - 2.0) * inv * inv * inv;
+            hd[3] = (d[3] - d[2] * 3.0 + d[1] * 3.0 - d[0]) * c;
+        }
+        if m >= 2 {
+            // Level p - 2 points from level p - m.
+            for r in 0..(m - 2) {
+                for i in 0..(m - r) {
+                    d[i] = d[i] * v + d[i + 1] * u;
+                }
+            }
+            hd[2] = (d[2] - d[1] * 2.0 + d[0]) * (pf * (pf - 1.0) * inv * inv);
+        }
+        if m >= 1 {
+            if m >= 2 {
+                d[0] = d[0] * v + d[1] * u;
+                d[1] = d[1] * v + d[2] * u;
+            } else {
+                // m == 1: d[0..=1] are the level p - 1 points already.
+            }
+            hd[1] = (d[1] - d[0]) * (pf * inv);
+            d[0] = d[0] * v + d[1] * u;
+        }
+        let h0 = d[0];
+        let w = h0.w;
+        let c0 = h0.xyz() / w;
+        let mut out = [Vector3::zeros(); 4];
+        out[0] = c0 + self.origin;
+        if n >= 1 {
+            let c1 = (hd[1].xyz() - c0 * hd[1].w) / w;
+            out[1] = c1;
+            if n >= 2 {
+                let c2 = (hd[2].xyz() - c1 * (2.0 * hd[1].w) - c0 * hd[2].w) / w;
+                out[2] = c2;
+                if n >= 3 {
+                    out[3] = (hd[3].xyz()
+                        - c2 * (3.0 * hd[1].w)
+                        - c1 * (3.0 * hd[2].w)
+                        - c0 * hd[3].w)
+                        / w;
+                }
+            }
+        }
+        out
     }
 
     fn factor(&self) -> f64 {
@@ -320,9 +646,36 @@ impl<'a> Certifier<'a> {
         want_lower: f64,
     ) -> Bound {
         match self.curve.degree() {
-            0..=3 => self.chord_error_m(&mut scratch.small, t0, t1, a, b, limit, want_lower),
-            4..=7 => self.chord_error_m(&mut scratch.medium, t0, t1, a, b, limit, want_lower),
-            _ => self.chord_error_m(&mut scratch.large, t0, t1, a, b, limit, want_lower),
+            0..=3 => self.chord_error_m(
+                &mut scratch.small,
+                &mut scratch.start,
+                t0,
+                t1,
+                a,
+                b,
+                limit,
+                want_lower,
+            ),
+            4..=7 => self.chord_error_m(
+                &mut scratch.medium,
+                &mut scratch.start,
+                t0,
+                t1,
+                a,
+                b,
+                limit,
+                want_lower,
+            ),
+            _ => self.chord_error_m(
+                &mut scratch.large,
+                &mut scratch.start,
+                t0,
+                t1,
+                a,
+                b,
+                limit,
+                want_lower,
+            ),
         }
     }
 
@@ -331,6 +684,7 @@ impl<'a> Certifier<'a> {
     fn chord_error_m<const M: usize>(
         &self,
         pieces: &mut Vec<Piece<M>>,
+        start: &mut Option<(f64, usize, Vector4<f64>)>,
         t0: f64,
         t1: f64,
         a: &Point3<f64>,
@@ -339,17 +693,35 @@ impl<'a> Certifier<'a> {
         want_lower: f64,
     ) -> Bound {
         let (al, bl) = (a - self.origin, b - self.origin);
-        let chord = Chord::new(al, bl);
+        let chord = Segment::between(&al, &bl);
         let f = self.factor();
         let p = self.curve.degree();
         let mut margin = 8.0 * f64::EPSILON * al.coords.amax().max(bl.coords.amax());
         pieces.clear();
         let mut lower = 0.0f64;
         let local = &self.local;
-        // The Bezier pieces of [t0, t1], one per knot span it meets (as
-        // `NurbsCurve::for_each_bezier_piece`), extracted straight into the work space.
         let knots = local.knots();
         let mut span = local.span(t0);
+        // Most segments lie in one span and are decided by the interpolation certificate
+        // without any subdivision.
+        if t1 <= knots[span + 1] {
+            let m = margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span])
+                + self.representation;
+            if let Some(bd) = self.interpolation_bound::<M>(
+                start, span, t0, t1, &chord, &al.coords, &bl.coords, m,
+            ) {
+                let tight = bd.upper - bd.lower <= 0.002 * limit;
+                if bd.lower > limit
+                    || (bd.upper <= limit
+                        && (bd.lower >= want_lower || bd.upper < want_lower || tight))
+                {
+                    return bd;
+                }
+                lower = bd.lower;
+            }
+        }
+        // The Bezier pieces of [t0, t1], one per knot span it meets (as
+        // `NurbsCurve::for_each_bezier_piece`), extracted straight into the work space.
         let mut lo = t0;
         loop {
             let hi = knots[span + 1].min(t1);
@@ -360,7 +732,7 @@ impl<'a> Certifier<'a> {
                     depth: 0,
                 };
                 self.piece_in_span(span, lo, hi, &mut pc.cpw[..=p]);
-                let (upper, end) = chord.piece(&pc.cpw[..=p]);
+                let (upper, end) = hull_distance(&chord, &pc.cpw[..=p]);
                 pc.upper = upper;
                 margin = margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span]);
                 lower = lower.max(end);
@@ -423,8 +795,8 @@ impl<'a> Certifier<'a> {
             let (head, tail) = pieces.split_at_mut(last);
             let (l, r) = (&mut head[worst], &mut tail[0]);
             l.split(r, p);
-            let (ul, el) = chord.piece(&l.cpw[..=p]);
-            let (ur, _) = chord.piece(&r.cpw[..=p]);
+            let (ul, el) = hull_distance(&chord, &l.cpw[..=p]);
+            let (ur, _) = hull_distance(&chord, &r.cpw[..=p]);
             lower = lower.max(el);
             l.upper = ul;
             r.upper = ur;

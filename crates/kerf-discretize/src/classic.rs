@@ -213,7 +213,7 @@ pub(crate) fn equal_chord(
                     speed: None,
                 };
                 let end = End::PieceEnd { t: b, p: pb };
-                let hit = first_crossing(curve, &p0, r, start, end, 8.0 * dt);
+                let hit = first_crossing(cert, &p0, r, start, end, 8.0 * dt);
                 if hit.t <= t0 {
                     return None;
                 }

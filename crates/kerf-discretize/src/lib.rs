@@ -168,7 +168,7 @@ impl Discretization {
         {
             return fail(0, "a C0 break is not a cutting point", t);
         }
-        let points: Vec<Point3<f64>> = params.iter().map(|&t| curve.point(t)).collect();
+        let points: Vec<Point3<f64>> = params.iter().map(|&t| cert.point(t)).collect();
         let mut scratch = bound::Scratch::default();
         let (mut upper, mut lower) = (0.0f64, 0.0f64);
         for i in 0..params.len() - 1 {
@@ -383,7 +383,7 @@ pub fn discretize_range(
         c0_breaks: ends[1..ends.len() - 1].to_vec(),
         ..Default::default()
     };
-    let mut pa = curve.point(ends[0]);
+    let mut pa = cert.point(ends[0]);
     out.params.push(ends[0]);
     out.points.push(pa);
     let mut walker = walk::Walker {
@@ -397,7 +397,7 @@ pub fn discretize_range(
     };
     for w in ends.windows(2) {
         let (a, b) = (w[0], w[1]);
-        let pb = curve.point(b);
+        let pb = walker.cert.point(b);
         match opts.strategy {
             Strategy::ReferenceSphere | Strategy::EqualError => walker.piece(a, b, pb, &mut out)?,
             Strategy::EqualParameter | Strategy::EqualChordLength => {

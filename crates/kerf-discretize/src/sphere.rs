@@ -1,7 +1,8 @@
 //! Intersection of the reference sphere with the curve (paper 004, eq 6).
 
-use kerf_nurbs::NurbsCurve;
 use nalgebra::Point3;
+
+use crate::bound::Certifier;
 
 /// Relative accuracy of the intersection radius. The exact crossing is not needed: the step is
 /// certified for whatever parameter is returned, so a loose tolerance saves evaluations.
@@ -43,7 +44,7 @@ pub(crate) enum End {
 /// as in sphere tracing), never longer than `max_dt`; if the sphere is not reached before the
 /// piece end, the piece end itself is returned.
 pub(crate) fn first_crossing(
-    curve: &NurbsCurve,
+    cert: &Certifier<'_>,
     centre: &Point3<f64>,
     radius: f64,
     start: Start,
@@ -55,7 +56,7 @@ pub(crate) fn first_crossing(
         End::Outside { t, d } => {
             // Distance is close to linear in t over a short step: start from the interpolation.
             let f = ((radius - start.d) / (d - start.d)).clamp(0.0, 1.0);
-            return solve(curve, centre, radius, lo, t, lo + f * (t - lo));
+            return solve(cert, centre, radius, lo, t, lo + f * (t - lo));
         }
         End::PieceEnd { t, p } => (t, p),
     };
@@ -65,14 +66,14 @@ pub(crate) fn first_crossing(
         let (d, speed) = match known.take() {
             Some(ds) => ds,
             None => {
-                let (c, d1) = curve.eval_d1(t);
+                let (c, d1) = cert.eval_d1(t);
                 let d = (c - centre).norm();
                 if d >= radius {
                     // Crossed during the last step: the root lies in [lo, t].
                     return if d <= radius * (1.0 + RADIUS_TOL) {
                         Hit { t, p: c }
                     } else {
-                        solve(curve, centre, radius, lo, t, 0.5 * (lo + t))
+                        solve(cert, centre, radius, lo, t, 0.5 * (lo + t))
                     };
                 }
                 if radius - d <= radius * RADIUS_TOL {
@@ -87,7 +88,7 @@ pub(crate) fn first_crossing(
             if (p_hi - centre).norm() < radius {
                 return Hit { t: hi, p: p_hi };
             }
-            return solve(curve, centre, radius, t, hi, 0.5 * (t + hi));
+            return solve(cert, centre, radius, t, hi, 0.5 * (t + hi));
         }
         let next = t + dt;
         if next <= t {
@@ -95,14 +96,14 @@ pub(crate) fn first_crossing(
         }
         t = next;
     }
-    let (c, _) = curve.eval_d1(t);
+    let (c, _) = cert.eval_d1(t);
     Hit { t, p: c }
 }
 
 /// Newton's method on `|C(t) - centre|^2 - radius^2` safeguarded by bisection in `[lo, hi]`,
 /// where the function is negative at `lo` and positive at `hi`.
 fn solve(
-    curve: &NurbsCurve,
+    cert: &Certifier<'_>,
     centre: &Point3<f64>,
     radius: f64,
     mut lo: f64,
@@ -117,7 +118,7 @@ fn solve(
     };
     let mut best = None;
     for _ in 0..80 {
-        let (c, d1) = curve.eval_d1(t);
+        let (c, d1) = cert.eval_d1(t);
         let v = c - centre;
         let f = v.norm_squared() - r2;
         if f.abs() <= 2.0 * RADIUS_TOL * r2 {
@@ -142,7 +143,7 @@ fn solve(
         t = next;
     }
     best.unwrap_or_else(|| {
-        let (c, _) = curve.eval_d1(hi);
+        let (c, _) = cert.eval_d1(hi);
         Hit { t: hi, p: c }
     })
 }

@@ -92,7 +92,7 @@ impl Walker<'_> {
         // sqrt(k) |C'| at the previous cutting point.
         let mut prev_f = None;
         while t0 < b {
-            let d = self.curve.eval_d3(t0);
+            let d = self.cert.eval_d3(t0);
             let (d1, d2) = (d[1], d[2]);
             let k = curvature_of(&d1, &d2);
             let f0 = crate::sqrt_curvature_speed(&d);
@@ -136,7 +136,7 @@ impl Walker<'_> {
                     let p = if t_try >= b {
                         pb
                     } else {
-                        self.curve.point(t_try)
+                        self.cert.point(t_try)
                     };
                     Hit { t: t_try.min(b), p }
                 } else {
@@ -159,7 +159,7 @@ impl Walker<'_> {
                         },
                         _ => End::PieceEnd { t: b, p: pb },
                     };
-                    first_crossing(self.curve, &p0, r, start, end, max_dt)
+                    first_crossing(&self.cert, &p0, r, start, end, max_dt)
                 };
                 if hit.t <= t0 {
                     stuck = true;

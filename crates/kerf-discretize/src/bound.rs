@@ -39,10 +39,14 @@ pub struct Scratch {
     small: Vec<Piece<4>>,
     medium: Vec<Piece<8>>,
     large: Vec<Piece<MAX_ORDER>>,
-    /// The homogeneous curve point at the last segment start seen by the interpolation
-    /// certificate (`t0`, its span, the point): the walk tries several ends from one start.
-    start: Option<(f64, usize, Vector4<f64>)>,
+    /// Homogeneous curve points the interpolation certificate evaluated last (`t`, its span,
+    /// the point): the walk tries several ends from one start, and the end it accepts is the
+    /// next start.
+    ends: Ends,
 }
+
+/// Two remembered homogeneous points of the local frame, by parameter and span.
+type Ends = [Option<(f64, usize, Vector4<f64>)>; 2];
 
 #[derive(Debug, Clone, Copy)]
 struct Piece<const M: usize> {
@@ -367,7 +371,8 @@ impl<'a> Certifier<'a> {
     #[inline]
     fn interpolation_bound<const M: usize>(
         &self,
-        start: &mut Option<(f64, usize, Vector4<f64>)>,
+        ends: &mut Ends,
+        end_hint: Option<(usize, Vector4<f64>)>,
         span: usize,
         t0: f64,
         t1: f64,
@@ -388,15 +393,25 @@ impl<'a> Certifier<'a> {
             return None;
         }
         let um = 0.5 * (u0 + u1);
-        let h0 = match *start {
-            Some((t, s, v)) if t == t0 && s == span => v,
-            _ => {
+        let find = |ends: &Ends, t: f64| {
+            ends.iter()
+                .flatten()
+                .find(|e| e.0 == t && e.1 == span)
+                .map(|e| e.2)
+        };
+        let (h0, keep) = match find(ends, t0) {
+            Some(v) => (v, ends.iter().position(|e| e.is_some_and(|e| e.0 == t0))),
+            None => {
                 let v = self.span_point::<M>(span, u0);
-                *start = Some((t0, span, v));
-                v
+                ends[0] = Some((t0, span, v));
+                (v, Some(0))
             }
         };
-        let h1 = self.span_point::<M>(span, u1);
+        let h1 = match end_hint.filter(|e| e.0 == span) {
+            Some((_, v)) => v,
+            None => self.span_point::<M>(span, u1),
+        };
+        ends[if keep == Some(0) { 1 } else { 0 }] = Some((t1, span, h1));
         let hm = self.span_point::<M>(span, um);
         let proj = |v: &Vector4<f64>| v.xyz() / v.w;
         let (c0, c1, cm) = (proj(&h0), proj(&h1), proj(&hm));
@@ -492,30 +507,45 @@ impl<'a> Certifier<'a> {
     /// and far cheaper than a basis-function evaluation. Counts as one evaluation.
     pub(crate) fn point(&self, t: f64) -> Point3<f64> {
         match self.curve.degree() {
-            0..=3 => self.local_derivs::<4>(t, 0)[0],
-            4..=7 => self.local_derivs::<8>(t, 0)[0],
-            _ => self.local_derivs::<MAX_ORDER>(t, 0)[0],
+            0..=3 => self.local_derivs::<4>(t, 0).0[0],
+            4..=7 => self.local_derivs::<8>(t, 0).0[0],
+            _ => self.local_derivs::<MAX_ORDER>(t, 0).0[0],
         }
         .into()
     }
 
-    /// The point (global frame) and first derivative at `t`, as [`Certifier::point`].
-    pub(crate) fn eval_d1(&self, t: f64) -> (Point3<f64>, Vector3<f64>) {
-        let d = match self.curve.degree() {
+    /// The point (global frame) and first derivative at `t`, as [`Certifier::point`], and
+    /// the knot span and homogeneous local point they come from (for the certificate).
+    pub(crate) fn eval_d1_h(
+        &self,
+        t: f64,
+    ) -> (Point3<f64>, Vector3<f64>, (usize, Vector4<f64>)) {
+        let (d, span, h) = match self.curve.degree() {
             0..=3 => self.local_derivs::<4>(t, 1),
             4..=7 => self.local_derivs::<8>(t, 1),
             _ => self.local_derivs::<MAX_ORDER>(t, 1),
         };
-        (d[0].into(), d[1])
+        (d[0].into(), d[1], (span, h))
+    }
+
+    /// The point (global frame) and its span and homogeneous local point, as
+    /// [`Certifier::eval_d1_h`].
+    pub(crate) fn point_h(&self, t: f64) -> (Point3<f64>, (usize, Vector4<f64>)) {
+        let (d, span, h) = match self.curve.degree() {
+            0..=3 => self.local_derivs::<4>(t, 0),
+            4..=7 => self.local_derivs::<8>(t, 0),
+            _ => self.local_derivs::<MAX_ORDER>(t, 0),
+        };
+        (d[0].into(), (span, h))
     }
 
     /// The point (global frame) and the first three derivatives at `t`, as
     /// [`Certifier::point`].
     pub(crate) fn eval_d3(&self, t: f64) -> [Vector3<f64>; 4] {
         match self.curve.degree() {
-            0..=3 => self.local_derivs::<4>(t, 3),
-            4..=7 => self.local_derivs::<8>(t, 3),
-            _ => self.local_derivs::<MAX_ORDER>(t, 3),
+            0..=3 => self.local_derivs::<4>(t, 3).0,
+            4..=7 => self.local_derivs::<8>(t, 3).0,
+            _ => self.local_derivs::<MAX_ORDER>(t, 3).0,
         }
     }
 
@@ -524,7 +554,11 @@ impl<'a> Certifier<'a> {
     /// Casteljau down to level `p - n`, whose forward differences give the homogeneous
     /// derivatives (`p! / (p - k)! Delta^k`), then the quotient rule.
     #[inline]
-    fn local_derivs<const M: usize>(&self, t: f64, n: usize) -> [Vector3<f64>; 4] {
+    fn local_derivs<const M: usize>(
+        &self,
+        t: f64,
+        n: usize,
+    ) -> ([Vector3<f64>; 4], usize, Vector4<f64>) {
         kerf_nurbs::tick();
         let p = self.curve.degree();
         let span = self.local.span(t);
@@ -592,7 +626,7 @@ impl<'a> Certifier<'a> {
                 }
             }
         }
-        out
+        (out, span, h0)
     }
 
     fn factor(&self) -> f64 {
@@ -645,10 +679,28 @@ impl<'a> Certifier<'a> {
         limit: f64,
         want_lower: f64,
     ) -> Bound {
+        self.chord_error_hinted(scratch, t0, t1, a, b, None, limit, want_lower)
+    }
+
+    /// [`Certifier::chord_error`] with, optionally, the span and homogeneous local point that
+    /// `b` was evaluated from (by [`Certifier::eval_d1_h`]), which saves evaluating it again.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn chord_error_hinted(
+        &self,
+        scratch: &mut Scratch,
+        t0: f64,
+        t1: f64,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        end_hint: Option<(usize, Vector4<f64>)>,
+        limit: f64,
+        want_lower: f64,
+    ) -> Bound {
         match self.curve.degree() {
             0..=3 => self.chord_error_m(
                 &mut scratch.small,
-                &mut scratch.start,
+                &mut scratch.ends,
+                end_hint,
                 t0,
                 t1,
                 a,
@@ -658,7 +710,8 @@ impl<'a> Certifier<'a> {
             ),
             4..=7 => self.chord_error_m(
                 &mut scratch.medium,
-                &mut scratch.start,
+                &mut scratch.ends,
+                end_hint,
                 t0,
                 t1,
                 a,
@@ -668,7 +721,8 @@ impl<'a> Certifier<'a> {
             ),
             _ => self.chord_error_m(
                 &mut scratch.large,
-                &mut scratch.start,
+                &mut scratch.ends,
+                end_hint,
                 t0,
                 t1,
                 a,
@@ -684,7 +738,8 @@ impl<'a> Certifier<'a> {
     fn chord_error_m<const M: usize>(
         &self,
         pieces: &mut Vec<Piece<M>>,
-        start: &mut Option<(f64, usize, Vector4<f64>)>,
+        ends: &mut Ends,
+        end_hint: Option<(usize, Vector4<f64>)>,
         t0: f64,
         t1: f64,
         a: &Point3<f64>,
@@ -708,7 +763,7 @@ impl<'a> Certifier<'a> {
             let m = margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span])
                 + self.representation;
             if let Some(bd) = self.interpolation_bound::<M>(
-                start, span, t0, t1, &chord, &al.coords, &bl.coords, m,
+                ends, end_hint, span, t0, t1, &chord, &al.coords, &bl.coords, m,
             ) {
                 let tight = bd.upper - bd.lower <= 0.002 * limit;
                 if bd.lower > limit

@@ -211,6 +211,7 @@ pub(crate) fn equal_chord(
                     t: t0,
                     d: 0.0,
                     speed: None,
+                    derivs: None,
                 };
                 let end = End::PieceEnd { t: b, p: pb };
                 let hit = first_crossing(cert, &p0, r, start, end, 8.0 * dt);

@@ -53,9 +53,16 @@ enum Fail {
 impl Walker<'_> {
     fn certify(&mut self, t0: f64, p0: &Point3<f64>, hit: &Hit) -> (Bound, Option<Fail>) {
         let tol = self.opts.tolerance;
-        let bound = self
-            .cert
-            .chord_error(&mut self.scratch, t0, hit.t, p0, &hit.p, tol, self.emin);
+        let bound = self.cert.chord_error_hinted(
+            &mut self.scratch,
+            t0,
+            hit.t,
+            p0,
+            &hit.p,
+            hit.h,
+            tol,
+            self.emin,
+        );
         if bound.upper > tol {
             return (bound, Some(Fail::Chord));
         }
@@ -133,23 +140,33 @@ impl Walker<'_> {
             let mut t_try = t0 + last_dt.min(b - t0);
             for _ in 0..MAX_ITERS {
                 let hit = if param_mode {
-                    let p = if t_try >= b {
-                        pb
+                    if t_try >= b {
+                        Hit {
+                            t: b,
+                            p: pb,
+                            h: None,
+                        }
                     } else {
-                        self.cert.point(t_try)
-                    };
-                    Hit { t: t_try.min(b), p }
+                        let (p, h) = self.cert.point_h(t_try);
+                        Hit {
+                            t: t_try,
+                            p,
+                            h: Some(h),
+                        }
+                    }
                 } else {
                     let start = good.map_or(
                         Start {
                             t: t0,
                             d: 0.0,
                             speed: Some(speed0),
+                            derivs: Some([d[1], d[2], d[3]]),
                         },
                         |g| Start {
                             t: g.hit.t,
                             d: g.r,
                             speed: None,
+                            derivs: None,
                         },
                     );
                     let end = match bad {
@@ -166,7 +183,15 @@ impl Walker<'_> {
                     break;
                 }
                 // Certify exactly the point that will be output for the piece end.
-                let hit = if hit.t >= b { Hit { t: b, p: pb } } else { hit };
+                let hit = if hit.t >= b {
+                    Hit {
+                        t: b,
+                        p: pb,
+                        h: None,
+                    }
+                } else {
+                    hit
+                };
                 let (bound, fail) = self.certify(t0, &p0, &hit);
                 let ok = fail.is_none();
                 if let Some(f) = fail {

@@ -55,8 +55,13 @@ use rayon::prelude::*;
 /// bound of every segment of given parameters itself. So [`Discretization::max_chord_error`] is
 /// always a certified bound, and later stages (the normals' `orient`) can rely on it. Points read
 /// back from a toolpath file are a claim, not a certificate: check them with `kerf-check`, or
-/// turn them into a `Discretization` with [`Discretization::certify`].
-#[derive(Debug, Clone, PartialEq, Default)]
+/// turn them into a `Discretization` with [`Discretization::certify`]. There is deliberately no
+/// `Default` (an empty value would carry a certificate no walk produced):
+///
+/// ```compile_fail
+/// let forged = kerf_discretize::Discretization::default();
+/// ```
+#[derive(Debug, Clone, PartialEq)]
 pub struct Discretization {
     params: Vec<f64>,
     points: Vec<Point3<f64>>,
@@ -380,8 +385,10 @@ pub fn discretize_range(
     let mut out = Discretization {
         params: Vec::with_capacity(cap),
         points: Vec::with_capacity(cap),
+        max_chord_error: 0.0,
+        estimated_chord_error: 0.0,
         c0_breaks: ends[1..ends.len() - 1].to_vec(),
-        ..Default::default()
+        sqrt_curvature: 0.0,
     };
     let mut pa = cert.point(ends[0]);
     out.params.push(ends[0]);

@@ -465,8 +465,9 @@ impl<'a> Certifier<'a> {
                 let g = v.xyz() - al * v.w;
                 m4 = m4.max((g - dir * g.dot(&dir)).norm());
             }
-            // The de Casteljau value is off by the rounding of q levels (within `slack`).
-            m3_perp = m3_perp.min(mid + 0.5 * h * (m4 + (p as f64 - 3.0) * slack) + slack);
+            // The de Casteljau value is off by the rounding of q levels (within `slack`); the
+            // fourth differences amplify the Bezier points' rounding by `16 p^4` (`p slack`).
+            m3_perp = m3_perp.min(mid + slack + 0.5 * h * (m4 + p as f64 * slack));
         }
         m3_perp += slack;
         m3_par += slack + l * (sb.w3 + 3.0 * sb.w2 / h);

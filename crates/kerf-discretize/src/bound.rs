@@ -389,7 +389,7 @@ impl<'a> Certifier<'a> {
         let u0 = ((t0 - klo) / dk).clamp(0.0, 1.0);
         let u1 = ((t1 - klo) / dk).clamp(0.0, 1.0);
         let h = u1 - u0;
-        if !(h > 0.0) {
+        if h.is_nan() || h <= 0.0 {
             return None;
         }
         let um = 0.5 * (u0 + u1);
@@ -431,7 +431,7 @@ impl<'a> Certifier<'a> {
         let lower = chord.distance_upper(&cm);
         // w(u) >= w_m (1 - a |s - 1/2|) on the step.
         let a = h * sb.w1 / wm;
-        if !(a <= 0.5) {
+        if a.is_nan() || a > 0.5 {
             return None;
         }
         let w_lo = wm * (1.0 - 0.5 * a);
@@ -475,7 +475,7 @@ impl<'a> Certifier<'a> {
         // Every curve point's foot on the chord's line lies in the chord (up to the ends'
         // offset `e`): then the distance to the chord is that to its line.
         let along = 4.0 * ((wm * (par - 0.5 * l)).abs() + w_hi * e) + h3 * m3_par / 12.0;
-        if !(along <= 0.5 * l * w_lo) {
+        if along.is_nan() || along > 0.5 * l * w_lo {
             return None;
         }
         // |N_perp(u)| <= e_w + (1/4 - x^2) (4 n + c x) at x = |s - 1/2|, and w(u) >= w_m (1 - a x),
@@ -517,10 +517,7 @@ impl<'a> Certifier<'a> {
 
     /// The point (global frame) and first derivative at `t`, as [`Certifier::point`], and
     /// the knot span and homogeneous local point they come from (for the certificate).
-    pub(crate) fn eval_d1_h(
-        &self,
-        t: f64,
-    ) -> (Point3<f64>, Vector3<f64>, (usize, Vector4<f64>)) {
+    pub(crate) fn eval_d1_h(&self, t: f64) -> (Point3<f64>, Vector3<f64>, (usize, Vector4<f64>)) {
         let (d, span, h) = match self.curve.degree() {
             0..=3 => self.local_derivs::<4>(t, 1),
             4..=7 => self.local_derivs::<8>(t, 1),
@@ -619,11 +616,9 @@ impl<'a> Certifier<'a> {
                 let c2 = (hd[2].xyz() - c1 * (2.0 * hd[1].w) - c0 * hd[2].w) / w;
                 out[2] = c2;
                 if n >= 3 {
-                    out[3] = (hd[3].xyz()
-                        - c2 * (3.0 * hd[1].w)
-                        - c1 * (3.0 * hd[2].w)
-                        - c0 * hd[3].w)
-                        / w;
+                    out[3] =
+                        (hd[3].xyz() - c2 * (3.0 * hd[1].w) - c1 * (3.0 * hd[2].w) - c0 * hd[3].w)
+                            / w;
                 }
             }
         }
@@ -761,8 +756,8 @@ impl<'a> Certifier<'a> {
         // Most segments lie in one span and are decided by the interpolation certificate
         // without any subdivision.
         if t1 <= knots[span + 1] {
-            let m = margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span])
-                + self.representation;
+            let m =
+                margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span]) + self.representation;
             if let Some(bd) = self.interpolation_bound::<M>(
                 ends, end_hint, span, t0, t1, &chord, &al.coords, &bl.coords, m,
             ) {

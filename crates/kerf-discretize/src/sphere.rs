@@ -91,7 +91,7 @@ pub(crate) fn first_crossing(
             }
             x = next;
         }
-        if !(x <= 1.6 * x1) {
+        if x.is_nan() || x > 1.6 * x1 {
             x = x1;
         }
         let x = x.min(max_dt);

@@ -58,7 +58,10 @@ fn a_claim_that_is_too_coarse_is_refused_with_the_segment() {
     match Discretization::certify(&c, &params, 0.01) {
         Err(DiscretizeError::NotCertified { index, bound, .. }) => {
             assert_eq!(index, 0, "the first segment fails");
-            assert!(bound >= sagitta, "bound {bound} at least the sagitta {sagitta}");
+            assert!(
+                bound >= sagitta,
+                "bound {bound} at least the sagitta {sagitta}"
+            );
         }
         other => panic!("expected NotCertified, got {other:?}"),
     }

@@ -93,5 +93,8 @@ fn tight_on_short_steps_of_smooth_curves_and_three_evaluations_at_most() {
             }
         }
     }
-    assert!(tight as f64 >= 0.95 * total as f64, "{tight} of {total} within 2 %");
+    assert!(
+        tight as f64 >= 0.95 * total as f64,
+        "{tight} of {total} within 2 %"
+    );
 }

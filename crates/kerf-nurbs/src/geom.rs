@@ -33,7 +33,11 @@ impl<const D: usize> Segment<D> {
             start: a,
             direction,
             length_squared,
-            inv_length_squared: if inv.is_finite() && inv > 0.0 { inv } else { 0.0 },
+            inv_length_squared: if inv.is_finite() && inv > 0.0 {
+                inv
+            } else {
+                0.0
+            },
         }
     }
 
@@ -113,4 +117,36 @@ pub fn distance_to_segment(q: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) ->
 #[inline]
 pub fn nearest_on_segment(q: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> (f64, f64) {
     Segment::between(a, b).nearest(&q.coords)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    /// `distance_upper` (reciprocal) against the analytic distance: on a segment along x, the
+    /// distance of `(x, y, z)` is `hypot(y, z)` beside it and the distance to the nearer end
+    /// beyond it. Never below (beyond a rounding), never above by more than a rounding.
+    #[test]
+    fn distance_upper_is_the_analytic_distance_up_to_rounding() {
+        let len = 3.0f64;
+        let s = Segment::<3>::new(
+            Vector3::new(1.0, 2.0, 3.0),
+            Vector3::new(1.0 + len, 2.0, 3.0),
+        );
+        for i in -20..=50 {
+            for j in -5..=5 {
+                let (x, y, z) = (0.1 * i as f64, 0.37 * j as f64, 0.11 * j as f64);
+                let q = Vector3::new(1.0 + x, 2.0 + y, 3.0 + z);
+                let dx = if x < 0.0 { -x } else { (x - len).max(0.0) };
+                let exact = (dx * dx + y * y + z * z).sqrt();
+                let d = s.distance_upper(&q);
+                assert!(d >= exact * (1.0 - 1e-15) - 1e-15, "{d} below {exact}");
+                assert!(d <= exact * (1.0 + 1e-14) + 1e-14, "{d} above {exact}");
+            }
+        }
+        // A zero-length segment is its start point.
+        let p = Segment::<3>::new(Vector3::new(1.0, 1.0, 1.0), Vector3::new(1.0, 1.0, 1.0));
+        assert_eq!(p.distance_upper(&Vector3::new(4.0, 5.0, 1.0)), 5.0, "3-4-5");
+    }
 }

@@ -64,7 +64,7 @@ fn a_job_from_files_gives_every_stage_and_its_toolpath_passes_the_independent_ch
     for (rec, o) in job.curves().curves.iter().zip(&out.oriented) {
         if rec.surface.is_none() {
             assert!(
-                o.normals.iter().all(|v| (v.z - 1.0).abs() < 1e-15),
+                o.normals().iter().all(|v| (v.z - 1.0).abs() < 1e-15),
                 "{}",
                 rec.id
             );

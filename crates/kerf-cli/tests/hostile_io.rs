@@ -6,16 +6,8 @@ use std::fs;
 use std::os::unix::fs::{FileTypeExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn kerf() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_kerf"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
+mod common;
+use common::{fixture, kerf};
 
 fn bad(name: &str) -> PathBuf {
     fixture("bad/io").join(name)

@@ -282,7 +282,7 @@ fn station_and_fit_errors() {
         matches!(
             e,
             Err(InterpError::BadParameter {
-                name: "tolerance",
+                name: "tolerance_mm",
                 ..
             })
         ),

@@ -2,18 +2,13 @@
 //! of [`std::error::Error::source`] reaches the kinematics' own error and the operating
 //! system's [`std::io::Error`], not only their messages.
 
-use std::path::{Path, PathBuf};
-
 use kerf_interp::{solve_stations, MachineModel};
-use kerf_kinematics::{KinematicsError, Machine};
+use kerf_kinematics::KinematicsError;
 use kerf_pipeline::{Error, Job};
 use nalgebra::{Point3, Vector3};
 
-fn fixture(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(rel)
-}
+mod common;
+use common::{fixture, machine};
 
 /// Every error in the chain of `e`, itself first.
 fn chain(e: &Error) -> Vec<&(dyn std::error::Error + 'static)> {
@@ -26,8 +21,7 @@ fn chain(e: &Error) -> Vec<&(dyn std::error::Error + 'static)> {
 
 #[test]
 fn an_unreachable_pose_keeps_the_kinematics_error_as_source() {
-    let machine = Machine::read(fixture("fixtures/machines/ac_head.json")).expect("machine");
-    let model = MachineModel::new(machine).expect("model");
+    let model = MachineModel::new(machine()).expect("model");
     // A tool axis pointing down: no tilt of the A axis reaches it.
     let tips = [Point3::origin(), Point3::new(1.0, 0.0, 0.0)];
     let axes = [Vector3::z(), -Vector3::z()];
@@ -50,7 +44,7 @@ fn an_unreachable_pose_keeps_the_kinematics_error_as_source() {
 fn a_missing_machine_file_keeps_the_io_error() {
     let dir = tempfile::tempdir().expect("tempdir");
     let missing = dir.path().join("no_machine.json");
-    let e = Job::from_files(fixture("fixtures/door_trim.json"), &missing).expect_err("missing");
+    let e = Job::from_files(fixture("door_trim.json"), &missing).expect_err("missing");
     let links = chain(&e);
     assert!(
         links
@@ -70,7 +64,7 @@ fn a_missing_curves_file_keeps_the_io_error() {
     let dir = tempfile::tempdir().expect("tempdir");
     let e = Job::from_files(
         dir.path().join("none.json"),
-        fixture("fixtures/machines/ac_head.json"),
+        fixture("machines/ac_head.json"),
     )
     .expect_err("missing");
     let io = chain(&e)

@@ -41,7 +41,7 @@ fn main() {
             std::process::exit(1);
         }
     };
-    let opts = Options { band, ..defaults };
+    let opts = defaults.with_band(band);
     let cpu = thread_cpu_seconds().is_some();
     let now = || thread_cpu_seconds().unwrap_or(0.0);
     let wall = Instant::now();

@@ -22,12 +22,12 @@
 //! `fixtures/README.md` describes each file and what it tests. Fitted control points are rounded
 //! to 1e-9 mm so that the files stay readable; the measurements are made on the written files.
 
-use std::f64::consts::{FRAC_1_SQRT_2, PI, TAU};
+use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use kerf::format::curves::{self, RawCurve, RawCurvesFile, RawNurbsSurface, RawStl, RawSurface};
-use kerf::nurbs::{basis_funs, find_span, NurbsSurface, MAX_ORDER};
+use kerf::nurbs::{basis_funs, find_span, NurbsCurve, NurbsSurface, MAX_ORDER};
 use nalgebra::{DMatrix, Matrix3x2, Point2, Point3, Vector2, Vector3};
 
 /// The largest curve-to-surface distance the generator accepts, mm (kerf's default on-surface
@@ -665,40 +665,12 @@ const MAIN_Z: f64 = 60.0; // the main tube lies on the table: axis at z = 60
 const MAIN_X: f64 = 150.0; // main tube from x = -150 to 150
 const BRANCH_R: f64 = 30.0;
 
-/// A full circle in the plane spanned by the unit vectors `e1`, `e2` around `c`: the nine
-/// control points and weights of the exact rational quadratic, starting at `c + r e1`.
-fn circle_net(
-    c: Vector3<f64>,
-    e1: Vector3<f64>,
-    e2: Vector3<f64>,
-    r: f64,
-) -> (Vec<[f64; 3]>, Vec<f64>) {
-    let corners = [
-        (1.0, 0.0),
-        (1.0, 1.0),
-        (0.0, 1.0),
-        (-1.0, 1.0),
-        (-1.0, 0.0),
-        (-1.0, -1.0),
-        (0.0, -1.0),
-        (1.0, -1.0),
-        (1.0, 0.0),
-    ];
-    let pts = corners.iter().map(|&(a, b)| {
-        let p = c + (e1 * a + e2 * b) * r;
-        [p.x, p.y, p.z]
-    });
-    let w = (0..9).map(|i| if i % 2 == 1 { FRAC_1_SQRT_2 } else { 1.0 });
-    (pts.collect(), w.collect())
-}
-
-const CIRCLE_KNOTS: [f64; 12] = [
-    0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0,
-];
-
-/// A cylinder as a rational quadratic (around, u) x linear (along, v) NURBS surface: the circle
-/// of radius `r` around `c0` in the plane `e1, e2`, swept from `c0` to `c0 + axis`. With
-/// `e1 x e2 = axis / |axis|` the normal `Su x Sv` points outward.
+/// A cylinder ([`NurbsSurface::revolve`] of a line): the line from `c0 + r e1` to
+/// `c0 + r e1 + axis` turned a full turn about the axis through `c0` along `axis`, so `u` goes
+/// round from `c0 + r e1` towards `e2` (the exact 9-point rational quadratic circle) and `v`
+/// runs along the axis. With `e1 x e2 = axis / |axis|` the normal `Su x Sv` points outward.
+/// ([`NurbsSurface::cylinder`] would choose the seam itself; here it is placed away from the
+/// cut.)
 fn cylinder(
     id: &str,
     c0: Vector3<f64>,
@@ -707,18 +679,33 @@ fn cylinder(
     e2: Vector3<f64>,
     r: f64,
 ) -> RawNurbsSurface {
-    let (ring, w) = circle_net(c0, e1, e2, r);
+    assert!(
+        (e1.cross(&e2) - axis.normalize()).norm() < 1e-12,
+        "{id}: e1 x e2 must be the axis direction"
+    );
+    let foot = Point3::from(c0 + e1 * r);
+    let line = NurbsCurve::line(foot, foot + axis).expect("the cylinder's line");
+    let surface = NurbsSurface::revolve(&line, Point3::from(c0), axis, TAU).expect("the cylinder");
+    raw_surface(id, &surface)
+}
+
+/// The `kerf.curves/1` record of `surface`, its control points rounded to 1e-9 mm (the shape
+/// constructors' points differ from the exact corners by rounding only: regenerated, the
+/// fixtures are byte-identical to the committed ones).
+fn raw_surface(id: &str, surface: &NurbsSurface) -> RawNurbsSurface {
     RawNurbsSurface {
         id: id.into(),
-        degree_u: 2,
-        degree_v: 1,
-        knots_u: CIRCLE_KNOTS.to_vec(),
-        knots_v: vec![0.0, 0.0, 1.0, 1.0],
-        control_points: ring
+        degree_u: surface.degree_u(),
+        degree_v: surface.degree_v(),
+        knots_u: surface.knots_u().to_vec(),
+        knots_v: surface.knots_v().to_vec(),
+        control_points: surface
+            .control_points()
             .iter()
-            .map(|p| vec![*p, [p[0] + axis.x, p[1] + axis.y, p[2] + axis.z]])
+            // `+ 0.0` writes a rounded -0 as 0, as the exact corners are.
+            .map(|row| row.iter().map(|p| r9p(*p).map(|v| v + 0.0)).collect())
             .collect(),
-        weights: Some(w.iter().map(|&w| vec![w, w]).collect()),
+        weights: surface.is_rational().then(|| surface.weights()),
         flip: false,
     }
 }

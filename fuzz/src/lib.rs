@@ -153,10 +153,7 @@ impl<'a> Arbitrary<'a> for CurveCase {
 }
 
 fn options(tolerance: f64) -> Options {
-    Options {
-        max_points: 200_000,
-        ..Options::with_tolerance(tolerance)
-    }
+    Options::with_tolerance(tolerance).with_max_points(200_000)
 }
 
 /// The chord error of the segment `[a, b]` sampled at 32 interior parameters: a lower bound of
@@ -289,8 +286,8 @@ pub fn normals(case: &SurfaceCase) {
     let Ok(o) = orient(&case.curve, &d, &source, &dopts, &NormalOptions::default()) else {
         return;
     };
-    assert_eq!(o.params.len(), o.normals.len(), "one normal per point");
-    for (i, nv) in o.normals.iter().enumerate() {
+    assert_eq!(o.params().len(), o.normals().len(), "one normal per point");
+    for (i, nv) in o.normals().iter().enumerate() {
         assert!(
             (nv.norm() - 1.0).abs() < 1e-9,
             "normals[{i}] is a unit vector"

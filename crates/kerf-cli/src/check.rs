@@ -60,10 +60,7 @@ pub(crate) fn run(args: &CheckArgs) -> Result<(), CliError> {
         RawToolpath::load(&args.toolpath)?
     };
     let defaults = CheckOptions::default();
-    let opts = CheckOptions {
-        samples: args.samples.unwrap_or(defaults.samples),
-        ..defaults
-    };
+    let opts = defaults.with_samples(args.samples.unwrap_or(defaults.samples));
     let report = check(&curves.curves, &toolpath, &opts);
     let stdout = io::stdout();
     let mut out = stdout.lock();

@@ -312,6 +312,14 @@ pub(crate) struct MotionArgs {
     /// height). Choose it so that the traverse clears the part.
     #[arg(long, default_value_t = 10.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
     pub(crate) retract: f64,
+
+    /// The traverses between cuts: > 0 runs each through the waypoints the axes file records
+    /// for it (its `traverse` key, checked by `kerf run` to keep this clearance from the part),
+    /// as `kerf run`'s own program does; 0 = the unchecked retract and straight traverse
+    /// everywhere. The axes file's traverses were planned for the clearance `kerf run` was
+    /// given: without the part's surfaces they cannot be planned again here (mm).
+    #[arg(long, default_value_t = 5.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
+    pub(crate) clearance: f64,
 }
 
 /// Arguments of `kerf interpolate`.

@@ -18,35 +18,33 @@ use crate::error::CliError;
 use crate::input::{load_curves, ProgressBar};
 
 /// The discretizer options the arguments ask for.
-// `..d` keeps the defaults of options added to `Options` later (every field is set today).
-#[allow(clippy::needless_update)]
 pub(crate) fn options(args: &DiscretizeArgs) -> Options {
     let d = Options::default();
-    Options {
-        tolerance: args.tolerance,
-        band: args.band.unwrap_or(d.band),
-        max_segment_length: args.max_segment_length.unwrap_or(d.max_segment_length),
-        min_segment_length: args.min_segment_length.unwrap_or(d.min_segment_length),
-        max_turn: args.max_turn.map_or(d.max_turn, f64::to_radians),
-        strategy: args.strategy.into(),
-        max_points: args
-            .max_points
-            .map_or(d.max_points, |n| usize::try_from(n).unwrap_or(usize::MAX)),
-        ..d
-    }
+    Options::with_tolerance(args.tolerance)
+        .with_band(args.band.unwrap_or(d.band))
+        .with_max_segment_length(args.max_segment_length.unwrap_or(d.max_segment_length))
+        .with_min_segment_length(args.min_segment_length.unwrap_or(d.min_segment_length))
+        .with_max_turn(args.max_turn.map_or(d.max_turn, f64::to_radians))
+        .with_strategy(args.strategy.into())
+        .with_max_points(
+            args.max_points
+                .map_or(d.max_points, |n| usize::try_from(n).unwrap_or(usize::MAX)),
+        )
 }
 
 /// The normals-stage options the arguments ask for (`--normals` refuses curves without a
 /// surface).
 fn orient_options(args: &DiscretizeArgs) -> OrientOptions {
     let d = NormalOptions::default();
-    let normals = NormalOptions {
-        on_surface_tolerance: args.on_surface_tolerance.unwrap_or(d.on_surface_tolerance),
-        max_normal_step: args
-            .max_normal_step
-            .map_or(d.max_normal_step, f64::to_radians),
-        ..d
-    };
+    let normals = d
+        .with_on_surface_tolerance_mm(
+            args.on_surface_tolerance
+                .unwrap_or(d.on_surface_tolerance_mm),
+        )
+        .with_max_normal_step_rad(
+            args.max_normal_step
+                .map_or(d.max_normal_step_rad, f64::to_radians),
+        );
     let o = OrientOptions::default()
         .with_normals(normals)
         .with_missing_surface(MissingSurface::Error);

@@ -71,8 +71,8 @@ pub(crate) fn is_step(path: &Path) -> bool {
 
 fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
     let mut o = ImportOptions::default()
-        .with_close_gaps(a.close_gaps)
-        .with_face_tolerance(a.face_tolerance)
+        .with_close_gaps_mm(a.close_gaps)
+        .with_face_tolerance_mm(a.face_tolerance)
         .with_all_faces(a.all_faces);
     if a.edges {
         let ids = a

@@ -21,7 +21,8 @@ fn program(args: &MotionArgs, options: MotionOptions) -> Result<Program, CliErro
         .with_cycle_s(args.cycle)
         .with_fit_tolerance_mm(args.fit_tolerance)
         .with_chord_tolerance_mm(args.chord_tolerance)
-        .with_retract_mm(args.retract);
+        .with_retract_mm(args.retract)
+        .with_recorded_traverses(args.clearance > 0.0);
     Ok(plan_program(&machine, &input, &options, Some(&args.input))?)
 }
 

@@ -1,11 +1,13 @@
 //! `kerf post`: machine axes for a toolpath with normals (`kerf.toolpath/1` with
-//! `[x, y, z, i, j, k]` points), written as `kerf.axes/1`.
+//! `[x, y, z, i, j, k]` points), written as `kerf.axes/1`: argument parsing and printing over
+//! [`kerf_pipeline::post_toolpath`].
 
 use std::path::Path;
 use std::time::Instant;
 
-use kerf_format::toolpath::{self, ToolpathPoints};
-use kerf_kinematics::{solve_paths, AxesFile, Machine, PathInput, PathOptions, Pose};
+use kerf_format::toolpath;
+use kerf_kinematics::{Machine, PathOptions};
+use kerf_pipeline::{post_toolpath, MissingNormals};
 use serde_json::json;
 
 use crate::cli::PostArgs;
@@ -14,14 +16,12 @@ use crate::error::CliError;
 /// The path options the arguments ask for.
 pub(crate) fn options(args: &PostArgs) -> PathOptions {
     let d = PathOptions::default();
-    PathOptions {
-        linearization_tolerance: args
-            .linearization_tolerance
-            .unwrap_or(d.linearization_tolerance),
-        max_rotary_step_deg: args.max_rotary_step.unwrap_or(d.max_rotary_step_deg),
-        pole_tolerance_rad: args.pole_tolerance.unwrap_or(d.pole_tolerance_rad),
-        ..d
-    }
+    d.with_linearization_tolerance_mm(
+        args.linearization_tolerance
+            .unwrap_or(d.linearization_tolerance_mm),
+    )
+    .with_max_rotary_step_deg(args.max_rotary_step.unwrap_or(d.max_rotary_step_deg))
+    .with_pole_tolerance_rad(args.pole_tolerance.unwrap_or(d.pole_tolerance_rad))
 }
 
 /// Runs `kerf post`.
@@ -34,48 +34,18 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
     crate::guard::refuse_overwrite("--output", &dest, &[&args.toolpath, &args.machine])?;
     let machine = Machine::read(&args.machine)?;
     let tp = toolpath::load(&args.toolpath)?;
-    let mut poses = Vec::with_capacity(tp.paths.len());
-    for (i, p) in tp.paths.iter().enumerate() {
-        match &p.points {
-            ToolpathPoints::Poses(v) => {
-                poses.push(v.iter().copied().map(Pose::from_array).collect::<Vec<_>>())
-            }
-            ToolpathPoints::Positions(_) => {
-                return Err(kerf_pipeline::Error::NoNormals {
-                    file: Some(args.toolpath.clone()),
-                    index: i,
-                    id: p.id.clone(),
-                }
-                .into())
-            }
-        }
-    }
     let opts = options(args);
-    let ids: Vec<&str> = tp.paths.iter().map(|p| p.id.as_str()).collect();
-    let placed = kerf_pipeline::place(
+    let posted = post_toolpath(
         &machine,
-        &ids,
-        &poses,
-        args.place.unwrap_or_default(),
+        &tp,
         &opts,
-        kerf_pipeline::AUTO_CLEARANCE_MM,
+        args.place.unwrap_or_default(),
+        MissingNormals::Error,
         Some(&args.toolpath),
     )?;
-    let poses = placed.apply(&poses);
-    let inputs: Vec<PathInput<'_>> = tp
-        .paths
-        .iter()
-        .zip(&poses)
-        .map(|(p, q)| PathInput {
-            id: &p.id,
-            poses: q,
-            curve: None,
-        })
-        .collect();
-    let solved = solve_paths(&machine, &inputs, &opts)
-        .map_err(|e| kerf_pipeline::Error::from(e).in_file(&args.toolpath))?;
-    let file = AxesFile::new(&machine, &solved);
-    file.write(&dest)?;
+    posted.axes.write(&dest)?;
+    let (solved, placed) = (&posted.solved, &posted.placed);
+    let ids: Vec<&str> = tp.paths.iter().map(|p| p.id.as_str()).collect();
     let inserted: usize = solved.iter().map(|s| s.inserted).sum();
     let points: usize = solved.iter().map(|s| s.poses.len()).sum();
     let max_rot = solved
@@ -99,7 +69,7 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
             "inserted": inserted,
             "max_rotary_step_between_cutting_points": max_rot,
             "max_linearization_error": max_lin,
-            "linearization_tolerance": opts.linearization_tolerance,
+            "linearization_tolerance": opts.linearization_tolerance_mm,
             "pole_points": pole,
             "pole_tip_error": pole_err,
             "placement": placed.json(&ids),
@@ -118,7 +88,7 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
             args.toolpath.display(),
             solved.len(),
             machine.name,
-            opts.linearization_tolerance,
+            opts.linearization_tolerance_mm,
             dest.display(),
             if placed.is_identity() {
                 String::new()

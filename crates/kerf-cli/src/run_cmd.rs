@@ -17,16 +17,15 @@ fn job_options(args: &RunArgs) -> JobOptions {
     discretize.max_segment_length = args.max_segment_length.unwrap_or(f64::INFINITY);
     let mut normals = NormalOptions::default();
     if let Some(deg) = args.max_normal_step {
-        normals.max_normal_step = deg.to_radians();
+        normals.max_normal_step_rad = deg.to_radians();
     }
     let d = PathOptions::default();
-    let path = PathOptions {
-        linearization_tolerance: args
-            .linearization_tolerance
-            .unwrap_or(d.linearization_tolerance),
-        max_rotary_step_deg: args.max_rotary_step.unwrap_or(f64::INFINITY),
-        ..d
-    };
+    let path = d
+        .with_linearization_tolerance_mm(
+            args.linearization_tolerance
+                .unwrap_or(d.linearization_tolerance_mm),
+        )
+        .with_max_rotary_step_deg(args.max_rotary_step.unwrap_or(f64::INFINITY));
     JobOptions::default()
         .with_discretize(discretize)
         .with_orient(OrientOptions::default().with_normals(normals))

@@ -2,20 +2,12 @@
 //! (a point removed from a curved path, a C0 corner removed, a point moved off its curve,
 //! params reversed) fail with exit status 1 and the violation named.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
 use serde_json::Value;
-
-fn kerf() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_kerf"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
+mod common;
+use common::{fixture, kerf};
 
 /// `kerf discretize fixtures/mixed.json -t 0.01` into `dir`, read back as JSON.
 fn discretized(dir: &Path) -> Value {

@@ -1,17 +1,7 @@
 //! `kerf discretize` end to end: the binary on fixtures, its output read back and checked.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn kerf() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_kerf"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
+mod common;
+use common::{fixture, kerf};
 
 #[test]
 fn writes_a_certified_toolpath_for_every_curve() {

@@ -5,23 +5,15 @@
 //! The fixtures come from `cargo run --release --example make_fixtures` (see
 //! `fixtures/README.md`); the machines from `fixtures/machines/`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
 use serde_json::Value;
+mod common;
+use common::{fixture, kerf};
 
 const TOLERANCE: f64 = 0.01;
 const FEED: &str = "6000";
-
-fn kerf() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_kerf"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
 
 /// Runs `kerf args...`, asserting success; returns standard output.
 fn run(args: &[&std::ffi::OsStr]) -> String {

@@ -6,16 +6,8 @@ use std::fs;
 use std::os::unix::fs::{FileTypeExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn kerf() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_kerf"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
+mod common;
+use common::{fixture, kerf};
 
 fn bad(name: &str) -> PathBuf {
     fixture("bad/io").join(name)
@@ -311,7 +303,36 @@ fn every_output_gets_the_mode_of_any_created_file() {
         .arg("-q")
         .arg("-o")
         .arg(&tp));
-    for p in [&nc, &csv, &tp] {
+    // With normals, then `kerf post` (the axes writer) and `kerf run` (every file of its
+    // output directory, written all or nothing).
+    let normals = dir.path().join("dome.toolpath.json");
+    ok(kerf()
+        .arg("discretize")
+        .arg(fixture("dome.json"))
+        .args(["--normals", "-q", "-o"])
+        .arg(&normals));
+    let axes = dir.path().join("dome.axes.json");
+    ok(kerf()
+        .arg("post")
+        .arg(&normals)
+        .arg("-m")
+        .arg(fixture(MACHINE))
+        .args(["-q", "-o"])
+        .arg(&axes));
+    let run = dir.path().join("run");
+    ok(kerf()
+        .arg("run")
+        .arg(fixture("dome.json"))
+        .arg("--machine")
+        .arg(fixture(MACHINE))
+        .args(["-q", "--out"])
+        .arg(&run));
+    let mut written = vec![nc, csv, tp, normals, axes];
+    for entry in fs::read_dir(&run).expect("run output") {
+        written.push(entry.expect("entry").path());
+    }
+    assert!(written.len() >= 9, "kerf run wrote its files: {written:?}");
+    for p in &written {
         assert_eq!(mode(p), mode(&reference), "{}", p.display());
     }
 }

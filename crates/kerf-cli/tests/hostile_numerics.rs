@@ -1,20 +1,16 @@
 //! Issue 13 through the binary: hostile numerical inputs end at once with a certified result
 //! or an error that gives the real reason, in readable numbers, naming the option to change.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
+mod common;
+use common::fixture;
 
 fn kerf(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_kerf"))
         .args(args)
         .output()
         .expect("kerf runs")
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
 }
 
 fn path(p: &Path) -> &str {

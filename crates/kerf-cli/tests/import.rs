@@ -1,18 +1,10 @@
 //! `kerf import` and `kerf run PART.step` through the binary, on the STEP fixtures (made with
 //! Open CASCADE, checked against its reader by scripts/step_check.py) and the real parts.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-
-fn kerf() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_kerf"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
+mod common;
+use common::{fixture, kerf};
 
 fn run(c: &mut Command) -> (i32, String, String) {
     let o = c.output().unwrap();

@@ -1,18 +1,9 @@
 //! The whole chain through the binary: run, post, interpolate, gcode, and what a failed run
 //! leaves behind.
 
-use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn kerf() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_kerf"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
+mod common;
+use common::{fixture, kerf};
 
 fn ok(c: &mut Command) -> std::process::Output {
     let o = c.output().unwrap();

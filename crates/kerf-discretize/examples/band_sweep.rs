@@ -21,10 +21,7 @@ fn main() {
         for tol in [0.01, 0.001] {
             let nstar: f64 = curves.iter().map(|c| minimum_count(c, tol)).sum();
             for band in [0.5, 0.7, 0.8, 0.9, 0.95, 0.98] {
-                let opts = Options {
-                    band,
-                    ..Options::with_tolerance(tol)
-                };
+                let opts = Options::with_tolerance(tol).with_band(band);
                 let start = Instant::now();
                 let mut segs = 0;
                 let mut pts = 0;

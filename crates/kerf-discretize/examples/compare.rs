@@ -42,10 +42,7 @@ fn main() {
             nstar_total += nstar;
             let mut cells = Vec::new();
             for (i, (s, _)) in STRATEGIES.iter().enumerate() {
-                let opts = Options {
-                    strategy: *s,
-                    ..Options::with_tolerance(tol)
-                };
+                let opts = Options::with_tolerance(tol).with_strategy(*s);
                 // Best of 5 runs: the first run of a curve pays for cold caches.
                 let mut secs = f64::INFINITY;
                 let mut d = None;

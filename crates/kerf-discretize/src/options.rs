@@ -22,24 +22,27 @@ pub enum Strategy {
 
 /// Options of the discretizer. Lengths in the units of the curve (mm), angles in radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Options {
-    /// The chord tolerance `E_max`: every segment's chord error is at most this. Must be > 0.
+    /// The chord tolerance `E_max`: every segment's chord error is at most this, mm. Must be > 0;
+    /// default 0.01 (start a chain with [`Options::with_tolerance`]).
     pub tolerance: f64,
     /// The lower edge of the band as a fraction of the tolerance: `E_min = band * tolerance`.
     /// A step whose estimated chord error lies in `[E_min, E_max]` is accepted at once; a
     /// shorter one is lengthened. In `(0, 1)`; default 0.97 (measured: see
     /// `docs/discretization.md`).
     pub band: f64,
-    /// The longest chord allowed (machines limit block length). `f64::INFINITY` for none.
+    /// The longest chord allowed (machines limit block length), mm. `f64::INFINITY` (the
+    /// default) for none.
     pub max_segment_length: f64,
     /// The sphere radius is never proposed below this length; the tolerance still wins where
     /// it needs shorter segments, and the last segment before a C0 break or the end may be
-    /// shorter. Default 0.
+    /// shorter, mm. Default 0.
     pub min_segment_length: f64,
     /// The largest turn of the tangent between the two ends of a segment, in radians.
     /// `f64::INFINITY` (the default) for none.
     pub max_turn: f64,
-    /// Which method to use.
+    /// Which method to use. Default [`Strategy::ReferenceSphere`].
     pub strategy: Strategy,
     /// Refuse curves that would need more points than this (protects against a tolerance
     /// typed in the wrong unit). Default 50,000,000.
@@ -61,6 +64,46 @@ impl Default for Options {
 }
 
 impl Options {
+    /// Sets [`band`](Self::band): the lower edge of the band as a fraction of the tolerance.
+    pub fn with_band(mut self, band: f64) -> Self {
+        self.band = band;
+        self
+    }
+
+    /// Sets [`max_segment_length`](Self::max_segment_length): the longest chord allowed
+    /// (machines limit block length).
+    pub fn with_max_segment_length(mut self, max_segment_length: f64) -> Self {
+        self.max_segment_length = max_segment_length;
+        self
+    }
+
+    /// Sets [`min_segment_length`](Self::min_segment_length): the sphere radius is never
+    /// proposed below this length.
+    pub fn with_min_segment_length(mut self, min_segment_length: f64) -> Self {
+        self.min_segment_length = min_segment_length;
+        self
+    }
+
+    /// Sets [`max_turn`](Self::max_turn): the largest turn of the tangent between the two
+    /// ends of a segment, in radians.
+    pub fn with_max_turn(mut self, max_turn: f64) -> Self {
+        self.max_turn = max_turn;
+        self
+    }
+
+    /// Sets [`strategy`](Self::strategy): which method to use.
+    pub fn with_strategy(mut self, strategy: Strategy) -> Self {
+        self.strategy = strategy;
+        self
+    }
+
+    /// Sets [`max_points`](Self::max_points): refuse curves that would need more points
+    /// than this (protects against a tolerance typed in the wrong unit).
+    pub fn with_max_points(mut self, max_points: usize) -> Self {
+        self.max_points = max_points;
+        self
+    }
+
     /// Default options with the given tolerance.
     pub fn with_tolerance(tolerance: f64) -> Self {
         Self {

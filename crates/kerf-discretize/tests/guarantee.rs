@@ -19,10 +19,7 @@ fn single_span_arcs_have_the_exact_circle_count() {
     ] {
         let phi = f64::to_radians(phi_deg);
         let c = arc(r, phi);
-        let opts = Options {
-            band: 0.999,
-            ..Options::with_tolerance(tol)
-        };
+        let opts = Options::with_tolerance(tol).with_band(0.999);
         let d = discretize(&c, &opts).unwrap();
         check(&c, &d, tol);
         let theta = 2.0 * (1.0 - tol / r).acos();
@@ -58,10 +55,7 @@ fn a_straight_line_is_one_segment_or_what_max_length_demands() {
     );
     let d = discretize(&cubic_line, &Options::with_tolerance(0.001)).unwrap();
     assert_eq!(d.segments(), 1, "a straight cubic needs one segment");
-    let opts = Options {
-        max_segment_length: 7.0,
-        ..Options::with_tolerance(0.001)
-    };
+    let opts = Options::with_tolerance(0.001).with_max_segment_length(7.0);
     let d = discretize(&line, &opts).unwrap();
     let len = (100.0f64 * 100.0 + 400.0 + 25.0).sqrt();
     assert_eq!(
@@ -151,10 +145,7 @@ fn every_strategy_keeps_the_guarantee() {
         Strategy::EqualParameter,
         Strategy::EqualChordLength,
     ] {
-        let opts = Options {
-            strategy: s,
-            ..Options::with_tolerance(0.01)
-        };
+        let opts = Options::with_tolerance(0.01).with_strategy(s);
         let d = discretize(&c, &opts).unwrap();
         check(&c, &d, 0.01);
         counts.push(d.segments());

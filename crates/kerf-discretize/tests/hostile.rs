@@ -170,10 +170,7 @@ fn tolerance_below_precision_is_refused_before_the_walk() {
             Strategy::EqualChordLength,
             Strategy::EqualError,
         ] {
-            let opts = Options {
-                strategy,
-                ..Options::with_tolerance(1e-12)
-            };
+            let opts = Options::with_tolerance(1e-12).with_strategy(strategy);
             let (r, work) = run(&c, &opts);
             match r {
                 Err(DiscretizeError::ToleranceBelowMargin {
@@ -334,11 +331,9 @@ fn classic_strategies_refuse_as_fast_as_the_default() {
         Strategy::EqualError,
     ] {
         for (tol, max_points) in [(1e-12, 50_000_000), (1e-3, 100)] {
-            let opts = Options {
-                strategy,
-                max_points,
-                ..Options::with_tolerance(tol)
-            };
+            let opts = Options::with_tolerance(tol)
+                .with_strategy(strategy)
+                .with_max_points(max_points);
             let (r, work) = run(&circle, &opts);
             assert!(
                 matches!(
@@ -358,10 +353,7 @@ fn classic_strategies_refuse_as_fast_as_the_default() {
     // The classic searches themselves certify lazily: a count whose first segment fails costs
     // one certificate, so even the search's failures stay linear in the output.
     for strategy in [Strategy::EqualParameter, Strategy::EqualChordLength] {
-        let opts = Options {
-            strategy,
-            ..Options::with_tolerance(0.001)
-        };
+        let opts = Options::with_tolerance(0.001).with_strategy(strategy);
         let (r, work) = run(&circle, &opts);
         let d = r.expect("certified");
         check(&circle, &d, 0.001);
@@ -399,10 +391,7 @@ fn max_turn_bounds_the_turn_inside_the_segment() {
     // The S-curve's end tangents are equal; its tangent swings about 90 degrees inside.
     let (_, c) = fixture("hostile/hostile_s_curve.json").remove(0);
     let max_turn = 10f64.to_radians();
-    let opts = Options {
-        max_turn,
-        ..Options::with_tolerance(1.0)
-    };
+    let opts = Options::with_tolerance(1.0).with_max_turn(max_turn);
     let (r, work) = run(&c, &opts);
     let d = r.expect("reachable");
     assert!(work <= walk_budget(&c, &d), "{work} evaluations");
@@ -433,10 +422,7 @@ fn max_turn_at_a_corner_inside_a_span_puts_a_point_on_the_corner() {
     // corner (to the coordinates' resolution) instead of giving up or ignoring the turn.
     let (_, c) = fixture("hostile/hostile_corner_simple_knot.json").remove(0);
     let max_turn = 10f64.to_radians();
-    let opts = Options {
-        max_turn,
-        ..Options::with_tolerance(0.01)
-    };
+    let opts = Options::with_tolerance(0.01).with_max_turn(max_turn);
     let (r, work) = run(&c, &opts);
     let d = r.expect("a point lands on the corner");
     assert!(work <= walk_budget(&c, &d), "{work} evaluations");
@@ -461,10 +447,7 @@ fn max_turn_that_needs_too_many_points_is_refused_up_front() {
     // The S-curve turns about 180 degrees in all; 1e-7 degrees per segment would need more
     // than 1e9 points: refused from the estimate, before the walk.
     let (_, c) = fixture("hostile/hostile_s_curve.json").remove(0);
-    let opts = Options {
-        max_turn: 1e-7f64.to_radians(),
-        ..Options::with_tolerance(0.01)
-    };
+    let opts = Options::with_tolerance(0.01).with_max_turn(1e-7f64.to_radians());
     let (r, work) = run(&c, &opts);
     assert!(
         matches!(r, Err(DiscretizeError::TooManyPoints { .. })),

@@ -15,49 +15,23 @@ fn every_bad_option_is_named() {
         (Options::with_tolerance(-1.0), "tolerance"),
         (Options::with_tolerance(f64::NAN), "tolerance"),
         (Options::with_tolerance(f64::INFINITY), "tolerance"),
+        (Options::default().with_band(1.0), "band"),
+        (Options::default().with_band(0.0), "band"),
         (
-            Options {
-                band: 1.0,
-                ..Options::default()
-            },
-            "band",
-        ),
-        (
-            Options {
-                band: 0.0,
-                ..Options::default()
-            },
-            "band",
-        ),
-        (
-            Options {
-                max_segment_length: 0.0,
-                ..Options::default()
-            },
+            Options::default().with_max_segment_length(0.0),
             "max_segment_length",
         ),
         (
-            Options {
-                min_segment_length: f64::NAN,
-                ..Options::default()
-            },
+            Options::default().with_min_segment_length(f64::NAN),
             "min_segment_length",
         ),
         (
-            Options {
-                min_segment_length: 5.0,
-                max_segment_length: 1.0,
-                ..Options::default()
-            },
+            Options::default()
+                .with_min_segment_length(5.0)
+                .with_max_segment_length(1.0),
             "min_segment_length",
         ),
-        (
-            Options {
-                max_turn: -1.0,
-                ..Options::default()
-            },
-            "max_turn",
-        ),
+        (Options::default().with_max_turn(-1.0), "max_turn"),
     ];
     for (opts, name) in cases {
         match discretize(&c, &opts) {
@@ -70,10 +44,7 @@ fn every_bad_option_is_named() {
 #[test]
 fn max_turn_limits_the_tangent_turn_per_segment() {
     let c = arc(100.0, 2.0);
-    let opts = Options {
-        max_turn: 0.05,
-        ..Options::with_tolerance(0.1)
-    };
+    let opts = Options::with_tolerance(0.1).with_max_turn(0.05);
     let d = discretize(&c, &opts).unwrap();
     check(&c, &d, 0.1);
     for w in d.params().windows(2) {
@@ -89,10 +60,7 @@ fn max_turn_limits_the_tangent_turn_per_segment() {
 #[test]
 fn min_segment_length_keeps_proposals_long_but_tolerance_wins() {
     let c = arc(5.0, 2.5);
-    let opts = Options {
-        min_segment_length: 3.0,
-        ..Options::with_tolerance(0.01)
-    };
+    let opts = Options::with_tolerance(0.01).with_min_segment_length(3.0);
     let d = discretize(&c, &opts).unwrap();
     check(&c, &d, 0.01);
 }
@@ -145,10 +113,7 @@ fn a_joined_multiplicity_p_plus_one_knot_is_fine() {
 #[test]
 fn too_many_points_is_refused_before_work() {
     let c = arc(1000.0, 3.0);
-    let opts = Options {
-        max_points: 1000,
-        ..Options::with_tolerance(1e-7)
-    };
+    let opts = Options::with_tolerance(1e-7).with_max_points(1000);
     assert!(
         matches!(
             discretize(&c, &opts),

@@ -32,6 +32,7 @@ pub enum FormatError {
         /// The file, as given by the caller.
         file: PathBuf,
         /// What is wrong in it.
+        #[source]
         error: Box<FormatError>,
     },
     /// The file could not be read (missing, a directory, no permission, ...).
@@ -39,6 +40,7 @@ pub enum FormatError {
     #[error("cannot read: {error}")]
     Read {
         /// The operating system's error.
+        #[source]
         error: io::Error,
     },
     /// The output could not be written, or the temporary file could not be created or renamed.
@@ -47,6 +49,7 @@ pub enum FormatError {
     #[error("cannot write: {error}")]
     Write {
         /// The operating system's error.
+        #[source]
         error: io::Error,
     },
     /// The document is empty (or only white space). Fix: the file was probably truncated or
@@ -352,6 +355,7 @@ pub enum StlProblem {
     #[error("cannot read: {error}")]
     Read {
         /// The operating system's error.
+        #[source]
         error: io::Error,
     },
     /// The file is neither a complete binary STL nor a parsable ASCII STL. Fix: export it

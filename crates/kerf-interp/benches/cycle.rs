@@ -39,11 +39,9 @@ fn program(c: &mut Criterion) {
             &st,
             None,
             0,
-            &FitOptions {
-                arcs,
-                tolerance: 0.005,
-                ..FitOptions::default()
-            },
+            &FitOptions::default()
+                .with_arcs(arcs)
+                .with_tolerance_mm(0.005),
         )
         .expect("fit");
         let motion = plan(&m, &blocks, &PlanOptions::new(10000.0, 0.001)).expect("plan");
@@ -70,10 +68,7 @@ fn program(c: &mut Criterion) {
         &st,
         None,
         0,
-        &FitOptions {
-            tolerance: 0.005,
-            ..FitOptions::default()
-        },
+        &FitOptions::default().with_tolerance_mm(0.005),
     )
     .expect("fit");
     let motion = plan(&mm, &blocks, &PlanOptions::new(10000.0, 0.001)).expect("plan");

@@ -40,12 +40,10 @@ fn planning(c: &mut Criterion) {
             &st,
             None,
             0,
-            &FitOptions {
-                arcs,
-                merge_lines: arcs,
-                tolerance: 0.005,
-                ..FitOptions::default()
-            },
+            &FitOptions::default()
+                .with_arcs(arcs)
+                .with_merge_lines(arcs)
+                .with_tolerance_mm(0.005),
         )
         .expect("fit")
     };

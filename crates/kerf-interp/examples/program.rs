@@ -85,11 +85,9 @@ fn main() {
         let fits = [
             (
                 "one line per chord",
-                FitOptions {
-                    arcs: false,
-                    merge_lines: false,
-                    ..FitOptions::with_tolerance(tol)
-                },
+                FitOptions::with_tolerance(tol)
+                    .with_arcs(false)
+                    .with_merge_lines(false),
             ),
             ("arc fit", FitOptions::with_tolerance(tol)),
         ];
@@ -100,10 +98,7 @@ fn main() {
             let exact = plan(
                 &m,
                 &blocks,
-                &PlanOptions {
-                    block_ends_on_cycles: true,
-                    ..PlanOptions::new(feed, cycle)
-                },
+                &PlanOptions::new(feed, cycle).with_block_ends_on_cycles(true),
             )
             .expect("plan");
             println!(

@@ -71,8 +71,8 @@ pub fn solve_stations<M: AxisModel + ?Sized>(
         let q = model
             .inverse(tip, &axis, prev.as_ref())
             .map_err(|e| match e {
-                InterpError::Kinematics { message, .. } => {
-                    InterpError::Kinematics { index: i, message }
+                InterpError::Kinematics { source, .. } => {
+                    InterpError::Kinematics { index: i, source }
                 }
                 other => other,
             })?;

@@ -55,12 +55,14 @@ pub enum InterpError {
     },
     /// The machine model could not reach a pose (inverse kinematics failed: outside the axis
     /// ranges, or not a unit tool axis). Fix: see the message from the kinematics.
-    #[error("point {index}: kinematics: {message}")]
+    #[error("point {index}: kinematics: {source}")]
     Kinematics {
         /// Index of the pose within its path.
         index: usize,
-        /// The kinematics' own message.
-        message: String,
+        /// The kinematics' own error (boxed, so that no `Result` of the interpolator or of the
+        /// pipeline grows by its size).
+        #[source]
+        source: kerf_kinematics::BoxedKinematicsError,
     },
     /// An interpolated set-point leaves an axis range of the machine (an arc bulging past a
     /// limit between two reachable points). Fix: move the part, or interpolate lines only
@@ -106,12 +108,13 @@ pub enum InterpError {
         limit: usize,
     },
     /// Writing an output file failed. Fix: check that the directory exists and is writable.
-    #[error("{path}: {message}")]
+    #[error("{path}: {source}")]
     Io {
         /// The file.
         path: String,
-        /// The operating system's message.
-        message: String,
+        /// The operating system's error (its [`std::io::Error`] is the source of this one).
+        #[source]
+        source: kerf_kinematics::IoError,
     },
     /// The laser process codes given to the G-code writer are unusable (the message names the
     /// key, as `process.beam_on[0]: must not be empty`). Fix: correct the `process` object of
@@ -135,6 +138,20 @@ pub enum InterpError {
         /// `an arc` or `a line merged over N poses`.
         what: String,
     },
+}
+
+impl InterpError {
+    /// A [`InterpError::Kinematics`] at point 0 (callers that know the point set the index)
+    /// for a pose the point-wise inverse cannot solve.
+    pub(crate) fn unreachable(reason: impl Into<String>) -> Self {
+        InterpError::Kinematics {
+            index: 0,
+            source: kerf_kinematics::KinematicsError::Unreachable {
+                reason: reason.into(),
+            }
+            .into(),
+        }
+    }
 }
 
 /// `Result` with [`InterpError`].

@@ -35,10 +35,11 @@ use kerf_nurbs::nearest_on_segment;
 
 /// Options of [`fit_blocks`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FitOptions {
     /// Largest distance (mm) of a block from the points and the curve it replaces. Default
     /// 0.001 mm; the natural choice is the toolpath's own `tolerance`.
-    pub tolerance: f64,
+    pub tolerance_mm: f64,
     /// Largest angle (degrees) between the interpolated and the given tool axis at a point.
     /// Default 0.1.
     pub orientation_tolerance_deg: f64,
@@ -52,46 +53,104 @@ pub struct FitOptions {
     /// full turn; G-code `CIP` needs less than 360).
     pub max_sweep_deg: f64,
     /// Largest arc radius, mm; flatter runs are lines. Default 1e5.
-    pub max_radius: f64,
+    pub max_radius_mm: f64,
     /// Curve points tested between two neighbouring cutting points when the curve is known.
     /// Default 4.
     pub curve_samples: usize,
     /// Retract distance (mm) of the rapid moves between paths ([`crate::fit_program`]): the
     /// head backs off along the tool axis, traverses, and approaches the next start along its
     /// tool axis, instead of crossing at cutting height. Default 10; 0 gives one straight rapid.
-    pub retract: f64,
+    pub retract_mm: f64,
 }
 
 impl Default for FitOptions {
     fn default() -> Self {
         Self {
-            tolerance: 0.001,
+            tolerance_mm: 0.001,
             orientation_tolerance_deg: 0.1,
             arcs: true,
             merge_lines: true,
             max_points: 1024,
             max_sweep_deg: 270.0,
-            max_radius: 1e5,
+            max_radius_mm: 1e5,
             curve_samples: 4,
-            retract: 10.0,
+            retract_mm: 10.0,
         }
     }
 }
 
 impl FitOptions {
-    /// The defaults with this tolerance (mm).
-    pub fn with_tolerance(tolerance: f64) -> Self {
-        Self {
-            tolerance,
-            ..Self::default()
-        }
+    /// Sets [`tolerance_mm`](Self::tolerance_mm): largest distance (mm) of a block from the
+    /// points and the curve it replaces.
+    pub fn with_tolerance_mm(mut self, tolerance_mm: f64) -> Self {
+        self.tolerance_mm = tolerance_mm;
+        self
+    }
+
+    /// Sets [`orientation_tolerance_deg`](Self::orientation_tolerance_deg): largest angle
+    /// (degrees) between the interpolated and the given tool axis at a point.
+    pub fn with_orientation_tolerance_deg(mut self, orientation_tolerance_deg: f64) -> Self {
+        self.orientation_tolerance_deg = orientation_tolerance_deg;
+        self
+    }
+
+    /// Sets [`arcs`](Self::arcs): fit arcs (default true).
+    pub fn with_arcs(mut self, arcs: bool) -> Self {
+        self.arcs = arcs;
+        self
+    }
+
+    /// Sets [`merge_lines`](Self::merge_lines): merge runs of collinear points into one
+    /// line (default true).
+    pub fn with_merge_lines(mut self, merge_lines: bool) -> Self {
+        self.merge_lines = merge_lines;
+        self
+    }
+
+    /// Sets [`max_points`](Self::max_points): most cutting points one block may span
+    /// (bounds the fitting cost).
+    pub fn with_max_points(mut self, max_points: usize) -> Self {
+        self.max_points = max_points;
+        self
+    }
+
+    /// Sets [`max_sweep_deg`](Self::max_sweep_deg): largest swept angle of an arc, degrees.
+    pub fn with_max_sweep_deg(mut self, max_sweep_deg: f64) -> Self {
+        self.max_sweep_deg = max_sweep_deg;
+        self
+    }
+
+    /// Sets [`max_radius_mm`](Self::max_radius_mm): largest arc radius, mm.
+    pub fn with_max_radius_mm(mut self, max_radius_mm: f64) -> Self {
+        self.max_radius_mm = max_radius_mm;
+        self
+    }
+
+    /// Sets [`curve_samples`](Self::curve_samples): curve points tested between two
+    /// neighbouring cutting points when the curve is known.
+    pub fn with_curve_samples(mut self, curve_samples: usize) -> Self {
+        self.curve_samples = curve_samples;
+        self
+    }
+
+    /// Sets [`retract_mm`](Self::retract_mm): retract distance (mm) of the rapid moves
+    /// between paths ([`crate::fit_program`]).
+    pub fn with_retract_mm(mut self, retract_mm: f64) -> Self {
+        self.retract_mm = retract_mm;
+        self
+    }
+
+    /// The defaults with this tolerance (mm): a constructor, the start of a chain of the
+    /// `with_*` setters (`FitOptions::with_tolerance(0.01).with_arcs(false)`).
+    pub fn with_tolerance(tolerance_mm: f64) -> Self {
+        Self::default().with_tolerance_mm(tolerance_mm)
     }
 
     fn validate(&self) -> Result<()> {
-        positive("tolerance", self.tolerance)?;
+        positive("tolerance_mm", self.tolerance_mm)?;
         positive("orientation_tolerance_deg", self.orientation_tolerance_deg)?;
         positive("max_sweep_deg", self.max_sweep_deg)?;
-        positive("max_radius", self.max_radius)?;
+        positive("max_radius_mm", self.max_radius_mm)?;
         Ok(())
     }
 }
@@ -267,7 +326,7 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
             return true;
         }
         let (a, b) = (&self.st[i], &self.st[j]);
-        let tol = self.opts.tolerance;
+        let tol = self.opts.tolerance_mm;
         if (b.tip - a.tip).norm() <= MIN_TRAVEL || !self.distinct_tips(i, j) {
             return false;
         }
@@ -301,14 +360,15 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
         let Ok(arc) = SpaceArc::through(a.tip, mid.tip, b.tip) else {
             return false;
         };
-        if arc.radius > self.opts.max_radius || arc.angle_end.to_degrees() > self.opts.max_sweep_deg
+        if arc.radius > self.opts.max_radius_mm
+            || arc.angle_end.to_degrees() > self.opts.max_sweep_deg
         {
             return false;
         }
         if !self.distinct_tips(i, j) {
             return false;
         }
-        let tol = self.opts.tolerance;
+        let tol = self.opts.tolerance_mm;
         let mut last = (0.0, 0.0); // (angle, distance) of the previous point
         for k in i + 1..=j {
             let (d, theta) = if k == j {

@@ -70,7 +70,13 @@ pub use fit::{fit_blocks, BlockCounts, CurveFn, FitOptions};
 pub use geometry::SpaceArc;
 pub use machine::{stations_from_axes, stations_from_solved, MachineModel};
 pub use model::{AxisLimits, AxisModel, PaperAcHead};
-pub use output::{comment_text, write_atomic, DEFAULT_BLEND_TOLERANCE, MAX_COMMENT};
+pub use output::{comment_text, write_atomic, MAX_COMMENT};
+
+/// The default controller-blending term (the planner's and the G-code writer's, so it lives
+/// at the root, used by both) of the tolerance budget, mm: LinuxCNC's `G64 P`,
+/// Sinumerik's `CTOL` plus the tip error of `OTOL`.
+pub const DEFAULT_BLEND_TOLERANCE: f64 = 0.005;
+
 pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_csv_to, write_gcode, Dialect,
     GcodeOptions, ProcessCodes,
@@ -124,7 +130,7 @@ pub fn fit_program<M: AxisModel + ?Sized>(
     for (n, p) in paths.iter().enumerate() {
         all.push(fit_blocks(model, &p.stations, p.curve, n, opts)?);
     }
-    Ok(plan::link_paths_with_retract(model, all, opts.retract))
+    Ok(plan::link_paths_with_retract(model, all, opts.retract_mm))
 }
 
 /// [`interpolate`] with the rapid moves between consecutive paths running through the given
@@ -144,7 +150,7 @@ pub fn interpolate_through<M: AxisModel + ?Sized>(
     for (n, p) in paths.iter().enumerate() {
         all.push(fit_blocks(model, &p.stations, p.curve, n, fit)?);
     }
-    let blocks = plan::link_paths_through(model, all, traverses, fit.retract);
+    let blocks = plan::link_paths_through(model, all, traverses, fit.retract_mm);
     plan(model, &blocks, plan_options)
 }
 

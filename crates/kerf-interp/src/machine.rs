@@ -83,10 +83,9 @@ impl AxisModel for MachineModel {
         let k = &self.machine.kinematics;
         let n = axis.norm();
         if !(n.is_finite() && (n - 1.0).abs() < 1e-6 && tip.coords.iter().all(|v| v.is_finite())) {
-            return Err(InterpError::Kinematics {
-                index: 0,
-                message: format!("tool axis must be a unit vector (norm {n})"),
-            });
+            return Err(InterpError::unreachable(format!(
+                "tool axis must be a unit vector (norm {n})"
+            )));
         }
         let pose = Pose {
             position: *tip,
@@ -101,10 +100,7 @@ impl AxisModel for MachineModel {
         let previous = Axes::new(0.0, 0.0, 0.0, prev_t, prev_c);
         nearest_solution(candidates, &previous, |q| self.in_range(&q.to_array()))
             .map(|q| q.to_array())
-            .ok_or_else(|| InterpError::Kinematics {
-                index: 0,
-                message: "no solution within the axis ranges".into(),
-            })
+            .ok_or_else(|| InterpError::unreachable("no solution within the axis ranges"))
     }
 
     /// The forward kinematics give the tool axis of `(tilt, c)`; `inverse_with_c` at that C

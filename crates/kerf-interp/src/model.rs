@@ -196,7 +196,7 @@ impl AxisModel for PaperAcHead {
         axis: &Vector3<f64>,
         previous: Option<&[f64; 5]>,
     ) -> Result<[f64; 5]> {
-        let kin = |message: String| InterpError::Kinematics { index: 0, message };
+        let kin = |reason: String| InterpError::unreachable(reason);
         let n = axis.norm();
         if !(n.is_finite() && (n - 1.0).abs() < 1e-6 && tip.coords.iter().all(|v| v.is_finite())) {
             return Err(kin(format!("tool axis must be a unit vector (norm {n})")));
@@ -226,7 +226,7 @@ impl AxisModel for PaperAcHead {
             (0..5).all(|k| self.in_range(k, q[k]))
         })
         .map(|q| q.to_array())
-        .ok_or_else(|| kin("no solution within the axis ranges".to_string()))
+        .ok_or_else(|| kin("no solution within the axis ranges".into()))
     }
 
     #[inline]

@@ -63,10 +63,12 @@ pub const JERK_FILTER_WIDTH: f64 = 1.25;
 
 /// Options of [`plan`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct PlanOptions {
-    /// Programmed cutting feed, mm/min (the tip's speed along the path). Must be > 0.
+    /// Programmed cutting feed, mm/min (the tip's speed along the path). Must be > 0; no
+    /// default (given to [`PlanOptions::new`]).
     pub feed: f64,
-    /// Interpolation cycle `T`, seconds. Must be > 0.
+    /// Interpolation cycle `T`, seconds. Must be > 0; no default (given to [`PlanOptions::new`]).
     pub cycle: f64,
     /// Largest chord error between two set-points on a curve, mm (paper 000 eq 17-18): caps
     /// the feed on small radii. Default 0.001.
@@ -91,7 +93,7 @@ pub struct PlanOptions {
     pub max_grid_points: usize,
     /// With jerk limits: how far the set-points' tip may leave the smooth path (the tip spline)
     /// to blend a curvature jump, mm (the tolerance budget's `controller_blending` term, default
-    /// [`crate::output::DEFAULT_BLEND_TOLERANCE`]). The tip follows the spline's mean over a
+    /// [`crate::DEFAULT_BLEND_TOLERANCE`]). The tip follows the spline's mean over a
     /// window of at most `2 sqrt(6 e / max |p''|)`, which ramps every curvature change over the
     /// window (a clothoid-like transition) within `e`. 0 for none; not used without jerk limits
     /// (a curvature jump is an acceleration jump, which they allow) or with
@@ -100,6 +102,64 @@ pub struct PlanOptions {
 }
 
 impl PlanOptions {
+    /// Sets [`feed`](Self::feed): programmed cutting feed, mm/min (the tip's speed along the path).
+    pub fn with_feed(mut self, feed: f64) -> Self {
+        self.feed = feed;
+        self
+    }
+
+    /// Sets [`cycle`](Self::cycle): interpolation cycle `T`, seconds.
+    pub fn with_cycle(mut self, cycle: f64) -> Self {
+        self.cycle = cycle;
+        self
+    }
+
+    /// Sets [`chord_tolerance`](Self::chord_tolerance): largest chord error between two
+    /// set-points on a curve, mm (paper 000 eq 17-18).
+    pub fn with_chord_tolerance(mut self, chord_tolerance: f64) -> Self {
+        self.chord_tolerance = chord_tolerance;
+        self
+    }
+
+    /// Sets [`max_cycles`](Self::max_cycles): refuse programs of more cycles than this.
+    pub fn with_max_cycles(mut self, max_cycles: usize) -> Self {
+        self.max_cycles = max_cycles;
+        self
+    }
+
+    /// Sets [`max_refinements`](Self::max_refinements): most re-plans after a verification
+    /// finds a cycle over a limit.
+    pub fn with_max_refinements(mut self, max_refinements: usize) -> Self {
+        self.max_refinements = max_refinements;
+        self
+    }
+
+    /// Sets [`block_ends_on_cycles`](Self::block_ends_on_cycles): land every block's end
+    /// exactly on a cycle, as paper 000's block-by-block interpolator does (default false).
+    pub fn with_block_ends_on_cycles(mut self, block_ends_on_cycles: bool) -> Self {
+        self.block_ends_on_cycles = block_ends_on_cycles;
+        self
+    }
+
+    /// Sets [`grid_step`](Self::grid_step): largest spacing of the planning grid along the
+    /// path, mm (degrees on a turn).
+    pub fn with_grid_step(mut self, grid_step: f64) -> Self {
+        self.grid_step = grid_step;
+        self
+    }
+
+    /// Sets [`max_grid_points`](Self::max_grid_points): work budget.
+    pub fn with_max_grid_points(mut self, max_grid_points: usize) -> Self {
+        self.max_grid_points = max_grid_points;
+        self
+    }
+
+    /// Sets [`blend_tolerance`](Self::blend_tolerance): with jerk limits.
+    pub fn with_blend_tolerance(mut self, blend_tolerance: f64) -> Self {
+        self.blend_tolerance = blend_tolerance;
+        self
+    }
+
     /// Options with this feed (mm/min) and cycle (s), defaults otherwise.
     pub fn new(feed: f64, cycle: f64) -> Self {
         Self {
@@ -111,7 +171,7 @@ impl PlanOptions {
             block_ends_on_cycles: false,
             grid_step: 0.5,
             max_grid_points: 5_000_000,
-            blend_tolerance: crate::output::DEFAULT_BLEND_TOLERANCE,
+            blend_tolerance: crate::DEFAULT_BLEND_TOLERANCE,
         }
     }
 

@@ -32,12 +32,10 @@ fn program(m: &PaperAcHead, dialect: Dialect) -> Motion {
             curve: None,
         },
     ];
-    let fit = FitOptions {
-        arcs: !dialect.raw_axes(),
-        merge_lines: !dialect.raw_axes(),
-        retract: 10.0,
-        ..FitOptions::with_tolerance(0.005)
-    };
+    let fit = FitOptions::with_tolerance(0.005)
+        .with_arcs(!dialect.raw_axes())
+        .with_merge_lines(!dialect.raw_axes())
+        .with_retract_mm(10.0);
     interpolate(m, &paths, &fit, &PlanOptions::new(6000.0, 0.001)).expect("plan")
 }
 
@@ -204,12 +202,10 @@ fn headers_state_units_feed_budget_machine_and_process() {
     let m = PaperAcHead::paper_000();
     for dialect in DIALECTS {
         let motion = program(&m, dialect);
-        let opts = GcodeOptions {
-            linearization_tolerance: Some(0.005),
-            fit_tolerance: 0.01,
-            source: Some("part.json".into()),
-            ..GcodeOptions::new(dialect, 6000.0)
-        };
+        let opts = GcodeOptions::new(dialect, 6000.0)
+            .with_linearization_tolerance_mm(Some(0.005))
+            .with_fit_tolerance_mm(0.01)
+            .with_source(Some("part.json".into()));
         let text = gcode_motion(&m, &motion, &[], &opts).expect("gcode");
         let head: String = text.lines().take(16).collect::<Vec<_>>().join("\n");
         for want in [
@@ -263,14 +259,11 @@ fn feed_words_reproduce_the_planned_block_times() {
     let m = PaperAcHead::paper_000();
     for dialect in DIALECTS {
         let motion = program(&m, dialect);
-        let opts = GcodeOptions {
-            process: Process {
-                pierce_standoff: Some(0.0),
-                pierce_dwell_s: Some(0.0),
-                ..Process::default()
-            },
-            ..GcodeOptions::new(dialect, 6000.0)
-        };
+        let opts = GcodeOptions::new(dialect, 6000.0).with_process(Process {
+            pierce_standoff: Some(0.0),
+            pierce_dwell_s: Some(0.0),
+            ..Process::default()
+        });
         let text = gcode_motion(&m, &motion, &[], &opts).expect("gcode");
         let planned: f64 = (0..motion.blocks().len())
             .filter(|&b| !motion.blocks()[b].rapid)
@@ -348,15 +341,11 @@ fn hostile_ids_and_names_never_make_a_block() {
         let motion = program(&m, dialect);
         for pair in hostile.chunks(2) {
             let ids: Vec<String> = pair.to_vec();
-            let opts = GcodeOptions {
-                source: Some(format!("{}.json", pair[0])),
-                ..GcodeOptions::new(dialect, 6000.0)
-            };
+            let opts =
+                GcodeOptions::new(dialect, 6000.0).with_source(Some(format!("{}.json", pair[0])));
             let bad = gcode_motion(&m, &motion, &ids, &opts).expect("gcode");
-            let tame_opts = GcodeOptions {
-                source: Some("part.json".into()),
-                ..GcodeOptions::new(dialect, 6000.0)
-            };
+            let tame_opts =
+                GcodeOptions::new(dialect, 6000.0).with_source(Some("part.json".into()));
             let good = gcode_motion(&m, &motion, &tame, &tame_opts).expect("gcode");
             let codes = |t: &str| -> Vec<String> {
                 t.lines().map(code).filter(|c| !c.is_empty()).collect()
@@ -402,20 +391,17 @@ fn bad_process_codes_are_named_errors() {
         (Process { beam_on: Some(vec![]), ..Process::default() }, "process.beam_on: must list at least one program line"),
         (Process { beam_off: Some(vec!["M65 P0\nG0 X0".into()]), ..Process::default() }, "process.beam_off[0]: must be one printable ASCII program line without comments (found '\\n')"),
     ] {
-        let opts = GcodeOptions { process: p, ..GcodeOptions::new(Dialect::Linuxcnc, 6000.0) };
+        let opts = GcodeOptions::new(Dialect::Linuxcnc, 6000.0).with_process(p);
         let e = gcode_motion(&m, &motion, &[], &opts).expect_err(want);
         assert_eq!(e.to_string(), want);
     }
     // Given codes are written as given, in place of the defaults.
-    let opts = GcodeOptions {
-        process: Process {
-            beam_on: Some(vec!["M62 P2".into(), "M3 S900".into()]),
-            beam_off: Some(vec!["M5".into()]),
-            pierce_dwell_s: Some(0.5),
-            pierce_standoff: Some(0.0),
-        },
-        ..GcodeOptions::new(Dialect::Linuxcnc, 6000.0)
-    };
+    let opts = GcodeOptions::new(Dialect::Linuxcnc, 6000.0).with_process(Process {
+        beam_on: Some(vec!["M62 P2".into(), "M3 S900".into()]),
+        beam_off: Some(vec!["M5".into()]),
+        pierce_dwell_s: Some(0.5),
+        pierce_standoff: Some(0.0),
+    });
     let text = gcode_motion(&m, &motion, &[], &opts).expect("gcode");
     assert_eq!(
         text.matches("\nM62 P2\nM3 S900\nG4 P0.5\n").count(),

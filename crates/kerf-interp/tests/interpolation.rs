@@ -267,13 +267,22 @@ fn station_and_fit_errors() {
         matches!(e, Err(InterpError::Kinematics { index: 1, .. })),
         "{e:?}"
     );
+    // The kinematics' own error is kept as the source.
+    let source = e.as_ref().err().and_then(std::error::Error::source);
+    assert!(
+        matches!(
+            source.and_then(|s| s.downcast_ref::<kerf_kinematics::KinematicsError>()),
+            Some(kerf_kinematics::KinematicsError::Unreachable { .. })
+        ),
+        "{e:?}"
+    );
     let st = solve_stations(&m, &tips, None, None, None).expect("stations");
     let e = fit_blocks(&m, &st, None, 0, &FitOptions::with_tolerance(f64::NAN));
     assert!(
         matches!(
             e,
             Err(InterpError::BadParameter {
-                name: "tolerance",
+                name: "tolerance_mm",
                 ..
             })
         ),

@@ -77,15 +77,7 @@ fn a_slot_is_blended_within_the_tolerance_and_planned_near_the_optimum() {
     for feed in [20000.0, 40000.0] {
         let opts = PlanOptions::new(feed, 0.001);
         let jerk = plan(&m, &blocks, &opts).expect("plan");
-        let unblended = plan(
-            &m,
-            &blocks,
-            &PlanOptions {
-                blend_tolerance: 0.0,
-                ..opts.clone()
-            },
-        )
-        .expect("plan");
+        let unblended = plan(&m, &blocks, &opts.clone().with_blend_tolerance(0.0)).expect("plan");
         let limits = m.limits.max_jerk.take();
         let acc = plan(&m, &blocks, &opts).expect("plan");
         m.limits.max_jerk = limits;
@@ -128,10 +120,7 @@ fn a_negative_blend_tolerance_is_refused() {
     let st = solve_stations(&m, &slot(), None, None, None).expect("reachable");
     let blocks = fit_blocks(&m, &st, None, 0, &FitOptions::with_tolerance(0.001)).expect("fit");
     for bad in [-0.001, f64::NAN, f64::INFINITY] {
-        let opts = PlanOptions {
-            blend_tolerance: bad,
-            ..PlanOptions::new(20000.0, 0.001)
-        };
+        let opts = PlanOptions::new(20000.0, 0.001).with_blend_tolerance(bad);
         let err = plan(&m, &blocks, &opts).expect_err("refused");
         assert!(
             matches!(err, InterpError::BadParameter { name, .. } if name == "blend_tolerance"),
@@ -175,11 +164,9 @@ fn a_pose_exactly_on_the_tilt_limit_is_reached_and_never_passed() {
             &st,
             None,
             0,
-            &FitOptions {
-                arcs: false,
-                merge_lines: false,
-                ..FitOptions::default()
-            },
+            &FitOptions::default()
+                .with_arcs(false)
+                .with_merge_lines(false),
         )
         .expect("fit");
         for feed in [6000.0, 20000.0] {
@@ -241,11 +228,9 @@ fn a_long_edge_between_two_corners_stays_straight() {
         &st,
         None,
         0,
-        &FitOptions {
-            arcs: false,
-            merge_lines: false,
-            ..FitOptions::default()
-        },
+        &FitOptions::default()
+            .with_arcs(false)
+            .with_merge_lines(false),
     )
     .expect("fit");
     for jerk in [true, false] {
@@ -297,11 +282,9 @@ fn long_edges_between_fine_corners_do_not_make_the_spline_ring() {
         &st,
         None,
         0,
-        &FitOptions {
-            arcs: false,
-            merge_lines: false,
-            ..FitOptions::default()
-        },
+        &FitOptions::default()
+            .with_arcs(false)
+            .with_merge_lines(false),
     )
     .expect("fit");
     for jerk in [false, true] {

@@ -129,11 +129,8 @@ fn circles_plan_within_five_percent_of_the_dense_reference() {
         let blocks =
             fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::with_tolerance(0.01)).expect("fit");
         for feed in feeds {
-            let opts = PlanOptions {
-                // The reference has no chord cap: lift it out of the way.
-                chord_tolerance: 1.0,
-                ..PlanOptions::new(feed, 0.001)
-            };
+            // The reference has no chord cap: lift it out of the way.
+            let opts = PlanOptions::new(feed, 0.001).with_chord_tolerance(1.0);
             let motion = plan(&m, &blocks, &opts).expect("plan");
             let reference = circle_reference(
                 radius,
@@ -348,11 +345,9 @@ fn the_smooth_path_stays_on_the_curve() {
             &st,
             None,
             0,
-            &FitOptions {
-                arcs: false,
-                merge_lines: false,
-                ..FitOptions::default()
-            },
+            &FitOptions::default()
+                .with_arcs(false)
+                .with_merge_lines(false),
         )
         .expect("lines");
         let motion = plan(&m, &lines, &PlanOptions::new(6000.0, 0.001)).expect("plan");
@@ -381,11 +376,9 @@ fn a_hole_too_small_for_the_feed_gets_one_lower_modal_f_word() {
         &st,
         None,
         0,
-        &FitOptions {
-            arcs: false,
-            merge_lines: false,
-            ..FitOptions::default()
-        },
+        &FitOptions::default()
+            .with_arcs(false)
+            .with_merge_lines(false),
     )
     .expect("lines");
     let motion = plan(&m, &lines, &PlanOptions::new(20000.0, 0.001)).expect("plan");

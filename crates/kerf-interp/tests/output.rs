@@ -105,11 +105,9 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
         ),
         "arcs or merged lines in a generic program are refused: {refused:?}"
     );
-    let lines_only = FitOptions {
-        arcs: false,
-        merge_lines: false,
-        ..FitOptions::default()
-    };
+    let lines_only = FitOptions::default()
+        .with_arcs(false)
+        .with_merge_lines(false);
     let blocks = fit_blocks(&m, &st, Some(&curve), 0, &lines_only).expect("fit");
     assert_eq!(blocks.len(), st.len() - 1, "one block per pose step");
     let text = gcode(&m, &blocks, &["door-trim-1".to_string()], None, &opts).expect("gcode");

@@ -97,10 +97,7 @@ fn freeform_with_varying_tool_axis_stays_within_limits() {
     let loose = plan(
         &m,
         &fitted,
-        &PlanOptions {
-            chord_tolerance: 1.0,
-            ..PlanOptions::new(15000.0, 0.001)
-        },
+        &PlanOptions::new(15000.0, 0.001).with_chord_tolerance(1.0),
     )
     .expect("plan");
     println!("freeform fitted, no chord cap: {} cycles", loose.cycles());
@@ -110,11 +107,9 @@ fn freeform_with_varying_tool_axis_stays_within_limits() {
         &st,
         None,
         0,
-        &FitOptions {
-            arcs: false,
-            merge_lines: false,
-            ..FitOptions::default()
-        },
+        &FitOptions::default()
+            .with_arcs(false)
+            .with_merge_lines(false),
     )
     .expect("lines");
     assert_eq!(lines.len(), st.len() - 1, "one line per chord");
@@ -193,15 +188,8 @@ fn two_paths_are_linked_by_a_rapid_move() {
         (down + rapids[2].end_tool_axis * 10.0).norm() < 1e-9,
         "approach along the axis"
     );
-    let straight = fit_program(
-        &m,
-        &paths,
-        &FitOptions {
-            retract: 0.0,
-            ..FitOptions::default()
-        },
-    )
-    .expect("fit");
+    let straight =
+        fit_program(&m, &paths, &FitOptions::default().with_retract_mm(0.0)).expect("fit");
     assert_eq!(
         straight.iter().filter(|b| b.rapid).count(),
         1,
@@ -218,10 +206,7 @@ fn plan_refuses_bad_options() {
     for o in [
         PlanOptions::new(f64::NAN, 0.001),
         PlanOptions::new(1000.0, 0.0),
-        PlanOptions {
-            chord_tolerance: -1.0,
-            ..PlanOptions::new(1000.0, 0.001)
-        },
+        PlanOptions::new(1000.0, 0.001).with_chord_tolerance(-1.0),
     ] {
         let e = plan(&m, &blocks, &o);
         assert!(
@@ -232,10 +217,7 @@ fn plan_refuses_bad_options() {
     let e = plan(
         &m,
         &blocks,
-        &PlanOptions {
-            max_cycles: 10,
-            ..PlanOptions::new(1.0, 0.001)
-        },
+        &PlanOptions::new(1.0, 0.001).with_max_cycles(10),
     );
     assert!(
         matches!(e, Err(kerf_interp::InterpError::TooManyCycles { .. })),
@@ -262,18 +244,13 @@ fn block_ends_on_cycles() {
         &st,
         None,
         0,
-        &FitOptions {
-            arcs: false,
-            merge_lines: false,
-            ..FitOptions::default()
-        },
+        &FitOptions::default()
+            .with_arcs(false)
+            .with_merge_lines(false),
     )
     .expect("lines");
     for (name, blocks) in [("fitted", &fitted), ("lines", &lines)] {
-        let opts = PlanOptions {
-            block_ends_on_cycles: true,
-            ..PlanOptions::new(15000.0, 0.001)
-        };
+        let opts = PlanOptions::new(15000.0, 0.001).with_block_ends_on_cycles(true);
         let motion = check_with(&format!("{name}, block ends on cycles"), &m, blocks, &opts);
         let rows = motion.setpoints(&m);
         let mut r = rows.iter();
@@ -296,19 +273,15 @@ fn plan_error_variants() {
         &st,
         None,
         0,
-        &FitOptions {
-            arcs: false,
-            merge_lines: false,
-            ..FitOptions::default()
-        },
+        &FitOptions::default()
+            .with_arcs(false)
+            .with_merge_lines(false),
     )
     .expect("lines");
     // Block ends on cycles need refinements here; with none allowed the plan says so.
-    let opts = PlanOptions {
-        block_ends_on_cycles: true,
-        max_refinements: 0,
-        ..PlanOptions::new(15000.0, 0.001)
-    };
+    let opts = PlanOptions::new(15000.0, 0.001)
+        .with_block_ends_on_cycles(true)
+        .with_max_refinements(0);
     let e = plan(&m, &lines, &opts);
     assert!(
         matches!(e, Err(kerf_interp::InterpError::LimitsNotMet { .. })),

@@ -13,10 +13,9 @@
 use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
-use serde_json::Value;
 
 use crate::error::Result;
-use crate::kinematics::Kinematics;
+use crate::kinematics::{Kinematics, Parameter};
 use crate::params::{non_negative, KinematicsType};
 use crate::pose::{Axes, Pose};
 use crate::rotation::{Angles, Orientation, TiltAbout};
@@ -99,7 +98,7 @@ impl Kinematics for AcHead {
         self.r_a
     }
 
-    fn parameters(&self) -> Vec<(&'static str, Value)> {
+    fn parameters(&self) -> Vec<(&'static str, Parameter)> {
         vec![("r_a", self.r_a.into()), ("r_c", self.r_c.into())]
     }
 }

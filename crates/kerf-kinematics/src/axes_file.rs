@@ -256,7 +256,7 @@ impl AxesFile {
         let mut w = BufWriter::new(writer);
         self.write_json(&mut w)
             .and_then(|()| w.flush())
-            .map_err(|e| io_error("<writer>", &e))
+            .map_err(|e| io_error("<writer>", e))
     }
 
     /// Checks the document and returns it as JSON text.
@@ -279,7 +279,7 @@ impl AxesFile {
         let dest = dest.as_ref();
         self.validate()?;
         kerf_io::write_file(dest, |mut w| self.write_json(&mut w))
-            .map_err(|e| io_error(&dest.display().to_string(), &e))
+            .map_err(|e| io_error(&dest.display().to_string(), e))
     }
 
     /// Reads a `kerf.axes/1` file (at most [`kerf_io::MAX_INPUT_BYTES`]).
@@ -423,10 +423,10 @@ fn json_string(s: &str) -> String {
     serde_json::to_string(s).unwrap_or_else(|_| "\"\"".to_owned())
 }
 
-fn io_error(file: &str, e: &io::Error) -> KinematicsError {
+fn io_error(file: &str, e: io::Error) -> KinematicsError {
     KinematicsError::Io {
         file: file.to_owned(),
         action: "write",
-        message: e.to_string(),
+        source: e.into(),
     }
 }

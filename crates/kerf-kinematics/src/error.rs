@@ -5,7 +5,89 @@
 //! errors name the path id, the index of the cutting point and the axis, e.g.
 //! `path "rim": point 73: C = 362 is outside its limits [-360, 360]; ...`.
 
+use std::sync::Arc;
+
 use thiserror::Error;
+
+/// An operating-system error that kerf's error enums can hold, clone and compare while
+/// keeping it as their [`source`](std::error::Error::source).
+///
+/// The [`std::io::Error`] is shared (clones point at the same one); two are equal when their
+/// kind and message are (an `io::Error` itself is neither `Clone` nor `PartialEq`). It
+/// dereferences to the `io::Error` and is deliberately not an [`std::error::Error`] itself, so
+/// that a `#[source]` field of this type makes the `io::Error` the next link of the chain
+/// (`downcast_ref::<std::io::Error>()` finds it).
+#[derive(Debug, Clone)]
+pub struct IoError(Arc<std::io::Error>);
+
+impl IoError {
+    /// Keeps `error`.
+    pub fn new(error: std::io::Error) -> Self {
+        Self(Arc::new(error))
+    }
+}
+
+impl From<std::io::Error> for IoError {
+    fn from(error: std::io::Error) -> Self {
+        Self::new(error)
+    }
+}
+
+impl std::ops::Deref for IoError {
+    type Target = std::io::Error;
+    fn deref(&self) -> &std::io::Error {
+        &self.0
+    }
+}
+
+impl PartialEq for IoError {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.kind() == other.0.kind() && self.0.to_string() == other.0.to_string()
+    }
+}
+
+impl std::fmt::Display for IoError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+/// A [`KinematicsError`] on the heap, for the error enums of later stages that keep one as
+/// their source (`kerf_interp::InterpError::Kinematics`, the pipeline's error) without growing
+/// every `Result` by its size.
+///
+/// It dereferences to the error and is deliberately not an [`std::error::Error`] itself: a
+/// `#[source] Box<KinematicsError>` would make the *box* the next link of the chain, which
+/// `downcast_ref::<KinematicsError>()` does not find; with this type the link is the
+/// `KinematicsError`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoxedKinematicsError(Box<KinematicsError>);
+
+impl BoxedKinematicsError {
+    /// The error, unboxed.
+    pub fn into_inner(self) -> KinematicsError {
+        *self.0
+    }
+}
+
+impl From<KinematicsError> for BoxedKinematicsError {
+    fn from(error: KinematicsError) -> Self {
+        Self(Box::new(error))
+    }
+}
+
+impl std::ops::Deref for BoxedKinematicsError {
+    type Target = KinematicsError;
+    fn deref(&self) -> &KinematicsError {
+        &self.0
+    }
+}
+
+impl std::fmt::Display for BoxedKinematicsError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
 
 /// `Result` with [`KinematicsError`].
 pub type Result<T> = std::result::Result<T, KinematicsError>;
@@ -21,18 +103,20 @@ pub enum KinematicsError {
         /// The file, as given.
         file: String,
         /// What is wrong in it.
+        #[source]
         error: Box<KinematicsError>,
     },
     /// A file could not be read or written (nothing was written to the destination).
     /// Fix: check the path, the directory and its permissions.
-    #[error("{file}: cannot {action}: {message}")]
+    #[error("{file}: cannot {action}: {source}")]
     Io {
         /// The file, as given.
         file: String,
         /// `"read"` or `"write"`.
         action: &'static str,
-        /// The operating system's message.
-        message: String,
+        /// The operating system's error (its [`std::io::Error`] is the source of this one).
+        #[source]
+        source: IoError,
     },
     /// The document is not well-formed JSON (or holds a number out of the range of a double,
     /// such as `1e400`). Fix: correct the text at the given line and column.
@@ -127,9 +211,19 @@ pub enum KinematicsError {
         /// How many rotations of the part were tried.
         rotations_tried: usize,
     },
+    /// A single pose has no inverse solution within the axis ranges, or is no pose at all (a
+    /// tool axis that is not a unit vector, a non-finite tip): what the point-by-point inverse
+    /// of the interpolator's machine models reports. Fix: a tool axis of length 1, a point
+    /// within reach of the machine (move the part), or solve the whole path with
+    /// [`crate::solve_path`], which says which axis and limit.
+    #[error("{reason}")]
+    Unreachable {
+        /// What is wrong, e.g. `no solution within the axis ranges`.
+        reason: String,
+    },
     /// More than [`crate::PathOptions::max_inserted`] points would have to be inserted in
-    /// one path. Fix: raise `linearization_tolerance` or `max_rotary_step`, or the limit.
-    #[error("path \"{path_id}\": more than {limit} points would have to be inserted (at point {index}); raise linearization_tolerance or max_rotary_step")]
+    /// one path. Fix: raise `linearization_tolerance_mm` or `max_rotary_step_deg`, or the limit.
+    #[error("path \"{path_id}\": more than {limit} points would have to be inserted (at point {index}); raise linearization_tolerance_mm or max_rotary_step_deg")]
     TooManyInserted {
         /// The id of the path.
         path_id: String,

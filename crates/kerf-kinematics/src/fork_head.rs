@@ -11,10 +11,9 @@
 use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
-use serde_json::Value;
 
 use crate::error::{KinematicsError, Result};
-use crate::kinematics::Kinematics;
+use crate::kinematics::{Kinematics, Parameter};
 use crate::params::{finite, non_negative, KinematicsType, Params};
 use crate::pose::{Axes, Pose};
 use crate::rotation::{rot_z, Angles, Orientation, TiltAbout};
@@ -150,7 +149,7 @@ impl Kinematics for ForkHead {
         }
     }
 
-    fn parameters(&self) -> Vec<(&'static str, Value)> {
+    fn parameters(&self) -> Vec<(&'static str, Parameter)> {
         vec![
             ("tilt", self.tilt_name().into()),
             ("L", self.l.into()),

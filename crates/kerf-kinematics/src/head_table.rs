@@ -9,10 +9,9 @@
 use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
-use serde_json::Value;
 
 use crate::error::Result;
-use crate::kinematics::Kinematics;
+use crate::kinematics::{Kinematics, Parameter};
 use crate::params::{finite, non_negative, sign, KinematicsType, Params};
 use crate::pose::{Axes, Pose};
 use crate::rotation::{inv, rot_y, rot_z, Angles, Orientation, TiltAbout};
@@ -118,7 +117,7 @@ impl Kinematics for HeadTable {
         self.l
     }
 
-    fn parameters(&self) -> Vec<(&'static str, Value)> {
+    fn parameters(&self) -> Vec<(&'static str, Parameter)> {
         let q = self.c_point;
         vec![
             ("L", self.l.into()),

@@ -30,7 +30,7 @@ pub(crate) fn read(path: &Path) -> Result<Vec<u8>> {
     kerf_io::read_file(path).map_err(|e| KinematicsError::Io {
         file: path.display().to_string(),
         action: "read",
-        message: e.to_string(),
+        source: e.into(),
     })
 }
 

@@ -3,7 +3,6 @@
 use std::fmt;
 
 use nalgebra::Vector3;
-use serde_json::Value;
 
 use crate::pose::{Axes, Pose};
 use crate::rotation::angle_to_z_line;
@@ -56,6 +55,46 @@ pub trait Kinematics: fmt::Debug + Send + Sync {
     }
 
     /// The parameters as written in the `kinematics` object of a machine file (without
-    /// `type`), in the order of `shared/formats.md`.
-    fn parameters(&self) -> Vec<(&'static str, Value)>;
+    /// `type`), in the order of `shared/formats.md`: typed values, which the machine file's
+    /// writer ([`crate::Machine::to_json`]) turns into JSON (the maths does not speak JSON).
+    fn parameters(&self) -> Vec<(&'static str, Parameter)>;
+}
+
+/// One parameter of a machine type, typed (lengths in mm; the meaning of each is documented
+/// on the machine type and in `shared/formats.md`).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum Parameter {
+    /// A number (a length in mm, a sign, an offset).
+    Number(f64),
+    /// A list of numbers (a point or a vector in mm, a lateral offset).
+    Numbers(Vec<f64>),
+    /// A name (the tilt axis, `A` or `B`).
+    Name(&'static str),
+    /// A yes/no switch.
+    Flag(bool),
+}
+
+impl From<f64> for Parameter {
+    fn from(v: f64) -> Self {
+        Parameter::Number(v)
+    }
+}
+
+impl From<Vec<f64>> for Parameter {
+    fn from(v: Vec<f64>) -> Self {
+        Parameter::Numbers(v)
+    }
+}
+
+impl From<&'static str> for Parameter {
+    fn from(v: &'static str) -> Self {
+        Parameter::Name(v)
+    }
+}
+
+impl From<bool> for Parameter {
+    fn from(v: bool) -> Self {
+        Parameter::Flag(v)
+    }
 }

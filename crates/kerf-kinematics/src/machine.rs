@@ -456,7 +456,7 @@ impl Machine {
         let names = self.axis_names();
         let mut kin = vec![format!("\"type\": {}", json(self.kinematics.type_name()))];
         for (key, value) in self.kinematics.parameters() {
-            kin.push(format!("{}: {value}", json(key)));
+            kin.push(format!("{}: {}", json(key), parameter_json(&value)));
         }
         let object = |values: Vec<String>| {
             let body: Vec<String> = names
@@ -561,4 +561,17 @@ fn per_axis<T>(
     }
     out.try_into()
         .map_err(|_| KinematicsError::doc(key, "internal: wrong axis count"))
+}
+
+/// A machine type's parameter as JSON text, as `serde_json` writes the value (the machine
+/// file's writer is the one place where the typed parameters become JSON).
+fn parameter_json(p: &crate::kinematics::Parameter) -> String {
+    use crate::kinematics::Parameter;
+    let value = match p {
+        Parameter::Number(v) => serde_json::Value::from(*v),
+        Parameter::Numbers(v) => serde_json::Value::from(v.clone()),
+        Parameter::Name(v) => serde_json::Value::from(*v),
+        Parameter::Flag(v) => serde_json::Value::from(*v),
+    };
+    value.to_string()
 }

@@ -5,7 +5,7 @@
 //! toolpath means: with a 200 mm pivot, 5 degrees of tilt over one segment bulge the tip
 //! `200 (1 - cos 2.5 deg) = 0.190 mm` off the line. [`linearization_error`] measures the
 //! largest distance of the tip from the segment; [`crate::solve_path`] inserts poses
-//! ([`interpolate`]) until it is at most `linearization_tolerance` on every segment.
+//! ([`interpolate`]) until it is at most `linearization_tolerance_mm` on every segment.
 //!
 //! The measure is an estimate (dense sampling refined by golden-section search), not a
 //! certified bound: a bulge narrower than the sample spacing could be missed. The sampling is
@@ -14,7 +14,7 @@
 //!
 //! **Error budget.** The tip's distance from the true curve is at most the chord error of the
 //! discretizer (`tolerance` of `kerf.toolpath/1`, certified) plus the linearization error
-//! (estimated, `<= linearization_tolerance`): a user asking for 0.01 mm of chord error and the
+//! (estimated, `<= linearization_tolerance_mm`): a user asking for 0.01 mm of chord error and the
 //! default 0.005 mm of linearization tolerance should expect up to 0.015 mm. The interpolator's
 //! own chord error, if any, adds to that.
 

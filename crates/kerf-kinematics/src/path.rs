@@ -32,7 +32,7 @@
 //! **Rotary steps.** Near the pole C moves as `1/sin(tilt)` for a given change of the tool
 //! axis. Every move whose rotary step `max(|d tilt|, |d C|)` exceeds `max_rotary_step_deg`, and
 //! every move whose non-linearity error ([`crate::nonlinear`]) exceeds
-//! `linearization_tolerance`, is split by inserting poses: the position on the curve when the
+//! `linearization_tolerance_mm`, is split by inserting poses: the position on the curve when the
 //! path has one ([`PathCurve`]), else on the straight segment; the tool axis on the great
 //! circle ([`crate::nonlinear::slerp`]). Inserted poses are solved with the same continuity
 //! rule, and split again if needed.
@@ -61,6 +61,7 @@ pub(super) const MAX_PIECES: f64 = 1024.0;
 
 /// Options of [`solve_path`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct PathOptions {
     /// A pose whose tool axis is within this angle (radians) of the C axis is at the pole: C
     /// keeps its previous value. Finite and >= 0; default 1e-6.
@@ -70,7 +71,7 @@ pub struct PathOptions {
     pub max_rotary_step_deg: f64,
     /// The largest non-linearity error (mm) of a move; moves with more are split. > 0;
     /// `f64::INFINITY` turns the insertion off. Default 0.005.
-    pub linearization_tolerance: f64,
+    pub linearization_tolerance_mm: f64,
     /// Refuse a path that needs more inserted points than this (protects against a tolerance
     /// typed in the wrong unit). Default 1,000,000.
     pub max_inserted: usize,
@@ -81,13 +82,41 @@ impl Default for PathOptions {
         Self {
             pole_tolerance_rad: 1e-6,
             max_rotary_step_deg: f64::INFINITY,
-            linearization_tolerance: 0.005,
+            linearization_tolerance_mm: 0.005,
             max_inserted: 1_000_000,
         }
     }
 }
 
 impl PathOptions {
+    /// Sets [`pole_tolerance_rad`](Self::pole_tolerance_rad): a pose whose tool axis is
+    /// within this angle (radians) of the C axis is at the pole.
+    pub fn with_pole_tolerance_rad(mut self, pole_tolerance_rad: f64) -> Self {
+        self.pole_tolerance_rad = pole_tolerance_rad;
+        self
+    }
+
+    /// Sets [`max_rotary_step_deg`](Self::max_rotary_step_deg): the largest move of a
+    /// rotary axis between two points (degrees).
+    pub fn with_max_rotary_step_deg(mut self, max_rotary_step_deg: f64) -> Self {
+        self.max_rotary_step_deg = max_rotary_step_deg;
+        self
+    }
+
+    /// Sets [`linearization_tolerance_mm`](Self::linearization_tolerance_mm): the largest
+    /// non-linearity error (mm) of a move.
+    pub fn with_linearization_tolerance_mm(mut self, linearization_tolerance_mm: f64) -> Self {
+        self.linearization_tolerance_mm = linearization_tolerance_mm;
+        self
+    }
+
+    /// Sets [`max_inserted`](Self::max_inserted): refuse a path that needs more inserted
+    /// points than this (protects against a tolerance typed in the wrong unit).
+    pub fn with_max_inserted(mut self, max_inserted: usize) -> Self {
+        self.max_inserted = max_inserted;
+        self
+    }
+
     /// Checks every option.
     ///
     /// # Errors
@@ -114,10 +143,10 @@ impl PathOptions {
                 "must be > 0 (degrees; infinity for no limit)",
             );
         }
-        if self.linearization_tolerance.is_nan() || self.linearization_tolerance <= 0.0 {
+        if self.linearization_tolerance_mm.is_nan() || self.linearization_tolerance_mm <= 0.0 {
             return bad(
-                "linearization_tolerance",
-                self.linearization_tolerance,
+                "linearization_tolerance_mm",
+                self.linearization_tolerance_mm,
                 "must be > 0 (mm; infinity to insert no points)",
             );
         }

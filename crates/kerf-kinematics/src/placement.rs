@@ -199,6 +199,14 @@ impl Default for AutoPlaceOptions {
 }
 
 impl AutoPlaceOptions {
+    /// Sets [`tilt_margin_deg`](Self::tilt_margin_deg): distance kept from the tilt axis'
+    /// limits, degrees (the interpolator's smooth motion between poses may swing slightly
+    /// past a pose that sits on a limit).
+    pub fn with_tilt_margin_deg(mut self, tilt_margin_deg: f64) -> Self {
+        self.tilt_margin_deg = tilt_margin_deg;
+        self
+    }
+
     /// With or without trying rotations.
     pub fn with_rotate(mut self, rotate: bool) -> Self {
         self.rotate = rotate;

@@ -12,10 +12,9 @@
 use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
-use serde_json::Value;
 
 use crate::error::Result;
-use crate::kinematics::Kinematics;
+use crate::kinematics::{Kinematics, Parameter};
 use crate::params::{finite, KinematicsType, Params};
 use crate::pose::{Axes, Pose};
 use crate::rotation::{inv, rot_x, rot_z, sin_cos_deg, Angles, Orientation, TiltAbout};
@@ -158,7 +157,7 @@ impl Kinematics for TableTable {
         self.y_offset.hypot(self.z_offset)
     }
 
-    fn parameters(&self) -> Vec<(&'static str, Value)> {
+    fn parameters(&self) -> Vec<(&'static str, Parameter)> {
         let q = self.rot_point;
         vec![
             ("rot_point", vec![q.x, q.y, q.z].into()),

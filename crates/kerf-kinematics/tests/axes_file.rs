@@ -108,6 +108,14 @@ fn writes_atomically_and_replaces() {
         ),
         "{err:?}"
     );
+    // The operating system's error is kept as the source, not only its message.
+    let io = std::iter::successors(Some(&err as &dyn std::error::Error), |e| e.source())
+        .find_map(|e| e.downcast_ref::<std::io::Error>());
+    assert_eq!(
+        io.map(std::io::Error::kind),
+        Some(std::io::ErrorKind::NotFound),
+        "{err:?}"
+    );
 }
 
 #[test]

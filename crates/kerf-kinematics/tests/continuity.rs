@@ -215,10 +215,7 @@ fn a_path_through_the_pole_does_not_swing_c() {
 fn passing_just_outside_the_pole_tolerance_stays_continuous() {
     // 1e-4 rad beside the pole, sideways: C must turn by about 90 degrees within one step.
     let machine = fixture("ac_head.json");
-    let options = PathOptions {
-        max_rotary_step_deg: 5.0,
-        ..PathOptions::default()
-    };
+    let options = PathOptions::default().with_max_rotary_step_deg(5.0);
     let poses = through_the_pole(Some(polar(1e-4, 30f64.to_radians())));
     let path = solve(&machine, "beside", &poses, &options).expect("reachable");
     assert_exact(&machine, &path, &options);
@@ -245,10 +242,7 @@ fn passing_just_outside_the_pole_tolerance_stays_continuous() {
 fn leaving_the_pole_sideways_turns_c_at_the_pole() {
     // Tilt down to the pole along C = 0, stay there, leave along C = 90.
     let machine = fixture("ac_head.json");
-    let options = PathOptions {
-        max_rotary_step_deg: 5.0,
-        ..PathOptions::default()
-    };
+    let options = PathOptions::default().with_max_rotary_step_deg(5.0);
     let mut poses = Vec::new();
     for k in 0..15 {
         let u = match k {
@@ -299,10 +293,7 @@ fn a_trunnion_turns_c_at_the_pole_rather_than_tilt_below_its_limit() {
     // A in [-10, 120]: through the pole, the natural continuation (A negative) would reach
     // -30; C turns 180 at the pole instead and A stays positive.
     let machine = fixture("table_table.json");
-    let options = PathOptions {
-        max_rotary_step_deg: 10.0,
-        ..PathOptions::default()
-    };
+    let options = PathOptions::default().with_max_rotary_step_deg(10.0);
     let poses: Vec<Pose> = (0..=60)
         .map(|k| {
             let theta = (30.0 - k as f64).to_radians();
@@ -388,11 +379,9 @@ fn first_point_out_of_reach_is_point_0() {
 #[test]
 fn long_rotary_moves_are_split() {
     let machine = unlimited(Arc::new(AcHead::try_new(180.0, 95.0).unwrap()));
-    let options = PathOptions {
-        max_rotary_step_deg: 10.0,
-        linearization_tolerance: f64::INFINITY,
-        ..PathOptions::default()
-    };
+    let options = PathOptions::default()
+        .with_max_rotary_step_deg(10.0)
+        .with_linearization_tolerance_mm(f64::INFINITY);
     let poses = vec![
         Pose {
             position: Point3::origin(),

@@ -172,10 +172,7 @@ fn inserted_points_lie_on_the_curve_when_it_is_known() {
         params: &params,
         point: &circle,
     };
-    let options = PathOptions {
-        linearization_tolerance: 0.001,
-        ..PathOptions::default()
-    };
+    let options = PathOptions::default().with_linearization_tolerance_mm(0.001);
     let on_curve = solve_path(
         &machine,
         &PathInput {
@@ -228,10 +225,7 @@ fn inserted_points_lie_on_the_curve_when_it_is_known() {
 #[test]
 fn infinite_tolerance_inserts_nothing_and_still_reports() {
     let machine = pivot_200();
-    let options = PathOptions {
-        linearization_tolerance: f64::INFINITY,
-        ..PathOptions::default()
-    };
+    let options = PathOptions::default().with_linearization_tolerance_mm(f64::INFINITY);
     let poses = one_mm_five_degrees();
     let path = solve_path(
         &machine,
@@ -254,11 +248,9 @@ fn infinite_tolerance_inserts_nothing_and_still_reports() {
 #[test]
 fn too_many_inserted_points_is_an_error() {
     let machine = pivot_200();
-    let options = PathOptions {
-        linearization_tolerance: 1e-7,
-        max_inserted: 10,
-        ..PathOptions::default()
-    };
+    let options = PathOptions::default()
+        .with_linearization_tolerance_mm(1e-7)
+        .with_max_inserted(10);
     let poses = one_mm_five_degrees();
     let err = solve_path(
         &machine,
@@ -282,7 +274,7 @@ fn too_many_inserted_points_is_an_error() {
         "{err}"
     );
     assert!(
-        err.to_string().contains("raise linearization_tolerance"),
+        err.to_string().contains("raise linearization_tolerance_mm"),
         "{err}"
     );
 }

@@ -26,39 +26,24 @@ fn bad_options_are_named() {
     };
     for (options, name) in [
         (
-            PathOptions {
-                pole_tolerance_rad: f64::NAN,
-                ..PathOptions::default()
-            },
+            PathOptions::default().with_pole_tolerance_rad(f64::NAN),
             "pole_tolerance_rad",
         ),
         (
-            PathOptions {
-                pole_tolerance_rad: -1.0,
-                ..PathOptions::default()
-            },
+            PathOptions::default().with_pole_tolerance_rad(-1.0),
             "pole_tolerance_rad",
         ),
         (
-            PathOptions {
-                max_rotary_step_deg: 0.0,
-                ..PathOptions::default()
-            },
+            PathOptions::default().with_max_rotary_step_deg(0.0),
             "max_rotary_step_deg",
         ),
         (
-            PathOptions {
-                linearization_tolerance: -0.1,
-                ..PathOptions::default()
-            },
-            "linearization_tolerance",
+            PathOptions::default().with_linearization_tolerance_mm(-0.1),
+            "linearization_tolerance_mm",
         ),
         (
-            PathOptions {
-                linearization_tolerance: f64::NAN,
-                ..PathOptions::default()
-            },
-            "linearization_tolerance",
+            PathOptions::default().with_linearization_tolerance_mm(f64::NAN),
+            "linearization_tolerance_mm",
         ),
     ] {
         let err = solve_path(&m, &input, &options).unwrap_err();

@@ -79,7 +79,7 @@ proptest! {
         tol in 0.005..0.1f64,
     ) {
         let machine = unlimited(kin);
-        let options = PathOptions { max_rotary_step_deg: max_step, linearization_tolerance: tol, ..PathOptions::default() };
+        let options = PathOptions::default().with_max_rotary_step_deg(max_step).with_linearization_tolerance_mm(tol);
         let path = solve_path(&machine, &PathInput { id: "p", poses: &poses, curve: None }, &options)
             .map_err(|e| TestCaseError::fail(e.to_string()))?;
         let kin = machine.kinematics.as_ref();

@@ -7,10 +7,10 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum NormalsError {
-    /// A cutting point is farther from its surface than `on_surface_tolerance`: the curve does
+    /// A cutting point is farther from its surface than `on_surface_tolerance_mm`: the curve does
     /// not lie on the surface it names. Fix: check that the curve's `surface` id is right, or
     /// raise the tolerance if the CAD export is coarse.
-    #[error("point at t = {} is {distance:.3e} mm from its surface (on_surface_tolerance {} mm): the curve does not lie on the surface", Readable(*.t), Readable(*.tolerance))]
+    #[error("point at t = {} is {distance:.3e} mm from its surface (on_surface_tolerance_mm {} mm): the curve does not lie on the surface", Readable(*.t), Readable(*.tolerance))]
     OffSurface {
         /// Curve parameter.
         t: f64,
@@ -54,8 +54,8 @@ pub enum NormalsError {
     #[error(transparent)]
     Discretize(#[from] kerf_discretize::DiscretizeError),
     /// Inserting points against the normal step would exceed the limit. Fix: raise
-    /// `max_normal_step`.
-    #[error("more than {limit} points inserted for the normal step; raise max_normal_step (--max-normal-step)")]
+    /// `max_normal_step_rad`.
+    #[error("more than {limit} points inserted for the normal step; raise max_normal_step_rad (--max-normal-step, degrees)")]
     TooManyInserted {
         /// The limit.
         limit: usize,

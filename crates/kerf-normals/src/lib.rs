@@ -5,9 +5,9 @@
 //! point, warm-started from the previous point) or a triangle mesh ([`MeshNormals`], parry3d's
 //! `TriMesh` with crease-aware smooth normals). [`orient`] also
 //!
-//! - rejects a curve that does not lie on its surface (`on_surface_tolerance`),
+//! - rejects a curve that does not lie on its surface (`on_surface_tolerance_mm`),
 //! - inserts cutting points (on the curve) until neighbouring normals differ by at most
-//!   `max_normal_step`, re-certifying every new segment so the chord-error guarantee holds,
+//!   `max_normal_step_rad`, re-certifying every new segment so the chord-error guarantee holds,
 //! - refuses a normal that reverses between neighbouring points (inconsistent orientation),
 //!   and reports normal jumps that insertion cannot remove (a curve crossing a sharp mesh edge).
 //!
@@ -28,43 +28,66 @@ use nalgebra::{Point3, Vector3};
 
 /// Options of the normals stage. Lengths in mm, angles in radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct NormalOptions {
     /// A cutting point farther than this from its surface is an error. Default 0.01 mm.
-    pub on_surface_tolerance: f64,
+    pub on_surface_tolerance_mm: f64,
     /// The largest angle between the normals of neighbouring cutting points; points are
-    /// inserted until it holds. Default 1 degree.
-    pub max_normal_step: f64,
-    /// Refuse a curve that needs more inserted points than this. Default 1,000,000.
+    /// inserted until it holds, radians (strictly between 0 and pi). Default 1 degree
+    /// (`1f64.to_radians()`).
+    pub max_normal_step_rad: f64,
+    /// Refuse a curve that needs more inserted points than this (a count). Default 1,000,000.
     pub max_inserted: usize,
 }
 
 impl Default for NormalOptions {
     fn default() -> Self {
         Self {
-            on_surface_tolerance: 0.01,
-            max_normal_step: 1f64.to_radians(),
+            on_surface_tolerance_mm: 0.01,
+            max_normal_step_rad: 1f64.to_radians(),
             max_inserted: 1_000_000,
         }
     }
 }
 
 impl NormalOptions {
+    /// Sets [`on_surface_tolerance_mm`](Self::on_surface_tolerance_mm): a cutting point
+    /// farther than this from its surface is an error.
+    pub fn with_on_surface_tolerance_mm(mut self, on_surface_tolerance_mm: f64) -> Self {
+        self.on_surface_tolerance_mm = on_surface_tolerance_mm;
+        self
+    }
+
+    /// Sets [`max_normal_step_rad`](Self::max_normal_step_rad): the largest angle between
+    /// the normals of neighbouring cutting points.
+    pub fn with_max_normal_step_rad(mut self, max_normal_step_rad: f64) -> Self {
+        self.max_normal_step_rad = max_normal_step_rad;
+        self
+    }
+
+    /// Sets [`max_inserted`](Self::max_inserted): refuse a curve that needs more inserted
+    /// points than this.
+    pub fn with_max_inserted(mut self, max_inserted: usize) -> Self {
+        self.max_inserted = max_inserted;
+        self
+    }
+
     /// Checks every option.
     ///
     /// # Errors
     /// [`NormalsError::BadOption`] naming the first bad option.
     pub fn validate(&self) -> Result<()> {
-        if !(self.on_surface_tolerance.is_finite() && self.on_surface_tolerance > 0.0) {
+        if !(self.on_surface_tolerance_mm.is_finite() && self.on_surface_tolerance_mm > 0.0) {
             return Err(NormalsError::BadOption {
-                name: "on_surface_tolerance",
-                value: self.on_surface_tolerance,
+                name: "on_surface_tolerance_mm",
+                value: self.on_surface_tolerance_mm,
                 reason: "must be finite and > 0",
             });
         }
-        if !(self.max_normal_step > 0.0 && self.max_normal_step < std::f64::consts::PI) {
+        if !(self.max_normal_step_rad > 0.0 && self.max_normal_step_rad < std::f64::consts::PI) {
             return Err(NormalsError::BadOption {
-                name: "max_normal_step",
-                value: self.max_normal_step,
+                name: "max_normal_step_rad",
+                value: self.max_normal_step_rad,
                 reason: "must lie strictly between 0 and 180 degrees",
             });
         }
@@ -72,20 +95,23 @@ impl NormalOptions {
     }
 }
 
-/// Cutting points with their normals.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// Cutting points with their normals, and the certified chord-error bound of the polyline
+/// through them.
+///
+/// The points, parameters, normals and bound are private and read through accessors: an
+/// `Oriented` comes only from [`orient`] or [`Oriented::vertical`], both of which start from a
+/// [`Discretization`] (itself only made by the discretizer or
+/// [`Discretization::certify`]), so [`Oriented::max_chord_error`] is always a proven bound for
+/// exactly these points and cannot be set by hand.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Oriented {
-    /// Curve parameters, strictly increasing (the discretization's plus inserted ones).
-    pub params: Vec<f64>,
-    /// The points `C(t)`.
-    pub points: Vec<Point3<f64>>,
-    /// The unit normals.
-    pub normals: Vec<Vector3<f64>>,
-    /// Certified chord-error bound over all segments (including the new ones).
-    pub max_chord_error: f64,
+    params: Vec<f64>,
+    points: Vec<Point3<f64>>,
+    normals: Vec<Vector3<f64>>,
+    max_chord_error: f64,
     /// How many points were inserted for the normal step (and the re-certification).
     pub inserted: usize,
-    /// The largest distance from a cutting point to the surface.
+    /// The largest distance from a cutting point to the surface, mm.
     pub max_surface_distance: f64,
     /// The largest angle between neighbouring normals, radians.
     pub max_normal_angle: f64,
@@ -95,6 +121,57 @@ pub struct Oriented {
 }
 
 impl Oriented {
+    /// The points of `disc` with the tool axis +z at every one (flat 2D cutting with a
+    /// vertical beam: a curve without a surface). The bound is the discretization's own.
+    pub fn vertical(disc: &Discretization) -> Self {
+        Self {
+            params: disc.params().to_vec(),
+            points: disc.points().to_vec(),
+            normals: vec![Vector3::z(); disc.points().len()],
+            max_chord_error: disc.max_chord_error(),
+            inserted: 0,
+            max_surface_distance: 0.0,
+            max_normal_angle: 0.0,
+            jumps: Vec::new(),
+        }
+    }
+
+    /// An empty result to be filled by [`orient`], starting from the bound of `disc`.
+    fn start(disc: &Discretization) -> Self {
+        let n = disc.params().len();
+        Self {
+            params: Vec::with_capacity(n),
+            points: Vec::with_capacity(n),
+            normals: Vec::with_capacity(n),
+            max_chord_error: disc.max_chord_error(),
+            inserted: 0,
+            max_surface_distance: 0.0,
+            max_normal_angle: 0.0,
+            jumps: Vec::new(),
+        }
+    }
+
+    /// Curve parameters, strictly increasing (the discretization's plus inserted ones).
+    pub fn params(&self) -> &[f64] {
+        &self.params
+    }
+
+    /// The points `C(t)`, mm.
+    pub fn points(&self) -> &[Point3<f64>] {
+        &self.points
+    }
+
+    /// The unit normals, one per point.
+    pub fn normals(&self) -> &[Vector3<f64>] {
+        &self.normals
+    }
+
+    /// Certified chord-error bound over all segments (the discretization's and every segment
+    /// that inserted points made), mm.
+    pub fn max_chord_error(&self) -> f64 {
+        self.max_chord_error
+    }
+
     /// `[x, y, z, i, j, k]` per point.
     pub fn poses(&self) -> Vec<[f64; 6]> {
         self.points
@@ -135,8 +212,8 @@ impl Ctx<'_> {
         let mut pr = self.surface.project(&p, hint);
         let degenerate = self.surface.is_degenerate(pr.hint);
         if hint != Hint::None
-            && (pr.distance > self.nopts.on_surface_tolerance
-                || (degenerate && pr.distance > 1e-6 * self.nopts.on_surface_tolerance))
+            && (pr.distance > self.nopts.on_surface_tolerance_mm
+                || (degenerate && pr.distance > 1e-6 * self.nopts.on_surface_tolerance_mm))
         {
             // A warm start can settle in a local minimum, or stay on a collapsed edge the
             // point has left: decide globally, keep the closer.
@@ -145,11 +222,11 @@ impl Ctx<'_> {
                 pr = global;
             }
         }
-        if pr.distance > self.nopts.on_surface_tolerance || pr.distance.is_nan() {
+        if pr.distance > self.nopts.on_surface_tolerance_mm || pr.distance.is_nan() {
             return Err(NormalsError::OffSurface {
                 t,
                 distance: pr.distance,
-                tolerance: self.nopts.on_surface_tolerance,
+                tolerance: self.nopts.on_surface_tolerance_mm,
             });
         }
         self.out.max_surface_distance = self.out.max_surface_distance.max(pr.distance);
@@ -203,7 +280,7 @@ impl Ctx<'_> {
     fn segment(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
         let angle = a.n_after.angle(&b.n);
         let tm = 0.5 * (a.t + b.t);
-        if angle > self.nopts.max_normal_step {
+        if angle > self.nopts.max_normal_step_rad {
             // Stop splitting when the interval is tiny, or so close to the float spacing that
             // its midpoint is no longer strictly inside (large parameter values).
             if b.t - a.t <= self.min_dt || !(a.t < tm && tm < b.t) {
@@ -261,7 +338,7 @@ impl Ctx<'_> {
 
 /// Gives every cutting point of `disc` (a discretization of `curve` with options `dopts`) the
 /// unit normal of `surface`, inserting points where neighbouring normals differ by more than
-/// `nopts.max_normal_step`.
+/// `nopts.max_normal_step_rad`.
 ///
 /// # Errors
 /// [`NormalsError::OffSurface`] naming the parameter and distance, [`NormalsError::NoNormal`],
@@ -284,13 +361,7 @@ pub fn orient(
         dopts,
         nopts,
         min_dt: (1e-9 * (db - da)).max(8.0 * f64::EPSILON * da.abs().max(db.abs())),
-        out: Oriented {
-            max_chord_error: disc.max_chord_error(),
-            params: Vec::with_capacity(disc.params().len()),
-            points: Vec::with_capacity(disc.params().len()),
-            normals: Vec::with_capacity(disc.params().len()),
-            ..Default::default()
-        },
+        out: Oriented::start(disc),
     };
     let Some((&t0, &p0)) = disc.params().first().zip(disc.points().first()) else {
         return Ok(ctx.out);
@@ -300,7 +371,7 @@ pub fn orient(
     for i in 1..disc.params().len() {
         let s = ctx.sample(disc.params()[i], disc.points()[i], prev.hint)?;
         ctx.segment(prev, s, true)?;
-        if s.n.angle(&s.n_after) > ctx.nopts.max_normal_step {
+        if s.n.angle(&s.n_after) > ctx.nopts.max_normal_step_rad {
             // The normal jumps at a degenerate point of the surface (a cone's apex): the head
             // turns in place there; no insertion can remove it.
             ctx.out.jumps.push(s.t);

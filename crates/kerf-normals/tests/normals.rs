@@ -102,7 +102,7 @@ fn assert_normals(
     truth: impl Fn(&Point3<f64>) -> Vector3<f64>,
     eps: f64,
 ) {
-    for (p, n) in o.points.iter().zip(&o.normals) {
+    for (p, n) in o.points().iter().zip(o.normals()) {
         let t = truth(p);
         assert!(
             (n - t).norm() < eps,
@@ -152,7 +152,7 @@ fn cylinder_normal_is_radial_on_a_helix_and_a_circle() {
         o.max_normal_angle <= 1f64.to_radians() + 1e-12,
         "normal step held"
     );
-    assert!(o.max_chord_error <= 0.01, "chord error still certified");
+    assert!(o.max_chord_error() <= 0.01, "chord error still certified");
 }
 
 #[test]
@@ -260,13 +260,10 @@ fn cylinder_mesh_normals_within_the_facet_bound() {
     let curve = circle_curve(20.0 - sag / 2.0, 50.0);
     let opts = Options::with_tolerance(0.01);
     let d = discretize(&curve, &opts).unwrap();
-    let nopts = NormalOptions {
-        on_surface_tolerance: sag,
-        ..NormalOptions::default()
-    };
+    let nopts = NormalOptions::default().with_on_surface_tolerance_mm(sag);
     let o = orient(&curve, &d, &mesh, &opts, &nopts).unwrap();
     let bound = PI / n as f64; // half the facet angle
-    for (p, nrm) in o.points.iter().zip(&o.normals) {
+    for (p, nrm) in o.points().iter().zip(o.normals()) {
         let truth = Vector3::new(p.x, p.y, 0.0).normalize();
         assert!(
             nrm.angle(&truth) <= bound + 1e-9,
@@ -284,10 +281,10 @@ fn cylinder_mesh_normals_within_the_facet_bound() {
     let (v, t) = cylinder_mesh(20.0, 100.0, n, true);
     let flipped = MeshNormals::new(v, t, 30.0, false).unwrap();
     let of = orient(&curve, &d, &flipped, &opts, &nopts).unwrap();
-    assert_eq!(o.params, of.params, "same points");
+    assert_eq!(o.params(), of.params(), "same points");
     // (Exactly, except where a point is equidistant from two facets and the two meshes pick
     // different ones: then both normals are valid and differ by ~1e-5 rad.)
-    for ((a, b), p) in o.normals.iter().zip(&of.normals).zip(&o.points) {
+    for ((a, b), p) in o.normals().iter().zip(of.normals()).zip(o.points()) {
         assert!(
             (a + b).norm() < 1e-4,
             "reversed winding reverses the normal at {p:?}: {a:?} {b:?}"
@@ -341,7 +338,7 @@ fn box_mesh_edges_are_not_blended() {
         None,
     );
     let o = run(&curve, &mesh, 0.01).unwrap();
-    for (p, n) in o.points.iter().zip(&o.normals) {
+    for (p, n) in o.points().iter().zip(o.normals()) {
         if p.z > 10.0 - 1e-9 && p.x < 10.0 - 1e-9 {
             assert!(
                 (n - Vector3::z()).norm() < 1e-12,
@@ -404,12 +401,16 @@ fn real_parts_get_normals_and_never_reverse() {
             let src = NurbsNormals::new(s.clone(), false);
             let o =
                 run(&rec.curve, &src, 0.01).unwrap_or_else(|e| panic!("{file} {}: {e}", rec.id));
-            assert_eq!(o.points.len(), o.normals.len(), "every point has a normal");
-            for w in o.normals.windows(2) {
+            assert_eq!(
+                o.points().len(),
+                o.normals().len(),
+                "every point has a normal"
+            );
+            for w in o.normals().windows(2) {
                 assert!(w[0].dot(&w[1]) > 0.0, "{file} {}: normal reverses", rec.id);
             }
             assert!(
-                o.max_chord_error <= 0.01,
+                o.max_chord_error() <= 0.01,
                 "{file} {}: guarantee kept",
                 rec.id
             );
@@ -436,7 +437,7 @@ fn large_parameter_values_do_not_recurse_forever_at_a_jump() {
     );
     let o = run(&curve, &mesh, 0.01).unwrap();
     assert_eq!(o.jumps.len(), 1, "one jump at the edge");
-    for w in o.params.windows(2) {
+    for w in o.params().windows(2) {
         assert!(w[1] > w[0], "params strictly increase");
     }
 }
@@ -457,10 +458,7 @@ fn cone_apex_normals_are_the_limits_along_the_curve() {
     };
     let src = NurbsNormals::new(surface.clone(), false);
     // Short segments, so that many cutting points lie just past the apex.
-    let dopts = Options {
-        max_segment_length: 0.5,
-        ..Options::with_tolerance(0.01)
-    };
+    let dopts = Options::with_tolerance(0.01).with_max_segment_length(0.5);
     let disc = discretize(&rec.curve, &dopts).expect("discretized");
     let o = orient(&rec.curve, &disc, &src, &dopts, &NormalOptions::default()).expect("oriented");
     // Analytic: on z = r (half angle 45 degrees) Su x Sv points along (x / r, y / r, -1).
@@ -476,9 +474,9 @@ fn cone_apex_normals_are_the_limits_along_the_curve() {
         Vector3::new(cx, cy, -1.0).normalize()
     };
     for (i, (t, (p, n))) in o
-        .params
+        .params()
         .iter()
-        .zip(o.points.iter().zip(&o.normals))
+        .zip(o.points().iter().zip(o.normals()))
         .enumerate()
     {
         let want = analytic(p, *t <= 0.5);
@@ -488,13 +486,13 @@ fn cone_apex_normals_are_the_limits_along_the_curve() {
         );
     }
     assert!(
-        o.params
+        o.params()
             .iter()
             .filter(|&&t| t > 0.5 && t < 0.5 + 1e-3)
             .count()
             <= 1,
         "no normal-step points squeezed after the apex: {:?}",
-        o.params
+        o.params()
             .iter()
             .filter(|&&t| t > 0.5 && t < 0.51)
             .collect::<Vec<_>>()

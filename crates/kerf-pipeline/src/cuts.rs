@@ -65,7 +65,7 @@ pub(crate) fn plan(
                     kerf_format::ScrapSide::Left => kerf_process::Side::Left,
                     kerf_format::ScrapSide::Right => kerf_process::Side::Right,
                 }),
-                start: starts[i].map(|t| kerf_process::index_of_param(&oriented[i].params, t)),
+                start: starts[i].map(|t| kerf_process::index_of_param(oriented[i].params(), t)),
             })
             .collect();
         let plan = plan_cuts(&contours, options).map_err(|e| Error::Process {
@@ -90,7 +90,7 @@ fn cut_path(
     k: usize,
 ) -> CutPath {
     let lead = &plan.leads[k];
-    let t = &o.params;
+    let t = o.params();
     let n = t.len();
     let s = lead.start;
     let closed = plan.closed[k];

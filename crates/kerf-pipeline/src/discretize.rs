@@ -91,9 +91,9 @@ pub fn toolpath_of_poses(
         tolerance_mm,
         oriented.iter().map(|o| {
             (
-                o.params.as_slice(),
+                o.params(),
                 ToolpathPoints::Poses(o.poses()),
-                o.max_chord_error,
+                o.max_chord_error(),
             )
         }),
     )
@@ -235,13 +235,7 @@ pub fn orient_curves(
                 .filter_map(|&si| sources[si].as_deref())
                 .collect();
             let result = if picked.is_empty() {
-                Ok(Oriented {
-                    params: d.params().to_vec(),
-                    points: d.points().to_vec(),
-                    normals: vec![nalgebra::Vector3::z(); d.points().len()],
-                    max_chord_error: d.max_chord_error(),
-                    ..Default::default()
-                })
+                Ok(Oriented::vertical(d))
             } else {
                 let nearest;
                 let src: &dyn NormalSource = if picked.len() == 1 {

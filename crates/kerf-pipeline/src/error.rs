@@ -112,7 +112,7 @@ pub enum Error {
         file: Option<PathBuf>,
         /// What went wrong.
         #[source]
-        source: Box<kerf_kinematics::KinematicsError>,
+        source: kerf_kinematics::BoxedKinematicsError,
     },
     /// The interpolator or the G-code writer refused (an option out of range, unusable process
     /// codes, a program the dialect cannot run). Fix: as the message says.
@@ -209,7 +209,7 @@ impl From<kerf_kinematics::KinematicsError> for Error {
     fn from(e: kerf_kinematics::KinematicsError) -> Self {
         Error::Kinematics {
             file: None,
-            source: Box::new(e),
+            source: e.into(),
         }
     }
 }
@@ -221,7 +221,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 pub(crate) fn kin(file: Option<&Path>) -> impl Fn(kerf_kinematics::KinematicsError) -> Error + '_ {
     move |e| Error::Kinematics {
         file: file.map(Path::to_path_buf),
-        source: Box::new(e),
+        source: e.into(),
     }
 }
 

@@ -41,6 +41,7 @@ mod job;
 mod motion;
 mod output;
 mod place;
+mod post;
 mod run;
 
 pub use discretize::{discretize_curves, orient_curves, toolpath_of_points, toolpath_of_poses};
@@ -49,6 +50,7 @@ pub use job::{Job, JobOptions, MissingSurface, OrientOptions};
 pub use motion::{fit_options, path_report, plan_program, MotionInput, MotionOptions, Program};
 pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};
 pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};
+pub use post::{post_toolpath, toolpath_poses, MissingNormals, Posted};
 
 /// A stage of a job, as [`Progress`] reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -18,8 +18,7 @@ use kerf_interp::{
     gcode_motion, stations_from_axes, stations_from_solved, write_csv_to, AxisModel, Dialect,
     FitOptions, GcodeOptions, MachineModel, Motion, PlanOptions, ProgramPath,
 };
-use kerf_kinematics::{solve_path, AxesFile, Machine, PathOptions, Pose};
-use nalgebra::Vector3;
+use kerf_kinematics::{AxesFile, Machine, PathOptions};
 use serde_json::json;
 
 use crate::error::{interp, kin, Error, Result};
@@ -29,12 +28,10 @@ use crate::error::{interp, kin, Error, Result};
 /// tool tip on the programmed path (see the module documentation).
 pub fn fit_options(tolerance_mm: f64, dialect: Option<Dialect>, retract_mm: f64) -> FitOptions {
     let raw_axes = dialect.is_some_and(Dialect::raw_axes);
-    FitOptions {
-        arcs: !raw_axes,
-        merge_lines: !raw_axes,
-        retract: retract_mm,
-        ..FitOptions::with_tolerance(tolerance_mm)
-    }
+    FitOptions::with_tolerance(tolerance_mm)
+        .with_arcs(!raw_axes)
+        .with_merge_lines(!raw_axes)
+        .with_retract_mm(retract_mm)
 }
 
 /// What the motion stage reads: machine axes (`kerf.axes/1`, from `kerf post` or any tool), or
@@ -108,6 +105,12 @@ pub struct MotionOptions {
     /// The controller's blending tolerance, mm. Default
     /// [`kerf_interp::DEFAULT_BLEND_TOLERANCE`].
     pub blend_tolerance_mm: f64,
+    /// Run the traverse before a path through the waypoints an axes file records for it (its
+    /// `traverse` key: checked by `kerf run` to clear the part), as `kerf run`'s own program
+    /// does; a path without one gets the unchecked retract and straight traverse. False: the
+    /// unchecked traverse everywhere (`kerf gcode --clearance 0`). Default true; a toolpath
+    /// input records no traverses.
+    pub recorded_traverses: bool,
 }
 
 impl Default for MotionOptions {
@@ -120,6 +123,7 @@ impl Default for MotionOptions {
             chord_tolerance_mm: None,
             retract_mm: 10.0,
             blend_tolerance_mm: kerf_interp::DEFAULT_BLEND_TOLERANCE,
+            recorded_traverses: true,
         }
     }
 }
@@ -160,6 +164,11 @@ impl MotionOptions {
         self.blend_tolerance_mm = mm;
         self
     }
+    /// With or without the traverses an axes file records.
+    pub fn with_recorded_traverses(mut self, recorded: bool) -> Self {
+        self.recorded_traverses = recorded;
+        self
+    }
 }
 
 /// A planned program: the machine model, the path ids and the motion, with what it was
@@ -195,6 +204,7 @@ pub fn plan_program(
 ) -> Result<Program> {
     let model = MachineModel::new(machine.clone()).map_err(interp(source))?;
     let mut linearization = None;
+    let mut traverses: Vec<Vec<kerf_interp::Station>> = Vec::new();
     let (ids, paths, file_tol) = match input {
         MotionInput::Axes(axes) => {
             let mut paths = Vec::new();
@@ -209,6 +219,15 @@ pub fn plan_program(
                     curve: None,
                 });
             }
+            // The traverse before each path but the first (empty: the unchecked one).
+            for p in axes.paths.iter().skip(1) {
+                traverses.push(match &p.traverse {
+                    Some(m) if options.recorded_traverses => {
+                        stations_from_axes(&m.positions, &m.poses).map_err(interp(source))?
+                    }
+                    _ => Vec::new(),
+                });
+            }
             (
                 axes.paths.iter().map(|p| p.id.clone()).collect::<Vec<_>>(),
                 paths,
@@ -216,29 +235,21 @@ pub fn plan_program(
             )
         }
         MotionInput::Toolpath(tp) => {
-            linearization = Some(PathOptions::default().linearization_tolerance);
+            let path_options = PathOptions::default();
+            linearization = Some(path_options.linearization_tolerance_mm);
+            let posted = crate::post::post_toolpath(
+                machine,
+                tp,
+                &path_options,
+                crate::PlaceMode::AsModelled,
+                crate::post::MissingNormals::Vertical,
+                source,
+            )?;
             let mut paths = Vec::new();
-            for p in &tp.paths {
-                let poses: Vec<Pose> = (0..p.points.len())
-                    .map(|n| {
-                        let q = p.points.position(n);
-                        let a = p.points.normal(n).unwrap_or_else(Vector3::z);
-                        Pose::new(q.x, q.y, q.z, a.x, a.y, a.z)
-                    })
-                    .collect();
-                let solved = solve_path(
-                    machine,
-                    &kerf_kinematics::PathInput {
-                        id: &p.id,
-                        poses: &poses,
-                        curve: None,
-                    },
-                    &PathOptions::default(),
-                )
-                .map_err(kin(source))?;
+            for (p, solved) in tp.paths.iter().zip(&posted.solved) {
                 paths.push(ProgramPath {
                     id: p.id.clone(),
-                    stations: stations_from_solved(&solved, Some(&p.params))
+                    stations: stations_from_solved(solved, Some(&p.params))
                         .map_err(interp(source))?,
                     curve: None,
                 });
@@ -255,12 +266,12 @@ pub fn plan_program(
     if let Some(c) = options.chord_tolerance_mm {
         plan.chord_tolerance = c;
     }
-    let motion = kerf_interp::interpolate(
-        &model,
-        &paths,
-        &fit_options(fit_tolerance, options.dialect, options.retract_mm),
-        &plan,
-    )
+    let fit = fit_options(fit_tolerance, options.dialect, options.retract_mm);
+    let motion = if traverses.is_empty() {
+        kerf_interp::interpolate(&model, &paths, &fit, &plan)
+    } else {
+        kerf_interp::interpolate_through(&model, &paths, &traverses, &fit, &plan)
+    }
     .map_err(interp(source))?;
     Ok(Program {
         model,
@@ -281,18 +292,16 @@ impl Program {
     /// [`Error::NoDialect`] for a program planned for set-points only.
     pub fn gcode_options(&self) -> Result<GcodeOptions> {
         let dialect = self.options.dialect.ok_or(Error::NoDialect)?;
-        Ok(GcodeOptions {
-            fit_tolerance: self.fit_tolerance_mm,
-            chord_tolerance: self.options.chord_tolerance_mm.unwrap_or(0.001),
-            linearization_tolerance: self.linearization_tolerance_mm,
-            ..gcode_options(
-                &self.model,
-                dialect,
-                self.options.feed_mm_per_min,
-                self.options.blend_tolerance_mm,
-                self.source.as_deref(),
-            )
-        })
+        Ok(gcode_options(
+            &self.model,
+            dialect,
+            self.options.feed_mm_per_min,
+            self.options.blend_tolerance_mm,
+            self.source.as_deref(),
+        )
+        .with_fit_tolerance_mm(self.fit_tolerance_mm)
+        .with_chord_tolerance_mm(self.options.chord_tolerance_mm.unwrap_or(0.001))
+        .with_linearization_tolerance_mm(self.linearization_tolerance_mm))
     }
 
     /// The program text in its dialect.
@@ -364,11 +373,9 @@ pub(crate) fn gcode_options(
     blend_tolerance: f64,
     source: Option<&str>,
 ) -> GcodeOptions {
-    GcodeOptions {
-        blend_tolerance,
-        pivot_length: Some(model.machine.kinematics.pivot_length()),
-        process: model.machine.process.clone(),
-        source: source.map(str::to_owned),
-        ..GcodeOptions::new(dialect, feed)
-    }
+    GcodeOptions::new(dialect, feed)
+        .with_blend_tolerance_mm(blend_tolerance)
+        .with_pivot_length_mm(Some(model.machine.kinematics.pivot_length()))
+        .with_process(model.machine.process.clone())
+        .with_source(source.map(str::to_owned))
 }

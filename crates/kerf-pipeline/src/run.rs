@@ -8,8 +8,7 @@ use std::time::Instant;
 
 use kerf_discretize::Discretization;
 use kerf_interp::{
-    gcode_motion, stations_from_solved, GcodeOptions, MachineModel, PlanOptions,
-    ProgramPath as InterpPath,
+    gcode_motion, stations_from_solved, MachineModel, PlanOptions, ProgramPath as InterpPath,
 };
 use kerf_kinematics::{solve_paths, AxesFile, PathCurve, PathInput, Pose};
 use kerf_normals::Oriented;
@@ -122,18 +121,16 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let fit = crate::motion::fit_options(dopts.tolerance, Some(dialect), o.retract_mm);
     let plan = PlanOptions::new(o.feed_mm_per_min, o.cycle_s);
     let source_name = path.map(|p| p.display().to_string());
-    let gopts = GcodeOptions {
-        fit_tolerance: dopts.tolerance,
-        chord_tolerance: plan.chord_tolerance,
-        linearization_tolerance: Some(popts.linearization_tolerance),
-        ..crate::motion::gcode_options(
-            &model,
-            dialect,
-            o.feed_mm_per_min,
-            o.blend_tolerance_mm,
-            source_name.as_deref(),
-        )
-    };
+    let gopts = crate::motion::gcode_options(
+        &model,
+        dialect,
+        o.feed_mm_per_min,
+        o.blend_tolerance_mm,
+        source_name.as_deref(),
+    )
+    .with_fit_tolerance_mm(dopts.tolerance)
+    .with_chord_tolerance_mm(plan.chord_tolerance)
+    .with_linearization_tolerance_mm(Some(popts.linearization_tolerance_mm));
     let mut motions = Vec::new();
     let mut programs = Vec::new();
     let mut setup_ids: Vec<Vec<String>> = Vec::new();
@@ -289,9 +286,9 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         "machine": machine.name,
         "tolerance_budget_mm": {
             "chord": dopts.tolerance,
-            "linearization": popts.linearization_tolerance,
+            "linearization": popts.linearization_tolerance_mm,
             "interpolation_chord": plan.chord_tolerance,
-            "controller_blending": gopts.blend_tolerance,
+            "controller_blending": gopts.blend_tolerance_mm,
             "total": gopts.budget_total(),
         },
         "program": {
@@ -311,7 +308,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
             "c0_breaks": discs.iter().map(|d| d.c0_breaks().len()).sum::<usize>(),
         },
         "normals": {
-            "points": oriented.iter().map(|o| o.points.len()).sum::<usize>(),
+            "points": oriented.iter().map(|o| o.points().len()).sum::<usize>(),
             "inserted": oriented.iter().map(|o| o.inserted).sum::<usize>(),
             "max_surface_distance": oriented.iter().map(|o| o.max_surface_distance).fold(0.0, f64::max),
             "jumps": oriented.iter().map(|o| o.jumps.len()).sum::<usize>(),

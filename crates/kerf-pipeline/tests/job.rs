@@ -2,12 +2,10 @@
 //! error type, the generic-dialect rule and the outputs, checked against independent truth
 //! (`kerf-check`'s brute-force measurement, the exact circle, forward kinematics).
 
-use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use kerf_check::{check, CheckOptions, RawToolpath};
 use kerf_interp::{Dialect, Geometry};
-use kerf_kinematics::Machine;
 use kerf_nurbs::NurbsCurve;
 use kerf_pipeline::{
     plan_program, Error, Job, JobOptions, MissingSurface, MotionInput, MotionOptions,
@@ -15,15 +13,8 @@ use kerf_pipeline::{
 };
 use nalgebra::Point3;
 
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
-
-fn machine() -> Machine {
-    Machine::read(fixture("machines/ac_head.json")).expect("machine")
-}
+mod common;
+use common::{fixture, machine};
 
 /// A straight line from `a` to `b` (degree 1).
 fn line(a: [f64; 3], b: [f64; 3]) -> NurbsCurve {
@@ -64,7 +55,7 @@ fn a_job_from_files_gives_every_stage_and_its_toolpath_passes_the_independent_ch
     for (rec, o) in job.curves().curves.iter().zip(&out.oriented) {
         if rec.surface.is_none() {
             assert!(
-                o.normals.iter().all(|v| (v.z - 1.0).abs() < 1e-15),
+                o.normals().iter().all(|v| (v.z - 1.0).abs() < 1e-15),
                 "{}",
                 rec.id
             );

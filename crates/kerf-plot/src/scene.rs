@@ -56,6 +56,7 @@ pub struct AxesChart {
 
 /// How densely to sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct SceneOptions {
     /// Samples per segment for the displayed chord error (default 32).
     pub error_samples: usize,
@@ -71,6 +72,22 @@ impl Default for SceneOptions {
             error_samples: 32,
             curve_samples: 2000,
         }
+    }
+}
+
+impl SceneOptions {
+    /// Sets [`error_samples`](Self::error_samples): samples per segment for the displayed
+    /// chord error (default 32).
+    pub fn with_error_samples(mut self, error_samples: usize) -> Self {
+        self.error_samples = error_samples;
+        self
+    }
+
+    /// Sets [`curve_samples`](Self::curve_samples): samples of a curve as long as the whole
+    /// scene is wide, for drawing it (default 2000).
+    pub fn with_curve_samples(mut self, curve_samples: usize) -> Self {
+        self.curve_samples = curve_samples;
+        self
     }
 }
 

@@ -48,6 +48,62 @@ impl Default for LeadOptions {
 }
 
 impl LeadOptions {
+    /// Sets [`lead_in_mm`](Self::lead_in_mm): length of the straight part of a lead-in,
+    /// from the pierce point to the arc, mm (default 2).
+    pub fn with_lead_in_mm(mut self, lead_in_mm: f64) -> Self {
+        self.lead_in_mm = lead_in_mm;
+        self
+    }
+
+    /// Sets [`lead_in_radius_mm`](Self::lead_in_radius_mm): radius of the quarter arc that
+    /// joins a closed contour tangentially, mm (default 1).
+    pub fn with_lead_in_radius_mm(mut self, lead_in_radius_mm: f64) -> Self {
+        self.lead_in_radius_mm = lead_in_radius_mm;
+        self
+    }
+
+    /// Sets [`overcut_mm`](Self::overcut_mm): how far the cut runs on past its start on a
+    /// closed contour, so that no notch is left, mm (default 0.5).
+    pub fn with_overcut_mm(mut self, overcut_mm: f64) -> Self {
+        self.overcut_mm = overcut_mm;
+        self
+    }
+
+    /// Sets [`lead_out_mm`](Self::lead_out_mm): length of the straight exit into the scrap
+    /// after the overcut, mm (default 1).
+    pub fn with_lead_out_mm(mut self, lead_out_mm: f64) -> Self {
+        self.lead_out_mm = lead_out_mm;
+        self
+    }
+
+    /// Sets [`arc_tolerance_mm`](Self::arc_tolerance_mm): chord error of the lead-in arc's
+    /// polyline, mm (default 0.001).
+    pub fn with_arc_tolerance_mm(mut self, arc_tolerance_mm: f64) -> Self {
+        self.arc_tolerance_mm = arc_tolerance_mm;
+        self
+    }
+
+    /// Sets [`closed_tolerance_mm`](Self::closed_tolerance_mm): a contour whose first and
+    /// last points are this close is closed, mm (default 1e-6).
+    pub fn with_closed_tolerance_mm(mut self, closed_tolerance_mm: f64) -> Self {
+        self.closed_tolerance_mm = closed_tolerance_mm;
+        self
+    }
+
+    /// Sets [`corner_deg`](Self::corner_deg): a turn of the contour by more than this at a
+    /// cutting point is a corner, where no cut starts, degrees (default 20).
+    pub fn with_corner_deg(mut self, corner_deg: f64) -> Self {
+        self.corner_deg = corner_deg;
+        self
+    }
+
+    /// Sets [`min_lead_mm`](Self::min_lead_mm): a lead-in that does not fit the scrap is
+    /// halved until it does, down to this size (straight part plus radius), mm.
+    pub fn with_min_lead_mm(mut self, min_lead_mm: f64) -> Self {
+        self.min_lead_mm = min_lead_mm;
+        self
+    }
+
     /// With this straight lead-in length and arc radius, mm.
     pub fn with_lead_in(mut self, line_mm: f64, radius_mm: f64) -> Self {
         self.lead_in_mm = line_mm;

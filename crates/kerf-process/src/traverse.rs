@@ -453,6 +453,35 @@ impl Default for TraverseOptions {
 }
 
 impl TraverseOptions {
+    /// Sets [`clearance_mm`](Self::clearance_mm): no point of the travel (tip or nozzle)
+    /// comes closer to the part than this, mm (default 5).
+    pub fn with_clearance_mm(mut self, clearance_mm: f64) -> Self {
+        self.clearance_mm = clearance_mm;
+        self
+    }
+
+    /// Sets [`retract_mm`](Self::retract_mm): how far the head first backs off along the
+    /// tool axis, mm.
+    pub fn with_retract_mm(mut self, retract_mm: f64) -> Self {
+        self.retract_mm = retract_mm;
+        self
+    }
+
+    /// Sets [`nozzle_mm`](Self::nozzle_mm): length of the nozzle, a segment from the tip
+    /// along the tool axis toward the head that must keep the clearance too, mm (default
+    /// 20).
+    pub fn with_nozzle_mm(mut self, nozzle_mm: f64) -> Self {
+        self.nozzle_mm = nozzle_mm;
+        self
+    }
+
+    /// Sets [`up`](Self::up): the direction in the workpiece frame that is "up" (away from
+    /// the fixture, toward the free space).
+    pub fn with_up(mut self, up: Vector3<f64>) -> Self {
+        self.up = up;
+        self
+    }
+
     /// With this clearance, mm; the retract becomes 1.5 times it.
     pub fn with_clearance(mut self, clearance_mm: f64) -> Self {
         self.clearance_mm = clearance_mm;

@@ -5,14 +5,14 @@
 //!   systems put laser trim lines): composite curves of trimmed lines, circles, ellipses and
 //!   B-splines (rational or not), trimmed curves, polylines, B-splines, full circles. Each
 //!   composite becomes one NURBS curve with a C0 knot at every join and its segments' senses
-//!   applied; gaps up to [`ImportOptions::close_gaps`] are closed by moving the two end poles
+//!   applied; gaps up to [`ImportOptions::close_gaps_mm`] are closed by moving the two end poles
 //!   to their midpoint (the largest move is reported), larger gaps open the contour (reported).
 //!   With [`ImportOptions::edges`], the boundary loops of the faces are the contours instead.
 //! - **Surfaces**: every face a contour lies on becomes a NURBS surface (exact for B-spline
 //!   surfaces, planes, cylinders, cones, spheres, tori, extrusions and revolutions), cut to the
 //!   face's parameter range and oriented so that `Su x Sv` is the face's outward normal. Faces
 //!   are found by projection: dense samples of the contour within
-//!   [`ImportOptions::face_tolerance`] of the face. A contour over several faces names them all
+//!   [`ImportOptions::face_tolerance_mm`] of the face. A contour over several faces names them all
 //!   (the list form of `surface`).
 //! - **Units**: lengths to mm (inch, cm, m files), plane angles from degrees or radians.
 //! - **Errors** name the entity: `#23805 COMPOSITE_CURVE: segment 12 (#23790): ...`.
@@ -69,15 +69,16 @@ use crate::model::{name_of, refs, Model};
 pub struct ImportOptions {
     /// Gaps between consecutive segments up to this (mm) are closed by moving the shared pole;
     /// larger gaps open the contour. Default 0.1 mm (the largest seen on automotive data).
-    pub close_gaps: f64,
+    pub close_gaps_mm: f64,
     /// A contour lies on a face where every dense sample is within this distance (mm) of one
     /// of the faces named. Default 0.01 mm.
-    pub face_tolerance: f64,
-    /// Take the boundary loops of faces as the contours instead of the geometric sets.
+    pub face_tolerance_mm: f64,
+    /// Take the boundary loops of faces as the contours instead of the geometric sets
+    /// (default false; set with [`ImportOptions::with_edges`]).
     pub edges: bool,
     /// With `edges`: only the faces with these `#id`s (default: every face).
     pub faces: Option<Vec<u64>>,
-    /// Write every face read as a surface, not only those a contour lies on.
+    /// Write every face read as a surface, not only those a contour lies on (default false).
     pub all_faces: bool,
 }
 
@@ -88,26 +89,35 @@ impl Default for ImportOptions {
 }
 
 impl ImportOptions {
+    /// Sets [`close_gaps_mm`](Self::close_gaps_mm): gaps between consecutive segments up to
+    /// this (mm) are closed by moving the shared pole.
+    pub fn with_close_gaps_mm(mut self, close_gaps_mm: f64) -> Self {
+        self.close_gaps_mm = close_gaps_mm;
+        self
+    }
+
+    /// Sets [`face_tolerance_mm`](Self::face_tolerance_mm): a contour lies on a face where
+    /// every dense sample is within this distance (mm) of one of the faces named.
+    pub fn with_face_tolerance_mm(mut self, face_tolerance_mm: f64) -> Self {
+        self.face_tolerance_mm = face_tolerance_mm;
+        self
+    }
+
+    /// Sets [`faces`](Self::faces): with `edges`, only the faces with these `#id`s (`None`:
+    /// every face).
+    pub fn with_faces(mut self, faces: Option<Vec<u64>>) -> Self {
+        self.faces = faces;
+        self
+    }
+
     /// The defaults, as a constant.
     pub const DEFAULT: Self = Self {
-        close_gaps: 0.1,
-        face_tolerance: 0.01,
+        close_gaps_mm: 0.1,
+        face_tolerance_mm: 0.01,
         edges: false,
         faces: None,
         all_faces: false,
     };
-
-    /// With a gap threshold (mm).
-    pub fn with_close_gaps(mut self, mm: f64) -> Self {
-        self.close_gaps = mm;
-        self
-    }
-
-    /// With a face tolerance (mm).
-    pub fn with_face_tolerance(mut self, mm: f64) -> Self {
-        self.face_tolerance = mm;
-        self
-    }
 
     /// Write every face read as a surface, used or not.
     pub fn with_all_faces(mut self, all: bool) -> Self {
@@ -184,8 +194,8 @@ pub fn import_file(
 /// [`StepError::Options`] for a non-positive or non-finite option.
 pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     for (name, v) in [
-        ("close_gaps", opts.close_gaps),
-        ("face_tolerance", opts.face_tolerance),
+        ("close_gaps_mm", opts.close_gaps_mm),
+        ("face_tolerance_mm", opts.face_tolerance_mm),
     ] {
         if !(v >= 0.0 && v.is_finite()) {
             return Err(StepError::Options(format!(
@@ -217,7 +227,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                 }
             }
             for (li, l) in f.loops.iter().enumerate() {
-                let j = contour::join(l, opts.close_gaps, true);
+                let j = contour::join(l, opts.close_gaps_mm, true);
                 note_join(&mut report, &format!("#{} face loop {}", f.id, li + 1), &j);
                 let n = j.contours.len();
                 for (k, c) in j.contours.into_iter().enumerate() {
@@ -289,9 +299,9 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                 let closed_hint = {
                     let a = &curves_only[0];
                     let b = &curves_only[curves_only.len() - 1];
-                    (a.point(a.domain().0) - b.point(b.domain().1)).norm() <= opts.close_gaps
+                    (a.point(a.domain().0) - b.point(b.domain().1)).norm() <= opts.close_gaps_mm
                 };
-                let j = contour::join(&curves_only, opts.close_gaps, closed_hint);
+                let j = contour::join(&curves_only, opts.close_gaps_mm, closed_hint);
                 for (before, after, gap) in &j.opened {
                     report.opened.push(format!(
                         "#{eid} {}: segment {} (#{}) does not join segment {} (#{}) (gap {gap:.3} mm): opened there",
@@ -322,12 +332,12 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                     } else {
                         format!("{base}.{}", k + 1)
                     };
-                    let named = match faces::associate(&c.curve, &faces, opts.face_tolerance) {
+                    let named = match faces::associate(&c.curve, &faces, opts.face_tolerance_mm) {
                         Ok(f) => f,
                         Err(worst) => {
                             report.skipped.push(format!(
                                 "{id}: on no face (a sample is {worst:.3e} mm from every face, more than {} mm): cut without a surface",
-                                opts.face_tolerance
+                                opts.face_tolerance_mm
                             ));
                             Vec::new()
                         }

@@ -300,10 +300,10 @@ fn errors_name_the_entity() {
 
     let e = import(
         &step(""),
-        &ImportOptions::default().with_close_gaps(f64::NAN),
+        &ImportOptions::default().with_close_gaps_mm(f64::NAN),
     )
     .unwrap_err();
-    assert!(e.to_string().contains("close_gaps"), "{e}");
+    assert!(e.to_string().contains("close_gaps_mm"), "{e}");
 }
 
 #[test]
@@ -339,7 +339,7 @@ fn a_line_trim_and_degree_units_in_a_hand_written_file() {
 
 #[test]
 fn gaps_above_the_threshold_open_the_contour() {
-    let strict = ImportOptions::default().with_close_gaps(0.01);
+    let strict = ImportOptions::default().with_close_gaps_mm(0.01);
     let im = import_file(fixture("composite_mm.step"), &strict).expect("reads");
     // The 0.04 mm gap between the end of contour 1 and its start is no longer closed: the
     // contour stays open, its start where the file has it.

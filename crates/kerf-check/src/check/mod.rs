@@ -26,6 +26,7 @@ pub const ROUNDING_ALLOWANCE: f64 = 1e-14;
 
 /// How strictly to check.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct CheckOptions {
     /// Samples per knot span within a segment before refinement (at least `4 (degree + 1)` are
     /// used). Default 32.
@@ -49,6 +50,38 @@ impl Default for CheckOptions {
             param_tolerance: 1e-9,
             normal_tolerance: kerf_format::toolpath::UNIT_NORMAL_TOLERANCE,
         }
+    }
+}
+
+impl CheckOptions {
+    /// Sets [`samples`](Self::samples): samples per knot span within a segment before
+    /// refinement (at least `4 (degree + 1)` are used).
+    pub fn with_samples(mut self, samples: usize) -> Self {
+        self.samples = samples;
+        self
+    }
+
+    /// Sets [`point_tolerance`](Self::point_tolerance): how far a point may lie from the
+    /// curve at its param, relative to the curve size (the diagonal of its control points'
+    /// bounding box).
+    pub fn with_point_tolerance(mut self, point_tolerance: f64) -> Self {
+        self.point_tolerance = point_tolerance;
+        self
+    }
+
+    /// Sets [`param_tolerance`](Self::param_tolerance): how far a param may be from a
+    /// domain end or a C0 knot and still count as it, relative to the width of the curve's
+    /// domain.
+    pub fn with_param_tolerance(mut self, param_tolerance: f64) -> Self {
+        self.param_tolerance = param_tolerance;
+        self
+    }
+
+    /// Sets [`normal_tolerance`](Self::normal_tolerance): how far the length of a normal
+    /// may be from 1.
+    pub fn with_normal_tolerance(mut self, normal_tolerance: f64) -> Self {
+        self.normal_tolerance = normal_tolerance;
+        self
     }
 }
 

@@ -1,5 +1,5 @@
-//! Helpers shared by the tests that read `kerf run`'s output files (`placement.rs`,
-//! `cut_process.rs`).
+//! Helpers shared by the `kerf` binary's tests: the binary, the fixtures, and readers of
+//! `kerf run`'s output files.
 
 #![allow(dead_code)] // each test file uses its own subset
 

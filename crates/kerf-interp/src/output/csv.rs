@@ -61,7 +61,7 @@ pub fn write_csv<R: Borrow<[f64; 5]>>(
     kerf_io::write_file(path, |w| write_csv_to(w, names, cycle, rows)).map_err(|e| {
         InterpError::Io {
             path: path.display().to_string(),
-            message: e.to_string(),
+            source: e.into(),
         }
     })
 }
@@ -76,6 +76,6 @@ pub fn write_csv<R: Borrow<[f64; 5]>>(
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     kerf_io::write_file(path, |w| w.write_all(bytes)).map_err(|e| InterpError::Io {
         path: path.display().to_string(),
-        message: e.to_string(),
+        source: e.into(),
     })
 }

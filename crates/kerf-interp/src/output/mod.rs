@@ -31,6 +31,7 @@ use std::path::Path;
 use crate::block::{Block, Geometry};
 use crate::error::{positive, InterpError, Result};
 use crate::model::AxisModel;
+use crate::DEFAULT_BLEND_TOLERANCE;
 
 mod csv;
 mod dialect;
@@ -40,36 +41,37 @@ pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};
 pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
 use writer::Writer;
 
-/// The default controller-blending term of the tolerance budget, mm: LinuxCNC's `G64 P`,
-/// Sinumerik's `CTOL` plus the tip error of `OTOL`.
-pub const DEFAULT_BLEND_TOLERANCE: f64 = 0.005;
-
-/// What goes into a program besides the blocks.
+/// What goes into a program besides the blocks. Start from [`GcodeOptions::new`] (dialect
+/// and feed) and the `with_*` setters.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct GcodeOptions {
-    /// Dialect.
+    /// Dialect (given to [`GcodeOptions::new`]).
     pub dialect: Dialect,
     /// Programmed cutting feed, mm/min of the tool tip: the descent after the pierce, and the
-    /// blocks' speed when no planned times are given.
-    pub feed: f64,
+    /// blocks' speed when no planned times are given (given to [`GcodeOptions::new`]).
+    pub feed_mm_per_min: f64,
     /// The discretizer's chord tolerance (also the arc-fit tolerance), mm: the budget's
-    /// `chord` term.
-    pub fit_tolerance: f64,
+    /// `chord` term. Default 0.001.
+    pub fit_tolerance_mm: f64,
     /// Chord tolerance of arcs, mm: raw-axis programs write arcs as chords within it (the
-    /// budget's `interpolation_chord` term).
-    pub chord_tolerance: f64,
+    /// budget's `interpolation_chord` term). Default 0.001.
+    pub chord_tolerance_mm: f64,
     /// The kinematics' linearization tolerance the axes were solved with, mm, if known (the
-    /// budget's `linearization` term).
-    pub linearization_tolerance: Option<f64>,
+    /// budget's `linearization` term). Default `None`.
+    pub linearization_tolerance_mm: Option<f64>,
     /// The controller's blending tolerance, mm (the budget's `controller_blending` term):
-    /// `G64 P` on LinuxCNC, split half into `CTOL` and half into `OTOL` on Sinumerik.
-    pub blend_tolerance: f64,
+    /// `G64 P` on LinuxCNC, split half into `CTOL` and half into `OTOL` on Sinumerik. Default
+    /// [`DEFAULT_BLEND_TOLERANCE`].
+    pub blend_tolerance_mm: f64,
     /// The machine's pivot length, mm (tip to tilt axis): turns the orientation half of the
-    /// blending term into Sinumerik's `OTOL` in degrees. Without it `OTOL` is not written.
-    pub pivot_length: Option<f64>,
-    /// The machine file's `process` object (absent keys take the dialect's defaults).
+    /// blending term into Sinumerik's `OTOL` in degrees. Without it `OTOL` is not
+    /// written. Default `None`.
+    pub pivot_length_mm: Option<f64>,
+    /// The machine file's `process` object (absent keys take the dialect's defaults). Default
+    /// [`kerf_kinematics::Process::default`].
     pub process: kerf_kinematics::Process,
-    /// The input file the program was made from (header only, escaped).
+    /// The input file the program was made from (header only, escaped). Default `None`.
     pub source: Option<String>,
     /// Decimals of coordinates (default 6).
     pub decimals: usize,
@@ -79,17 +81,95 @@ pub struct GcodeOptions {
 }
 
 impl GcodeOptions {
+    /// Sets [`dialect`](Self::dialect): the G-code dialect.
+    pub fn with_dialect(mut self, dialect: Dialect) -> Self {
+        self.dialect = dialect;
+        self
+    }
+
+    /// Sets [`feed_mm_per_min`](Self::feed_mm_per_min): programmed cutting feed, mm/min of
+    /// the tool tip.
+    pub fn with_feed_mm_per_min(mut self, feed_mm_per_min: f64) -> Self {
+        self.feed_mm_per_min = feed_mm_per_min;
+        self
+    }
+
+    /// Sets [`fit_tolerance_mm`](Self::fit_tolerance_mm): the discretizer's chord tolerance
+    /// (also the arc-fit tolerance), mm.
+    pub fn with_fit_tolerance_mm(mut self, fit_tolerance_mm: f64) -> Self {
+        self.fit_tolerance_mm = fit_tolerance_mm;
+        self
+    }
+
+    /// Sets [`chord_tolerance_mm`](Self::chord_tolerance_mm): chord tolerance of arcs, mm.
+    pub fn with_chord_tolerance_mm(mut self, chord_tolerance_mm: f64) -> Self {
+        self.chord_tolerance_mm = chord_tolerance_mm;
+        self
+    }
+
+    /// Sets [`linearization_tolerance_mm`](Self::linearization_tolerance_mm): the
+    /// kinematics' linearization tolerance the axes were solved with, mm, if known (the
+    /// budget's `linearization` term). Default `None`.
+    pub fn with_linearization_tolerance_mm(
+        mut self,
+        linearization_tolerance_mm: Option<f64>,
+    ) -> Self {
+        self.linearization_tolerance_mm = linearization_tolerance_mm;
+        self
+    }
+
+    /// Sets [`blend_tolerance_mm`](Self::blend_tolerance_mm): the controller's blending
+    /// tolerance, mm (the budget's `controller_blending` term).
+    pub fn with_blend_tolerance_mm(mut self, blend_tolerance_mm: f64) -> Self {
+        self.blend_tolerance_mm = blend_tolerance_mm;
+        self
+    }
+
+    /// Sets [`pivot_length_mm`](Self::pivot_length_mm): the machine's pivot length, mm (tip
+    /// to tilt axis).
+    pub fn with_pivot_length_mm(mut self, pivot_length_mm: Option<f64>) -> Self {
+        self.pivot_length_mm = pivot_length_mm;
+        self
+    }
+
+    /// Sets [`process`](Self::process): the machine file's `process` object (absent keys
+    /// take the dialect's defaults).
+    pub fn with_process(mut self, process: kerf_kinematics::Process) -> Self {
+        self.process = process;
+        self
+    }
+
+    /// Sets [`source`](Self::source): the input file the program was made from (header
+    /// only, escaped).
+    pub fn with_source(mut self, source: Option<String>) -> Self {
+        self.source = source;
+        self
+    }
+
+    /// Sets [`decimals`](Self::decimals): decimals of coordinates (default 6).
+    pub fn with_decimals(mut self, decimals: usize) -> Self {
+        self.decimals = decimals;
+        self
+    }
+
+    /// Sets [`header`](Self::header): more header comment lines, written after the source
+    /// (each through the same comment sanitizer), e.g.
+    pub fn with_header(mut self, header: Vec<String>) -> Self {
+        self.header = header;
+        self
+    }
+
     /// Options for `dialect` at `feed` mm/min, with 0.001 mm tolerances, the default blending
     /// term, the dialect's default process codes and 6 decimals.
     pub fn new(dialect: Dialect, feed: f64) -> Self {
         Self {
             dialect,
-            feed,
-            fit_tolerance: 0.001,
-            chord_tolerance: 0.001,
-            linearization_tolerance: None,
-            blend_tolerance: DEFAULT_BLEND_TOLERANCE,
-            pivot_length: None,
+            feed_mm_per_min: feed,
+            fit_tolerance_mm: 0.001,
+            chord_tolerance_mm: 0.001,
+            linearization_tolerance_mm: None,
+            blend_tolerance_mm: DEFAULT_BLEND_TOLERANCE,
+            pivot_length_mm: None,
             process: kerf_kinematics::Process::default(),
             source: None,
             decimals: 6,
@@ -101,10 +181,10 @@ impl GcodeOptions {
     /// `linearization` (`None` when unknown), `interpolation_chord`, `controller_blending`.
     pub fn budget(&self) -> [(&'static str, Option<f64>); 4] {
         [
-            ("chord", Some(self.fit_tolerance)),
-            ("linearization", self.linearization_tolerance),
-            ("interpolation_chord", Some(self.chord_tolerance)),
-            ("controller_blending", Some(self.blend_tolerance)),
+            ("chord", Some(self.fit_tolerance_mm)),
+            ("linearization", self.linearization_tolerance_mm),
+            ("interpolation_chord", Some(self.chord_tolerance_mm)),
+            ("controller_blending", Some(self.blend_tolerance_mm)),
         ]
     }
 
@@ -118,7 +198,8 @@ impl GcodeOptions {
 ///
 /// `path_ids[b.path]` names the source curve of block `b` (missing ids are written as
 /// `path <n>`); `block_feeds`, if given, is the planned tip speed (mm/min) of each block, from
-/// which its time is `length / feed`; otherwise every cutting block runs at `opts.feed`. For
+/// which its time is `length / feed`; otherwise every cutting block runs at
+/// `opts.feed_mm_per_min`. For
 /// the planned block times of a [`crate::Motion`] use [`gcode_motion`].
 ///
 /// # Errors
@@ -130,7 +211,7 @@ pub fn gcode<M: AxisModel + ?Sized>(
     block_feeds: Option<&[f64]>,
     opts: &GcodeOptions,
 ) -> Result<String> {
-    positive("feed", opts.feed)?;
+    positive("feed_mm_per_min", opts.feed_mm_per_min)?;
     let times: Vec<f64> = blocks
         .iter()
         .enumerate()
@@ -138,7 +219,7 @@ pub fn gcode<M: AxisModel + ?Sized>(
             let f = block_feeds
                 .and_then(|f| f.get(i).copied())
                 .filter(|f| f.is_finite() && *f > 0.0)
-                .unwrap_or(opts.feed);
+                .unwrap_or(opts.feed_mm_per_min);
             b.length() / (f / 60.0)
         })
         .collect();
@@ -191,7 +272,8 @@ fn refuse_unchecked_blocks(blocks: &[Block], dialect: Dialect) -> Result<()> {
 }
 
 /// The G-code program of `blocks`, cutting block `b` taking `block_times[b]` seconds (a
-/// missing, zero or non-finite time falls back to `length / opts.feed`); rapid blocks are
+/// missing, zero or non-finite time falls back to
+/// `length / opts.feed_mm_per_min`); rapid blocks are
 /// `G0` at the controller's rapid rate.
 ///
 /// # Errors
@@ -206,9 +288,9 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     block_times: &[f64],
     opts: &GcodeOptions,
 ) -> Result<String> {
-    positive("feed", opts.feed)?;
-    positive("chord_tolerance", opts.chord_tolerance)?;
-    positive("blend_tolerance", opts.blend_tolerance)?;
+    positive("feed_mm_per_min", opts.feed_mm_per_min)?;
+    positive("chord_tolerance_mm", opts.chord_tolerance_mm)?;
+    positive("blend_tolerance_mm", opts.blend_tolerance_mm)?;
     refuse_unchecked_blocks(blocks, opts.dialect)?;
     let process = ProcessCodes::resolve(opts.dialect, &opts.process)?;
     let mut w = Writer {
@@ -260,7 +342,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
             .get(bi)
             .copied()
             .filter(|t| t.is_finite() && *t > 0.0)
-            .unwrap_or_else(|| b.length() / (opts.feed / 60.0));
+            .unwrap_or_else(|| b.length() / (opts.feed_mm_per_min / 60.0));
         w.cut(b, t);
     }
     if w.in_cut {

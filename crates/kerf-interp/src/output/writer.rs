@@ -136,7 +136,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 None => format!("{k} unknown"),
             })
             .collect();
-        let unknown = if o.linearization_tolerance.is_none() {
+        let unknown = if o.linearization_tolerance_mm.is_none() {
             " (the known terms; the axes file does not record the linearization tolerance)"
         } else {
             ""
@@ -159,7 +159,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         self.comment(&pm);
         let pm = format!(
             "process: pierce {} mm above the cut start along the tool axis, dwell {} s, descent at {} mm/min",
-            p.pierce_standoff, p.pierce_dwell_s, o.feed
+            p.pierce_standoff, p.pierce_dwell_s, o.feed_mm_per_min
         );
         self.comment(&pm);
         match o.dialect {
@@ -173,13 +173,13 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 self.line("G17 G71 G90 G94 G40");
                 self.line("G54");
                 self.line("SOFT");
-                let ctol = o.blend_tolerance / 2.0;
-                match o.pivot_length.filter(|l| l.is_finite() && *l > 0.0) {
+                let ctol = o.blend_tolerance_mm / 2.0;
+                match o.pivot_length_mm.filter(|l| l.is_finite() && *l > 0.0) {
                     Some(l) => {
                         let otol = (ctol / l).to_degrees();
                         self.line(&format!("CTOL={ctol} OTOL={otol:.6}"));
                     }
-                    None => self.line(&format!("CTOL={}", o.blend_tolerance)),
+                    None => self.line(&format!("CTOL={}", o.blend_tolerance_mm)),
                 }
                 self.line("TRAORI");
                 self.line("ORIWKS");
@@ -235,7 +235,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         }
         match self.opts.dialect {
             Dialect::Linuxcnc => {
-                let l = format!("G64 P{} Q0", self.opts.blend_tolerance);
+                let l = format!("G64 P{} Q0", self.opts.blend_tolerance_mm);
                 self.line(&l);
             }
             Dialect::Sinumerik => self.line("G642"),
@@ -243,10 +243,10 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         }
         self.in_cut = true;
         if h > 0.0 {
-            let t = self.process.descent_s(self.opts.feed);
+            let t = self.process.descent_s(self.opts.feed_mm_per_min);
             match self.opts.dialect {
                 Dialect::Sinumerik => {
-                    let f = format!("{:.1}", self.opts.feed);
+                    let f = format!("{:.1}", self.opts.feed_mm_per_min);
                     let l = format!("G1 {} F{f}", self.tip_words(&start, &u));
                     self.line(&l);
                     self.last_f = Some(f);
@@ -301,7 +301,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 // shared in proportion to the path parameter.
                 let mut ends = Vec::new();
                 if let Geometry::Arc(a) = &b.geometry {
-                    let k = (b.length() / max_step(a.radius, self.opts.chord_tolerance))
+                    let k = (b.length() / max_step(a.radius, self.opts.chord_tolerance_mm))
                         .ceil()
                         .max(1.0) as usize;
                     for i in 1..k {

@@ -400,7 +400,7 @@ impl Ctx<'_> {
                 let step = prev.axes.rotary_step(&q);
                 let dev = linearization_error(self.kin, &prev.axes, &q).distance;
                 let rotary_ok = step <= opts.max_rotary_step_deg + LIMIT_SLACK;
-                let linear_ok = dev <= opts.linearization_tolerance;
+                let linear_ok = dev <= opts.linearization_tolerance_mm;
                 if rotary_ok && linear_ok {
                     max_dev = max_dev.max(dev);
                     if node.source.is_none() {
@@ -439,7 +439,7 @@ impl Ctx<'_> {
                     pieces = pieces.max((step / opts.max_rotary_step_deg).ceil());
                 }
                 if !linear_ok {
-                    pieces = pieces.max((dev / opts.linearization_tolerance).sqrt().ceil());
+                    pieces = pieces.max((dev / opts.linearization_tolerance_mm).sqrt().ceil());
                 }
                 let pieces = pieces.min(MAX_PIECES) as usize;
                 let dc = q.c - prev.axes.c;

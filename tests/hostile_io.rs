@@ -1,13 +1,19 @@
 //! The hostile I/O fixtures of `fixtures/bad/io/` (listed with their expected outcome in
-//! `expect.tsv`) through the public curves and toolpath readers, plus inputs above the size
-//! limit made at test time.
+//! `expect.tsv`) through every reader of kerf's documents, one harness for all: the curves and
+//! toolpath readers (`kerf-format`), the machine and axes readers (`kerf-kinematics`), the
+//! checker's lenient toolpath reader (`kerf-check`) and the motion stage's axes-or-toolpath
+//! reader (`kerf-pipeline`); a byte-order mark is accepted by each. Plus inputs above the
+//! size limit made at test time, and the checks of ids and names built in code.
 
 use std::path::{Path, PathBuf};
 
-use kerf_format::{curves, toolpath};
+use kerf::check::RawToolpath;
+use kerf::format::{curves, toolpath};
+use kerf::kinematics::{AxesFile, Machine};
+use kerf::pipeline::MotionInput;
 
 fn dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/bad/io")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bad/io")
 }
 
 /// `(file, expected)` rows of `expect.tsv` for `reader`.
@@ -82,7 +88,7 @@ fn a_file_above_the_size_limit_is_refused_without_reading_it() {
     let huge = dir.path().join("huge.json");
     // A sparse file: 1 GiB + 1 byte of size, no disk space, no memory.
     let f = std::fs::File::create(&huge).expect("create");
-    f.set_len(kerf_io::MAX_INPUT_BYTES + 1).expect("set_len");
+    f.set_len(kerf::io::MAX_INPUT_BYTES + 1).expect("set_len");
     for e in [
         curves::load(&huge)
             .map(drop)
@@ -105,6 +111,74 @@ fn a_file_above_the_size_limit_is_refused_without_reading_it() {
 fn a_stream_above_a_limit_stops_there() {
     // The readers take at most MAX_INPUT_BYTES of a stream; the same code with a small limit
     // shows that an endless stream (like /dev/zero) ends in an error, not a hang.
-    let e = kerf_io::read_to_end(std::io::repeat(b' '), 1 << 16).expect_err("endless");
+    let e = kerf::io::read_to_end(std::io::repeat(b' '), 1 << 16).expect_err("endless");
     assert_eq!(e.kind(), std::io::ErrorKind::FileTooLarge, "{e}");
+}
+
+#[test]
+fn hostile_machine_files() {
+    run("machine", |p| {
+        Machine::read(p).map(drop).map_err(|e| e.to_string())
+    });
+}
+
+#[test]
+fn hostile_axes_files() {
+    run("axes", |p| {
+        AxesFile::read(p).map(drop).map_err(|e| e.to_string())
+    });
+}
+
+#[test]
+fn a_machine_built_in_code_with_a_newline_in_its_name_is_refused() {
+    let good = Machine::read(dir().join("machine_bom.json")).expect("valid");
+    let e = Machine::try_new(
+        "laser\nM30",
+        good.kinematics.clone(),
+        good.limits,
+        good.max_velocity,
+        good.max_acceleration,
+    )
+    .map(drop)
+    .expect_err("refused");
+    assert!(
+        e.to_string()
+            .starts_with("name: contains the control character U+000A"),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_axes_file_with_a_hostile_id_is_not_written() {
+    let mut axes = AxesFile::read(dir().join("axes_bom.json")).expect("valid");
+    axes.paths[0].id = "hole\nG0 X1400\nM30".to_owned();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let dest = dir.path().join("out.axes.json");
+    let e = axes.write(&dest).expect_err("refused");
+    assert!(
+        e.to_string()
+            .contains("paths[0].id: contains the control character"),
+        "{e}"
+    );
+    assert!(!dest.exists(), "nothing written");
+}
+
+#[test]
+fn every_reader_accepts_a_byte_order_mark() {
+    // The four document readers are in `expect.tsv` (`*_bom.json ... ok`); the checker's
+    // and the motion stage's readers read the same files.
+    let bom = |name: &str| {
+        let path = dir().join(name);
+        let bytes = std::fs::read(&path).expect("read");
+        assert_eq!(&bytes[..3], b"\xEF\xBB\xBF", "{name} starts with a BOM");
+        path
+    };
+    RawToolpath::load(bom("toolpath_bom.json")).expect("the checker reads a BOM toolpath");
+    let tp = MotionInput::read(bom("toolpath_bom.json")).expect("motion stage, toolpath");
+    assert!(
+        matches!(tp, MotionInput::Toolpath(_)),
+        "told apart as a toolpath"
+    );
+    let axes = MotionInput::read(bom("axes_bom.json")).expect("motion stage, axes");
+    assert!(matches!(axes, MotionInput::Axes(_)), "told apart as axes");
 }

@@ -1,0 +1,281 @@
+//! No module cycle within any crate: the top-level modules of each crate's `src/` (one file
+//! `src/a.rs` or directory `src/a/` each) must depend on each other without a cycle, so that
+//! a crate can be read module by module, each using only the ones before it (issue 14).
+//!
+//! A module depends on another where its source names it: `crate::b` (in `use` or in a path,
+//! also inside `use crate::{b::X, c}`), `super::b` from a top-level module, or an item that the
+//! crate root re-exports from `b` (`crate::X` with `pub use b::X` in `lib.rs`/`main.rs`).
+//! Comments are skipped. Modules nested inside a top-level module (`src/a/x.rs`) count as `a`:
+//! a parent and its children may use each other. The crate root itself is not a node (it
+//! declares and re-exports every module).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fs;
+use std::path::{Path, PathBuf};
+
+/// The top-level module of each source file, and the file's text without comments.
+fn sources(src: &Path) -> Vec<(Option<String>, String)> {
+    let mut out = Vec::new();
+    let mut stack = vec![src.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in fs::read_dir(&dir).expect("read src") {
+            let path = entry.expect("entry").path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                let rel = path.strip_prefix(src).expect("under src");
+                let first = rel.components().next().expect("a component");
+                let first = first.as_os_str().to_string_lossy();
+                let module = match first.strip_suffix(".rs") {
+                    Some("lib" | "main") => None,
+                    Some(m) => Some(m.to_string()),
+                    None => Some(first.to_string()),
+                };
+                let text = fs::read_to_string(&path).expect("read source");
+                out.push((module, strip_comments(&text)));
+            }
+        }
+    }
+    out
+}
+
+/// The text without `//` comments (line and doc comments) and `/* */` blocks; string
+/// literals are kept (a `//` inside a string is rare in these sources and harmless: it only
+/// hides the rest of that line).
+fn strip_comments(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while !rest.is_empty() {
+        if let Some(r) = rest.strip_prefix("/*") {
+            rest = r.find("*/").map_or("", |k| &r[k + 2..]);
+        } else if rest.starts_with("//") {
+            rest = rest.find('\n').map_or("", |k| &rest[k..]);
+        } else {
+            let c = rest.chars().next().expect("non-empty");
+            out.push(c);
+            rest = &rest[c.len_utf8()..];
+        }
+    }
+    out
+}
+
+fn is_ident(c: char) -> bool {
+    c.is_alphanumeric() || c == '_'
+}
+
+/// The first path segments after each `prefix::` in `text`, reading `prefix::{a::X, b}` as
+/// `a` and `b`.
+fn first_segments(text: &str, prefix: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    let pat = format!("{prefix}::");
+    let mut at = 0;
+    while let Some(k) = text[at..].find(&pat) {
+        let start = at + k;
+        at = start + pat.len();
+        if start > 0 && text[..start].chars().next_back().is_some_and(is_ident) {
+            continue; // `foo_crate::` is not `crate::`
+        }
+        let rest = &text[at..];
+        if let Some(group) = rest.strip_prefix('{') {
+            // Top-level items of the group.
+            let mut depth = 0;
+            let mut item_start = true;
+            let mut word = String::new();
+            for c in group.chars() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => break,
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => item_start = true,
+                    c if is_ident(c) && depth == 0 && item_start => word.push(c),
+                    _ => {
+                        if !word.is_empty() {
+                            found.push(std::mem::take(&mut word));
+                        }
+                        if !c.is_whitespace() {
+                            item_start = false;
+                        }
+                    }
+                }
+            }
+            if !word.is_empty() {
+                found.push(word);
+            }
+        } else {
+            let word: String = rest.chars().take_while(|&c| is_ident(c)).collect();
+            if !word.is_empty() {
+                found.push(word);
+            }
+        }
+    }
+    found
+}
+
+/// Names the crate root re-exports, with the top-level module each comes from.
+fn root_reexports(root: &str) -> BTreeMap<String, String> {
+    let mut map = BTreeMap::new();
+    for stmt in root.split(';') {
+        let stmt = stmt.trim();
+        let Some(rest) = stmt
+            .strip_prefix("pub use ")
+            .or_else(|| stmt.strip_prefix("pub(crate) use "))
+        else {
+            continue;
+        };
+        let rest = rest.trim_start_matches("self::");
+        let Some((module, items)) = rest.split_once("::") else {
+            continue;
+        };
+        let items = items.trim().trim_start_matches('{').trim_end_matches('}');
+        for item in items.split(',') {
+            let name = item.rsplit(" as ").next().unwrap_or(item).trim();
+            let name = name.rsplit("::").next().unwrap_or(name).trim();
+            if !name.is_empty() {
+                map.insert(name.to_string(), module.trim().to_string());
+            }
+        }
+    }
+    map
+}
+
+/// The dependency graph of the top-level modules of the crate whose sources are in `src`.
+fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let files = sources(src);
+    let modules: BTreeSet<String> = files.iter().filter_map(|(m, _)| m.clone()).collect();
+    let root: String = files
+        .iter()
+        .filter(|(m, _)| m.is_none())
+        .map(|(_, t)| t.as_str())
+        .collect();
+    let reexports = root_reexports(&root);
+    let mut g: BTreeMap<String, BTreeSet<String>> = modules
+        .iter()
+        .map(|m| (m.clone(), BTreeSet::new()))
+        .collect();
+    for (module, text) in &files {
+        let Some(module) = module else { continue };
+        let mut names = first_segments(text, "crate");
+        // `super::` from a top-level module file is the crate root.
+        let top_level_file = src.join(format!("{module}.rs")).exists();
+        if top_level_file {
+            names.extend(first_segments(text, "super"));
+        }
+        for name in names {
+            let target = if modules.contains(&name) {
+                Some(name)
+            } else {
+                reexports.get(&name).cloned()
+            };
+            if let Some(t) = target.filter(|t| t != module && modules.contains(t)) {
+                g.get_mut(module).expect("node").insert(t);
+            }
+        }
+    }
+    g
+}
+
+/// A cycle of `g`, if it has one.
+fn find_cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    // 0 unvisited, 1 on the stack, 2 done.
+    fn visit(
+        g: &BTreeMap<String, BTreeSet<String>>,
+        n: &str,
+        state: &mut BTreeMap<String, u8>,
+        stack: &mut Vec<String>,
+    ) -> Option<Vec<String>> {
+        state.insert(n.to_string(), 1);
+        stack.push(n.to_string());
+        for m in &g[n] {
+            match state.get(m).copied().unwrap_or(0) {
+                1 => {
+                    let from = stack.iter().position(|s| s == m).expect("on stack");
+                    let mut cycle = stack[from..].to_vec();
+                    cycle.push(m.clone());
+                    return Some(cycle);
+                }
+                0 => {
+                    if let Some(c) = visit(g, m, state, stack) {
+                        return Some(c);
+                    }
+                }
+                _ => {}
+            }
+        }
+        stack.pop();
+        state.insert(n.to_string(), 2);
+        None
+    }
+    let mut state = BTreeMap::new();
+    for n in g.keys() {
+        if state.get(n).copied().unwrap_or(0) == 0 {
+            let mut stack = Vec::new();
+            if let Some(c) = visit(g, n, &mut state, &mut stack) {
+                return Some(c);
+            }
+        }
+    }
+    None
+}
+
+fn crate_dirs() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut dirs: Vec<PathBuf> = fs::read_dir(root.join("crates"))
+        .expect("crates/")
+        .map(|e| e.expect("entry").path().join("src"))
+        .filter(|p| p.is_dir())
+        .collect();
+    dirs.push(root.join("src"));
+    dirs.sort();
+    dirs
+}
+
+#[test]
+fn no_crate_has_a_module_cycle() {
+    let mut cycles = Vec::new();
+    for src in crate_dirs() {
+        if let Some(c) = find_cycle(&graph(&src)) {
+            cycles.push(format!("{}: {}", src.display(), c.join(" -> ")));
+        }
+    }
+    assert!(cycles.is_empty(), "module cycles:\n{}", cycles.join("\n"));
+}
+
+#[test]
+fn the_scanner_sees_a_cycle_and_the_kinds_of_use() {
+    // Two modules that use each other, one through a group, one through a re-export of the
+    // root, and a third used through `super::`.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let src = dir.path();
+    fs::write(
+        src.join("lib.rs"),
+        "mod a; mod b; mod c;\npub use b::Thing;\n",
+    )
+    .expect("write");
+    fs::write(
+        src.join("a.rs"),
+        "// use crate::c::Nothing; (a comment)\nuse crate::{Thing, self as _};\nfn f() { super::c::g() }\n",
+    )
+    .expect("write");
+    fs::write(
+        src.join("b.rs"),
+        "pub struct Thing;\nuse crate::{c::X, a::f};\n",
+    )
+    .expect("write");
+    fs::write(src.join("c.rs"), "pub fn g() {}\n").expect("write");
+    let g = graph(src);
+    assert_eq!(
+        g["a"],
+        ["b", "c"].iter().map(|s| s.to_string()).collect(),
+        "a uses b through the root's re-export and c through super"
+    );
+    assert_eq!(
+        g["b"],
+        ["a", "c"].iter().map(|s| s.to_string()).collect(),
+        "b uses a and c through one group"
+    );
+    let cycle = find_cycle(&g).expect("a <-> b is a cycle");
+    assert_eq!(cycle.first(), cycle.last(), "a closed cycle: {cycle:?}");
+    // Without b's use of a there is none.
+    fs::write(src.join("b.rs"), "pub struct Thing;\nuse crate::c::X;\n").expect("write");
+    assert_eq!(find_cycle(&graph(src)), None, "no cycle left");
+}

@@ -32,7 +32,7 @@ mod traverse;
 
 pub use lead::{LeadIn, LeadOptions};
 pub use order::CutPlan;
-pub use rapid::{plan_rapids, rapid_moves, Gap, RapidMoves};
+pub use rapid::{in_the_cuts_way, plan_rapids, rapid_moves, Gap, RapidMoves};
 pub use start::{index_of_param, prepare_start};
 pub use traverse::{
     check_move, plan_traverse, plan_traverse_within, Obstacles, Route, Traverse, TraverseOptions,
@@ -131,7 +131,7 @@ pub enum ProcessError {
     /// Fix: a smaller clearance, another placement, or check the tool axes (one pointing into
     /// a pocket).
     #[error(
-        "traverse from ({:.3}, {:.3}, {:.3}) to ({:.3}, {:.3}, {:.3}): no route keeps the {clearance_mm} mm clearance; ({:.3}, {:.3}, {:.3}) is {distance_mm:.3} mm from the part",
+        "traverse from ({:.3}, {:.3}, {:.3}) to ({:.3}, {:.3}, {:.3}): no route keeps the {clearance_mm} mm clearance ({why}); ({:.3}, {:.3}, {:.3}) is {distance_mm:.3} mm from the part",
         from[0], from[1], from[2], to[0], to[1], to[2], at[0], at[1], at[2]
     )]
     TraverseBlocked {
@@ -145,6 +145,10 @@ pub enum ProcessError {
         distance_mm: f64,
         /// The clearance asked for, mm.
         clearance_mm: f64,
+        /// Why, in words: which part of the traverse found no clear way (the retract at the
+        /// exit, the approach to the pierce, every travel route, the axis limits, the
+        /// machine's rapid swing).
+        why: String,
     },
 }
 

@@ -175,6 +175,9 @@ pub fn rapid_moves(
                         at: [at.x, at.y, at.z],
                         distance_mm: d,
                         clearance_mm: c,
+                        why: format!(
+                            "the machine's rapid move swings too close even split {MAX_SPLIT} times"
+                        ),
                     });
                 }
                 Some(_) => pieces *= 2,
@@ -215,19 +218,71 @@ pub struct Gap {
     pub to_surfaces: Vec<String>,
 }
 
+/// The surfaces that the head meets at a gap's ends while it cuts or pierces there, and
+/// which no traverse can therefore keep the clearance from: for each end (the last cut's
+/// contour end and its exit, the next cut's pierce and its contour start), the line along the
+/// tool axis there up to the retract plus the nozzle (the head is on the part of that line the
+/// nozzle covers while it cuts or pierces, and backs off along it), and
+///
+/// - a surface the cut's curve does not name that comes within half the clearance of the line
+///   from its foot: not there while that contour is cut (a file holding two workpieces in the
+///   same place, as a tube joint's hole in the main tube and the end of the branch tube, lists
+///   both, and each contour passes through the other workpiece) or in the way of the cut;
+/// - a surface the curve names (its own carrying surface) that comes within half the
+///   clearance of the line from three quarters of the clearance up: the surface curls back
+///   over the head (a hole narrower than about the clearance whose tool axis is its wall's
+///   normal, a tight bend's inside), so the cut's own nozzle meets it.
+///
+/// Ids as in [`Obstacles::from_file`], each once, in the order found.
+pub fn in_the_cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<String> {
+    let c = opts.clearance_mm;
+    let mut absent: Vec<String> = Vec::new();
+    for (p, axis, named) in [
+        (&g.from_contour, &g.from, &g.from_surfaces),
+        (
+            &[g.from[0], g.from[1], g.from[2]],
+            &g.from,
+            &g.from_surfaces,
+        ),
+        (&g.to_contour, &g.to, &g.to_surfaces),
+        (&[g.to[0], g.to[1], g.to[2]], &g.to, &g.to_surfaces),
+    ] {
+        let at = Point3::new(p[0], p[1], p[2]);
+        let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
+            .try_normalize(1e-12)
+            .unwrap_or_else(nalgebra::Vector3::z);
+        let top = at + n * (opts.retract_mm + opts.nozzle_mm);
+        let mut add = |id: String| {
+            if !absent.contains(&id) {
+                absent.push(id);
+            }
+        };
+        for id in obs.near_segment(&at, &top, 0.5 * c) {
+            if !named.contains(&id) {
+                add(id);
+            }
+        }
+        let low = at + n * (0.75 * c);
+        for id in obs.near_segment(&low, &top, 0.5 * c) {
+            if named.contains(&id) {
+                add(id);
+            }
+        }
+    }
+    absent
+}
+
 /// Plans and checks the traverse of every gap ([`crate::plan_traverse_within`] among the
 /// routes whose waypoints lie within `limits`, `(min, max)` of `[X, Y, Z, tilt, C]` or `None`
 /// for an unlimited axis, then [`rapid_moves`]), in order; one result per gap (a blocked gap does not stop the others:
 /// the caller decides, e.g. to fall back to an unchecked traverse and say so).
 ///
-/// Which surfaces are checked: all of `obs`, except, for one gap, a surface that the cut's
-/// curve does not name and that comes within half the clearance of the line along the tool
-/// axis at the last cut's contour end or the next cut's contour start (from the contour up to
-/// the retract plus the nozzle). The head is on that line while it cuts: such a surface is
-/// either not there while that contour is cut (a file holding two workpieces in the same
-/// place, as a tube joint's hole in the main tube and the end of the branch tube, lists both,
-/// and each contour passes through the other workpiece) or in the way of the cut itself, which
-/// no traverse can mend; the ids are returned with the gap so that they can be reported.
+/// Which surfaces are checked: all of `obs`, except, for one gap, those [`in_the_cuts_way`]
+/// at its two ends (returned with the gap so that they can be reported).
+///
+/// A route is taken only if its waypoints and the interpolated moves between them lie within
+/// the limits and the machine's own rapid moves ([`rapid_moves`]) clear too; otherwise the
+/// next shortest route is tried.
 ///
 /// Each result's error is as [`crate::plan_traverse`] and [`rapid_moves`].
 pub fn plan_rapids(
@@ -240,22 +295,7 @@ pub fn plan_rapids(
     use rayon::prelude::*;
     gaps.par_iter()
         .map(|g| {
-            let mut absent: Vec<String> = Vec::new();
-            for (p, axis, named) in [
-                (&g.from_contour, &g.from, &g.from_surfaces),
-                (&g.to_contour, &g.to, &g.to_surfaces),
-            ] {
-                let at = Point3::new(p[0], p[1], p[2]);
-                let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
-                    .try_normalize(1e-12)
-                    .unwrap_or_else(nalgebra::Vector3::z);
-                let top = at + n * (opts.retract_mm + opts.nozzle_mm);
-                for id in obs.near_segment(&at, &top, 0.5 * opts.clearance_mm) {
-                    if !named.contains(&id) && !absent.contains(&id) {
-                        absent.push(id);
-                    }
-                }
-            }
+            let absent = in_the_cuts_way(obs, g, opts);
             let here = obs.without(&absent);
             // A route is tried only if the machine reaches its waypoints (with the rotary
             // axes as [`rapid_moves`] sets them).
@@ -297,8 +337,22 @@ pub fn plan_rapids(
                     })
                 })
             };
-            let t = crate::plan_traverse_within(&here, &g.from, &g.to, opts, &reachable)?;
-            let r = rapid_moves(kin, &here, g.from_axes, g.to_axes, &t, opts)?;
+            // A route is taken only if the machine's own rapid moves along it clear too.
+            let (t, r) = crate::traverse::plan_traverse_accepting(
+                &here,
+                &g.from,
+                &g.to,
+                opts,
+                &reachable,
+                &mut |t| {
+                    rapid_moves(kin, &here, g.from_axes, g.to_axes, t, opts).map_err(|e| match e {
+                        ProcessError::TraverseBlocked {
+                            at, distance_mm, ..
+                        } => (Point3::from(at), distance_mm),
+                        _ => (Point3::from(g.from_contour), 0.0),
+                    })
+                },
+            )?;
             Ok((t, r, absent))
         })
         .collect()

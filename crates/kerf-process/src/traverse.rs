@@ -360,6 +360,47 @@ impl Obstacles {
         Ok(obs)
     }
 
+    /// The largest coordinate along `up` of the boxes of the surfaces that come within
+    /// `radius_mm` of the segment `a b` seen along `up` (their boxes' distance with the `up`
+    /// component left out), or `None` if none does or `up` is not a coordinate axis.
+    fn local_top(
+        &self,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        up: &Vector3<f64>,
+        radius_mm: f64,
+    ) -> Option<f64> {
+        let k = (0..3).find(|&k| (up[k].abs() - 1.0).abs() < 1e-12)?;
+        let n = (((b - a).norm() / (0.5 * radius_mm)).ceil() as usize).clamp(1, 100_000);
+        self.items
+            .iter()
+            .filter(|i| {
+                (0..=n).any(|j| {
+                    let p = a + (b - a) * (j as f64 / n as f64);
+                    let d = Vector3::from_fn(|m, _| {
+                        if m == k {
+                            0.0
+                        } else {
+                            (i.lo[m] - p[m]).max(p[m] - i.hi[m]).max(0.0)
+                        }
+                    });
+                    // Samples half the radius apart: a box within it of the segment is within
+                    // 1.25 times it of a sample.
+                    d.norm() <= 1.25 * radius_mm
+                })
+            })
+            .map(|i| top_along(&i.lo, &i.hi, up))
+            .reduce(f64::max)
+    }
+
+    /// The id of the nearest surface to `p` and its distance, mm (`None` without surfaces).
+    pub fn nearest(&self, p: &Point3<f64>) -> Option<(String, f64)> {
+        self.items
+            .iter()
+            .map(|i| (i.id.clone(), shape_distance(&i.shape, p)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
     /// True if there are no surfaces.
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
@@ -488,10 +529,17 @@ impl TraverseOptions {
         check("up", self.up.norm(), up_ok)
     }
 
-    /// The margin of the checks, mm: a sample closer than the clearance plus this is taken
-    /// as blocked (so the sphere tracing advances by at least half of it).
+    /// The height step of the lifted routes above the surfaces' boxes (two of them), mm.
     fn step(&self) -> f64 {
         self.clearance_mm / 8.0
+    }
+
+    /// The margin of the checks, mm: a sample closer than the clearance plus this is taken
+    /// as blocked (so the sphere tracing advances by at least half of it, which bounds its
+    /// work). A sixty-fourth of the clearance: a route that keeps 1.02 times the clearance is
+    /// found, and the claim (the clearance) does not depend on it.
+    fn margin(&self) -> f64 {
+        self.clearance_mm / 64.0
     }
 }
 
@@ -503,6 +551,10 @@ pub enum Route {
     /// Retract, rise along the up direction to the safe plane above every surface, travel in
     /// it, descend, approach.
     SafePlane,
+    /// Retract, rise along the up direction to a clearance above the surfaces whose boxes
+    /// come near the travel (seen along the up direction), travel, descend, approach: lower
+    /// than the safe plane, so often within the axis limits where that is not.
+    Lifted,
 }
 
 impl Route {
@@ -511,6 +563,7 @@ impl Route {
         match self {
             Route::Straight => "straight",
             Route::SafePlane => "safe_plane",
+            Route::Lifted => "lifted",
         }
     }
 }
@@ -669,6 +722,24 @@ pub fn plan_traverse_within(
     opts: &TraverseOptions,
     reachable: &dyn Fn(&[PoseArray]) -> bool,
 ) -> Result<Traverse> {
+    plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(())).map(|(t, ())| t)
+}
+
+/// Why a route was refused by the caller's own check (e.g. the machine's rapid swing): the
+/// first offending point and its distance, mm.
+pub(crate) type Refusal = (Point3<f64>, f64);
+
+/// [`plan_traverse_within`], where a route that is clear is also handed to `accept` (e.g.
+/// the check of the machine's own rapid moves); the first route both accept is returned with
+/// `accept`'s result, the next shortest tried otherwise.
+pub(crate) fn plan_traverse_accepting<T>(
+    obs: &Obstacles,
+    from: &PoseArray,
+    to: &PoseArray,
+    opts: &TraverseOptions,
+    reachable: &dyn Fn(&[PoseArray]) -> bool,
+    accept: &mut dyn FnMut(&Traverse) -> std::result::Result<T, Refusal>,
+) -> Result<(Traverse, T)> {
     opts.validate()?;
     for (name, p) in [("from", from), ("to", to)] {
         let axis_ok = normal(p).norm() > 1e-9;
@@ -681,6 +752,7 @@ pub fn plan_traverse_within(
     }
     let c = opts.clearance_mm;
     let h = opts.step();
+    let floor = opts.margin();
     let up = opts.up.normalize();
     let unit = |p: &PoseArray| {
         let n = normal(p).normalize();
@@ -693,10 +765,9 @@ pub fn plan_traverse_within(
         let (q, n) = (position(p), normal(p));
         let low = with_axis(q + n * (0.75 * c), n);
         let high = with_axis(q + n * height, n);
-        certify(obs, &low, &high, 0.5 * c, 0.0, h)?;
+        certify(obs, &low, &high, 0.5 * c, 0.0, floor)?;
         Ok(high)
     };
-    let mut blocked: Option<Blocked> = None;
     let length_of = |way: &[PoseArray]| {
         let mut pts = vec![position(&from)];
         pts.extend(way.iter().map(position));
@@ -706,85 +777,147 @@ pub fn plan_traverse_within(
     let tip_ends = |w: &[PoseArray]| -> std::result::Result<f64, Blocked> {
         let mut least = f64::INFINITY;
         for s in w.windows(2) {
-            least = least.min(certify(obs, &s[0], &s[1], c, opts.nozzle_mm, h)?);
+            least = least.min(certify(obs, &s[0], &s[1], c, opts.nozzle_mm, floor)?);
         }
         Ok(least)
     };
-    // The retract heights tried at each end (doubling), those whose axial move is clear.
-    let heights: Vec<f64> = (0..5)
-        .map(|k| opts.retract_mm * f64::from(1 << k))
-        .collect();
-    let mut ends = |p: &PoseArray| -> Vec<PoseArray> {
-        heights
-            .iter()
-            .filter_map(|&hh| match axial(p, hh) {
-                Ok(q) => Some(q),
-                Err(e) => {
-                    blocked = Some(e);
-                    None
-                }
-            })
-            .collect()
-    };
-    let (ends_a, ends_b) = (ends(&from), ends(&to));
-    // Every route: straight between any two retract points, or over the safe plane above
-    // every surface (risen along `up` from them); checked shortest first.
-    let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::new();
-    let lift = obs.bounding_box().map(|(lo, hi)| {
-        let top = (0..8)
-            .map(|k| {
-                let corner = Point3::new(
-                    if k & 1 == 0 { lo.x } else { hi.x },
-                    if k & 2 == 0 { lo.y } else { hi.y },
-                    if k & 4 == 0 { lo.z } else { hi.z },
-                );
-                corner.coords.dot(&up)
-            })
-            .fold(f64::NEG_INFINITY, f64::max)
-            + c
-            + 2.0 * h;
-        move |p: &PoseArray| {
-            let q = position(p);
-            let rise = (top - q.coords.dot(&up)).max(0.0);
-            with_axis(q + up * rise, normal(p))
-        }
-    });
-    for a in &ends_a {
-        for b in &ends_b {
-            let straight = vec![*a, *b];
-            routes.push((length_of(&straight), Route::Straight, straight));
-            if let Some(lift) = &lift {
-                let plane = vec![*a, lift(a), lift(b), *b];
-                routes.push((length_of(&plane), Route::SafePlane, plane));
-            }
-        }
-    }
-    routes.sort_by(|x, y| x.0.total_cmp(&y.0));
-    for (length_mm, route, waypoints) in routes {
-        if !reachable(&waypoints) {
-            continue;
-        }
-        match tip_ends(&waypoints) {
-            Ok(least) => {
-                return Ok(Traverse {
-                    length_mm,
-                    waypoints,
-                    route,
-                    min_distance_mm: least,
-                })
-            }
-            Err(e) => blocked = Some(e),
-        }
-    }
-    let b = blocked.unwrap_or(Blocked {
-        at: position(&from),
-        distance: 0.0,
-    });
-    Err(ProcessError::TraverseBlocked {
+    let blocked_err = |b: Blocked, why: String| ProcessError::TraverseBlocked {
         from: [from[0], from[1], from[2]],
         to: [to[0], to[1], to[2]],
         at: [b.at.x, b.at.y, b.at.z],
         distance_mm: b.distance,
         clearance_mm: c,
-    })
+        why,
+    };
+    // The retract heights tried at each end (doubling), those whose axial move is clear.
+    let heights: Vec<f64> = (0..5)
+        .map(|k| opts.retract_mm * f64::from(1 << k))
+        .collect();
+    let ends = |p: &PoseArray| -> std::result::Result<Vec<PoseArray>, Blocked> {
+        let mut last = None;
+        let ok: Vec<PoseArray> = heights
+            .iter()
+            .filter_map(|&hh| match axial(p, hh) {
+                Ok(q) => Some(q),
+                Err(e) => {
+                    last = Some(e);
+                    None
+                }
+            })
+            .collect();
+        match (ok.is_empty(), last) {
+            (true, Some(e)) => Err(e),
+            _ => Ok(ok),
+        }
+    };
+    let top = heights[heights.len() - 1];
+    let ends_a = ends(&from).map_err(|b| {
+        blocked_err(
+            b,
+            format!(
+                "the retract along the tool axis from the exit is blocked at every height from {:.1} to {top:.1} mm",
+                heights[0]
+            ),
+        )
+    })?;
+    let ends_b = ends(&to).map_err(|b| {
+        blocked_err(
+            b,
+            format!(
+                "the approach along the tool axis to the pierce is blocked at every height from {:.1} to {top:.1} mm",
+                heights[0]
+            ),
+        )
+    })?;
+    // Every route: straight between any two retract points, lifted along `up` over the
+    // surfaces near the travel, or over the safe plane above every surface; checked shortest
+    // first.
+    let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::new();
+    let lift_to = |level: f64| {
+        move |p: &PoseArray| {
+            let q = position(p);
+            let rise = (level - q.coords.dot(&up)).max(0.0);
+            with_axis(q + up * rise, normal(p))
+        }
+    };
+    let global_top = obs
+        .bounding_box()
+        .map(|(lo, hi)| top_along(&lo, &hi, &up) + c + 2.0 * h);
+    for a in &ends_a {
+        for b in &ends_b {
+            let straight = vec![*a, *b];
+            routes.push((length_of(&straight), Route::Straight, straight));
+            let (pa, pb) = (position(a), position(b));
+            // Each lift at a clearance and two steps above the boxes' top, and a clearance
+            // higher (where a tilted nozzle reaches down past the first).
+            let local = obs.local_top(&pa, &pb, &up, 2.0 * c + opts.nozzle_mm + 4.0 * h);
+            for extra in [0.0, c + 2.0 * h] {
+                if let Some(level) = local {
+                    let lift = lift_to(level + c + 2.0 * h + extra);
+                    let way = vec![*a, lift(a), lift(b), *b];
+                    routes.push((length_of(&way), Route::Lifted, way));
+                }
+                if let Some(level) = global_top {
+                    let lift = lift_to(level + extra);
+                    let plane = vec![*a, lift(a), lift(b), *b];
+                    routes.push((length_of(&plane), Route::SafePlane, plane));
+                }
+            }
+        }
+    }
+    routes.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let (mut unreachable, mut refused) = (0usize, 0usize);
+    let mut blocked: Option<Blocked> = None;
+    for (length_mm, route, waypoints) in &routes {
+        if !reachable(waypoints) {
+            unreachable += 1;
+            continue;
+        }
+        match tip_ends(waypoints) {
+            Ok(least) => {
+                let t = Traverse {
+                    length_mm: *length_mm,
+                    waypoints: waypoints.clone(),
+                    route: *route,
+                    min_distance_mm: least,
+                };
+                match accept(&t) {
+                    Ok(v) => return Ok((t, v)),
+                    Err((at, distance)) => {
+                        refused += 1;
+                        blocked = Some(Blocked { at, distance });
+                    }
+                }
+            }
+            Err(e) => blocked = Some(e),
+        }
+    }
+    let n = routes.len();
+    let why = if unreachable == n {
+        format!("none of the {n} routes lies within the machine's axis limits")
+    } else {
+        format!(
+            "{} of {n} routes come too close, {refused} of them only in the machine's rapid swing, {unreachable} leave the axis limits",
+            n - unreachable
+        )
+    };
+    let b = blocked.unwrap_or(Blocked {
+        at: position(&from),
+        distance: 0.0,
+    });
+    Err(blocked_err(b, why))
+}
+
+/// The largest coordinate along `up` of the box `lo hi`, mm.
+fn top_along(lo: &Point3<f64>, hi: &Point3<f64>, up: &Vector3<f64>) -> f64 {
+    (0..8)
+        .map(|k| {
+            let corner = Point3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            corner.coords.dot(up)
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
 }

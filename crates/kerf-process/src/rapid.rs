@@ -235,18 +235,32 @@ pub struct Gap {
 ///
 /// Ids as in [`Obstacles::from_file`], each once, in the order found.
 pub fn in_the_cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<String> {
+    cuts_way(obs, g, opts, true)
+}
+
+/// [`in_the_cuts_way`]; with `all` false, only the surfaces the curves do not name on the
+/// contour lines (what [`plan_rapids`] leaves out first).
+fn cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions, all: bool) -> Vec<String> {
     let c = opts.clearance_mm;
     let mut absent: Vec<String> = Vec::new();
-    for (p, axis, named) in [
-        (&g.from_contour, &g.from, &g.from_surfaces),
-        (
-            &[g.from[0], g.from[1], g.from[2]],
-            &g.from,
-            &g.from_surfaces,
-        ),
-        (&g.to_contour, &g.to, &g.to_surfaces),
-        (&[g.to[0], g.to[1], g.to[2]], &g.to, &g.to_surfaces),
-    ] {
+    let (exit, pierce) = (
+        [g.from[0], g.from[1], g.from[2]],
+        [g.to[0], g.to[1], g.to[2]],
+    );
+    let lines: Vec<(&[f64; 3], &PoseArray, &Vec<String>)> = if all {
+        vec![
+            (&g.from_contour, &g.from, &g.from_surfaces),
+            (&exit, &g.from, &g.from_surfaces),
+            (&g.to_contour, &g.to, &g.to_surfaces),
+            (&pierce, &g.to, &g.to_surfaces),
+        ]
+    } else {
+        vec![
+            (&g.from_contour, &g.from, &g.from_surfaces),
+            (&g.to_contour, &g.to, &g.to_surfaces),
+        ]
+    };
+    for (p, axis, named) in lines {
         let at = Point3::new(p[0], p[1], p[2]);
         let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
             .try_normalize(1e-12)
@@ -261,6 +275,9 @@ pub fn in_the_cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<
             if !named.contains(&id) {
                 add(id);
             }
+        }
+        if !all {
+            continue;
         }
         let low = at + n * (0.75 * c);
         for id in obs.near_segment(&low, &top, 0.5 * c) {
@@ -277,8 +294,11 @@ pub fn in_the_cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<
 /// for an unlimited axis, then [`rapid_moves`]), in order; one result per gap (a blocked gap does not stop the others:
 /// the caller decides, e.g. to fall back to an unchecked traverse and say so).
 ///
-/// Which surfaces are checked: all of `obs`, except, for one gap, those [`in_the_cuts_way`]
-/// at its two ends (returned with the gap so that they can be reported).
+/// Which surfaces are checked: all of `obs`, except, for one gap, those a cut's curve does not
+/// name that come within half the clearance of the tool axis line at the last cut's contour
+/// end or the next cut's contour start; only where no route clears then, all those
+/// [`in_the_cuts_way`] at its two ends. The ids left out are returned with the gap so that
+/// they can be reported.
 ///
 /// A route is taken only if its waypoints and the interpolated moves between them lie within
 /// the limits and the machine's own rapid moves ([`rapid_moves`]) clear too; otherwise the
@@ -295,8 +315,9 @@ pub fn plan_rapids(
     use rayon::prelude::*;
     gaps.par_iter()
         .map(|g| {
-            let absent = in_the_cuts_way(obs, g, opts);
-            let here = obs.without(&absent);
+            // First with the surfaces a cut's curve does not name on its contour lines left
+            // out; only where no route clears then, with all those in the cuts' way.
+            let first = cuts_way(obs, g, opts, false);
             // A route is tried only if the machine reaches its waypoints (with the rotary
             // axes as [`rapid_moves`] sets them).
             let reachable = |way: &[PoseArray]| {
@@ -338,22 +359,37 @@ pub fn plan_rapids(
                 })
             };
             // A route is taken only if the machine's own rapid moves along it clear too.
-            let (t, r) = crate::traverse::plan_traverse_accepting(
-                &here,
-                &g.from,
-                &g.to,
-                opts,
-                &reachable,
-                &mut |t| {
-                    rapid_moves(kin, &here, g.from_axes, g.to_axes, t, opts).map_err(|e| match e {
-                        ProcessError::TraverseBlocked {
-                            at, distance_mm, ..
-                        } => (Point3::from(at), distance_mm),
-                        _ => (Point3::from(g.from_contour), 0.0),
-                    })
-                },
-            )?;
-            Ok((t, r, absent))
+            let plan = |absent: &[String]| {
+                let here = obs.without(absent);
+                crate::traverse::plan_traverse_accepting(
+                    &here,
+                    &g.from,
+                    &g.to,
+                    opts,
+                    &reachable,
+                    &mut |t| {
+                        rapid_moves(kin, &here, g.from_axes, g.to_axes, t, opts).map_err(
+                            |e| match e {
+                                ProcessError::TraverseBlocked {
+                                    at, distance_mm, ..
+                                } => (Point3::from(at), distance_mm),
+                                _ => (Point3::from(g.from_contour), 0.0),
+                            },
+                        )
+                    },
+                )
+            };
+            match plan(&first) {
+                Ok((t, r)) => Ok((t, r, first)),
+                Err(e) => {
+                    let all = cuts_way(obs, g, opts, true);
+                    if all.len() == first.len() {
+                        return Err(e);
+                    }
+                    let (t, r) = plan(&all)?;
+                    Ok((t, r, all))
+                }
+            }
         })
         .collect()
 }

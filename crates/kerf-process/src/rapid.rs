@@ -169,7 +169,7 @@ pub fn rapid_moves(
                     break;
                 }
                 Some((at, d)) if pieces >= MAX_SPLIT => {
-                    return Err(ProcessError::TraverseBlocked {
+                    return Err(ProcessError::TraverseBlocked(Box::new(crate::Blockage {
                         from: [ta.x, ta.y, ta.z],
                         to: [tb.x, tb.y, tb.z],
                         at: [at.x, at.y, at.z],
@@ -178,7 +178,7 @@ pub fn rapid_moves(
                         why: format!(
                             "the machine's rapid move swings too close even split {MAX_SPLIT} times"
                         ),
-                    });
+                    })));
                 }
                 Some(_) => pieces *= 2,
             }
@@ -370,9 +370,9 @@ pub fn plan_rapids(
                     &mut |t| {
                         rapid_moves(kin, &here, g.from_axes, g.to_axes, t, opts).map_err(
                             |e| match e {
-                                ProcessError::TraverseBlocked {
-                                    at, distance_mm, ..
-                                } => (Point3::from(at), distance_mm),
+                                ProcessError::TraverseBlocked(b) => {
+                                    (Point3::from(b.at), b.distance_mm)
+                                }
                                 _ => (Point3::from(g.from_contour), 0.0),
                             },
                         )

@@ -889,13 +889,15 @@ pub(crate) fn plan_traverse_accepting<T>(
         }
         Ok(least)
     };
-    let blocked_err = |b: Blocked, why: String| ProcessError::TraverseBlocked {
-        from: [from[0], from[1], from[2]],
-        to: [to[0], to[1], to[2]],
-        at: [b.at.x, b.at.y, b.at.z],
-        distance_mm: b.distance,
-        clearance_mm: c,
-        why,
+    let blocked_err = |b: Blocked, why: String| {
+        ProcessError::TraverseBlocked(Box::new(crate::Blockage {
+            from: [from[0], from[1], from[2]],
+            to: [to[0], to[1], to[2]],
+            at: [b.at.x, b.at.y, b.at.z],
+            distance_mm: b.distance,
+            clearance_mm: c,
+            why,
+        }))
     };
     // The retract heights tried at each end (doubling), those whose axial move is clear.
     let heights: Vec<f64> = (0..5)

@@ -233,7 +233,7 @@ fn a_head_under_a_roof_it_cannot_leave_is_refused_with_the_place() {
     let opts = TraverseOptions::default();
     let inside = [0.0, 40.0, R - 6.0, 0.0, 0.0, 1.0];
     let e = plan_traverse(&obs, &inside, &on_arch(90.0, 40.0), &opts).unwrap_err();
-    assert!(matches!(e, ProcessError::TraverseBlocked { .. }), "{e}");
+    assert!(matches!(e, ProcessError::TraverseBlocked(..)), "{e}");
     assert!(
         e.to_string().contains("no route keeps the 5 mm clearance"),
         "{e}"

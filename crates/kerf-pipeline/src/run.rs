@@ -194,7 +194,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                 .collect();
             let rapids =
                 kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, &obs, &gaps, topts);
-            for (w, planned) in in_setup.windows(2).zip(&rapids) {
+            for ((w, planned), gap) in in_setup.windows(2).zip(&rapids).zip(&gaps) {
                 let (t, r, absent) = match planned {
                     Ok(p) => p,
                     Err(e) => {
@@ -240,14 +240,8 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                 );
                 // Surfaces left out that a neighbouring cut names itself: its own surface
                 // curls over its head line (the cut meets it, whatever the traverse does).
-                let (ca, cb) = (
-                    &file.curves[cuts[w[0]].curve],
-                    &file.curves[cuts[w[1]].curve],
-                );
-                let own: Vec<&String> = absent
-                    .iter()
-                    .filter(|id| ca.surfaces.contains(id) || cb.surfaces.contains(id))
-                    .collect();
+                let over = kerf_process::own_surfaces_over_the_head(&obs, gap, topts);
+                let own: Vec<&String> = absent.iter().filter(|id| over.contains(id)).collect();
                 if !own.is_empty() {
                     own_report.push(json!({
                         "after": solved[w[0]].id,

@@ -32,7 +32,9 @@ mod traverse;
 
 pub use lead::{LeadIn, LeadOptions};
 pub use order::CutPlan;
-pub use rapid::{in_the_cuts_way, plan_rapids, rapid_moves, Gap, RapidMoves};
+pub use rapid::{
+    in_the_cuts_way, own_surfaces_over_the_head, plan_rapids, rapid_moves, Gap, RapidMoves,
+};
 pub use start::{index_of_param, prepare_start};
 pub use traverse::{
     check_move, plan_traverse, plan_traverse_within, Obstacles, Route, Traverse, TraverseOptions,

@@ -238,6 +238,36 @@ pub fn in_the_cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<
     cuts_way(obs, g, opts, true)
 }
 
+/// Of [`in_the_cuts_way`], only the surfaces a cut's curve names itself (its own surface
+/// curling back over the head line from three quarters of the clearance up): where such a
+/// surface is left out, that cut's own nozzle meets its surface.
+pub fn own_surfaces_over_the_head(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<String> {
+    let c = opts.clearance_mm;
+    let mut own: Vec<String> = Vec::new();
+    let (exit, pierce) = (
+        [g.from[0], g.from[1], g.from[2]],
+        [g.to[0], g.to[1], g.to[2]],
+    );
+    for (p, axis, named) in [
+        (&g.from_contour, &g.from, &g.from_surfaces),
+        (&exit, &g.from, &g.from_surfaces),
+        (&g.to_contour, &g.to, &g.to_surfaces),
+        (&pierce, &g.to, &g.to_surfaces),
+    ] {
+        let at = Point3::new(p[0], p[1], p[2]);
+        let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
+            .try_normalize(1e-12)
+            .unwrap_or_else(nalgebra::Vector3::z);
+        let top = at + n * (opts.retract_mm + opts.nozzle_mm);
+        for id in obs.near_segment(&(at + n * (0.75 * c)), &top, 0.5 * c) {
+            if named.contains(&id) && !own.contains(&id) {
+                own.push(id);
+            }
+        }
+    }
+    own
+}
+
 /// [`in_the_cuts_way`]; with `all` false, only the surfaces the curves do not name on the
 /// contour lines (what [`plan_rapids`] leaves out first).
 fn cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions, all: bool) -> Vec<String> {

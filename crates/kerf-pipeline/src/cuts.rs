@@ -259,6 +259,7 @@ pub(crate) fn traverse_report(
         Vec<String>,
     )],
     blocked: Vec<Value>,
+    own: Vec<Value>,
 ) -> Value {
     let mut unchecked: Vec<&str> = Vec::new();
     for (_, _, absent) in rapids {
@@ -284,6 +285,8 @@ pub(crate) fn traverse_report(
         "length_mm": rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>(),
         "min_distance_mm": rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min),
         "surfaces_in_the_cuts_way": unchecked,
-        "surfaces_note": "surfaces a cut's curve does not name that lie on the tool axis line at that cut (another workpiece in the same place, or in the way of the cut itself) are not checked for the traverses next to it",
+        "surfaces_note": "surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)",
+        "own_surface_over_the_head": own,
+        "unchecked_note": "where no route keeps the clearance (unchecked, with the reason), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning",
     })
 }

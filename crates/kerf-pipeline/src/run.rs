@@ -142,6 +142,10 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let limits = machine.limits.map(|r| r.map(|r| (r.min, r.max)));
     let mut rapid_report = Vec::new();
     let mut blocked_report = Vec::new();
+    let mut own_report = Vec::new();
+    // The traverses for the plot, part coordinates, and a cut's last pose.
+    let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
+    let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
     let mut warnings: Vec<String> = Vec::new();
     for setup in 0..placed.plan.setups.len() {
         let mut ipaths = Vec::new();
@@ -187,7 +191,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                 .collect();
             let rapids =
                 kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, &obs, &gaps, topts);
-            for (w, planned) in in_setup.windows(2).zip(&rapids) {
+            for ((w, planned), gap) in in_setup.windows(2).zip(&rapids).zip(&gaps) {
                 let (t, r, absent) = match planned {
                     Ok(p) => p,
                     Err(e) => {
@@ -200,6 +204,18 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                             "reason": e.to_string(),
                         }));
                         traverses.push(Vec::new());
+                        // The plot: the unchecked retract, straight move and approach.
+                        let up = |q: &kerf_process::PoseArray, r: f64| {
+                            nalgebra::Point3::new(q[0], q[1], q[2])
+                                + nalgebra::Vector3::new(q[3], q[4], q[5]) * r
+                        };
+                        let (ea, pb) = (cut_end(w[0]), &cuts[w[1]].poses[0]);
+                        plot_traverses.push(vec![
+                            up(&ea, 0.0),
+                            up(&ea, o.retract_mm),
+                            up(pb, o.retract_mm),
+                            up(pb, 0.0),
+                        ]);
                         continue;
                     }
                 };
@@ -219,7 +235,31 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                         })
                         .collect::<Vec<_>>(),
                 );
+                // Surfaces left out that a neighbouring cut names itself: its own surface
+                // curls over its head line (the cut meets it, whatever the traverse does).
+                let over = kerf_process::own_surfaces_over_the_head(&obs, gap, topts);
+                let own: Vec<&String> = absent.iter().filter(|id| over.contains(id)).collect();
+                if !own.is_empty() {
+                    own_report.push(json!({
+                        "after": solved[w[0]].id,
+                        "before": solved[w[1]].id,
+                        "surfaces": own,
+                    }));
+                }
                 rapid_report.push((t.clone(), r.clone(), absent.clone()));
+                // The plot: the checked traverse back in part coordinates.
+                let (rot, shift) = (placement.rotation(), placement.translation_mm);
+                let part = |q: &[f64; 6]| {
+                    nalgebra::Point3::from(
+                        rot.inverse() * (nalgebra::Point3::new(q[0], q[1], q[2]) - shift).coords,
+                    )
+                };
+                let ea = cut_end(w[0]);
+                let pb = cuts[w[1]].poses[0];
+                let mut line = vec![nalgebra::Point3::new(ea[0], ea[1], ea[2])];
+                line.extend(r.poses.iter().map(part));
+                line.push(nalgebra::Point3::new(pb[0], pb[1], pb[2]));
+                plot_traverses.push(line);
             }
         }
         for (k, s) in solved.iter().enumerate() {
@@ -268,6 +308,35 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         machine.name
     );
     scene.axes = Some(kerf_plot::AxesChart::new(&axes, Some(machine))?);
+    // The process over the paths (part coordinates): pierces numbered in cutting order,
+    // lead-ins, lead-outs and the traverses, set-up by set-up as the programs run them.
+    let pt = |q: &kerf_process::PoseArray| nalgebra::Point3::new(q[0], q[1], q[2]);
+    let mut order: Vec<usize> = (0..cuts.len()).collect();
+    order.sort_by_key(|&k| placed.plan.setup_of(cuts[k].curve));
+    scene.process = Some(kerf_plot::ProcessPicture {
+        cuts: order
+            .iter()
+            .map(|&k| {
+                let c = &cuts[k];
+                let [m, n, _] = c.counts;
+                kerf_plot::CutPicture {
+                    id: file.curves[c.curve].id.clone(),
+                    pierce: pt(&c.poses[0]),
+                    lead_in: if m > 0 {
+                        c.poses[..=m].iter().map(pt).collect()
+                    } else {
+                        Vec::new()
+                    },
+                    lead_out: if m + n < c.poses.len() {
+                        c.poses[m + n - 1..].iter().map(pt).collect()
+                    } else {
+                        Vec::new()
+                    },
+                }
+            })
+            .collect(),
+        traverses: plot_traverses,
+    });
     let svg = kerf_plot::render(&scene);
     let mut counts = motions[0].counts();
     for m in &motions[1..] {
@@ -324,7 +393,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         },
         "placement": placed.json(&id_refs),
         "process": crate::cuts::report(file, &cuts, &cut_plans),
-        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report),
+        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report, own_report),
         "interpolation": {
             "feed_mm_per_min": o.feed_mm_per_min,
             "cycle_s": o.cycle_s,

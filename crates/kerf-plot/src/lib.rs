@@ -19,7 +19,11 @@
 //! The SVG is plain text (no scripts, no external fonts or images) and opens in any browser.
 //! Its groups have stable ids for tests and styling: `view-top`, `view-front`, `view-side`,
 //! `view-iso`, `legend-error`, `chart-chord-error`, `chart-axes`; every cutting point is one
-//! `<circle class="pt">` per view.
+//! `<circle class="pt">` per view. With a [`ProcessPicture`], every view also holds a group
+//! `class="process"`: each traverse a dashed `<polyline class="traverse">`, each lead-in a
+//! `<polyline class="lead-in">`, each lead-out a `<polyline class="lead-out">`, each pierce a
+//! `<circle class="pierce" data-order="k">` and beside it `<text class="order">k</text>`, `k`
+//! from 1 in cutting order.
 //!
 //! The chord errors drawn are sampled estimates ([`sampled_chord_error`]), for display; the
 //! independent measurement is `kerf check` (crate `kerf-check`).
@@ -41,6 +45,7 @@
 //!         segment_errors: vec![0.0, 0.0],
 //!     }],
 //!     axes: None,
+//!     process: None,
 //! };
 //! let svg = render(&scene);
 //! assert!(svg.starts_with("<?xml"), "an XML document");
@@ -57,7 +62,10 @@ mod scene;
 mod svg;
 mod views;
 
-pub use scene::{sample_curve, sampled_chord_error, AxesChart, PathPicture, Scene, SceneOptions};
+pub use scene::{
+    sample_curve, sampled_chord_error, AxesChart, CutPicture, PathPicture, ProcessPicture, Scene,
+    SceneOptions,
+};
 
 use layout::Rect;
 use views::View;
@@ -300,6 +308,7 @@ mod tests {
                 },
             ],
             axes: None,
+            process: None,
         }
     }
 
@@ -483,6 +492,7 @@ mod tests {
             tolerance: 0.01,
             paths: Vec::new(),
             axes: None,
+            process: None,
         };
         let svg = render(&empty);
         well_formed(&svg).unwrap();
@@ -538,5 +548,79 @@ mod tests {
         let bad = dir.path().join("missing").join("p.svg");
         assert!(write_svg(&bad, "<svg/>").is_err(), "no such directory");
         assert!(!bad.exists(), "nothing written");
+    }
+
+    #[test]
+    fn the_process_is_drawn_pierces_numbered_in_cutting_order() {
+        let mut scene = arc_scene(true);
+        // Cut "line" first, then the arc: pierces off both, a traverse between them.
+        let p0 = Point3::new(-3.0, -12.0, 0.0);
+        let p1 = Point3::new(28.0, 2.0, 0.0);
+        scene.process = Some(ProcessPicture {
+            cuts: vec![
+                CutPicture {
+                    id: "line".into(),
+                    pierce: p0,
+                    lead_in: vec![p0, Point3::new(0.0, -10.0, 0.0)],
+                    lead_out: vec![Point3::new(40.0, -10.0, 0.0), Point3::new(42.0, -8.0, 0.0)],
+                },
+                CutPicture {
+                    id: "arc".into(),
+                    pierce: p1,
+                    lead_in: vec![p1, Point3::new(30.0, 0.0, 0.0)],
+                    lead_out: Vec::new(),
+                },
+            ],
+            traverses: vec![vec![Point3::new(42.0, -8.0, 0.0), p1]],
+        });
+        let svg = render(&scene);
+        well_formed(&svg).unwrap();
+        let top = between(&svg, "id=\"view-top\"", "id=\"view-iso\"");
+        assert_eq!(
+            top.matches("class=\"pierce\"").count(),
+            2,
+            "one marker a pierce"
+        );
+        assert_eq!(top.matches("class=\"traverse\"").count(), 1);
+        assert_eq!(top.matches("class=\"lead-in\"").count(), 2);
+        assert_eq!(
+            top.matches("class=\"lead-out\"").count(),
+            1,
+            "none drawn when empty"
+        );
+        // The numbers, in document order, are 1..n, each beside its own marker.
+        let mut numbers = Vec::new();
+        let mut rest = top;
+        while let Some(i) = rest.find("class=\"pierce\" data-order=\"") {
+            let tag_start = rest[..i].rfind("<circle").unwrap();
+            let tag = &rest[tag_start..i];
+            let attr = |name: &str| -> f64 {
+                let a = tag.find(&format!("{name}=\"")).unwrap() + name.len() + 2;
+                tag[a..a + tag[a..].find('"').unwrap()].parse().unwrap()
+            };
+            let (cx, cy) = (attr("cx"), attr("cy"));
+            let after = &rest[i..];
+            let t = after.find("class=\"order\">").unwrap();
+            let text_tag = &after[after[..t].rfind("<text").unwrap()..t];
+            let tx: f64 = {
+                let a = text_tag.find("x=\"").unwrap() + 3;
+                text_tag[a..a + text_tag[a..].find('"').unwrap()]
+                    .parse()
+                    .unwrap()
+            };
+            let n: usize = after[t + 14..t + 14 + after[t + 14..].find('<').unwrap()]
+                .parse()
+                .unwrap();
+            assert!((tx - cx - 4.5).abs() < 0.01, "number {n} beside its marker");
+            assert!(cx.is_finite() && cy.is_finite());
+            numbers.push(n);
+            rest = &after[t..];
+        }
+        assert_eq!(numbers, vec![1, 2]);
+        assert_eq!(
+            svg.matches("class=\"pierce\"").count(),
+            2 * 4,
+            "in all 4 views"
+        );
     }
 }

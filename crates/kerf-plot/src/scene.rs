@@ -22,6 +22,34 @@ pub struct Scene {
     pub paths: Vec<PathPicture>,
     /// The machine axes, if known.
     pub axes: Option<AxesChart>,
+    /// The laser process over the paths (pierces, lead-ins and lead-outs, cutting order,
+    /// traverses), if planned.
+    pub process: Option<ProcessPicture>,
+}
+
+/// The laser process drawn over the paths, in the same coordinates as the paths: each cut's
+/// pierce as a marker numbered in cutting order, its lead-in and lead-out in their own
+/// styles, and the traverses between cuts dashed.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ProcessPicture {
+    /// The cuts in cutting order (the number drawn by a pierce is its index here plus one).
+    pub cuts: Vec<CutPicture>,
+    /// The traverses: the tip's polyline from one cut's exit to the next cut's pierce.
+    pub traverses: Vec<Vec<Point3<f64>>>,
+}
+
+/// One cut of [`ProcessPicture`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CutPicture {
+    /// The contour's id.
+    pub id: String,
+    /// Where the beam pierces (the lead-in's first point, or the contour's start when the
+    /// cut pierces on the contour).
+    pub pierce: Point3<f64>,
+    /// The lead-in from the pierce to the contour (empty: none).
+    pub lead_in: Vec<Point3<f64>>,
+    /// The lead-out from the contour's last cutting point (empty: none).
+    pub lead_out: Vec<Point3<f64>>,
 }
 
 /// One cut contour: its curve, cutting points, normals and per-segment chord errors.
@@ -169,6 +197,7 @@ impl Scene {
             tolerance: toolpath.tolerance,
             paths,
             axes: None,
+            process: None,
         })
     }
 }

@@ -196,6 +196,20 @@ pub(crate) fn draw_view(doc: &mut Doc, scene: &Scene, view: View, panel: Rect, n
             }
         }
     }
+    if let Some(process) = &scene.process {
+        for c in &process.cuts {
+            grow(view.project(&c.pierce));
+            c.lead_in
+                .iter()
+                .chain(&c.lead_out)
+                .for_each(|q| grow(view.project(q)));
+        }
+        process
+            .traverses
+            .iter()
+            .flatten()
+            .for_each(|q| grow(view.project(q)));
+    }
     if !b.0.is_finite() {
         doc.rect(frame.x, frame.y, frame.w, frame.h, "class=\"frame\"");
         doc.text(
@@ -268,6 +282,9 @@ pub(crate) fn draw_view(doc: &mut Doc, scene: &Scene, view: View, panel: Rect, n
         }
     }
     doc.close();
+    if let Some(process) = &scene.process {
+        draw_process(doc, process, view, &fit);
+    }
     if view == View::Top && scene.paths.len() <= 12 {
         doc.open("class=\"labels\"");
         // Beside each path's first point, moved down a line at a time while it would cover
@@ -484,6 +501,43 @@ pub(crate) fn draw_legend(doc: &mut Doc, scene: &Scene, area: Rect) {
 }
 
 /// The stylesheet used by the views.
+/// The process over a view: traverses dashed, lead-ins and lead-outs, then the pierces with
+/// their numbers in cutting order on top.
+fn draw_process(doc: &mut Doc, process: &crate::ProcessPicture, view: View, fit: &Fit) {
+    let line = |pts: &[Point3<f64>]| -> Vec<(f64, f64)> {
+        pts.iter().map(|q| fit.px(view.project(q))).collect()
+    };
+    doc.open("class=\"process\"");
+    for t in &process.traverses {
+        if t.len() >= 2 {
+            doc.polyline(&line(t), "class=\"traverse\"");
+        }
+    }
+    for c in &process.cuts {
+        if c.lead_in.len() >= 2 {
+            doc.polyline(&line(&c.lead_in), "class=\"lead-in\"");
+        }
+        if c.lead_out.len() >= 2 {
+            doc.polyline(&line(&c.lead_out), "class=\"lead-out\"");
+        }
+    }
+    for (k, c) in process.cuts.iter().enumerate() {
+        let (x, y) = fit.px(view.project(&c.pierce));
+        if !(x.is_finite() && y.is_finite()) {
+            continue;
+        }
+        let order = k + 1;
+        doc.circle(
+            x,
+            y,
+            3.2,
+            &format!("class=\"pierce\" data-order=\"{order}\""),
+        );
+        doc.text(x + 4.5, y - 4.5, &order.to_string(), "class=\"order\"");
+    }
+    doc.close();
+}
+
 pub(crate) const STYLE: &str = concat!(
     ".panel{fill:#fcfcfc;stroke:#d0d0d0}",
     ".frame{fill:none;stroke:#888;stroke-width:0.8}",
@@ -494,4 +548,9 @@ pub(crate) const STYLE: &str = concat!(
     ".normals line{stroke:#1f6fb4;stroke-width:1;stroke-opacity:0.7}",
     ".pt{fill:#fff;stroke:#111;stroke-width:0.8}",
     ".label{font-size:11px;fill:#222;stroke:#fff;stroke-width:3px;paint-order:stroke}",
+    ".traverse{stroke:#777;stroke-width:0.9;stroke-dasharray:5 4}",
+    ".lead-in{stroke:#e07b00;stroke-width:1.8}",
+    ".lead-out{stroke:#8e44ad;stroke-width:1.4;stroke-dasharray:2 2}",
+    ".pierce{fill:#d62728;stroke:#fff;stroke-width:0.8}",
+    ".order{font-size:10px;font-weight:bold;fill:#d62728;stroke:#fff;stroke-width:2.5px;paint-order:stroke}",
 );

@@ -32,7 +32,9 @@ mod traverse;
 
 pub use lead::{LeadIn, LeadOptions};
 pub use order::CutPlan;
-pub use rapid::{plan_rapids, rapid_moves, Gap, RapidMoves};
+pub use rapid::{
+    in_the_cuts_way, own_surfaces_over_the_head, plan_rapids, rapid_moves, Gap, RapidMoves,
+};
 pub use start::{index_of_param, prepare_start};
 pub use traverse::{
     check_move, plan_traverse, plan_traverse_within, Obstacles, Route, Traverse, TraverseOptions,
@@ -127,25 +129,34 @@ pub enum ProcessError {
         reason: String,
     },
     /// No traverse route between two cuts keeps the clearance: the retract along the tool
-    /// axis, the straight travel and the travel over the safe plane all come too close.
-    /// Fix: a smaller clearance, another placement, or check the tool axes (one pointing into
-    /// a pocket).
-    #[error(
-        "traverse from ({:.3}, {:.3}, {:.3}) to ({:.3}, {:.3}, {:.3}): no route keeps the {clearance_mm} mm clearance; ({:.3}, {:.3}, {:.3}) is {distance_mm:.3} mm from the part",
-        from[0], from[1], from[2], to[0], to[1], to[2], at[0], at[1], at[2]
-    )]
-    TraverseBlocked {
-        /// Where the last cut ends, mm.
-        from: [f64; 3],
-        /// The next pierce point, mm.
-        to: [f64; 3],
-        /// The first point too close on the last route tried, mm.
-        at: [f64; 3],
-        /// Its distance from the part, mm.
-        distance_mm: f64,
-        /// The clearance asked for, mm.
-        clearance_mm: f64,
-    },
+    /// axis, the approach, or every travel route comes too close (details boxed, so that the
+    /// error stays small). Fix: a smaller clearance, another placement, or check the tool axes
+    /// (one pointing into a pocket).
+    #[error("{0}")]
+    TraverseBlocked(Box<Blockage>),
+}
+
+/// Where and why a traverse found no clear route ([`ProcessError::TraverseBlocked`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error(
+    "traverse from ({:.3}, {:.3}, {:.3}) to ({:.3}, {:.3}, {:.3}): no route keeps the {clearance_mm} mm clearance ({why}); ({:.3}, {:.3}, {:.3}) is {distance_mm:.3} mm from the part",
+    from[0], from[1], from[2], to[0], to[1], to[2], at[0], at[1], at[2]
+)]
+pub struct Blockage {
+    /// Where the last cut ends, mm.
+    pub from: [f64; 3],
+    /// The next pierce point, mm.
+    pub to: [f64; 3],
+    /// The first point too close on the last route tried, mm.
+    pub at: [f64; 3],
+    /// Its distance from the part, mm.
+    pub distance_mm: f64,
+    /// The clearance asked for, mm.
+    pub clearance_mm: f64,
+    /// Why, in words: which part of the traverse found no clear way (the retract at the
+    /// exit, the approach to the pierce, every travel route, the axis limits, the machine's
+    /// rapid swing).
+    pub why: String,
 }
 
 /// `Result` with [`ProcessError`].

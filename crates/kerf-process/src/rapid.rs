@@ -169,13 +169,16 @@ pub fn rapid_moves(
                     break;
                 }
                 Some((at, d)) if pieces >= MAX_SPLIT => {
-                    return Err(ProcessError::TraverseBlocked {
+                    return Err(ProcessError::TraverseBlocked(Box::new(crate::Blockage {
                         from: [ta.x, ta.y, ta.z],
                         to: [tb.x, tb.y, tb.z],
                         at: [at.x, at.y, at.z],
                         distance_mm: d,
                         clearance_mm: c,
-                    });
+                        why: format!(
+                            "the machine's rapid move swings too close even split {MAX_SPLIT} times"
+                        ),
+                    })));
                 }
                 Some(_) => pieces *= 2,
             }
@@ -215,19 +218,121 @@ pub struct Gap {
     pub to_surfaces: Vec<String>,
 }
 
+/// The surfaces that the head meets at a gap's ends while it cuts or pierces there, and
+/// which no traverse can therefore keep the clearance from: for each end (the last cut's
+/// contour end and its exit, the next cut's pierce and its contour start), the line along the
+/// tool axis there up to the retract plus the nozzle (the head is on the part of that line the
+/// nozzle covers while it cuts or pierces, and backs off along it), and
+///
+/// - a surface the cut's curve does not name that comes within half the clearance of the line
+///   from its foot: not there while that contour is cut (a file holding two workpieces in the
+///   same place, as a tube joint's hole in the main tube and the end of the branch tube, lists
+///   both, and each contour passes through the other workpiece) or in the way of the cut;
+/// - a surface the curve names (its own carrying surface) that comes within half the
+///   clearance of the line from three quarters of the clearance up: the surface curls back
+///   over the head (a hole narrower than about the clearance whose tool axis is its wall's
+///   normal, a tight bend's inside), so the cut's own nozzle meets it.
+///
+/// Ids as in [`Obstacles::from_file`], each once, in the order found.
+pub fn in_the_cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<String> {
+    cuts_way(obs, g, opts, true)
+}
+
+/// Of [`in_the_cuts_way`], only the surfaces a cut's curve names itself (its own surface
+/// curling back over the head line from three quarters of the clearance up): where such a
+/// surface is left out, that cut's own nozzle meets its surface.
+pub fn own_surfaces_over_the_head(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<String> {
+    let c = opts.clearance_mm;
+    let mut own: Vec<String> = Vec::new();
+    let (exit, pierce) = (
+        [g.from[0], g.from[1], g.from[2]],
+        [g.to[0], g.to[1], g.to[2]],
+    );
+    for (p, axis, named) in [
+        (&g.from_contour, &g.from, &g.from_surfaces),
+        (&exit, &g.from, &g.from_surfaces),
+        (&g.to_contour, &g.to, &g.to_surfaces),
+        (&pierce, &g.to, &g.to_surfaces),
+    ] {
+        let at = Point3::new(p[0], p[1], p[2]);
+        let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
+            .try_normalize(1e-12)
+            .unwrap_or_else(nalgebra::Vector3::z);
+        let top = at + n * (opts.retract_mm + opts.nozzle_mm);
+        for id in obs.near_segment(&(at + n * (0.75 * c)), &top, 0.5 * c) {
+            if named.contains(&id) && !own.contains(&id) {
+                own.push(id);
+            }
+        }
+    }
+    own
+}
+
+/// [`in_the_cuts_way`]; with `all` false, only the surfaces the curves do not name on the
+/// contour lines (what [`plan_rapids`] leaves out first).
+fn cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions, all: bool) -> Vec<String> {
+    let c = opts.clearance_mm;
+    let mut absent: Vec<String> = Vec::new();
+    let (exit, pierce) = (
+        [g.from[0], g.from[1], g.from[2]],
+        [g.to[0], g.to[1], g.to[2]],
+    );
+    let lines: Vec<(&[f64; 3], &PoseArray, &Vec<String>)> = if all {
+        vec![
+            (&g.from_contour, &g.from, &g.from_surfaces),
+            (&exit, &g.from, &g.from_surfaces),
+            (&g.to_contour, &g.to, &g.to_surfaces),
+            (&pierce, &g.to, &g.to_surfaces),
+        ]
+    } else {
+        vec![
+            (&g.from_contour, &g.from, &g.from_surfaces),
+            (&g.to_contour, &g.to, &g.to_surfaces),
+        ]
+    };
+    for (p, axis, named) in lines {
+        let at = Point3::new(p[0], p[1], p[2]);
+        let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
+            .try_normalize(1e-12)
+            .unwrap_or_else(nalgebra::Vector3::z);
+        let top = at + n * (opts.retract_mm + opts.nozzle_mm);
+        let mut add = |id: String| {
+            if !absent.contains(&id) {
+                absent.push(id);
+            }
+        };
+        for id in obs.near_segment(&at, &top, 0.5 * c) {
+            if !named.contains(&id) {
+                add(id);
+            }
+        }
+        if !all {
+            continue;
+        }
+        let low = at + n * (0.75 * c);
+        for id in obs.near_segment(&low, &top, 0.5 * c) {
+            if named.contains(&id) {
+                add(id);
+            }
+        }
+    }
+    absent
+}
+
 /// Plans and checks the traverse of every gap ([`crate::plan_traverse_within`] among the
 /// routes whose waypoints lie within `limits`, `(min, max)` of `[X, Y, Z, tilt, C]` or `None`
 /// for an unlimited axis, then [`rapid_moves`]), in order; one result per gap (a blocked gap does not stop the others:
 /// the caller decides, e.g. to fall back to an unchecked traverse and say so).
 ///
-/// Which surfaces are checked: all of `obs`, except, for one gap, a surface that the cut's
-/// curve does not name and that comes within half the clearance of the line along the tool
-/// axis at the last cut's contour end or the next cut's contour start (from the contour up to
-/// the retract plus the nozzle). The head is on that line while it cuts: such a surface is
-/// either not there while that contour is cut (a file holding two workpieces in the same
-/// place, as a tube joint's hole in the main tube and the end of the branch tube, lists both,
-/// and each contour passes through the other workpiece) or in the way of the cut itself, which
-/// no traverse can mend; the ids are returned with the gap so that they can be reported.
+/// Which surfaces are checked: all of `obs`, except, for one gap, those a cut's curve does not
+/// name that come within half the clearance of the tool axis line at the last cut's contour
+/// end or the next cut's contour start; only where no route clears then, all those
+/// [`in_the_cuts_way`] at its two ends. The ids left out are returned with the gap so that
+/// they can be reported.
+///
+/// A route is taken only if its waypoints and the interpolated moves between them lie within
+/// the limits and the machine's own rapid moves ([`rapid_moves`]) clear too; otherwise the
+/// next shortest route is tried.
 ///
 /// Each result's error is as [`crate::plan_traverse`] and [`rapid_moves`].
 pub fn plan_rapids(
@@ -240,23 +345,9 @@ pub fn plan_rapids(
     use rayon::prelude::*;
     gaps.par_iter()
         .map(|g| {
-            let mut absent: Vec<String> = Vec::new();
-            for (p, axis, named) in [
-                (&g.from_contour, &g.from, &g.from_surfaces),
-                (&g.to_contour, &g.to, &g.to_surfaces),
-            ] {
-                let at = Point3::new(p[0], p[1], p[2]);
-                let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
-                    .try_normalize(1e-12)
-                    .unwrap_or_else(nalgebra::Vector3::z);
-                let top = at + n * (opts.retract_mm + opts.nozzle_mm);
-                for id in obs.near_segment(&at, &top, 0.5 * opts.clearance_mm) {
-                    if !named.contains(&id) && !absent.contains(&id) {
-                        absent.push(id);
-                    }
-                }
-            }
-            let here = obs.without(&absent);
+            // First with the surfaces a cut's curve does not name on its contour lines left
+            // out; only where no route clears then, with all those in the cuts' way.
+            let first = cuts_way(obs, g, opts, false);
             // A route is tried only if the machine reaches its waypoints (with the rotary
             // axes as [`rapid_moves`] sets them).
             let reachable = |way: &[PoseArray]| {
@@ -297,9 +388,38 @@ pub fn plan_rapids(
                     })
                 })
             };
-            let t = crate::plan_traverse_within(&here, &g.from, &g.to, opts, &reachable)?;
-            let r = rapid_moves(kin, &here, g.from_axes, g.to_axes, &t, opts)?;
-            Ok((t, r, absent))
+            // A route is taken only if the machine's own rapid moves along it clear too.
+            let plan = |absent: &[String]| {
+                let here = obs.without(absent);
+                crate::traverse::plan_traverse_accepting(
+                    &here,
+                    &g.from,
+                    &g.to,
+                    opts,
+                    &reachable,
+                    &mut |t| {
+                        rapid_moves(kin, &here, g.from_axes, g.to_axes, t, opts).map_err(
+                            |e| match e {
+                                ProcessError::TraverseBlocked(b) => {
+                                    (Point3::from(b.at), b.distance_mm)
+                                }
+                                _ => (Point3::from(g.from_contour), 0.0),
+                            },
+                        )
+                    },
+                )
+            };
+            match plan(&first) {
+                Ok((t, r)) => Ok((t, r, first)),
+                Err(e) => {
+                    let all = cuts_way(obs, g, opts, true);
+                    if all.len() == first.len() {
+                        return Err(e);
+                    }
+                    let (t, r) = plan(&all)?;
+                    Ok((t, r, all))
+                }
+            }
         })
         .collect()
 }

@@ -36,8 +36,87 @@ struct Tessellated {
     /// `(u, v)` of each mesh vertex.
     uv: Vec<(f64, f64)>,
     /// Twice the largest distance found between the surface (cell centres and edge
-    /// middles) and the mesh, plus a small floor: an estimate of the deviation, mm.
+    /// middles) and the mesh, plus a small floor: an estimate of the deviation, mm (it only
+    /// chooses between the warm-started and the global closest point, never skips a query).
     sag: f64,
+    /// The proven boxes of the surface's pieces, by strips of cells along u: each strip's
+    /// box and its cells' boxes. A piece (the surface over one cell) lies in the convex hull
+    /// of the control points of its rational Bezier form (positive weights), so in their box;
+    /// the distance to the nearest box is a lower bound of the distance to the surface.
+    strips: Vec<Strip>,
+}
+
+/// A strip of cells along v at one u interval, with its box and its cells' boxes.
+#[derive(Debug)]
+struct Strip {
+    lo: Point3<f64>,
+    hi: Point3<f64>,
+    cells: Vec<(Point3<f64>, Point3<f64>)>,
+}
+
+/// The proven boxes of `surface` over the cells `cu` x `cv` (each `(span, start, end)`
+/// inside one knot span): the rational Bezier form of the surface on a cell is taken row by
+/// row along u (each row of the homogeneous net a curve in u), then column by column along v
+/// (tensor-product blossoming commutes); its control points' box contains the piece.
+fn cell_boxes(
+    surface: &NurbsSurface,
+    cu: &[(usize, f64, f64)],
+    cv: &[(usize, f64, f64)],
+) -> Vec<Strip> {
+    let (n_u, n_v) = surface.net_size();
+    let (p, q) = (surface.degree_u(), surface.degree_v());
+    let cpw = surface.homogeneous_points();
+    let rows: Vec<kerf_nurbs::NurbsCurve> = (0..n_v)
+        .map(|b| {
+            kerf_nurbs::NurbsCurve::from_homogeneous_unchecked(
+                p,
+                surface.knots_u().to_vec(),
+                (0..n_u).map(|a| cpw[a * n_v + b]).collect(),
+            )
+        })
+        .collect();
+    let mut strips = Vec::with_capacity(cu.len());
+    let mut out = vec![nalgebra::Vector4::zeros(); p.max(q) + 1];
+    for &(su, u0, u1) in cu {
+        // Q[a][b]: the u-Bezier points of row b on this u interval.
+        let mut cols: Vec<Vec<nalgebra::Vector4<f64>>> = vec![Vec::with_capacity(n_v); p + 1];
+        for row in &rows {
+            row.bezier_in_span_into(su, u0, u1, &mut out);
+            for (a, col) in cols.iter_mut().enumerate() {
+                col.push(out[a]);
+            }
+        }
+        let cols: Vec<kerf_nurbs::NurbsCurve> = cols
+            .into_iter()
+            .map(|c| {
+                kerf_nurbs::NurbsCurve::from_homogeneous_unchecked(q, surface.knots_v().to_vec(), c)
+            })
+            .collect();
+        let mut cells = Vec::with_capacity(cv.len());
+        let mut slo = Point3::from([f64::INFINITY; 3]);
+        let mut shi = Point3::from([f64::NEG_INFINITY; 3]);
+        for &(sv, v0, v1) in cv {
+            let mut lo = Point3::from([f64::INFINITY; 3]);
+            let mut hi = Point3::from([f64::NEG_INFINITY; 3]);
+            for col in &cols {
+                col.bezier_in_span_into(sv, v0, v1, &mut out);
+                for h in &out[..=q] {
+                    let x = Point3::new(h.x / h.w, h.y / h.w, h.z / h.w);
+                    lo = lo.inf(&x);
+                    hi = hi.sup(&x);
+                }
+            }
+            slo = slo.inf(&lo);
+            shi = shi.sup(&hi);
+            cells.push((lo, hi));
+        }
+        strips.push(Strip {
+            lo: slo,
+            hi: shi,
+            cells,
+        });
+    }
+    strips
 }
 
 /// Cells per knot span in each direction of a tessellation (at least 12 over the domain).
@@ -45,21 +124,30 @@ const CELLS_PER_SPAN: usize = 6;
 
 impl Tessellated {
     fn new(surface: NurbsSurface) -> Self {
+        // The grid's values and its cells, each cell inside one knot span.
         let grid = |spans: Vec<(usize, f64, f64)>| {
             let per = CELLS_PER_SPAN.max(12usize.div_ceil(spans.len().max(1)));
             let mut g = Vec::new();
-            for (k, &(_, a, b)) in spans.iter().enumerate() {
+            let mut cells = Vec::new();
+            for (k, &(span, a, b)) in spans.iter().enumerate() {
                 for j in 0..per {
                     g.push(a + (b - a) * j as f64 / per as f64);
+                    let end = if j + 1 == per {
+                        b
+                    } else {
+                        a + (b - a) * (j + 1) as f64 / per as f64
+                    };
+                    cells.push((span, g[g.len() - 1], end));
                 }
                 if k + 1 == spans.len() {
                     g.push(b);
                 }
             }
-            g
+            (g, cells)
         };
-        let us = grid(surface.spans_u());
-        let vs = grid(surface.spans_v());
+        let (us, cu) = grid(surface.spans_u());
+        let (vs, cv) = grid(surface.spans_v());
+        let strips = cell_boxes(&surface, &cu, &cv);
         let (nu, nv) = (us.len(), vs.len());
         let mut vertices = Vec::with_capacity(nu * nv);
         let mut uv = Vec::with_capacity(nu * nv);
@@ -112,20 +200,40 @@ impl Tessellated {
             mesh,
             uv,
             sag,
+            strips,
         }
     }
 
+    /// A proven lower bound of the distance from `p` to the surface: the distance to the
+    /// nearest of its pieces' boxes (a strip is passed over when its own box is farther than
+    /// the best cell so far, or than `enough`, past which the exact value does not matter).
+    fn lower_bound(&self, p: &Point3<f64>, enough: f64) -> f64 {
+        let mut best = f64::INFINITY;
+        for s in &self.strips {
+            let d = box_distance(p, &s.lo, &s.hi);
+            if d >= best || d >= enough {
+                best = best.min(d);
+                continue;
+            }
+            for (lo, hi) in &s.cells {
+                best = best.min(box_distance(p, lo, hi));
+            }
+        }
+        best
+    }
+
     /// The exact distance from `p` where it may be below `limit`; else a value `>= limit`
-    /// (the mesh's distance less the deviation estimate).
+    /// that is a proven lower bound of it (the distance to the nearest piece's box).
     fn distance(&self, p: &Point3<f64>, limit: f64) -> f64 {
+        let floor = self.lower_bound(p, limit);
+        if floor >= limit {
+            return floor;
+        }
         let Some(m) = &self.mesh else {
             return self.surface.closest_point(p, None).distance;
         };
         let (proj, (tri, _)) = m.project_local_point_and_get_location(p, false);
         let dm = (proj.point - p).norm();
-        if dm - self.sag >= limit {
-            return dm - self.sag;
-        }
         let corner = m.indices()[tri as usize][0] as usize;
         let warm = self
             .surface
@@ -360,6 +468,47 @@ impl Obstacles {
         Ok(obs)
     }
 
+    /// The largest coordinate along `up` of the boxes of the surfaces that come within
+    /// `radius_mm` of the segment `a b` seen along `up` (their boxes' distance with the `up`
+    /// component left out), or `None` if none does or `up` is not a coordinate axis.
+    fn local_top(
+        &self,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        up: &Vector3<f64>,
+        radius_mm: f64,
+    ) -> Option<f64> {
+        let k = (0..3).find(|&k| (up[k].abs() - 1.0).abs() < 1e-12)?;
+        let n = (((b - a).norm() / (0.5 * radius_mm)).ceil() as usize).clamp(1, 100_000);
+        self.items
+            .iter()
+            .filter(|i| {
+                (0..=n).any(|j| {
+                    let p = a + (b - a) * (j as f64 / n as f64);
+                    let d = Vector3::from_fn(|m, _| {
+                        if m == k {
+                            0.0
+                        } else {
+                            (i.lo[m] - p[m]).max(p[m] - i.hi[m]).max(0.0)
+                        }
+                    });
+                    // Samples half the radius apart: a box within it of the segment is within
+                    // 1.25 times it of a sample.
+                    d.norm() <= 1.25 * radius_mm
+                })
+            })
+            .map(|i| top_along(&i.lo, &i.hi, up))
+            .reduce(f64::max)
+    }
+
+    /// The id of the nearest surface to `p` and its distance, mm (`None` without surfaces).
+    pub fn nearest(&self, p: &Point3<f64>) -> Option<(String, f64)> {
+        self.items
+            .iter()
+            .map(|i| (i.id.clone(), shape_distance(&i.shape, p)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
     /// True if there are no surfaces.
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
@@ -517,10 +666,17 @@ impl TraverseOptions {
         check("up", self.up.norm(), up_ok)
     }
 
-    /// The margin of the checks, mm: a sample closer than the clearance plus this is taken
-    /// as blocked (so the sphere tracing advances by at least half of it).
+    /// The height step of the lifted routes above the surfaces' boxes (two of them), mm.
     fn step(&self) -> f64 {
         self.clearance_mm / 8.0
+    }
+
+    /// The margin of the checks, mm: a sample closer than the clearance plus this is taken
+    /// as blocked (so the sphere tracing advances by at least half of it, which bounds its
+    /// work). A sixty-fourth of the clearance: a route that keeps 1.02 times the clearance is
+    /// found, and the claim (the clearance) does not depend on it.
+    fn margin(&self) -> f64 {
+        self.clearance_mm / 64.0
     }
 }
 
@@ -532,6 +688,10 @@ pub enum Route {
     /// Retract, rise along the up direction to the safe plane above every surface, travel in
     /// it, descend, approach.
     SafePlane,
+    /// Retract, rise along the up direction to a clearance above the surfaces whose boxes
+    /// come near the travel (seen along the up direction), travel, descend, approach: lower
+    /// than the safe plane, so often within the axis limits where that is not.
+    Lifted,
 }
 
 impl Route {
@@ -540,6 +700,7 @@ impl Route {
         match self {
             Route::Straight => "straight",
             Route::SafePlane => "safe_plane",
+            Route::Lifted => "lifted",
         }
     }
 }
@@ -698,6 +859,24 @@ pub fn plan_traverse_within(
     opts: &TraverseOptions,
     reachable: &dyn Fn(&[PoseArray]) -> bool,
 ) -> Result<Traverse> {
+    plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(())).map(|(t, ())| t)
+}
+
+/// Why a route was refused by the caller's own check (e.g. the machine's rapid swing): the
+/// first offending point and its distance, mm.
+pub(crate) type Refusal = (Point3<f64>, f64);
+
+/// [`plan_traverse_within`], where a route that is clear is also handed to `accept` (e.g.
+/// the check of the machine's own rapid moves); the first route both accept is returned with
+/// `accept`'s result, the next shortest tried otherwise.
+pub(crate) fn plan_traverse_accepting<T>(
+    obs: &Obstacles,
+    from: &PoseArray,
+    to: &PoseArray,
+    opts: &TraverseOptions,
+    reachable: &dyn Fn(&[PoseArray]) -> bool,
+    accept: &mut dyn FnMut(&Traverse) -> std::result::Result<T, Refusal>,
+) -> Result<(Traverse, T)> {
     opts.validate()?;
     for (name, p) in [("from", from), ("to", to)] {
         let axis_ok = normal(p).norm() > 1e-9;
@@ -710,6 +889,7 @@ pub fn plan_traverse_within(
     }
     let c = opts.clearance_mm;
     let h = opts.step();
+    let floor = opts.margin();
     let up = opts.up.normalize();
     let unit = |p: &PoseArray| {
         let n = normal(p).normalize();
@@ -722,10 +902,9 @@ pub fn plan_traverse_within(
         let (q, n) = (position(p), normal(p));
         let low = with_axis(q + n * (0.75 * c), n);
         let high = with_axis(q + n * height, n);
-        certify(obs, &low, &high, 0.5 * c, 0.0, h)?;
+        certify(obs, &low, &high, 0.5 * c, 0.0, floor)?;
         Ok(high)
     };
-    let mut blocked: Option<Blocked> = None;
     let length_of = |way: &[PoseArray]| {
         let mut pts = vec![position(&from)];
         pts.extend(way.iter().map(position));
@@ -735,85 +914,212 @@ pub fn plan_traverse_within(
     let tip_ends = |w: &[PoseArray]| -> std::result::Result<f64, Blocked> {
         let mut least = f64::INFINITY;
         for s in w.windows(2) {
-            least = least.min(certify(obs, &s[0], &s[1], c, opts.nozzle_mm, h)?);
+            least = least.min(certify(obs, &s[0], &s[1], c, opts.nozzle_mm, floor)?);
         }
         Ok(least)
+    };
+    let blocked_err = |b: Blocked, why: String| {
+        ProcessError::TraverseBlocked(Box::new(crate::Blockage {
+            from: [from[0], from[1], from[2]],
+            to: [to[0], to[1], to[2]],
+            at: [b.at.x, b.at.y, b.at.z],
+            distance_mm: b.distance,
+            clearance_mm: c,
+            why,
+        }))
     };
     // The retract heights tried at each end (doubling), those whose axial move is clear.
     let heights: Vec<f64> = (0..5)
         .map(|k| opts.retract_mm * f64::from(1 << k))
         .collect();
-    let mut ends = |p: &PoseArray| -> Vec<PoseArray> {
-        heights
+    let ends = |p: &PoseArray| -> std::result::Result<Vec<PoseArray>, Blocked> {
+        let mut last = None;
+        let ok: Vec<PoseArray> = heights
             .iter()
             .filter_map(|&hh| match axial(p, hh) {
                 Ok(q) => Some(q),
                 Err(e) => {
-                    blocked = Some(e);
+                    last = Some(e);
                     None
                 }
             })
-            .collect()
+            .collect();
+        match (ok.is_empty(), last) {
+            (true, Some(e)) => Err(e),
+            _ => Ok(ok),
+        }
     };
-    let (ends_a, ends_b) = (ends(&from), ends(&to));
-    // Every route: straight between any two retract points, or over the safe plane above
-    // every surface (risen along `up` from them); checked shortest first.
+    let top = heights[heights.len() - 1];
+    let ends_a = ends(&from).map_err(|b| {
+        blocked_err(
+            b,
+            format!(
+                "the retract along the tool axis from the exit is blocked at every height from {:.1} to {top:.1} mm",
+                heights[0]
+            ),
+        )
+    })?;
+    let ends_b = ends(&to).map_err(|b| {
+        blocked_err(
+            b,
+            format!(
+                "the approach along the tool axis to the pierce is blocked at every height from {:.1} to {top:.1} mm",
+                heights[0]
+            ),
+        )
+    })?;
+    // Every route: straight between any two retract points, lifted along `up` over the
+    // surfaces near the travel, or over the safe plane above every surface; checked shortest
+    // first.
     let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::new();
-    let lift = obs.bounding_box().map(|(lo, hi)| {
-        let top = (0..8)
-            .map(|k| {
-                let corner = Point3::new(
-                    if k & 1 == 0 { lo.x } else { hi.x },
-                    if k & 2 == 0 { lo.y } else { hi.y },
-                    if k & 4 == 0 { lo.z } else { hi.z },
-                );
-                corner.coords.dot(&up)
-            })
-            .fold(f64::NEG_INFINITY, f64::max)
-            + c
-            + 2.0 * h;
+    let lift_to = |level: f64| {
         move |p: &PoseArray| {
             let q = position(p);
-            let rise = (top - q.coords.dot(&up)).max(0.0);
+            let rise = (level - q.coords.dot(&up)).max(0.0);
             with_axis(q + up * rise, normal(p))
         }
-    });
+    };
+    let global_top = obs
+        .bounding_box()
+        .map(|(lo, hi)| top_along(&lo, &hi, &up) + c + 2.0 * h);
     for a in &ends_a {
         for b in &ends_b {
             let straight = vec![*a, *b];
             routes.push((length_of(&straight), Route::Straight, straight));
-            if let Some(lift) = &lift {
-                let plane = vec![*a, lift(a), lift(b), *b];
-                routes.push((length_of(&plane), Route::SafePlane, plane));
+            let (pa, pb) = (position(a), position(b));
+            // Each lift at a clearance and two steps above the boxes' top, and a clearance
+            // higher (where a tilted nozzle reaches down past the first).
+            let local = obs.local_top(&pa, &pb, &up, 2.0 * c + opts.nozzle_mm + 4.0 * h);
+            for extra in [0.0, c + 2.0 * h] {
+                if let Some(level) = local {
+                    let lift = lift_to(level + c + 2.0 * h + extra);
+                    let way = vec![*a, lift(a), lift(b), *b];
+                    routes.push((length_of(&way), Route::Lifted, way));
+                }
+                if let Some(level) = global_top {
+                    let lift = lift_to(level + extra);
+                    let plane = vec![*a, lift(a), lift(b), *b];
+                    routes.push((length_of(&plane), Route::SafePlane, plane));
+                }
             }
         }
     }
     routes.sort_by(|x, y| x.0.total_cmp(&y.0));
-    for (length_mm, route, waypoints) in routes {
-        if !reachable(&waypoints) {
+    let (mut unreachable, mut refused) = (0usize, 0usize);
+    let mut blocked: Option<Blocked> = None;
+    for (length_mm, route, waypoints) in &routes {
+        if !reachable(waypoints) {
+            unreachable += 1;
             continue;
         }
-        match tip_ends(&waypoints) {
+        match tip_ends(waypoints) {
             Ok(least) => {
-                return Ok(Traverse {
-                    length_mm,
-                    waypoints,
-                    route,
+                let t = Traverse {
+                    length_mm: *length_mm,
+                    waypoints: waypoints.clone(),
+                    route: *route,
                     min_distance_mm: least,
-                })
+                };
+                match accept(&t) {
+                    Ok(v) => return Ok((t, v)),
+                    Err((at, distance)) => {
+                        refused += 1;
+                        blocked = Some(Blocked { at, distance });
+                    }
+                }
             }
             Err(e) => blocked = Some(e),
         }
     }
+    let n = routes.len();
+    let why = if unreachable == n {
+        format!("none of the {n} routes lies within the machine's axis limits")
+    } else {
+        format!(
+            "{} of {n} routes come too close, {refused} of them only in the machine's rapid swing, {unreachable} leave the axis limits",
+            n - unreachable
+        )
+    };
     let b = blocked.unwrap_or(Blocked {
         at: position(&from),
         distance: 0.0,
     });
-    Err(ProcessError::TraverseBlocked {
-        from: [from[0], from[1], from[2]],
-        to: [to[0], to[1], to[2]],
-        at: [b.at.x, b.at.y, b.at.z],
-        distance_mm: b.distance,
-        clearance_mm: c,
-    })
+    Err(blocked_err(b, why))
+}
+
+/// The largest coordinate along `up` of the box `lo hi`, mm.
+fn top_along(lo: &Point3<f64>, hi: &Point3<f64>, up: &Vector3<f64>) -> f64 {
+    (0..8)
+        .map(|k| {
+            let corner = Point3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            corner.coords.dot(up)
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The proven lower bound never exceeds the exact distance (a sphere and a cylinder,
+    /// distances known in closed form), and the far skip returns it only above the limit.
+    #[test]
+    fn the_piece_boxes_bound_the_exact_distance_from_below() {
+        let c = Point3::new(10.0, -5.0, 3.0);
+        let sphere = NurbsSurface::sphere(c, 40.0).unwrap();
+        let cyl =
+            NurbsSurface::cylinder(Point3::new(0.0, 0.0, 0.0), Vector3::z(), 25.0, 60.0).unwrap();
+        let exact_sphere = |p: &Point3<f64>| ((p - c).norm() - 40.0).abs();
+        let exact_cyl = |p: &Point3<f64>| {
+            let r = (p.x * p.x + p.y * p.y).sqrt();
+            let dz = if p.z < 0.0 {
+                -p.z
+            } else if p.z > 60.0 {
+                p.z - 60.0
+            } else {
+                0.0
+            };
+            if dz == 0.0 {
+                (r - 25.0).abs()
+            } else {
+                ((r - 25.0).powi(2) + dz * dz).sqrt()
+            }
+        };
+        let ts = Tessellated::new(sphere);
+        let tc = Tessellated::new(cyl);
+        let mut worst_gap = 0.0_f64;
+        let mut k = 0u32;
+        for i in 0..12 {
+            for j in 0..12 {
+                for r in [0.0, 5.0, 20.0, 39.0, 41.0, 45.0, 60.0, 120.0] {
+                    let (th, ph) = (0.52 * f64::from(i), 0.26 * f64::from(j) - 1.5);
+                    let dir = Vector3::new(ph.cos() * th.cos(), ph.cos() * th.sin(), ph.sin());
+                    let p = c + dir * r;
+                    let lb = ts.lower_bound(&p, f64::INFINITY);
+                    assert!(lb <= exact_sphere(&p) + 1e-9, "sphere at {p}: {lb}");
+                    worst_gap = worst_gap.max(exact_sphere(&p) - lb);
+                    let q = Point3::new(p.x - 10.0, p.y + 5.0, p.z + 27.0);
+                    let lb = tc.lower_bound(&q, f64::INFINITY);
+                    assert!(lb <= exact_cyl(&q) + 1e-9, "cylinder at {q}: {lb}");
+                    // The skip: at or above the limit only if the exact distance is too.
+                    for limit in [1.0, 5.0, 12.5] {
+                        let d = tc.distance(&q, limit);
+                        if d >= limit {
+                            assert!(exact_cyl(&q) >= limit - 1e-9, "{q}: {d} {limit}");
+                        } else {
+                            assert!((d - exact_cyl(&q)).abs() < 1e-6, "{q}: {d}");
+                        }
+                    }
+                    k += 1;
+                }
+            }
+        }
+        assert_eq!(k, 12 * 12 * 8);
+        // Tight enough to skip: within a piece's size (the sphere's 1/12-domain cells).
+        assert!(worst_gap < 20.0, "{worst_gap}");
+    }
 }

@@ -109,7 +109,11 @@ fn the_straight_traverse_over_an_arch_cuts_through_it_and_the_planned_one_clears
         "the straight retract-to-retract move runs through the arch"
     );
     let t = plan_traverse(&obs, &from, &to, &opts).expect("a clear route");
-    assert_eq!(t.route, Route::SafePlane, "the arch is in the way");
+    assert!(
+        matches!(t.route, Route::SafePlane | Route::Lifted),
+        "the arch is in the way: {:?}",
+        t.route
+    );
     let exact = dense_min(&t.waypoints, opts.nozzle_mm);
     assert!(
         exact >= opts.clearance_mm - 1e-9,
@@ -209,7 +213,11 @@ fn a_mesh_half_cylinder_is_checked_like_the_nurbs_one() {
     obs.add_mesh(vertices, triangles).expect("valid mesh");
     let opts = TraverseOptions::default();
     let t = plan_traverse(&obs, &on_arch(15.0, 40.0), &on_arch(165.0, 40.0), &opts).expect("clear");
-    assert_eq!(t.route, Route::SafePlane, "the arch is in the way");
+    assert!(
+        matches!(t.route, Route::SafePlane | Route::Lifted),
+        "the arch is in the way: {:?}",
+        t.route
+    );
     let exact = dense_min(&t.waypoints, opts.nozzle_mm);
     assert!(
         exact >= opts.clearance_mm - sag - 1e-9,
@@ -225,7 +233,7 @@ fn a_head_under_a_roof_it_cannot_leave_is_refused_with_the_place() {
     let opts = TraverseOptions::default();
     let inside = [0.0, 40.0, R - 6.0, 0.0, 0.0, 1.0];
     let e = plan_traverse(&obs, &inside, &on_arch(90.0, 40.0), &opts).unwrap_err();
-    assert!(matches!(e, ProcessError::TraverseBlocked { .. }), "{e}");
+    assert!(matches!(e, ProcessError::TraverseBlocked(..)), "{e}");
     assert!(
         e.to_string().contains("no route keeps the 5 mm clearance"),
         "{e}"

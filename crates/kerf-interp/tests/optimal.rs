@@ -7,40 +7,9 @@
 
 mod common;
 
-use common::{circle, stations};
-use kerf_interp::{fit_blocks, plan, AxisModel, FitOptions, PaperAcHead, PlanOptions, Station};
+use common::{circle, gantry, one_line_per_pose, ratios, stations};
+use kerf_interp::{fit_blocks, plan, FitOptions, PaperAcHead, PlanOptions, Station};
 use nalgebra::{Point3, Vector3};
-
-/// Largest ratio of finite-difference velocity, acceleration and jerk to the limits over every
-/// cycle, at rest before the first and after the last row.
-fn ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> [f64; 3] {
-    let lim = m.limits();
-    let n = rows.len() as isize;
-    let at = |i: isize| rows[i.clamp(0, n - 1) as usize];
-    let mut r = [0.0f64; 3];
-    for i in -2..=n + 2 {
-        for k in 0..5 {
-            let v = (at(i)[k] - at(i - 1)[k]) / t;
-            let a = (at(i + 1)[k] - 2.0 * at(i)[k] + at(i - 1)[k]) / (t * t);
-            let j =
-                (at(i + 1)[k] - 3.0 * at(i)[k] + 3.0 * at(i - 1)[k] - at(i - 2)[k]) / (t * t * t);
-            r[0] = r[0].max(v.abs() / lim.max_velocity[k]);
-            r[1] = r[1].max(a.abs() / lim.max_acceleration[k]);
-            if let Some(jm) = lim.max_jerk {
-                r[2] = r[2].max(j.abs() / jm[k]);
-            }
-        }
-    }
-    r
-}
-
-/// The large gantry of `fixtures/machines/gantry_ac.json`: 6 m/s^2 on X and Y, 40 m/min.
-fn gantry() -> PaperAcHead {
-    let mut m = PaperAcHead::paper_000();
-    m.limits.max_velocity = [40000.0 / 60.0, 40000.0 / 60.0, 20000.0 / 60.0, 600.0, 600.0];
-    m.limits.max_acceleration = [6000.0, 6000.0, 5000.0, 20000.0, 20000.0];
-    m
-}
 
 /// Dense phase-plane reference for a full circle of radius `r` in the XY plane traversed
 /// from rest to rest, each of X and Y limited to `vmax` and `amax`, tip speed to `feed`.
@@ -343,18 +312,7 @@ fn the_smooth_path_stays_on_the_curve() {
         ("hole", circle(5.0, 0.0, 0.0, 0.0), 0.002),
     ] {
         let st = stations(&m, &c, 0.01, vertical);
-        let lines = fit_blocks(
-            &m,
-            &st,
-            None,
-            0,
-            &FitOptions {
-                arcs: false,
-                merge_lines: false,
-                ..FitOptions::default()
-            },
-        )
-        .expect("lines");
+        let lines = one_line_per_pose(&m, &st);
         let motion = plan(&m, &lines, &PlanOptions::new(6000.0, 0.001)).expect("plan");
         let mut worst = 0.0f64;
         for q in motion.iter(&m) {
@@ -376,18 +334,7 @@ fn a_hole_too_small_for_the_feed_gets_one_lower_modal_f_word() {
     let m = gantry();
     let c = circle(5.0, 0.0, 0.0, 0.0);
     let st = stations(&m, &c, 0.01, vertical);
-    let lines = fit_blocks(
-        &m,
-        &st,
-        None,
-        0,
-        &FitOptions {
-            arcs: false,
-            merge_lines: false,
-            ..FitOptions::default()
-        },
-    )
-    .expect("lines");
+    let lines = one_line_per_pose(&m, &st);
     let motion = plan(&m, &lines, &PlanOptions::new(20000.0, 0.001)).expect("plan");
     let feeds = motion.block_feeds();
     let first = feeds[0];

@@ -173,6 +173,55 @@ fn the_70_mm_hole_runs_at_the_programmed_feed_with_one_modal_f_word() {
     assert!((st.length_at_feed / st.cutting_length - share).abs() < 0.01);
 }
 
+#[test]
+fn the_70_mm_hole_cut_one_line_per_chord_keeps_the_feed() {
+    // The generic dialect's program: one line per chord. The discretizer ends each span of the
+    // circle with a short chord between full ones (more than 4 times shorter); graded as if
+    // the long chords were straight edges, the spline kinked there and the hole fell to 70 %
+    // at feed. Truth: the set-points' own speeds (tool vertical: the tip moves as X, Y do).
+    let c = circle(35.0, 0.0, 0.0, 0.0);
+    let feed = 20000.0;
+    for (name, m) in [
+        ("acceleration", gantry()),
+        ("jerk", common::gantry_with_jerk()),
+    ] {
+        let st = stations(&m, &c, 0.01, vertical);
+        let len = |i: usize| (st[i + 1].tip - st[i].tip).norm();
+        let jumps = (1..st.len() - 1)
+            .filter(|&i| len(i) > 4.0 * len(i - 1) || len(i - 1) > 4.0 * len(i))
+            .count();
+        assert!(
+            jumps > 0,
+            "the case under test: chord lengths jumping 4 times"
+        );
+        let motion = plan(
+            &m,
+            &one_line_per_pose(&m, &st),
+            &PlanOptions::new(feed, 0.001),
+        )
+        .expect("plan");
+        let rows = motion.setpoints(&m);
+        let (mut total, mut at_feed) = (0.0, 0.0);
+        for w in rows.windows(2) {
+            let step = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
+            total += step;
+            if step / 0.001 >= feed / 60.0 * 0.999 {
+                at_feed += step;
+            }
+        }
+        let share = at_feed / total;
+        println!(
+            "{name}: {jumps} chord jumps, {:.1} % at feed",
+            100.0 * share
+        );
+        assert!(share >= 0.90, "{name}: {share}");
+        assert!(
+            ratios(&m, &rows, 0.001).iter().all(|&r| r <= 1.0),
+            "{name}: limits"
+        );
+    }
+}
+
 fn line_stations(m: &PaperAcHead, len: f64) -> Vec<Station> {
     let tips: Vec<Point3<f64>> = (0..=100)
         .map(|i| Point3::new(len * i as f64 / 100.0 - 0.5 * len, 20.0, 0.0))

@@ -262,6 +262,45 @@ fn a_straight_line_is_the_analytic_trapezoid_and_s_curve() {
 }
 
 #[test]
+fn a_short_line_takes_its_acceleration_reversal_within_the_jerk() {
+    // 20 mm along X on the gantry at 40 m/min: too short to reach the feed, so the
+    // acceleration-limited optimum is a triangle (+A, then at once -A). The jerk-optimal
+    // rest-to-rest motion (7-phase S-curve without cruise, A reached since L > 2 A^3 / J^2)
+    // takes T = 2 (2 T_j + T_a) with T_j = A / J and A (T_j + T_a)(2 T_j + T_a) = L. The plan
+    // must not beat it (that would be a limit violation) and the reversal must not need the
+    // verification's refinements (the filter alone would take it at 160 % of the jerk; the
+    // plateau at the peak keeps it within).
+    let m = common::gantry_with_jerk();
+    let len = 20.0;
+    let blocks =
+        fit_blocks(&m, &line_stations(&m, len), None, 0, &FitOptions::default()).expect("fit");
+    let (a, j) = (
+        m.limits.max_acceleration[0],
+        m.limits.max_jerk.expect("jerk")[0],
+    );
+    let tj = a / j;
+    // (tj + ta)(2 tj + ta) = len / a: ta^2 + 3 tj ta + 2 tj^2 - len / a = 0.
+    let ta = 0.5 * (-3.0 * tj + (tj * tj + 4.0 * len / a).sqrt());
+    let optimum = 2.0 * (2.0 * tj + ta);
+    let motion = plan(&m, &blocks, &PlanOptions::new(40000.0, 0.001)).expect("plan");
+    let r = ratios(&m, &motion.setpoints(&m), 0.001);
+    let ratio = motion.duration() / optimum;
+    println!(
+        "20 mm line with jerk: {:.5} s against the jerk-optimal {optimum:.5} s ({ratio:.4} x), \
+         {} refinements, limits {r:?}",
+        motion.duration(),
+        motion.refinements()
+    );
+    assert!(
+        ratio >= 0.999,
+        "faster than the jerk-limited optimum: {ratio}"
+    );
+    assert!(ratio <= 1.05, "{ratio}");
+    assert_eq!(motion.refinements(), 0, "the reversal needed refinements");
+    assert!(r.iter().all(|&x| x <= 1.0), "limits {r:?}");
+}
+
+#[test]
 fn jerk_limited_plans_stay_within_every_limit_and_near_the_optimum() {
     // Circles of 70 and 10 mm and a free-form curve with a varying tool axis, with the jerk
     // limits of fixtures/machines/ac_head.json (10 ms jerk time, 1000 m/s^3 on X and Y): every

@@ -17,7 +17,10 @@
 //!    `tau = JERK_FILTER_WIDTH max_k A_k / J_k` (an S-curve: the path jerk is the difference of
 //!    two accelerations over `tau`), after the maximum velocity curve was lowered to its minimum
 //!    over the filter's reach (measured with the speed of the unfiltered optimum) so that the
-//!    averaged speed stays under it; the run takes `tau` longer.
+//!    averaged speed stays under it; the run takes `tau` longer. Where the profile accelerates
+//!    and at once brakes (a triangle), its peak is capped to a plateau of one filter width, so
+//!    that no window of the filter sees the whole reversal of the acceleration (which would
+//!    take 160 % of the jerk).
 //! 4. The set-points are the plan sampled every cycle `T`. The plan is then **verified the way a
 //!    test would**: velocities `(q_i - q_{i-1}) / T`, accelerations
 //!    `(q_{i+1} - 2 q_i + q_{i-1}) / T^2` and jerks `(q_{i+1} - 3 q_i + 3 q_{i-1} - q_{i-2}) / T^3`

@@ -3,43 +3,11 @@
 //! geometry (the distance of a point from a stadium is `| dist(p, centre segment) - R |`), the
 //! axis ranges, and the set-points' own finite differences against every limit.
 
-use kerf_interp::{
-    fit_blocks, plan, solve_stations, AxisModel, FitOptions, InterpError, PaperAcHead, PlanOptions,
-};
+mod common;
+
+use common::{gantry_with_jerk as gantry, one_line_per_pose, ratios};
+use kerf_interp::{fit_blocks, plan, solve_stations, FitOptions, InterpError, PlanOptions};
 use nalgebra::{Point3, Vector3};
-
-/// Largest ratio of finite-difference velocity, acceleration and jerk to the limits over every
-/// cycle, at rest before the first and after the last row.
-fn ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> [f64; 3] {
-    let lim = m.limits();
-    let n = rows.len() as isize;
-    let at = |i: isize| rows[i.clamp(0, n - 1) as usize];
-    let mut r = [0.0f64; 3];
-    for i in -2..=n + 2 {
-        for k in 0..5 {
-            let v = (at(i)[k] - at(i - 1)[k]) / t;
-            let a = (at(i + 1)[k] - 2.0 * at(i)[k] + at(i - 1)[k]) / (t * t);
-            let j =
-                (at(i + 1)[k] - 3.0 * at(i)[k] + 3.0 * at(i - 1)[k] - at(i - 2)[k]) / (t * t * t);
-            r[0] = r[0].max(v.abs() / lim.max_velocity[k]);
-            r[1] = r[1].max(a.abs() / lim.max_acceleration[k]);
-            if let Some(jm) = lim.max_jerk {
-                r[2] = r[2].max(j.abs() / jm[k]);
-            }
-        }
-    }
-    r
-}
-
-/// The large gantry of `fixtures/machines/gantry_ac.json`, with its shipped jerk limits
-/// (10 ms jerk time: 600 m/s^3 on X and Y).
-fn gantry() -> PaperAcHead {
-    let mut m = PaperAcHead::paper_000();
-    m.limits.max_velocity = [40000.0 / 60.0, 40000.0 / 60.0, 20000.0 / 60.0, 600.0, 600.0];
-    m.limits.max_acceleration = [6000.0, 6000.0, 5000.0, 20000.0, 20000.0];
-    m.limits.max_jerk = Some([600_000.0, 600_000.0, 500_000.0, 2_000_000.0, 2_000_000.0]);
-    m
-}
 
 /// A 60 x 12 slot (the stadium of centres (+-24, 0), radius 6) from (-24, -6), counter-clockwise:
 /// points every 1 mm on the lines and every 2 degrees on the half circles.
@@ -159,16 +127,7 @@ fn a_pose_exactly_on_the_tilt_limit_is_reached_and_never_passed() {
             .expect("stations");
         let range = [-peak.abs(), peak.abs()];
         m.limits.range[3] = Some(range);
-        let blocks = fit_blocks(
-            &m,
-            &st,
-            None,
-            0,
-            &FitOptions::default()
-                .with_arcs(false)
-                .with_merge_lines(false),
-        )
-        .expect("fit");
+        let blocks = one_line_per_pose(&m, &st);
         for feed in [6000.0, 20000.0] {
             let motion = plan(&m, &blocks, &PlanOptions::new(feed, 0.001)).expect("planned");
             let rows = motion.setpoints(&m);
@@ -223,16 +182,7 @@ fn a_long_edge_between_two_corners_stays_straight() {
         Point3::new(-235.0, 40.0, 0.0),
     ];
     let st = solve_stations(&m, &tips, None, None, None).expect("reachable");
-    let blocks = fit_blocks(
-        &m,
-        &st,
-        None,
-        0,
-        &FitOptions::default()
-            .with_arcs(false)
-            .with_merge_lines(false),
-    )
-    .expect("fit");
+    let blocks = one_line_per_pose(&m, &st);
     for jerk in [true, false] {
         if !jerk {
             m.limits.max_jerk = None;
@@ -277,16 +227,7 @@ fn long_edges_between_fine_corners_do_not_make_the_spline_ring() {
         }
     }
     let st = solve_stations(&m, &tips, None, None, None).expect("reachable");
-    let blocks = fit_blocks(
-        &m,
-        &st,
-        None,
-        0,
-        &FitOptions::default()
-            .with_arcs(false)
-            .with_merge_lines(false),
-    )
-    .expect("fit");
+    let blocks = one_line_per_pose(&m, &st);
     for jerk in [false, true] {
         if !jerk {
             m.limits.max_jerk = None;

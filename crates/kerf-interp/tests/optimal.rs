@@ -7,40 +7,9 @@
 
 mod common;
 
-use common::{circle, stations};
-use kerf_interp::{fit_blocks, plan, AxisModel, FitOptions, PaperAcHead, PlanOptions, Station};
+use common::{circle, gantry, one_line_per_pose, ratios, stations};
+use kerf_interp::{fit_blocks, plan, FitOptions, PaperAcHead, PlanOptions, Station};
 use nalgebra::{Point3, Vector3};
-
-/// Largest ratio of finite-difference velocity, acceleration and jerk to the limits over every
-/// cycle, at rest before the first and after the last row.
-fn ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> [f64; 3] {
-    let lim = m.limits();
-    let n = rows.len() as isize;
-    let at = |i: isize| rows[i.clamp(0, n - 1) as usize];
-    let mut r = [0.0f64; 3];
-    for i in -2..=n + 2 {
-        for k in 0..5 {
-            let v = (at(i)[k] - at(i - 1)[k]) / t;
-            let a = (at(i + 1)[k] - 2.0 * at(i)[k] + at(i - 1)[k]) / (t * t);
-            let j =
-                (at(i + 1)[k] - 3.0 * at(i)[k] + 3.0 * at(i - 1)[k] - at(i - 2)[k]) / (t * t * t);
-            r[0] = r[0].max(v.abs() / lim.max_velocity[k]);
-            r[1] = r[1].max(a.abs() / lim.max_acceleration[k]);
-            if let Some(jm) = lim.max_jerk {
-                r[2] = r[2].max(j.abs() / jm[k]);
-            }
-        }
-    }
-    r
-}
-
-/// The large gantry of `fixtures/machines/gantry_ac.json`: 6 m/s^2 on X and Y, 40 m/min.
-fn gantry() -> PaperAcHead {
-    let mut m = PaperAcHead::paper_000();
-    m.limits.max_velocity = [40000.0 / 60.0, 40000.0 / 60.0, 20000.0 / 60.0, 600.0, 600.0];
-    m.limits.max_acceleration = [6000.0, 6000.0, 5000.0, 20000.0, 20000.0];
-    m
-}
 
 /// Dense phase-plane reference for a full circle of radius `r` in the XY plane traversed
 /// from rest to rest, each of X and Y limited to `vmax` and `amax`, tip speed to `feed`.
@@ -165,6 +134,21 @@ fn circles_plan_within_five_percent_of_the_dense_reference() {
     }
 }
 
+/// Share of the length at the programmed feed `feed` (mm/min, within 0.1 %) from set-points
+/// alone, cycle `t`; the tool vertical and the path in a plane of constant Z, so the tip moves
+/// as X and Y do.
+fn share_at_feed(rows: &[[f64; 5]], feed: f64, t: f64) -> f64 {
+    let (mut total, mut at_feed) = (0.0, 0.0);
+    for w in rows.windows(2) {
+        let step = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
+        total += step;
+        if step / t >= feed / 60.0 * 0.999 {
+            at_feed += step;
+        }
+    }
+    at_feed / total
+}
+
 #[test]
 fn the_70_mm_hole_runs_at_the_programmed_feed_with_one_modal_f_word() {
     let m = gantry();
@@ -180,16 +164,7 @@ fn the_70_mm_hole_runs_at_the_programmed_feed_with_one_modal_f_word() {
     }
     // Share of the length at the programmed feed, from the set-points alone (tool vertical:
     // the tip moves as X, Y, Z do).
-    let rows = motion.setpoints(&m);
-    let (mut total, mut at_feed) = (0.0, 0.0);
-    for w in rows.windows(2) {
-        let step = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
-        total += step;
-        if step / 0.001 >= feed / 60.0 * 0.999 {
-            at_feed += step;
-        }
-    }
-    let share = at_feed / total;
+    let share = share_at_feed(&motion.setpoints(&m), feed, 0.001);
     let st = &motion.path_stats()[0];
     println!(
         "70 mm hole at 20 m/min: {:.3} s, {:.1} % of the length at feed (planner says {:.1} %)",
@@ -199,6 +174,47 @@ fn the_70_mm_hole_runs_at_the_programmed_feed_with_one_modal_f_word() {
     );
     assert!(share >= 0.90, "{share}");
     assert!((st.length_at_feed / st.cutting_length - share).abs() < 0.01);
+}
+
+#[test]
+fn the_70_mm_hole_cut_one_line_per_chord_keeps_the_feed() {
+    // The generic dialect's program: one line per chord. The discretizer ends each span of the
+    // circle with a short chord between full ones (more than 4 times shorter); graded as if
+    // the long chords were straight edges, the spline kinked there and the hole fell to 70 %
+    // at feed. Truth: the set-points' own speeds (tool vertical: the tip moves as X, Y do).
+    let c = circle(35.0, 0.0, 0.0, 0.0);
+    let feed = 20000.0;
+    for (name, m) in [
+        ("acceleration", gantry()),
+        ("jerk", common::gantry_with_jerk()),
+    ] {
+        let st = stations(&m, &c, 0.01, vertical);
+        let len = |i: usize| (st[i + 1].tip - st[i].tip).norm();
+        let jumps = (1..st.len() - 1)
+            .filter(|&i| len(i) > 4.0 * len(i - 1) || len(i - 1) > 4.0 * len(i))
+            .count();
+        assert!(
+            jumps > 0,
+            "the case under test: chord lengths jumping 4 times"
+        );
+        let motion = plan(
+            &m,
+            &one_line_per_pose(&m, &st),
+            &PlanOptions::new(feed, 0.001),
+        )
+        .expect("plan");
+        let rows = motion.setpoints(&m);
+        let share = share_at_feed(&rows, feed, 0.001);
+        println!(
+            "{name}: {jumps} chord jumps, {:.1} % at feed",
+            100.0 * share
+        );
+        assert!(share >= 0.90, "{name}: {share}");
+        assert!(
+            ratios(&m, &rows, 0.001).iter().all(|&r| r <= 1.0),
+            "{name}: limits"
+        );
+    }
 }
 
 fn line_stations(m: &PaperAcHead, len: f64) -> Vec<Station> {
@@ -237,6 +253,45 @@ fn a_straight_line_is_the_analytic_trapezoid_and_s_curve() {
         jerked.duration()
     );
     assert!((0.999..=1.011).contains(&ratio), "S-curve: {ratio}");
+    assert!(r.iter().all(|&x| x <= 1.0), "limits {r:?}");
+}
+
+#[test]
+fn a_short_line_takes_its_acceleration_reversal_within_the_jerk() {
+    // 20 mm along X on the gantry at 40 m/min: too short to reach the feed, so the
+    // acceleration-limited optimum is a triangle (+A, then at once -A). The jerk-optimal
+    // rest-to-rest motion (7-phase S-curve without cruise, A reached since L > 2 A^3 / J^2)
+    // takes T = 2 (2 T_j + T_a) with T_j = A / J and A (T_j + T_a)(2 T_j + T_a) = L. The plan
+    // must not beat it (that would be a limit violation) and the reversal must not need the
+    // verification's refinements (the filter alone would take it at 160 % of the jerk; the
+    // plateau at the peak keeps it within).
+    let m = common::gantry_with_jerk();
+    let len = 20.0;
+    let blocks =
+        fit_blocks(&m, &line_stations(&m, len), None, 0, &FitOptions::default()).expect("fit");
+    let (a, j) = (
+        m.limits.max_acceleration[0],
+        m.limits.max_jerk.expect("jerk")[0],
+    );
+    let tj = a / j;
+    // (tj + ta)(2 tj + ta) = len / a: ta^2 + 3 tj ta + 2 tj^2 - len / a = 0.
+    let ta = 0.5 * (-3.0 * tj + (tj * tj + 4.0 * len / a).sqrt());
+    let optimum = 2.0 * (2.0 * tj + ta);
+    let motion = plan(&m, &blocks, &PlanOptions::new(40000.0, 0.001)).expect("plan");
+    let r = ratios(&m, &motion.setpoints(&m), 0.001);
+    let ratio = motion.duration() / optimum;
+    println!(
+        "20 mm line with jerk: {:.5} s against the jerk-optimal {optimum:.5} s ({ratio:.4} x), \
+         {} refinements, limits {r:?}",
+        motion.duration(),
+        motion.refinements()
+    );
+    assert!(
+        ratio >= 0.999,
+        "faster than the jerk-limited optimum: {ratio}"
+    );
+    assert!(ratio <= 1.05, "{ratio}");
+    assert_eq!(motion.refinements(), 0, "the reversal needed refinements");
     assert!(r.iter().all(|&x| x <= 1.0), "limits {r:?}");
 }
 
@@ -340,16 +395,7 @@ fn the_smooth_path_stays_on_the_curve() {
         ("hole", circle(5.0, 0.0, 0.0, 0.0), 0.002),
     ] {
         let st = stations(&m, &c, 0.01, vertical);
-        let lines = fit_blocks(
-            &m,
-            &st,
-            None,
-            0,
-            &FitOptions::default()
-                .with_arcs(false)
-                .with_merge_lines(false),
-        )
-        .expect("lines");
+        let lines = one_line_per_pose(&m, &st);
         let motion = plan(&m, &lines, &PlanOptions::new(6000.0, 0.001)).expect("plan");
         let mut worst = 0.0f64;
         for q in motion.iter(&m) {
@@ -371,16 +417,7 @@ fn a_hole_too_small_for_the_feed_gets_one_lower_modal_f_word() {
     let m = gantry();
     let c = circle(5.0, 0.0, 0.0, 0.0);
     let st = stations(&m, &c, 0.01, vertical);
-    let lines = fit_blocks(
-        &m,
-        &st,
-        None,
-        0,
-        &FitOptions::default()
-            .with_arcs(false)
-            .with_merge_lines(false),
-    )
-    .expect("lines");
+    let lines = one_line_per_pose(&m, &st);
     let motion = plan(&m, &lines, &PlanOptions::new(20000.0, 0.001)).expect("plan");
     let feeds = motion.block_feeds();
     let first = feeds[0];

@@ -179,8 +179,11 @@ pub struct AutoPlaceOptions {
     pub flip: bool,
     /// Distance kept from every linear limit, mm. Default 1.
     pub margin_mm: f64,
-    /// Distance kept from the tilt axis' limits, degrees (the interpolator's smooth motion
-    /// between poses may swing slightly past a pose that sits on a limit). Default 0.5.
+    /// Distance kept from the tilt axis' limits, degrees. Default 0: the interpolator splines
+    /// the rotary axes in coordinates mapped onto their ranges, so its motion between poses
+    /// never leaves a range even where a pose sits exactly on a limit (kerf-interp
+    /// `tests/jerk.rs`); a margin is only needed for a controller that interpolates past the
+    /// poses itself.
     pub tilt_margin_deg: f64,
     /// The options the paths are solved with (the same as for the final solve).
     pub path_options: PathOptions,
@@ -192,7 +195,7 @@ impl Default for AutoPlaceOptions {
             rotate: true,
             flip: true,
             margin_mm: 1.0,
-            tilt_margin_deg: 0.5,
+            tilt_margin_deg: 0.0,
             path_options: PathOptions::default(),
         }
     }

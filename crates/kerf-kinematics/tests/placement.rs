@@ -194,8 +194,8 @@ fn contours_facing_down_are_cut_from_the_reachable_side() {
     )
     .expect_err("A would need 180 deg");
     assert!(
-        // 180 deg against 135, less the default 0.5 deg tilt margin.
-        matches!(err, KinematicsError::NoPlacement { axis: "A", missing, .. } if (missing - 45.5).abs() < 1e-6),
+        // 180 deg against 135 (the default tilt margin is 0).
+        matches!(err, KinematicsError::NoPlacement { axis: "A", missing, .. } if (missing - 45.0).abs() < 1e-6),
         "{err}"
     );
 }
@@ -213,7 +213,8 @@ fn tilt_out_of_reach_on_both_sides_is_a_named_error() {
     let err = auto_place(&m, &refs, &AutoPlaceOptions::default().with_rotate(false))
         .expect_err("90 deg of tilt on a 30 deg head");
     assert!(
-        matches!(err, KinematicsError::NoPlacement { axis: "A", missing, .. } if (missing - 60.5).abs() < 1e-6),
+        // 90 deg against 30 (the default tilt margin is 0).
+        matches!(err, KinematicsError::NoPlacement { axis: "A", missing, .. } if (missing - 60.0).abs() < 1e-6),
         "{err}"
     );
     // With rotations the wall is laid flat and fits.

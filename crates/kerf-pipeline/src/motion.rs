@@ -103,7 +103,10 @@ pub struct MotionOptions {
     /// Retract between contours along the tool axis, mm. Default 10.
     pub retract_mm: f64,
     /// The controller's blending tolerance, mm. Default
-    /// [`kerf_interp::DEFAULT_BLEND_TOLERANCE`].
+    /// [`kerf_interp::DEFAULT_BLEND_TOLERANCE`]. It is also the planner's
+    /// `PlanOptions::blend_tolerance`: with jerk limits the set-points' tip leaves the smooth
+    /// path by at most this much to blend curvature jumps (reported by
+    /// `Motion::blend_deviation`).
     pub blend_tolerance_mm: f64,
     /// Run the traverse before a path through the waypoints an axes file records for it (its
     /// `traverse` key: checked by `kerf run` to clear the part), as `kerf run`'s own program
@@ -263,6 +266,9 @@ pub fn plan_program(
     };
     let fit_tolerance = options.fit_tolerance_mm.or(file_tol).unwrap_or(0.001);
     let mut plan = PlanOptions::new(options.feed_mm_per_min, options.cycle_s);
+    // One number bounds both blends: the controller's (G64 P, CTOL) and, with jerk limits,
+    // the planner's blend of curvature jumps in the set-points.
+    plan.blend_tolerance = options.blend_tolerance_mm;
     if let Some(c) = options.chord_tolerance_mm {
         plan.chord_tolerance = c;
     }

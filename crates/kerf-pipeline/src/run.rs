@@ -119,7 +119,8 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let dialect = o.dialect;
     // The generic-dialect rule: the fit follows from the dialect, no option can change it.
     let fit = crate::motion::fit_options(dopts.tolerance, Some(dialect), o.retract_mm);
-    let plan = PlanOptions::new(o.feed_mm_per_min, o.cycle_s);
+    let mut plan = PlanOptions::new(o.feed_mm_per_min, o.cycle_s);
+    plan.blend_tolerance = o.blend_tolerance_mm; // the planner's blend and the controller's
     let source_name = path.map(|p| p.display().to_string());
     let gopts = crate::motion::gcode_options(
         &model,

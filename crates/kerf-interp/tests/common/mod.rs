@@ -96,3 +96,49 @@ pub fn limit_ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> (f64, f64, 
     }
     (rv, ra, iv, ia)
 }
+
+/// Largest ratio of finite-difference velocity, acceleration and jerk to the limits over every
+/// cycle, at rest before the first and after the last row.
+pub fn ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> [f64; 3] {
+    let lim = m.limits();
+    let n = rows.len() as isize;
+    let at = |i: isize| rows[i.clamp(0, n - 1) as usize];
+    let mut r = [0.0f64; 3];
+    for i in -2..=n + 2 {
+        for k in 0..5 {
+            let v = (at(i)[k] - at(i - 1)[k]) / t;
+            let a = (at(i + 1)[k] - 2.0 * at(i)[k] + at(i - 1)[k]) / (t * t);
+            let j =
+                (at(i + 1)[k] - 3.0 * at(i)[k] + 3.0 * at(i - 1)[k] - at(i - 2)[k]) / (t * t * t);
+            r[0] = r[0].max(v.abs() / lim.max_velocity[k]);
+            r[1] = r[1].max(a.abs() / lim.max_acceleration[k]);
+            if let Some(jm) = lim.max_jerk {
+                r[2] = r[2].max(j.abs() / jm[k]);
+            }
+        }
+    }
+    r
+}
+
+/// The large gantry of `fixtures/machines/gantry_ac.json`: 6 m/s^2 on X and Y, 40 m/min.
+pub fn gantry() -> PaperAcHead {
+    let mut m = PaperAcHead::paper_000();
+    m.limits.max_velocity = [40000.0 / 60.0, 40000.0 / 60.0, 20000.0 / 60.0, 600.0, 600.0];
+    m.limits.max_acceleration = [6000.0, 6000.0, 5000.0, 20000.0, 20000.0];
+    m
+}
+
+/// [`gantry`] with its shipped jerk limits (10 ms jerk time: 600 m/s^3 on X and Y).
+pub fn gantry_with_jerk() -> PaperAcHead {
+    let mut m = gantry();
+    m.limits.max_jerk = Some([600_000.0, 600_000.0, 500_000.0, 2_000_000.0, 2_000_000.0]);
+    m
+}
+
+/// One line block per pose of `stations` (the generic dialect's fit: no arcs, no merged lines).
+pub fn one_line_per_pose(m: &dyn AxisModel, stations: &[Station]) -> Vec<kerf_interp::Block> {
+    let o = kerf_interp::FitOptions::default()
+        .with_arcs(false)
+        .with_merge_lines(false);
+    kerf_interp::fit_blocks(m, stations, None, 0, &o).expect("one line per pose")
+}

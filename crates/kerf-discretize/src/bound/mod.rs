@@ -1,0 +1,323 @@
+//! The certified chord-error bound.
+//!
+//! For a segment `[t0, t1]` with chord `A = C(t0)`, `B = C(t1)`, the curve between the two is
+//! split into rational Bezier pieces (one per knot span). With positive weights, each piece is a
+//! convex combination of its projected control points, so it lies in their convex hull; the
+//! distance to the segment `AB` is a convex function, so its maximum over the hull is attained
+//! at a control point. Hence `max_j dist(Q_j, AB)` bounds the chord error of that piece from
+//! above. Subdividing a piece (de Casteljau) makes the bound converge to the true maximum; the
+//! curve points found on the way (the pieces' end points) give a lower bound. The search stops
+//! as soon as the bounds decide the question asked. See `docs/discretization.md`.
+
+mod hull;
+mod interpolation;
+mod span;
+mod turn;
+
+use hull::Piece;
+use interpolation::{span_derivative_bounds, SpanBounds};
+use kerf_nurbs::{NurbsCurve, MAX_ORDER};
+use nalgebra::{Point3, Vector3, Vector4};
+
+/// The verdict on one segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bound {
+    /// A certified upper bound of the chord error (includes the floating-point margin), or
+    /// `f64::INFINITY` when the search stopped before it could certify anything below `limit`.
+    pub upper: f64,
+    /// The largest distance from a curve point found during the search to the chord: a lower
+    /// bound of the chord error (up to rounding), and an estimate of it.
+    pub lower: f64,
+}
+
+impl Bound {
+    /// True if the segment is certified to meet `tolerance`.
+    #[inline]
+    pub fn certified(&self, tolerance: f64) -> bool {
+        self.upper <= tolerance
+    }
+}
+
+/// Reusable work space of [`Certifier::chord_error`], so that a walk along a curve allocates once.
+/// Pieces are kept in arrays sized for the degree (4, 8 or `MAX_ORDER` control points), so a
+/// cubic's piece is 128 bytes to copy, not 800.
+#[derive(Debug, Default, Clone)]
+pub struct Scratch {
+    small: Vec<Piece<4>>,
+    medium: Vec<Piece<8>>,
+    large: Vec<Piece<MAX_ORDER>>,
+    /// Homogeneous curve points the interpolation certificate evaluated last (`t`, its span,
+    /// the point): the walk tries several ends from one start, and the end it accepts is the
+    /// next start.
+    ends: Ends,
+}
+
+/// Two remembered homogeneous points of the local frame, by parameter and span.
+type Ends = [Option<(f64, usize, Vector4<f64>)>; 2];
+
+/// Subdivisions of one Bezier piece beyond which it is not refined further: the rounding
+/// margin covers the de Casteljau levels of this many halvings (see [`MARGIN_FACTOR`]).
+pub const MAX_SUBDIVISION_DEPTH: u32 = 48;
+
+/// The margin constant: `MARGIN_FACTOR (p + 1) eps * 2 L` (`L` the span's largest local
+/// coordinate). It covers
+/// the `p` de Boor levels of the Bezier extraction, `p` de Casteljau levels for each of up to
+/// [`MAX_SUBDIVISION_DEPTH`] halvings, the projection and the distance, each one rounding of a
+/// convex combination (`docs/discretization.md`, Step 5).
+pub const MARGIN_FACTOR: f64 = 128.0;
+
+/// The curve prepared for certification: a copy translated to a local origin (so that rounding
+/// is relative to the curve's size, not its distance from the origin) and, per knot span, the
+/// magnitudes that bound the rounding of its Bezier pieces.
+///
+/// The origin `O` is the centre of the control points' box rounded to a multiple of a power of
+/// two `g >= ` the box's extent; then `P_i - O` is exact in floating point (checked for every
+/// coordinate; if any were inexact `O = 0` would be used). Build one per curve and reuse it:
+/// construction costs one pass over the control points.
+#[derive(Debug, Clone)]
+pub struct Certifier<'a> {
+    curve: &'a NurbsCurve,
+    local: NurbsCurve,
+    origin: Vector3<f64>,
+    /// Per knot span index: `L = max_i |P_i - O|_inf` over the span's `p + 1` control points.
+    spans: Vec<f64>,
+    /// Per knot span index `i`: the homogeneous control points of the whole span's Bezier form
+    /// at `span_bezier[i * (p + 1)..(i + 1) * (p + 1)]` (zeros for empty spans). A segment's
+    /// piece in the span is cut from it by two de Casteljau splits (`docs/discretization.md`,
+    /// Step 1), instead of a blossom per trial.
+    span_bezier: Vec<Vector4<f64>>,
+    /// Per knot span index `i`: the third hodograph of the span's homogeneous Bezier form,
+    /// `p (p - 1) (p - 2) Delta^3 Q^w_j` for `j <= p - 3`, at `span_h3[i * (p + 1)..]` (the
+    /// control points of the third derivatives of `(P, w)` in the local parameter).
+    span_h3: Vec<Vector4<f64>>,
+    /// The fourth hodographs likewise (`j <= p - 4`): a bound of how fast the third
+    /// derivative changes, so that the third derivative near a step is bounded from its value
+    /// at the step's middle rather than over the whole span.
+    span_h4: Vec<Vector4<f64>>,
+    /// Per knot span index: the bounds of the interpolation certificate.
+    span_bounds: Vec<SpanBounds>,
+    /// `4 eps max |P_i|` for curves whose weights are not powers of two (the control points are
+    /// recovered from `w P` by one division, within two ulps), else 0.
+    representation: f64,
+}
+
+/// `a - b` and whether it is exact (Knuth's TwoSum error term is zero).
+fn exact_diff(a: f64, b: f64) -> (f64, bool) {
+    let s = a - b;
+    let bb = s - a;
+    let err = (a - (s - bb)) + (-b - bb);
+    (s, err == 0.0)
+}
+
+impl<'a> Certifier<'a> {
+    /// Prepares `curve` for certification.
+    pub fn new(curve: &'a NurbsCurve) -> Self {
+        let (lo, hi) = curve.bounding_box();
+        let extent = (hi - lo).amax();
+        let centre = (lo.coords + hi.coords) * 0.5;
+        let g = if extent > 0.0 && extent.is_finite() {
+            2f64.powi(extent.log2().ceil() as i32)
+        } else {
+            1.0
+        };
+        let mut origin = centre.map(|c| (c / g).round() * g);
+        if !origin.iter().all(|c| c.is_finite()) {
+            origin = Vector3::zeros();
+        }
+        let points = curve.control_points();
+        let weights = curve.weights();
+        let mut shifted = Vec::with_capacity(points.len());
+        let mut exact = true;
+        for p in &points {
+            let mut d = Vector3::zeros();
+            for k in 0..3 {
+                let (v, ok) = exact_diff(p[k], origin[k]);
+                d[k] = v;
+                exact &= ok;
+            }
+            shifted.push(d);
+        }
+        if !exact {
+            origin = Vector3::zeros();
+            shifted = points.iter().map(|p| p.coords).collect();
+        }
+        let cpw: Vec<Vector4<f64>> = shifted
+            .iter()
+            .zip(&weights)
+            .map(|(d, &w)| Vector4::new(d.x * w, d.y * w, d.z * w, w))
+            .collect();
+        let p = curve.degree();
+        let mut spans = vec![0.0; curve.len()];
+        for (i, _, _) in curve.spans() {
+            spans[i] = shifted[i - p..=i]
+                .iter()
+                .map(|d| d.amax())
+                .fold(0.0, f64::max);
+        }
+        let pow2 = |w: f64| w.log2().fract() == 0.0;
+        let representation = if weights.iter().all(|&w| pow2(w)) {
+            0.0
+        } else {
+            let scale = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
+            4.0 * f64::EPSILON * scale
+        };
+        let local = NurbsCurve::from_homogeneous_unchecked(p, curve.knots().to_vec(), cpw);
+        let mut span_bezier = vec![Vector4::zeros(); curve.len() * (p + 1)];
+        for (i, a, b) in curve.spans() {
+            local.bezier_in_span_into(i, a, b, &mut span_bezier[i * (p + 1)..(i + 1) * (p + 1)]);
+        }
+        let (span_h3, span_h4, span_bounds) = span_derivative_bounds(p, &span_bezier, &spans);
+        Self {
+            curve,
+            local,
+            origin,
+            spans,
+            span_bezier,
+            span_h3,
+            span_h4,
+            span_bounds,
+            representation,
+        }
+    }
+
+    /// The curve being certified.
+    pub fn curve(&self) -> &NurbsCurve {
+        self.curve
+    }
+
+    /// The local origin `O` the certificate computes in.
+    pub fn origin(&self) -> Vector3<f64> {
+        self.origin
+    }
+
+    fn factor(&self) -> f64 {
+        MARGIN_FACTOR * (self.curve.degree() + 1) as f64 * f64::EPSILON
+    }
+
+    /// The largest rounding margin any segment of the curve can get, known before any walk:
+    /// `128 (p + 1) eps * 2 L + 8 eps L` with `L` the largest `|P_i - O|_inf` of a knot span's
+    /// control points, plus the representation term. The weights do not enter: every
+    /// homogeneous value the certificate computes is a convex combination
+    /// `sum_i lambda_i w_i (P_i - O, 1)`, whose rounding is at most a few `eps` times
+    /// `sum_i lambda_i w_i |P_i - O| <= w L` per level, so after dividing by its weight `w` the
+    /// projected point is off by a few `eps L` per level, whatever the weights' ratio
+    /// (`docs/discretization.md`, Step 5). A tolerance not well above the margin cannot be
+    /// certified.
+    pub fn max_margin(&self) -> f64 {
+        let f = self.factor();
+        let worst = self
+            .curve
+            .spans()
+            .iter()
+            .map(|&(i, _, _)| self.spans[i])
+            .fold(0.0, f64::max);
+        (2.0 * f + 8.0 * f64::EPSILON) * worst + self.representation
+    }
+
+    /// The resolution of the output: one ulp of the largest coordinate of the curve's control
+    /// points. A cutting point is a rounded `f64`, so it is off the curve by up to about half
+    /// of this per coordinate, and no chord error below it can be certified reliably.
+    pub fn output_resolution(&self) -> f64 {
+        let scale = self
+            .curve
+            .control_points()
+            .iter()
+            .map(|p| p.coords.amax())
+            .fold(0.0, f64::max);
+        2.0 * f64::EPSILON * scale
+    }
+
+    /// Certifies the chord error of the curve on `[t0, t1]` against the chord `a b`; see
+    /// [`chord_error`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn chord_error(
+        &self,
+        scratch: &mut Scratch,
+        t0: f64,
+        t1: f64,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        limit: f64,
+        want_lower: f64,
+    ) -> Bound {
+        self.chord_error_hinted(scratch, t0, t1, a, b, None, limit, want_lower)
+    }
+
+    /// [`Certifier::chord_error`] with, optionally, the span and homogeneous local point that
+    /// `b` was evaluated from (by [`Certifier::eval_d1_h`]), which saves evaluating it again.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn chord_error_hinted(
+        &self,
+        scratch: &mut Scratch,
+        t0: f64,
+        t1: f64,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        end_hint: Option<(usize, Vector4<f64>)>,
+        limit: f64,
+        want_lower: f64,
+    ) -> Bound {
+        match self.curve.degree() {
+            0..=3 => self.chord_error_m(
+                &mut scratch.small,
+                &mut scratch.ends,
+                end_hint,
+                t0,
+                t1,
+                a,
+                b,
+                limit,
+                want_lower,
+            ),
+            4..=7 => self.chord_error_m(
+                &mut scratch.medium,
+                &mut scratch.ends,
+                end_hint,
+                t0,
+                t1,
+                a,
+                b,
+                limit,
+                want_lower,
+            ),
+            _ => self.chord_error_m(
+                &mut scratch.large,
+                &mut scratch.ends,
+                end_hint,
+                t0,
+                t1,
+                a,
+                b,
+                limit,
+                want_lower,
+            ),
+        }
+    }
+}
+
+/// Certifies the chord error of the curve on `[t0, t1]` against the chord `a b`, where `a` and
+/// `b` are the points the caller will output for `t0` and `t1` (normally `curve.point(t0)` and
+/// `curve.point(t1)`; any points are allowed, the bound is about the segment between them).
+/// The search refines until one of:
+/// - the upper bound is `<= limit` and the lower bound is `>= want_lower` (or cannot rise any
+///   more): returns the bounds;
+/// - the lower bound exceeds `limit`: the segment certainly fails; `upper` is then the
+///   current (larger) bound;
+/// - the refinement budget (`48 + 4 * pieces` subdivisions, none deeper than
+///   [`MAX_SUBDIVISION_DEPTH`]) is spent: `upper` is the bound reached (possibly `> limit`).
+///
+/// The rounding margin of [`Certifier`] (from the magnitudes of each span's control points
+/// relative to a local origin, and its weights) is included in `upper`. This builds a
+/// [`Certifier`] per call; a walk along a curve should build one and call
+/// [`Certifier::chord_error`].
+pub fn chord_error(
+    curve: &NurbsCurve,
+    t0: f64,
+    t1: f64,
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    limit: f64,
+    want_lower: f64,
+) -> Bound {
+    Certifier::new(curve).chord_error(&mut Scratch::default(), t0, t1, a, b, limit, want_lower)
+}

@@ -1,0 +1,349 @@
+//! The part's surfaces in the workpiece frame and their distance queries.
+
+use nalgebra::{Point3, Vector3};
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::{TriMesh, TriMeshFlags};
+
+use kerf_nurbs::NurbsSurface;
+
+use super::tessellated::{box_distance, Tessellated};
+use crate::{ProcessError, Result};
+
+/// One surface of the part, placed in the workpiece frame.
+#[derive(Debug)]
+enum Obstacle {
+    Nurbs(Box<Tessellated>),
+    Mesh(Box<TriMesh>),
+}
+
+/// One surface with its bounding box and its name.
+#[derive(Debug)]
+struct Item {
+    shape: std::sync::Arc<Obstacle>,
+    lo: Point3<f64>,
+    hi: Point3<f64>,
+    id: String,
+}
+
+/// The part's surfaces in the workpiece frame, for distance queries.
+#[derive(Debug, Default)]
+pub struct Obstacles {
+    items: Vec<Item>,
+    /// How many exact distance queries have been made (the work the checks cost).
+    queries: std::sync::atomic::AtomicUsize,
+}
+
+impl Obstacles {
+    /// No surfaces (every traverse is clear).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a NURBS surface (already placed in the workpiece frame).
+    pub fn add_nurbs(&mut self, surface: NurbsSurface) {
+        let id = format!("#{}", self.items.len());
+        self.add_nurbs_named(surface, id);
+    }
+
+    fn add_nurbs_named(&mut self, surface: NurbsSurface, id: String) {
+        let (lo, hi) = surface.bounding_box();
+        self.items.push(Item {
+            shape: std::sync::Arc::new(Obstacle::Nurbs(Box::new(Tessellated::new(surface)))),
+            lo,
+            hi,
+            id,
+        });
+    }
+
+    /// The same surfaces without those named in `ids` (shared, not copied).
+    pub fn without(&self, ids: &[String]) -> Obstacles {
+        Obstacles {
+            items: self
+                .items
+                .iter()
+                .filter(|i| !ids.contains(&i.id))
+                .map(|i| Item {
+                    shape: i.shape.clone(),
+                    lo: i.lo,
+                    hi: i.hi,
+                    id: i.id.clone(),
+                })
+                .collect(),
+            queries: Default::default(),
+        }
+    }
+
+    /// The names of the surfaces that come within `distance_mm` of the segment `a b` (sampled
+    /// at most `distance_mm / 2` apart, so a surface within half of it anywhere on the
+    /// segment is found).
+    pub fn near_segment(&self, a: &Point3<f64>, b: &Point3<f64>, distance_mm: f64) -> Vec<String> {
+        let k = (((b - a).norm() / (0.5 * distance_mm)).ceil() as usize).clamp(1, 100_000);
+        self.items
+            .iter()
+            .filter(|i| {
+                (0..=k).any(|j| {
+                    let p = a + (b - a) * (j as f64 / k as f64);
+                    box_distance(&p, &i.lo, &i.hi) < distance_mm
+                        && shape_distance(&i.shape, &p) < distance_mm
+                })
+            })
+            .map(|i| i.id.clone())
+            .collect()
+    }
+
+    /// The names of the surfaces within `tolerance_mm` of `p` (from [`Obstacles::from_file`]:
+    /// the surface ids; otherwise `#0`, `#1`, ... in the order added).
+    pub fn touching(&self, p: &Point3<f64>, tolerance_mm: f64) -> Vec<String> {
+        self.items
+            .iter()
+            .filter(|i| box_distance(p, &i.lo, &i.hi) <= tolerance_mm)
+            .filter(|i| shape_distance(&i.shape, p) <= tolerance_mm)
+            .map(|i| i.id.clone())
+            .collect()
+    }
+
+    /// Adds a triangle mesh (vertices in the workpiece frame, mm).
+    ///
+    /// # Errors
+    /// [`ProcessError::BadSurface`] if a vertex is not finite, an index is out of range or no
+    /// triangle remains.
+    pub fn add_mesh(&mut self, vertices: Vec<Point3<f64>>, triangles: Vec<[u32; 3]>) -> Result<()> {
+        let id = format!("#{}", self.items.len());
+        self.add_mesh_named(vertices, triangles, id)
+    }
+
+    fn add_mesh_named(
+        &mut self,
+        vertices: Vec<Point3<f64>>,
+        triangles: Vec<[u32; 3]>,
+        id: String,
+    ) -> Result<()> {
+        let bad = |reason: String| ProcessError::BadSurface { reason };
+        if let Some(i) = vertices
+            .iter()
+            .position(|v| !v.coords.iter().all(|x| x.is_finite()))
+        {
+            return Err(bad(format!("mesh vertex {i} is not finite")));
+        }
+        let n = vertices.len() as u32;
+        if let Some(t) = triangles.iter().position(|t| t.iter().any(|&i| i >= n)) {
+            return Err(bad(format!("mesh triangle {t} has a vertex index >= {n}")));
+        }
+        let mut lo = Point3::from([f64::INFINITY; 3]);
+        let mut hi = Point3::from([f64::NEG_INFINITY; 3]);
+        for v in &vertices {
+            lo = lo.inf(v);
+            hi = hi.sup(v);
+        }
+        let mesh = TriMesh::with_flags(
+            vertices,
+            triangles,
+            TriMeshFlags::DELETE_DEGENERATE_TRIANGLES,
+        )
+        .map_err(|e| bad(format!("mesh: {e:?}")))?;
+        if mesh.indices().is_empty() {
+            return Err(bad("mesh: no triangle with a non-zero area".into()));
+        }
+        self.items.push(Item {
+            shape: std::sync::Arc::new(Obstacle::Mesh(Box::new(mesh))),
+            lo,
+            hi,
+            id,
+        });
+        Ok(())
+    }
+
+    /// Adds a NURBS surface moved by the rigid motion `map` (the placement of the part): the
+    /// control points are mapped, the knots and weights kept, which moves the surface exactly.
+    ///
+    /// # Errors
+    /// [`ProcessError::BadSurface`] if the mapped control net is not valid (a non-finite
+    /// point).
+    pub fn add_nurbs_mapped(
+        &mut self,
+        surface: &NurbsSurface,
+        map: impl Fn(&Point3<f64>) -> Point3<f64>,
+    ) -> Result<()> {
+        let cps = surface
+            .control_points()
+            .iter()
+            .map(|row| row.iter().map(&map).collect())
+            .collect();
+        let moved = NurbsSurface::try_new(
+            surface.degree_u(),
+            surface.degree_v(),
+            surface.knots_u().to_vec(),
+            surface.knots_v().to_vec(),
+            cps,
+            surface.is_rational().then(|| surface.weights()),
+        )
+        .map_err(|e| ProcessError::BadSurface {
+            reason: e.to_string(),
+        })?;
+        self.add_nurbs(moved);
+        Ok(())
+    }
+
+    fn add_nurbs_mapped_named(
+        &mut self,
+        surface: &NurbsSurface,
+        map: impl Fn(&Point3<f64>) -> Point3<f64>,
+        id: &str,
+    ) -> Result<()> {
+        self.add_nurbs_mapped(surface, map)?;
+        if let Some(last) = self.items.last_mut() {
+            last.id = id.to_string();
+        }
+        Ok(())
+    }
+
+    /// The surfaces that carry the curves `curves` (indices into `file.curves`), each once,
+    /// moved by the rigid motion `map` (the part's placement on the machine), named by their
+    /// ids.
+    ///
+    /// # Errors
+    /// [`ProcessError::BadSurface`] as [`Obstacles::add_mesh`] and
+    /// [`Obstacles::add_nurbs_mapped`].
+    pub fn from_file(
+        file: &kerf_format::CurvesFile,
+        curves: &[usize],
+        map: impl Fn(&Point3<f64>) -> Point3<f64>,
+    ) -> Result<Self> {
+        let mut obs = Self::new();
+        let mut seen: Vec<&str> = Vec::new();
+        for &i in curves {
+            for id in &file.curves[i].surfaces {
+                if seen.contains(&id.as_str()) {
+                    continue;
+                }
+                seen.push(id);
+                let Some(s) = file.surface(id) else { continue };
+                match &s.geometry {
+                    kerf_format::SurfaceGeometry::Nurbs(n) => {
+                        obs.add_nurbs_mapped_named(n, &map, id)?
+                    }
+                    kerf_format::SurfaceGeometry::Mesh {
+                        vertices,
+                        triangles,
+                    } => obs.add_mesh_named(
+                        vertices.iter().map(&map).collect(),
+                        triangles.clone(),
+                        id.clone(),
+                    )?,
+                }
+            }
+        }
+        Ok(obs)
+    }
+
+    /// The largest coordinate along `up` of the boxes of the surfaces that come within
+    /// `radius_mm` of the segment `a b` seen along `up` (their boxes' distance with the `up`
+    /// component left out), or `None` if none does or `up` is not a coordinate axis.
+    pub(super) fn local_top(
+        &self,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        up: &Vector3<f64>,
+        radius_mm: f64,
+    ) -> Option<f64> {
+        let k = (0..3).find(|&k| (up[k].abs() - 1.0).abs() < 1e-12)?;
+        let n = (((b - a).norm() / (0.5 * radius_mm)).ceil() as usize).clamp(1, 100_000);
+        self.items
+            .iter()
+            .filter(|i| {
+                (0..=n).any(|j| {
+                    let p = a + (b - a) * (j as f64 / n as f64);
+                    let d = Vector3::from_fn(|m, _| {
+                        if m == k {
+                            0.0
+                        } else {
+                            (i.lo[m] - p[m]).max(p[m] - i.hi[m]).max(0.0)
+                        }
+                    });
+                    // Samples half the radius apart: a box within it of the segment is within
+                    // 1.25 times it of a sample.
+                    d.norm() <= 1.25 * radius_mm
+                })
+            })
+            .map(|i| top_along(&i.lo, &i.hi, up))
+            .reduce(f64::max)
+    }
+
+    /// The id of the nearest surface to `p` and its distance, mm (`None` without surfaces).
+    pub fn nearest(&self, p: &Point3<f64>) -> Option<(String, f64)> {
+        self.items
+            .iter()
+            .map(|i| (i.id.clone(), shape_distance(&i.shape, p)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// True if there are no surfaces.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// The axis-aligned box `(min, max)` that contains every surface, or `None` without any.
+    pub fn bounding_box(&self) -> Option<(Point3<f64>, Point3<f64>)> {
+        let mut it = self.items.iter();
+        let first = it.next()?;
+        Some(it.fold((first.lo, first.hi), |(a, b), i| {
+            (a.inf(&i.lo), b.sup(&i.hi))
+        }))
+    }
+
+    /// How many exact distance queries (one surface, one point) the checks have made so far.
+    pub fn queries(&self) -> usize {
+        self.queries.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// The distance from `p` to the nearest surface, mm (infinite without surfaces).
+    pub fn distance(&self, p: &Point3<f64>) -> f64 {
+        self.distance_below(p, f64::INFINITY)
+    }
+
+    /// The distance from `p` to the nearest surface if it is below `limit`; otherwise some
+    /// value `>= limit` (surfaces whose box is at least `limit` away are not queried).
+    pub fn distance_below(&self, p: &Point3<f64>, limit: f64) -> f64 {
+        // Skipped surfaces are at least their box's distance away: the result is exact below
+        // `limit` and a lower bound of the distance (itself >= limit) above it.
+        let mut best = f64::INFINITY;
+        let mut floor = f64::INFINITY;
+        for item in &self.items {
+            let gap = box_distance(p, &item.lo, &item.hi);
+            if gap >= limit.min(best) {
+                floor = floor.min(gap);
+                continue;
+            }
+            self.queries
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let d = shape_distance_below(&item.shape, p, limit.min(best));
+            best = best.min(d);
+        }
+        best.min(floor)
+    }
+}
+
+fn shape_distance(o: &Obstacle, p: &Point3<f64>) -> f64 {
+    shape_distance_below(o, p, f64::INFINITY)
+}
+
+fn shape_distance_below(o: &Obstacle, p: &Point3<f64>, limit: f64) -> f64 {
+    match o {
+        Obstacle::Nurbs(s) => s.distance(p, limit),
+        Obstacle::Mesh(m) => m.distance_to_local_point(p, false),
+    }
+}
+
+/// The largest coordinate along `up` of the box `lo hi`, mm.
+pub(super) fn top_along(lo: &Point3<f64>, hi: &Point3<f64>, up: &Vector3<f64>) -> f64 {
+    (0..8)
+        .map(|k| {
+            let corner = Point3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            corner.coords.dot(up)
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}

@@ -1,0 +1,114 @@
+//! The options of the traverses.
+
+use nalgebra::Vector3;
+
+use crate::{ProcessError, Result};
+
+/// Options of the traverses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct TraverseOptions {
+    /// No point of the travel (tip or nozzle) comes closer to the part than this, mm
+    /// (default 5).
+    pub clearance_mm: f64,
+    /// How far the head first backs off along the tool axis, mm; at least 1.25 times the
+    /// clearance, raised where the retract point is not clear (default 7.5).
+    pub retract_mm: f64,
+    /// Length of the nozzle, a segment from the tip along the tool axis toward the head that
+    /// must keep the clearance too, mm (default 20).
+    pub nozzle_mm: f64,
+    /// The direction in the workpiece frame that is "up" (away from the fixture, toward the
+    /// free space): a lifted travel runs in the plane perpendicular to it above every
+    /// surface (default +z).
+    pub up: Vector3<f64>,
+}
+
+impl Default for TraverseOptions {
+    fn default() -> Self {
+        Self {
+            clearance_mm: 5.0,
+            retract_mm: 7.5,
+            nozzle_mm: 20.0,
+            up: Vector3::z(),
+        }
+    }
+}
+
+impl TraverseOptions {
+    /// Sets [`clearance_mm`](Self::clearance_mm): no point of the travel (tip or nozzle)
+    /// comes closer to the part than this, mm (default 5).
+    pub fn with_clearance_mm(mut self, clearance_mm: f64) -> Self {
+        self.clearance_mm = clearance_mm;
+        self
+    }
+
+    /// Sets [`retract_mm`](Self::retract_mm): how far the head first backs off along the
+    /// tool axis, mm.
+    pub fn with_retract_mm(mut self, retract_mm: f64) -> Self {
+        self.retract_mm = retract_mm;
+        self
+    }
+
+    /// Sets [`nozzle_mm`](Self::nozzle_mm): length of the nozzle, a segment from the tip
+    /// along the tool axis toward the head that must keep the clearance too, mm (default
+    /// 20).
+    pub fn with_nozzle_mm(mut self, nozzle_mm: f64) -> Self {
+        self.nozzle_mm = nozzle_mm;
+        self
+    }
+
+    /// Sets [`up`](Self::up): the direction in the workpiece frame that is "up" (away from
+    /// the fixture, toward the free space).
+    pub fn with_up(mut self, up: Vector3<f64>) -> Self {
+        self.up = up;
+        self
+    }
+
+    /// With this clearance, mm; the retract becomes 1.5 times it.
+    pub fn with_clearance(mut self, clearance_mm: f64) -> Self {
+        self.clearance_mm = clearance_mm;
+        self.retract_mm = 1.5 * clearance_mm;
+        self
+    }
+
+    pub(super) fn validate(&self) -> Result<()> {
+        let check = |name: &'static str, v: f64, ok: bool| {
+            if ok {
+                Ok(())
+            } else {
+                Err(ProcessError::BadOption {
+                    name,
+                    value: v,
+                    reason: "must be finite, > 0 and <= 1e4 (retract_mm >= 1.25 clearance_mm)",
+                })
+            }
+        };
+        let fine = |v: f64| v.is_finite() && v > 0.0 && v <= 1e4;
+        check("clearance_mm", self.clearance_mm, fine(self.clearance_mm))?;
+        check(
+            "retract_mm",
+            self.retract_mm,
+            fine(self.retract_mm) && self.retract_mm >= 1.25 * self.clearance_mm,
+        )?;
+        check(
+            "nozzle_mm",
+            self.nozzle_mm,
+            self.nozzle_mm.is_finite() && (0.0..=1e4).contains(&self.nozzle_mm),
+        )?;
+        let up_ok = self.up.iter().all(|v| v.is_finite()) && self.up.norm() > 1e-9;
+        check("up", self.up.norm(), up_ok)
+    }
+
+    /// The height step of the lifted routes above the surfaces' boxes (two of them), mm.
+    pub(super) fn step(&self) -> f64 {
+        self.clearance_mm / 8.0
+    }
+
+    /// The margin of the checks, mm: a sample closer than the clearance plus this is taken
+    /// as blocked (so the sphere tracing advances by at least half of it, which bounds its
+    /// work). A sixty-fourth of the clearance: a route that keeps 1.02 times the clearance is
+    /// found, and the claim (the clearance) does not depend on it.
+    pub(super) fn margin(&self) -> f64 {
+        self.clearance_mm / 64.0
+    }
+}

@@ -1,0 +1,284 @@
+//! The routes of a traverse (straight, lifted, over the safe plane), checked shortest first.
+
+use nalgebra::{Point3, Vector3};
+
+use super::check::{certify, Blocked};
+use super::obstacles::top_along;
+use super::{Obstacles, TraverseOptions};
+use crate::geometry::{normal, position};
+use crate::{PoseArray, ProcessError, Result};
+
+/// How a traverse runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Route {
+    /// Retract, one straight travel, approach.
+    Straight,
+    /// Retract, rise along the up direction to the safe plane above every surface, travel in
+    /// it, descend, approach.
+    SafePlane,
+    /// Retract, rise along the up direction to a clearance above the surfaces whose boxes
+    /// come near the travel (seen along the up direction), travel, descend, approach: lower
+    /// than the safe plane, so often within the axis limits where that is not.
+    Lifted,
+}
+
+impl Route {
+    /// `"straight"` or `"safe_plane"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Route::Straight => "straight",
+            Route::SafePlane => "safe_plane",
+            Route::Lifted => "lifted",
+        }
+    }
+}
+
+/// A planned traverse from the end of one cut to the pierce of the next.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Traverse {
+    /// The waypoints with tool axes, workpiece frame, from the retract point above the exit
+    /// to the point above the pierce; the head reaches the first along the exit's tool axis
+    /// and leaves the last along the pierce's tool axis. Between waypoints it moves straight,
+    /// the tool axis turning from one waypoint's to the next's.
+    pub waypoints: Vec<PoseArray>,
+    /// The route taken.
+    pub route: Route,
+    /// The smallest surface distance found over the travel's samples (tip and nozzle), mm;
+    /// the travel is certified to stay at least the clearance away.
+    pub min_distance_mm: f64,
+    /// The length of the tip's path from the exit to the pierce: retract, travel, approach,
+    /// mm.
+    pub length_mm: f64,
+}
+
+fn with_axis(p: Point3<f64>, n: Vector3<f64>) -> PoseArray {
+    [p.x, p.y, p.z, n.x, n.y, n.z]
+}
+
+fn path_length(points: &[Point3<f64>]) -> f64 {
+    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// Plans the traverse from `from` (where the last cut ended: tip and tool axis, workpiece
+/// frame) to `to` (the next pierce point and its tool axis).
+///
+/// The head backs off along `from`'s axis by the retract (doubled, up to 16 times the larger of
+/// clearance and retract, where a route from there is not clear), and the straight travel to
+/// the point as far above `to` is checked; where it is blocked, the travel rises along
+/// [`TraverseOptions::up`] to the safe plane a clearance and a sample step above every
+/// surface's bounding box, crosses in it and comes down. Along the retract and the approach,
+/// from 3/4 of the clearance up the tip keeps half the clearance (their lower ends touch the
+/// part by design); along the travel the tip and the nozzle keep the full clearance.
+///
+/// # Errors
+/// [`ProcessError::BadOption`] for bad options, [`ProcessError::BadContour`] for non-finite
+/// poses, [`ProcessError::TraverseBlocked`] if no route is clear (e.g. a tool axis pointing
+/// into a pocket the head cannot back out of).
+pub fn plan_traverse(
+    obs: &Obstacles,
+    from: &PoseArray,
+    to: &PoseArray,
+    opts: &TraverseOptions,
+) -> Result<Traverse> {
+    plan_traverse_within(obs, from, to, opts, &|_| true)
+}
+
+/// [`plan_traverse`] among the routes whose waypoints `reachable` accepts (e.g. within the
+/// machine's axis limits); the others are not tried.
+///
+/// # Errors
+/// As [`plan_traverse`].
+pub fn plan_traverse_within(
+    obs: &Obstacles,
+    from: &PoseArray,
+    to: &PoseArray,
+    opts: &TraverseOptions,
+    reachable: &dyn Fn(&[PoseArray]) -> bool,
+) -> Result<Traverse> {
+    plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(())).map(|(t, ())| t)
+}
+
+/// Why a route was refused by the caller's own check (e.g. the machine's rapid swing): the
+/// first offending point and its distance, mm.
+pub(crate) type Refusal = (Point3<f64>, f64);
+
+/// [`plan_traverse_within`], where a route that is clear is also handed to `accept` (e.g.
+/// the check of the machine's own rapid moves); the first route both accept is returned with
+/// `accept`'s result, the next shortest tried otherwise.
+pub(crate) fn plan_traverse_accepting<T>(
+    obs: &Obstacles,
+    from: &PoseArray,
+    to: &PoseArray,
+    opts: &TraverseOptions,
+    reachable: &dyn Fn(&[PoseArray]) -> bool,
+    accept: &mut dyn FnMut(&Traverse) -> std::result::Result<T, Refusal>,
+) -> Result<(Traverse, T)> {
+    opts.validate()?;
+    for (name, p) in [("from", from), ("to", to)] {
+        let axis_ok = normal(p).norm() > 1e-9;
+        if !p.iter().all(|v| v.is_finite()) || !axis_ok {
+            return Err(ProcessError::BadContour {
+                id: format!("traverse {name}"),
+                reason: "a non-finite pose or a zero tool axis".into(),
+            });
+        }
+    }
+    let c = opts.clearance_mm;
+    let h = opts.step();
+    let floor = opts.margin();
+    let up = opts.up.normalize();
+    let unit = |p: &PoseArray| {
+        let n = normal(p).normalize();
+        with_axis(position(p), n)
+    };
+    let (from, to) = (unit(from), unit(to));
+    // The retract (and the approach) along the tool axis: from 3/4 of the clearance to the
+    // retract height, the tip keeps half the clearance; raised where it does not.
+    let axial = |p: &PoseArray, height: f64| -> std::result::Result<PoseArray, Blocked> {
+        let (q, n) = (position(p), normal(p));
+        let low = with_axis(q + n * (0.75 * c), n);
+        let high = with_axis(q + n * height, n);
+        certify(obs, &low, &high, 0.5 * c, 0.0, floor)?;
+        Ok(high)
+    };
+    let length_of = |way: &[PoseArray]| {
+        let mut pts = vec![position(&from)];
+        pts.extend(way.iter().map(position));
+        pts.push(position(&to));
+        path_length(&pts)
+    };
+    let tip_ends = |w: &[PoseArray]| -> std::result::Result<f64, Blocked> {
+        let mut least = f64::INFINITY;
+        for s in w.windows(2) {
+            least = least.min(certify(obs, &s[0], &s[1], c, opts.nozzle_mm, floor)?);
+        }
+        Ok(least)
+    };
+    let blocked_err = |b: Blocked, why: String| {
+        ProcessError::TraverseBlocked(Box::new(crate::Blockage {
+            from: [from[0], from[1], from[2]],
+            to: [to[0], to[1], to[2]],
+            at: [b.at.x, b.at.y, b.at.z],
+            distance_mm: b.distance,
+            clearance_mm: c,
+            why,
+        }))
+    };
+    // The retract heights tried at each end (doubling), those whose axial move is clear.
+    let heights: Vec<f64> = (0..5)
+        .map(|k| opts.retract_mm * f64::from(1 << k))
+        .collect();
+    let ends = |p: &PoseArray| -> std::result::Result<Vec<PoseArray>, Blocked> {
+        let mut last = None;
+        let ok: Vec<PoseArray> = heights
+            .iter()
+            .filter_map(|&hh| match axial(p, hh) {
+                Ok(q) => Some(q),
+                Err(e) => {
+                    last = Some(e);
+                    None
+                }
+            })
+            .collect();
+        match (ok.is_empty(), last) {
+            (true, Some(e)) => Err(e),
+            _ => Ok(ok),
+        }
+    };
+    let top = heights[heights.len() - 1];
+    let ends_a = ends(&from).map_err(|b| {
+        blocked_err(
+            b,
+            format!(
+                "the retract along the tool axis from the exit is blocked at every height from {:.1} to {top:.1} mm",
+                heights[0]
+            ),
+        )
+    })?;
+    let ends_b = ends(&to).map_err(|b| {
+        blocked_err(
+            b,
+            format!(
+                "the approach along the tool axis to the pierce is blocked at every height from {:.1} to {top:.1} mm",
+                heights[0]
+            ),
+        )
+    })?;
+    // Every route: straight between any two retract points, lifted along `up` over the
+    // surfaces near the travel, or over the safe plane above every surface; checked shortest
+    // first.
+    let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::new();
+    let lift_to = |level: f64| {
+        move |p: &PoseArray| {
+            let q = position(p);
+            let rise = (level - q.coords.dot(&up)).max(0.0);
+            with_axis(q + up * rise, normal(p))
+        }
+    };
+    let global_top = obs
+        .bounding_box()
+        .map(|(lo, hi)| top_along(&lo, &hi, &up) + c + 2.0 * h);
+    for a in &ends_a {
+        for b in &ends_b {
+            let straight = vec![*a, *b];
+            routes.push((length_of(&straight), Route::Straight, straight));
+            let (pa, pb) = (position(a), position(b));
+            // Each lift at a clearance and two steps above the boxes' top, and a clearance
+            // higher (where a tilted nozzle reaches down past the first).
+            let local = obs.local_top(&pa, &pb, &up, 2.0 * c + opts.nozzle_mm + 4.0 * h);
+            for extra in [0.0, c + 2.0 * h] {
+                if let Some(level) = local {
+                    let lift = lift_to(level + c + 2.0 * h + extra);
+                    let way = vec![*a, lift(a), lift(b), *b];
+                    routes.push((length_of(&way), Route::Lifted, way));
+                }
+                if let Some(level) = global_top {
+                    let lift = lift_to(level + extra);
+                    let plane = vec![*a, lift(a), lift(b), *b];
+                    routes.push((length_of(&plane), Route::SafePlane, plane));
+                }
+            }
+        }
+    }
+    routes.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let (mut unreachable, mut refused) = (0usize, 0usize);
+    let mut blocked: Option<Blocked> = None;
+    for (length_mm, route, waypoints) in &routes {
+        if !reachable(waypoints) {
+            unreachable += 1;
+            continue;
+        }
+        match tip_ends(waypoints) {
+            Ok(least) => {
+                let t = Traverse {
+                    length_mm: *length_mm,
+                    waypoints: waypoints.clone(),
+                    route: *route,
+                    min_distance_mm: least,
+                };
+                match accept(&t) {
+                    Ok(v) => return Ok((t, v)),
+                    Err((at, distance)) => {
+                        refused += 1;
+                        blocked = Some(Blocked { at, distance });
+                    }
+                }
+            }
+            Err(e) => blocked = Some(e),
+        }
+    }
+    let n = routes.len();
+    let why = if unreachable == n {
+        format!("none of the {n} routes lies within the machine's axis limits")
+    } else {
+        format!(
+            "{} of {n} routes come too close, {refused} of them only in the machine's rapid swing, {unreachable} leave the axis limits",
+            n - unreachable
+        )
+    };
+    let b = blocked.unwrap_or(Blocked {
+        at: position(&from),
+        distance: 0.0,
+    });
+    Err(blocked_err(b, why))
+}

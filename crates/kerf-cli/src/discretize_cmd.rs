@@ -22,9 +22,9 @@ pub(crate) fn options(args: &DiscretizeArgs) -> Options {
     let d = Options::default();
     Options::with_tolerance(args.tolerance)
         .with_band(args.band.unwrap_or(d.band))
-        .with_max_segment_length(args.max_segment_length.unwrap_or(d.max_segment_length))
-        .with_min_segment_length(args.min_segment_length.unwrap_or(d.min_segment_length))
-        .with_max_turn(args.max_turn.map_or(d.max_turn, f64::to_radians))
+        .with_max_segment_length_mm(args.max_segment_length.unwrap_or(d.max_segment_length_mm))
+        .with_min_segment_length_mm(args.min_segment_length.unwrap_or(d.min_segment_length_mm))
+        .with_max_turn_rad(args.max_turn.map_or(d.max_turn_rad, f64::to_radians))
         .with_strategy(args.strategy.into())
         .with_max_points(
             args.max_points
@@ -80,8 +80,8 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
         None
     };
     let out = match &oriented {
-        None => toolpath_of_points(&file, opts.tolerance, &results),
-        Some(o) => toolpath_of_poses(&file, opts.tolerance, o),
+        None => toolpath_of_points(&file, opts.tolerance_mm, &results),
+        Some(o) => toolpath_of_poses(&file, opts.tolerance_mm, o),
     };
     // `-` is standard output; kerf_io also writes devices and FIFOs through.
     toolpath::write(&out, &dest)?;
@@ -101,7 +101,7 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
     });
     // N* (a diagnostic) comes from the curvature the walk evaluated at its points (no
     // quadrature of its own; `Discretization::n_star`).
-    let nstar: f64 = results.iter().map(|d| d.n_star(opts.tolerance)).sum();
+    let nstar: f64 = results.iter().map(|d| d.n_star(opts.tolerance_mm)).sum();
     let elapsed = start.elapsed().as_secs_f64();
     let breaks: usize = results.iter().map(|d| d.c0_breaks().len()).sum();
     if args.json {
@@ -112,7 +112,7 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             "points": points,
             "segments": segments,
             "c0_breaks": breaks,
-            "tolerance": opts.tolerance,
+            "tolerance": opts.tolerance_mm,
             "max_chord_error": worst,
             "n_star": nstar,
             "segments_over_n_star": if nstar > 0.0 { segments as f64 / nstar } else { f64::NAN },
@@ -141,7 +141,7 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
              (segments / N* = {:.3}), {:.3} s -> {}",
             path.display(),
             file.curves.len(),
-            opts.tolerance,
+            opts.tolerance_mm,
             if nstar > 0.0 {
                 segments as f64 / nstar
             } else {

@@ -14,7 +14,7 @@ use crate::input::{load_curves, ProgressBar};
 /// The job options the arguments ask for.
 fn job_options(args: &RunArgs) -> JobOptions {
     let mut discretize = kerf_discretize::Options::with_tolerance(args.tolerance);
-    discretize.max_segment_length = args.max_segment_length.unwrap_or(f64::INFINITY);
+    discretize.max_segment_length_mm = args.max_segment_length.unwrap_or(f64::INFINITY);
     let mut normals = NormalOptions::default();
     if let Some(deg) = args.max_normal_step {
         normals.max_normal_step_rad = deg.to_radians();

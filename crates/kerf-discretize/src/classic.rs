@@ -43,10 +43,10 @@ impl<'c, 'a> Builder<'c, 'a> {
     fn push(&mut self, t: f64, p: Point3<f64>) -> Option<()> {
         let (params, points, up, lo) = &mut self.trial;
         let (t0, p0) = (*params.last()?, *points.last()?);
-        if (p - p0).norm() > self.opts.max_segment_length {
+        if (p - p0).norm() > self.opts.max_segment_length_mm {
             return None;
         }
-        let tol = self.opts.tolerance;
+        let tol = self.opts.tolerance_mm;
         let b = self
             .cert
             .chord_error(self.scratch, t0, t, &p0, &p, tol, 0.0);
@@ -169,7 +169,7 @@ pub(crate) fn equal_parameter(
             Some(tr.trial)
         },
         a,
-        opts.tolerance,
+        opts.tolerance_mm,
     )?;
     append(out, trial);
     Ok(())
@@ -226,7 +226,7 @@ pub(crate) fn equal_chord(
             Some(tr.trial)
         },
         a,
-        opts.tolerance,
+        opts.tolerance_mm,
     )?;
     append(out, trial);
     Ok(())

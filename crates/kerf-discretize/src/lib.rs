@@ -349,7 +349,7 @@ pub fn discretize_range(
             reason: "must satisfy domain start <= a < b <= domain end",
         });
     }
-    let mut ends = piece_ends(curve, opts.tolerance)?;
+    let mut ends = piece_ends(curve, opts.tolerance_mm)?;
     ends.retain(|&t| t > a && t < b);
     ends.insert(0, a);
     ends.push(b);
@@ -357,20 +357,20 @@ pub fn discretize_range(
     // margin (known from the control points), then the size of the output.
     let cert = Certifier::new(curve);
     let margin = cert.max_margin() + cert.output_resolution();
-    if margin.is_nan() || margin > 0.5 * opts.tolerance {
+    if margin.is_nan() || margin > 0.5 * opts.tolerance_mm {
         return Err(DiscretizeError::ToleranceBelowMargin {
-            tolerance: opts.tolerance,
+            tolerance: opts.tolerance_mm,
             margin,
         });
     }
-    let estimate = estimate_count(curve, opts.tolerance);
-    let by_length = if opts.max_segment_length.is_finite() {
-        curve.size() / opts.max_segment_length
+    let estimate = estimate_count(curve, opts.tolerance_mm);
+    let by_length = if opts.max_segment_length_mm.is_finite() {
+        curve.size() / opts.max_segment_length_mm
     } else {
         0.0
     };
-    let by_turn = if opts.max_turn.is_finite() {
-        minimum::estimate_turning(curve) / opts.max_turn
+    let by_turn = if opts.max_turn_rad.is_finite() {
+        minimum::estimate_turning(curve) / opts.max_turn_rad
     } else {
         0.0
     };
@@ -398,7 +398,7 @@ pub fn discretize_range(
         opts,
         scratch: Default::default(),
         param_only: opts.strategy == Strategy::EqualError,
-        emin: opts.band * (opts.tolerance - margin),
+        emin: opts.band * (opts.tolerance_mm - margin),
         cert,
         sqrt_curvature: 0.0,
     };

@@ -26,7 +26,7 @@ pub enum Strategy {
 pub struct Options {
     /// The chord tolerance `E_max`: every segment's chord error is at most this, mm. Must be > 0;
     /// default 0.01 (start a chain with [`Options::with_tolerance`]).
-    pub tolerance: f64,
+    pub tolerance_mm: f64,
     /// The lower edge of the band as a fraction of the tolerance: `E_min = band * tolerance`.
     /// A step whose estimated chord error lies in `[E_min, E_max]` is accepted at once; a
     /// shorter one is lengthened. In `(0, 1)`; default 0.97 (measured: see
@@ -34,14 +34,14 @@ pub struct Options {
     pub band: f64,
     /// The longest chord allowed (machines limit block length), mm. `f64::INFINITY` (the
     /// default) for none.
-    pub max_segment_length: f64,
+    pub max_segment_length_mm: f64,
     /// The sphere radius is never proposed below this length; the tolerance still wins where
     /// it needs shorter segments, and the last segment before a C0 break or the end may be
     /// shorter, mm. Default 0.
-    pub min_segment_length: f64,
+    pub min_segment_length_mm: f64,
     /// The largest turn of the tangent between the two ends of a segment, in radians.
     /// `f64::INFINITY` (the default) for none.
-    pub max_turn: f64,
+    pub max_turn_rad: f64,
     /// Which method to use. Default [`Strategy::ReferenceSphere`].
     pub strategy: Strategy,
     /// Refuse curves that would need more points than this (protects against a tolerance
@@ -52,11 +52,11 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Self {
-            tolerance: 0.01,
+            tolerance_mm: 0.01,
             band: 0.97,
-            max_segment_length: f64::INFINITY,
-            min_segment_length: 0.0,
-            max_turn: f64::INFINITY,
+            max_segment_length_mm: f64::INFINITY,
+            min_segment_length_mm: 0.0,
+            max_turn_rad: f64::INFINITY,
             strategy: Strategy::ReferenceSphere,
             max_points: 50_000_000,
         }
@@ -70,24 +70,24 @@ impl Options {
         self
     }
 
-    /// Sets [`max_segment_length`](Self::max_segment_length): the longest chord allowed
+    /// Sets [`max_segment_length_mm`](Self::max_segment_length_mm): the longest chord allowed
     /// (machines limit block length).
-    pub fn with_max_segment_length(mut self, max_segment_length: f64) -> Self {
-        self.max_segment_length = max_segment_length;
+    pub fn with_max_segment_length_mm(mut self, max_segment_length_mm: f64) -> Self {
+        self.max_segment_length_mm = max_segment_length_mm;
         self
     }
 
-    /// Sets [`min_segment_length`](Self::min_segment_length): the sphere radius is never
+    /// Sets [`min_segment_length_mm`](Self::min_segment_length_mm): the sphere radius is never
     /// proposed below this length.
-    pub fn with_min_segment_length(mut self, min_segment_length: f64) -> Self {
-        self.min_segment_length = min_segment_length;
+    pub fn with_min_segment_length_mm(mut self, min_segment_length_mm: f64) -> Self {
+        self.min_segment_length_mm = min_segment_length_mm;
         self
     }
 
-    /// Sets [`max_turn`](Self::max_turn): the largest turn of the tangent between the two
+    /// Sets [`max_turn_rad`](Self::max_turn_rad): the largest turn of the tangent between the two
     /// ends of a segment, in radians.
-    pub fn with_max_turn(mut self, max_turn: f64) -> Self {
-        self.max_turn = max_turn;
+    pub fn with_max_turn_rad(mut self, max_turn_rad: f64) -> Self {
+        self.max_turn_rad = max_turn_rad;
         self
     }
 
@@ -104,12 +104,19 @@ impl Options {
         self
     }
 
-    /// Default options with the given tolerance.
-    pub fn with_tolerance(tolerance: f64) -> Self {
+    /// Default options with the given chord tolerance, mm (a constructor: the setter of an
+    /// existing value is [`Options::with_tolerance_mm`]).
+    pub fn with_tolerance(tolerance_mm: f64) -> Self {
         Self {
-            tolerance,
+            tolerance_mm,
             ..Self::default()
         }
+    }
+
+    /// Sets [`tolerance_mm`](Self::tolerance_mm): the chord tolerance, mm.
+    pub fn with_tolerance_mm(mut self, tolerance_mm: f64) -> Self {
+        self.tolerance_mm = tolerance_mm;
+        self
     }
 
     /// Checks every option.
@@ -124,31 +131,35 @@ impl Options {
                 reason,
             })
         };
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return bad("tolerance", self.tolerance, "must be finite and > 0");
+        if !(self.tolerance_mm.is_finite() && self.tolerance_mm > 0.0) {
+            return bad("tolerance_mm", self.tolerance_mm, "must be finite and > 0");
         }
         if !(self.band > 0.0 && self.band < 1.0) {
             return bad("band", self.band, "must lie strictly between 0 and 1");
         }
-        if self.max_segment_length.is_nan() || self.max_segment_length <= 0.0 {
-            return bad("max_segment_length", self.max_segment_length, "must be > 0");
-        }
-        if !(self.min_segment_length.is_finite() && self.min_segment_length >= 0.0) {
+        if self.max_segment_length_mm.is_nan() || self.max_segment_length_mm <= 0.0 {
             return bad(
-                "min_segment_length",
-                self.min_segment_length,
+                "max_segment_length_mm",
+                self.max_segment_length_mm,
+                "must be > 0",
+            );
+        }
+        if !(self.min_segment_length_mm.is_finite() && self.min_segment_length_mm >= 0.0) {
+            return bad(
+                "min_segment_length_mm",
+                self.min_segment_length_mm,
                 "must be finite and >= 0",
             );
         }
-        if self.min_segment_length > self.max_segment_length {
+        if self.min_segment_length_mm > self.max_segment_length_mm {
             return bad(
-                "min_segment_length",
-                self.min_segment_length,
-                "must not exceed max_segment_length",
+                "min_segment_length_mm",
+                self.min_segment_length_mm,
+                "must not exceed max_segment_length_mm",
             );
         }
-        if self.max_turn.is_nan() || self.max_turn <= 0.0 {
-            return bad("max_turn", self.max_turn, "must be > 0 (radians)");
+        if self.max_turn_rad.is_nan() || self.max_turn_rad <= 0.0 {
+            return bad("max_turn_rad", self.max_turn_rad, "must be > 0 (radians)");
         }
         Ok(())
     }

@@ -52,7 +52,7 @@ enum Fail {
 
 impl Walker<'_> {
     fn certify(&mut self, t0: f64, p0: &Point3<f64>, hit: &Hit) -> (Bound, Option<Fail>) {
-        let tol = self.opts.tolerance;
+        let tol = self.opts.tolerance_mm;
         let bound = self.cert.chord_error_hinted(
             &mut self.scratch,
             t0,
@@ -66,11 +66,11 @@ impl Walker<'_> {
         if bound.upper > tol {
             return (bound, Some(Fail::Chord));
         }
-        if (hit.p - p0).norm() > self.opts.max_segment_length {
+        if (hit.p - p0).norm() > self.opts.max_segment_length_mm {
             return (bound, Some(Fail::Chord));
         }
-        if self.opts.max_turn.is_finite()
-            && self.cert.turn_bound(t0, hit.t, self.opts.max_turn) > self.opts.max_turn
+        if self.opts.max_turn_rad.is_finite()
+            && self.cert.turn_bound(t0, hit.t, self.opts.max_turn_rad) > self.opts.max_turn_rad
         {
             return (bound, Some(Fail::Turn));
         }
@@ -85,11 +85,11 @@ impl Walker<'_> {
         pb: Point3<f64>,
         out: &mut Discretization,
     ) -> Result<()> {
-        let tol = self.opts.tolerance;
+        let tol = self.opts.tolerance_mm;
         let emin = self.emin;
         let hp = 0.5 * (emin + tol);
-        let max_len = self.opts.max_segment_length;
-        let min_len = self.opts.min_segment_length;
+        let max_len = self.opts.max_segment_length_mm;
+        let min_len = self.opts.min_segment_length_mm;
         let mut t0 = a;
         let mut p0 = *out.points.last().expect("start point pushed");
         // Ratio of the accepted radius to the curvature prediction at the previous point: the
@@ -273,7 +273,7 @@ impl Walker<'_> {
                 return Err(if last_fail == Fail::Turn {
                     DiscretizeError::TurnUnreachable {
                         t: t0,
-                        max_turn_deg: self.opts.max_turn.to_degrees(),
+                        max_turn_deg: self.opts.max_turn_rad.to_degrees(),
                     }
                 } else if stuck || next_float_gap(t0) * 4.0 >= b - t0 {
                     DiscretizeError::ParameterResolution { t: t0 }

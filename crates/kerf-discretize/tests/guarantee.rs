@@ -55,7 +55,7 @@ fn a_straight_line_is_one_segment_or_what_max_length_demands() {
     );
     let d = discretize(&cubic_line, &Options::with_tolerance(0.001)).unwrap();
     assert_eq!(d.segments(), 1, "a straight cubic needs one segment");
-    let opts = Options::with_tolerance(0.001).with_max_segment_length(7.0);
+    let opts = Options::with_tolerance(0.001).with_max_segment_length_mm(7.0);
     let d = discretize(&line, &opts).unwrap();
     let len = (100.0f64 * 100.0 + 400.0 + 25.0).sqrt();
     assert_eq!(

@@ -11,27 +11,27 @@ use nalgebra::Point3;
 fn every_bad_option_is_named() {
     let c = arc(10.0, 1.0);
     let cases: Vec<(Options, &str)> = vec![
-        (Options::with_tolerance(0.0), "tolerance"),
-        (Options::with_tolerance(-1.0), "tolerance"),
-        (Options::with_tolerance(f64::NAN), "tolerance"),
-        (Options::with_tolerance(f64::INFINITY), "tolerance"),
+        (Options::with_tolerance(0.0), "tolerance_mm"),
+        (Options::with_tolerance(-1.0), "tolerance_mm"),
+        (Options::with_tolerance(f64::NAN), "tolerance_mm"),
+        (Options::with_tolerance(f64::INFINITY), "tolerance_mm"),
         (Options::default().with_band(1.0), "band"),
         (Options::default().with_band(0.0), "band"),
         (
-            Options::default().with_max_segment_length(0.0),
-            "max_segment_length",
+            Options::default().with_max_segment_length_mm(0.0),
+            "max_segment_length_mm",
         ),
         (
-            Options::default().with_min_segment_length(f64::NAN),
-            "min_segment_length",
+            Options::default().with_min_segment_length_mm(f64::NAN),
+            "min_segment_length_mm",
         ),
         (
             Options::default()
-                .with_min_segment_length(5.0)
-                .with_max_segment_length(1.0),
-            "min_segment_length",
+                .with_min_segment_length_mm(5.0)
+                .with_max_segment_length_mm(1.0),
+            "min_segment_length_mm",
         ),
-        (Options::default().with_max_turn(-1.0), "max_turn"),
+        (Options::default().with_max_turn_rad(-1.0), "max_turn_rad"),
     ];
     for (opts, name) in cases {
         match discretize(&c, &opts) {
@@ -44,7 +44,7 @@ fn every_bad_option_is_named() {
 #[test]
 fn max_turn_limits_the_tangent_turn_per_segment() {
     let c = arc(100.0, 2.0);
-    let opts = Options::with_tolerance(0.1).with_max_turn(0.05);
+    let opts = Options::with_tolerance(0.1).with_max_turn_rad(0.05);
     let d = discretize(&c, &opts).unwrap();
     check(&c, &d, 0.1);
     for w in d.params().windows(2) {
@@ -60,7 +60,7 @@ fn max_turn_limits_the_tangent_turn_per_segment() {
 #[test]
 fn min_segment_length_keeps_proposals_long_but_tolerance_wins() {
     let c = arc(5.0, 2.5);
-    let opts = Options::with_tolerance(0.01).with_min_segment_length(3.0);
+    let opts = Options::with_tolerance(0.01).with_min_segment_length_mm(3.0);
     let d = discretize(&c, &opts).unwrap();
     check(&c, &d, 0.01);
 }

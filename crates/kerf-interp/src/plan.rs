@@ -5,7 +5,7 @@
 //!    than 5 degrees, rapid moves, pure rotations, path changes) and lays a C2 spline through
 //!    the poses of each run: the path the machine follows, smooth between corners. With jerk
 //!    limits the tip follows the spline's moving mean over a window within
-//!    [`PlanOptions::blend_tolerance`], which ramps every curvature jump (a clothoid-like
+//!    [`PlanOptions::blend_tolerance_mm`], which ramps every curvature jump (a clothoid-like
 //!    blend); the rotary axes never leave their ranges (soft-range coordinates).
 //! 2. Along a run the machine axes are `q(s)` of the tip's arc length `s`; with `x = (ds/dt)^2`
 //!    and `u = d2s/dt2` every axis must satisfy `-A_k <= q'_k(s) u + q''_k(s) x <= A_k` and
@@ -70,12 +70,12 @@ pub const JERK_FILTER_WIDTH: f64 = 1.25;
 pub struct PlanOptions {
     /// Programmed cutting feed, mm/min (the tip's speed along the path). Must be > 0; no
     /// default (given to [`PlanOptions::new`]).
-    pub feed: f64,
+    pub feed_mm_per_min: f64,
     /// Interpolation cycle `T`, seconds. Must be > 0; no default (given to [`PlanOptions::new`]).
-    pub cycle: f64,
+    pub cycle_s: f64,
     /// Largest chord error between two set-points on a curve, mm (paper 000 eq 17-18): caps
     /// the feed on small radii. Default 0.001.
-    pub chord_tolerance: f64,
+    pub chord_tolerance_mm: f64,
     /// Refuse programs of more cycles than this. Default 50 million.
     pub max_cycles: usize,
     /// Most re-plans after a verification finds a cycle over a limit. Default 60.
@@ -90,7 +90,7 @@ pub struct PlanOptions {
     pub block_ends_on_cycles: bool,
     /// Largest spacing of the planning grid along the path, mm (degrees on a turn); the grid
     /// also has at least two intervals between neighbouring spline nodes. Default 0.5.
-    pub grid_step: f64,
+    pub grid_step_mm: f64,
     /// Work budget: most grid points of the whole program; longer programs get a coarser grid
     /// (the verification still holds every cycle to the limits). Default 5 million.
     pub max_grid_points: usize,
@@ -101,26 +101,26 @@ pub struct PlanOptions {
     /// window (a clothoid-like transition) within `e`. 0 for none; not used without jerk limits
     /// (a curvature jump is an acceleration jump, which they allow) or with
     /// [`PlanOptions::block_ends_on_cycles`] (whose block ends are exact).
-    pub blend_tolerance: f64,
+    pub blend_tolerance_mm: f64,
 }
 
 impl PlanOptions {
-    /// Sets [`feed`](Self::feed): programmed cutting feed, mm/min (the tip's speed along the path).
-    pub fn with_feed(mut self, feed: f64) -> Self {
-        self.feed = feed;
+    /// Sets [`feed_mm_per_min`](Self::feed_mm_per_min): programmed cutting feed, mm/min (the tip's speed along the path).
+    pub fn with_feed_mm_per_min(mut self, feed_mm_per_min: f64) -> Self {
+        self.feed_mm_per_min = feed_mm_per_min;
         self
     }
 
-    /// Sets [`cycle`](Self::cycle): interpolation cycle `T`, seconds.
-    pub fn with_cycle(mut self, cycle: f64) -> Self {
-        self.cycle = cycle;
+    /// Sets [`cycle_s`](Self::cycle_s): interpolation cycle `T`, seconds.
+    pub fn with_cycle_s(mut self, cycle_s: f64) -> Self {
+        self.cycle_s = cycle_s;
         self
     }
 
-    /// Sets [`chord_tolerance`](Self::chord_tolerance): largest chord error between two
+    /// Sets [`chord_tolerance_mm`](Self::chord_tolerance_mm): largest chord error between two
     /// set-points on a curve, mm (paper 000 eq 17-18).
-    pub fn with_chord_tolerance(mut self, chord_tolerance: f64) -> Self {
-        self.chord_tolerance = chord_tolerance;
+    pub fn with_chord_tolerance_mm(mut self, chord_tolerance_mm: f64) -> Self {
+        self.chord_tolerance_mm = chord_tolerance_mm;
         self
     }
 
@@ -144,10 +144,10 @@ impl PlanOptions {
         self
     }
 
-    /// Sets [`grid_step`](Self::grid_step): largest spacing of the planning grid along the
+    /// Sets [`grid_step_mm`](Self::grid_step_mm): largest spacing of the planning grid along the
     /// path, mm (degrees on a turn).
-    pub fn with_grid_step(mut self, grid_step: f64) -> Self {
-        self.grid_step = grid_step;
+    pub fn with_grid_step_mm(mut self, grid_step_mm: f64) -> Self {
+        self.grid_step_mm = grid_step_mm;
         self
     }
 
@@ -157,36 +157,36 @@ impl PlanOptions {
         self
     }
 
-    /// Sets [`blend_tolerance`](Self::blend_tolerance): with jerk limits.
-    pub fn with_blend_tolerance(mut self, blend_tolerance: f64) -> Self {
-        self.blend_tolerance = blend_tolerance;
+    /// Sets [`blend_tolerance_mm`](Self::blend_tolerance_mm): with jerk limits.
+    pub fn with_blend_tolerance_mm(mut self, blend_tolerance_mm: f64) -> Self {
+        self.blend_tolerance_mm = blend_tolerance_mm;
         self
     }
 
     /// Options with this feed (mm/min) and cycle (s), defaults otherwise.
-    pub fn new(feed: f64, cycle: f64) -> Self {
+    pub fn new(feed_mm_per_min: f64, cycle_s: f64) -> Self {
         Self {
-            feed,
-            cycle,
-            chord_tolerance: 0.001,
+            feed_mm_per_min,
+            cycle_s,
+            chord_tolerance_mm: 0.001,
             max_cycles: 50_000_000,
             max_refinements: 60,
             block_ends_on_cycles: false,
-            grid_step: 0.5,
+            grid_step_mm: 0.5,
             max_grid_points: 5_000_000,
-            blend_tolerance: crate::DEFAULT_BLEND_TOLERANCE,
+            blend_tolerance_mm: crate::DEFAULT_BLEND_TOLERANCE,
         }
     }
 
     fn validate(&self) -> Result<()> {
-        positive("feed", self.feed)?;
-        positive("cycle", self.cycle)?;
-        positive("chord_tolerance", self.chord_tolerance)?;
-        positive("grid_step", self.grid_step)?;
-        if !(self.blend_tolerance >= 0.0 && self.blend_tolerance.is_finite()) {
+        positive("feed_mm_per_min", self.feed_mm_per_min)?;
+        positive("cycle_s", self.cycle_s)?;
+        positive("chord_tolerance_mm", self.chord_tolerance_mm)?;
+        positive("grid_step_mm", self.grid_step_mm)?;
+        if !(self.blend_tolerance_mm >= 0.0 && self.blend_tolerance_mm.is_finite()) {
             return Err(InterpError::BadParameter {
-                name: "blend_tolerance",
-                value: self.blend_tolerance,
+                name: "blend_tolerance_mm",
+                value: self.blend_tolerance_mm,
                 reason: "must be finite and >= 0",
             });
         }
@@ -228,7 +228,7 @@ pub fn plan<M: AxisModel + ?Sized>(
     let path = PathOptions {
         rotary_ranges: [limits.range[3], limits.range[4]],
         blend_tolerance: if limits.max_jerk.is_some() && !opts.block_ends_on_cycles {
-            opts.blend_tolerance
+            opts.blend_tolerance_mm
         } else {
             0.0
         },
@@ -237,7 +237,7 @@ pub fn plan<M: AxisModel + ?Sized>(
     let total_len: f64 = runs.iter().map(Run::len).sum();
     // The work budget: a coarser grid for very long programs.
     let step = opts
-        .grid_step
+        .grid_step_mm
         .max(2.0 * total_len / opts.max_grid_points.max(1000) as f64);
     let tau = limits.max_jerk.map_or(0.0, |j| {
         (0..5)
@@ -307,7 +307,7 @@ pub fn plan<M: AxisModel + ?Sized>(
                 1 => (f, f),
                 _ => (f.powf(1.0 / 3.0), f),
             };
-            let (mut lo, mut hi) = (v.time - 3.0 * opts.cycle, v.time + 3.0 * opts.cycle);
+            let (mut lo, mut hi) = (v.time - 3.0 * opts.cycle_s, v.time + 3.0 * opts.cycle_s);
             if opts.block_ends_on_cycles {
                 // The speed jumps where two blocks slowed by different factors meet: lower the
                 // whole blocks around the cycle.

@@ -45,7 +45,8 @@ fn a_slot_is_blended_within_the_tolerance_and_planned_near_the_optimum() {
     for feed in [20000.0, 40000.0] {
         let opts = PlanOptions::new(feed, 0.001);
         let jerk = plan(&m, &blocks, &opts).expect("plan");
-        let unblended = plan(&m, &blocks, &opts.clone().with_blend_tolerance(0.0)).expect("plan");
+        let unblended =
+            plan(&m, &blocks, &opts.clone().with_blend_tolerance_mm(0.0)).expect("plan");
         let limits = m.limits.max_jerk.take();
         let acc = plan(&m, &blocks, &opts).expect("plan");
         m.limits.max_jerk = limits;
@@ -71,14 +72,14 @@ fn a_slot_is_blended_within_the_tolerance_and_planned_near_the_optimum() {
             jerk.duration() < 0.98 * unblended.duration(),
             "{feed}: the blend buys time"
         );
-        assert!(jerk.blend_deviation() <= opts.blend_tolerance, "{feed}");
+        assert!(jerk.blend_deviation() <= opts.blend_tolerance_mm, "{feed}");
         assert!(
-            jerk.blend_deviation() > 0.2 * opts.blend_tolerance,
+            jerk.blend_deviation() > 0.2 * opts.blend_tolerance_mm,
             "{feed}"
         );
         assert_eq!(acc.blend_deviation(), 0.0, "no blend without jerk limits");
         // The set-points against the exact slot: the blend plus the spline's own few um.
-        assert!(worst <= opts.blend_tolerance + 0.002, "{feed}: {worst}");
+        assert!(worst <= opts.blend_tolerance_mm + 0.002, "{feed}: {worst}");
     }
 }
 
@@ -88,10 +89,10 @@ fn a_negative_blend_tolerance_is_refused() {
     let st = solve_stations(&m, &slot(), None, None, None).expect("reachable");
     let blocks = fit_blocks(&m, &st, None, 0, &FitOptions::with_tolerance(0.001)).expect("fit");
     for bad in [-0.001, f64::NAN, f64::INFINITY] {
-        let opts = PlanOptions::new(20000.0, 0.001).with_blend_tolerance(bad);
+        let opts = PlanOptions::new(20000.0, 0.001).with_blend_tolerance_mm(bad);
         let err = plan(&m, &blocks, &opts).expect_err("refused");
         assert!(
-            matches!(err, InterpError::BadParameter { name, .. } if name == "blend_tolerance"),
+            matches!(err, InterpError::BadParameter { name, .. } if name == "blend_tolerance_mm"),
             "{err}"
         );
     }
@@ -243,7 +244,7 @@ fn long_edges_between_fine_corners_do_not_make_the_spline_ring() {
             .fold(0.0, f64::max);
         println!("jerk {jerk}: largest distance from the rounded rectangle {worst:.2e} mm");
         let sagitta = 3.0 * (1.0 - 5f64.to_radians().cos());
-        let blend = if jerk { opts.blend_tolerance } else { 0.0 };
+        let blend = if jerk { opts.blend_tolerance_mm } else { 0.0 };
         assert!(worst <= sagitta + blend + 1e-4, "jerk {jerk}: {worst}");
     }
 }

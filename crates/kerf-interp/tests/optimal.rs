@@ -99,7 +99,7 @@ fn circles_plan_within_five_percent_of_the_dense_reference() {
             fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::with_tolerance(0.01)).expect("fit");
         for feed in feeds {
             // The reference has no chord cap: lift it out of the way.
-            let opts = PlanOptions::new(feed, 0.001).with_chord_tolerance(1.0);
+            let opts = PlanOptions::new(feed, 0.001).with_chord_tolerance_mm(1.0);
             let motion = plan(&m, &blocks, &opts).expect("plan");
             let reference = circle_reference(
                 radius,

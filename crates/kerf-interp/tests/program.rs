@@ -25,7 +25,7 @@ fn check_with(
     blocks: &[kerf_interp::Block],
     opts: &PlanOptions,
 ) -> kerf_interp::Motion {
-    let cycle = opts.cycle;
+    let cycle = opts.cycle_s;
     let motion = plan(m, blocks, opts).expect("plan");
     let rows = motion.setpoints(m);
     assert_eq!(rows.len(), motion.cycles() + 1, "{name}: one row per cycle");
@@ -97,7 +97,7 @@ fn freeform_with_varying_tool_axis_stays_within_limits() {
     let loose = plan(
         &m,
         &fitted,
-        &PlanOptions::new(15000.0, 0.001).with_chord_tolerance(1.0),
+        &PlanOptions::new(15000.0, 0.001).with_chord_tolerance_mm(1.0),
     )
     .expect("plan");
     println!("freeform fitted, no chord cap: {} cycles", loose.cycles());
@@ -206,7 +206,7 @@ fn plan_refuses_bad_options() {
     for o in [
         PlanOptions::new(f64::NAN, 0.001),
         PlanOptions::new(1000.0, 0.0),
-        PlanOptions::new(1000.0, 0.001).with_chord_tolerance(-1.0),
+        PlanOptions::new(1000.0, 0.001).with_chord_tolerance_mm(-1.0),
     ] {
         let e = plan(&m, &blocks, &o);
         assert!(

@@ -310,7 +310,7 @@ impl Ctx<'_> {
     /// pushes `b`.
     fn finish(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
         if !certified {
-            let tol = self.dopts.tolerance;
+            let tol = self.dopts.tolerance_mm;
             let bound = self
                 .cert
                 .chord_error(&mut self.scratch, a.t, b.t, &a.p, &b.p, tol, 0.0);

@@ -458,7 +458,7 @@ fn cone_apex_normals_are_the_limits_along_the_curve() {
     };
     let src = NurbsNormals::new(surface.clone(), false);
     // Short segments, so that many cutting points lie just past the apex.
-    let dopts = Options::with_tolerance(0.01).with_max_segment_length(0.5);
+    let dopts = Options::with_tolerance(0.01).with_max_segment_length_mm(0.5);
     let disc = discretize(&rec.curve, &dopts).expect("discretized");
     let o = orient(&rec.curve, &disc, &src, &dopts, &NormalOptions::default()).expect("oriented");
     // Analytic: on z = r (half angle 45 degrees) Su x Sv points along (x / r, y / r, -1).

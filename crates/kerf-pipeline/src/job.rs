@@ -135,7 +135,7 @@ impl Default for JobOptions {
 impl JobOptions {
     /// With this chord tolerance, mm: every segment's chord error is at most this (certified).
     pub fn with_tolerance_mm(mut self, mm: f64) -> Self {
-        self.discretize.tolerance = mm;
+        self.discretize.tolerance_mm = mm;
         self
     }
 

@@ -104,7 +104,7 @@ pub struct MotionOptions {
     pub retract_mm: f64,
     /// The controller's blending tolerance, mm. Default
     /// [`kerf_interp::DEFAULT_BLEND_TOLERANCE`]. It is also the planner's
-    /// `PlanOptions::blend_tolerance`: with jerk limits the set-points' tip leaves the smooth
+    /// `PlanOptions::blend_tolerance_mm`: with jerk limits the set-points' tip leaves the smooth
     /// path by at most this much to blend curvature jumps (reported by
     /// `Motion::blend_deviation`).
     pub blend_tolerance_mm: f64,
@@ -268,9 +268,9 @@ pub fn plan_program(
     let mut plan = PlanOptions::new(options.feed_mm_per_min, options.cycle_s);
     // One number bounds both blends: the controller's (G64 P, CTOL) and, with jerk limits,
     // the planner's blend of curvature jumps in the set-points.
-    plan.blend_tolerance = options.blend_tolerance_mm;
+    plan.blend_tolerance_mm = options.blend_tolerance_mm;
     if let Some(c) = options.chord_tolerance_mm {
-        plan.chord_tolerance = c;
+        plan.chord_tolerance_mm = c;
     }
     let fit = fit_options(fit_tolerance, options.dialect, options.retract_mm);
     let motion = if traverses.is_empty() {

@@ -56,11 +56,13 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let starts: Vec<Option<f64>> = discs
         .iter_mut()
         .zip(&file.curves)
-        .map(|(d, r)| kerf_process::prepare_start(&r.curve, d, r.start, &o.leads, dopts.tolerance))
+        .map(|(d, r)| {
+            kerf_process::prepare_start(&r.curve, d, r.start, &o.leads, dopts.tolerance_mm)
+        })
         .collect();
     // 2. Normals (+z for curves that name no surface, unless the options refuse them).
     let oriented: Vec<Oriented> = orient_curves(file, &discs, &dopts, &o.orient, path, progress)?;
-    let tp = toolpath_of_poses(file, dopts.tolerance, &oriented);
+    let tp = toolpath_of_poses(file, dopts.tolerance_mm, &oriented);
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
     let popts = o.path;
     progress(Progress::new(Stage::Kinematics, 0, 1));
@@ -118,9 +120,9 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let model = MachineModel::new(machine.clone()).map_err(interp(path))?;
     let dialect = o.dialect;
     // The generic-dialect rule: the fit follows from the dialect, no option can change it.
-    let fit = crate::motion::fit_options(dopts.tolerance, Some(dialect), o.retract_mm);
+    let fit = crate::motion::fit_options(dopts.tolerance_mm, Some(dialect), o.retract_mm);
     let mut plan = PlanOptions::new(o.feed_mm_per_min, o.cycle_s);
-    plan.blend_tolerance = o.blend_tolerance_mm; // the planner's blend and the controller's
+    plan.blend_tolerance_mm = o.blend_tolerance_mm; // the planner's blend and the controller's
     let source_name = path.map(|p| p.display().to_string());
     let gopts = crate::motion::gcode_options(
         &model,
@@ -129,8 +131,8 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         o.blend_tolerance_mm,
         source_name.as_deref(),
     )
-    .with_fit_tolerance_mm(dopts.tolerance)
-    .with_chord_tolerance_mm(plan.chord_tolerance)
+    .with_fit_tolerance_mm(dopts.tolerance_mm)
+    .with_chord_tolerance_mm(plan.chord_tolerance_mm)
     .with_linearization_tolerance_mm(Some(popts.linearization_tolerance_mm));
     let mut motions = Vec::new();
     let mut programs = Vec::new();
@@ -349,15 +351,15 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let duration: f64 = motions.iter().map(|m| m.duration()).sum();
     let cycles: usize = motions.iter().map(|m| m.cycles()).sum();
     // N* from the curvature the walk evaluated at its points (`Discretization::n_star`).
-    let nstar: f64 = discs.iter().map(|d| d.n_star(dopts.tolerance)).sum();
+    let nstar: f64 = discs.iter().map(|d| d.n_star(dopts.tolerance_mm)).sum();
     let segments: usize = discs.iter().map(Discretization::segments).sum();
     let report = json!({
         "input": source_name,
         "machine": machine.name,
         "tolerance_budget_mm": {
-            "chord": dopts.tolerance,
+            "chord": dopts.tolerance_mm,
             "linearization": popts.linearization_tolerance_mm,
-            "interpolation_chord": plan.chord_tolerance,
+            "interpolation_chord": plan.chord_tolerance_mm,
             "controller_blending": gopts.blend_tolerance_mm,
             "total": gopts.budget_total(),
         },

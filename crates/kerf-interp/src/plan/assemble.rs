@@ -27,14 +27,14 @@ pub(super) fn assemble(
         starts.push(total);
         total += tm.duration;
     }
-    let cycles = total / opts.cycle;
+    let cycles = total / opts.cycle_s;
     if cycles.is_nan() || cycles > opts.max_cycles as f64 {
         return Err(InterpError::TooManyCycles {
             cycles,
             limit: opts.max_cycles,
         });
     }
-    let feed = opts.feed / 60.0;
+    let feed = opts.feed_mm_per_min / 60.0;
     let mut block_times = vec![[0.0; 2]; blocks.len()];
     let mut feeds = vec![0.0; blocks.len()];
     let mut stats: Vec<PathStats> = Vec::new();
@@ -88,7 +88,7 @@ pub(super) fn assemble(
             st.cutting_time += tm.duration;
             st.cutting_length += run.len();
             // Sample the run at half a cycle.
-            let dt = opts.cycle / 2.0;
+            let dt = opts.cycle_s / 2.0;
             let steps = (tm.duration / dt).ceil() as usize;
             let dt = tm.duration / steps.max(1) as f64;
             for k in 0..steps {
@@ -112,7 +112,7 @@ pub(super) fn assemble(
             .iter()
             .map(|[a, e]| {
                 let d = e - a;
-                let n = ((d / opts.cycle - 1e-9).ceil() as usize).max(1);
+                let n = ((d / opts.cycle_s - 1e-9).ceil() as usize).max(1);
                 let c = BlockClock {
                     first,
                     n,
@@ -124,7 +124,7 @@ pub(super) fn assemble(
             })
             .collect();
         total_cycles = first;
-        duration = first as f64 * opts.cycle;
+        duration = first as f64 * opts.cycle_s;
         clock
     });
     if total_cycles > opts.max_cycles {
@@ -139,7 +139,7 @@ pub(super) fn assemble(
         timed,
         starts,
         duration,
-        cycle: opts.cycle,
+        cycle: opts.cycle_s,
         refinements,
         grid_points: grids.iter().map(|g| g.s.len()).sum(),
         axis_names: names.clone(),

@@ -158,7 +158,7 @@ impl Motion {
     }
 
     /// The largest distance of the tip, over every set-point, from the smooth path before the
-    /// blend of curvature changes ([`PlanOptions::blend_tolerance`](super::PlanOptions)), mm:
+    /// blend of curvature changes ([`PlanOptions::blend_tolerance_mm`](super::PlanOptions)), mm:
     /// measured on the set-points' own path parameters, so it is what the blend really cost;
     /// at most the blend tolerance, 0 without jerk limits.
     pub fn blend_deviation(&self) -> f64 {

@@ -222,7 +222,7 @@ pub(super) fn run_grid<M: AxisModel + ?Sized>(
     let mut tip_speed = Vec::with_capacity(n);
     let mut cap = Vec::with_capacity(n);
     let mut static_mv = Vec::with_capacity(n);
-    let feed = opts.feed / 60.0;
+    let feed = opts.feed_mm_per_min / 60.0;
     for (&si, &(a, b, c)) in s.iter().zip(&fine_d) {
         let (t1, t2) = run.tip_derivatives(si);
         let speed = t1.norm();
@@ -243,8 +243,8 @@ pub(super) fn run_grid<M: AxisModel + ?Sized>(
             }
             let kappa = t1.cross(&t2).norm() / speed.powi(3);
             if kappa > 1e-12 {
-                let step = (8.0 * opts.chord_tolerance / kappa).sqrt();
-                x = x.min((step / opts.cycle / speed).powi(2));
+                let step = (8.0 * opts.chord_tolerance_mm / kappa).sqrt();
+                x = x.min((step / opts.cycle_s / speed).powi(2));
             }
         }
         let x = x.min(1e18);

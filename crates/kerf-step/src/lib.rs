@@ -165,7 +165,8 @@ pub struct Report {
     pub surfaces: Vec<String>,
 }
 
-/// Reads a STEP file from disk; see [`import`].
+/// Reads a STEP file from disk through kerf's one reader (`kerf_io::read_file`: at most 1 GiB,
+/// a leading UTF-8 byte-order mark skipped); see [`import`].
 ///
 /// # Errors
 /// [`FileError`] naming the file around any [`StepError`].
@@ -174,18 +175,19 @@ pub fn import_file(
     opts: &ImportOptions,
 ) -> std::result::Result<Import, FileError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| {
+    let bytes = kerf_io::read_file(path).map_err(|source| {
         StepError::Read {
             path: path.to_path_buf(),
             source,
         }
         .in_file(path)
     })?;
-    let text = String::from_utf8_lossy(&bytes);
+    let text = String::from_utf8_lossy(kerf_io::strip_bom(&bytes));
     import(&text, opts).map_err(|e| e.in_file(path))
 }
 
-/// Reads the text of a STEP file into a `kerf.curves/1` document.
+/// Reads the text of a STEP file into a `kerf.curves/1` document (a leading byte-order mark,
+/// `U+FEFF`, is skipped).
 ///
 /// # Errors
 /// [`StepError::Syntax`] for malformed Part 21, [`StepError::Entity`] naming the entity for a
@@ -193,6 +195,7 @@ pub fn import_file(
 /// reported instead), [`StepError::NoContour`] if nothing can be cut,
 /// [`StepError::Options`] for a non-positive or non-finite option.
 pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (name, v) in [
         ("close_gaps_mm", opts.close_gaps_mm),
         ("face_tolerance_mm", opts.face_tolerance_mm),

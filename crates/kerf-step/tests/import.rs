@@ -437,3 +437,34 @@ fn hostile_files_give_errors_not_hangs_or_panics() {
         "{e}"
     );
 }
+
+#[test]
+fn a_byte_order_mark_is_skipped_by_both_entry_points() {
+    let path = fixture("composite_mm.step");
+    let bytes = std::fs::read(&path).expect("fixture");
+    let opts = ImportOptions::default();
+    let plain = import_file(&path, &opts).expect("the fixture imports");
+    let json = |i: &kerf_step::Import| serde_json::to_string(&i.file).expect("serialises");
+
+    let mut with_bom = b"\xEF\xBB\xBF".to_vec();
+    with_bom.extend_from_slice(&bytes);
+    let dir = std::env::temp_dir().join(format!("kerf-step-bom-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let bom_path = dir.join("composite_mm.step");
+    std::fs::write(&bom_path, &with_bom).expect("write");
+    let from_file = import_file(&bom_path, &opts).expect("a BOM file imports");
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(
+        json(&from_file),
+        json(&plain),
+        "the same document as without the BOM"
+    );
+
+    let text = format!("\u{feff}{}", String::from_utf8(bytes).expect("ASCII"));
+    let from_text = import(&text, &opts).expect("a BOM text imports");
+    assert_eq!(
+        json(&from_text),
+        json(&plain),
+        "the same document from text"
+    );
+}

@@ -20,7 +20,7 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
 use curvo::prelude::NurbsCurve3D;
-use kerf::nurbs::NurbsCurve;
+use kerf_nurbs::NurbsCurve;
 use nalgebra::Point3;
 
 /// Parameters evaluated per iteration.

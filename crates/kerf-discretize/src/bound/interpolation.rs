@@ -84,8 +84,26 @@ pub(super) fn span_derivative_bounds(
             d1: 2.0 * (pmax + cmax * (w1 + wslack)) / w_min,
             slack,
         };
+        // A NaN anywhere (inf - inf after an overflow) would vanish in the `f64::max` folds
+        // and shrink a bound: then this span is never certified by this route (an infinite
+        // `d1` makes every upper bound infinite, which `interpolation_bound` refuses).
+        let r = i * (p + 1)..(i + 1) * (p + 1);
+        if !all_finite(&h3[r.clone()], &h4[r], &out[i]) {
+            out[i].d1 = f64::INFINITY;
+        }
     }
     (h3, h4, out)
+}
+
+/// Whether a span's hodograph bounds and derived numbers are all finite (no NaN that a
+/// `f64::max` fold would drop).
+fn all_finite(h3: &[Vector4<f64>], h4: &[Vector4<f64>], sb: &SpanBounds) -> bool {
+    let finite = |v: &Vector4<f64>| v.iter().all(|c| c.is_finite());
+    h3.iter().all(finite)
+        && h4.iter().all(finite)
+        && [sb.w_max, sb.w1, sb.w2, sb.w3, sb.d1, sb.slack]
+            .iter()
+            .all(|x| x.is_finite())
 }
 
 impl Certifier<'_> {
@@ -228,5 +246,34 @@ impl Certifier<'_> {
             upper,
             lower: lower.min(upper),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{all_finite, span_derivative_bounds};
+    use nalgebra::Vector4;
+
+    #[test]
+    fn a_nan_in_a_span_bound_is_seen() {
+        let b: Vec<Vector4<f64>> = (0..5)
+            .map(|j| Vector4::new(j as f64, (j * j) as f64, 0.0, 1.0))
+            .collect();
+        let (h3, h4, out) = span_derivative_bounds(4, &b, &[16.0]);
+        assert!(out[0].d1.is_finite(), "{:?}", out[0]);
+        assert!(all_finite(&h3, &h4, &out[0]), "a tame span is usable");
+        let mut bad = h3.clone();
+        bad[0].y = f64::NAN;
+        assert!(
+            bad.iter().map(|v| v.amax()).fold(0.0, f64::max).is_finite(),
+            "a max fold drops the NaN: why the check exists"
+        );
+        assert!(
+            !all_finite(&bad, &h4, &out[0]),
+            "NaN in the third hodograph"
+        );
+        let mut sb = out[0];
+        sb.w3 = f64::NAN;
+        assert!(!all_finite(&h3, &h4, &sb), "NaN in a weight bound");
     }
 }

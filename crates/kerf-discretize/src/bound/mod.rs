@@ -154,8 +154,7 @@ impl<'a> Certifier<'a> {
                 .map(|d| d.amax())
                 .fold(0.0, f64::max);
         }
-        let pow2 = |w: f64| w.log2().fract() == 0.0;
-        let representation = if weights.iter().all(|&w| pow2(w)) {
+        let representation = if weights.iter().all(|&w| is_power_of_two(w)) {
             0.0
         } else {
             let scale = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
@@ -320,4 +319,55 @@ pub fn chord_error(
     want_lower: f64,
 ) -> Bound {
     Certifier::new(curve).chord_error(&mut Scratch::default(), t0, t1, a, b, limit, want_lower)
+}
+
+/// Whether `w` is exactly a power of two (then `(w P) / w == P` exactly, so the weighted
+/// points carry no representation error). Decided from the bits: a normal number with an
+/// empty mantissa, or a subnormal with one mantissa bit. (`log2().fract() == 0` is not
+/// enough: `log2` rounds, so `2^-5 (1 + 2^-52)` passed it.)
+fn is_power_of_two(w: f64) -> bool {
+    if !(w > 0.0 && w.is_finite()) {
+        return false;
+    }
+    let bits = w.to_bits();
+    let mantissa = bits & ((1u64 << 52) - 1);
+    if bits >> 52 == 0 {
+        mantissa.is_power_of_two()
+    } else {
+        mantissa == 0
+    }
+}
+
+#[cfg(test)]
+mod power_of_two_tests {
+    use super::is_power_of_two;
+
+    #[test]
+    fn only_exact_powers_of_two_count() {
+        for k in -1074i64..=1023 {
+            // 2^k built from its bits (powi would round the subnormal ones).
+            let w = if k >= -1022 {
+                f64::from_bits(((k + 1023) as u64) << 52)
+            } else {
+                f64::from_bits(1u64 << (k + 1074))
+            };
+            assert_eq!(w.log2(), k as f64, "2^{k} built right");
+            assert!(is_power_of_two(w), "2^{k}");
+        }
+        let near = 2f64.powi(-5) * (1.0 + f64::EPSILON);
+        assert!(near.log2().fract() == 0.0, "the old test took this one");
+        assert!(!is_power_of_two(near), "2^-5 (1 + 2^-52)");
+        for w in [
+            0.0,
+            -1.0,
+            -0.5,
+            3.0,
+            0.75,
+            f64::NAN,
+            f64::INFINITY,
+            f64::MIN_POSITIVE * 1.5,
+        ] {
+            assert!(!is_power_of_two(w), "{w}");
+        }
+    }
 }

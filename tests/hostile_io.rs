@@ -3,7 +3,7 @@
 //! toolpath readers (`kerf-format`), the machine and axes readers (`kerf-kinematics`), the
 //! checker's lenient toolpath reader (`kerf-check`) and the motion stage's axes-or-toolpath
 //! reader (`kerf-pipeline`); a byte-order mark is accepted by each. Plus inputs above the
-//! size limit made at test time, and the checks of ids and names built in code.
+//! size limit made at test time (names and ids built in code: `crates/kerf-kinematics/tests/hostile_io.rs`).
 
 use std::path::{Path, PathBuf};
 
@@ -127,40 +127,6 @@ fn hostile_axes_files() {
     run("axes", |p| {
         AxesFile::read(p).map(drop).map_err(|e| e.to_string())
     });
-}
-
-#[test]
-fn a_machine_built_in_code_with_a_newline_in_its_name_is_refused() {
-    let good = Machine::read(dir().join("machine_bom.json")).expect("valid");
-    let e = Machine::try_new(
-        "laser\nM30",
-        good.kinematics.clone(),
-        good.limits,
-        good.max_velocity,
-        good.max_acceleration,
-    )
-    .map(drop)
-    .expect_err("refused");
-    assert!(
-        e.to_string()
-            .starts_with("name: contains the control character U+000A"),
-        "{e}"
-    );
-}
-
-#[test]
-fn an_axes_file_with_a_hostile_id_is_not_written() {
-    let mut axes = AxesFile::read(dir().join("axes_bom.json")).expect("valid");
-    axes.paths[0].id = "hole\nG0 X1400\nM30".to_owned();
-    let dir = tempfile::tempdir().expect("temp dir");
-    let dest = dir.path().join("out.axes.json");
-    let e = axes.write(&dest).expect_err("refused");
-    assert!(
-        e.to_string()
-            .contains("paths[0].id: contains the control character"),
-        "{e}"
-    );
-    assert!(!dest.exists(), "nothing written");
 }
 
 #[test]

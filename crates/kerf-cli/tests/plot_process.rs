@@ -4,27 +4,12 @@
 
 mod common;
 
-use common::{fixture, kerf, read_json};
+use common::{read_json, run_auto};
 
 #[test]
 fn the_plot_numbers_the_pierces_in_cutting_order() {
     for curves in ["sheet_metal_holes.json", "door_trim.json"] {
-        let dir = tempfile::tempdir().expect("temporary directory");
-        let out = kerf()
-            .arg("run")
-            .arg(fixture(curves))
-            .arg("--machine")
-            .arg(fixture("machines").join("ac_head.json"))
-            .args(["--place", "auto", "--out"])
-            .arg(dir.path())
-            .arg("-q")
-            .output()
-            .expect("run kerf");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let dir = run_auto(curves, "ac_head.json");
         let report = read_json(&dir.path().join("report.json"));
         let pierces = report["process"]["pierces"].as_u64().expect("pierces") as usize;
         let gaps = report["traverses"]["count"].as_u64().expect("count") as usize;

@@ -51,23 +51,27 @@ fn gcode_on_the_axes_of_run_is_runs_program() {
             text.contains("\"traverse\""),
             "the part has checked traverses to honour"
         );
+        // `kerf gcode` on run's axes file, with run's feed and fit, plus `extra` options.
+        let gcode_of = |extra: &[&str], program: &std::path::Path| {
+            ok(kerf()
+                .arg("gcode")
+                .arg(&axes)
+                .arg("-m")
+                .arg(&machine)
+                .args([
+                    "-f",
+                    "6000",
+                    "--fit-tolerance",
+                    "0.01",
+                    "--dialect",
+                    dialect,
+                ])
+                .args(extra)
+                .args(["-q", "-o"])
+                .arg(program));
+        };
         let gcode = dir.path().join(format!("{dialect}.nc"));
-        ok(kerf()
-            .arg("gcode")
-            .arg(&axes)
-            .arg("-m")
-            .arg(&machine)
-            .args([
-                "-f",
-                "6000",
-                "--fit-tolerance",
-                "0.01",
-                "--dialect",
-                dialect,
-                "-q",
-                "-o",
-            ])
-            .arg(&gcode));
+        gcode_of(&[], &gcode);
         let run = blocks(&out.join("program.nc"));
         let from_axes = blocks(&gcode);
         assert!(run.len() > 100, "{dialect}: a real program");
@@ -75,21 +79,7 @@ fn gcode_on_the_axes_of_run_is_runs_program() {
 
         // `--clearance 0`: the unchecked retract instead of the recorded traverses.
         let unchecked = dir.path().join(format!("{dialect}-unchecked.nc"));
-        ok(kerf()
-            .arg("gcode")
-            .arg(&axes)
-            .arg("-m")
-            .arg(&machine)
-            .args([
-                "-f",
-                "6000",
-                "--fit-tolerance",
-                "0.01",
-                "--dialect",
-                dialect,
-            ])
-            .args(["--clearance", "0", "-q", "-o"])
-            .arg(&unchecked));
+        gcode_of(&["--clearance", "0"], &unchecked);
         assert_ne!(
             blocks(&unchecked),
             run,

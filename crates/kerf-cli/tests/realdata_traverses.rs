@@ -6,26 +6,11 @@
 
 mod common;
 
-use common::{fixture, kerf, read_json};
+use common::{fixture, read_json, run_auto};
 use serde_json::Value;
 
 fn run(curves: &str) -> (Value, Value, Value) {
-    let dir = tempfile::tempdir().expect("temporary directory");
-    let out = kerf()
-        .arg("run")
-        .arg(fixture(curves))
-        .arg("--machine")
-        .arg(fixture("machines").join("gantry_ac.json"))
-        .args(["--place", "auto", "--out"])
-        .arg(dir.path())
-        .arg("-q")
-        .output()
-        .expect("run kerf");
-    assert!(
-        out.status.success(),
-        "{curves}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let dir = run_auto(curves, "gantry_ac.json");
     let curves_file = read_json(&fixture(curves));
     (
         read_json(&dir.path().join("report.json")),

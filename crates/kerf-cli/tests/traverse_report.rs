@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{fixture, kerf, read_json};
+use common::{read_json, run_auto};
 use serde_json::Value;
 
 fn dist(a: &Value, b: &Value) -> f64 {
@@ -33,22 +33,7 @@ fn every_fixture_reports_pierces_lengths_saved_traverse_and_time() {
         ("quarter_arc.json", "ac_head.json"),
     ];
     for (curves, machine) in cases {
-        let dir = tempfile::tempdir().expect("temporary directory");
-        let out = kerf()
-            .arg("run")
-            .arg(fixture(curves))
-            .arg("--machine")
-            .arg(fixture("machines").join(machine))
-            .args(["--place", "auto", "--out"])
-            .arg(dir.path())
-            .arg("-q")
-            .output()
-            .expect("run kerf");
-        assert!(
-            out.status.success(),
-            "{curves}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let dir = run_auto(curves, machine);
         let report = read_json(&dir.path().join("report.json"));
         let axes = read_json(&dir.path().join("axes.json"));
         let paths = axes["paths"].as_array().expect("paths");

@@ -41,3 +41,25 @@ pub(crate) fn rows(v: &Value) -> Vec<Vec<f64>> {
         })
         .unwrap_or_default()
 }
+
+/// `kerf run CURVES --machine MACHINE --place auto --out DIR -q` on shipped fixtures (the
+/// machine under `fixtures/machines/`), asserted to succeed; the directory holds its outputs.
+pub(crate) fn run_auto(curves: &str, machine: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let out = kerf()
+        .arg("run")
+        .arg(fixture(curves))
+        .arg("--machine")
+        .arg(fixture("machines").join(machine))
+        .args(["--place", "auto", "--out"])
+        .arg(dir.path())
+        .arg("-q")
+        .output()
+        .expect("run kerf");
+    assert!(
+        out.status.success(),
+        "kerf run {curves} on {machine}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    dir
+}

@@ -8,8 +8,11 @@
 //! refinement of each local maximum), and checks every rule of the format
 //! (`shared/formats.md`): same ids in the same order, params strictly increasing from one end
 //! of the domain to the other, every point on the curve at its param (to `1e-9` of the curve
-//! size), every C0 corner a cutting point, unit normals, every segment's chord error at most
-//! the tolerance and a `max_chord_error` claim that does not understate the measurement.
+//! size, plus two ulps of the point's coordinates), every C0 corner a cutting point, unit
+//! normals, every segment's chord error at most the tolerance and a `max_chord_error` claim that
+//! does not understate the measurement. Distances are measured about the curve's local origin
+//! ([`kerf_nurbs::LocalCurve`], an exact translation), so a curve 1e6 mm from the origin is
+//! measured with the rounding of its own size.
 //!
 //! The measurement is an estimate from below of the true chord error (the maximum of a
 //! distance is found by sampling and local search, not proved), good to about `1e-12` of the

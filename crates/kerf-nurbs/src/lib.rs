@@ -32,6 +32,7 @@ mod curve;
 mod error;
 mod geom;
 mod knots;
+mod local;
 #[cfg(feature = "samples")]
 mod samples;
 mod shapes;
@@ -52,6 +53,7 @@ pub use curve::{
 pub use error::{NurbsError, Readable, Result};
 pub use geom::{distance_to_segment, nearest_on_segment, Segment};
 pub use knots::{find_span, interior_knots, multiplicity, validate as validate_knots};
+pub use local::{is_power_of_two, LocalCurve};
 #[cfg(feature = "samples")]
 pub use samples::{smooth_random_curves, Lcg};
 pub use surface::{NurbsSurface, SurfaceProjection};

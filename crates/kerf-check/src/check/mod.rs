@@ -6,7 +6,7 @@
 use std::collections::HashMap;
 
 use kerf_format::CurveRecord;
-use kerf_nurbs::NurbsCurve;
+use kerf_nurbs::{LocalCurve, NurbsCurve};
 use nalgebra::Point3;
 
 use crate::input::{RawPathRecord, RawToolpath};
@@ -21,7 +21,9 @@ pub use report::{Defect, PathReport, Report, Violation, WorstSegment};
 /// Floating-point allowance of the chord-error comparisons, relative to the curve size: a
 /// measured error may exceed the tolerance (or a claim) by this much before it counts, so that
 /// rounding in the evaluation of a 3 m curve (about `1e-12` mm) does not flag a segment whose
-/// true error is exactly the tolerance.
+/// true error is exactly the tolerance. The measurement runs about the curve's local origin
+/// ([`kerf_nurbs::LocalCurve`]), so the rounding scales with the curve's size wherever it lies;
+/// for weights off powers of two the representation term (`4 eps max |P_i|`) is added.
 pub const ROUNDING_ALLOWANCE: f64 = 1e-14;
 
 /// How strictly to check.
@@ -32,7 +34,9 @@ pub struct CheckOptions {
     /// used). Default 32.
     pub samples: usize,
     /// How far a point may lie from the curve at its param, relative to the curve size (the
-    /// diagonal of its control points' bounding box). Default `1e-9`.
+    /// diagonal of its control points' bounding box). Default `1e-9`. Two ulps of the point's
+    /// largest coordinate are allowed on top: a written double cannot come closer than half an
+    /// ulp, which far from the origin can exceed the relative figure.
     pub point_tolerance: f64,
     /// How far a param may be from a domain end or a C0 knot and still count as it, relative
     /// to the width of the curve's domain. Default `1e-9`.
@@ -272,7 +276,12 @@ fn check_path(
     let (a, b) = curve.domain();
     let ptol = opts.param_tolerance * (b - a);
     let size = curve.size().max(f64::MIN_POSITIVE);
-    let allowance = ROUNDING_ALLOWANCE * size;
+    // Every distance is measured about the curve's local origin (an exact translation), so
+    // that the rounding is relative to the curve's size even 1e6 mm from the origin. The
+    // stored curve may differ from the file's by the representation term (weights off powers
+    // of two), which a claim proven about the file's curve does not include.
+    let local = LocalCurve::new(curve);
+    let allowance = ROUNDING_ALLOWANCE * size + local.representation_mm();
     // Ends of the domain and interior params inside it.
     if let (Some(&first), Some(&last)) = (path.params.first(), path.params.last()) {
         let starts = (first - a).abs() <= ptol;
@@ -324,16 +333,21 @@ fn check_path(
         .iter()
         .map(|p| {
             (p.len() >= 3 && p[..3].iter().all(|x| x.is_finite()))
-                .then(|| Point3::new(p[0], p[1], p[2]))
+                .then(|| local.to_local(&Point3::new(p[0], p[1], p[2])))
         })
         .collect();
-    let allowed = opts.point_tolerance * size;
     for i in 0..k {
         let t = path.params[i];
         let (Some(p), true) = (positions[i], t.is_finite()) else {
             continue;
         };
-        let distance = (p - curve.point(t)).norm();
+        // A written coordinate is a double: it can only be within half an ulp of the curve,
+        // which 1e9 mm from the origin is 6e-8 mm, more than 1e-9 of a small curve's size.
+        let magnitude = path.points[i][..3]
+            .iter()
+            .fold(0.0, |m: f64, x| m.max(x.abs()));
+        let allowed = opts.point_tolerance * size + 2.0 * f64::EPSILON * magnitude;
+        let distance = (p - local.curve().point(t)).norm();
         report.max_point_distance = report.max_point_distance.max(distance);
         let on_curve = distance <= allowed;
         if !on_curve {
@@ -355,7 +369,7 @@ fn check_path(
         if !(t0.is_finite() && t1.is_finite() && t1 > t0) {
             continue;
         }
-        let e = segment_chord_error(curve, t0, t1, &p0, &p1, opts.samples);
+        let e = segment_chord_error(local.curve(), t0, t1, &p0, &p1, opts.samples);
         report.segments += 1;
         report.measured = true;
         if report.worst.is_none_or(|w| e.error > w.error) {

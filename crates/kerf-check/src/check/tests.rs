@@ -432,3 +432,115 @@ fn a_tighter_tolerance_flags_the_file() {
         "{json}"
     );
 }
+
+/// The parabola `y = x^2 / 64`, `x` in `[-32, 32]`, moved by `offset`: a quadratic Bezier with
+/// exactly representable control points, and its cutting points at `x = -32, -24, ..., 32`
+/// (parameter `(x + 32) / 64`), all exact in floating point even 3e6 mm from the origin.
+fn parabola(offset: [f64; 3]) -> (CurveRecord, RawPathRecord) {
+    let [ox, oy, oz] = offset;
+    let curve = NurbsCurve::new(
+        2,
+        vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        vec![
+            Point3::new(ox - 32.0, oy + 16.0, oz),
+            Point3::new(ox, oy - 16.0, oz),
+            Point3::new(ox + 32.0, oy + 16.0, oz),
+        ],
+        None,
+    );
+    let xs: Vec<f64> = (0..9).map(|k| -32.0 + 8.0 * k as f64).collect();
+    let record = RawPathRecord {
+        id: "parabola".into(),
+        params: xs.iter().map(|x| (x + 32.0) / 64.0).collect(),
+        points: xs
+            .iter()
+            .map(|x| vec![ox + x, oy + x * x / 64.0, oz])
+            .collect(),
+        claimed_chord_error: None,
+        point_count: None,
+    };
+    let curve = CurveRecord {
+        id: "parabola".into(),
+        curve,
+        surface: None,
+        surfaces: Vec::new(),
+        start: None,
+        scrap: None,
+    };
+    (curve, record)
+}
+
+/// The exact chord error of the parabola `y = a x^2` between `x0` and `x1`: the largest
+/// vertical gap `a (x1 - x0)^2 / 4` (at the middle) times the cosine of the chord's slope
+/// `a (x0 + x1)`.
+fn parabola_sagitta(x0: f64, x1: f64) -> f64 {
+    let a = 1.0 / 64.0;
+    a * (x1 - x0).powi(2) / 4.0 / (1.0 + (a * (x0 + x1)).powi(2)).sqrt()
+}
+
+#[test]
+fn far_from_the_origin_the_measurement_keeps_the_curves_own_precision() {
+    // The same parabola and points at the origin and 3e6 mm away (every coordinate exact):
+    // both must measure the closed-form chord errors to the curve's own rounding (1e-13 of
+    // its size), and a claim 1e-9 mm short of the truth must be caught far away too. In global
+    // coordinates the far evaluation rounds by eps * 3e6 ~ 7e-10 mm: the claim's check then
+    // failed on exact claims (the reviewer's false alarms) and could not see 1e-9 mm.
+    let worst = (0..8)
+        .map(|k| parabola_sagitta(-32.0 + 8.0 * k as f64, -24.0 + 8.0 * k as f64))
+        .fold(0.0, f64::max);
+    for offset in [[0.0, 0.0, 0.0], [1e6, -3e6, 2.5e5]] {
+        let (curve, mut path) = parabola(offset);
+        let size = curve.curve.size();
+        let opts = CheckOptions::default();
+        let report = |claim: f64, path: &mut RawPathRecord| {
+            path.claimed_chord_error = Some(claim);
+            let tp = RawToolpath {
+                units: Some("mm".into()),
+                tolerance: 0.3,
+                paths: vec![path.clone()],
+            };
+            check(std::slice::from_ref(&curve), &tp, &opts)
+        };
+        let exact = report(worst, &mut path);
+        assert!(exact.passed(), "{offset:?}: {:#?}", exact.violations);
+        let p = &exact.paths[0];
+        assert_eq!(p.segments, 8, "{offset:?}");
+        assert!(
+            (p.measured_chord_error - worst).abs() <= 1e-13 * size,
+            "{offset:?}: measured {} vs exact {worst}",
+            p.measured_chord_error
+        );
+        assert!(p.max_point_distance <= 1e-13 * size, "{offset:?}: {p:?}");
+        let short = report(worst - 1e-9, &mut path);
+        assert!(
+            short
+                .violations
+                .iter()
+                .any(|v| matches!(v.defect, Defect::ClaimUnderstated { .. })),
+            "{offset:?}: a claim 1e-9 mm short is caught: {:#?}",
+            short.violations
+        );
+    }
+}
+
+#[test]
+fn certified_toolpaths_of_far_curves_pass() {
+    // The discretizer's certified output for curves far from the origin (1e6 and 1e9 mm): the
+    // checker measured them in global coordinates and raised false alarms (claims understated
+    // by its own rounding; points off the curve by less than an ulp of their coordinates).
+    for (name, tol) in [
+        ("hostile_degree24_far.json", 1e-6),
+        ("hostile_far_cubic.json", 1e-3),
+        ("hostile_small_far_circle.json", 1e-4),
+    ] {
+        let path = format!(
+            "{}/../../fixtures/hostile/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let file = kerf_format::curves::load(&path).expect("fixture loads");
+        let tp = toolpath(&file, tol);
+        let report = check(&file.curves, &tp, &CheckOptions::default());
+        assert!(report.passed(), "{name}: {:#?}", report.violations);
+        assert!(report.paths.iter().all(|p| p.measured), "{name}: measured");
+    }
+}

@@ -320,6 +320,12 @@ pub(crate) struct MotionArgs {
     /// given: without the part's surfaces they cannot be planned again here (mm).
     #[arg(long, default_value_t = 5.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
     pub(crate) clearance: f64,
+
+    /// The kerf.curves/1 file a toolpath input was made from: every segment is certified
+    /// against its curve again, so the program's budget states a proven chord term. Without it
+    /// a toolpath's `tolerance` is stated as the file's claim; an axes file records none.
+    #[arg(long, value_name = "CURVES.json")]
+    pub(crate) curves: Option<PathBuf>,
 }
 
 /// Arguments of `kerf interpolate`.

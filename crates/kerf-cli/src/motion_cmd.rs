@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use kerf_interp::{AxisModel, Dialect};
 use kerf_kinematics::Machine;
-use kerf_pipeline::{path_report, plan_program, MotionInput, MotionOptions, Program};
+use kerf_pipeline::{
+    path_report, plan_program, CertifiedToolpath, MotionInput, MotionOptions, Program,
+};
 use serde_json::json;
 
 use crate::cli::{GcodeArgs, InterpolateArgs, MotionArgs};
@@ -15,7 +17,17 @@ use crate::error::CliError;
 /// (dialect, blending) and the arguments' feed, cycle and tolerances.
 fn program(args: &MotionArgs, options: MotionOptions) -> Result<Program, CliError> {
     let machine = Machine::read(&args.machine)?;
-    let input = MotionInput::read(&args.input)?;
+    let mut input = MotionInput::read(&args.input)?;
+    if let Some(curves) = &args.curves {
+        let MotionInput::Toolpath(tp) = input else {
+            return Err(CliError::Usage(format!(
+                "--curves certifies a kerf.toolpath/1 input; {} is an axes file",
+                args.input.display()
+            )));
+        };
+        let curves = crate::input::load_curves(curves)?;
+        input = MotionInput::Certified(CertifiedToolpath::new(tp, &curves, Some(&args.input))?);
+    }
     let options = options
         .with_feed_mm_per_min(args.feed)
         .with_cycle_s(args.cycle)

@@ -4,8 +4,8 @@
 //! the program `kerf gcode` makes from the toolpath directly.
 //!
 //! The programs are compared block by block, byte for byte; only the comment lines differ
-//! where they must: the source file's name, the set-up line `kerf run` adds, the
-//! linearization term of the budget (an axes file does not record it) and the curve
+//! where they must: the source file's name, the set-up line `kerf run` adds, the chord and
+//! linearization terms of the budget (an axes file records neither) and the curve
 //! parameter of each path's start (an axes file has no parameters).
 
 use std::path::Path;
@@ -120,4 +120,68 @@ fn post_then_gcode_is_gcode_on_the_toolpath() {
     let direct = gcode(&toolpath, "direct.nc");
     assert!(direct.len() > 10, "a real program");
     assert_eq!(gcode(&axes, "posted.nc"), direct, "post then gcode");
+}
+
+#[test]
+fn gcode_with_curves_certifies_the_toolpath_or_writes_nothing() {
+    // A toolpath from `kerf discretize`: with its curves the header states the chord term as
+    // proven; a copy whose first path lost most of its points is refused with exit status 1,
+    // the path named, and no program left behind.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let curves = fixture("door_trim.json");
+    let machine = fixture("machines/ac_head.json");
+    let tp = dir.path().join("door.toolpath.json");
+    ok(kerf()
+        .arg("discretize")
+        .arg(&curves)
+        .args(["-t", "0.01", "--normals", "-q", "-o"])
+        .arg(&tp));
+    let gcode = |toolpath: &Path, program: &Path| {
+        kerf()
+            .arg("gcode")
+            .arg(toolpath)
+            .arg("-m")
+            .arg(&machine)
+            .args(["-f", "6000", "-q", "--curves"])
+            .arg(&curves)
+            .arg("-o")
+            .arg(program)
+            .output()
+            .expect("kerf runs")
+    };
+    let good = dir.path().join("good.nc");
+    let o = gcode(&tp, &good);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&good).expect("program");
+    assert!(
+        text.contains("tolerance budget mm: chord 0.01 + ") && !text.contains("claim"),
+        "certified chord term"
+    );
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&tp).expect("toolpath")).expect("JSON");
+    let path = &mut doc["paths"][0];
+    let n = path["params"].as_array().expect("params").len();
+    for key in ["params", "points"] {
+        let all = path[key].as_array().expect("array").clone();
+        let kept: Vec<_> = all
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i == 0 || *i == n - 1 || i % 5 == 0)
+            .map(|(_, v)| v.clone())
+            .collect();
+        path[key] = serde_json::Value::Array(kept);
+    }
+    let kept = path["params"].as_array().expect("params").len();
+    path["point_count"] = kept.into();
+    let thinned = dir.path().join("thinned.toolpath.json");
+    std::fs::write(&thinned, doc.to_string()).expect("write");
+    let bad = dir.path().join("bad.nc");
+    let o = gcode(&thinned, &bad);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("paths[0]") && err.contains("not certified against its curve"),
+        "{err}"
+    );
+    assert!(!bad.exists(), "no program from an uncertified toolpath");
 }

@@ -6,8 +6,8 @@ mod common;
 
 use common::{circle, stations};
 use kerf_interp::{
-    gcode_motion, interpolate, AxisModel, Dialect, FitOptions, GcodeOptions, Motion, PaperAcHead,
-    PlanOptions, ProgramPath,
+    gcode_motion, interpolate, AxisModel, ChordTerm, Dialect, FitOptions, GcodeOptions, Motion,
+    PaperAcHead, PlanOptions, ProgramPath,
 };
 use kerf_kinematics::Process;
 use nalgebra::{Point3, Vector3};
@@ -205,8 +205,29 @@ fn headers_state_units_feed_budget_machine_and_process() {
         let opts = GcodeOptions::new(dialect, 6000.0)
             .with_linearization_tolerance_mm(Some(0.005))
             .with_fit_tolerance_mm(0.01)
+            .with_chord_term(ChordTerm::Certified(0.01))
             .with_source(Some("part.json".into()));
         let text = gcode_motion(&m, &motion, &[], &opts).expect("gcode");
+        // Without being told where the chord term comes from, the program states none, and a
+        // claim is stated as one.
+        let line = |o: &GcodeOptions| -> String {
+            gcode_motion(&m, &motion, &[], o)
+                .expect("gcode")
+                .lines()
+                .filter(|l| l.contains("tolerance budget"))
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        let unknown = line(&opts.clone().with_chord_term(ChordTerm::Unknown));
+        assert!(
+            unknown.contains("chord unknown + ") && unknown.contains("= 0.011"),
+            "{dialect:?}: {unknown}"
+        );
+        let claimed = line(&opts.clone().with_chord_term(ChordTerm::Claimed(0.01)));
+        assert!(
+            claimed.contains("chord 0.01 + ") && claimed.contains("claim, not verified"),
+            "{dialect:?}: {claimed}"
+        );
         let head: String = text.lines().take(16).collect::<Vec<_>>().join("\n");
         for want in [
             "machine: paper-000 laser head",

@@ -104,6 +104,28 @@ pub enum Error {
         /// Its id.
         id: String,
     },
+    /// A toolpath could not be certified against its curves (`kerf gcode --curves`): its
+    /// path has no curve of that id at that index, its params are refused by the certificate,
+    /// or its points lie too far off the curve. Fix: discretize the curves again.
+    #[error(
+        "{}paths[{index}] ({id:?}): not certified against its curve: {reason}{}",
+        at(file),
+        source.as_ref().map(|e| format!(": {e}")).unwrap_or_default()
+    )]
+    NotCertified {
+        /// The toolpath file, when known.
+        file: Option<PathBuf>,
+        /// Index of the path in `paths`.
+        index: usize,
+        /// Its id.
+        id: String,
+        /// What failed.
+        reason: String,
+        /// The certificate's refusal, if that is what failed (boxed: the error type stays
+        /// small for every `Result` of the pipeline).
+        #[source]
+        source: Option<Box<kerf_discretize::DiscretizeError>>,
+    },
     /// The machine file is invalid, a path cannot be solved on the machine (a pose out of
     /// reach, an axis limit), or no placement fits. Fix: as the message says.
     #[error("{}{source}", at(file))]

@@ -34,6 +34,7 @@
 //! # Ok::<(), kerf_pipeline::Error>(())
 //! ```
 
+mod certify;
 mod cuts;
 mod discretize;
 mod error;
@@ -44,6 +45,7 @@ mod place;
 mod post;
 mod run;
 
+pub use certify::CertifiedToolpath;
 pub use discretize::{discretize_curves, orient_curves, toolpath_of_points, toolpath_of_poses};
 pub use error::{Error, Result};
 pub use job::{Job, JobOptions, MissingSurface, OrientOptions};

@@ -15,12 +15,13 @@ use std::path::Path;
 
 use kerf_format::toolpath::{self, ToolpathFile};
 use kerf_interp::{
-    gcode_motion, stations_from_axes, stations_from_solved, write_csv_to, AxisModel, Dialect,
-    FitOptions, GcodeOptions, MachineModel, Motion, PlanOptions, ProgramPath,
+    gcode_motion, stations_from_axes, stations_from_solved, write_csv_to, AxisModel, ChordTerm,
+    Dialect, FitOptions, GcodeOptions, MachineModel, Motion, PlanOptions, ProgramPath,
 };
 use kerf_kinematics::{AxesFile, Machine, PathOptions};
 use serde_json::json;
 
+use crate::certify::CertifiedToolpath;
 use crate::error::{interp, kin, Error, Result};
 
 /// The fit of a program for `dialect` (`None`: set-points only, run with tool-tip control):
@@ -40,8 +41,11 @@ pub fn fit_options(tolerance_mm: f64, dialect: Option<Dialect>, retract_mm: f64)
 pub enum MotionInput {
     /// Machine axes, with the lead-ins and lead-outs the file records.
     Axes(AxesFile),
-    /// Cutting points; points without normals get the tool axis +z.
+    /// Cutting points; points without normals get the tool axis +z. The program states the
+    /// file's `tolerance` as a claim.
     Toolpath(ToolpathFile),
+    /// Cutting points certified against their curves: the program states the certified bound.
+    Certified(CertifiedToolpath),
 }
 
 impl MotionInput {
@@ -186,6 +190,9 @@ pub struct Program {
     pub motion: Motion,
     /// The tolerance the blocks were fitted with, mm.
     pub fit_tolerance_mm: f64,
+    /// The budget's chord term: unknown for an axes file, the file's claim for a toolpath,
+    /// certified for a [`CertifiedToolpath`].
+    pub chord_term: ChordTerm,
     /// The linearization tolerance the axes were solved with, mm (`None` for an axes file,
     /// which does not record it).
     pub linearization_tolerance_mm: Option<f64>,
@@ -208,7 +215,7 @@ pub fn plan_program(
     let model = MachineModel::new(machine.clone()).map_err(interp(source))?;
     let mut linearization = None;
     let mut traverses: Vec<Vec<kerf_interp::Station>> = Vec::new();
-    let (ids, paths, file_tol) = match input {
+    let (ids, paths, file_tol, chord_term) = match input {
         MotionInput::Axes(axes) => {
             let mut paths = Vec::new();
             for p in &axes.paths {
@@ -235,9 +242,18 @@ pub fn plan_program(
                 axes.paths.iter().map(|p| p.id.clone()).collect::<Vec<_>>(),
                 paths,
                 None,
+                // An axes file records no chord tolerance.
+                ChordTerm::Unknown,
             )
         }
-        MotionInput::Toolpath(tp) => {
+        MotionInput::Toolpath(_) | MotionInput::Certified(_) => {
+            let (tp, chord_term) = match input {
+                MotionInput::Certified(c) => {
+                    (c.toolpath(), ChordTerm::Certified(c.toolpath().tolerance))
+                }
+                MotionInput::Toolpath(tp) => (tp, ChordTerm::Claimed(tp.tolerance)),
+                MotionInput::Axes(_) => unreachable!("matched above"),
+            };
             let path_options = PathOptions::default();
             linearization = Some(path_options.linearization_tolerance_mm);
             let posted = crate::post::post_toolpath(
@@ -261,6 +277,7 @@ pub fn plan_program(
                 tp.paths.iter().map(|p| p.id.clone()).collect(),
                 paths,
                 Some(tp.tolerance),
+                chord_term,
             )
         }
     };
@@ -284,6 +301,7 @@ pub fn plan_program(
         ids,
         motion,
         fit_tolerance_mm: fit_tolerance,
+        chord_term,
         linearization_tolerance_mm: linearization,
         options: *options,
         source: source.map(|s| s.display().to_string()),
@@ -306,6 +324,7 @@ impl Program {
             self.source.as_deref(),
         )
         .with_fit_tolerance_mm(self.fit_tolerance_mm)
+        .with_chord_term(self.chord_term)
         .with_chord_tolerance_mm(self.options.chord_tolerance_mm.unwrap_or(0.001))
         .with_linearization_tolerance_mm(self.linearization_tolerance_mm))
     }

@@ -8,7 +8,8 @@ use std::time::Instant;
 
 use kerf_discretize::Discretization;
 use kerf_interp::{
-    gcode_motion, stations_from_solved, MachineModel, PlanOptions, ProgramPath as InterpPath,
+    gcode_motion, stations_from_solved, ChordTerm, MachineModel, PlanOptions,
+    ProgramPath as InterpPath,
 };
 use kerf_kinematics::{solve_paths, AxesFile, PathCurve, PathInput, Pose};
 use kerf_normals::Oriented;
@@ -132,6 +133,9 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         source_name.as_deref(),
     )
     .with_fit_tolerance_mm(dopts.tolerance_mm)
+    // Every segment was certified within the tolerance by the discretizer (and re-certified
+    // where the normals or the start point inserted points).
+    .with_chord_term(ChordTerm::Certified(dopts.tolerance_mm))
     .with_chord_tolerance_mm(plan.chord_tolerance_mm)
     .with_linearization_tolerance_mm(Some(popts.linearization_tolerance_mm));
     let mut motions = Vec::new();

@@ -8,8 +8,8 @@ use kerf_check::{check, CheckOptions, RawToolpath};
 use kerf_interp::{Dialect, Geometry};
 use kerf_nurbs::NurbsCurve;
 use kerf_pipeline::{
-    plan_program, Error, Job, JobOptions, MissingSurface, MotionInput, MotionOptions,
-    OrientOptions, Progress, Stage,
+    plan_program, CertifiedToolpath, Error, Job, JobOptions, MissingSurface, MotionInput,
+    MotionOptions, OrientOptions, Progress, Stage,
 };
 use nalgebra::Point3;
 
@@ -289,5 +289,124 @@ fn the_output_directory_is_written_all_or_nothing() {
         left,
         vec![std::ffi::OsString::from("report.json")],
         "nothing else written"
+    );
+}
+
+#[test]
+fn a_program_states_the_chord_term_only_as_far_as_kerf_proved_it() {
+    let job = Job::from_files(fixture("dome.json"), fixture("machines/ac_head.json"))
+        .expect("inputs")
+        .with_options(JobOptions::default().with_tolerance_mm(0.01));
+    let out = job.run().expect("run");
+    let budget = |text: &str| -> String {
+        text.lines()
+            .filter(|l| l.contains("tolerance budget"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let gcode = |input: MotionInput| -> String {
+        plan_program(&machine(), &input, &MotionOptions::default(), None)
+            .expect("plan")
+            .gcode()
+            .expect("gcode")
+    };
+    // kerf run certified every segment: the term stands unqualified.
+    let own = budget(&out.programs[0].text);
+    assert!(
+        own.contains("chord 0.01 + ") && !own.contains("known terms"),
+        "{own}"
+    );
+    // The same cutting points read as a toolpath: only the file's claim.
+    let tp = out.toolpath.clone();
+    let claimed = budget(&gcode(MotionInput::Toolpath(tp.clone())));
+    assert!(
+        claimed.contains("the toolpath file's claim, not verified"),
+        "{claimed}"
+    );
+    // An axes file records no chord tolerance: unknown, and left out of the total.
+    let axes = budget(&gcode(MotionInput::Axes(out.axes.clone())));
+    assert!(axes.contains("chord unknown"), "{axes}");
+    // Certified again against the curves: the bound covers what the brute force measures.
+    let certified = CertifiedToolpath::new(tp.clone(), job.curves(), None).expect("certifies");
+    let raw = |tp: &kerf_format::toolpath::ToolpathFile| {
+        let mut text = Vec::new();
+        kerf_format::toolpath::to_writer(tp, &mut text).expect("toolpath to memory");
+        RawToolpath::from_slice(&text).expect("reads back")
+    };
+    let measured =
+        check(&job.curves().curves, &raw(&tp), &CheckOptions::default()).measured_chord_error();
+    assert!(
+        measured <= certified.bound_mm() && certified.bound_mm() <= 0.01,
+        "measured {measured}, certified {}",
+        certified.bound_mm()
+    );
+    assert_eq!(
+        budget(&gcode(MotionInput::Certified(certified))),
+        own,
+        "certified like kerf run's"
+    );
+    // Segments merged into one (dropping points that are no knots, as few as take the chord
+    // over the tolerance by the checker's own measurement): the certificate refuses, naming
+    // the path.
+    let curve = &job.curves().curves[0].curve;
+    let path = &tp.paths[0];
+    let inside = |k: usize| !curve.knots().contains(&path.params[k]);
+    let pos = |k: usize| path.points.position(k);
+    let (k, m) = (1..path.params.len() - 1)
+        .flat_map(|k| (1..8).map(move |m| (k, m)))
+        .find(|&(k, m)| {
+            k + m < path.params.len()
+                && (k..k + m).all(inside)
+                && kerf_check::segment_chord_error(
+                    curve,
+                    path.params[k - 1],
+                    path.params[k + m],
+                    &pos(k - 1),
+                    &pos(k + m),
+                    32,
+                )
+                .error
+                    > 0.01
+        })
+        .expect("a run of points to drop");
+    let mut merged = tp.clone();
+    merged.paths[0].params.drain(k..k + m);
+    if let kerf_format::toolpath::ToolpathPoints::Poses(p) = &mut merged.paths[0].points {
+        p.drain(k..k + m);
+    }
+    let report = check(
+        &job.curves().curves,
+        &raw(&merged),
+        &CheckOptions::default(),
+    );
+    assert!(report.measured_chord_error() > 0.01, "the premise");
+    let err = CertifiedToolpath::new(merged, job.curves(), None).expect_err("refused");
+    assert!(
+        matches!(
+            &err,
+            Error::NotCertified {
+                index: 0,
+                source: Some(_),
+                ..
+            }
+        ),
+        "{err}"
+    );
+    // A point moved 0.02 mm off its curve: its chords may be that far off; refused.
+    let mut moved = tp.clone();
+    if let kerf_format::toolpath::ToolpathPoints::Poses(p) = &mut moved.paths[1].points {
+        p[1][2] += 0.02;
+    }
+    let err = CertifiedToolpath::new(moved, job.curves(), None).expect_err("refused");
+    assert!(
+        matches!(
+            &err,
+            Error::NotCertified {
+                index: 1,
+                source: None,
+                ..
+            }
+        ) && err.to_string().contains("2.000e-2 mm from the curve"),
+        "{err}"
     );
 }

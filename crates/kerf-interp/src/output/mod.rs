@@ -41,6 +41,23 @@ pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};
 pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
 use writer::Writer;
 
+/// Where the tolerance budget's `chord` term (the cutting points' chord error against the
+/// designed curve) comes from. A program states it in its header; only a bound kerf proved
+/// itself may be stated without a qualifier.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum ChordTerm {
+    /// A bound kerf certified, mm: the discretizer's tolerance (every segment proven within
+    /// it), or a toolpath re-certified against its curves.
+    Certified(f64),
+    /// A figure an input file states and kerf has not verified, mm (a toolpath's `tolerance`
+    /// read without its curves). The header says so.
+    Claimed(f64),
+    /// Not known: an axes file records no chord tolerance. The header says so and the total
+    /// leaves it out.
+    Unknown,
+}
+
 /// What goes into a program besides the blocks. Start from [`GcodeOptions::new`] (dialect
 /// and feed) and the `with_*` setters.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,9 +68,13 @@ pub struct GcodeOptions {
     /// Programmed cutting feed, mm/min of the tool tip: the descent after the pierce, and the
     /// blocks' speed when no planned times are given (given to [`GcodeOptions::new`]).
     pub feed_mm_per_min: f64,
-    /// The discretizer's chord tolerance (also the arc-fit tolerance), mm: the budget's
-    /// `chord` term. Default 0.001.
+    /// The arc-fit tolerance, mm: arcs and merged lines (dialects with tool-tip control) lie
+    /// within it of the cutting points. Default 0.001.
     pub fit_tolerance_mm: f64,
+    /// The budget's `chord` term and where it comes from. Default [`ChordTerm::Unknown`]: a
+    /// program states a chord bound only when told where it comes from. With arcs or merged
+    /// lines (Sinumerik) the term is the larger of this and [`fit_tolerance_mm`](Self::fit_tolerance_mm).
+    pub chord_term: ChordTerm,
     /// Chord tolerance of arcs, mm: raw-axis programs write arcs as chords within it (the
     /// budget's `interpolation_chord` term). Default 0.001.
     pub chord_tolerance_mm: f64,
@@ -94,10 +115,16 @@ impl GcodeOptions {
         self
     }
 
-    /// Sets [`fit_tolerance_mm`](Self::fit_tolerance_mm): the discretizer's chord tolerance
-    /// (also the arc-fit tolerance), mm.
+    /// Sets [`fit_tolerance_mm`](Self::fit_tolerance_mm): the arc-fit tolerance, mm.
     pub fn with_fit_tolerance_mm(mut self, fit_tolerance_mm: f64) -> Self {
         self.fit_tolerance_mm = fit_tolerance_mm;
+        self
+    }
+
+    /// Sets [`chord_term`](Self::chord_term): the budget's `chord` term and where it comes
+    /// from.
+    pub fn with_chord_term(mut self, chord_term: ChordTerm) -> Self {
+        self.chord_term = chord_term;
         self
     }
 
@@ -159,13 +186,14 @@ impl GcodeOptions {
         self
     }
 
-    /// Options for `dialect` at `feed` mm/min, with 0.001 mm tolerances, the default blending
-    /// term, the dialect's default process codes and 6 decimals.
+    /// Options for `dialect` at `feed` mm/min, with 0.001 mm tolerances, an unknown chord
+    /// term, the default blending term, the dialect's default process codes and 6 decimals.
     pub fn new(dialect: Dialect, feed: f64) -> Self {
         Self {
             dialect,
             feed_mm_per_min: feed,
             fit_tolerance_mm: 0.001,
+            chord_term: ChordTerm::Unknown,
             chord_tolerance_mm: 0.001,
             linearization_tolerance_mm: None,
             blend_tolerance_mm: DEFAULT_BLEND_TOLERANCE,
@@ -177,11 +205,21 @@ impl GcodeOptions {
         }
     }
 
-    /// The tolerance budget term by term, mm, named as in `report.json`: `chord`,
-    /// `linearization` (`None` when unknown), `interpolation_chord`, `controller_blending`.
+    /// The tolerance budget term by term, mm, named as in `report.json`: `chord` (`None` when
+    /// unknown; claimed or certified as [`chord_term`](Self::chord_term) says), `linearization`
+    /// (`None` when unknown), `interpolation_chord`, `controller_blending`.
     pub fn budget(&self) -> [(&'static str, Option<f64>); 4] {
+        let chord = match self.chord_term {
+            ChordTerm::Certified(mm) | ChordTerm::Claimed(mm) if self.dialect.raw_axes() => {
+                Some(mm)
+            }
+            ChordTerm::Certified(mm) | ChordTerm::Claimed(mm) => {
+                Some(mm.max(self.fit_tolerance_mm))
+            }
+            ChordTerm::Unknown => None,
+        };
         [
-            ("chord", Some(self.fit_tolerance_mm)),
+            ("chord", chord),
             ("linearization", self.linearization_tolerance_mm),
             ("interpolation_chord", Some(self.chord_tolerance_mm)),
             ("controller_blending", Some(self.blend_tolerance_mm)),

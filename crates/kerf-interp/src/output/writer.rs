@@ -4,7 +4,7 @@ use crate::block::{Block, Geometry};
 use crate::chord::max_step;
 use crate::model::AxisModel;
 
-use super::{comment_text, Dialect, GcodeOptions, ProcessCodes};
+use super::{comment_text, ChordTerm, Dialect, GcodeOptions, ProcessCodes};
 
 /// The state of one program being written.
 pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
@@ -136,16 +136,32 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 None => format!("{k} unknown"),
             })
             .collect();
-        let unknown = if o.linearization_tolerance_mm.is_none() {
-            " (the known terms; the axes file does not record the linearization tolerance)"
-        } else {
+        let mut notes = Vec::new();
+        match o.chord_term {
+            ChordTerm::Certified(_) => {}
+            ChordTerm::Claimed(_) => notes.push(
+                "the chord term is the toolpath file's claim, not verified by kerf: kerf gcode --curves certifies it",
+            ),
+            ChordTerm::Unknown => {
+                notes.push("the chord term is unknown: the input records no certified chord tolerance")
+            }
+        }
+        if o.linearization_tolerance_mm.is_none() {
+            notes.push("the axes file does not record the linearization tolerance");
+        }
+        let qualifier = if notes.is_empty() {
             ""
+        } else {
+            " (the known terms)"
         };
         self.comment(&format!(
-            "tolerance budget mm: {} = {}{unknown}",
+            "tolerance budget mm: {} = {}{qualifier}",
             terms.join(" + "),
             o.budget_total()
         ));
+        for note in notes {
+            self.comment(&format!("tolerance budget: {note}"));
+        }
         self.comment(&format!(
             "blocks: {} lines, {} arcs, {} turns, {arcs_as}",
             counts.lines, counts.arcs, counts.turns

@@ -10,6 +10,13 @@
 //! `SAMPLES.txt` is `halsampler -t` output: the sample number, the five joint positions (the
 //! machine file's axis order) and the beam bit, one servo cycle per line. `KERF_OUT_DIR` holds
 //! `axes.json`, `toolpath.json` and `report.json` of the same `kerf run`.
+//!
+//! The tip is measured three ways while the beam is on: against the poses (the program's own
+//! path, lead-ins and the pierce descent included), against the cutting points (placed with
+//! the set-up's placement from the report), and against the designed NURBS curve itself (the
+//! `kerf.curves/1` file the report names as its input; global closest point in part
+//! coordinates), wherever the curve is nearer than the leads and the pierce descent: the last
+//! is the end-to-end figure the tolerance budget is a claim about.
 
 use std::path::Path;
 
@@ -26,6 +33,16 @@ fn fail(msg: String) -> ! {
 /// One cut: the tips of its poses (axes file), its cutting points (toolpath) and the tool axis
 /// at its start.
 type Cut = (Vec<Point3<f64>>, Vec<Point3<f64>>, Vector3<f64>);
+
+/// What the beam-on samples of one cut are measured against besides its poses: the designed
+/// curve (part coordinates) with the set-up's placement `p' = R p + t`, and the lead polylines
+/// (workpiece frame), where the beam is off the curve by design.
+struct Design {
+    curve: Option<kerf_nurbs::NurbsCurve>,
+    rot: nalgebra::Rotation3<f64>,
+    shift: Vector3<f64>,
+    leads: Vec<Vec<Point3<f64>>>,
+}
 
 /// Distance from `p` to the polyline `pts`, over all its segments (exact, no search window).
 fn poly_dist(p: &Point3<f64>, pts: &[Point3<f64>]) -> f64 {
@@ -66,6 +83,11 @@ fn main() {
         .unwrap_or_else(|e| fail(e.to_string()));
     let report: Value =
         serde_json::from_str(&read("report.json")).unwrap_or_else(|e| fail(e.to_string()));
+    // The designed curves, from the input `kerf run` read (its path as the report gives it);
+    // a STEP input or a moved file leaves the curve measure out.
+    let curves = report["input"]
+        .as_str()
+        .and_then(|f| kerf_format::curves::load(f).ok());
     let budget = report["tolerance_budget_mm"]["total"]
         .as_f64()
         .unwrap_or(f64::NAN);
@@ -133,9 +155,66 @@ fn main() {
             }
         }
     }
+    // The toolpath is in part coordinates; the axes, the program and so the samples in the
+    // workpiece frame of the path's set-up: `p' = R p + t` with `R = Rz Ry Rx` of the report's
+    // `rotation_deg` (x, y, z) and `t` its `translation_mm` (none without a placement).
+    let placement_of = |id: &str| -> (nalgebra::Rotation3<f64>, Vector3<f64>) {
+        let setups = report["placement"]["setups"].as_array();
+        let setup = setups.and_then(|s| {
+            s.iter().find(|s| {
+                s["paths"]
+                    .as_array()
+                    .is_some_and(|p| p.iter().any(|v| v.as_str() == Some(id)))
+            })
+        });
+        let Some(setup) = setup else {
+            return (nalgebra::Rotation3::identity(), Vector3::zeros());
+        };
+        let v3 = |key: &str| {
+            let a = setup[key]
+                .as_array()
+                .unwrap_or_else(|| fail(format!("placement {key}")));
+            let x = |k: usize| a.get(k).and_then(Value::as_f64).unwrap_or(0.0);
+            Vector3::new(x(0), x(1), x(2))
+        };
+        let r = v3("rotation_deg").map(f64::to_radians);
+        let rot = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), r.z)
+            * nalgebra::Rotation3::from_axis_angle(&Vector3::y_axis(), r.y)
+            * nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), r.x);
+        (rot, v3("translation_mm"))
+    };
     // Paths run in cutting order (not the toolpath's): each with its lead-in, the cut from its
     // start point and its lead-out, against the lead polylines and the cutting points in the
     // same order.
+    let designs: Vec<Design> = axes
+        .paths
+        .iter()
+        .map(|a| {
+            let (rot, shift) = placement_of(&a.id);
+            let tip = |p: &[f64; 6]| Point3::new(p[0], p[1], p[2]);
+            // Each lead as a polyline joined to the cut: the lead-in ends where the cut's first
+            // pose begins, the lead-out starts at its last.
+            let mut leads = Vec::new();
+            if let (Some(m), Some(first)) = (&a.lead_in, a.poses.first()) {
+                leads.push(m.poses.iter().chain([first]).map(tip).collect());
+            }
+            if let (Some(m), Some(last)) = (&a.lead_out, a.poses.last()) {
+                leads.push([last].into_iter().chain(&m.poses).map(tip).collect());
+            }
+            let curve = curves.as_ref().and_then(|c| {
+                c.curves
+                    .iter()
+                    .find(|c| c.id == a.id)
+                    .map(|c| c.curve.clone())
+            });
+            Design {
+                curve,
+                rot,
+                shift,
+                leads,
+            }
+        })
+        .collect();
     let cuts: Vec<Cut> =
         axes.paths
             .iter()
@@ -158,7 +237,8 @@ fn main() {
                 if let Some(m) = &a.lead_in {
                     pts.extend(m.poses.iter().map(tip));
                 }
-                pts.extend(order.iter().map(|&k| t.points.position(k)));
+                let (rot, shift) = placement_of(&a.id);
+                pts.extend(order.iter().map(|&k| rot * t.points.position(k) + shift));
                 if let Some(m) = &a.lead_out {
                     pts.extend(m.poses.iter().map(tip));
                 }
@@ -171,8 +251,10 @@ fn main() {
     let mut max_dev_union: f64 = 0.0;
     let mut max_dev_points: f64 = 0.0;
     let mut max_dev_orient_deg: f64 = 0.0;
+    let mut max_dev_curve: Option<f64> = None;
     let mut framing_ok = intervals.len() == cuts.len();
     for (k, (iv, (poses, pts, u0))) in intervals.iter().zip(&cuts).enumerate() {
+        let design = &designs[k];
         let start = poses[0];
         let end = *poses.last().unwrap_or(&start);
         let pierce = start + u0 * standoff;
@@ -198,11 +280,27 @@ fn main() {
         let mut dev_union: f64 = 0.0;
         let mut dev_points: f64 = 0.0;
         let mut dev_orient: f64 = 0.0;
+        let mut dev_curve: Option<f64> = None;
         for (p, u) in tips.iter().take(iv.1 + 1).skip(iv.0) {
             let d_cut = poly_dist(p, poses);
             let d_pierce = seg_dist(p, &start, &pierce);
             dev_union = dev_union.max(d_cut.min(d_pierce));
             dev_points = dev_points.max(poly_dist(p, pts).min(d_pierce));
+            // The tip against the designed curve itself (global closest point, in part
+            // coordinates), where the curve is nearer than the pierce segment and the leads:
+            // the end-to-end figure the budget bounds.
+            if let Some(c) = &design.curve {
+                let local = Point3::from(design.rot.inverse() * (p - Point3::from(design.shift)));
+                let d = c.closest_point(&local).distance;
+                let d_lead = design
+                    .leads
+                    .iter()
+                    .map(|l| poly_dist(p, l))
+                    .fold(d_pierce, f64::min);
+                if d <= d_lead {
+                    dev_curve = Some(dev_curve.map_or(d, |m| m.max(d)));
+                }
+            }
             if d_pierce < d_cut {
                 continue;
             }
@@ -230,6 +328,9 @@ fn main() {
             && dwell_on >= dwell - 2.0 * period;
         framing_ok &= ok;
         max_dev_points = max_dev_points.max(dev_points);
+        if let Some(d) = dev_curve {
+            max_dev_curve = Some(max_dev_curve.map_or(d, |m| m.max(d)));
+        }
         max_dev_orient_deg = max_dev_orient_deg.max(dev_orient);
         per_cut.push(json!({
             "id": axes.paths[k].id,
@@ -241,6 +342,7 @@ fn main() {
             "distance_from_cut_end_after_beam_off_mm": after,
             "max_deviation_beam_on_mm": dev_union,
             "max_deviation_from_cutting_points_mm": dev_points,
+            "max_deviation_from_curve_mm": dev_curve,
             "max_tool_axis_deviation_deg": dev_orient,
             "beam_on_at_pierce_point_s": dwell_on,
             "framing_ok": ok,
@@ -318,6 +420,7 @@ fn main() {
         "tolerance_budget_mm": budget,
         "max_deviation_beam_on_mm": max_dev_union,
         "max_deviation_from_cutting_points_mm": max_dev_points,
+        "max_deviation_from_curve_mm": max_dev_curve,
         "max_tool_axis_deviation_deg": max_dev_orient_deg,
         "limit_violations": limit_violations,
         "max_tip_speed_beam_on_mm_per_min": max_tip_speed,

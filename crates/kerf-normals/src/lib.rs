@@ -18,7 +18,7 @@ mod mesh;
 mod surface;
 
 pub use error::{NormalsError, Result};
-pub use mesh::{MeshNormals, DEFAULT_CREASE_ANGLE_DEG};
+pub use mesh::{MeshNormals, DEFAULT_CREASE_ANGLE_DEG, MAX_MESH_COORDINATE_MM};
 pub use surface::{Hint, NormalSource, NurbsNormals, Projection};
 
 use kerf_discretize::{discretize_range, Discretization, Options};

@@ -27,13 +27,20 @@ pub struct MeshNormals {
 /// surface.
 pub const DEFAULT_CREASE_ANGLE_DEG: f64 = 30.0;
 
+/// The largest vertex coordinate a mesh may have, mm (1,000 km). The distance queries square
+/// coordinate differences and the face normals square cross products (fourth powers of the
+/// coordinates): far beyond any part, yet small enough that neither overflows (a vertex at
+/// 1e155 mm made parry's query panic, one at 1e100 mm lost every face normal).
+pub const MAX_MESH_COORDINATE_MM: f64 = 1e9;
+
 impl MeshNormals {
     /// Builds the mesh (duplicate vertices merged, degenerate triangles removed) and its corner
     /// normals. The normal follows the winding (counter-clockwise = outward), reversed if
     /// `flip`. `crease_angle_deg` in degrees (like [`DEFAULT_CREASE_ANGLE_DEG`]).
     ///
     /// # Errors
-    /// [`NormalsError::BadMesh`] for non-finite vertices, bad indices or no usable triangle;
+    /// [`NormalsError::BadMesh`] for non-finite vertices or ones beyond
+    /// [`MAX_MESH_COORDINATE_MM`], bad indices or no usable triangle;
     /// [`NormalsError::BadOption`] for a crease angle outside `[0, 180]` degrees.
     pub fn new(
         vertices: Vec<Point3<f64>>,
@@ -53,6 +60,16 @@ impl MeshNormals {
             .position(|v| !v.coords.iter().all(|x| x.is_finite()))
         {
             return Err(NormalsError::BadMesh(format!("vertex {i} is not finite")));
+        }
+        if let Some((i, v)) = vertices
+            .iter()
+            .enumerate()
+            .find(|(_, v)| v.coords.amax() > MAX_MESH_COORDINATE_MM)
+        {
+            return Err(NormalsError::BadMesh(format!(
+                "vertex {i} has a coordinate of {:e} mm, beyond the {MAX_MESH_COORDINATE_MM:e} mm a mesh may reach",
+                v.coords.amax()
+            )));
         }
         let n = vertices.len() as u32;
         if let Some(t) = triangles.iter().position(|t| t.iter().any(|&i| i >= n)) {

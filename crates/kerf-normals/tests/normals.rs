@@ -499,3 +499,33 @@ fn cone_apex_normals_are_the_limits_along_the_curve() {
     );
     assert_eq!(o.jumps, vec![0.5], "one jump, at the apex");
 }
+
+#[test]
+fn meshes_beyond_the_coordinate_bound_are_refused_not_panicked_on() {
+    // A triangle reaching 1e155 mm made parry's point query unwrap a None (the squared
+    // distances overflow); one at 1e100 mm lost its face normal to the overflow of |n|^2. Both
+    // are refused with the vertex named; a mesh 1e8 mm out still gives its exact normal.
+    use kerf_normals::MAX_MESH_COORDINATE_MM;
+    use kerf_normals::{Hint, NormalSource};
+    for far in [1e100, 1e155, 2.0 * MAX_MESH_COORDINATE_MM] {
+        let v = vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(far, 0.0, 0.0),
+            Point3::new(0.0, far, 0.0),
+        ];
+        match MeshNormals::new(v, vec![[0, 1, 2]], 30.0, false) {
+            Err(NormalsError::BadMesh(m)) => assert!(m.contains("vertex 1"), "{far}: {m}"),
+            other => panic!("{far}: expected a refusal, got {other:?}"),
+        }
+    }
+    let far = 0.5 * MAX_MESH_COORDINATE_MM;
+    let v = vec![
+        Point3::new(far, far, 0.0),
+        Point3::new(far + 10.0, far, 0.0),
+        Point3::new(far, far + 10.0, 0.0),
+    ];
+    let mesh = MeshNormals::new(v, vec![[0, 1, 2]], 30.0, false).expect("within the bound");
+    let p = mesh.project(&Point3::new(far + 2.0, far + 3.0, 1.0), Hint::None);
+    assert_eq!(p.normal, Some(Vector3::z()), "the winding's normal");
+    assert!((p.distance - 1.0).abs() < 1e-6, "{}", p.distance);
+}

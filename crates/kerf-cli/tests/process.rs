@@ -82,7 +82,7 @@ fn bad_process_is_a_named_error_and_writes_nothing() {
     for (process, want) in [
         (
             r#"{"pierce_dwell_s": -0.1}"#,
-            "process.pierce_dwell_s: must be finite and >= 0 (got -0.1)",
+            "process.pierce_dwell_s: must lie in [0, 60] (got -0.1)",
         ),
         (
             r#"{"beam_on": [""]}"#,

@@ -80,6 +80,26 @@ pub enum InterpError {
         /// Upper limit.
         max: f64,
     },
+    /// A pierce point, `pierce_standoff` above a cut's start along the tool axis, puts an axis
+    /// outside its range (the cut itself is within them). Fix: a smaller `pierce_standoff` in
+    /// the machine's `process`, or place the part farther from that limit.
+    #[error(
+        "path {path}: the pierce point {standoff_mm} mm above the cut's start puts {axis} at {value}, outside its range [{min}, {max}]"
+    )]
+    PierceOutOfRange {
+        /// Index of the path whose cut it starts.
+        path: usize,
+        /// The pierce standoff, mm.
+        standoff_mm: f64,
+        /// Axis name.
+        axis: String,
+        /// The axis value at the pierce point.
+        value: f64,
+        /// Lower limit.
+        min: f64,
+        /// Upper limit.
+        max: f64,
+    },
     /// The feed plan did not bring every axis within its velocity and acceleration limits after
     /// the allowed number of refinements. This does not happen with consistent limits; fix:
     /// check that the machine's limits are positive and finite, or lower the feed.

@@ -6,8 +6,8 @@ mod common;
 
 use common::{circle, stations};
 use kerf_interp::{
-    gcode_motion, interpolate, AxisModel, ChordTerm, Dialect, FitOptions, GcodeOptions, Motion,
-    PaperAcHead, PlanOptions, ProgramPath,
+    gcode_motion, interpolate, AxisModel, ChordTerm, Dialect, FitOptions, GcodeOptions,
+    InterpError, Motion, PaperAcHead, PlanOptions, ProgramPath,
 };
 use kerf_kinematics::Process;
 use nalgebra::{Point3, Vector3};
@@ -407,8 +407,8 @@ fn bad_process_codes_are_named_errors() {
     let m = PaperAcHead::paper_000();
     let motion = program(&m, Dialect::Linuxcnc);
     for (p, want) in [
-        (Process { pierce_dwell_s: Some(-1.0), ..Process::default() }, "process.pierce_dwell_s: must be finite and >= 0 (got -1)"),
-        (Process { pierce_standoff: Some(f64::NAN), ..Process::default() }, "process.pierce_standoff: must be finite and >= 0 (got NaN)"),
+        (Process { pierce_dwell_s: Some(-1.0), ..Process::default() }, "process.pierce_dwell_s: must lie in [0, 60] (got -1)"),
+        (Process { pierce_standoff: Some(f64::NAN), ..Process::default() }, "process.pierce_standoff: must lie in [0, 100] (got NaN)"),
         (Process { beam_on: Some(vec![]), ..Process::default() }, "process.beam_on: must list at least one program line"),
         (Process { beam_off: Some(vec!["M65 P0\nG0 X0".into()]), ..Process::default() }, "process.beam_off[0]: must be one printable ASCII program line without comments (found '\\n')"),
     ] {
@@ -433,4 +433,35 @@ fn bad_process_codes_are_named_errors() {
         !text.contains("M64") && !text.contains("M65"),
         "no default codes"
     );
+}
+
+#[test]
+fn a_pierce_point_outside_an_axis_range_is_refused() {
+    // The planned blocks stay within the ranges; the pierce standoff above each cut's start
+    // is added by the writer. With Z's range ending 1 mm above the highest cut start, a
+    // 1.5 mm standoff leaves it (the review's machine wrote Z680 on a Z range ending at 600)
+    // and a 0.5 mm one does not.
+    let m = PaperAcHead::paper_000();
+    for dialect in DIALECTS {
+        let motion = program(&m, dialect);
+        let blocks = motion.blocks();
+        let top = (0..blocks.len())
+            .filter(|&k| !blocks[k].rapid && (k == 0 || blocks[k - 1].rapid))
+            .map(|k| blocks[k].start_axes[2])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let mut low = m.clone();
+        low.limits.range[2] = Some([-100.0, top + 1.0]);
+        let with = |standoff: f64| {
+            GcodeOptions::new(dialect, 6000.0).with_process(Process {
+                pierce_standoff: Some(standoff),
+                ..Process::default()
+            })
+        };
+        let e = gcode_motion(&low, &motion, &[], &with(1.5)).expect_err("pierce above the range");
+        assert!(
+            matches!(&e, InterpError::PierceOutOfRange { axis, value, .. } if axis == "Z" && *value > top + 1.0),
+            "{dialect:?}: {e}"
+        );
+        gcode_motion(&low, &motion, &[], &with(0.5)).expect("pierce within the range");
+    }
 }

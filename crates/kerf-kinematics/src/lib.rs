@@ -57,7 +57,10 @@ pub use error::{BoxedKinematicsError, IoError, KinematicsError, Result};
 pub use fork_head::{ForkHead, ForkTilt};
 pub use head_table::HeadTable;
 pub use kinematics::{Kinematics, Parameter};
-pub use machine::{Machine, Process, Range, MACHINE_FORMAT};
+pub use machine::{
+    process_line_defect, Machine, Process, Range, MACHINE_FORMAT, MAX_PIERCE_DWELL_S,
+    MAX_PIERCE_STANDOFF_MM,
+};
 pub use nonlinear::{interpolate, linearization_error, slerp, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
 pub use path::{LIMIT_SLACK, UNIT_AXIS_TOLERANCE};

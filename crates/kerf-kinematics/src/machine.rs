@@ -90,15 +90,120 @@ pub struct Machine {
 pub struct Process {
     /// Program lines that switch the beam on, written as given (e.g. `["M64 P0"]`); never
     /// empty, each line non-empty, printable, without `;` or parentheses (they would start a
-    /// comment in some dialects).
+    /// comment in some dialects), and only process words ([`process_line_defect`]): no motion,
+    /// feed, tool or program-flow word can enter a program through them.
     pub beam_on: Option<Vec<String>>,
     /// Program lines that switch the beam off, with the same rules.
     pub beam_off: Option<Vec<String>>,
-    /// Seconds the head stands at the pierce point with the beam on before it moves, >= 0.
+    /// Seconds the head stands at the pierce point with the beam on before it moves, in
+    /// `[0, MAX_PIERCE_DWELL_S]`.
     pub pierce_dwell_s: Option<f64>,
-    /// mm along the tool axis above the start of a cut where the pierce happens, >= 0; the
-    /// head then descends along the tool axis to the cutting height with the beam on.
+    /// mm along the tool axis above the start of a cut where the pierce happens, in
+    /// `[0, MAX_PIERCE_STANDOFF_MM]`; the head then descends along the tool axis to the cutting
+    /// height with the beam on.
     pub pierce_standoff: Option<f64>,
+}
+
+/// The longest pierce dwell a machine file may ask for, s: thick plate pierces in seconds; a
+/// minute is beyond any process and keeps the program's timing meaningful.
+pub const MAX_PIERCE_DWELL_S: f64 = 60.0;
+
+/// The highest pierce standoff a machine file may ask for, mm: pierce heights are a few mm; a
+/// standoff of metres would send the head far off the part with the beam on.
+pub const MAX_PIERCE_STANDOFF_MM: f64 = 100.0;
+
+/// Why `line` may not be a process line, if it may not: it must be words of a letter and a
+/// number (`M64 P0`, `M3 S2000`) or Sinumerik system-variable assignments
+/// (`$A_OUT[1]=1`), and no word may move the machine, set a feed, change a tool or its
+/// offsets, or change the program's flow: `G` other than the dwell `G4` (motion and modes),
+/// the axis and arc words `X Y Z A B C U V W I J K R`, `F` (except as a `G4` line's dwell time,
+/// Sinumerik's `G4 F`), `T`, `D`, `H`, `L` (subprogram calls), `N`, `O` (o-words), `%` and `#`
+/// (parameters), and the M-words that stop, end, call or return
+/// (`M0 M1 M2 M6 M17 M30 M47 M60 M98 M99`). Allowed: other `M` words, `S`, and the parameters
+/// `P Q E`.
+pub fn process_line_defect(line: &str) -> Option<String> {
+    const FLOW_M: [u32; 10] = [0, 1, 2, 6, 17, 30, 47, 60, 98, 99];
+    let mut dwell = false;
+    let mut feed = None;
+    for token in line.split_whitespace() {
+        if let Some(var) = token.strip_prefix('$') {
+            if !system_variable_ok(var) {
+                return Some(format!(
+                    "{token:?} is not a system-variable assignment $NAME[INDEX]=NUMBER"
+                ));
+            }
+            continue;
+        }
+        let b = token.as_bytes();
+        let mut i = 0;
+        while i < b.len() {
+            let letter = b[i].to_ascii_uppercase();
+            if !letter.is_ascii_alphabetic() {
+                return Some(format!(
+                    "{token:?}: expected words of a letter and a number"
+                ));
+            }
+            i += 1;
+            let start = i;
+            while i < b.len()
+                && (b[i].is_ascii_digit()
+                    || b[i] == b'.'
+                    || (i == start && matches!(b[i], b'-' | b'+')))
+            {
+                i += 1;
+            }
+            let number = &token[start..i];
+            let Ok(value) = number.parse::<f64>() else {
+                return Some(format!(
+                    "{token:?}: the word {} needs a number",
+                    letter as char
+                ));
+            };
+            let refused = match letter {
+                b'M' => value.fract() != 0.0 || (value >= 0.0 && FLOW_M.contains(&(value as u32))),
+                b'G' if value == 4.0 => {
+                    dwell = true;
+                    false
+                }
+                b'F' => {
+                    feed = Some(number.to_string());
+                    false
+                }
+                b'S' | b'P' | b'Q' | b'E' => false,
+                _ => true,
+            };
+            if refused {
+                return Some(format!(
+                    "{}{number} may not be a process word: it moves the machine, sets a feed or a tool, or changes the program's flow",
+                    letter as char
+                ));
+            }
+        }
+    }
+    match feed {
+        Some(number) if !dwell => Some(format!(
+            "F{number} may not be a process word: it moves the machine, sets a feed or a tool, or changes the program's flow"
+        )),
+        _ => None,
+    }
+}
+
+/// `NAME[INDEX]=NUMBER` or `NAME=NUMBER` (after the `$`), `NAME` of letters, digits and `_`.
+fn system_variable_ok(var: &str) -> bool {
+    let Some((lhs, value)) = var.split_once('=') else {
+        return false;
+    };
+    let (name, index) = match lhs.split_once('[') {
+        Some((n, rest)) => match rest.strip_suffix(']') {
+            Some(i) => (n, Some(i)),
+            None => return false,
+        },
+        None => (lhs, None),
+    };
+    !name.is_empty()
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && index.is_none_or(|i| !i.is_empty() && i.chars().all(|c| c.is_ascii_digit() || c == ','))
+        && value.parse::<f64>().is_ok_and(f64::is_finite)
 }
 
 impl Process {
@@ -138,17 +243,29 @@ impl Process {
                         ),
                     ));
                 }
+                if let Some(why) = process_line_defect(line) {
+                    return Err(KinematicsError::doc(path, why));
+                }
             }
         }
-        for (key, v) in [
-            ("pierce_dwell_s", self.pierce_dwell_s),
-            ("pierce_standoff", self.pierce_standoff),
+        for (key, v, max) in [
+            ("pierce_dwell_s", self.pierce_dwell_s, MAX_PIERCE_DWELL_S),
+            (
+                "pierce_standoff",
+                self.pierce_standoff,
+                MAX_PIERCE_STANDOFF_MM,
+            ),
         ] {
             if let Some(v) = v {
-                if !(v.is_finite() && v >= 0.0) {
+                if !(v.is_finite() && (0.0..=max).contains(&v)) {
+                    let got = if v.abs() < 1e9 {
+                        format!("{v}")
+                    } else {
+                        format!("{v:e}")
+                    };
                     return Err(KinematicsError::doc(
                         format!("process.{key}"),
-                        format!("must be finite and >= 0 (got {v})"),
+                        format!("must lie in [0, {max}] (got {got})"),
                     ));
                 }
             }

@@ -39,10 +39,37 @@ fn absent_process_is_empty_and_a_full_one_reads_back() {
 }
 
 #[test]
+fn real_process_codes_are_accepted() {
+    // Beam codes of LinuxCNC (digital outputs, spindle-as-laser with power), Sinumerik
+    // (system variables) and vendor M-codes with parameters.
+    for line in [
+        "M64 P0",
+        "M62 P2",
+        "M3 S900",
+        "M3S2000",
+        "M7",
+        "M10 P1 Q2",
+        "M66 E0",
+        "G4 P0.5",
+        "G4 F0.5",
+        "$A_OUT[1]=1",
+        "$A_DBB[0]=255 M100",
+    ] {
+        assert_eq!(
+            kerf_kinematics::process_line_defect(line),
+            None,
+            "{line:?} is a process line"
+        );
+        let process = format!(r#", "process": {{"beam_on": [{line:?}]}}"#);
+        Machine::from_str(&machine(&process)).expect(line);
+    }
+}
+
+#[test]
 fn bad_process_values_are_named_errors() {
     let cases = [
-        (r#"{"pierce_dwell_s": -1}"#, "process.pierce_dwell_s: must be finite and >= 0 (got -1)"),
-        (r#"{"pierce_standoff": -0.5}"#, "process.pierce_standoff: must be finite and >= 0 (got -0.5)"),
+        (r#"{"pierce_dwell_s": -1}"#, "process.pierce_dwell_s: must lie in [0, 60] (got -1)"),
+        (r#"{"pierce_standoff": -0.5}"#, "process.pierce_standoff: must lie in [0, 100] (got -0.5)"),
         (r#"{"pierce_dwell_s": "long"}"#, "process.pierce_dwell_s: expected a number, found a string"),
         (r#"{"beam_on": []}"#, "process.beam_on: must list at least one program line"),
         (r#"{"beam_on": ["M64 P0", " "]}"#, "process.beam_on[1]: must not be empty"),
@@ -52,6 +79,19 @@ fn bad_process_values_are_named_errors() {
         (r#"{"beam_on": ["M3 (on)"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '(')"),
         (r#"{"beam_on": ["M3"], "dwell": 1}"#, "process.dwell: unknown key (known: beam_on, beam_off, pierce_dwell_s, pierce_standoff)"),
         (r#"["M3"]"#, "process: expected an object, found an array"),
+        // The review's machine files: no motion, program end, o-word or tape mark can ride
+        // in on a process line, and no absurd pierce.
+        (r#"{"beam_on": ["G0 X1400 Y700 Z-90"]}"#, "process.beam_on[0]: G0 may not be a process word: it moves the machine, sets a feed or a tool, or changes the program's flow"),
+        (r#"{"beam_on": ["M30"]}"#, "process.beam_on[0]: M30 may not be a process word: it moves the machine, sets a feed or a tool, or changes the program's flow"),
+        (r#"{"beam_off": ["M5", "M2"]}"#, "process.beam_off[1]: M2 may not be a process word: it moves the machine, sets a feed or a tool, or changes the program's flow"),
+        (r#"{"beam_on": ["%"]}"#, "process.beam_on[0]: \"%\": expected words of a letter and a number"),
+        (r#"{"beam_on": ["o100 call"]}"#, "process.beam_on[0]: O100 may not be a process word: it moves the machine, sets a feed or a tool, or changes the program's flow"),
+        (r#"{"beam_on": ["M3 S1000 F20"]}"#, "process.beam_on[0]: F20 may not be a process word: it moves the machine, sets a feed or a tool, or changes the program's flow"),
+        (r##"{"beam_on": ["#1=5"]}"##, "process.beam_on[0]: \"#1=5\": expected words of a letter and a number"),
+        (r#"{"beam_on": ["$A_OUT[1]=1 X5"]}"#, "process.beam_on[0]: X5 may not be a process word: it moves the machine, sets a feed or a tool, or changes the program's flow"),
+        (r#"{"beam_on": ["$A_OUT[1]"]}"#, "process.beam_on[0]: \"$A_OUT[1]\" is not a system-variable assignment $NAME[INDEX]=NUMBER"),
+        (r#"{"pierce_standoff": 1e300}"#, "process.pierce_standoff: must lie in [0, 100] (got 1e300)"),
+        (r#"{"pierce_dwell_s": 1e300}"#, "process.pierce_dwell_s: must lie in [0, 60] (got 1e300)"),
     ];
     for (process, want) in cases {
         let e =

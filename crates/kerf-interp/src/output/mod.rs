@@ -309,6 +309,37 @@ fn refuse_unchecked_blocks(blocks: &[Block], dialect: Dialect) -> Result<()> {
     Ok(())
 }
 
+/// Every pierce point (the rapid's end above each cut's start) within the machine's axis
+/// ranges: the blocks were planned within them, the pierce standoff is added here.
+fn refuse_pierces_out_of_range<M: AxisModel + ?Sized>(
+    model: &M,
+    blocks: &[Block],
+    process: &ProcessCodes,
+) -> Result<()> {
+    let names = model.axis_names();
+    for (k, b) in blocks.iter().enumerate() {
+        let starts_cut = !b.rapid && (k == 0 || blocks[k - 1].rapid);
+        if !starts_cut {
+            continue;
+        }
+        let (_, q, _) = writer::pierce_point(model, process, b);
+        for (axis, &range) in model.limits().range.iter().enumerate() {
+            let Some([min, max]) = range else { continue };
+            if !(q[axis] >= min && q[axis] <= max) {
+                return Err(InterpError::PierceOutOfRange {
+                    path: b.path,
+                    standoff_mm: process.pierce_standoff,
+                    axis: names[axis].to_string(),
+                    value: q[axis],
+                    min,
+                    max,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The G-code program of `blocks`, cutting block `b` taking `block_times[b]` seconds (a
 /// missing, zero or non-finite time falls back to
 /// `length / opts.feed_mm_per_min`); rapid blocks are
@@ -318,7 +349,8 @@ fn refuse_unchecked_blocks(blocks: &[Block], dialect: Dialect) -> Result<()> {
 /// [`InterpError::BadParameter`] for a feed, chord or blending tolerance that is not finite
 /// and > 0; [`InterpError::Process`] for unusable process codes;
 /// [`InterpError::UncheckedBlock`] for an arc or a merged line in a program for a dialect that
-/// gives the raw machine axes ([`Dialect::raw_axes`]).
+/// gives the raw machine axes ([`Dialect::raw_axes`]); [`InterpError::PierceOutOfRange`] for a
+/// pierce point (the standoff above a cut's start) outside an axis range.
 pub fn gcode_timed<M: AxisModel + ?Sized>(
     model: &M,
     blocks: &[Block],
@@ -331,6 +363,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     positive("blend_tolerance_mm", opts.blend_tolerance_mm)?;
     refuse_unchecked_blocks(blocks, opts.dialect)?;
     let process = ProcessCodes::resolve(opts.dialect, &opts.process)?;
+    refuse_pierces_out_of_range(model, blocks, &process)?;
     let mut w = Writer {
         model,
         opts,

@@ -226,17 +226,9 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
 
     /// Rapid to the pierce point of the cut starting with `b`, beam on, dwell, descent.
     pub(super) fn start_cut(&mut self, b: &Block) {
-        let (tilt, c) = (b.start_axes[3], b.start_axes[4]);
+        let (pierce, qp, u) = pierce_point(self.model, &self.process, b);
         let start = b.start_tip();
-        let u = self.model.tool_axis(tilt, c);
         let h = self.process.pierce_standoff;
-        let pierce = start + u * h;
-        let lin = self.model.linear_axes(&pierce, tilt, c);
-        let qp = if h > 0.0 {
-            [lin[0], lin[1], lin[2], tilt, c]
-        } else {
-            b.start_axes
-        };
         self.rapid(pierce, qp, u);
         for l in self.process.beam_on.clone() {
             self.line(&l);
@@ -376,4 +368,24 @@ fn feed_number(f: f64) -> String {
     let mag = f.log10().floor() as i32;
     let decimals = (5 - mag).clamp(0, 12) as usize;
     format!("{f:.decimals$}")
+}
+
+/// The pierce point of the cut starting with `b` (`pierce_standoff` above its start along the
+/// tool axis), the machine axes there (the start's rotary axes) and the tool axis.
+pub(super) fn pierce_point<M: AxisModel + ?Sized>(
+    model: &M,
+    process: &ProcessCodes,
+    b: &Block,
+) -> (nalgebra::Point3<f64>, [f64; 5], nalgebra::Vector3<f64>) {
+    let (tilt, c) = (b.start_axes[3], b.start_axes[4]);
+    let u = model.tool_axis(tilt, c);
+    let h = process.pierce_standoff;
+    let pierce = b.start_tip() + u * h;
+    let q = if h > 0.0 {
+        let lin = model.linear_axes(&pierce, tilt, c);
+        [lin[0], lin[1], lin[2], tilt, c]
+    } else {
+        b.start_axes
+    };
+    (pierce, q, u)
 }

@@ -61,15 +61,19 @@ fn process_codes_reach_the_program() {
         assert_eq!(report["program"]["pierce_standoff_mm"], 2.0);
         assert_eq!(report["program"]["cuts"], 2);
         let b = &report["tolerance_budget_mm"];
-        let sum = [
-            "chord",
-            "linearization",
-            "interpolation_chord",
-            "controller_blending",
-        ]
-        .iter()
-        .map(|k| b[*k].as_f64().unwrap())
-        .sum::<f64>();
+        // Every term, `fit` too where arcs and merged lines are written (Sinumerik).
+        let sum = b
+            .as_object()
+            .expect("budget object")
+            .iter()
+            .filter(|(k, _)| *k != "total")
+            .map(|(_, v)| v.as_f64().expect("a known term"))
+            .sum::<f64>();
+        assert_eq!(
+            b.get("fit").is_some(),
+            dialect == "sinumerik",
+            "{dialect}: a fit term exactly where blocks are fitted"
+        );
         assert!(
             (b["total"].as_f64().unwrap() - sum).abs() < 1e-12,
             "total is the sum"

@@ -12,18 +12,18 @@
 //! - the tool axis interpolated at each point (rotary axes in proportion to the distance, or
 //!   to the swept angle piecewise `i -> m -> j` on arcs) is within `orientation_tolerance_deg` of
 //!   the point's own tool axis;
+//! - **the polyline**: each piece of the block between neighbouring points lies within
+//!   `tolerance` of their chord (a line: its points are within it, and so is every point of
+//!   the chord between two of them; an arc: its sagitta over the chord plus the points' own
+//!   distances). This is proven, so the block lies within `tolerance` plus the chord error of
+//!   the curve: the budget's `chord + fit`;
 //! - **the curve**: where the curve is known (a closure giving the curve point at a parameter,
 //!   and both neighbouring points carry their parameters), `curve_samples` points of the curve
-//!   between them lie within `tolerance` of the block; where it is not known (no closure, or a
-//!   point inserted by the kinematics without a parameter), the polyline stands in for it: each piece of the block between neighbouring points
-//!   lies within `tolerance` of their chord (for an arc: its sagitta over the chord plus the
-//!   points' own distances).
+//!   between them also lie within `tolerance` of the block (sampled, so a check, not a
+//!   bound).
 //!
 //! The search is exponential then bisecting in `j` (the acceptance is not strictly monotone in
-//! `j`, so the result is a good, not necessarily the longest, block). The curve test samples,
-//! so it is an estimate, not a certificate: the sampled deviation is a lower bound of the true
-//! one, and it is tight when the samples are dense relative to the curvature change between two
-//! cutting points (which the discretizer's chord tolerance keeps small).
+//! `j`, so the result is a good, not necessarily the longest, block).
 
 use nalgebra::Point3;
 
@@ -381,13 +381,13 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
             if d > tol || theta <= last.0 || theta > arc.angle_end {
                 return false;
             }
-            if self.samples[k - 1].is_none() {
-                // The polyline stands in for the curve: the arc piece between neighbours stays
-                // within the tolerance of their chord.
-                let sagitta = arc.radius * (1.0 - (0.5 * (theta - last.0)).cos());
-                if sagitta + d.max(last.1) > tol * (1.0 + 1e-9) {
-                    return false;
-                }
+            // The arc piece between neighbours stays within the tolerance of their chord
+            // (its sagitta over the chord plus the points' own distances): the proven half of
+            // the budget's `chord + fit`, the chord being within the certified chord error of
+            // the curve. The curve samples below only keep the arc near the curve too.
+            let sagitta = arc.radius * (1.0 - (0.5 * (theta - last.0)).cos());
+            if sagitta + d.max(last.1) > tol * (1.0 + 1e-9) {
+                return false;
             }
             last = (theta, d);
             if k < j && k != m {

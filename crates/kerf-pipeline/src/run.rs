@@ -357,16 +357,18 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     // N* from the curvature the walk evaluated at its points (`Discretization::n_star`).
     let nstar: f64 = discs.iter().map(|d| d.n_star(dopts.tolerance_mm)).sum();
     let segments: usize = discs.iter().map(Discretization::segments).sum();
+    // The budget as the program's header states it (a `fit` term where arcs and merged lines
+    // are written), and its total.
+    let mut budget: serde_json::Map<String, serde_json::Value> = gopts
+        .budget()
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), json!(v)))
+        .collect();
+    budget.insert("total".into(), json!(gopts.budget_total()));
     let report = json!({
         "input": source_name,
         "machine": machine.name,
-        "tolerance_budget_mm": {
-            "chord": dopts.tolerance_mm,
-            "linearization": popts.linearization_tolerance_mm,
-            "interpolation_chord": plan.chord_tolerance_mm,
-            "controller_blending": gopts.blend_tolerance_mm,
-            "total": gopts.budget_total(),
-        },
+        "tolerance_budget_mm": budget,
         "program": {
             "dialect": dialect.name(),
             "beam_on": process.beam_on,

@@ -410,3 +410,79 @@ fn a_program_states_the_chord_term_only_as_far_as_kerf_proved_it() {
         "{err}"
     );
 }
+
+#[test]
+fn sinumerik_arcs_and_merged_lines_stay_within_chord_plus_fit_of_the_curve() {
+    // With tool-tip control the program's blocks are arcs and lines merged over several
+    // cutting points; the budget states `chord + fit` for them. Every cutting block that
+    // carries curve parameters is measured against the curve itself, densely sampled between
+    // them (64 points), with the block's exact geometry.
+    let job = Job::from_files(fixture("door_trim.json"), fixture("machines/ac_head.json"))
+        .expect("inputs")
+        .with_options(
+            JobOptions::default()
+                .with_tolerance_mm(0.01)
+                .with_dialect(Dialect::Sinumerik),
+        );
+    let out = job.run().expect("run");
+    let text = &out.programs[0].text;
+    assert!(
+        text.contains("chord 0.01 + fit 0.01 + "),
+        "{}",
+        text.lines().find(|l| l.contains("budget")).unwrap_or("")
+    );
+    let program = &out.programs[0];
+    let (mut measured, mut merged) = (0.0f64, 0usize);
+    for b in program.motion.blocks().iter().filter(|b| !b.rapid) {
+        let Some([t0, t1]) = b.params.filter(|p| p[1] > p[0]) else {
+            continue;
+        };
+        let id = &program.ids[b.path];
+        let curve = &job
+            .curves()
+            .curves
+            .iter()
+            .find(|c| &c.id == id)
+            .expect("curve")
+            .curve;
+        // The cut's parameters: the contour from its start point `u_s` round to it again
+        // (`+ period` past the seam), the lead-in below `u_s`, the lead-out above the end.
+        let params = &out
+            .toolpath
+            .paths
+            .iter()
+            .find(|p| &p.id == id)
+            .expect("toolpath path")
+            .params;
+        let start = out
+            .axes
+            .paths
+            .iter()
+            .find(|p| &p.id == id)
+            .and_then(|p| p.start_point)
+            .unwrap_or(0);
+        let (a, e) = curve.domain();
+        let period = e - a;
+        let u_s = params[start];
+        let u_e = if start > 0 { u_s + period } else { e };
+        let (lo, hi) = (t0.max(u_s), t1.min(u_e));
+        if hi <= lo {
+            continue; // a lead-in or lead-out block: not on the curve, no claim
+        }
+        if b.stations[1] > b.stations[0] + 1 {
+            merged += 1;
+        }
+        for k in 0..=64 {
+            let u = lo + (hi - lo) * k as f64 / 64.0;
+            let p = curve.point(if u > e { u - period } else { u });
+            let d = match b.geometry {
+                Geometry::Line { start, end } => kerf_nurbs::distance_to_segment(&p, &start, &end),
+                Geometry::Arc(arc) => arc.distance(&p).0,
+                Geometry::Turn { at } => (p - at).norm(),
+            };
+            measured = measured.max(d);
+        }
+    }
+    assert!(merged > 10, "arcs and merged lines to test: {merged}");
+    assert!(measured <= 0.01 + 0.01, "{measured} mm from the curve");
+}

@@ -73,7 +73,7 @@ pub struct GcodeOptions {
     pub fit_tolerance_mm: f64,
     /// The budget's `chord` term and where it comes from. Default [`ChordTerm::Unknown`]: a
     /// program states a chord bound only when told where it comes from. With arcs or merged
-    /// lines (Sinumerik) the term is the larger of this and [`fit_tolerance_mm`](Self::fit_tolerance_mm).
+    /// lines (Sinumerik) the budget adds a `fit` term of [`fit_tolerance_mm`](Self::fit_tolerance_mm).
     pub chord_term: ChordTerm,
     /// Chord tolerance of arcs, mm: raw-axis programs write arcs as chords within it (the
     /// budget's `interpolation_chord` term). Default 0.001.
@@ -206,24 +206,26 @@ impl GcodeOptions {
     }
 
     /// The tolerance budget term by term, mm, named as in `report.json`: `chord` (`None` when
-    /// unknown; claimed or certified as [`chord_term`](Self::chord_term) says), `linearization`
-    /// (`None` when unknown), `interpolation_chord`, `controller_blending`.
-    pub fn budget(&self) -> [(&'static str, Option<f64>); 4] {
+    /// unknown; claimed or certified as [`chord_term`](Self::chord_term) says), `fit` (only
+    /// for dialects with tool-tip control, whose arcs and merged lines lie within
+    /// [`fit_tolerance_mm`](Self::fit_tolerance_mm) of the polyline of cutting points, so
+    /// within `chord + fit` of the curve), `linearization` (`None` when unknown),
+    /// `interpolation_chord`, `controller_blending`.
+    pub fn budget(&self) -> Vec<(&'static str, Option<f64>)> {
         let chord = match self.chord_term {
-            ChordTerm::Certified(mm) | ChordTerm::Claimed(mm) if self.dialect.raw_axes() => {
-                Some(mm)
-            }
-            ChordTerm::Certified(mm) | ChordTerm::Claimed(mm) => {
-                Some(mm.max(self.fit_tolerance_mm))
-            }
+            ChordTerm::Certified(mm) | ChordTerm::Claimed(mm) => Some(mm),
             ChordTerm::Unknown => None,
         };
-        [
-            ("chord", chord),
+        let mut terms = vec![("chord", chord)];
+        if !self.dialect.raw_axes() {
+            terms.push(("fit", Some(self.fit_tolerance_mm)));
+        }
+        terms.extend([
             ("linearization", self.linearization_tolerance_mm),
             ("interpolation_chord", Some(self.chord_tolerance_mm)),
             ("controller_blending", Some(self.blend_tolerance_mm)),
-        ]
+        ]);
+        terms
     }
 
     /// The sum of the known budget terms, mm.

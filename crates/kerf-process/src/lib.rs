@@ -147,7 +147,8 @@ pub struct Blockage {
     pub from: [f64; 3],
     /// The next pierce point, mm.
     pub to: [f64; 3],
-    /// The first point too close on the last route tried, mm.
+    /// A point too close on the route that came nearest to clearing (its sample farthest from
+    /// the part: closer than the clearance where measured so, else within the margin), mm.
     pub at: [f64; 3],
     /// Its distance from the part, mm.
     pub distance_mm: f64,

@@ -26,12 +26,34 @@ fn real_files_route_every_traverse_but_an_asserted_residue() {
     // with five retract heights at each end) is measured closer than the clearance somewhere
     // (a witness sample, not the tracing's margin: none is left unproven); `own` gaps
     // leave out a cut's own surface that curls over its head line (holes narrower than the
-    // clearance cut with the wall's radial normal as tool axis).
-    for (curves, gaps, unchecked, own) in [
-        ("realdata/nori_sheetmetal.json", 74, 2, 13),
-        ("realdata/occt_propeller.json", 46, 3, 1),
+    // clearance cut with the wall's radial normal as tool axis). `turned`: contours cut from
+    // the other side of the sheet because the nozzle's line meets the part from the given
+    // side and not from the other; `both`: contours kept although their nozzle's line meets
+    // the part from both sides (or the head cannot reach the clear side): most of the `own`
+    // residue.
+    for (curves, gaps, unchecked, own, turned, both) in [
+        ("realdata/nori_sheetmetal.json", 74, 2, 9, 6, 13),
+        ("realdata/occt_propeller.json", 46, 3, 1, 9, 13),
     ] {
         let (report, axes, file) = run(curves);
+        let sides = report["placement"]["sides"].as_array().expect("sides");
+        let reasons = |needle: &str| {
+            sides
+                .iter()
+                .filter(|s| s["reason"].as_str().expect("reason").contains(needle))
+                .collect::<Vec<_>>()
+        };
+        let by_head = reasons("from the other side at none");
+        assert_eq!(by_head.len(), turned, "{curves}: {sides:#?}");
+        let flipped = report["placement"]["flipped_paths"]
+            .as_array()
+            .expect("flipped");
+        for s in &by_head {
+            assert_eq!(s["side"], "other", "{s}");
+            assert!(flipped.contains(&s["id"]), "{curves}: {s}");
+        }
+        let kept = reasons("both sides").len() + reasons("cannot reach the other side").len();
+        assert_eq!(kept, both, "{curves}: {sides:#?}");
         let t = &report["traverses"];
         let clearance = t["clearance_mm"].as_f64().expect("clearance");
         assert_eq!(t["count"].as_u64(), Some(gaps), "{curves}: gaps");

@@ -27,6 +27,7 @@ mod geometry;
 mod lead;
 mod order;
 mod rapid;
+mod side;
 mod start;
 mod traverse;
 
@@ -35,6 +36,7 @@ pub use order::CutPlan;
 pub use rapid::{
     in_the_cuts_way, own_surfaces_over_the_head, plan_rapids, rapid_moves, Gap, RapidMoves,
 };
+pub use side::{head_lines, HeadLines, HEAD_LINE_POINTS};
 pub use start::{index_of_param, prepare_start};
 pub use traverse::{
     check_move, plan_traverse, plan_traverse_within, Obstacles, Route, Traverse, TraverseOptions,

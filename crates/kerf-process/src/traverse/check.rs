@@ -177,14 +177,16 @@ impl<'a> Trace<'a> {
     /// margin, like one that keeps the need by a hair. Where [`Trace::certify`] stopped within
     /// the margin (at `stall`), this looks for a *witness* ahead of the stall: samples of the
     /// swept surface `delta` further along the move and along the nozzle, `delta` doubling
-    /// from [`FINEST_MARGIN`] of the need to twice the need (each spending one of `work`). A
-    /// sample closer than the need is a measured violation: the move is blocked, whatever the
-    /// margin. Returns the closest such sample, or `None` if none is found.
+    /// from the stall's excess over the need (at least [`FINEST_MARGIN`] of the need: the
+    /// distance is 1-Lipschitz, so nothing nearer can be closer than the need) to twice the
+    /// need (each spending one of `work`). A sample closer than the need is a measured
+    /// violation: the move is blocked, whatever the margin. Returns the closest sample of the
+    /// first doubling that holds one, or `None` if none is found.
     pub(super) fn witness(&self, stall: &Blocked, work: &mut Work) -> Option<Blocked> {
         let need = self.need;
         let limit = need.abs() + 1.0;
         let mut found: Option<Blocked> = None;
-        let mut delta = need.abs() * FINEST_MARGIN + 1e-9;
+        let mut delta = (stall.distance - need).max(need.abs() * FINEST_MARGIN + 1e-9);
         while delta <= 2.0 * need.abs() + 1e-9 {
             let df = if self.speed > 0.0 {
                 delta / self.speed
@@ -214,6 +216,9 @@ impl<'a> Trace<'a> {
                         s,
                     });
                 }
+            }
+            if found.is_some() {
+                return found;
             }
             delta *= 2.0;
         }

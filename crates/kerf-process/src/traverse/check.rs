@@ -272,9 +272,10 @@ impl<'a> Trace<'a> {
 /// samples departs from it by the second order of their spacing, which the caller keeps small
 /// (or adds to `need_mm`).
 ///
-/// Each stretch is traced with a margin of a hundredth of `need_mm` first; a stretch that
-/// fails only within it (its closest sample keeps `need_mm`) is traced again with finer
-/// margins, down to [`FINEST_MARGIN`] of the need, within a counted budget of samples.
+/// Each stretch is traced with a margin of a hundredth of `need_mm` first; where the trace
+/// stops within it (its sample keeps `need_mm`), samples ahead of the stop look for one closer
+/// than `need_mm` (a measured violation), and without one the stretch is traced again with
+/// finer margins, down to 1/4096 of the need, within a counted budget of samples.
 ///
 /// # Errors
 /// `Err((point, distance))` for the first point closer than `need_mm` plus the margin it was

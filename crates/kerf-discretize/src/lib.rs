@@ -204,6 +204,89 @@ impl Discretization {
     }
 }
 
+impl Discretization {
+    /// This discretization of `curve` with one more cutting point, at `t` strictly between two
+    /// cutting points (for instance where a cut must start): only the two new segments are
+    /// certified, with the bound of [`Discretization::certify`] at `tolerance` (the tolerance
+    /// the discretization was made with); every other segment keeps its certificate. The
+    /// certified maximum becomes the larger of the old one and the new segments' (a bound,
+    /// possibly above the true maximum when the replaced segment held it); the observed
+    /// maximum, which must stay a lower bound of the true one, becomes the new segments' (the
+    /// replaced segment may have held the old one).
+    ///
+    /// # Errors
+    /// As [`Discretization::certify`] for the tolerance; [`DiscretizeError::NotCertified`] if
+    /// `t` is not strictly between two cutting points (or `curve` is not the one discretized:
+    /// its domain differs) or a new segment cannot be certified.
+    pub fn with_point(&self, curve: &NurbsCurve, t: f64, tolerance: f64) -> Result<Self> {
+        Options::with_tolerance(tolerance).validate()?;
+        let cert = Certifier::new(curve);
+        let margin = cert.max_margin() + cert.output_resolution();
+        if margin.is_nan() || margin > 0.5 * tolerance {
+            return Err(DiscretizeError::ToleranceBelowMargin { tolerance, margin });
+        }
+        let n = self.params.len();
+        let i = self.params.partition_point(|&p| p < t);
+        let (a, b) = curve.domain();
+        let inside = i > 0 && i < n && self.params[i - 1] < t && t < self.params[i];
+        if !inside || self.params[0] != a || self.params[n - 1] != b {
+            return Err(DiscretizeError::NotCertified {
+                index: i,
+                reason: "the new parameter must lie strictly between two cutting points",
+                bound: t,
+            });
+        }
+        let p = cert.point(t);
+        let mut scratch = bound::Scratch::default();
+        let (t0, t1) = (self.params[i - 1], self.params[i]);
+        let left = cert.chord_error(
+            &mut scratch,
+            t0,
+            t,
+            &self.points[i - 1],
+            &p,
+            tolerance,
+            tolerance,
+        );
+        let right = cert.chord_error(
+            &mut scratch,
+            t,
+            t1,
+            &p,
+            &self.points[i],
+            tolerance,
+            tolerance,
+        );
+        for (k, bd) in [(i - 1, left), (i, right)] {
+            if bd.upper.is_nan() || bd.upper > tolerance {
+                return Err(DiscretizeError::NotCertified {
+                    index: k,
+                    reason: "the segment's chord error cannot be certified",
+                    bound: bd.upper,
+                });
+            }
+        }
+        let mut params = self.params.clone();
+        let mut points = self.points.clone();
+        params.insert(i, t);
+        points.insert(i, p);
+        let value = |u: f64| sqrt_curvature_speed(&curve.eval_d3(u));
+        let (v0, v, v1) = (value(t0), value(t), value(t1));
+        let sqrt_curvature = self.sqrt_curvature - trapezoid_step(curve, t0, t1, v0, v1)
+            + trapezoid_step(curve, t0, t, v0, v)
+            + trapezoid_step(curve, t, t1, v, v1);
+        let new_lower = left.lower.max(right.lower);
+        Ok(Self {
+            params,
+            points,
+            max_chord_error: self.max_chord_error.max(left.upper).max(right.upper),
+            estimated_chord_error: new_lower,
+            c0_breaks: self.c0_breaks.clone(),
+            sqrt_curvature,
+        })
+    }
+}
+
 /// `f = sqrt(k) |C'|` and its derivative `df/dt` from the first three derivatives. With
 /// `a = C' x C''` and `s = |C'|`: `f = (|a| / s)^(1/2)` and
 /// `df/dt = (a . (C' x C''')) / (2 |a|^(3/2) s^(1/2)) - f (C' . C'') / (2 s^2)`.

@@ -38,10 +38,12 @@ use crate::pose::{Axes, Pose};
 
 mod setups;
 mod shift;
+mod work;
 
 pub use setups::{auto_setups, Setup, SetupPlan};
 use setups::{reachable_directions, turn_up, up_directions};
 use shift::translation;
+use work::Work;
 
 /// A rigid transform from part coordinates to workpiece coordinates: `p' = R p + t`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -243,6 +245,9 @@ pub struct AutoPlacement {
     pub clearance_mm: f64,
     /// How many rotations were tried.
     pub rotations_tried: usize,
+    /// How many paths were solved in all (with the linear axes free, and against the real
+    /// limits): the work the search cost.
+    pub paths_solved: usize,
 }
 
 impl AutoPlacement {
@@ -331,6 +336,18 @@ pub fn auto_place(
     paths: &[(&str, &[Pose])],
     options: &AutoPlaceOptions,
 ) -> Result<AutoPlacement> {
+    validate(options)?;
+    let work = Work::new(machine, paths, options);
+    let all: Vec<usize> = (0..paths.len()).collect();
+    let found = search(&work, &all, false)?;
+    Ok(AutoPlacement {
+        paths_solved: work.solved.load(std::sync::atomic::Ordering::Relaxed),
+        ..found
+    })
+}
+
+/// Checks the options [`auto_place`] and [`auto_setups`] take.
+fn validate(options: &AutoPlaceOptions) -> Result<()> {
     options.path_options.validate()?;
     if !(options.margin_mm.is_finite() && options.margin_mm >= 0.0) {
         return Err(KinematicsError::BadOption {
@@ -339,7 +356,15 @@ pub fn auto_place(
             reason: "must be finite and >= 0 (mm)",
         });
     }
-    let owned: Vec<Vec<Pose>> = paths.iter().map(|(_, p)| p.to_vec()).collect();
+    Ok(())
+}
+
+/// The search of [`auto_place`] over the paths `idx` of `work`. With `bound`, a candidate
+/// whose poses cannot fit the linear travel in any translation ([`Work::envelope_short`]) is
+/// refused before it is solved; its shortfall is then only a lower bound, so the error names
+/// the exact shortfall only without it (set-ups only ask whether a group fits).
+fn search(work: &Work<'_>, idx: &[usize], bound: bool) -> Result<AutoPlacement> {
+    let options = work.options;
     let mut best_short: Option<Shortfall> = None;
     let mut tried = 0;
     // Rounds of candidates: the part as modelled; quarter turns; general orientations that
@@ -362,7 +387,7 @@ pub fn auto_place(
             rounds[round].clone()
         } else if !general_done {
             general_done = true;
-            general_orientations(machine, &owned, options.flip)
+            general_orientations(&work.reach(idx))
         } else {
             break;
         };
@@ -370,7 +395,7 @@ pub fn auto_place(
         let mut best: Option<AutoPlacement> = None;
         for rot in candidates {
             tried += 1;
-            match try_rotation(machine, paths, &owned, &rot, options) {
+            match try_rotation(work, idx, &rot, bound) {
                 Ok(found) => {
                     if best
                         .as_ref()
@@ -409,11 +434,11 @@ pub fn auto_place(
 
 /// Orientations of the part in which every contour's tool axes (on one side of the sheet or
 /// the other) are within the tilt range: directions `d` of the part that could point up (a
-/// Fibonacci lattice of 2,048 directions, each checked on up to 64 poses per contour), the
-/// closest to the modelled up direction first, each with 8 turns about the vertical.
-fn general_orientations(machine: &Machine, paths: &[Vec<Pose>], flip: bool) -> Vec<Rotation3<f64>> {
+/// Fibonacci lattice of 2,048 directions; `fits`, per path and direction, from
+/// [`Work::reach`]), the closest to the modelled up direction first, each with 8 turns about
+/// the vertical.
+fn general_orientations(fits: &[&[bool]]) -> Vec<Rotation3<f64>> {
     let lattice = up_directions();
-    let fits = reachable_directions(machine, paths, flip, &lattice);
     let mut good: Vec<(f64, Vector3<f64>)> = lattice
         .iter()
         .enumerate()
@@ -489,28 +514,24 @@ fn path_tilt_shortfall(machine: &Machine, poses: &[Pose]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// One candidate rotation for the paths `idx` of `work`: the side of each path, the solve with
+/// the linear axes free, the translation, and the check against the real limits. With
+/// `bound`, refused before any solve where [`Work::envelope_short`] says the travel is short.
 fn try_rotation(
-    real: &Machine,
-    paths: &[(&str, &[Pose])],
-    owned: &[Vec<Pose>],
+    work: &Work<'_>,
+    idx: &[usize],
     rot: &Rotation3<f64>,
-    options: &AutoPlaceOptions,
+    bound: bool,
 ) -> std::result::Result<AutoPlacement, TryError> {
-    // The tilt range less its margin (when the range is wide enough to keep one).
-    let mut inset = real.clone();
-    if let Some(r) = inset.limits[3] {
-        let m = options.tilt_margin_deg.max(0.0);
-        if r.max - r.min > 4.0 * m {
-            inset.limits[3] = Some(Range::new(r.min + m, r.max - m));
-        }
-    }
-    let machine = &inset;
+    let options = work.options;
+    let machine = &work.inset;
     let tilt_name = machine.kinematics.tilt_name();
     let rotation = Placement::from_rotation(Vector3::zeros(), rot);
-    let rotated = place_paths(&rotation, &[], owned);
+    let owned: Vec<Vec<Pose>> = idx.iter().map(|&i| work.paths[i].1.to_vec()).collect();
+    let rotated = place_paths(&rotation, &[], &owned);
     // 1. The side of each contour.
     let mut flipped = vec![false; rotated.len()];
-    for (i, poses) in rotated.iter().enumerate() {
+    for (k, poses) in rotated.iter().enumerate() {
         let short = path_tilt_shortfall(machine, poses);
         if short == 0.0 {
             continue;
@@ -524,7 +545,7 @@ fn try_rotation(
             .collect();
         let short_rev = path_tilt_shortfall(machine, &reversed);
         if options.flip && short_rev == 0.0 {
-            flipped[i] = true;
+            flipped[k] = true;
         } else {
             let missing = if options.flip {
                 short.min(short_rev)
@@ -536,7 +557,7 @@ fn try_rotation(
                 missing,
                 detail: format!(
                     "path \"{}\": its tool axes need {missing:.3} deg more {tilt_name} travel{}",
-                    paths[i].0,
+                    work.paths[idx[k]].0,
                     if options.flip {
                         " on either side of the sheet"
                     } else {
@@ -547,32 +568,35 @@ fn try_rotation(
         }
     }
     let sided = place_paths(&Placement::IDENTITY, &flipped, &rotated);
-    // 2. Solve with the linear axes unlimited.
-    let mut free = machine.clone();
-    for k in 0..3 {
-        free.limits[k] = None;
+    // 2. The linear travel, cheaply (a lower bound); then the solve with the linear axes free.
+    if bound {
+        if let Some(s) = work.envelope_short(&sided) {
+            return Err(TryError::Short(s));
+        }
     }
-    let solved = solve(&free, paths, &sided, &options.path_options).map_err(|e| match e {
-        KinematicsError::OutOfLimits {
-            axis,
-            value,
-            min,
-            max,
-            ref path_id,
-            ..
-        } => TryError::Short(Shortfall {
-            axis,
-            missing: (min - value).max(value - max),
-            detail: format!("path \"{path_id}\": {e}"),
-        }),
-        other => TryError::Hard(other),
-    })?;
+    let solved = work
+        .free_solve(idx, rot, &flipped, &sided)
+        .map_err(|e| match e {
+            KinematicsError::OutOfLimits {
+                axis,
+                value,
+                min,
+                max,
+                ref path_id,
+                ..
+            } => TryError::Short(Shortfall {
+                axis,
+                missing: (min - value).max(value - max),
+                detail: format!("path \"{path_id}\": {e}"),
+            }),
+            other => TryError::Hard(other),
+        })?;
     // 3. The translation.
     let t = translation(machine, &solved, options.margin_mm).map_err(TryError::Short)?;
     let placement = Placement::new(t, rotation.rotation_deg);
     // 4. Check against the real limits.
-    let placed = place_paths(&placement, &flipped, owned);
-    let check = solve(machine, paths, &placed, &options.path_options).map_err(|e| match e {
+    let placed = place_paths(&placement, &flipped, &owned);
+    let check = work.check_solve(idx, &placed).map_err(|e| match e {
         KinematicsError::OutOfLimits {
             axis,
             value,
@@ -592,25 +616,8 @@ fn try_rotation(
         flipped,
         clearance_mm,
         rotations_tried: 0,
+        paths_solved: 0,
     })
-}
-
-fn solve(
-    machine: &Machine,
-    paths: &[(&str, &[Pose])],
-    poses: &[Vec<Pose>],
-    options: &PathOptions,
-) -> Result<Vec<SolvedPath>> {
-    let inputs: Vec<PathInput<'_>> = paths
-        .iter()
-        .zip(poses)
-        .map(|((id, _), p)| PathInput {
-            id,
-            poses: p,
-            curve: None,
-        })
-        .collect();
-    solve_paths(machine, &inputs, options)
 }
 
 /// The smallest distance of any solved linear axis value to its limits.

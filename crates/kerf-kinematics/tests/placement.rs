@@ -6,8 +6,8 @@ mod common;
 
 use common::fixture;
 use kerf_kinematics::{
-    auto_place, axis_aligned_rotations, solve_path, AutoPlaceOptions, KinematicsError, Machine,
-    PathInput, PathOptions, Placement, Pose,
+    auto_place, auto_setups, axis_aligned_rotations, solve_path, AutoPlaceOptions, KinematicsError,
+    Machine, PathInput, PathOptions, Placement, Pose,
 };
 use nalgebra::{Point3, Vector3};
 
@@ -246,5 +246,90 @@ fn table_machine_placement_is_verified_against_the_limits() {
             found.clearance_mm
         );
         solve_placed(&m, &found.apply(&paths));
+    }
+}
+
+/// Four small flat squares (tool axis +z) in a row along x, `spacing` apart: a row too long
+/// for the machine, each half of it short enough.
+fn row(spacing: f64) -> Vec<Vec<Pose>> {
+    (0..4)
+        .map(|i| square(spacing * f64::from(i), 0.0, 0.0, 10.0, Vector3::z(), 4))
+        .collect()
+}
+
+/// `auto_setups` on `paths`: the plan, every set-up verified by solving its placed paths
+/// against the real limits.
+fn setups_verified(
+    m: &Machine,
+    paths: &[Vec<Pose>],
+    options: &AutoPlaceOptions,
+) -> kerf_kinematics::SetupPlan {
+    let ids: Vec<String> = (0..paths.len()).map(|i| format!("p{i}")).collect();
+    let refs: Vec<(&str, &[Pose])> = ids
+        .iter()
+        .map(String::as_str)
+        .zip(paths.iter().map(Vec::as_slice))
+        .collect();
+    let plan = auto_setups(m, &refs, options).expect("set-ups");
+    let placed = plan.apply(paths);
+    for s in &plan.setups {
+        let group: Vec<Vec<Pose>> = s.paths.iter().map(|&i| placed[i].clone()).collect();
+        solve_placed(m, &group);
+    }
+    plan
+}
+
+#[test]
+fn set_ups_solve_each_path_once_per_orientation_however_many_levels_try_it() {
+    // A table machine (no cheap travel bound: the linear axes do not follow the tip one to
+    // one), the part as modelled only: 4 squares 500 mm apart along x need 1,510 mm of X, the
+    // machine has 800. The whole part is solved (4 paths) and does not fit; its one
+    // orientation group is the whole part again (no new solve), then each half fits: its
+    // paths' free solves are the ones already made, only the check against the limits is
+    // new (4). Each path: one free solve, one check: 8 in all (16 if every level solved
+    // again).
+    let m = fixture("table_table.json");
+    let plan = setups_verified(
+        &m,
+        &row(500.0),
+        &AutoPlaceOptions::default().with_rotate(false),
+    );
+    assert_eq!(plan.setups.len(), 2, "{plan:?}");
+    assert_eq!(plan.paths_solved, 8, "{plan:?}");
+}
+
+#[test]
+fn orientations_that_cannot_fit_the_travel_are_refused_before_any_solve() {
+    // A head machine: 4 squares 2,000 mm apart along x need 6,010 mm of travel in some axis
+    // whichever way the part is turned (5,000 mm of X at most). Every candidate orientation of
+    // the whole part (24 quarter turns and the general ones) is refused by the travel of its
+    // cutting points alone; each half fits as modelled: 2 solves per path (free, check), 8 in
+    // all. Solving each refused candidate would cost 4 paths each.
+    let m = fixture("gantry_ac.json");
+    let plan = setups_verified(&m, &row(2000.0), &AutoPlaceOptions::default());
+    assert_eq!(plan.setups.len(), 2, "{plan:?}");
+    assert!(plan.rotations_tried > 24, "{}", plan.rotations_tried);
+    assert_eq!(plan.paths_solved, 8, "{plan:?}");
+    // auto_place's error solves (no bound): the shortfall of the best candidate, at most that
+    // of the part as modelled, laid along X (6,010 - 4,998 mm: the tool axes are vertical,
+    // so X moves exactly as the tips do).
+    let paths = row(2000.0);
+    let refs: Vec<(&str, &[Pose])> = paths.iter().map(|p| ("p", p.as_slice())).collect();
+    let err = auto_place(&m, &refs, &AutoPlaceOptions::default()).expect_err("too long");
+    let as_modelled = auto_place(&m, &refs, &AutoPlaceOptions::default().with_rotate(false))
+        .expect_err("too long");
+    assert!(
+        matches!(as_modelled, KinematicsError::NoPlacement { axis: "X", missing, .. } if (missing - (6010.0 - 4998.0)).abs() < 1e-6),
+        "{as_modelled}"
+    );
+    match &err {
+        KinematicsError::NoPlacement { axis, missing, .. } => {
+            assert_eq!(*axis, "X", "{err}");
+            assert!(
+                *missing > 0.0 && *missing <= 6010.0 - 4998.0 + 1e-6,
+                "{err}"
+            );
+        }
+        other => panic!("expected NoPlacement, got {other}"),
     }
 }

@@ -54,9 +54,97 @@ pub struct Placed {
     pub plan: SetupPlan,
     /// Chosen by [`PlaceMode::Auto`].
     pub auto: bool,
+    /// For each path, how its head lines meet the part from each side of the sheet
+    /// ([`kerf_process::head_lines`], part coordinates, the given side being the surface's
+    /// normal); empty where they were not looked at (not `auto`, or unchecked traverses).
+    pub head_lines: Vec<kerf_process::HeadLines>,
+}
+
+/// Why a path is cut from the side it is, where that is not simply the given side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SideReason {
+    /// Turned: the head cannot reach the given side within the tilt limits.
+    Reach,
+    /// Turned: the nozzle meets the part from the given side and not from the other.
+    HeadLines,
+    /// Kept: the nozzle meets the part from the given side and not from the other, but the
+    /// machine cannot reach the other side.
+    HeadLinesUnreachable,
+    /// Kept: the nozzle meets the part from both sides.
+    BothSides,
 }
 
 impl Placed {
+    /// The paths' sides by their head lines ([`kerf_process::head_lines`]): each path whose
+    /// head meets the part from the given side and not from the other is turned, unless the
+    /// placement turned it back because the machine cannot reach that side. `self` must have
+    /// been placed with those paths already turned (see [`sides_by_head_lines`]).
+    pub(crate) fn with_head_lines(mut self, head_lines: Vec<kerf_process::HeadLines>) -> Self {
+        for (flip, h) in self.plan.flipped.iter_mut().zip(&head_lines) {
+            if h.prefers_other_side() {
+                *flip = !*flip;
+            }
+        }
+        self.head_lines = head_lines;
+        self
+    }
+
+    /// Why path `i` is cut from its side, where there is more to it than the given side.
+    fn side_reason(&self, i: usize) -> Option<SideReason> {
+        let flipped = self.plan.flipped.get(i).copied().unwrap_or(false);
+        let h = self.head_lines.get(i).copied().unwrap_or_default();
+        let prefer = h.prefers_other_side();
+        match (flipped, prefer) {
+            (true, true) => Some(SideReason::HeadLines),
+            (true, false) => Some(SideReason::Reach),
+            (false, true) => Some(SideReason::HeadLinesUnreachable),
+            (false, false) => (h.given > 0 && h.other > 0).then_some(SideReason::BothSides),
+        }
+    }
+
+    /// The `sides` entries of the report: every path turned, or kept on the given side
+    /// although its nozzle meets the part there, with the reason.
+    fn sides_json(&self, ids: &[&str]) -> Vec<Value> {
+        (0..ids.len())
+            .filter_map(|i| {
+                let why = self.side_reason(i)?;
+                let h = self.head_lines.get(i).copied().unwrap_or_default();
+                let (side, reason) = match why {
+                    SideReason::Reach => (
+                        "other",
+                        "the head cannot reach the given side within the tilt limits".to_string(),
+                    ),
+                    SideReason::HeadLines => (
+                        "other",
+                        format!(
+                            "the nozzle's line along the tool axis meets the part from the given side at {} of {} points (from {:.1} mm along the axis), from the other side at none",
+                            h.given, h.points, h.given_from_mm
+                        ),
+                    ),
+                    SideReason::HeadLinesUnreachable => (
+                        "given",
+                        format!(
+                            "the nozzle's line meets the part from the given side at {} of {} points (from {:.1} mm along the axis) and not from the other, but the head cannot reach the other side",
+                            h.given, h.points, h.given_from_mm
+                        ),
+                    ),
+                    SideReason::BothSides => (
+                        "given",
+                        format!(
+                            "the nozzle's line meets the part from both sides: the given side at {} of {} points (from {:.1} mm along the axis), the other at {} (from {:.1} mm)",
+                            h.given, h.points, h.given_from_mm, h.other, h.other_from_mm
+                        ),
+                    ),
+                };
+                Some(json!({
+                    "id": ids.get(i).copied().unwrap_or(""),
+                    "side": side,
+                    "reason": reason,
+                }))
+            })
+            .collect()
+    }
+
     /// The poses of every path in workpiece coordinates.
     pub fn apply(&self, poses: &[Vec<Pose>]) -> Vec<Vec<Pose>> {
         self.plan.apply(poses)
@@ -101,17 +189,25 @@ impl Placed {
             "mode": if self.auto { "auto" } else { "given" },
             "rotation_order": "Rz Ry Rx (about fixed workpiece axes, x first); p' = R p + t",
             "setups": setups,
+            "paths_solved": if self.auto { Some(self.plan.paths_solved) } else { None },
             "flipped_paths": ids.iter().zip(&self.plan.flipped).filter(|(_, f)| **f).map(|(id, _)| *id).collect::<Vec<_>>(),
+            "sides": self.sides_json(ids),
+            "sides_note": "side: given = the tool axis is the surface's normal, other = reversed (the beam comes from the other side of the sheet); with --place auto and checked traverses a contour is turned where the nozzle's line along the tool axis (from 3/4 of the clearance to the retract plus the nozzle, at up to 64 of its points) comes within half the clearance of a surface of the file from the given side and from the other side nowhere, reach permitting; the lead-ins stay on the scrap side decided with the given normal",
         })
     }
 
     /// One line for the summary.
     pub fn summary(&self) -> String {
         let flips = self.plan.flipped.iter().filter(|f| **f).count();
-        let flips = if flips > 0 {
-            format!(", {flips} contours cut from the other side of the sheet")
-        } else {
-            String::new()
+        let for_head = (0..self.plan.flipped.len())
+            .filter(|&i| self.side_reason(i) == Some(SideReason::HeadLines))
+            .count();
+        let flips = match (flips, for_head) {
+            (0, _) => String::new(),
+            (n, 0) => format!(", {n} contours cut from the other side of the sheet"),
+            (n, k) => format!(
+                ", {n} contours cut from the other side of the sheet ({k} of them because the nozzle meets the part from the given side)"
+            ),
         };
         match self.plan.setups.as_slice() {
             [one] => format!(
@@ -152,8 +248,10 @@ pub fn place(
             }],
             flipped: vec![false; poses.len()],
             rotations_tried: 0,
+            paths_solved: 0,
         },
         auto: false,
+        head_lines: Vec::new(),
     };
     match mode {
         PlaceMode::AsModelled => Ok(single(Placement::IDENTITY)),
@@ -172,7 +270,62 @@ pub fn place(
                     .with_margin_mm(clearance_mm),
             )
             .map_err(kin(file))?;
-            Ok(Placed { plan, auto: true })
+            Ok(Placed {
+                plan,
+                auto: true,
+                head_lines: Vec::new(),
+            })
         }
     }
+}
+
+/// How the head lines of every path (`poses`, part coordinates, the surfaces' normals) meet
+/// the part, the file's surfaces all in their places ([`kerf_process::head_lines`]), and the
+/// paths' poses with the tool axes of those better cut from the other side already turned:
+/// what [`place`] is then given, so that the placement checks the machine's reach on the
+/// chosen side (and turns a path back where only the given side is reachable);
+/// [`Placed::with_head_lines`] then records the choice.
+///
+/// # Errors
+/// [`Error::Process`] for a surface that cannot be used for the distance queries.
+pub(crate) fn sides_by_head_lines(
+    file: &kerf_format::CurvesFile,
+    poses: &[Vec<Pose>],
+    opts: &kerf_process::TraverseOptions,
+    source: Option<&std::path::Path>,
+) -> Result<(Vec<kerf_process::HeadLines>, Vec<Vec<Pose>>), Error> {
+    let all: Vec<usize> = (0..file.curves.len()).collect();
+    let obs = kerf_process::Obstacles::from_file(file, &all, |p| *p).map_err(|source_err| {
+        Error::Process {
+            file: source.map(std::path::Path::to_path_buf),
+            source: source_err,
+        }
+    })?;
+    let heads: Vec<kerf_process::HeadLines> = {
+        use rayon::prelude::*;
+        poses
+            .par_iter()
+            .map(|p| {
+                let arrays: Vec<kerf_process::PoseArray> = p.iter().map(Pose::to_array).collect();
+                kerf_process::head_lines(&obs, &arrays, opts)
+            })
+            .collect()
+    };
+    let turned = poses
+        .iter()
+        .zip(&heads)
+        .map(|(p, h)| {
+            if h.prefers_other_side() {
+                p.iter()
+                    .map(|q| Pose {
+                        position: q.position,
+                        axis: -q.axis,
+                    })
+                    .collect()
+            } else {
+                p.clone()
+            }
+        })
+        .collect();
+    Ok((heads, turned))
 }

@@ -71,18 +71,36 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         .iter()
         .map(|o| o.poses().into_iter().map(Pose::from_array).collect())
         .collect();
-    // 3a. Where the part goes on the machine; from here on, workpiece coordinates.
+    // Checked traverses (None: the unchecked retract); never a shorter retract than asked.
+    let topts = o.traverse.map(|mut t| {
+        t.retract_mm = t.retract_mm.max(o.retract_mm);
+        t
+    });
+    // 3a. Which side of the sheet each contour is cut from, where kerf chooses (`--place
+    // auto`, checked traverses): the side from which the nozzle's line along the tool axis
+    // does not meet the part, reach permitting (the placement checks it).
+    let head_lines = match (o.place, &topts) {
+        (crate::PlaceMode::Auto, Some(t)) => {
+            Some(crate::place::sides_by_head_lines(file, &poses, t, path)?)
+        }
+        _ => None,
+    };
+    // 3b. Where the part goes on the machine; from here on, workpiece coordinates.
     let id_refs: Vec<&str> = file.curves.iter().map(|c| c.id.as_str()).collect();
     let placed = crate::place::place(
         machine,
         &id_refs,
-        &poses,
+        head_lines.as_ref().map_or(&poses, |(_, turned)| turned),
         o.place,
         &popts,
         o.retract_mm.max(0.0) + 1.0,
         path,
     )?;
-    // 3b. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
+    let placed = match head_lines {
+        Some((h, _)) => placed.with_head_lines(h),
+        None => placed,
+    };
+    // 3c. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
     // outlines, the shortest traverse; in part coordinates, then placed.
     let (cuts, cut_plans) = crate::cuts::plan(file, &oriented, &placed, &starts, &o.leads, path)?;
     let cut_poses: Vec<Vec<Pose>> = cuts
@@ -141,11 +159,6 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let mut motions = Vec::new();
     let mut programs = Vec::new();
     let mut setup_ids: Vec<Vec<String>> = Vec::new();
-    // Checked traverses (None: the unchecked retract); never a shorter retract than asked.
-    let topts = o.traverse.map(|mut t| {
-        t.retract_mm = t.retract_mm.max(o.retract_mm);
-        t
-    });
     let limits = machine.limits.map(|r| r.map(|r| (r.min, r.max)));
     let mut rapid_report = Vec::new();
     let mut blocked_report = Vec::new();

@@ -27,6 +27,7 @@ mod geometry;
 mod lead;
 mod order;
 mod rapid;
+mod side;
 mod start;
 mod traverse;
 
@@ -35,6 +36,7 @@ pub use order::CutPlan;
 pub use rapid::{
     in_the_cuts_way, own_surfaces_over_the_head, plan_rapids, rapid_moves, Gap, RapidMoves,
 };
+pub use side::{head_lines, HeadLines, HEAD_LINE_POINTS};
 pub use start::{index_of_param, prepare_start};
 pub use traverse::{
     check_move, plan_traverse, plan_traverse_within, Obstacles, Route, Traverse, TraverseOptions,
@@ -147,7 +149,8 @@ pub struct Blockage {
     pub from: [f64; 3],
     /// The next pierce point, mm.
     pub to: [f64; 3],
-    /// The first point too close on the last route tried, mm.
+    /// A point too close on the route that came nearest to clearing (its sample farthest from
+    /// the part: closer than the clearance where measured so, else within the margin), mm.
     pub at: [f64; 3],
     /// Its distance from the part, mm.
     pub distance_mm: f64,

@@ -2,7 +2,7 @@
 //! or, on a polygon whose every cutting point is a corner, the middle of its longest edge,
 //! made a cutting point of the discretization so that the cut can begin there.
 
-use kerf_discretize::{chord_error, Discretization};
+use kerf_discretize::Discretization;
 use kerf_nurbs::NurbsCurve;
 use nalgebra::Point3;
 
@@ -37,11 +37,11 @@ fn turns(points: &[Point3<f64>]) -> Vec<f64> {
 ///   vertices), the middle of the longest edge, inserted, so that the cut starts on a straight
 ///   stretch instead of at a corner.
 ///
-/// An inserted point is `curve.point(t)`; the chord error of the two new chords is first
-/// bounded ([`kerf_discretize::chord_error`]) against the discretization's certified bound,
-/// then the new parameters are certified as a whole at `tolerance_mm` (the chord tolerance
-/// the discretization was made with) by [`Discretization::certify`], which replaces `disc`;
-/// if either fails, nothing is inserted and the nearest cutting point by parameter is used.
+/// An inserted point is on the curve; only the two new chords are certified
+/// ([`Discretization::with_point`], at `tolerance_mm`, the chord tolerance the discretization
+/// was made with), and they must stay within the discretization's certified bound; then the
+/// result replaces `disc`. Otherwise nothing is inserted and the nearest cutting point by
+/// parameter is used.
 pub fn prepare_start(
     curve: &NurbsCurve,
     disc: &mut Discretization,
@@ -96,26 +96,18 @@ pub fn prepare_start(
         return None;
     }
     let (ta, tb) = (params[i - 1], params[i]);
-    let p = curve.point(want);
-    let limit = disc.max_chord_error().max(1e-12);
-    let left = chord_error(curve, ta, want, &points[i - 1], &p, limit, 0.0);
-    let right = chord_error(curve, want, tb, &p, &points[i], limit, 0.0);
     let nearest = {
         let j = if want - ta <= tb - want { i - 1 } else { i };
         params[if j == n - 1 { 0 } else { j }]
     };
-    if left.upper > limit || right.upper > limit {
-        // Not certifiable within the bound: start at the nearer existing cutting point.
-        return Some(nearest);
-    }
-    let mut with_start = params.to_vec();
-    with_start.insert(i, want);
-    match Discretization::certify(curve, &with_start, tolerance_mm) {
-        Ok(certified) => {
-            *disc = certified;
+    // Only the two new chords are certified; within the discretization's certified bound, or
+    // the nearer existing cutting point is used.
+    match disc.with_point(curve, want, tolerance_mm) {
+        Ok(with_start) if with_start.max_chord_error() <= disc.max_chord_error() => {
+            *disc = with_start;
             Some(want)
         }
-        Err(_) => Some(nearest),
+        _ => Some(nearest),
     }
 }
 

@@ -1,7 +1,7 @@
 //! Start points prepared on the discretization: a polygon of corners starts mid-edge, a pinned
 //! `start` parameter becomes a cutting point on the curve; checked against the exact polygon.
 
-use kerf_discretize::{discretize, Options};
+use kerf_discretize::{discretize, Discretization, Options};
 use kerf_nurbs::NurbsCurve;
 use kerf_process::{index_of_param, plan_cuts, prepare_start, Contour, LeadOptions, PoseArray};
 use nalgebra::Point3;
@@ -137,4 +137,53 @@ fn smooth_or_open_curves_are_left_to_the_plan() {
         "smooth"
     );
     assert_eq!(d.points().len(), n, "untouched");
+}
+
+#[test]
+fn a_pinned_start_certifies_only_its_two_new_chords() {
+    // A circle of radius 100 at 0.001 mm: about 700 cutting points. Pinning a start between
+    // two of them costs a handful of evaluations (the two new chords), not a certificate of
+    // every segment again; the exact chord error of each new chord, `r (1 - cos(a / 2))` for
+    // the angle `a` it spans, is within the certified bound the discretization then claims.
+    let r = 100.0;
+    let circle = NurbsCurve::circle(Point3::origin(), nalgebra::Vector3::z(), r).expect("circle");
+    let tol = 0.001;
+    let mut d = discretize(&circle, &Options::with_tolerance(tol)).expect("discretize");
+    let n = d.points().len();
+    assert!(n > 500, "{n} points");
+    let i = n / 3;
+    let want =
+        0.5 * (d.params()[i] + d.params()[i + 1]) + 1e-3 * (d.params()[i + 1] - d.params()[i]);
+    let (t, evaluations) = kerf_nurbs::counted(|| {
+        prepare_start(&circle, &mut d, Some(want), &LeadOptions::default(), tol)
+    });
+    assert_eq!(t, Some(want), "inserted");
+    assert_eq!(d.points().len(), n + 1);
+    let evaluations = evaluations.expect("kerf-nurbs counts evaluations in this test");
+    // Certifying every segment again evaluates each cutting point at least once.
+    let (_, all) = kerf_nurbs::counted(|| Discretization::certify(&circle, d.params(), tol));
+    let all = all.expect("counted");
+    assert!(all >= n as u64, "{all}");
+    assert!(
+        evaluations < 100,
+        "{evaluations} evaluations (certifying all: {all})"
+    );
+    // Exact chord errors of the two new chords, from the angles of their ends.
+    let angle = |p: &Point3<f64>| p.y.atan2(p.x);
+    let j = index_of_param(d.params(), want);
+    for k in [j - 1, j] {
+        let (a, b) = (d.points()[k], d.points()[k + 1]);
+        assert!((a.coords.norm() - r).abs() < 1e-9 && (b.coords.norm() - r).abs() < 1e-9);
+        let mut span = (angle(&b) - angle(&a)).abs();
+        if span > std::f64::consts::PI {
+            span = std::f64::consts::TAU - span;
+        }
+        let exact = r * (1.0 - (0.5 * span).cos());
+        assert!(
+            exact <= d.max_chord_error(),
+            "{exact} against {}",
+            d.max_chord_error()
+        );
+        assert!(d.max_chord_error() <= tol);
+    }
 }

@@ -365,3 +365,118 @@ fn the_machines_rapid_moves_clear_the_arch_as_the_machine_runs_them() {
         "at least one swing needed splitting (the split path is exercised)"
     );
 }
+
+/// A flat ceiling at height `z` over `x` in [-100, 1100], `y` in [-100, 100], as a bilinear
+/// NURBS patch; its exact distance from a point below it (within that extent) is `z - p.z`.
+fn ceiling(z: f64) -> Obstacles {
+    let cps = vec![
+        vec![
+            Point3::new(-100.0, -100.0, z),
+            Point3::new(-100.0, 100.0, z),
+        ],
+        vec![
+            Point3::new(1100.0, -100.0, z),
+            Point3::new(1100.0, 100.0, z),
+        ],
+    ];
+    let s = NurbsSurface::try_new(
+        1,
+        1,
+        vec![0.0, 0.0, 1.0, 1.0],
+        vec![0.0, 0.0, 1.0, 1.0],
+        cps,
+        None,
+    )
+    .expect("valid patch");
+    let mut o = Obstacles::new();
+    o.add_nurbs(s);
+    o
+}
+
+/// Two cuts under a ceiling whose only clear route is the straight travel at the first
+/// retract height: the nozzle's top end (7.5 + 20 mm up) passes `gap` mm under the clearance
+/// (negative: closer than it). Returns the plan and the ceiling's height.
+fn under_a_ceiling(
+    gap: f64,
+    length: f64,
+) -> (Result<kerf_process::Traverse, ProcessError>, f64, Obstacles) {
+    let opts = TraverseOptions::default();
+    let top = opts.retract_mm + opts.nozzle_mm;
+    let z = top + opts.clearance_mm + gap;
+    let obs = ceiling(z);
+    let from = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    let to = [length, 0.0, 0.0, 0.0, 0.0, 1.0];
+    (plan_traverse(&obs, &from, &to, &opts), z, obs)
+}
+
+#[test]
+fn a_route_that_keeps_the_clearance_by_less_than_the_margin_is_proven() {
+    // 0.03 mm over the 5 mm clearance: within the coarse margin (5/64 mm), so only the finer
+    // re-trace proves it. The exact distance (the ceiling's height less the nozzle's top)
+    // is known in closed form, independently of the sphere tracing.
+    for gap in [0.03, 0.01] {
+        let (t, z, _) = under_a_ceiling(gap, 100.0);
+        let t = t.unwrap_or_else(|e| panic!("gap {gap}: {e}"));
+        assert_eq!(t.route, Route::Straight, "gap {gap}");
+        let opts = TraverseOptions::default();
+        // Dense exact check: every tip and nozzle point below the ceiling by at least c.
+        let mut least = f64::INFINITY;
+        for w in t.waypoints.windows(2) {
+            for j in 0..=2000 {
+                let f = f64::from(j) / 2000.0;
+                let zt = w[0][2] + (w[1][2] - w[0][2]) * f;
+                let nz = w[0][5] + (w[1][5] - w[0][5]) * f;
+                for s in 0..=40 {
+                    least = least.min(z - (zt + nz * opts.nozzle_mm * f64::from(s) / 40.0));
+                }
+            }
+        }
+        assert!(least >= opts.clearance_mm, "gap {gap}: exact {least}");
+        assert!(
+            (least - (opts.clearance_mm + gap)).abs() < 1e-9,
+            "gap {gap}: {least}"
+        );
+        assert!(
+            t.min_distance_mm >= opts.clearance_mm && t.min_distance_mm <= least + 1e-9,
+            "gap {gap}: reported {} against exact {least}",
+            t.min_distance_mm
+        );
+    }
+}
+
+#[test]
+fn a_route_closer_than_the_clearance_by_a_hair_is_refused_as_measured() {
+    // 0.02 mm under the clearance: the sphere tracing stalls just outside the margin, the
+    // search ahead of the stall finds a sample closer than the clearance.
+    let (t, z, _) = under_a_ceiling(-0.02, 100.0);
+    let e = t.expect_err("no route keeps the clearance");
+    let ProcessError::TraverseBlocked(b) = &e else {
+        panic!("{e}")
+    };
+    assert!(b.distance_mm < 5.0, "a measured violation: {e}");
+    // The reported sample is where it says, at the exact distance (below the ceiling).
+    assert!((z - b.at[2] - b.distance_mm).abs() < 1e-9, "{e}");
+    assert!(
+        e.to_string()
+            .contains("measured closer than the clearance, 0 not proven"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_finer_margins_stop_within_their_work_budget() {
+    // A kilometre of travel 0.002 mm outside the clearance: proving it would take millions
+    // of samples. The check gives up within its budget and says the route is not proven.
+    let (t, _, obs) = under_a_ceiling(0.002, 1000.0);
+    let e = t.expect_err("not proven within the budget");
+    // Every other route runs into the ceiling (measured); this one is undecided.
+    assert!(e.to_string().contains(", 1 not proven"), "{e}");
+    let ProcessError::TraverseBlocked(b) = &e else {
+        panic!("{e}")
+    };
+    assert!(
+        b.distance_mm >= 5.0 && b.distance_mm < 5.01,
+        "the nearest miss is the undecided route's closest sample: {e}"
+    );
+    assert!(obs.queries() < 20_000_000, "{} queries", obs.queries());
+}

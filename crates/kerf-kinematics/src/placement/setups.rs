@@ -21,6 +21,10 @@ pub struct SetupPlan {
     pub flipped: Vec<bool>,
     /// How many orientations were tried in all.
     pub rotations_tried: usize,
+    /// How many paths were solved in all (with the linear axes free, and against the real
+    /// limits): each path once per orientation and side, however many groups and levels of
+    /// splitting try it (see `docs/kinematics.md`, "Set-ups").
+    pub paths_solved: usize,
 }
 
 impl SetupPlan {
@@ -70,37 +74,33 @@ pub fn auto_setups(
     paths: &[(&str, &[Pose])],
     options: &AutoPlaceOptions,
 ) -> Result<SetupPlan> {
+    validate(options)?;
     let mut plan = SetupPlan {
         setups: Vec::new(),
         flipped: vec![false; paths.len()],
         rotations_tried: 0,
+        paths_solved: 0,
     };
+    let work = Work::new(machine, paths, options);
     let all: Vec<usize> = (0..paths.len()).collect();
-    if place_group(machine, paths, &all, options, &mut plan)? {
-        return Ok(plan);
-    }
-    if paths.len() <= 1 {
+    let placed = place_group(&work, &all, &mut plan)?;
+    if !placed && paths.len() <= 1 {
         // The whole part's error.
         auto_place(machine, paths, options)?;
-        return Ok(plan);
+    } else if !placed {
+        for group in orientation_groups(&work) {
+            bisect(&work, &group, &mut plan)?;
+        }
     }
-    let owned: Vec<Vec<Pose>> = paths.iter().map(|(_, p)| p.to_vec()).collect();
-    for group in orientation_groups(machine, &owned, options.flip) {
-        bisect(machine, paths, &group, options, &mut plan)?;
-    }
+    plan.paths_solved = work.solved.load(std::sync::atomic::Ordering::Relaxed);
     Ok(plan)
 }
 
 /// Places `group` as one set-up if it fits (true), else false; other errors pass through.
-pub(super) fn place_group(
-    machine: &Machine,
-    paths: &[(&str, &[Pose])],
-    group: &[usize],
-    options: &AutoPlaceOptions,
-    plan: &mut SetupPlan,
-) -> Result<bool> {
-    let sub: Vec<(&str, &[Pose])> = group.iter().map(|&i| paths[i]).collect();
-    match auto_place(machine, &sub, options) {
+/// Only whether it fits matters here, so candidates are refused on the cheap bound of the
+/// linear travel before they are solved.
+pub(super) fn place_group(work: &Work<'_>, group: &[usize], plan: &mut SetupPlan) -> Result<bool> {
+    match search(work, group, true) {
         Ok(found) => {
             plan.rotations_tried += found.rotations_tried;
             for (k, &i) in group.iter().enumerate() {
@@ -124,19 +124,14 @@ pub(super) fn place_group(
 }
 
 /// Places `group`, halving it spatially until every piece fits (see [`auto_setups`]).
-pub(super) fn bisect(
-    machine: &Machine,
-    paths: &[(&str, &[Pose])],
-    group: &[usize],
-    options: &AutoPlaceOptions,
-    plan: &mut SetupPlan,
-) -> Result<()> {
-    if place_group(machine, paths, group, options, plan)? {
+pub(super) fn bisect(work: &Work<'_>, group: &[usize], plan: &mut SetupPlan) -> Result<()> {
+    if place_group(work, group, plan)? {
         return Ok(());
     }
+    let paths = work.paths;
     if group.len() == 1 {
-        // The reason, for this contour alone.
-        auto_place(machine, &[paths[group[0]]], options)?;
+        // The reason, for this contour alone (exact: solved without the cheap bound).
+        auto_place(work.machine, &[paths[group[0]]], work.options)?;
         return Ok(());
     }
     let centre = |i: usize| {
@@ -167,8 +162,8 @@ pub(super) fn bisect(
     let mut second: Vec<usize> = order[half..].iter().map(|&k| group[k]).collect();
     first.sort_unstable();
     second.sort_unstable();
-    bisect(machine, paths, &first, options, plan)?;
-    bisect(machine, paths, &second, options, plan)
+    bisect(work, &first, plan)?;
+    bisect(work, &second, plan)
 }
 
 /// The directions of the part that may be turned to point up: a Fibonacci lattice of 2,048
@@ -236,14 +231,11 @@ pub(super) fn reachable_directions(
 /// most of the remaining paths within the tilt range (ties: the one nearest the modelled up
 /// direction) takes them. Paths no direction serves come last, one group each (their
 /// placement then fails with the reason).
-pub(super) fn orientation_groups(
-    machine: &Machine,
-    paths: &[Vec<Pose>],
-    flip: bool,
-) -> Vec<Vec<usize>> {
+pub(super) fn orientation_groups(work: &Work<'_>) -> Vec<Vec<usize>> {
     let lattice = up_directions();
-    let fits = reachable_directions(machine, paths, flip, &lattice);
-    let mut left: Vec<usize> = (0..paths.len()).collect();
+    let all: Vec<usize> = (0..work.paths.len()).collect();
+    let fits = work.reach(&all);
+    let mut left: Vec<usize> = all.clone();
     let mut out = Vec::new();
     while !left.is_empty() {
         let mut best: Option<(usize, usize, f64)> = None;

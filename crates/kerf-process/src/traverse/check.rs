@@ -1,6 +1,6 @@
 //! The certificate of a straight move: sphere tracing along the tip and the nozzle.
 
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 
 use super::Obstacles;
 use crate::geometry::{normal, position};
@@ -11,61 +11,254 @@ use crate::PoseArray;
 pub(super) struct Blocked {
     pub(super) at: Point3<f64>,
     pub(super) distance: f64,
+    /// True if the work budget ran out before the stretch was decided (then `at` and
+    /// `distance` are the closest sample so far, which keeps the need plus the margin).
+    pub(super) exhausted: bool,
+    /// Where along the move (interpolation parameter, 0 to 1) and along the nozzle (mm from
+    /// the tip) the sample was taken.
+    pub(super) f: f64,
+    pub(super) s: f64,
 }
 
-/// Certifies the straight move `a -> b` (the tool axis turning as the normalised linear
-/// interpolation of `a`'s and `b`'s): every point of the tip's segment and of the nozzle (from
-/// the tip `nozzle` mm along the axis) keeps at least `need` from the surfaces. Returns the
-/// smallest distance measured, or the first point closer than `need + floor`.
-///
-/// Sphere tracing with the 1-Lipschitz distance: along the nozzle at offset `s` with distance
-/// `e`, the next sample is `(e - need) / 2` further, so over each stretch the distance is at
-/// least `(e + need) / 2`, and the whole nozzle at this tip position at least `m`, the smallest
-/// of those. A point of the swept surface at interpolation parameter `f + df` lies within
-/// `df (|b - a| + nozzle |n_b - n_a| / cos(theta / 2))` of the one at `f` (the normalised
-/// interpolation turns at most that fast, `theta` the angle between the axes), so the tip
-/// advances by `df` with that distance equal to `m - need`.
-pub(super) fn certify(
-    obs: &Obstacles,
-    a: &PoseArray,
-    b: &PoseArray,
+impl Blocked {
+    /// A blockage at `at`, `distance` from the part, not tied to a move's parameters.
+    pub(super) fn at(at: Point3<f64>, distance: f64) -> Self {
+        Self {
+            at,
+            distance,
+            exhausted: false,
+            f: 0.0,
+            s: 0.0,
+        }
+    }
+
+    /// True if the stretch failed only within the margin: the offending sample keeps the
+    /// need (it is not closer than the clearance), so a finer margin may prove the stretch.
+    pub(super) fn within_margin(&self, need: f64) -> bool {
+        !self.exhausted && self.distance >= need
+    }
+}
+
+/// A counted work budget: how many more distance samples the checks may take. Every sample
+/// of [`Trace::certify`] spends one, so no loop outlives it, whatever rounding does to the steps.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Work {
+    pub(super) left: usize,
+}
+
+impl Work {
+    /// A budget of `samples` distance samples.
+    pub(super) fn new(samples: usize) -> Self {
+        Self { left: samples }
+    }
+}
+
+/// Samples one straight move may take with the coarse margin (a guard against hostile input:
+/// a 1,000 mm move along a surface just outside the margin takes about 2.5e5).
+pub(super) const MOVE_SAMPLES: usize = 1 << 21;
+
+/// The finest margin [`Trace::prove`] goes down to, as a fraction of the need: a stretch whose
+/// closest sample comes within this of the need stays unproven.
+pub(super) const FINEST_MARGIN: f64 = 1.0 / 4096.0;
+
+/// One straight move `a -> b` of the tip and the nozzle (`nozzle` mm from the tip along the
+/// tool axis, which turns as the normalised linear interpolation of `a`'s and `b`'s), to be
+/// kept `need` from the surfaces of `obs`.
+pub(super) struct Trace<'a> {
+    obs: &'a Obstacles,
+    pa: Point3<f64>,
+    pb: Point3<f64>,
+    na: Vector3<f64>,
+    nb: Vector3<f64>,
     need: f64,
     nozzle: f64,
-    floor: f64,
-) -> std::result::Result<f64, Blocked> {
-    let (pa, pb) = (position(a), position(b));
-    let (na, nb) = (normal(a).normalize(), normal(b).normalize());
-    let half_cos = (0.5 * (1.0 + na.dot(&nb))).max(0.0).sqrt().max(0.05);
-    let speed = (pb - pa).norm() + nozzle * (nb - na).norm() / half_cos;
-    let limit = need + 2.0 * floor.max(need / 4.0) + 0.25 * nozzle;
-    let mut least = f64::INFINITY;
-    let mut f = 0.0_f64;
-    loop {
-        let p = pa + (pb - pa) * f;
-        let n = (na * (1.0 - f) + nb * f)
+    /// How fast a point of the swept surface moves with the interpolation parameter, at most.
+    speed: f64,
+}
+
+impl<'a> Trace<'a> {
+    /// The move `a -> b` with its nozzle, kept `need` from `obs`.
+    pub(super) fn new(
+        obs: &'a Obstacles,
+        a: &PoseArray,
+        b: &PoseArray,
+        need: f64,
+        nozzle: f64,
+    ) -> Self {
+        let (pa, pb) = (position(a), position(b));
+        let (na, nb) = (normal(a).normalize(), normal(b).normalize());
+        let half_cos = (0.5 * (1.0 + na.dot(&nb))).max(0.0).sqrt().max(0.05);
+        let speed = (pb - pa).norm() + nozzle * (nb - na).norm() / half_cos;
+        Self {
+            obs,
+            pa,
+            pb,
+            na,
+            nb,
+            need,
+            nozzle,
+            speed,
+        }
+    }
+
+    /// The point of the swept surface at interpolation parameter `f` and nozzle offset `s`.
+    fn point(&self, f: f64, s: f64) -> Point3<f64> {
+        let n = (self.na * (1.0 - f) + self.nb * f)
             .try_normalize(1e-12)
-            .unwrap_or(if f < 0.5 { na } else { nb });
-        // The nozzle at this tip position.
-        let mut m = f64::INFINITY;
-        let mut s = 0.0_f64;
+            .unwrap_or(if f < 0.5 { self.na } else { self.nb });
+        self.pa + (self.pb - self.pa) * f + n * s
+    }
+
+    /// Certifies the move: every point of the tip's segment and of the nozzle keeps at least
+    /// `need` from the surfaces. Returns the smallest distance measured, or the first point
+    /// closer than `need + floor`, or the closest sample so far when `work` runs out (each
+    /// sample spends one).
+    ///
+    /// Sphere tracing with the 1-Lipschitz distance: along the nozzle at offset `s` with
+    /// distance `e`, the next sample is `(e - need) / 2` further, so over each stretch the
+    /// distance is at least `(e + need) / 2`, and the whole nozzle at this tip position at
+    /// least `m`, the smallest of those. A point of the swept surface at interpolation
+    /// parameter `f + df` lies within `df (|b - a| + nozzle |n_b - n_a| / cos(theta / 2))` of
+    /// the one at `f` (the normalised interpolation turns at most that fast, `theta` the angle
+    /// between the axes), so the tip advances by `df` with that distance equal to `m - need`.
+    pub(super) fn certify(&self, floor: f64, work: &mut Work) -> std::result::Result<f64, Blocked> {
+        let need = self.need;
+        let limit = need + 2.0 * floor.max(need / 4.0) + 0.25 * self.nozzle;
+        let mut least = f64::INFINITY;
+        let mut closest = (self.pa, 0.0, 0.0);
+        let mut f = 0.0_f64;
         loop {
-            let q = p + n * s;
-            let e = obs.distance_below(&q, limit);
-            least = least.min(e);
-            if e < need + floor {
-                return Err(Blocked { at: q, distance: e });
+            // The nozzle at this tip position.
+            let mut m = f64::INFINITY;
+            let mut s = 0.0_f64;
+            loop {
+                let q = self.point(f, s);
+                let e = self.obs.distance_below(&q, limit);
+                if e < least {
+                    least = e;
+                    closest = (q, f, s);
+                }
+                if e < need + floor {
+                    return Err(Blocked {
+                        at: q,
+                        distance: e,
+                        exhausted: false,
+                        f,
+                        s,
+                    });
+                }
+                if work.left == 0 {
+                    // Undecided: the closest sample so far.
+                    return Err(Blocked {
+                        at: closest.0,
+                        distance: least,
+                        exhausted: true,
+                        f: closest.1,
+                        s: closest.2,
+                    });
+                }
+                work.left -= 1;
+                let ds = 0.5 * (e - need);
+                m = m.min(e - ds);
+                if s >= self.nozzle {
+                    break;
+                }
+                s = (s + ds).min(self.nozzle);
             }
-            let ds = 0.5 * (e - need);
-            m = m.min(e - ds);
-            if s >= nozzle {
-                break;
+            if f >= 1.0 || self.speed == 0.0 {
+                return Ok(least);
             }
-            s = (s + ds).min(nozzle);
+            f = (f + (m - need) / self.speed).min(1.0);
         }
-        if f >= 1.0 || speed == 0.0 {
-            return Ok(least);
+    }
+
+    /// Sphere tracing slows down as it nears a point closer than the need (the steps are
+    /// half the excess), so a move that runs into the part ends on a sample just outside the
+    /// margin, like one that keeps the need by a hair. Where [`Trace::certify`] stopped within
+    /// the margin (at `stall`), this looks for a *witness* ahead of the stall: samples of the
+    /// swept surface `delta` further along the move and along the nozzle, `delta` doubling
+    /// from the stall's excess over the need (at least [`FINEST_MARGIN`] of the need: the
+    /// distance is 1-Lipschitz, so nothing nearer can be closer than the need) to twice the
+    /// need (each spending one of `work`). A sample closer than the need is a measured
+    /// violation: the move is blocked, whatever the margin. Returns the closest sample of the
+    /// first doubling that holds one, or `None` if none is found.
+    pub(super) fn witness(&self, stall: &Blocked, work: &mut Work) -> Option<Blocked> {
+        let need = self.need;
+        let limit = need.abs() + 1.0;
+        let mut found: Option<Blocked> = None;
+        let mut delta = (stall.distance - need).max(need.abs() * FINEST_MARGIN + 1e-9);
+        while delta <= 2.0 * need.abs() + 1e-9 {
+            let df = if self.speed > 0.0 {
+                delta / self.speed
+            } else {
+                0.0
+            };
+            for (f, s) in [
+                (stall.f + df, stall.s),
+                (stall.f, stall.s + delta),
+                (stall.f, stall.s - delta),
+                (stall.f + df, stall.s + delta),
+                (stall.f + df, stall.s - delta),
+            ] {
+                if work.left == 0 {
+                    return found;
+                }
+                work.left -= 1;
+                let (f, s) = (f.clamp(0.0, 1.0), s.clamp(0.0, self.nozzle.max(0.0)));
+                let q = self.point(f, s);
+                let e = self.obs.distance_below(&q, limit);
+                if e < need && found.is_none_or(|w| e < w.distance) {
+                    found = Some(Blocked {
+                        at: q,
+                        distance: e,
+                        exhausted: false,
+                        f,
+                        s,
+                    });
+                }
+            }
+            if found.is_some() {
+                return found;
+            }
+            delta *= 2.0;
         }
-        f = (f + (m - need) / speed).min(1.0);
+        found
+    }
+
+    /// [`Trace::certify`], and where it stopped within the margin, a [`Trace::witness`]
+    /// closer than the need (then that is the blockage).
+    pub(super) fn certify_or_witness(
+        &self,
+        floor: f64,
+        work: &mut Work,
+    ) -> std::result::Result<f64, Blocked> {
+        self.certify(floor, work).map_err(|bad| {
+            if bad.within_margin(self.need) {
+                self.witness(&bad, work).unwrap_or(bad)
+            } else {
+                bad
+            }
+        })
+    }
+
+    /// [`Trace::certify_or_witness`] with the margin `floor`, and where the move fails only
+    /// within that margin (its offending sample keeps the need and no witness closer than the
+    /// need was found ahead), again with the margin halved below that sample's excess
+    /// (`(distance - need) / 2`), down to [`FINEST_MARGIN`] of the need, all within `work`.
+    /// The claim stays the need: a sample closer than it blocks at once.
+    pub(super) fn prove(&self, floor: f64, work: &mut Work) -> std::result::Result<f64, Blocked> {
+        let finest = self.need.abs() * FINEST_MARGIN + 1e-9;
+        let mut floor = floor;
+        loop {
+            match self.certify_or_witness(floor, work) {
+                Err(bad) if bad.within_margin(self.need) && floor > finest => {
+                    floor = (0.5 * (bad.distance - self.need))
+                        .min(0.5 * floor)
+                        .max(finest);
+                }
+                done => return done,
+            }
+        }
     }
 }
 
@@ -79,8 +272,15 @@ pub(super) fn certify(
 /// samples departs from it by the second order of their spacing, which the caller keeps small
 /// (or adds to `need_mm`).
 ///
+/// Each stretch is traced with a margin of a hundredth of `need_mm` first; where the trace
+/// stops within it (its sample keeps `need_mm`), samples ahead of the stop look for one closer
+/// than `need_mm` (a measured violation), and without one the stretch is traced again with
+/// finer margins, down to 1/4096 of the need, within a counted budget of samples.
+///
 /// # Errors
-/// `Err((point, distance))` for the first point closer than `need_mm` plus a hundredth of it.
+/// `Err((point, distance))` for the first point closer than `need_mm` plus the margin it was
+/// last traced with (a distance below `need_mm` is a measured violation; one above it was
+/// not decided within the finest margin or the budget).
 pub fn check_move(
     obs: &Obstacles,
     samples: &[PoseArray],
@@ -89,9 +289,11 @@ pub fn check_move(
 ) -> std::result::Result<f64, (Point3<f64>, f64)> {
     let floor = need_mm.abs() / 100.0 + 1e-6;
     let mut least = f64::INFINITY;
+    let mut work = Work::new(MOVE_SAMPLES.max(256 * samples.len()));
     for w in samples.windows(2) {
         least = least.min(
-            certify(obs, &w[0], &w[1], need_mm, nozzle_mm, floor)
+            Trace::new(obs, &w[0], &w[1], need_mm, nozzle_mm)
+                .prove(floor, &mut work)
                 .map_err(|b| (b.at, b.distance))?,
         );
     }

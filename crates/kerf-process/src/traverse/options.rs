@@ -71,7 +71,7 @@ impl TraverseOptions {
         self
     }
 
-    pub(super) fn validate(&self) -> Result<()> {
+    pub(crate) fn validate(&self) -> Result<()> {
         let check = |name: &'static str, v: f64, ok: bool| {
             if ok {
                 Ok(())

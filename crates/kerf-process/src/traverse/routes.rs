@@ -2,7 +2,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::check::{certify, Blocked};
+use super::check::{Blocked, Trace, Work, MOVE_SAMPLES};
 use super::obstacles::top_along;
 use super::{Obstacles, TraverseOptions};
 use crate::geometry::{normal, position};
@@ -70,6 +70,12 @@ fn path_length(points: &[Point3<f64>]) -> f64 {
 /// from 3/4 of the clearance up the tip keeps half the clearance (their lower ends touch the
 /// part by design); along the travel the tip and the nozzle keep the full clearance.
 ///
+/// Each move is sphere-traced with a margin of a 64th of the clearance; where it stops within
+/// that margin, a sample closer than the clearance is looked for ahead of the stop (a measured
+/// violation); if no route clears, the routes that stopped within the margin with no such
+/// sample are traced again with finer margins, within a counted budget of samples
+/// (`docs/process.md`, "The margin and the witness").
+///
 /// # Errors
 /// [`ProcessError::BadOption`] for bad options, [`ProcessError::BadContour`] for non-finite
 /// poses, [`ProcessError::TraverseBlocked`] if no route is clear (e.g. a tool axis pointing
@@ -96,6 +102,23 @@ pub fn plan_traverse_within(
     reachable: &dyn Fn(&[PoseArray]) -> bool,
 ) -> Result<Traverse> {
     plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(())).map(|(t, ())| t)
+}
+
+/// Samples the finer margins may take over one gap's routes, after the coarse pass found
+/// none clear.
+const FINE_SAMPLES: usize = 1 << 22;
+
+/// How the routes of one gap failed.
+#[derive(Debug, Default)]
+struct Tally {
+    /// Outside the machine's axis limits.
+    unreachable: usize,
+    /// Clear, but refused by the caller's check (the machine's rapid swing).
+    refused: usize,
+    /// A sample measured closer than the clearance.
+    closer: usize,
+    /// Not proven: within the finest margin, or the work budget ran out.
+    undecided: usize,
 }
 
 /// Why a route was refused by the caller's own check (e.g. the machine's rapid swing): the
@@ -138,7 +161,7 @@ pub(crate) fn plan_traverse_accepting<T>(
         let (q, n) = (position(p), normal(p));
         let low = with_axis(q + n * (0.75 * c), n);
         let high = with_axis(q + n * height, n);
-        certify(obs, &low, &high, 0.5 * c, 0.0, floor)?;
+        Trace::new(obs, &low, &high, 0.5 * c, 0.0).prove(floor, &mut Work::new(MOVE_SAMPLES))?;
         Ok(high)
     };
     let length_of = |way: &[PoseArray]| {
@@ -147,13 +170,22 @@ pub(crate) fn plan_traverse_accepting<T>(
         pts.push(position(&to));
         path_length(&pts)
     };
-    let tip_ends = |w: &[PoseArray]| -> std::result::Result<f64, Blocked> {
-        let mut least = f64::INFINITY;
-        for s in w.windows(2) {
-            least = least.min(certify(obs, &s[0], &s[1], c, opts.nozzle_mm, floor)?);
-        }
-        Ok(least)
-    };
+    // The travel between the waypoints, tip and nozzle keeping the clearance: with the
+    // coarse margin (each move within its own budget), or with `Trace::prove`'s finer margins
+    // within the gap's budget `fine`.
+    let tip_ends =
+        |w: &[PoseArray], fine: Option<&mut Work>| -> std::result::Result<f64, Blocked> {
+            let mut least = f64::INFINITY;
+            let mut fine = fine;
+            for s in w.windows(2) {
+                let trace = Trace::new(obs, &s[0], &s[1], c, opts.nozzle_mm);
+                least = least.min(match fine.as_deref_mut() {
+                    None => trace.certify_or_witness(floor, &mut Work::new(MOVE_SAMPLES))?,
+                    Some(work) => trace.prove(floor, work)?,
+                });
+            }
+            Ok(least)
+        };
     let blocked_err = |b: Blocked, why: String| {
         ProcessError::TraverseBlocked(Box::new(crate::Blockage {
             from: [from[0], from[1], from[2]],
@@ -241,44 +273,89 @@ pub(crate) fn plan_traverse_accepting<T>(
         }
     }
     routes.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let (mut unreachable, mut refused) = (0usize, 0usize);
-    let mut blocked: Option<Blocked> = None;
-    for (length_mm, route, waypoints) in &routes {
-        if !reachable(waypoints) {
-            unreachable += 1;
-            continue;
+    // First every route with the coarse margin, shortest first; then, if none clears, the
+    // routes that failed only within the margin again with finer margins (`prove`), within
+    // the gap's budget of samples.
+    let mut tally = Tally::default();
+    // The blockage of the route that came nearest to clearing (its offending sample farthest
+    // from the part).
+    let mut nearest: Option<Blocked> = None;
+    let mut note = |b: Blocked| {
+        if nearest.is_none_or(|n| b.distance > n.distance) {
+            nearest = Some(b);
         }
-        match tip_ends(waypoints) {
-            Ok(least) => {
-                let t = Traverse {
-                    length_mm: *length_mm,
-                    waypoints: waypoints.clone(),
-                    route: *route,
-                    min_distance_mm: least,
-                };
-                match accept(&t) {
-                    Ok(v) => return Ok((t, v)),
-                    Err((at, distance)) => {
-                        refused += 1;
-                        blocked = Some(Blocked { at, distance });
+    };
+    // The routes that failed only within the coarse margin, with that failure.
+    let mut marginal: Vec<(usize, Blocked)> = Vec::new();
+    let mut fine = Work::new(FINE_SAMPLES);
+    for pass in 0..2 {
+        let candidates: Vec<(usize, Option<Blocked>)> = if pass == 0 {
+            (0..routes.len()).map(|k| (k, None)).collect()
+        } else {
+            marginal.drain(..).map(|(k, b)| (k, Some(b))).collect()
+        };
+        for (k, coarse) in candidates {
+            let (length_mm, route, waypoints) = &routes[k];
+            if let (Some(b), 0) = (coarse, fine.left) {
+                // No budget left to re-trace it: undecided at its coarse failure.
+                tally.undecided += 1;
+                note(b);
+                continue;
+            }
+            if pass == 0 && !reachable(waypoints) {
+                tally.unreachable += 1;
+                continue;
+            }
+            let checked = if pass == 0 {
+                tip_ends(waypoints, None)
+            } else {
+                tip_ends(waypoints, Some(&mut fine))
+            };
+            match checked {
+                Ok(least) => {
+                    let t = Traverse {
+                        length_mm: *length_mm,
+                        waypoints: waypoints.clone(),
+                        route: *route,
+                        min_distance_mm: least,
+                    };
+                    match accept(&t) {
+                        Ok(v) => return Ok((t, v)),
+                        Err((at, distance)) => {
+                            tally.refused += 1;
+                            note(Blocked::at(at, distance));
+                        }
                     }
                 }
+                Err(e) => {
+                    if pass == 0 && e.within_margin(c) {
+                        marginal.push((k, e));
+                        continue;
+                    }
+                    if e.distance < c && !e.exhausted {
+                        tally.closer += 1;
+                    } else {
+                        tally.undecided += 1;
+                    }
+                    note(e);
+                }
             }
-            Err(e) => blocked = Some(e),
         }
     }
     let n = routes.len();
-    let why = if unreachable == n {
+    let why = if tally.unreachable == n {
         format!("none of the {n} routes lies within the machine's axis limits")
     } else {
         format!(
-            "{} of {n} routes come too close, {refused} of them only in the machine's rapid swing, {unreachable} leave the axis limits",
-            n - unreachable
+            "{} of {n} routes come too close ({} measured closer than the clearance, {} not proven within a margin of {:.4} mm or the work budget), {} of them only in the machine's rapid swing, {} leave the axis limits",
+            n - tally.unreachable,
+            tally.closer,
+            tally.undecided,
+            c * super::check::FINEST_MARGIN,
+            tally.refused,
+            tally.unreachable
         )
     };
-    let b = blocked.unwrap_or(Blocked {
-        at: position(&from),
-        distance: 0.0,
-    });
+    let b = nearest.unwrap_or(Blocked::at(position(&from), 0.0));
     Err(blocked_err(b, why))
 }

@@ -1,0 +1,196 @@
+//! The side of the sheet a contour is cut from, chosen by its head lines (`--place auto`
+//! with checked traverses): a hole's edge whose wall normal points into a hole narrower than
+//! the nozzle's reach is cut from the other side, and its lead-in stays on the scrap side the
+//! file names with the wall's own normal (checked in closed form in part coordinates).
+
+use kerf_format::{
+    CurveRecord, CurvesFile, ScrapSide, SurfaceGeometry, SurfaceRecord, SurfaceSource,
+};
+use kerf_kinematics::Machine;
+use kerf_nurbs::{NurbsCurve, NurbsSurface};
+use kerf_pipeline::{Job, JobOptions, PlaceMode};
+use nalgebra::{Point3, Vector3};
+
+mod common;
+use common::fixture;
+
+const R: f64 = 3.0;
+
+/// A hole of radius `R` through a 2 mm sheet (its wall about the z axis, `0 <= z <= 2`, the
+/// normal flipped to point into the hole: the wall's outward normal as a CAD face has it),
+/// its edge at `z = 0` cut with the scrap on `side` (seen along the edge with the wall's
+/// normal toward the viewer).
+fn hole(side: ScrapSide) -> CurvesFile {
+    let wall = NurbsSurface::cylinder(Point3::origin(), Vector3::z(), R, 2.0).expect("wall");
+    let edge = NurbsCurve::circle(Point3::origin(), Vector3::z(), R).expect("edge");
+    CurvesFile {
+        units: kerf_format::Units::Millimetres,
+        curves: vec![CurveRecord {
+            id: "edge".into(),
+            curve: edge,
+            surface: Some("wall".into()),
+            surfaces: vec!["wall".into()],
+            start: None,
+            scrap: Some(side),
+        }],
+        surfaces: vec![SurfaceRecord {
+            id: "wall".into(),
+            geometry: SurfaceGeometry::Nurbs(wall),
+            source: SurfaceSource::Inline,
+            flip: true,
+        }],
+    }
+}
+
+/// The lead-in's points and tool axes in part coordinates (the placement undone).
+fn lead_in(out: &kerf_pipeline::Output) -> Vec<(Point3<f64>, Vector3<f64>)> {
+    let p = out.placement.placement_of(0);
+    let (r, t) = (p.rotation(), p.translation_mm);
+    out.axes.paths[0]
+        .lead_in
+        .as_ref()
+        .expect("a lead-in")
+        .poses
+        .iter()
+        .map(|q| {
+            let pos = r.inverse() * (Point3::new(q[0], q[1], q[2]) - t);
+            let axis = r.inverse() * Vector3::new(q[3], q[4], q[5]);
+            (Point3::from(pos), axis)
+        })
+        .collect()
+}
+
+fn run(side: ScrapSide, checked: bool) -> kerf_pipeline::Output {
+    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    let mut opts = JobOptions::default().with_place(PlaceMode::Auto);
+    if !checked {
+        opts = opts.with_traverse(None);
+    }
+    Job::new(hole(side), machine)
+        .with_options(opts)
+        .run()
+        .expect("run")
+}
+
+#[test]
+fn a_hole_edge_is_cut_from_the_other_side_and_its_lead_in_stays_in_the_scrap() {
+    for side in [ScrapSide::Left, ScrapSide::Right] {
+        let out = run(side, true);
+        assert_eq!(out.placement.plan.flipped, [true], "{side:?}: turned");
+        let sides = &out.report["placement"]["sides"];
+        assert_eq!(sides[0]["id"], "edge", "{sides}");
+        assert_eq!(sides[0]["side"], "other", "{sides}");
+        assert!(
+            sides[0]["reason"]
+                .as_str()
+                .unwrap()
+                .contains("from the given side at"),
+            "{sides}"
+        );
+        // Closed form: the edge runs counter-clockwise about +z, the wall's normal n points
+        // to the axis, so n x t = -z: the left (scrap) side is below the sheet (z < 0), the
+        // right side along the wall (z > 0). The lead-in lies in the tangent plane at its
+        // start, which holds z: every point but the last (the start, on the edge) strictly
+        // on the scrap side.
+        let lead = lead_in(&out);
+        assert!(lead.len() > 2, "{side:?}: {} lead-in points", lead.len());
+        let sign = match side {
+            ScrapSide::Left => -1.0,
+            ScrapSide::Right => 1.0,
+        };
+        // The start: the cut's first point, on the edge.
+        let pl = out.placement.placement_of(0);
+        let q = out.axes.paths[0].poses[0];
+        let start = pl.rotation().inverse() * (Point3::new(q[0], q[1], q[2]) - pl.translation_mm);
+        assert!(
+            (start.coords.xy().norm() - R).abs() < 1e-6 && start.z.abs() < 1e-6,
+            "{start}"
+        );
+        let radial = Vector3::new(start.x, start.y, 0.0).normalize();
+        for (p, axis) in &lead[..lead.len() - 1] {
+            assert!(
+                p.z * sign > 1e-6,
+                "{side:?}: lead-in point {p} off the scrap side"
+            );
+            // The tool axis (the normal at the start) is reversed: out of the hole.
+            assert!(
+                axis.dot(&radial) > 1.0 - 1e-9,
+                "{side:?}: axis {axis} at {p}"
+            );
+        }
+        // The same lead-in as without the side choice (unchecked traverses keep the given
+        // side): turning the tool axes does not move it.
+        let plain = run(side, false);
+        assert_eq!(plain.placement.plan.flipped, [false], "{side:?}");
+        let other = lead_in(&plain);
+        assert_eq!(other.len(), lead.len(), "{side:?}");
+        for ((p, a), (q, b)) in lead.iter().zip(&other) {
+            assert!((p - q).norm() < 1e-6, "{side:?}: {p} against {q}");
+            assert!((a + b).norm() < 1e-6, "{side:?}: axes {a} and {b} opposite");
+        }
+    }
+}
+
+#[test]
+fn a_contour_under_a_roof_keeps_its_side_when_the_head_cannot_reach_the_other() {
+    // A circle on a floor (normal +z) under a roof 10 mm up that another contour names: the
+    // nozzle's line up meets the roof, the line down meets nothing, but a tool axis pointing
+    // straight down is 180 degrees from up, beyond the head's +-135: the contour keeps its
+    // side, and the report says why.
+    let plate = |z: f64| {
+        NurbsSurface::plane(
+            Point3::new(-50.0, -50.0, z),
+            Vector3::x(),
+            Vector3::y(),
+            100.0,
+            100.0,
+        )
+        .expect("plate")
+    };
+    let (floor, roof) = (plate(0.0), plate(10.0));
+    let record = |id: &str, curve: NurbsCurve, surface: &str| CurveRecord {
+        id: id.into(),
+        curve,
+        surface: Some(surface.into()),
+        surfaces: vec![surface.into()],
+        start: None,
+        scrap: None,
+    };
+    let surface = |id: &str, s: NurbsSurface| SurfaceRecord {
+        id: id.into(),
+        geometry: SurfaceGeometry::Nurbs(s),
+        source: SurfaceSource::Inline,
+        flip: false,
+    };
+    let file = CurvesFile {
+        units: kerf_format::Units::Millimetres,
+        curves: vec![
+            record(
+                "under",
+                NurbsCurve::circle(Point3::origin(), Vector3::z(), 20.0).expect("circle"),
+                "floor",
+            ),
+            record(
+                "on-roof",
+                NurbsCurve::circle(Point3::new(0.0, 0.0, 10.0), Vector3::z(), 5.0).expect("circle"),
+                "roof",
+            ),
+        ],
+        surfaces: vec![surface("floor", floor), surface("roof", roof)],
+    };
+    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    let out = Job::new(file, machine)
+        .with_options(JobOptions::default().with_place(PlaceMode::Auto))
+        .run()
+        .expect("run");
+    assert_eq!(out.placement.plan.flipped, [false, false]);
+    let sides = out.report["placement"]["sides"].as_array().expect("sides");
+    assert_eq!(sides.len(), 1, "{sides:?}");
+    assert_eq!(sides[0]["id"], "under");
+    assert_eq!(sides[0]["side"], "given");
+    let why = sides[0]["reason"].as_str().unwrap();
+    assert!(why.contains("cannot reach the other side"), "{why}");
+    // The head lines (part coordinates): every point's line up meets the roof.
+    let h = out.placement.head_lines[0];
+    assert_eq!((h.given, h.other), (h.points, 0), "{h:?}");
+}

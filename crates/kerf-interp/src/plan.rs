@@ -239,9 +239,24 @@ pub fn plan<M: AxisModel + ?Sized>(
     let step = opts
         .grid_step_mm
         .max(2.0 * total_len / opts.max_grid_points.max(1000) as f64);
+    // No filter where the jerk limit cannot bind at this cycle: an axis' acceleration changes
+    // by at most `2 A_k` from one cycle to the next, a jerk of `2 A_k / T`, within `J_k` when
+    // `2 A_k / J_k <= T`. (A filter of width `~A / J` far below one cycle only degenerated: a
+    // jerk of 1e14 mm/s^3 planned the dome for 1.3e6 s.)
+    // The acceleration a jerk-limited axis can reach at all: from `-V` to `V` at jerk `J`,
+    // `a^2 / J <= 2 V`, so `a <= sqrt(2 J V)`. A larger `max_acceleration` is no limit, and
+    // taken as one it would set the filter's width (`A / J`: 1e300 mm/s^2 gave 1e294 s).
+    let acc: [f64; 5] = std::array::from_fn(|k| match limits.max_jerk {
+        Some(j) => limits.max_acceleration[k].min((2.0 * j[k] * limits.max_velocity[k]).sqrt()),
+        None => limits.max_acceleration[k],
+    });
     let tau = limits.max_jerk.map_or(0.0, |j| {
+        let binds = (0..5).any(|k| 2.0 * acc[k] / j[k] > opts.cycle_s);
+        if !binds {
+            return 0.0;
+        }
         (0..5)
-            .map(|k| JERK_FILTER_WIDTH * limits.max_acceleration[k] / j[k])
+            .map(|k| JERK_FILTER_WIDTH * acc[k] / j[k])
             .fold(0.0, f64::max)
     });
     let mut grids: Vec<RunGrid> = runs
@@ -250,7 +265,7 @@ pub fn plan<M: AxisModel + ?Sized>(
         .collect();
     let mut timed: Vec<Timed> = grids
         .iter()
-        .map(|g| time_run(g, limits.max_acceleration, limits.max_jerk, tau))
+        .map(|g| time_run(g, acc, limits.max_jerk, tau))
         .collect();
     let mut refinements = 0;
     loop {
@@ -347,7 +362,7 @@ pub fn plan<M: AxisModel + ?Sized>(
                     }
                     g.mult_a[i] *= fas[r][i];
                 }
-                timed[r] = time_run(&grids[r], limits.max_acceleration, limits.max_jerk, tau);
+                timed[r] = time_run(&grids[r], acc, limits.max_jerk, tau);
             }
         }
         refinements += 1;

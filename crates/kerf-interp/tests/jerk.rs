@@ -248,3 +248,50 @@ fn long_edges_between_fine_corners_do_not_make_the_spline_ring() {
         assert!(worst <= sagitta + blend + 1e-4, "jerk {jerk}: {worst}");
     }
 }
+
+#[test]
+fn a_jerk_limit_that_cannot_bind_plans_like_none() {
+    // A jerk limit of 1e14 mm/s^3 (or an acceleration of 1e300 with a real jerk limit) made
+    // the filter width A / J degenerate: the slot was planned for days (the review's dome: 1.3e6
+    // s). Within the cycle, an axis' acceleration changes by at most 2 A per cycle, a jerk of
+    // 2 A / T < J: the plan is the acceleration-limited one. An acceleration beyond
+    // sqrt(2 J V) is unreachable and plans like that bound. Both are verified against every
+    // limit by the set-points' own finite differences.
+    let mut m = gantry();
+    m.limits.max_jerk = None;
+    let st = solve_stations(&m, &slot(), None, None, None).expect("reachable");
+    let blocks = fit_blocks(&m, &st, None, 0, &FitOptions::with_tolerance(0.001)).expect("fit");
+    let opts = PlanOptions::new(20000.0, 0.001);
+    let acc = plan(&m, &blocks, &opts).expect("plan").duration();
+    for jerk in [1e14, 1e300] {
+        let mut j = m.clone();
+        j.limits.max_jerk = Some([jerk; 5]);
+        let motion = plan(&j, &blocks, &opts).expect("plan");
+        let r = ratios(&j, &motion.setpoints(&j), 0.001);
+        assert!(r.iter().all(|&x| x <= 1.0), "{jerk}: {r:?}");
+        assert!(
+            (motion.duration() - acc).abs() <= 0.01 * acc,
+            "{jerk}: {} s against {acc} s acceleration-limited",
+            motion.duration()
+        );
+    }
+    let mut huge = gantry();
+    let jerk: [f64; 5] = huge.limits.max_jerk.expect("jerk");
+    huge.limits.max_acceleration = [1e300; 5];
+    let motion = plan(&huge, &blocks, &opts).expect("plan");
+    let r = ratios(&huge, &motion.setpoints(&huge), 0.001);
+    assert!(r.iter().all(|&x| x <= 1.0), "{r:?}");
+    // The reachable acceleration's plan: the same limits with A = sqrt(2 J V).
+    let mut reach = gantry();
+    reach.limits.max_acceleration = std::array::from_fn(|k| {
+        (2.0 * jerk[k] * reach.limits.max_velocity[k])
+            .sqrt()
+            .min(1e300)
+    });
+    let expected = plan(&reach, &blocks, &opts).expect("plan").duration();
+    assert!(
+        (motion.duration() - expected).abs() <= 1e-9 * expected,
+        "{} s against {expected} s",
+        motion.duration()
+    );
+}

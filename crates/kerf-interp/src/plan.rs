@@ -32,6 +32,7 @@
 //! The derivations are in `docs/interpolation.md`.
 
 mod assemble;
+mod deviation;
 mod link;
 mod motion;
 mod profile;

@@ -123,6 +123,18 @@ impl<const D: usize> Spline<D> {
         (t, h, c)
     }
 
+    /// Each interval as `(s_i, s_{i+1}, Bezier control points)`: `y_i`, `y_i + h m_i / 3`,
+    /// `y_{i+1} - h m_{i+1} / 3`, `y_{i+1}` (the Hermite cubic in Bernstein form).
+    pub(crate) fn bezier_pieces(&self) -> impl Iterator<Item = (f64, f64, [[f64; D]; 4])> + '_ {
+        (0..self.s.len() - 1).map(|i| {
+            let h = self.s[i + 1] - self.s[i];
+            let (y0, y1, m0, m1) = (self.y[i], self.y[i + 1], self.m[i], self.m[i + 1]);
+            let b1 = std::array::from_fn(|d| y0[d] + h * m0[d] / 3.0);
+            let b2 = std::array::from_fn(|d| y1[d] - h * m1[d] / 3.0);
+            (self.s[i], self.s[i + 1], [y0, b1, b2, y1])
+        })
+    }
+
     /// The value at `s`.
     #[inline]
     pub(crate) fn at(&self, s: f64) -> [f64; D] {
@@ -250,6 +262,11 @@ impl Run {
     pub(crate) fn spline_tip(&self, s: f64) -> Point3<f64> {
         let p = self.tip.at(s);
         Point3::new(p[0], p[1], p[2])
+    }
+
+    /// The tip spline (what the set-points follow before the blend).
+    pub(crate) fn tip_spline(&self) -> &Spline<3> {
+        &self.tip
     }
 
     /// True when the tip is blended (block starts are then not passed exactly).

@@ -436,3 +436,43 @@ fn a_hole_too_small_for_the_feed_gets_one_lower_modal_f_word() {
         "not needlessly low: F{first} vs {limit}"
     );
 }
+
+#[test]
+fn the_set_points_stay_within_the_proven_spline_bound_of_the_blocks() {
+    // `Motion::spline_deviation_bound` is a proof (Bezier hulls of the tip spline against the
+    // chords of its nodes); the set-points, measured against the program's blocks (one line
+    // per chord: the polyline of cutting points), must stay within it, and it must not be loose
+    // (within 2 x of the largest measured distance plus a micron). With a curve that is cut
+    // at 0.01 mm, the set-points are then within chord + bound of the curve.
+    let m = PaperAcHead::paper_000();
+    for (name, c) in [
+        ("free-form", common::freeform()),
+        ("hole", circle(5.0, 0.0, 0.0, 0.0)),
+    ] {
+        let st = stations(&m, &c, 0.01, vertical);
+        let lines = one_line_per_pose(&m, &st);
+        let polyline: Vec<Point3<f64>> = st.iter().map(|s| s.tip).collect();
+        let motion = plan(&m, &lines, &PlanOptions::new(6000.0, 0.001)).expect("plan");
+        let bound = motion.spline_deviation_bound();
+        let (mut from_blocks, mut from_curve) = (0.0f64, 0.0f64);
+        for q in motion.iter(&m) {
+            let tip = Point3::new(q[0] + m.r_c, q[1], q[2] - m.r_a);
+            let d = polyline
+                .windows(2)
+                .map(|w| kerf_nurbs::distance_to_segment(&tip, &w[0], &w[1]))
+                .fold(f64::INFINITY, f64::min);
+            from_blocks = from_blocks.max(d);
+            from_curve = from_curve.max(c.closest_point(&tip).distance);
+        }
+        println!("{name}: spline bound {bound:.2e} mm, set-points {from_blocks:.2e} mm from the blocks, {from_curve:.2e} mm from the curve");
+        assert!(
+            from_blocks <= bound + 1e-12,
+            "{name}: {from_blocks} > {bound}"
+        );
+        assert!(
+            bound <= 2.0 * from_blocks + 1e-3,
+            "{name}: loose bound {bound}"
+        );
+        assert!(from_curve <= 0.01 + bound, "{name}: {from_curve}");
+    }
+}

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use kerf_discretize::Discretization;
 use kerf_interp::{
-    gcode_motion, stations_from_solved, ChordTerm, MachineModel, PlanOptions,
+    gcode_motion, stations_from_solved, ChordTerm, MachineModel, Motion, PlanOptions,
     ProgramPath as InterpPath,
 };
 use kerf_kinematics::{solve_paths, AxesFile, PathCurve, PathInput, Pose};
@@ -378,6 +378,17 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         .map(|(k, v)| (k.to_string(), json!(v)))
         .collect();
     budget.insert("total".into(), json!(gopts.budget_total()));
+    let spline_bound = motions
+        .iter()
+        .map(Motion::spline_deviation_bound)
+        .fold(0.0, f64::max);
+    let setpoints_budget = gopts
+        .budget()
+        .into_iter()
+        .filter(|(k, _)| *k != "linearization")
+        .filter_map(|(_, v)| v)
+        .sum::<f64>()
+        + spline_bound;
     let report = json!({
         "input": source_name,
         "machine": machine.name,
@@ -419,6 +430,12 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         "interpolation": {
             "feed_mm_per_min": o.feed_mm_per_min,
             "cycle_s": o.cycle_s,
+            // The set-points follow a smooth spline through the blocks' nodes: a proven bound
+            // of its distance from the blocks, and the set-points' own budget (the blocks'
+            // chord and fit terms, the spline, the interpolation chord, the blend; the
+            // linearization does not apply: the set-points put the tip on the path).
+            "spline_deviation_bound_mm": spline_bound,
+            "setpoints_budget_mm": setpoints_budget,
             "lines": counts.lines,
             "arcs": counts.arcs,
             "turns": counts.turns,

@@ -205,23 +205,22 @@ impl Discretization {
 }
 
 /// `f = sqrt(k) |C'|` and its derivative `df/dt` from the first three derivatives. With
-/// `a = C' x C''` and `s = |C'|`: `f = (|a| / s)^(1/2)` and
-/// `df/dt = (a . (C' x C''')) / (2 |a|^(3/2) s^(1/2)) - f (C' . C'') / (2 s^2)`.
+/// `s = |C'|` and, scaled by the speed, `u_i = C^(i) / s`, `b = u1 x u2`, `c = u1 x u3`:
+/// `k = |b| / s`, so `f = sqrt(|b| s)`, and (`b' = s c` up to terms along `b`'s own scaling)
+/// `df/dt = (f / 2) ((b . c) / |b|^2 - u1 . u2)`.
 /// `f` is 0 where it is not finite (a removable or integrable singularity of the integrand);
 /// `df/dt` is NaN where it is not finite (`k = 0`, where `sqrt(k)` has no derivative).
 #[inline]
 pub(crate) fn sqrt_curvature_speed(d: &[nalgebra::Vector3<f64>; 4]) -> (f64, f64) {
     let s = d[1].norm();
     // Scaled by the speed first, as `curvature_of`: tiny parameter ranges (knots scaled by
-    // 1e-50) give `|C'| ~ 1e52`, `|C''| ~ 1e104`, and `C' x C''` would overflow. With
-    // `u_i = C^(i) / s`, `b = u1 x u2`, `c = u1 x u3`: `f = sqrt(|b| s)` and
-    // `df/dt = s^(1/2) (b . c) / (2 |b|^(3/2)) - f (u1 . u2) / 2`.
+    // 1e-50) give `|C'| ~ 1e52`, `|C''| ~ 1e104`, and `C' x C''` would overflow.
     let inv = 1.0 / s;
     let (u1, u2, u3) = (d[1] * inv, d[2] * inv, d[3] * inv);
     let b = u1.cross(&u2);
-    let bn = b.norm();
-    let f = (bn * s).sqrt();
-    let df = s.sqrt() * b.dot(&u1.cross(&u3)) / (2.0 * bn * bn.sqrt()) - 0.5 * f * u1.dot(&u2);
+    let bb = b.norm_squared();
+    let f = (bb.sqrt() * s).sqrt();
+    let df = 0.5 * f * (b.dot(&u1.cross(&u3)) / bb - u1.dot(&u2));
     let f = if f.is_finite() { f } else { 0.0 };
     let df = if df.is_finite() { df } else { f64::NAN };
     (f, df)
@@ -235,7 +234,7 @@ fn trapezoid_sqrt_curvature(curve: &NurbsCurve, params: &[f64]) -> f64 {
     for &t in params {
         let v = sqrt_curvature_speed(&curve.eval_d3(t));
         if let Some((tp, vp)) = prev {
-            sum += trapezoid_step(curve, tp, t, vp, v);
+            sum += trapezoid_step(curve, (tp, curve.span(tp)), (t, curve.span(t)), vp, v);
         }
         prev = Some((t, v));
     }
@@ -250,16 +249,16 @@ fn trapezoid_sqrt_curvature(curve: &NurbsCurve, params: &[f64]) -> f64 {
 /// curvature may jump at a knot (degree 2, or repeated knots), so a step that crosses knots
 /// uses each end's value up to the nearest knot on its side (and the mean in between): the
 /// error is then of the order of the integrand's variation within a span, not of its jump.
+/// `span` and `span1` are the knot spans of `t0` and `t1` (`NurbsCurve::span`).
 #[inline]
 pub(crate) fn trapezoid_step(
     curve: &NurbsCurve,
-    t0: f64,
-    t1: f64,
+    (t0, span): (f64, usize),
+    (t1, span1): (f64, usize),
     (f0, g0): (f64, f64),
     (f1, g1): (f64, f64),
 ) -> f64 {
     let knots = curve.knots();
-    let span = curve.span(t0);
     let first = knots[span + 1];
     if first >= t1 || span + 1 >= curve.len() {
         let h = t1 - t0;
@@ -271,7 +270,7 @@ pub(crate) fn trapezoid_step(
             plain
         };
     }
-    let last = knots[curve.span(t1)].max(first);
+    let last = knots[span1].max(first);
     if last >= t1 {
         return f0 * (first - t0) + f1 * (t1 - first);
     }
@@ -363,7 +362,7 @@ pub fn discretize_range(
             margin,
         });
     }
-    let estimate = estimate_count(curve, opts.tolerance_mm);
+    let estimate = minimum::estimate_count_with(curve, opts.tolerance_mm, |t| cert.eval_d2(t));
     let by_length = if opts.max_segment_length_mm.is_finite() {
         curve.size() / opts.max_segment_length_mm
     } else {

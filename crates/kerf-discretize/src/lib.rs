@@ -45,7 +45,7 @@ pub use minimum::{
 pub use options::{Options, Strategy};
 
 use kerf_nurbs::NurbsCurve;
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 /// The cutting points of one curve, with the certificate of their chord error.
@@ -204,26 +204,49 @@ impl Discretization {
     }
 }
 
-/// `f = sqrt(k) |C'|` and its derivative `df/dt` from the first three derivatives. With
-/// `s = |C'|` and, scaled by the speed, `u_i = C^(i) / s`, `b = u1 x u2`, `c = u1 x u3`:
-/// `k = |b| / s`, so `f = sqrt(|b| s)`, and (`b' = s c` up to terms along `b`'s own scaling)
-/// `df/dt = (f / 2) ((b . c) / |b|^2 - u1 . u2)`.
-/// `f` is 0 where it is not finite (a removable or integrable singularity of the integrand);
-/// `df/dt` is NaN where it is not finite (`k = 0`, where `sqrt(k)` has no derivative).
-#[inline]
-pub(crate) fn sqrt_curvature_speed(d: &[nalgebra::Vector3<f64>; 4]) -> (f64, f64) {
-    let s = d[1].norm();
-    // Scaled by the speed first, as `curvature_of`: tiny parameter ranges (knots scaled by
-    // 1e-50) give `|C'| ~ 1e52`, `|C''| ~ 1e104`, and `C' x C''` would overflow.
-    let inv = 1.0 / s;
-    let (u1, u2, u3) = (d[1] * inv, d[2] * inv, d[3] * inv);
-    let b = u1.cross(&u2);
-    let bb = b.norm_squared();
-    let f = (bb.sqrt() * s).sqrt();
-    let df = 0.5 * f * (b.dot(&u1.cross(&u3)) / bb - u1.dot(&u2));
-    let f = if f.is_finite() { f } else { 0.0 };
-    let df = if df.is_finite() { df } else { f64::NAN };
-    (f, df)
+/// The first three derivatives at a point, scaled to a parameter that moves about as fast as
+/// the arc length: with `s = |C'|`, `v = C' / s`, `a = C'' / s^2`, `j = C''' / s^3` (the
+/// derivatives with respect to `x = s (t - t0)`). Whatever the scale of the knots (a range of
+/// `1e-50` gives `|C'| ~ 1e52`, `|C''| ~ 1e104`, and `C' x C''` would overflow), these are of the
+/// size of the geometry: the step model and `N*` work on them.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Scaled {
+    pub s: f64,
+    pub v: Vector3<f64>,
+    pub a: Vector3<f64>,
+    pub j: Vector3<f64>,
+}
+
+impl Scaled {
+    /// From the first three derivatives with respect to the curve's parameter.
+    #[inline]
+    pub(crate) fn new(d1: &Vector3<f64>, d2: &Vector3<f64>, d3: &Vector3<f64>) -> Self {
+        let s = d1.norm();
+        let inv = 1.0 / s;
+        Self {
+            s,
+            v: d1 * inv,
+            a: d2 * inv * inv,
+            j: d3 * inv * inv * inv,
+        }
+    }
+
+    /// `f = sqrt(k) |C'|` and its derivative `df/dt`. The curvature is `k = |v x a|`, so
+    /// `f = s sqrt(|b|)` with `b = v x a`, and (`db/dx = v x j` up to terms along `b`'s own
+    /// scaling) `df/dt = (f s / 2) ((b . c) / |b|^2 - v . a)` with `c = v x j`.
+    /// `f` is 0 where it is not finite (a removable or integrable singularity of the
+    /// integrand); `df/dt` is NaN where it is not finite (`k = 0`, where `sqrt(k)` has no
+    /// derivative).
+    #[inline]
+    pub(crate) fn sqrt_curvature_speed(&self) -> (f64, f64) {
+        let b = self.v.cross(&self.a);
+        let bb = b.norm_squared();
+        let f = bb.sqrt().sqrt() * self.s;
+        let df = 0.5 * f * self.s * (b.dot(&self.v.cross(&self.j)) / bb - self.v.dot(&self.a));
+        let f = if f.is_finite() { f } else { 0.0 };
+        let df = if df.is_finite() { df } else { f64::NAN };
+        (f, df)
+    }
 }
 
 /// The corrected trapezoid rule for `integral sqrt(k) |C'| dt` on the nodes `params` (one
@@ -232,7 +255,8 @@ fn trapezoid_sqrt_curvature(curve: &NurbsCurve, params: &[f64]) -> f64 {
     let mut sum = 0.0;
     let mut prev = None;
     for &t in params {
-        let v = sqrt_curvature_speed(&curve.eval_d3(t));
+        let d = curve.eval_d3(t);
+        let v = Scaled::new(&d[1], &d[2], &d[3]).sqrt_curvature_speed();
         if let Some((tp, vp)) = prev {
             sum += trapezoid_step(curve, (tp, curve.span(tp)), (t, curve.span(t)), vp, v);
         }

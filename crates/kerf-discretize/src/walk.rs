@@ -3,12 +3,12 @@
 //! "equal error" method, with every accepted segment certified by [`crate::bound`].
 
 use kerf_nurbs::NurbsCurve;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 
 use crate::bound::{by_degree, Bound, Certifier, Eval, Question, Scratch};
 use crate::error::{DiscretizeError, Result};
 use crate::options::Options;
-use crate::Discretization;
+use crate::{Discretization, Scaled};
 
 /// Trials per cutting point before giving up.
 const MAX_ITERS: usize = 80;
@@ -48,14 +48,15 @@ struct Cand {
     fail: Option<Fail>,
 }
 
-/// The arc's Taylor expansion at a cutting point, `C(t0 + x) - C(t0) = v x + a x^2 / 2 +
-/// j x^3 / 6 + O(x^4)`: the step model, kept as the six dot products of `v`, `a`, `j` (every
-/// quantity of the model is a polynomial in the step over them). Its chord error for a step
-/// is the interpolation certificate's closed form on the model (see [`Taylor::error`]); it is
-/// accurate to a relative `O(h^2)`, where the osculating circle's (paper 004's radius) is only
-/// `O(h)`.
+/// The arc's Taylor expansion at a cutting point, `C(t0 + h) - C(t0) = v x + a x^2 / 2 +
+/// j x^3 / 6 + O(x^4)` in the scaled step `x = s h` ([`Scaled`]: the model does not depend on
+/// the knots' scale), kept as `s` and the six dot products of `v`, `a`, `j` (every quantity of
+/// the model is a polynomial in the step over them). Its chord error for a step is the
+/// interpolation certificate's closed form on the model (see [`Taylor::error`]); it is accurate
+/// to a relative `O(h^2)`, where the osculating circle's (paper 004's radius) is only `O(h)`.
 #[derive(Debug, Clone, Copy)]
 struct Taylor {
+    s: f64,
     vv: f64,
     va: f64,
     vj: f64,
@@ -65,8 +66,10 @@ struct Taylor {
 }
 
 impl Taylor {
-    fn new(v: &Vector3<f64>, a: &Vector3<f64>, j: &Vector3<f64>) -> Self {
+    fn new(d: &Scaled) -> Self {
+        let (v, a, j) = (&d.v, &d.a, &d.j);
         Self {
+            s: d.s,
             vv: v.dot(v),
             va: v.dot(a),
             vj: v.dot(j),
@@ -81,11 +84,14 @@ impl Taylor {
     /// `max_x (1/4 - x^2) (4 n + cl x)` with `n` the middle point's distance from the chord and
     /// `cl` from the cubic term across the chord, so that the model predicts the certified
     /// bound the step will get, not only its middle point's distance (the error of a step
-    /// dominated by its cubic term peaks off the middle). With `c = v + a h / 2 + j h^2 / 6`
-    /// the chord over `h` and `m = a / 8 + j h / 16` the middle point's offset from the chord's
-    /// middle over `h^2`, the parts across the chord are `|m|^2 - (m.c)^2 / |c|^2` and so on.
+    /// dominated by its cubic term peaks off the middle). With `c = v + a x / 2 + j x^2 / 6`
+    /// the chord over `x` and `m = a / 8 + j x / 16` the middle point's offset from the chord's
+    /// middle over `x^2`, the parts across the chord are `|m|^2 - (m.c)^2 / |c|^2` and so on.
+    /// Where `cl <= n` the maximum is `n + cl^2 / (256 n)` to a relative `3e-5`.
     #[inline]
     fn error(&self, h: f64) -> f64 {
+        const THIRD: f64 = 1.0 / 3.0;
+        const SIXTH: f64 = 1.0 / 6.0;
         let Self {
             vv,
             va,
@@ -93,26 +99,26 @@ impl Taylor {
             aa,
             aj,
             jj,
+            ..
         } = *self;
-        const THIRD: f64 = 1.0 / 3.0;
-        const SIXTH: f64 = 1.0 / 6.0;
-        let cc = vv + h * (va + h * (0.25 * aa + THIRD * vj + h * (SIXTH * aj + h * jj / 36.0)));
-        let mc = 0.125 * va + h * (0.0625 * (aa + vj) + h * (aj * (5.0 / 96.0) + h * jj / 96.0));
-        let jc = vj + h * (0.5 * aj + SIXTH * h * jj);
-        let mm = aa / 64.0 + h * (aj / 64.0 + h * jj / 256.0);
-        let mj = 0.125 * aj + 0.0625 * h * jj;
+        let x = h * self.s;
+        let cc = vv + x * (va + x * (0.25 * aa + THIRD * vj + x * (SIXTH * aj + x * jj / 36.0)));
+        let mc = 0.125 * va + x * (0.0625 * (aa + vj) + x * (aj * (5.0 / 96.0) + x * jj / 96.0));
+        let jc = vj + x * (0.5 * aj + SIXTH * x * jj);
+        let mm = aa / 64.0 + x * (aj / 64.0 + x * jj / 256.0);
+        let mj = 0.125 * aj + 0.0625 * x * jj;
         let inv = 1.0 / cc;
-        let h2 = h * h;
-        let h3 = SIXTH * h2 * h;
-        // |d|, |j_perp| h^3 / 6 and |d . j_perp| h^3 / 6, d the offset across the chord.
-        let n = (mm - mc * mc * inv).max(0.0).sqrt() * h2;
-        let cj2 = (jj - jc * jc * inv).max(0.0) * h3 * h3;
-        let k = (mj - mc * jc * inv).abs() * h2 * h3;
-        let cl = if n > 0.0 {
-            ((k + 0.0625 * cj2) / n).min(cj2.sqrt())
-        } else {
-            cj2.sqrt()
-        };
+        let x2 = x * x;
+        let x3 = SIXTH * x2 * x;
+        // |d|, |j_perp| x^3 / 6 and |d . j_perp| x^3 / 6, d the offset across the chord.
+        let n = (mm - mc * mc * inv).max(0.0).sqrt() * x2;
+        let cj2 = (jj - jc * jc * inv).max(0.0) * x3 * x3;
+        let k = (mj - mc * jc * inv).abs() * x2 * x3;
+        let inv_n = 1.0 / n;
+        let cl = ((k + 0.0625 * cj2) * inv_n).min(cj2.sqrt());
+        if cl <= n {
+            return n + cl * cl * inv_n * (1.0 / 256.0);
+        }
         let root = (64.0 * n * n + 3.0 * cl * cl).sqrt() + 8.0 * n;
         let x = if root > 0.0 { cl / (2.0 * root) } else { 0.0 };
         (0.25 - x * x) * (4.0 * n + cl * x)
@@ -121,10 +127,11 @@ impl Taylor {
     /// The model's chord length for the step `h`.
     #[inline]
     fn length(&self, h: f64) -> f64 {
+        let x = h * self.s;
         let cc = self.vv
-            + h * (self.va
-                + h * (0.25 * self.aa + self.vj / 3.0 + h * (self.aj / 6.0 + h * self.jj / 36.0)));
-        cc.max(0.0).sqrt() * h
+            + x * (self.va
+                + x * (0.25 * self.aa + self.vj / 3.0 + x * (self.aj / 6.0 + x * self.jj / 36.0)));
+        cc.max(0.0).sqrt() * x
     }
 
     /// The step whose model error is `target`, from `guess` (the last step, which had about
@@ -139,17 +146,18 @@ impl Taylor {
         } else {
             // |v x a| / |v| and |v x j| / |v|: the curvature's and the cubic term's scales.
             let ka = ((self.aa - self.va * self.va / self.vv).max(0.0)).sqrt();
-            let mut h = (8.0 * target / ka).sqrt();
-            // The cubic term alone would reach the target at h = cbrt(16 target / kj): only
-            // where that is shorter (kj h^3 / 16 > target) does it matter.
+            let mut x = (8.0 * target / ka).sqrt();
+            // The cubic term alone would reach the target at x = cbrt(16 target / kj): only
+            // where that is shorter (kj x^3 / 16 > target) does it matter.
             let kj = ((self.jj - self.vj * self.vj / self.vv).max(0.0)).sqrt();
-            let cubic = kj * h * h * h;
+            let cubic = kj * x * x * x;
             if cubic.is_nan() || cubic > 16.0 * target {
-                let hj = (16.0 * target / kj).cbrt();
-                if hj < h || !h.is_finite() {
-                    h = hj;
+                let xj = (16.0 * target / kj).cbrt();
+                if xj < x || !x.is_finite() {
+                    x = xj;
                 }
             }
+            let h = x / self.s;
             if !(h.is_finite() && h > 0.0) {
                 return f64::INFINITY;
             }
@@ -280,13 +288,14 @@ impl Walker<'_> {
         while cur.t < b {
             let t0 = cur.t;
             let d = &cur.d;
-            let f0 = crate::sqrt_curvature_speed(&[cur.p.coords, d[0], d[1], d[2]]);
+            let scaled = Scaled::new(&d[0], &d[1], &d[2]);
+            let f0 = scaled.sqrt_curvature_speed();
             if let Some((tp, span, fp)) = prev_f {
                 self.sqrt_curvature +=
                     crate::trapezoid_step(self.curve, (tp, span), (t0, cur.span), fp, f0);
             }
             prev_f = Some((t0, cur.span, f0));
-            let model = Taylor::new(&d[0], &d[1], &d[2]);
+            let model = Taylor::new(&scaled);
             let rest = b - t0;
             let mut first_h = None;
             let mut h = if self.param_only {

@@ -176,25 +176,29 @@ impl Certifier<'_> {
         }
         let um = 0.5 * (u0 + u1);
         let hm = self.span_point::<P, M>(span, um);
-        let proj = |v: &Vector4<f64>| v.xyz() / v.w;
-        let (c0, c1, cm) = (proj(&h0), proj(&h1), proj(&hm));
+        let (c0, c1, cm) = (self.project(&h0), self.project(&h1), self.project(&hm));
         let bl = al + chord.direction();
         // How far the given chord ends are from the curve's ends.
-        let e = (c0 - al).norm().max((c1 - bl).norm());
+        let e = (c0 - al)
+            .norm_squared()
+            .max((c1 - bl).norm_squared())
+            .sqrt();
         let ab = chord.direction();
         let l = ab.norm();
         let wm = hm.w;
         if !(l > 0.0 && wm > 0.0 && e.is_finite()) {
             return None;
         }
-        let dir = ab / l;
+        let dir = ab * (1.0 / l);
         let xm = cm - al;
         let par = xm.dot(&dir);
-        // The middle point's distance to the chord's line, and to the chord itself.
+        // The middle point's distance to the chord's line: a lower bound of the chord error
+        // (the distance to the chord is no smaller).
         let dm = (xm - dir * par).norm();
-        let lower = chord.distance_upper(&cm);
+        let lower = dm;
         // w(u) >= w_m (1 - a |s - 1/2|) on the step.
-        let a = h * sb.w1 / wm;
+        let inv_wm = 1.0 / wm;
+        let a = h * sb.w1 * inv_wm;
         if a.is_nan() || a > 0.5 {
             return None;
         }
@@ -204,14 +208,15 @@ impl Certifier<'_> {
         let h3 = h * h * h;
         let e_w = w_hi * e;
         let n = wm * dm + e_w;
+        // a' = a / (1 - a/2); w_hi / w_lo = 1 + a'.
         let a2 = a / (1.0 - 0.5 * a);
         let along0 = 4.0 * ((wm * (par - 0.5 * l)).abs() + w_hi * e);
-        let par_w = l * (sb.w3 + 3.0 * sb.w2 / h);
+        let par_w = l * (sb.w3 + 3.0 * sb.w2 * (1.0 / h));
         // The foot of every curve point on the chord's line lies in the chord (up to the ends'
         // offset `e`), given a bound of the third derivative of N along the chord: then the
         // distance to the chord is that to its line.
         let feet_inside = |m3_par: f64| {
-            let along = along0 + h3 * (m3_par + slack + par_w) / 12.0;
+            let along = along0 + h3 * (m3_par + slack + par_w) * (1.0 / 12.0);
             along <= 0.5 * l * w_lo
         };
         // The bound from `cl`, the coefficient of the term linear in x = |s - 1/2|:
@@ -222,7 +227,7 @@ impl Certifier<'_> {
             let root = (64.0 * n * n + 3.0 * cl * cl).sqrt() + 8.0 * n;
             let x = if root > 0.0 { cl / (2.0 * root) } else { 0.0 };
             let phi = (0.25 - x * x) * (4.0 * n + cl * x);
-            let upper = (phi / wm + 2.0 * e_w / w_lo + 4.0 * f64::EPSILON * sb.d1)
+            let upper = (phi * inv_wm + 2.0 * e * (1.0 + a2) + 4.0 * f64::EPSILON * sb.d1)
                 * (1.0 + 64.0 * f64::EPSILON)
                 + margin;
             if !upper.is_finite() {
@@ -239,7 +244,7 @@ impl Certifier<'_> {
         // The scalar form: with |N'''| <= m3 on the step, c = h^3 m3 / 6 and
         // cl = c + 4 n a' + c a' / 2.
         let scalar = |m3: f64| {
-            let c = h3 * (m3 + slack) / 6.0;
+            let c = h3 * (m3 + slack) * (1.0 / 6.0);
             c + 4.0 * n * a2 + 0.5 * c * a2
         };
         // Level 1, from the span's norms: |N'''| <= |H_j - H_j^w A| <= |H_j| + |A| |H_j^w| over
@@ -288,11 +293,13 @@ impl Certifier<'_> {
             // The vector form (docs/discretization.md): with c = h^3 t / 6,
             // |4 D - x c| <= sqrt(16 n^2 + 8 x k + x^2 |c|^2) <= 4 n + x k / n + x^2 |c|^2 / (8 n)
             // for k >= |D . c| (from the middle point's own offset), then x^2 <= x / 2.
-            let c = tn * h3 / 6.0;
-            let nm_t = (xm - dir * par).dot(&t) * wm * h3 / 6.0;
+            let sixth = h3 * (1.0 / 6.0);
+            let c = tn * sixth;
+            let nm_t = (xm - dir * par).dot(&t) * wm * sixth;
             let k = (nm_t.abs() + (e_w + wm * margin) * c).min(n * c);
-            let beta = k / n + h3 * delta / 6.0;
-            let gamma = c * c / (8.0 * n);
+            let inv_n = 1.0 / n;
+            let beta = k * inv_n + delta * sixth;
+            let gamma = 0.125 * c * c * inv_n;
             let beta2 = beta + 4.0 * n * a2;
             let gamma2 = gamma + beta * a2 + 0.5 * gamma * a2;
             cl = cl.min(beta2 + 0.5 * gamma2);
@@ -332,7 +339,7 @@ impl Certifier<'_> {
         }
         let u = (u0 + (0.5 + x) * (u1 - u0)).clamp(u0, u1);
         let v = self.span_point::<P, M>(span, u);
-        Some(chord.distance_upper(&(v.xyz() / v.w)))
+        Some(chord.distance_upper(&self.project(&v)))
     }
 }
 

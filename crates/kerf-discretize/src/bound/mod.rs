@@ -120,6 +120,10 @@ pub struct Certifier<'a> {
     span_h3: Vec<Vector4<f64>>,
     /// Per knot span index: the bounds of the interpolation certificate.
     span_bounds: Vec<SpanBounds>,
+    /// Whether every weight is 1 (a polynomial curve): then every homogeneous weight the
+    /// certificate computes is exactly 1 and the projections are skipped
+    /// ([`Certifier::project`]).
+    unit_weights: bool,
     /// `4 eps max |P_i|` for curves whose weights are not powers of two (the control points are
     /// recovered from `w P` by one division, within two ulps), else 0.
     representation: f64,
@@ -198,6 +202,7 @@ impl<'a> Certifier<'a> {
             span_bezier,
             span_h3,
             span_bounds,
+            unit_weights: weights.iter().all(|&w| w == 1.0),
             representation,
         }
     }

@@ -47,6 +47,19 @@ impl Certifier<'_> {
         d
     }
 
+    /// The local Cartesian point of a homogeneous one: `h.xyz / h.w`, or `h.xyz` itself for a
+    /// curve whose weights are all 1 (every de Casteljau level of weights 1 is exactly 1, since
+    /// `fl(fl(1 - u) + u) = 1` for `u` in `[0, 1]`, so this is the same number without the
+    /// division).
+    #[inline(always)]
+    pub(super) fn project(&self, h: &Vector4<f64>) -> Vector3<f64> {
+        if self.unit_weights {
+            h.xyz()
+        } else {
+            h.xyz() / h.w
+        }
+    }
+
     /// The knot span of `t`: `hint` if `t` lies in it (the walk mostly stays in one span),
     /// else by binary search (right-sided at a knot, the last span at the domain's end).
     #[inline]
@@ -176,10 +189,16 @@ impl Certifier<'_> {
             d[0] = d[0] * v + d[1] * u;
         }
         let h = d[0];
-        let w = h.w;
-        let c0 = h.xyz() / w;
+        let c0 = self.project(&h);
         let mut out = [Vector3::zeros(); 3];
-        if N >= 1 {
+        if self.unit_weights {
+            // The weight's derivatives are exactly 0 (differences of ones): the quotient rule
+            // below would give these same numbers.
+            out[0] = hd[1].xyz();
+            out[1] = hd[2].xyz();
+            out[2] = hd[3].xyz();
+        } else if N >= 1 {
+            let w = h.w;
             let c1 = (hd[1].xyz() - c0 * hd[1].w) / w;
             out[0] = c1;
             if N >= 2 {
@@ -198,6 +217,43 @@ impl Certifier<'_> {
             h,
             p: (c0 + self.origin).into(),
             d: out,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Certifier;
+
+    /// The fast path of [`Certifier::project`] rests on this: with unit weights, the span's
+    /// Bezier weights (from the blossom) and every de Casteljau level on them are exactly 1,
+    /// whatever the parameter, so skipping the division changes no bit.
+    #[test]
+    fn unit_weights_stay_exactly_one() {
+        for degree in 1..=9 {
+            for c in kerf_nurbs::smooth_random_curves(degree, 3, 90 + degree as u64) {
+                let cert = Certifier::new(&c);
+                assert!(cert.unit_weights, "degree {degree}: unit weights seen");
+                assert!(
+                    cert.span_bezier.iter().all(|v| v.w == 1.0 || v.w == 0.0),
+                    "degree {degree}: span weights exactly 1 (0 for empty spans)"
+                );
+                for (span, _, _) in c.spans() {
+                    for k in 0..=1000 {
+                        // Parameters with long mantissas, and the ends.
+                        let u = (k as f64 * 0.618_033_988_749_894_9).fract();
+                        let u = if k == 0 {
+                            0.0
+                        } else if k == 1 {
+                            1.0
+                        } else {
+                            u
+                        };
+                        let w = cert.span_point::<0, { kerf_nurbs::MAX_ORDER }>(span, u).w;
+                        assert_eq!(w, 1.0, "degree {degree} span {span} u {u}");
+                    }
+                }
+            }
         }
     }
 }

@@ -10,22 +10,22 @@ use nalgebra::{Vector3, Vector4};
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct SpanBounds {
     /// The largest Bezier weight (a bound of `w` on the span: convex hull).
-    w_max: f64,
+    pub(super) w_max: f64,
     /// Bounds of `|w'|`, `|w''|`, `|w'''|` (first, second, third hodograph of the weights),
     /// each raised by `slack`.
-    w1: f64,
-    w2: f64,
-    w3: f64,
+    pub(super) w1: f64,
+    pub(super) w2: f64,
+    pub(super) w3: f64,
     /// A bound of `|C'|` on the span (a rounding of the local parameter moves a point by
     /// `eps` times it).
-    d1: f64,
+    pub(super) d1: f64,
     /// `max_j |H_j|` and `max_j |H_j^w|` over the third hodograph's control points `(H_j,
     /// H_j^w)`: the third derivative of `P - w A` is at most `h3 + |A| h3w` on the span.
-    h3: f64,
-    h3w: f64,
+    pub(super) h3: f64,
+    pub(super) h3w: f64,
     /// Added to the third-derivative bounds: the rounding of the Bezier points, amplified by
     /// the third differences (`64 p^4 eps w_max (L + |A|)`, the part in `L` stored here).
-    slack: f64,
+    pub(super) slack: f64,
 }
 
 /// The third hodographs and the derivative bounds of every span's Bezier form (see
@@ -134,11 +134,14 @@ impl Question {
                 && (bd.lower >= self.want_lower || bd.upper < self.want_lower || tight))
     }
 
-    /// Whether a refined bound `bd` answers the question: [`Question::decided`], or
-    /// certified for the walk.
+    /// Whether a refined bound `bd` answers the question: [`Question::decided`], or for the
+    /// walk, certified, or not certified by a bound within 5 % of the tolerance of a curve
+    /// point's distance (the hull's subdivisions could move the answer only within that: the
+    /// walk takes a slightly shorter step instead, for far less work).
     #[inline]
     pub(super) fn settled(&self, bd: &Bound) -> bool {
-        self.decided(bd) || (self.settle && bd.upper <= self.limit)
+        self.decided(bd)
+            || (self.settle && (bd.upper <= self.limit || bd.upper - bd.lower <= 0.05 * self.limit))
     }
 }
 

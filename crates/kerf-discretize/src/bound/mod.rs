@@ -124,6 +124,9 @@ pub struct Certifier<'a> {
     /// certificate computes is exactly 1 and the projections are skipped
     /// ([`Certifier::project`]).
     unit_weights: bool,
+    /// [`Certifier::max_margin`] and [`Certifier::output_resolution`], known on construction.
+    max_margin: f64,
+    output_resolution: f64,
     /// `4 eps max |P_i|` for curves whose weights are not powers of two (the control points are
     /// recovered from `w P` by one division, within two ulps), else 0.
     representation: f64,
@@ -140,6 +143,9 @@ fn exact_diff(a: f64, b: f64) -> (f64, bool) {
 impl<'a> Certifier<'a> {
     /// Prepares `curve` for certification.
     pub fn new(curve: &'a NurbsCurve) -> Self {
+        let hom = curve.homogeneous_points();
+        // The control points as the file gives them: (w P) / w, the curve's own projection.
+        let point = |c: &Vector4<f64>| kerf_nurbs::project(c).coords;
         let (lo, hi) = curve.bounding_box();
         let extent = (hi - lo).amax();
         let centre = (lo.coords + hi.coords) * 0.5;
@@ -152,48 +158,55 @@ impl<'a> Certifier<'a> {
         if !origin.iter().all(|c| c.is_finite()) {
             origin = Vector3::zeros();
         }
-        let points = curve.control_points();
-        let weights = curve.weights();
-        let mut shifted = Vec::with_capacity(points.len());
-        let mut exact = true;
-        for p in &points {
+        // One pass: the translated homogeneous points, whether every translation is exact,
+        // the largest coordinate, and the weights' kinds.
+        let mut cpw = Vec::with_capacity(hom.len());
+        // `|P_i - O|_inf` per control point.
+        let mut mags = Vec::with_capacity(hom.len());
+        let (mut exact, mut scale) = (true, 0.0f64);
+        let (mut powers_of_two, mut unit_weights) = (true, true);
+        for c in hom {
+            let (p, w) = (point(c), c.w);
             let mut d = Vector3::zeros();
             for k in 0..3 {
                 let (v, ok) = exact_diff(p[k], origin[k]);
                 d[k] = v;
                 exact &= ok;
             }
-            shifted.push(d);
+            cpw.push(Vector4::new(d.x * w, d.y * w, d.z * w, w));
+            mags.push(d.amax());
+            scale = scale.max(p.amax());
+            powers_of_two &= is_power_of_two(w);
+            unit_weights &= w == 1.0;
         }
         if !exact {
             origin = Vector3::zeros();
-            shifted = points.iter().map(|p| p.coords).collect();
+            for ((q, m), c) in cpw.iter_mut().zip(&mut mags).zip(hom) {
+                let (p, w) = (point(c), c.w);
+                *q = Vector4::new(p.x * w, p.y * w, p.z * w, w);
+                *m = p.amax();
+            }
         }
-        let cpw: Vec<Vector4<f64>> = shifted
-            .iter()
-            .zip(&weights)
-            .map(|(d, &w)| Vector4::new(d.x * w, d.y * w, d.z * w, w))
-            .collect();
         let p = curve.degree();
+        let knots = curve.knots();
         let mut spans = vec![0.0; curve.len()];
-        for (i, _, _) in curve.spans() {
-            spans[i] = shifted[i - p..=i]
-                .iter()
-                .map(|d| d.amax())
-                .fold(0.0, f64::max);
+        for i in (p..curve.len()).filter(|&i| knots[i] < knots[i + 1]) {
+            spans[i] = mags[i - p..=i].iter().copied().fold(0.0, f64::max);
         }
-        let representation = if weights.iter().all(|&w| is_power_of_two(w)) {
+        let representation = if powers_of_two {
             0.0
         } else {
-            let scale = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
             4.0 * f64::EPSILON * scale
         };
-        let local = NurbsCurve::from_homogeneous_unchecked(p, curve.knots().to_vec(), cpw);
+        let local = NurbsCurve::from_homogeneous_unchecked(p, knots.to_vec(), cpw);
         let mut span_bezier = vec![Vector4::zeros(); curve.len() * (p + 1)];
-        for (i, a, b) in curve.spans() {
-            local.bezier_in_span_into(i, a, b, &mut span_bezier[i * (p + 1)..(i + 1) * (p + 1)]);
+        for i in (p..curve.len()).filter(|&i| knots[i] < knots[i + 1]) {
+            let out = &mut span_bezier[i * (p + 1)..(i + 1) * (p + 1)];
+            local.bezier_in_span_into(i, knots[i], knots[i + 1], out);
         }
         let (span_h3, span_bounds) = span_derivative_bounds(p, &span_bezier, &spans);
+        let worst = spans.iter().copied().fold(0.0, f64::max);
+        let f = MARGIN_FACTOR * (p + 1) as f64 * f64::EPSILON;
         Self {
             curve,
             local,
@@ -202,8 +215,10 @@ impl<'a> Certifier<'a> {
             span_bezier,
             span_h3,
             span_bounds,
-            unit_weights: weights.iter().all(|&w| w == 1.0),
+            unit_weights,
             representation,
+            max_margin: (2.0 * f + 8.0 * f64::EPSILON) * worst + representation,
+            output_resolution: 2.0 * f64::EPSILON * scale,
         }
     }
 
@@ -231,27 +246,14 @@ impl<'a> Certifier<'a> {
     /// (`docs/discretization.md`, Step 5). A tolerance not well above the margin cannot be
     /// certified.
     pub fn max_margin(&self) -> f64 {
-        let f = self.factor();
-        let worst = self
-            .curve
-            .spans()
-            .iter()
-            .map(|&(i, _, _)| self.spans[i])
-            .fold(0.0, f64::max);
-        (2.0 * f + 8.0 * f64::EPSILON) * worst + self.representation
+        self.max_margin
     }
 
     /// The resolution of the output: one ulp of the largest coordinate of the curve's control
     /// points. A cutting point is a rounded `f64`, so it is off the curve by up to about half
     /// of this per coordinate, and no chord error below it can be certified reliably.
     pub fn output_resolution(&self) -> f64 {
-        let scale = self
-            .curve
-            .control_points()
-            .iter()
-            .map(|p| p.coords.amax())
-            .fold(0.0, f64::max);
-        2.0 * f64::EPSILON * scale
+        self.output_resolution
     }
 
     /// Certifies the chord error of the curve on `[t0, t1]` against the chord `a b`; see

@@ -115,7 +115,8 @@ impl Taylor {
         let cj2 = (jj - jc * jc * inv).max(0.0) * x3 * x3;
         let k = (mj - mc * jc * inv).abs() * x2 * x3;
         let inv_n = 1.0 / n;
-        let cl = ((k + 0.0625 * cj2) * inv_n).min(cj2.sqrt());
+        let cl = (k + 0.0625 * cj2) * inv_n;
+        let cl = if cl * cl <= cj2 { cl } else { cj2.sqrt() };
         if cl <= n {
             return n + cl * cl * inv_n * (1.0 / 256.0);
         }

@@ -224,12 +224,20 @@ impl Certifier<'_> {
         };
         // The bound from `cl`, the coefficient of the term linear in x = |s - 1/2|:
         // |N_perp(u)| <= e_w + (1/4 - x^2) (4 n + cl x), divided by w(u) (whose variation is
-        // inside `cl`); the maximum over x in [0, 1/2] is in closed form. With `x`, where the
-        // bound peaks.
+        // inside `cl`); the maximum over x in [0, 1/2] is in closed form, and where
+        // `cl <= 2 n` the bound `n + cl^2 / (256 n)` of it (dropping `-cl x^3`, the rest is a
+        // parabola in x) is used instead, within 0.05 % of it and without a root. With `x`,
+        // where the bound peaks.
+        let inv_n = 1.0 / n;
         let bound = |cl: f64, lower: f64| -> Option<(Bound, f64)> {
-            let root = (64.0 * n * n + 3.0 * cl * cl).sqrt() + 8.0 * n;
-            let x = if root > 0.0 { cl / (2.0 * root) } else { 0.0 };
-            let phi = (0.25 - x * x) * (4.0 * n + cl * x);
+            let (phi, x) = if n > 0.0 && cl <= 2.0 * n {
+                let r = cl * inv_n;
+                (n + cl * r * (1.0 / 256.0), r * (1.0 / 32.0))
+            } else {
+                let root = (64.0 * n * n + 3.0 * cl * cl).sqrt() + 8.0 * n;
+                let x = if root > 0.0 { cl / (2.0 * root) } else { 0.0 };
+                ((0.25 - x * x) * (4.0 * n + cl * x), x)
+            };
             let upper = (phi * inv_wm + 2.0 * e * (1.0 + a2) + 4.0 * f64::EPSILON * sb.d1)
                 * (1.0 + 64.0 * f64::EPSILON)
                 + margin;
@@ -300,7 +308,6 @@ impl Certifier<'_> {
             let c = tn * sixth;
             let nm_t = (xm - dir * par).dot(&t) * wm * sixth;
             let k = (nm_t.abs() + (e_w + wm * margin) * c).min(n * c);
-            let inv_n = 1.0 / n;
             let beta = k * inv_n + delta * sixth;
             let gamma = 0.125 * c * c * inv_n;
             let beta2 = beta + 4.0 * n * a2;

@@ -1,12 +1,14 @@
 //! Cutting points on NURBS curves with a certified chord error.
 //!
-//! The reference-sphere method of paper 004 (Wang et al., Chinese J. Lasers 2010): from each
-//! cutting point, the osculating circle predicts the sphere radius whose chord has the target
-//! sagitta; the sphere centred at the point meets the curve at the candidate next point; the
-//! radius is then bisected until the chord error lies in the band `[E_min, E_max]`. kerf
-//! replaces the paper's `dL/dt = 0` error estimate by a *certified* upper bound (convex hull of
-//! the rational Bezier pieces, refined by subdivision), so every segment's chord error is
-//! proven `<= tolerance`. The proof is in `docs/discretization.md`.
+//! After the reference-sphere method of paper 004 (Wang et al., Chinese J. Lasers 2010), which
+//! predicts each chord from the osculating circle, intersects the sphere of that radius with
+//! the curve and bisects the radius until the chord error lies in the band `[E_min, E_max]`:
+//! kerf predicts the parameter step from the arc's Taylor cubic at the point, certifies it, and
+//! corrects it from the certificate's own numbers, usually at once. The paper's `dL/dt = 0`
+//! error estimate is replaced by a *certified* upper bound (a closed-form interpolation bound
+//! inside a knot span, else the convex hull of the rational Bezier pieces refined by
+//! subdivision), so every segment's chord error is proven `<= tolerance`. The proof is in
+//! `docs/discretization.md`.
 //!
 //! ```
 //! use kerf_discretize::{discretize, Options};

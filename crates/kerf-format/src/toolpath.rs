@@ -258,7 +258,7 @@ pub fn write(file: &ToolpathFile, dest: impl AsRef<Path>) -> Result<()> {
     write_with(dest, file.units, file.tolerance, |w| write_paths(file, w))
 }
 
-/// Writes a document of the given units and tolerance to `dest` atomically, as [`write`], with
+/// Writes a document of the given units and tolerance to `dest` atomically, as [`write()`], with
 /// the paths `paths` hands to the [`ToolpathWriter`] one by one: a caller that produces paths
 /// one after the other (the discretizer) writes them as they come and never holds the whole
 /// document. If `paths` fails, or a path breaks a rule of the format, `dest` is untouched and

@@ -35,7 +35,7 @@ pub(crate) enum Command {
 
     /// Cutting points with a certified chord error for every curve, as kerf.toolpath/1.
     ///
-    /// Places cutting points by the reference-sphere method (paper 004) so that every
+    /// Places cutting points after the reference-sphere method (paper 004) so that every
     /// segment's chord error is proven <= the tolerance and every C0 corner is a cutting point.
     /// Prints a summary to standard error: curves, points, worst certified chord error, the
     /// theoretical minimum N* and the time.
@@ -213,7 +213,8 @@ pub(crate) struct DiscretizeArgs {
 /// `--strategy` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum StrategyArg {
-    /// The reference-sphere method of paper 004 (default).
+    /// After the reference-sphere method of paper 004: the step from the arc's Taylor model,
+    /// certified (default).
     ReferenceSphere,
     /// Longest certified step by bisection on the parameter.
     EqualError,

@@ -6,11 +6,13 @@ use std::time::Instant;
 
 use kerf_discretize::{Discretization, Options};
 use kerf_format::toolpath;
+use kerf_format::CurvesFile;
 use kerf_normals::NormalOptions;
 use kerf_pipeline::{
-    discretize_curves, orient_curves, toolpath_of_points, toolpath_of_poses, MissingSurface,
-    OrientOptions,
+    discretize_curves, orient_curves, toolpath_of_poses, MissingSurface, OrientOptions, Progress,
+    Stage,
 };
+use rayon::prelude::*;
 use serde_json::json;
 
 use crate::cli::DiscretizeArgs;
@@ -54,6 +56,74 @@ fn orient_options(args: &DiscretizeArgs) -> OrientOptions {
     }
 }
 
+/// What the summary reports, summed over the curves as they are written.
+#[derive(Debug, Default)]
+struct Totals {
+    points: usize,
+    segments: usize,
+    worst: f64,
+    n_star: f64,
+    breaks: usize,
+}
+
+impl Totals {
+    fn add(&mut self, d: &Discretization, tolerance: f64) {
+        self.points += d.points().len();
+        self.segments += d.segments();
+        self.worst = self.worst.max(d.max_chord_error());
+        // N* (a diagnostic) comes from the curvature the walk evaluated at its points (no
+        // quadrature of its own; `Discretization::n_star`).
+        self.n_star += d.n_star(tolerance);
+        self.breaks += d.c0_breaks().len();
+    }
+}
+
+/// Curves discretized together (in parallel) and then written, group after group, so that the
+/// points of a large file are never all in memory: the process holds the input and one group's
+/// output, and the output goes to the file as it comes.
+const GROUP: usize = 256;
+
+/// Discretizes every curve and writes its cutting points to `dest` as they come (positions
+/// only), in input order; on any failure `dest` is untouched (`toolpath::write_with`).
+fn discretize_to_file(
+    file: &CurvesFile,
+    input: &Path,
+    opts: &Options,
+    dest: &Path,
+    bar: &ProgressBar,
+) -> Result<Totals, CliError> {
+    opts.validate().map_err(kerf_pipeline::Error::Options)?;
+    let total = file.curves.len();
+    let mut totals = Totals::default();
+    bar.update(Progress::new(Stage::Discretize, 0, total));
+    toolpath::write_with(dest, file.units, opts.tolerance_mm, |w| {
+        for (g, group) in file.curves.chunks(GROUP).enumerate() {
+            let discs: Vec<_> = group
+                .par_iter()
+                .map(|r| kerf_discretize::discretize(&r.curve, opts))
+                .collect();
+            for (k, (rec, d)) in group.iter().zip(discs).enumerate() {
+                let d = d.map_err(|source| kerf_pipeline::Error::Discretize {
+                    file: Some(input.to_path_buf()),
+                    index: g * GROUP + k,
+                    id: rec.id.clone(),
+                    source,
+                })?;
+                w.path(&rec.id, d.params(), d.points(), d.max_chord_error())
+                    .map_err(|e| e.in_file(dest))?;
+                totals.add(&d, opts.tolerance_mm);
+            }
+            bar.update(Progress::new(
+                Stage::Discretize,
+                (g * GROUP + group.len()).min(total),
+                total,
+            ));
+        }
+        Ok::<(), CliError>(())
+    })?;
+    Ok(totals)
+}
+
 /// Runs `kerf discretize`.
 pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
     let start = Instant::now();
@@ -63,35 +133,40 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
     let file = load_curves(path)?;
     let opts = options(args);
     let bar = ProgressBar::new(file.curves.len());
-    let progress = |p| bar.update(p);
-    let results = discretize_curves(&file, &opts, Some(path), &progress);
-    bar.finish();
-    let results = results?;
-    let oriented = if args.normals {
-        Some(orient_curves(
+    let (totals, oriented) = if args.normals {
+        let progress = |p| bar.update(p);
+        let results = discretize_curves(&file, &opts, Some(path), &progress);
+        bar.finish();
+        let results = results?;
+        let oriented = orient_curves(
             &file,
             &results,
             &opts,
             &orient_options(args),
             Some(path),
             &|_| {},
-        )?)
+        )?;
+        let out = toolpath_of_poses(&file, opts.tolerance_mm, &oriented);
+        // `-` is standard output; kerf_io also writes devices and FIFOs through.
+        toolpath::write(&out, &dest)?;
+        let mut totals = Totals::default();
+        for d in &results {
+            totals.add(d, opts.tolerance_mm);
+        }
+        totals.points = out.paths.iter().map(|p| p.params.len()).sum();
+        (totals, Some(oriented))
     } else {
-        None
+        let totals = discretize_to_file(&file, path, &opts, &dest, &bar);
+        bar.finish();
+        (totals?, None)
     };
-    let out = match &oriented {
-        None => toolpath_of_points(&file, opts.tolerance_mm, &results),
-        Some(o) => toolpath_of_poses(&file, opts.tolerance_mm, o),
-    };
-    // `-` is standard output; kerf_io also writes devices and FIFOs through.
-    toolpath::write(&out, &dest)?;
-    let segments: usize = results.iter().map(Discretization::segments).sum();
-    let points: usize = out.paths.iter().map(|p| p.params.len()).sum();
-    let worst = out
-        .paths
-        .iter()
-        .map(|p| p.max_chord_error)
-        .fold(0.0, f64::max);
+    let Totals {
+        points,
+        segments,
+        worst,
+        n_star: nstar,
+        breaks,
+    } = totals;
     let (added, surface_dist, jumps) = oriented.as_ref().map_or((0, 0.0, 0), |o| {
         (
             o.iter().map(|o| o.inserted).sum::<usize>(),
@@ -99,11 +174,7 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             o.iter().map(|o| o.jumps.len()).sum::<usize>(),
         )
     });
-    // N* (a diagnostic) comes from the curvature the walk evaluated at its points (no
-    // quadrature of its own; `Discretization::n_star`).
-    let nstar: f64 = results.iter().map(|d| d.n_star(opts.tolerance_mm)).sum();
     let elapsed = start.elapsed().as_secs_f64();
-    let breaks: usize = results.iter().map(|d| d.c0_breaks().len()).sum();
     if args.json {
         let summary = json!({
             "file": path.display().to_string(),

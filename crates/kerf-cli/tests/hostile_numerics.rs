@@ -67,6 +67,40 @@ fn too_many_points_names_the_option() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// `kerf discretize` writes each curve's points as they come (it never holds the whole output):
+/// a curve that fails after others were written must still leave no output and no temporary
+/// file, and an existing output untouched.
+#[test]
+fn a_curve_failing_midway_leaves_the_output_as_it_was() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("out.json");
+    std::fs::write(&out, "old").expect("write");
+    // mixed.json at 0.01 mm: 53, 2, 81 and 55 points; 60 refuses the third curve only.
+    let o = kerf(&[
+        "discretize",
+        path(&fixture("mixed.json")),
+        "-t",
+        "0.01",
+        "--max-points",
+        "60",
+        "-o",
+        path(&out),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "bad input");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("curves[2]"), "names the third curve: {err}");
+    assert_eq!(
+        std::fs::read_to_string(&out).expect("read"),
+        "old",
+        "untouched"
+    );
+    assert_eq!(
+        std::fs::read_dir(dir.path()).expect("list").count(),
+        1,
+        "no temporary file left"
+    );
+}
+
 #[test]
 fn tiny_knots_and_subnormal_weights_are_cut_like_the_circle() {
     let dir = tempfile::tempdir().expect("tempdir");

@@ -7,7 +7,7 @@ use nalgebra::Point3;
 use crate::bound::{Certifier, Scratch};
 use crate::error::{DiscretizeError, Result};
 use crate::options::Options;
-use crate::sphere::{first_crossing, End, Start};
+use crate::sphere::first_crossing;
 use crate::Discretization;
 
 /// Points of one trial: parameters, points, worst upper bound and worst lower bound.
@@ -207,14 +207,7 @@ pub(crate) fn equal_chord(
                 if count > 4 * n + 8 {
                     return None;
                 }
-                let start = Start {
-                    t: t0,
-                    d: 0.0,
-                    speed: None,
-                    derivs: None,
-                };
-                let end = End::PieceEnd { t: b, p: pb };
-                let hit = first_crossing(cert, &p0, r, start, end, 8.0 * dt);
+                let hit = first_crossing(cert, &p0, r, t0, (b, pb), 8.0 * dt);
                 if hit.t <= t0 {
                     return None;
                 }

@@ -1,12 +1,14 @@
 //! Cutting points on NURBS curves with a certified chord error.
 //!
-//! The reference-sphere method of paper 004 (Wang et al., Chinese J. Lasers 2010): from each
-//! cutting point, the osculating circle predicts the sphere radius whose chord has the target
-//! sagitta; the sphere centred at the point meets the curve at the candidate next point; the
-//! radius is then bisected until the chord error lies in the band `[E_min, E_max]`. kerf
-//! replaces the paper's `dL/dt = 0` error estimate by a *certified* upper bound (convex hull of
-//! the rational Bezier pieces, refined by subdivision), so every segment's chord error is
-//! proven `<= tolerance`. The proof is in `docs/discretization.md`.
+//! After the reference-sphere method of paper 004 (Wang et al., Chinese J. Lasers 2010), which
+//! predicts each chord from the osculating circle, intersects the sphere of that radius with
+//! the curve and bisects the radius until the chord error lies in the band `[E_min, E_max]`:
+//! kerf predicts the parameter step from the arc's Taylor cubic at the point, certifies it, and
+//! corrects it from the certificate's own numbers, usually at once. The paper's `dL/dt = 0`
+//! error estimate is replaced by a *certified* upper bound (a closed-form interpolation bound
+//! inside a knot span, else the convex hull of the rational Bezier pieces refined by
+//! subdivision), so every segment's chord error is proven `<= tolerance`. The proof is in
+//! `docs/discretization.md`.
 //!
 //! ```
 //! use kerf_discretize::{discretize, Options};
@@ -45,7 +47,7 @@ pub use minimum::{
 pub use options::{Options, Strategy};
 
 use kerf_nurbs::NurbsCurve;
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 /// The cutting points of one curve, with the certificate of their chord error.
@@ -270,11 +272,15 @@ impl Discretization {
         let mut points = self.points.clone();
         params.insert(i, t);
         points.insert(i, p);
-        let value = |u: f64| sqrt_curvature_speed(&curve.eval_d3(u));
+        let value = |u: f64| {
+            let d = curve.eval_d3(u);
+            Scaled::new(&d[1], &d[2], &d[3]).sqrt_curvature_speed()
+        };
         let (v0, v, v1) = (value(t0), value(t), value(t1));
-        let sqrt_curvature = self.sqrt_curvature - trapezoid_step(curve, t0, t1, v0, v1)
-            + trapezoid_step(curve, t0, t, v0, v)
-            + trapezoid_step(curve, t, t1, v, v1);
+        let at = |u: f64| (u, curve.span(u));
+        let sqrt_curvature = self.sqrt_curvature - trapezoid_step(curve, at(t0), at(t1), v0, v1)
+            + trapezoid_step(curve, at(t0), at(t), v0, v)
+            + trapezoid_step(curve, at(t), at(t1), v, v1);
         let new_lower = left.lower.max(right.lower);
         Ok(Self {
             params,
@@ -287,27 +293,49 @@ impl Discretization {
     }
 }
 
-/// `f = sqrt(k) |C'|` and its derivative `df/dt` from the first three derivatives. With
-/// `a = C' x C''` and `s = |C'|`: `f = (|a| / s)^(1/2)` and
-/// `df/dt = (a . (C' x C''')) / (2 |a|^(3/2) s^(1/2)) - f (C' . C'') / (2 s^2)`.
-/// `f` is 0 where it is not finite (a removable or integrable singularity of the integrand);
-/// `df/dt` is NaN where it is not finite (`k = 0`, where `sqrt(k)` has no derivative).
-#[inline]
-pub(crate) fn sqrt_curvature_speed(d: &[nalgebra::Vector3<f64>; 4]) -> (f64, f64) {
-    let s = d[1].norm();
-    // Scaled by the speed first, as `curvature_of`: tiny parameter ranges (knots scaled by
-    // 1e-50) give `|C'| ~ 1e52`, `|C''| ~ 1e104`, and `C' x C''` would overflow. With
-    // `u_i = C^(i) / s`, `b = u1 x u2`, `c = u1 x u3`: `f = sqrt(|b| s)` and
-    // `df/dt = s^(1/2) (b . c) / (2 |b|^(3/2)) - f (u1 . u2) / 2`.
-    let inv = 1.0 / s;
-    let (u1, u2, u3) = (d[1] * inv, d[2] * inv, d[3] * inv);
-    let b = u1.cross(&u2);
-    let bn = b.norm();
-    let f = (bn * s).sqrt();
-    let df = s.sqrt() * b.dot(&u1.cross(&u3)) / (2.0 * bn * bn.sqrt()) - 0.5 * f * u1.dot(&u2);
-    let f = if f.is_finite() { f } else { 0.0 };
-    let df = if df.is_finite() { df } else { f64::NAN };
-    (f, df)
+/// The first three derivatives at a point, scaled to a parameter that moves about as fast as
+/// the arc length: with `s = |C'|`, `v = C' / s`, `a = C'' / s^2`, `j = C''' / s^3` (the
+/// derivatives with respect to `x = s (t - t0)`). Whatever the scale of the knots (a range of
+/// `1e-50` gives `|C'| ~ 1e52`, `|C''| ~ 1e104`, and `C' x C''` would overflow), these are of the
+/// size of the geometry: the step model and `N*` work on them.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Scaled {
+    pub s: f64,
+    pub v: Vector3<f64>,
+    pub a: Vector3<f64>,
+    pub j: Vector3<f64>,
+}
+
+impl Scaled {
+    /// From the first three derivatives with respect to the curve's parameter.
+    #[inline]
+    pub(crate) fn new(d1: &Vector3<f64>, d2: &Vector3<f64>, d3: &Vector3<f64>) -> Self {
+        let s = d1.norm();
+        let inv = 1.0 / s;
+        Self {
+            s,
+            v: d1 * inv,
+            a: d2 * inv * inv,
+            j: d3 * inv * inv * inv,
+        }
+    }
+
+    /// `f = sqrt(k) |C'|` and its derivative `df/dt`. The curvature is `k = |v x a|`, so
+    /// `f = s sqrt(|b|)` with `b = v x a`, and (`db/dx = v x j` up to terms along `b`'s own
+    /// scaling) `df/dt = (f s / 2) ((b . c) / |b|^2 - v . a)` with `c = v x j`.
+    /// `f` is 0 where it is not finite (a removable or integrable singularity of the
+    /// integrand); `df/dt` is NaN where it is not finite (`k = 0`, where `sqrt(k)` has no
+    /// derivative).
+    #[inline]
+    pub(crate) fn sqrt_curvature_speed(&self) -> (f64, f64) {
+        let b = self.v.cross(&self.a);
+        let bb = b.norm_squared();
+        let f = bb.sqrt().sqrt() * self.s;
+        let df = 0.5 * f * self.s * (b.dot(&self.v.cross(&self.j)) / bb - self.v.dot(&self.a));
+        let f = if f.is_finite() { f } else { 0.0 };
+        let df = if df.is_finite() { df } else { f64::NAN };
+        (f, df)
+    }
 }
 
 /// The corrected trapezoid rule for `integral sqrt(k) |C'| dt` on the nodes `params` (one
@@ -316,9 +344,10 @@ fn trapezoid_sqrt_curvature(curve: &NurbsCurve, params: &[f64]) -> f64 {
     let mut sum = 0.0;
     let mut prev = None;
     for &t in params {
-        let v = sqrt_curvature_speed(&curve.eval_d3(t));
+        let d = curve.eval_d3(t);
+        let v = Scaled::new(&d[1], &d[2], &d[3]).sqrt_curvature_speed();
         if let Some((tp, vp)) = prev {
-            sum += trapezoid_step(curve, tp, t, vp, v);
+            sum += trapezoid_step(curve, (tp, curve.span(tp)), (t, curve.span(t)), vp, v);
         }
         prev = Some((t, v));
     }
@@ -333,16 +362,16 @@ fn trapezoid_sqrt_curvature(curve: &NurbsCurve, params: &[f64]) -> f64 {
 /// curvature may jump at a knot (degree 2, or repeated knots), so a step that crosses knots
 /// uses each end's value up to the nearest knot on its side (and the mean in between): the
 /// error is then of the order of the integrand's variation within a span, not of its jump.
+/// `span` and `span1` are the knot spans of `t0` and `t1` (`NurbsCurve::span`).
 #[inline]
 pub(crate) fn trapezoid_step(
     curve: &NurbsCurve,
-    t0: f64,
-    t1: f64,
+    (t0, span): (f64, usize),
+    (t1, span1): (f64, usize),
     (f0, g0): (f64, f64),
     (f1, g1): (f64, f64),
 ) -> f64 {
     let knots = curve.knots();
-    let span = curve.span(t0);
     let first = knots[span + 1];
     if first >= t1 || span + 1 >= curve.len() {
         let h = t1 - t0;
@@ -354,7 +383,7 @@ pub(crate) fn trapezoid_step(
             plain
         };
     }
-    let last = knots[curve.span(t1)].max(first);
+    let last = knots[span1].max(first);
     if last >= t1 {
         return f0 * (first - t0) + f1 * (t1 - first);
     }
@@ -446,7 +475,7 @@ pub fn discretize_range(
             margin,
         });
     }
-    let estimate = estimate_count(curve, opts.tolerance_mm);
+    let estimate = minimum::estimate_count_with(curve, opts.tolerance_mm, |t| cert.eval_d2(t));
     let by_length = if opts.max_segment_length_mm.is_finite() {
         curve.size() / opts.max_segment_length_mm
     } else {

@@ -8,6 +8,7 @@
 use kerf_nurbs::curvature_of;
 use kerf_nurbs::integrate;
 use kerf_nurbs::{NurbsCurve, Quadrature};
+use nalgebra::Vector3;
 
 fn integrand(curve: &NurbsCurve, t: f64) -> f64 {
     let (_, d1, d2) = curve.eval_d2(t);
@@ -120,13 +121,36 @@ pub fn estimate_turning(curve: &NurbsCurve) -> f64 {
 /// magnitude; a finer rule would cost more evaluations than the walk itself at coarse
 /// tolerances.
 pub fn estimate_count(curve: &NurbsCurve, tol: f64) -> f64 {
+    estimate_count_with(curve, tol, |t| {
+        let (_, d1, d2) = curve.eval_d2(t);
+        (d1, d2)
+    })
+}
+
+/// [`estimate_count`] with the first two derivatives from `d12` (the discretizer passes its
+/// span-local evaluator, several times cheaper than the basis functions).
+pub(crate) fn estimate_count_with(
+    curve: &NurbsCurve,
+    tol: f64,
+    d12: impl Fn(f64) -> (Vector3<f64>, Vector3<f64>),
+) -> f64 {
     let x = 1.0 / 3f64.sqrt();
-    curve
-        .spans()
-        .iter()
-        .map(|&(_, a, b)| {
+    let f = |t: f64| {
+        let (d1, d2) = d12(t);
+        let v = curvature_of(&d1, &d2).sqrt() * d1.norm();
+        if v.is_finite() {
+            v
+        } else {
+            0.0
+        }
+    };
+    let knots = curve.knots();
+    (curve.degree()..curve.len())
+        .filter(|&i| knots[i] < knots[i + 1])
+        .map(|i| {
+            let (a, b) = (knots[i], knots[i + 1]);
             let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
-            h * (integrand(curve, m - h * x) + integrand(curve, m + h * x))
+            h * (f(m - h * x) + f(m + h * x))
         })
         .sum::<f64>()
         / (8.0 * tol).sqrt()

@@ -5,7 +5,9 @@ use crate::error::{DiscretizeError, Result};
 /// How cutting points are placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Strategy {
-    /// The reference-sphere method of paper 004, with a certified chord error (the default).
+    /// After the reference-sphere method of paper 004, with a certified chord error (the
+    /// default): the step predicted from the arc's Taylor cubic, certified, corrected by the
+    /// certificate's numbers (`docs/discretization.md`, "The walk").
     #[default]
     ReferenceSphere,
     /// Classic: the same number of equal parameter steps on every C0 piece, the smallest

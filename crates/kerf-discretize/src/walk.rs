@@ -1,29 +1,191 @@
-//! The reference-sphere walk of paper 004 (and the parameter-bisection walk of the classic
-//! "equal error" method), with every accepted segment certified by [`crate::bound`].
+//! The walk of the default strategy (paper 004's reference sphere, its radius and crossing
+//! predicted from the arc's Taylor expansion) and the parameter-bisection walk of the classic
+//! "equal error" method, with every accepted segment certified by [`crate::bound`].
 
-use kerf_nurbs::curvature_of;
 use kerf_nurbs::NurbsCurve;
 use nalgebra::Point3;
 
-use crate::bound::{Bound, Certifier, Scratch};
+use crate::bound::{by_degree, Bound, Certifier, Eval, Question, Scratch};
 use crate::error::{DiscretizeError, Result};
 use crate::options::Options;
-use crate::sphere::{first_crossing, End, Hit, Start};
-use crate::Discretization;
+use crate::{Discretization, Scaled};
 
-/// Iterations of the radius search per cutting point before giving up.
+/// Trials per cutting point before giving up.
 const MAX_ITERS: usize = 80;
-/// Consecutive failures with no good radius after which the search bisects the parameter
+/// Consecutive failures with no good step after which the search bisects the parameter
 /// instead (guaranteed progress on pathological curves).
 const PARAM_FALLBACK_AFTER: usize = 10;
-/// The radius search stops when the bracket is this narrow (relative).
+/// The search between a good and a bad step stops when they are this close (relative).
 const BRACKET_TOL: f64 = 2e-3;
+/// A good step whose chord is within this fraction of `max_segment_length_mm` is accepted:
+/// a longer one is refused, so the step cannot do better.
+const LENGTH_TOL: f64 = 2e-3;
 
+/// Why a trial failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Fail {
+    /// The chord error cannot be certified.
+    Chord,
+    /// The chord is longer than `max_segment_length_mm`.
+    Length,
+    /// The tangent turns more than `max_turn_rad`.
+    Turn,
+}
+
+/// One trial: the step `h` in the parameter, the chord's length, the end's evaluation (for
+/// the next step if accepted), the certificate and why it failed, if it did.
 #[derive(Debug, Clone, Copy)]
 struct Cand {
+    t: f64,
+    h: f64,
+    /// What the search steers on: the certified upper bound (the lower bound where the
+    /// upper is not finite).
+    err: f64,
     r: f64,
-    hit: Hit,
+    end: Option<Eval>,
+    p: Point3<f64>,
     bound: Bound,
+    fail: Option<Fail>,
+}
+
+/// The arc's Taylor expansion at a cutting point, `C(t0 + h) - C(t0) = v x + a x^2 / 2 +
+/// j x^3 / 6 + O(x^4)` in the scaled step `x = s h` ([`Scaled`]: the model does not depend on
+/// the knots' scale), kept as `s` and the six dot products of `v`, `a`, `j` (every quantity of
+/// the model is a polynomial in the step over them). Its chord error for a step is the
+/// interpolation certificate's closed form on the model (see [`Taylor::error`]); it is accurate
+/// to a relative `O(h^2)`, where the osculating circle's (paper 004's radius) is only `O(h)`.
+#[derive(Debug, Clone, Copy)]
+struct Taylor {
+    s: f64,
+    vv: f64,
+    va: f64,
+    vj: f64,
+    aa: f64,
+    aj: f64,
+    jj: f64,
+}
+
+impl Taylor {
+    fn new(d: &Scaled) -> Self {
+        let (v, a, j) = (&d.v, &d.a, &d.j);
+        Self {
+            s: d.s,
+            vv: v.dot(v),
+            va: v.dot(a),
+            vj: v.dot(j),
+            aa: a.dot(a),
+            aj: a.dot(j),
+            jj: j.dot(j),
+        }
+    }
+
+    /// The model's chord error for the step `h`: the interpolation certificate's closed form
+    /// on the model (a cubic, whose third derivative is known exactly),
+    /// `max_x (1/4 - x^2) (4 n + cl x)` with `n` the middle point's distance from the chord and
+    /// `cl` from the cubic term across the chord, so that the model predicts the certified
+    /// bound the step will get, not only its middle point's distance (the error of a step
+    /// dominated by its cubic term peaks off the middle). With `c = v + a x / 2 + j x^2 / 6`
+    /// the chord over `x` and `m = a / 8 + j x / 16` the middle point's offset from the chord's
+    /// middle over `x^2`, the parts across the chord are `|m|^2 - (m.c)^2 / |c|^2` and so on.
+    /// Where `cl <= n` the maximum is `n + cl^2 / (256 n)` to a relative `3e-5`.
+    #[inline]
+    fn error(&self, h: f64) -> f64 {
+        const THIRD: f64 = 1.0 / 3.0;
+        const SIXTH: f64 = 1.0 / 6.0;
+        let Self {
+            vv,
+            va,
+            vj,
+            aa,
+            aj,
+            jj,
+            ..
+        } = *self;
+        let x = h * self.s;
+        let cc = vv + x * (va + x * (0.25 * aa + THIRD * vj + x * (SIXTH * aj + x * jj / 36.0)));
+        let mc = 0.125 * va + x * (0.0625 * (aa + vj) + x * (aj * (5.0 / 96.0) + x * jj / 96.0));
+        let jc = vj + x * (0.5 * aj + SIXTH * x * jj);
+        let mm = aa / 64.0 + x * (aj / 64.0 + x * jj / 256.0);
+        let mj = 0.125 * aj + 0.0625 * x * jj;
+        let inv = 1.0 / cc;
+        let x2 = x * x;
+        let x3 = SIXTH * x2 * x;
+        // |d|, |j_perp| x^3 / 6 and |d . j_perp| x^3 / 6, d the offset across the chord.
+        let n = (mm - mc * mc * inv).max(0.0).sqrt() * x2;
+        let cj2 = (jj - jc * jc * inv).max(0.0) * x3 * x3;
+        let k = (mj - mc * jc * inv).abs() * x2 * x3;
+        let inv_n = 1.0 / n;
+        let cl = (k + 0.0625 * cj2) * inv_n;
+        let cl = if cl * cl <= cj2 { cl } else { cj2.sqrt() };
+        if cl <= n {
+            return n + cl * cl * inv_n * (1.0 / 256.0);
+        }
+        let root = (64.0 * n * n + 3.0 * cl * cl).sqrt() + 8.0 * n;
+        let x = if root > 0.0 { cl / (2.0 * root) } else { 0.0 };
+        (0.25 - x * x) * (4.0 * n + cl * x)
+    }
+
+    /// The model's chord length for the step `h`.
+    #[inline]
+    fn length(&self, h: f64) -> f64 {
+        let x = h * self.s;
+        let cc = self.vv
+            + x * (self.va
+                + x * (0.25 * self.aa + self.vj / 3.0 + x * (self.aj / 6.0 + x * self.jj / 36.0)));
+        cc.max(0.0).sqrt() * x
+    }
+
+    /// The step whose model error is `target`, from `guess` (the last step, which had about
+    /// the target error on a curve whose geometry changes slowly) by one fixed-point step
+    /// `h <- h sqrt(target / e(h))` (the error grows like `h^2`, so the step leaves only the
+    /// relative variation of `e / h^2` over the correction); without a guess, from the
+    /// circle's estimate (the cubic term's where that dominates, at an inflection) by two.
+    /// Infinite where the model has no error (straight).
+    fn step_for(&self, target: f64, guess: f64) -> f64 {
+        let (mut h, iterations) = if guess > 0.0 && guess.is_finite() {
+            (guess, 1)
+        } else {
+            // |v x a| / |v| and |v x j| / |v|: the curvature's and the cubic term's scales.
+            let ka = ((self.aa - self.va * self.va / self.vv).max(0.0)).sqrt();
+            let mut x = (8.0 * target / ka).sqrt();
+            // The cubic term alone would reach the target at x = cbrt(16 target / kj): only
+            // where that is shorter (kj x^3 / 16 > target) does it matter.
+            let kj = ((self.jj - self.vj * self.vj / self.vv).max(0.0)).sqrt();
+            let cubic = kj * x * x * x;
+            if cubic.is_nan() || cubic > 16.0 * target {
+                let xj = (16.0 * target / kj).cbrt();
+                if xj < x || !x.is_finite() {
+                    x = xj;
+                }
+            }
+            let h = x / self.s;
+            if !(h.is_finite() && h > 0.0) {
+                return f64::INFINITY;
+            }
+            (h, 2)
+        };
+        for _ in 0..iterations {
+            let e = self.error(h);
+            if !(e.is_finite() && e > 0.0) {
+                break;
+            }
+            h *= (target / e).sqrt();
+        }
+        h
+    }
+
+    /// The step whose model chord is `length` (two fixed-point steps from `h`; the chord is
+    /// nearly proportional to the step).
+    fn step_for_length(&self, mut h: f64, length: f64) -> f64 {
+        for _ in 0..2 {
+            let l = self.length(h);
+            if !(l > 0.0 && l.is_finite()) {
+                break;
+            }
+            h *= length / l;
+        }
+        h
+    }
 }
 
 /// Walks one C0 piece `[a, b]`; `out` already holds the point at `a`.
@@ -31,7 +193,8 @@ pub(crate) struct Walker<'a> {
     pub curve: &'a NurbsCurve,
     pub opts: &'a Options,
     pub scratch: Scratch,
-    /// Start in parameter-bisection mode (the classic "equal error" method).
+    /// Bisect the parameter from the last step (the classic "equal error" method) instead of
+    /// predicting the step from the Taylor model.
     pub param_only: bool,
     /// The curve prepared for certification.
     pub cert: Certifier<'a>,
@@ -39,46 +202,64 @@ pub(crate) struct Walker<'a> {
     /// reachable when the rounding margin is a visible part of the tolerance.
     pub emin: f64,
     /// `integral sqrt(k) |C'| dt` so far, by the trapezoid rule on the cutting points (the
-    /// curvature at each point is evaluated anyway, to predict the step): `N*` for free.
+    /// derivatives at each point are evaluated anyway, to predict the step): `N*` for free.
     pub sqrt_curvature: f64,
 }
 
-/// Why the last trial of a point failed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Fail {
-    Chord,
-    Turn,
-}
-
 impl Walker<'_> {
-    fn certify(&mut self, t0: f64, p0: &Point3<f64>, hit: &Hit) -> (Bound, Option<Fail>) {
+    /// Discretizes `[a, b]`, appending every cutting point after `a` (the last one is `b`).
+    pub(crate) fn piece(
+        &mut self,
+        a: f64,
+        b: f64,
+        pb: Point3<f64>,
+        out: &mut Discretization,
+    ) -> Result<()> {
+        macro_rules! go {
+            ($p:literal, $m:expr) => {
+                self.piece_of::<$p, $m>(a, b, pb, out)
+            };
+        }
+        by_degree!(self.curve.degree(), go)
+    }
+
+    /// Certifies the segment from `start` to the trial end `(t1, p1, end)`.
+    #[inline]
+    fn certify<const P: usize, const M: usize>(
+        &mut self,
+        start: &Eval,
+        t1: f64,
+        p1: &Point3<f64>,
+        end: Option<&Eval>,
+    ) -> (Bound, Option<Fail>) {
         let tol = self.opts.tolerance_mm;
-        let bound = self.cert.chord_error_hinted(
+        let bound = self.cert.chord_error_known::<P, M>(
             &mut self.scratch,
-            t0,
-            hit.t,
-            p0,
-            &hit.p,
-            hit.h,
-            tol,
-            self.emin,
+            (start.t, Some((start.span, start.h))),
+            (t1, end.map(|e| (e.span, e.h))),
+            &start.p,
+            p1,
+            Question {
+                limit: tol,
+                want_lower: self.emin,
+                settle: true,
+            },
         );
         if bound.upper > tol {
             return (bound, Some(Fail::Chord));
         }
-        if (hit.p - p0).norm() > self.opts.max_segment_length_mm {
-            return (bound, Some(Fail::Chord));
+        if (p1 - start.p).norm() > self.opts.max_segment_length_mm {
+            return (bound, Some(Fail::Length));
         }
         if self.opts.max_turn_rad.is_finite()
-            && self.cert.turn_bound(t0, hit.t, self.opts.max_turn_rad) > self.opts.max_turn_rad
+            && self.cert.turn_bound(start.t, t1, self.opts.max_turn_rad) > self.opts.max_turn_rad
         {
             return (bound, Some(Fail::Turn));
         }
         (bound, None)
     }
 
-    /// Discretizes `[a, b]`, appending every cutting point after `a` (the last one is `b`).
-    pub(crate) fn piece(
+    fn piece_of<const P: usize, const M: usize>(
         &mut self,
         a: f64,
         b: f64,
@@ -90,184 +271,186 @@ impl Walker<'_> {
         let hp = 0.5 * (emin + tol);
         let max_len = self.opts.max_segment_length_mm;
         let min_len = self.opts.min_segment_length_mm;
-        let mut t0 = a;
-        let mut p0 = *out.points.last().expect("start point pushed");
-        // Ratio of the accepted radius to the curvature prediction at the previous point: the
-        // walk learns the systematic error of the osculating-circle model (warm start).
+        let mut cur = self
+            .cert
+            .eval::<P, M, 3>(self.cert.span_at(a, self.curve.degree()), a);
+        cur.p = *out.points.last().expect("start point pushed");
+        // The ratio of the measured chord error to the model's at the last accepted step: the
+        // model's systematic error (the next terms of the expansion) changes slowly along the
+        // curve, so the next prediction is corrected by it (warm start).
         let mut bias = 1.0f64;
+        // Whether the last step was a full one (neither the piece's first nor cut short), so
+        // that it is a good first guess of the next.
+        let mut warm = false;
         let mut last_dt = (b - a) / 8.0;
-        // sqrt(k) |C'| at the previous cutting point.
-        let mut prev_f = None;
-        while t0 < b {
-            let d = self.cert.eval_d3(t0);
-            let (d1, d2) = (d[1], d[2]);
-            let k = curvature_of(&d1, &d2);
-            let f0 = crate::sqrt_curvature_speed(&d);
-            if let Some(fp) = prev_f {
-                self.sqrt_curvature += crate::trapezoid_step(self.curve, t0 - last_dt, t0, fp, f0);
+        // The previous cutting point's parameter and span, and sqrt(k) |C'| and its
+        // derivative there.
+        let mut prev_f: Option<(f64, usize, (f64, f64))> = None;
+        while cur.t < b {
+            let t0 = cur.t;
+            let d = &cur.d;
+            let scaled = Scaled::new(&d[0], &d[1], &d[2]);
+            let f0 = scaled.sqrt_curvature_speed();
+            if let Some((tp, span, fp)) = prev_f {
+                self.sqrt_curvature +=
+                    crate::trapezoid_step(self.curve, (tp, span), (t0, cur.span), fp, f0);
             }
-            prev_f = Some(f0);
-            let speed0 = d1.norm();
-            let remaining = (pb - p0).norm();
-            // Paper 004 eq 4-5: the chord of the osculating circle with sagitta H_p.
-            let r_curv = if k > 0.0 {
-                let r = 1.0 / k;
-                if hp >= r {
-                    2.0 * r
-                } else {
-                    2.0 * (hp * (2.0 * r - hp)).sqrt()
+            prev_f = Some((t0, cur.span, f0));
+            let model = Taylor::new(&scaled);
+            let rest = b - t0;
+            let mut first_h = None;
+            let mut h = if self.param_only {
+                last_dt
+            } else {
+                let mut h = model
+                    .step_for(hp / bias, if warm { last_dt } else { 0.0 })
+                    .min(8.0 * last_dt);
+                if h.is_nan() || h <= 0.0 {
+                    h = rest;
                 }
-            } else {
-                f64::INFINITY
-            };
-            let mut r = if r_curv.is_finite() {
-                r_curv * bias
-            } else {
-                // Straight here: try the rest of the piece (first-order length if it closes).
-                remaining.max(d1.norm() * (b - t0)) * (1.0 + 1e-9)
-            };
-            r = r.min(max_len).max(min_len);
-            if r.is_nan() || r <= 0.0 {
-                r = max_len.min(f64::MAX);
+                if h < rest && h < 8.0 * last_dt {
+                    first_h = Some(h);
+                }
+                if h < rest && (max_len.is_finite() || min_len > 0.0) {
+                    first_h = None;
+                    let len = model.length(h);
+                    if len > max_len * (1.0 - 0.5 * LENGTH_TOL) {
+                        h = model.step_for_length(h, max_len * (1.0 - 0.5 * LENGTH_TOL));
+                    } else if len < min_len {
+                        h = model.step_for_length(h, min_len);
+                    }
+                }
+                h
             }
-            let max_dt = (8.0 * last_dt).min(b - a);
+            .min(rest);
             let mut good: Option<Cand> = None;
             let mut bad: Option<Cand> = None;
             let mut param_mode = self.param_only;
             let mut fails = 0usize;
             let mut last_fail = Fail::Chord;
             let mut stuck = false;
-            let mut t_try = t0 + last_dt.min(b - t0);
+            let mut trials_made = 0;
             for _ in 0..MAX_ITERS {
-                let hit = if param_mode {
-                    if t_try >= b {
-                        Hit {
-                            t: b,
-                            p: pb,
-                            h: None,
-                        }
-                    } else {
-                        let (p, h) = self.cert.point_h(t_try);
-                        Hit {
-                            t: t_try,
-                            p,
-                            h: Some(h),
-                        }
-                    }
-                } else {
-                    let start = good.map_or(
-                        Start {
-                            t: t0,
-                            d: 0.0,
-                            speed: Some(speed0),
-                            derivs: Some([d[1], d[2], d[3]]),
-                        },
-                        |g| Start {
-                            t: g.hit.t,
-                            d: g.r,
-                            speed: None,
-                            derivs: None,
-                        },
-                    );
-                    let end = match bad {
-                        Some(bd) if bd.r > r => End::Outside {
-                            t: bd.hit.t,
-                            d: bd.r,
-                        },
-                        _ => End::PieceEnd { t: b, p: pb },
-                    };
-                    first_crossing(&self.cert, &p0, r, start, end, max_dt)
-                };
-                if hit.t <= t0 {
+                trials_made += 1;
+                let t1 = if h >= rest { b } else { t0 + h };
+                if t1.is_nan() || t1 <= t0 {
                     stuck = true;
                     break;
                 }
                 // Certify exactly the point that will be output for the piece end.
-                let hit = if hit.t >= b {
-                    Hit {
-                        t: b,
-                        p: pb,
-                        h: None,
-                    }
+                let (t1, p1, end) = if t1 >= b {
+                    (b, pb, None)
                 } else {
-                    hit
+                    let span = self.cert.span_at(t1, cur.span);
+                    let e = self.cert.eval::<P, M, 3>(span, t1);
+                    (t1, e.p, Some(e))
                 };
-                let (bound, fail) = self.certify(t0, &p0, &hit);
-                let ok = fail.is_none();
+                let (bound, fail) = self.certify::<P, M>(&cur, t1, &p1, end.as_ref());
+                let cand = Cand {
+                    t: t1,
+                    h: t1 - t0,
+                    err: if bound.upper.is_finite() {
+                        bound.upper
+                    } else {
+                        bound.lower
+                    },
+                    r: (p1 - cur.p).norm(),
+                    end,
+                    p: p1,
+                    bound,
+                    fail,
+                };
                 if let Some(f) = fail {
                     last_fail = f;
-                }
-                let cand = Cand {
-                    r: (hit.p - p0).norm(),
-                    hit,
-                    bound,
-                };
-                if ok {
-                    good = Some(cand);
-                    fails = 0;
-                    if hit.t >= b || bound.lower >= emin || cand.r >= max_len * (1.0 - 1e-12) {
-                        break;
-                    }
-                } else {
                     bad = Some(cand);
                     fails += 1;
                     if good.is_none() && fails >= PARAM_FALLBACK_AFTER {
                         param_mode = true;
                     }
+                } else {
+                    good = Some(cand);
+                    fails = 0;
+                    if t1 >= b || bound.upper >= emin || cand.r >= max_len * (1.0 - LENGTH_TOL) {
+                        break;
+                    }
                 }
                 // Next trial.
-                match (good, bad) {
+                h = match (good, bad) {
                     (Some(g), None) => {
-                        let f = if g.bound.lower > 0.0 {
-                            (hp / g.bound.lower).sqrt().clamp(1.005, 4.0)
+                        if param_mode {
+                            2.0 * g.h
                         } else {
-                            4.0
-                        };
-                        r = (g.r * f).min(max_len);
-                        t_try = t0 + 2.0 * (g.hit.t - t0);
+                            let mut h = if g.err > 0.0 {
+                                next_step(&model, g.h, g.err, hp).clamp(1.005 * g.h, 4.0 * g.h)
+                            } else {
+                                4.0 * g.h
+                            };
+                            if max_len.is_finite() {
+                                let at_max = g.h * max_len * (1.0 - 0.5 * LENGTH_TOL) / g.r;
+                                h = h.min(at_max.max(1.005 * g.h));
+                            }
+                            h
+                        }
                     }
                     (None, Some(bd)) => {
-                        let f = if bd.bound.lower > 0.0 {
-                            (hp / bd.bound.lower).sqrt().clamp(0.05, 0.995)
+                        let h = if param_mode {
+                            0.5 * bd.h
                         } else {
-                            0.5
+                            match bd.fail {
+                                Some(Fail::Length) => {
+                                    bd.h * (max_len * (1.0 - 0.5 * LENGTH_TOL) / bd.r).min(0.995)
+                                }
+                                Some(Fail::Chord) if bd.err > 0.0 => {
+                                    next_step(&model, bd.h, bd.err, hp)
+                                        .clamp(0.05 * bd.h, 0.995 * bd.h)
+                                }
+                                _ => 0.5 * bd.h,
+                            }
                         };
-                        r = (bd.r * f).max(if fails == 1 { min_len } else { 0.0 });
-                        if r >= bd.r {
-                            r = 0.5 * bd.r;
+                        let h = if fails == 1 && !param_mode && min_len > 0.0 {
+                            h.max(model.step_for_length(h, min_len))
+                        } else {
+                            h
+                        };
+                        if h >= bd.h {
+                            0.5 * bd.h
+                        } else {
+                            h
                         }
-                        t_try = t0 + 0.5 * (bd.hit.t - t0);
                     }
                     (Some(g), Some(bd)) => {
-                        let gap_t = bd.hit.t - g.hit.t;
-                        if gap_t <= 1e-9 * (g.hit.t - t0) {
+                        let gap = bd.h - g.h;
+                        if gap <= 1e-9 * g.h || gap <= BRACKET_TOL * g.h {
                             break;
                         }
                         if param_mode {
-                            if gap_t <= BRACKET_TOL * (g.hit.t - t0) {
-                                break;
-                            }
-                            t_try = 0.5 * (g.hit.t + bd.hit.t);
+                            0.5 * (g.h + bd.h)
                         } else {
-                            let gap = bd.r - g.r;
-                            if gap <= BRACKET_TOL * g.r || gap <= crate::sphere::RADIUS_TOL * bd.r {
-                                break;
-                            }
-                            // Power law e = c r^q through both ends of the bracket.
-                            let (eg, eb) = (g.bound.lower, bd.bound.lower);
-                            let model = if eg > 0.0 && eb > eg {
-                                let q = (eb / eg).ln() / (bd.r / g.r).ln();
-                                g.r * (hp / eg).powf(1.0 / q)
-                            } else if eg > 0.0 {
-                                g.r * (hp / eg).sqrt()
-                            } else {
-                                0.5 * (g.r + bd.r)
+                            let (eg, eb) = (g.err, bd.err);
+                            let next = match bd.fail {
+                                // Power law e = c h^q through both ends of the bracket.
+                                Some(Fail::Chord) if eg > 0.0 && eb > eg => {
+                                    let q = (eb / eg).ln() / (bd.h / g.h).ln();
+                                    g.h * (hp / eg).powf(1.0 / q)
+                                }
+                                Some(Fail::Chord) if eg > 0.0 => g.h * (hp / eg).sqrt(),
+                                // The chord's length is nearly linear in the step.
+                                Some(Fail::Length) if bd.r > g.r => {
+                                    let target = max_len * (1.0 - 0.5 * LENGTH_TOL);
+                                    g.h + gap * (target - g.r) / (bd.r - g.r)
+                                }
+                                _ => 0.5 * (g.h + bd.h),
                             };
-                            r = model.clamp(g.r + 0.1 * gap, bd.r - 0.1 * gap);
+                            if next.is_nan() {
+                                0.5 * (g.h + bd.h)
+                            } else {
+                                next.clamp(g.h + 0.1 * gap, bd.h - 0.1 * gap)
+                            }
                         }
                     }
                     (None, None) => unreachable!("a trial was made"),
                 }
+                .min(rest);
             }
             let Some(g) = good else {
                 return Err(if last_fail == Fail::Turn {
@@ -284,35 +467,64 @@ impl Walker<'_> {
                     }
                 });
             };
-            if r_curv.is_finite() && g.hit.t < b && g.bound.lower > 0.0 {
-                // The radius that would have hit H_p exactly, relative to the prediction.
-                bias = (g.r * (hp / g.bound.lower).sqrt() / r_curv).clamp(0.25, 4.0);
+            if !self.param_only && g.end.is_some() && g.err > 0.0 {
+                // A first trial from the model: its prediction was the target (one fixed-point
+                // step from a near guess leaves it within a fraction of a percent).
+                let predicted = if first_h.is_some() && trials_made == 1 {
+                    hp / bias
+                } else {
+                    model.error(g.h)
+                };
+                if predicted > 0.0 {
+                    bias = (g.err / predicted).clamp(0.25, 4.0);
+                }
+                warm = true;
+            } else {
+                warm = false;
             }
-            last_dt = g.hit.t - t0;
+            last_dt = g.h;
             out.max_chord_error = out.max_chord_error.max(g.bound.upper);
             out.estimated_chord_error = out.estimated_chord_error.max(g.bound.lower);
-            let (t1, p1) = if g.hit.t >= b {
-                (b, pb)
-            } else {
-                (g.hit.t, g.hit.p)
-            };
-            if t1 >= b {
-                // The piece's last segment: the value at its start (the value at `b` would
-                // cost an evaluation, and at a C0 break it belongs to the next piece).
-                self.sqrt_curvature += f0.0 * (t1 - t0);
-            }
-            out.params.push(t1);
-            out.points.push(p1);
+            out.params.push(g.t);
+            out.points.push(g.p);
             if out.points.len() > self.opts.max_points {
                 return Err(DiscretizeError::TooManyPoints {
                     limit: self.opts.max_points,
                     estimate: out.points.len() as f64,
                 });
             }
-            t0 = t1;
-            p0 = p1;
+            match g.end {
+                Some(e) => cur = e,
+                None => {
+                    // The piece's last segment: the value at its start (the value at `b` would
+                    // cost an evaluation, and at a C0 break it belongs to the next piece).
+                    self.sqrt_curvature += f0.0 * g.h;
+                    break;
+                }
+            }
         }
         Ok(())
+    }
+}
+
+/// The next step after a one-sided trial of step `h` whose error came out `err`, for the
+/// target `target`: the model's own step with its bias measured at `h`, kept between the
+/// power laws `err ~ h^2` and `err ~ h^4` through the trial (where the model is poor, across a
+/// knot, the trial's own scaling decides); NaN-free.
+fn next_step(model: &Taylor, h: f64, err: f64, target: f64) -> f64 {
+    let r = target / err;
+    let (q2, q4) = (h * r.sqrt(), h * r.sqrt().sqrt());
+    let (lo, hi) = if r >= 1.0 { (q4, q2) } else { (q2, q4) };
+    let predicted = model.error(h);
+    let h = if predicted > 0.0 {
+        model.step_for(target * predicted / err, h)
+    } else {
+        f64::NAN
+    };
+    if h.is_nan() {
+        q2
+    } else {
+        h.clamp(lo, hi)
     }
 }
 

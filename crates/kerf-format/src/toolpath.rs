@@ -29,7 +29,7 @@
 //! # Ok::<(), kerf_format::FormatError>(())
 //! ```
 
-use std::io::{self, BufWriter, Read, Write};
+use std::io::{self, Read, Write};
 use std::path::Path;
 
 use nalgebra::{Point3, Vector3};
@@ -154,7 +154,22 @@ impl ToolpathFile {
 }
 
 fn validate_path(index: usize, path: &ToolpathRecord, tolerance: f64) -> Result<()> {
-    let (n, m) = (path.points.len(), path.params.len());
+    let (params, e) = (&path.params, path.max_chord_error);
+    match &path.points {
+        ToolpathPoints::Positions(p) => validate_rows(index, params, p, e, tolerance),
+        ToolpathPoints::Poses(p) => validate_rows(index, params, p, e, tolerance),
+    }
+}
+
+/// The rules of one path (see the module documentation), on its parts.
+fn validate_rows<R: PointRow>(
+    index: usize,
+    params: &[f64],
+    points: &[R],
+    max_chord_error: f64,
+    tolerance: f64,
+) -> Result<()> {
+    let (n, m) = (points.len(), params.len());
     if n != m {
         return Err(FormatError::PathCount {
             index,
@@ -167,7 +182,7 @@ fn validate_path(index: usize, path: &ToolpathRecord, tolerance: f64) -> Result<
             problem: format!("{n} points; a path has at least 2 (the ends of the domain)"),
         });
     }
-    for (i, &t) in path.params.iter().enumerate() {
+    for (i, &t) in params.iter().enumerate() {
         if !t.is_finite() {
             return Err(FormatError::BadNumber {
                 path: format!("paths[{index}].params[{i}]"),
@@ -175,16 +190,17 @@ fn validate_path(index: usize, path: &ToolpathRecord, tolerance: f64) -> Result<
                 value: t,
             });
         }
-        if i > 0 && t <= path.params[i - 1] {
+        if i > 0 && t <= params[i - 1] {
             return Err(FormatError::ParamsNotIncreasing {
                 path: format!("paths[{index}].params[{i}]"),
                 value: t,
-                previous: path.params[i - 1],
+                previous: params[i - 1],
             });
         }
     }
-    for (i, point) in path.points.iter().enumerate() {
-        for (k, &x) in point.iter().enumerate() {
+    for (i, point) in points.iter().enumerate() {
+        let row = point.row();
+        for (k, &x) in row.iter().enumerate() {
             if !x.is_finite() {
                 return Err(FormatError::BadNumber {
                     path: format!("paths[{index}].points[{i}][{k}]"),
@@ -193,8 +209,8 @@ fn validate_path(index: usize, path: &ToolpathRecord, tolerance: f64) -> Result<
                 });
             }
         }
-        if let Some(normal) = path.points.normal(i) {
-            let norm = normal.norm();
+        if row.len() == 6 {
+            let norm = Vector3::new(row[3], row[4], row[5]).norm();
             if (norm - 1.0).abs() > UNIT_NORMAL_TOLERANCE {
                 return Err(FormatError::NotUnitNormal {
                     path: format!("paths[{index}].points[{i}]"),
@@ -203,7 +219,7 @@ fn validate_path(index: usize, path: &ToolpathRecord, tolerance: f64) -> Result<
             }
         }
     }
-    let e = path.max_chord_error;
+    let e = max_chord_error;
     if !(e.is_finite() && e >= 0.0) {
         return Err(FormatError::BadNumber {
             path: format!("paths[{index}].max_chord_error"),
@@ -238,11 +254,44 @@ fn validate_path(index: usize, path: &ToolpathRecord, tolerance: f64) -> Result<
 /// [`FormatError::File`] naming `dest`.
 pub fn write(file: &ToolpathFile, dest: impl AsRef<Path>) -> Result<()> {
     let dest = dest.as_ref();
-    let result = file.validate().and_then(|()| {
-        kerf_io::write_file(dest, |mut w| write_json(file, &mut w))
-            .map_err(|error| FormatError::Write { error })
+    file.validate().map_err(|e| e.in_file(dest))?;
+    write_with(dest, file.units, file.tolerance, |w| write_paths(file, w))
+}
+
+/// Writes a document of the given units and tolerance to `dest` atomically, as [`write()`], with
+/// the paths `paths` hands to the [`ToolpathWriter`] one by one: a caller that produces paths
+/// one after the other (the discretizer) writes them as they come and never holds the whole
+/// document. If `paths` fails, or a path breaks a rule of the format, `dest` is untouched and
+/// the error is returned.
+///
+/// # Errors
+/// The error of `paths`, or a [`FormatError`] (wrapped in [`FormatError::File`] naming `dest`,
+/// then converted to `E`).
+pub fn write_with<E: From<FormatError>>(
+    dest: &Path,
+    units: Units,
+    tolerance: f64,
+    paths: impl FnOnce(&mut ToolpathWriter<&mut dyn Write>) -> std::result::Result<(), E>,
+) -> std::result::Result<(), E> {
+    // The callback of `kerf_io::write_file` returns io errors: any other error is kept here.
+    let mut kept: Option<E> = None;
+    let mut keep = |e: E| {
+        kept = Some(e);
+        io::Error::other("stopped")
+    };
+    let result = kerf_io::write_file(dest, |w| {
+        let mut tw =
+            ToolpathWriter::new(w, units, tolerance).map_err(|e| keep(E::from(e.in_file(dest))))?;
+        paths(&mut tw).map_err(&mut keep)?;
+        tw.finish()
+            .map(drop)
+            .map_err(|e| keep(E::from(e.in_file(dest))))
     });
-    result.map_err(|e| e.in_file(dest))
+    match (result, kept) {
+        (_, Some(e)) => Err(e),
+        (Ok(()), None) => Ok(()),
+        (Err(error), None) => Err(E::from(FormatError::Write { error }.in_file(dest))),
+    }
 }
 
 /// Checks `file` and writes it to `writer`.
@@ -251,10 +300,7 @@ pub fn write(file: &ToolpathFile, dest: impl AsRef<Path>) -> Result<()> {
 /// Any error of [`ToolpathFile::validate`], or [`FormatError::Write`].
 pub fn to_writer(file: &ToolpathFile, writer: impl Write) -> Result<()> {
     file.validate()?;
-    let mut w = BufWriter::new(writer);
-    write_json(file, &mut w)
-        .and_then(|()| w.flush())
-        .map_err(|error| FormatError::Write { error })
+    write_document(file, writer)
 }
 
 /// Checks `file` and returns it as JSON text.
@@ -269,68 +315,280 @@ pub fn to_string(file: &ToolpathFile) -> Result<String> {
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
-/// Writes the JSON text: keys in the order of the format description, one point per line.
-fn write_json(file: &ToolpathFile, w: &mut impl Write) -> io::Result<()> {
-    writeln!(w, "{{")?;
-    writeln!(w, "  \"format\": \"{TOOLPATH_FORMAT}\",")?;
-    writeln!(w, "  \"units\": \"{}\",", file.units)?;
-    write!(w, "  \"tolerance\": ")?;
-    number(w, file.tolerance)?;
-    if file.paths.is_empty() {
-        writeln!(w, ",\n  \"paths\": []")?;
-    } else {
-        writeln!(w, ",\n  \"paths\": [")?;
-        for (i, path) in file.paths.iter().enumerate() {
-            write_path(path, w)?;
-            writeln!(w, "{}", if i + 1 < file.paths.len() { "," } else { "" })?;
-        }
-        writeln!(w, "  ]")?;
-    }
-    writeln!(w, "}}")
+/// Streams `file` through a [`ToolpathWriter`].
+fn write_document(file: &ToolpathFile, writer: impl Write) -> Result<()> {
+    let mut w = ToolpathWriter::new(writer, file.units, file.tolerance)?;
+    write_paths(file, &mut w)?;
+    w.finish().map(drop)
 }
 
-fn write_path(path: &ToolpathRecord, w: &mut impl Write) -> io::Result<()> {
-    writeln!(w, "    {{")?;
-    write!(w, "      \"id\": ")?;
-    serde_json::to_writer(&mut *w, &path.id)?;
-    writeln!(w, ",\n      \"point_count\": {},", path.points.len())?;
-    write!(w, "      \"max_chord_error\": ")?;
-    number(w, path.max_chord_error)?;
-    writeln!(w, ",\n      \"params\": [")?;
-    // The numbers go straight from the formatter into `w` (a buffered writer): no string per
-    // number, no serializer per number.
-    let mut fmt = zmij::Buffer::new();
-    for (i, chunk) in path.params.chunks(8).enumerate() {
-        w.write_all(b"        ")?;
-        for (k, &t) in chunk.iter().enumerate() {
-            if k > 0 {
-                w.write_all(b", ")?;
+/// Every path of `file`, in order.
+fn write_paths<W: Write>(file: &ToolpathFile, w: &mut ToolpathWriter<W>) -> Result<()> {
+    for path in &file.paths {
+        match &path.points {
+            ToolpathPoints::Positions(p) => {
+                w.path(&path.id, &path.params, p, path.max_chord_error)?
             }
-            w.write_all(fmt.format_finite(t).as_bytes())?;
+            ToolpathPoints::Poses(p) => w.path(&path.id, &path.params, p, path.max_chord_error)?,
         }
-        let last = (i + 1) * 8 >= path.params.len();
-        w.write_all(if last { b"\n" } else { b",\n" })?;
     }
-    w.write_all(b"      ],\n      \"points\": [\n")?;
-    let n = path.points.len();
-    for (i, point) in path.points.iter().enumerate() {
-        w.write_all(b"        [")?;
-        for (k, &x) in point.iter().enumerate() {
-            if k > 0 {
-                w.write_all(b", ")?;
-            }
-            w.write_all(fmt.format_finite(x).as_bytes())?;
-        }
-        w.write_all(if i + 1 < n { b"],\n" } else { b"]\n" })?;
-    }
-    write!(w, "      ]\n    }}")
+    Ok(())
 }
 
-/// Writes a finite number in the shortest form that reads back to the same double (the
-/// formatter serde_json uses, so the bytes are those serde_json would write).
-fn number(w: &mut impl Write, x: f64) -> io::Result<()> {
-    debug_assert!(x.is_finite(), "validated before writing");
-    w.write_all(zmij::Buffer::new().format_finite(x).as_bytes())
+/// One point of a path as written: `[x, y, z]` or `[x, y, z, i, j, k]` (a normal).
+pub trait PointRow {
+    /// The numbers of the row, 3 or 6.
+    fn row(&self) -> &[f64];
+}
+
+impl PointRow for [f64; 3] {
+    fn row(&self) -> &[f64] {
+        self
+    }
+}
+
+impl PointRow for [f64; 6] {
+    fn row(&self) -> &[f64] {
+        self
+    }
+}
+
+impl PointRow for Point3<f64> {
+    fn row(&self) -> &[f64] {
+        self.coords.as_slice()
+    }
+}
+
+/// Bytes gathered before they go to the underlying writer.
+const CHUNK: usize = 1 << 16;
+
+/// Room kept free beyond [`CHUNK`]: more than any line of points or parameters (at most
+/// `8 + 8 * 24 + 7 * 2 + 2` bytes), so that a line is assembled without checking for space.
+const LINE_ROOM: usize = 1024;
+
+/// The document's bytes on their way to the writer: lines are assembled in place with copies
+/// of fixed sizes (a number costs no call to `memcpy`), and go to the writer in pieces of
+/// [`CHUNK`] bytes.
+struct Sink<W: Write> {
+    out: W,
+    buf: Box<[u8]>,
+    len: usize,
+}
+
+impl<W: Write> Sink<W> {
+    /// Appends a constant piece of text (of a line, which [`Sink::line`] made room for).
+    #[inline]
+    fn push<const N: usize>(&mut self, s: &[u8; N]) {
+        self.buf[self.len..self.len + N].copy_from_slice(s);
+        self.len += N;
+    }
+
+    /// Appends a finite number in the shortest form that reads back to the same double (the
+    /// formatter serde_json uses, so the bytes are those serde_json would write; at most 24),
+    /// by two overlapping copies of a fixed size (the first and the last 16, 8 or 4 bytes), as
+    /// `memcpy` does for short lengths, without the call.
+    #[inline]
+    fn number(&mut self, fmt: &mut zmij::Buffer, x: f64) {
+        debug_assert!(x.is_finite(), "validated before writing");
+        let s = fmt.format_finite(x).as_bytes();
+        let n = s.len();
+        let out = &mut self.buf[self.len..self.len + n];
+        if n >= 16 {
+            out[..16].copy_from_slice(&s[..16]);
+            out[n - 16..].copy_from_slice(&s[n - 16..]);
+        } else if n >= 8 {
+            out[..8].copy_from_slice(&s[..8]);
+            out[n - 8..].copy_from_slice(&s[n - 8..]);
+        } else if n >= 4 {
+            out[..4].copy_from_slice(&s[..4]);
+            out[n - 4..].copy_from_slice(&s[n - 4..]);
+        } else {
+            for (o, &c) in out.iter_mut().zip(s) {
+                *o = c;
+            }
+        }
+        self.len += n;
+    }
+
+    /// Makes room for one line: hands a full piece to the writer.
+    #[inline]
+    fn line(&mut self) -> io::Result<()> {
+        if self.len >= CHUNK {
+            self.out.write_all(&self.buf[..self.len])?;
+            self.len = 0;
+        }
+        Ok(())
+    }
+
+    /// Appends text of any length (an id, a count).
+    fn bytes(&mut self, s: &[u8]) -> io::Result<()> {
+        if self.len + s.len() > self.buf.len() {
+            self.out.write_all(&self.buf[..self.len])?;
+            self.len = 0;
+            if s.len() > self.buf.len() {
+                return self.out.write_all(s);
+            }
+        }
+        self.buf[self.len..self.len + s.len()].copy_from_slice(s);
+        self.len += s.len();
+        Ok(())
+    }
+
+    /// Writes what is left and flushes.
+    fn finish(&mut self) -> io::Result<()> {
+        self.out.write_all(&self.buf[..self.len])?;
+        self.len = 0;
+        self.out.flush()
+    }
+}
+
+/// A `kerf.toolpath/1` document written path by path, so that a caller with many paths (the
+/// discretizer's output, millions of points) never holds the whole document: the header on
+/// [`ToolpathWriter::new`], each path on [`ToolpathWriter::path`] (checked by the reader's
+/// rules first: [`ToolpathFile::validate`] path by path, ids unique across the document), the
+/// end on [`ToolpathWriter::finish`]. The text is that of [`to_string`]: keys in the order of
+/// the format description, one point per line, every number in the shortest form that reads
+/// back to the same double.
+///
+/// Lines are assembled in one buffer that goes to `out` in 64 KiB pieces, so `out` sees a few
+/// large writes instead of one per number. A document left unfinished by an error is not a
+/// valid file: write through [`write_with`] (or [`kerf_io::write_file`]), which removes it.
+pub struct ToolpathWriter<W: Write> {
+    sink: Sink<W>,
+    fmt: zmij::Buffer,
+    tolerance: f64,
+    ids: IdSet,
+    paths: usize,
+}
+
+impl<W: Write> ToolpathWriter<W> {
+    /// Starts a document of the given units and chord tolerance (mm, finite and `> 0`).
+    ///
+    /// # Errors
+    /// [`FormatError::BadNumber`] for the tolerance, or [`FormatError::Write`].
+    pub fn new(out: W, units: Units, tolerance: f64) -> Result<Self> {
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(FormatError::BadNumber {
+                path: "tolerance".into(),
+                requirement: "finite and > 0",
+                value: tolerance,
+            });
+        }
+        let mut w = Self {
+            sink: Sink {
+                out,
+                buf: vec![0; CHUNK + LINE_ROOM].into_boxed_slice(),
+                len: 0,
+            },
+            fmt: zmij::Buffer::new(),
+            tolerance,
+            ids: IdSet::default(),
+            paths: 0,
+        };
+        let header = format!(
+            "{{\n  \"format\": \"{TOOLPATH_FORMAT}\",\n  \"units\": \"{units}\",\n  \"tolerance\": "
+        );
+        w.sink.bytes(header.as_bytes()).map_err(write_error)?;
+        w.sink.number(&mut w.fmt, tolerance);
+        w.sink.push(b",\n  \"paths\": [");
+        Ok(w)
+    }
+
+    /// Writes the next path: its id, parameters, points and certified chord error.
+    ///
+    /// # Errors
+    /// The path's defects as [`ToolpathFile::validate`] names them (with this path's index),
+    /// or [`FormatError::Write`].
+    pub fn path<R: PointRow>(
+        &mut self,
+        id: &str,
+        params: &[f64],
+        points: &[R],
+        max_chord_error: f64,
+    ) -> Result<()> {
+        let index = self.paths;
+        self.ids.insert("paths", index, id)?;
+        validate_rows(index, params, points, max_chord_error, self.tolerance)?;
+        self.paths += 1;
+        self.write_path(id, params, points, max_chord_error)
+            .map_err(write_error)
+    }
+
+    fn write_path<R: PointRow>(
+        &mut self,
+        id: &str,
+        params: &[f64],
+        points: &[R],
+        max_chord_error: f64,
+    ) -> io::Result<()> {
+        let (s, fmt) = (&mut self.sink, &mut self.fmt);
+        let head = format!(
+            "{}    {{\n      \"id\": {},\n      \"point_count\": {},\n      \"max_chord_error\": ",
+            if self.paths == 1 { "\n" } else { ",\n" },
+            serde_json::to_string(id).map_err(io::Error::from)?,
+            points.len()
+        );
+        s.bytes(head.as_bytes())?;
+        s.line()?;
+        s.number(fmt, max_chord_error);
+        s.push(b",\n      \"params\": [\n");
+        for (i, chunk) in params.chunks(8).enumerate() {
+            s.line()?;
+            s.push(b"        ");
+            for (k, &t) in chunk.iter().enumerate() {
+                if k > 0 {
+                    s.push(b", ");
+                }
+                s.number(fmt, t);
+            }
+            if (i + 1) * 8 >= params.len() {
+                s.push(b"\n");
+            } else {
+                s.push(b",\n");
+            }
+        }
+        s.line()?;
+        s.push(b"      ],\n      \"points\": [\n");
+        let n = points.len();
+        for (i, point) in points.iter().enumerate() {
+            s.line()?;
+            s.push(b"        [");
+            for (k, &x) in point.row().iter().enumerate() {
+                if k > 0 {
+                    s.push(b", ");
+                }
+                s.number(fmt, x);
+            }
+            if i + 1 < n {
+                s.push(b"],\n");
+            } else {
+                s.push(b"]\n");
+            }
+        }
+        s.line()?;
+        s.push(b"      ]\n    }");
+        Ok(())
+    }
+
+    /// Ends the document, writes what is left and flushes; returns the writer.
+    ///
+    /// # Errors
+    /// [`FormatError::Write`].
+    pub fn finish(mut self) -> Result<W> {
+        self.sink.line().map_err(write_error)?;
+        if self.paths == 0 {
+            self.sink.push(b"]\n}\n");
+        } else {
+            self.sink.push(b"\n  ]\n}\n");
+        }
+        self.sink.finish().map_err(write_error)?;
+        Ok(self.sink.out)
+    }
+}
+
+/// An output error as the format's error.
+fn write_error(error: io::Error) -> FormatError {
+    FormatError::Write { error }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -448,8 +706,10 @@ mod tests {
         fn numbers_are_serde_jsons_and_round_trip(bits in proptest::num::u64::ANY) {
             let x = f64::from_bits(bits);
             proptest::prop_assume!(x.is_finite());
-            let mut ours = Vec::new();
-            number(&mut ours, x).unwrap();
+            let mut sink = Sink { out: Vec::new(), buf: vec![0; 64].into_boxed_slice(), len: 0 };
+            sink.number(&mut zmij::Buffer::new(), x);
+            sink.finish().unwrap();
+            let ours = sink.out;
             let theirs = serde_json::to_string(&x).unwrap();
             proptest::prop_assert_eq!(std::str::from_utf8(&ours).unwrap(), theirs.as_str());
             let back: f64 = serde_json::from_slice(&ours).unwrap();
@@ -739,6 +999,73 @@ mod tests {
         // A directory that does not exist.
         let e = write(&sample(), dir.path().join("no/such/dir/out.json")).expect_err("no dir");
         assert!(e.to_string().contains("cannot write"), "{e}");
+    }
+
+    /// A document written path by path through `write_with` is the one `write` gives, also
+    /// when it is far larger than the writer's 64 KiB pieces; a failure of the caller midway,
+    /// or a path the reader would refuse, leaves no file and returns that error.
+    #[test]
+    fn paths_written_one_by_one_are_the_document() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut big = sample();
+        let n = 20_000;
+        big.paths.push(ToolpathRecord {
+            id: "long".into(),
+            params: (0..n).map(|i| f64::from(i) / 7.0).collect(),
+            points: ToolpathPoints::Positions(
+                (0..n)
+                    .map(|i| {
+                        let a = f64::from(i) * 1e-3;
+                        [a.sin() * 123.456789, a.cos(), -a / 3.0]
+                    })
+                    .collect(),
+            ),
+            max_chord_error: 0.000_999_999_999_999_9,
+        });
+        let dest = dir.path().join("one-by-one.json");
+        write_with(&dest, big.units, big.tolerance, |w| {
+            for p in &big.paths {
+                match &p.points {
+                    ToolpathPoints::Positions(q) => {
+                        w.path(&p.id, &p.params, q, p.max_chord_error)?
+                    }
+                    ToolpathPoints::Poses(q) => w.path(&p.id, &p.params, q, p.max_chord_error)?,
+                }
+            }
+            Ok::<(), FormatError>(())
+        })
+        .expect("written");
+        let text = std::fs::read_to_string(&dest).expect("read");
+        assert!(text.len() > 4 << 16, "several pieces: {} bytes", text.len());
+        assert_eq!(text, to_string(&big).expect("valid"), "the same bytes");
+        assert_eq!(from_str(&text).expect("reads back"), big, "round trip");
+
+        // The caller fails after one path: nothing is left, the caller's error comes back.
+        let failed = dir.path().join("failed.json");
+        let e = write_with(&failed, Units::Millimetres, 0.001, |w| {
+            w.path("a", &[0.0, 1.0], &[[0.0; 3], [1.0, 0.0, 0.0]], 0.0)?;
+            Err(FormatError::EmptyId {
+                path: "the caller's own error".into(),
+            })
+        })
+        .expect_err("fails");
+        assert_eq!(
+            e.to_string(),
+            "the caller's own error: id must not be empty",
+            "{e}"
+        );
+        // A path the reader would refuse: a duplicate id, named with the file.
+        let e = write_with(&failed, Units::Millimetres, 0.001, |w| {
+            w.path("a", &[0.0, 1.0], &[[0.0; 3], [1.0, 0.0, 0.0]], 0.0)?;
+            w.path("a", &[0.0, 1.0], &[[0.0; 3], [1.0, 0.0, 0.0]], 0.0)
+        })
+        .expect_err("duplicate");
+        assert!(e.to_string().contains("paths[1].id: duplicate id"), "{e}");
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .expect("list")
+            .map(|e| e.expect("entry").file_name())
+            .collect();
+        assert_eq!(names, ["one-by-one.json"], "no file from the failures");
     }
 
     #[test]

@@ -1,9 +1,9 @@
 //! The hull certificate: the rational Bezier pieces of a segment, the largest distance of
 //! their projected control points to the chord, refined by subdivision (de Casteljau).
 
-use super::{Bound, Certifier, Ends, MAX_SUBDIVISION_DEPTH};
+use super::{Bound, Certifier, MAX_SUBDIVISION_DEPTH};
 use kerf_nurbs::Segment;
-use nalgebra::{Point3, Vector3, Vector4};
+use nalgebra::{Vector3, Vector4};
 
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Piece<const M: usize> {
@@ -82,48 +82,28 @@ impl Certifier<'_> {
         }
     }
 
+    /// The hull certificate of `[t0, t1]` (Steps 1-4) against `chord` (local frame), starting
+    /// from the lower bound `lower` already known (the interpolation certificate's middle
+    /// point, or 0); `margin` is the chord ends' part of the rounding margin
+    /// (`8 eps max(|A|, |B|)`), to which each piece's span adds its own.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
-    pub(super) fn chord_error_m<const M: usize>(
+    pub(super) fn hull_bound<const M: usize>(
         &self,
         pieces: &mut Vec<Piece<M>>,
-        ends: &mut Ends,
-        end_hint: Option<(usize, Vector4<f64>)>,
         t0: f64,
         t1: f64,
-        a: &Point3<f64>,
-        b: &Point3<f64>,
+        chord: &Segment<3>,
+        mut margin: f64,
+        mut lower: f64,
         limit: f64,
         want_lower: f64,
     ) -> Bound {
-        let (al, bl) = (a - self.origin, b - self.origin);
-        let chord = Segment::between(&al, &bl);
         let f = self.factor();
         let p = self.curve.degree();
-        let mut margin = 8.0 * f64::EPSILON * al.coords.amax().max(bl.coords.amax());
         pieces.clear();
-        let mut lower = 0.0f64;
         let local = &self.local;
         let knots = local.knots();
         let mut span = local.span(t0);
-        // Most segments lie in one span and are decided by the interpolation certificate
-        // without any subdivision.
-        if t1 <= knots[span + 1] {
-            let m =
-                margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span]) + self.representation;
-            if let Some(bd) = self.interpolation_bound::<M>(
-                ends, end_hint, span, t0, t1, &chord, &al.coords, &bl.coords, m,
-            ) {
-                let tight = bd.upper - bd.lower <= 0.002 * limit;
-                if bd.lower > limit
-                    || (bd.upper <= limit
-                        && (bd.lower >= want_lower || bd.upper < want_lower || tight))
-                {
-                    return bd;
-                }
-                lower = bd.lower;
-            }
-        }
         // The Bezier pieces of [t0, t1], one per knot span it meets (as
         // `NurbsCurve::for_each_bezier_piece`), extracted straight into the work space.
         let mut lo = t0;
@@ -136,7 +116,7 @@ impl Certifier<'_> {
                     depth: 0,
                 };
                 self.piece_in_span(span, lo, hi, &mut pc.cpw[..=p]);
-                let (upper, end) = hull_distance(&chord, &pc.cpw[..=p]);
+                let (upper, end) = hull_distance(chord, &pc.cpw[..=p]);
                 pc.upper = upper;
                 margin = margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span]);
                 lower = lower.max(end);
@@ -199,8 +179,8 @@ impl Certifier<'_> {
             let (head, tail) = pieces.split_at_mut(last);
             let (l, r) = (&mut head[worst], &mut tail[0]);
             l.split(r, p);
-            let (ul, el) = hull_distance(&chord, &l.cpw[..=p]);
-            let (ur, _) = hull_distance(&chord, &r.cpw[..=p]);
+            let (ul, el) = hull_distance(chord, &l.cpw[..=p]);
+            let (ur, _) = hull_distance(chord, &r.cpw[..=p]);
             lower = lower.max(el);
             l.upper = ul;
             r.upper = ur;

@@ -16,7 +16,35 @@ mod turn;
 
 use hull::Piece;
 use interpolation::{span_derivative_bounds, SpanBounds};
-use kerf_nurbs::{NurbsCurve, MAX_ORDER};
+
+pub(crate) use interpolation::Question;
+
+pub(crate) use span::Eval;
+
+/// Runs `$go!(P, M)` with the const degree `P` of the curve's degree `$p` (and `M >= P + 1`,
+/// the size of the work arrays) for degrees 1 to 7, else with `P = 0` (the degree read at run
+/// time) and `M = MAX_ORDER`: the kernels of the walk and the interpolation certificate are
+/// unrolled for the degrees of real curves.
+macro_rules! by_degree {
+    ($p:expr, $go:ident) => {
+        match $p {
+            1 => $go!(1, 4),
+            2 => $go!(2, 4),
+            3 => $go!(3, 4),
+            4 => $go!(4, 8),
+            5 => $go!(5, 8),
+            6 => $go!(6, 8),
+            7 => $go!(7, 8),
+            _ => $go!(0, { kerf_nurbs::MAX_ORDER }),
+        }
+    };
+}
+pub(crate) use by_degree;
+
+/// A curve value the caller already knows: the knot span and the homogeneous local point at a
+/// parameter (from [`Certifier::eval`]), so that the certificate does not evaluate it again.
+pub(crate) type Known = Option<(usize, Vector4<f64>)>;
+use kerf_nurbs::{NurbsCurve, Segment, MAX_ORDER};
 use nalgebra::{Point3, Vector3, Vector4};
 
 /// The verdict on one segment.
@@ -90,12 +118,15 @@ pub struct Certifier<'a> {
     /// `p (p - 1) (p - 2) Delta^3 Q^w_j` for `j <= p - 3`, at `span_h3[i * (p + 1)..]` (the
     /// control points of the third derivatives of `(P, w)` in the local parameter).
     span_h3: Vec<Vector4<f64>>,
-    /// The fourth hodographs likewise (`j <= p - 4`): a bound of how fast the third
-    /// derivative changes, so that the third derivative near a step is bounded from its value
-    /// at the step's middle rather than over the whole span.
-    span_h4: Vec<Vector4<f64>>,
     /// Per knot span index: the bounds of the interpolation certificate.
     span_bounds: Vec<SpanBounds>,
+    /// Whether every weight is 1 (a polynomial curve): then every homogeneous weight the
+    /// certificate computes is exactly 1 and the projections are skipped
+    /// ([`Certifier::project`]).
+    unit_weights: bool,
+    /// [`Certifier::max_margin`] and [`Certifier::output_resolution`], known on construction.
+    max_margin: f64,
+    output_resolution: f64,
     /// `4 eps max |P_i|` for curves whose weights are not powers of two (the control points are
     /// recovered from `w P` by one division, within two ulps), else 0.
     representation: f64,
@@ -112,6 +143,9 @@ fn exact_diff(a: f64, b: f64) -> (f64, bool) {
 impl<'a> Certifier<'a> {
     /// Prepares `curve` for certification.
     pub fn new(curve: &'a NurbsCurve) -> Self {
+        let hom = curve.homogeneous_points();
+        // The control points as the file gives them: (w P) / w, the curve's own projection.
+        let point = |c: &Vector4<f64>| kerf_nurbs::project(c).coords;
         let (lo, hi) = curve.bounding_box();
         let extent = (hi - lo).amax();
         let centre = (lo.coords + hi.coords) * 0.5;
@@ -124,48 +158,55 @@ impl<'a> Certifier<'a> {
         if !origin.iter().all(|c| c.is_finite()) {
             origin = Vector3::zeros();
         }
-        let points = curve.control_points();
-        let weights = curve.weights();
-        let mut shifted = Vec::with_capacity(points.len());
-        let mut exact = true;
-        for p in &points {
+        // One pass: the translated homogeneous points, whether every translation is exact,
+        // the largest coordinate, and the weights' kinds.
+        let mut cpw = Vec::with_capacity(hom.len());
+        // `|P_i - O|_inf` per control point.
+        let mut mags = Vec::with_capacity(hom.len());
+        let (mut exact, mut scale) = (true, 0.0f64);
+        let (mut powers_of_two, mut unit_weights) = (true, true);
+        for c in hom {
+            let (p, w) = (point(c), c.w);
             let mut d = Vector3::zeros();
             for k in 0..3 {
                 let (v, ok) = exact_diff(p[k], origin[k]);
                 d[k] = v;
                 exact &= ok;
             }
-            shifted.push(d);
+            cpw.push(Vector4::new(d.x * w, d.y * w, d.z * w, w));
+            mags.push(d.amax());
+            scale = scale.max(p.amax());
+            powers_of_two &= is_power_of_two(w);
+            unit_weights &= w == 1.0;
         }
         if !exact {
             origin = Vector3::zeros();
-            shifted = points.iter().map(|p| p.coords).collect();
+            for ((q, m), c) in cpw.iter_mut().zip(&mut mags).zip(hom) {
+                let (p, w) = (point(c), c.w);
+                *q = Vector4::new(p.x * w, p.y * w, p.z * w, w);
+                *m = p.amax();
+            }
         }
-        let cpw: Vec<Vector4<f64>> = shifted
-            .iter()
-            .zip(&weights)
-            .map(|(d, &w)| Vector4::new(d.x * w, d.y * w, d.z * w, w))
-            .collect();
         let p = curve.degree();
+        let knots = curve.knots();
         let mut spans = vec![0.0; curve.len()];
-        for (i, _, _) in curve.spans() {
-            spans[i] = shifted[i - p..=i]
-                .iter()
-                .map(|d| d.amax())
-                .fold(0.0, f64::max);
+        for i in (p..curve.len()).filter(|&i| knots[i] < knots[i + 1]) {
+            spans[i] = mags[i - p..=i].iter().copied().fold(0.0, f64::max);
         }
-        let representation = if weights.iter().all(|&w| is_power_of_two(w)) {
+        let representation = if powers_of_two {
             0.0
         } else {
-            let scale = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
             4.0 * f64::EPSILON * scale
         };
-        let local = NurbsCurve::from_homogeneous_unchecked(p, curve.knots().to_vec(), cpw);
+        let local = NurbsCurve::from_homogeneous_unchecked(p, knots.to_vec(), cpw);
         let mut span_bezier = vec![Vector4::zeros(); curve.len() * (p + 1)];
-        for (i, a, b) in curve.spans() {
-            local.bezier_in_span_into(i, a, b, &mut span_bezier[i * (p + 1)..(i + 1) * (p + 1)]);
+        for i in (p..curve.len()).filter(|&i| knots[i] < knots[i + 1]) {
+            let out = &mut span_bezier[i * (p + 1)..(i + 1) * (p + 1)];
+            local.bezier_in_span_into(i, knots[i], knots[i + 1], out);
         }
-        let (span_h3, span_h4, span_bounds) = span_derivative_bounds(p, &span_bezier, &spans);
+        let (span_h3, span_bounds) = span_derivative_bounds(p, &span_bezier, &spans);
+        let worst = spans.iter().copied().fold(0.0, f64::max);
+        let f = MARGIN_FACTOR * (p + 1) as f64 * f64::EPSILON;
         Self {
             curve,
             local,
@@ -173,9 +214,11 @@ impl<'a> Certifier<'a> {
             spans,
             span_bezier,
             span_h3,
-            span_h4,
             span_bounds,
+            unit_weights,
             representation,
+            max_margin: (2.0 * f + 8.0 * f64::EPSILON) * worst + representation,
+            output_resolution: 2.0 * f64::EPSILON * scale,
         }
     }
 
@@ -203,27 +246,14 @@ impl<'a> Certifier<'a> {
     /// (`docs/discretization.md`, Step 5). A tolerance not well above the margin cannot be
     /// certified.
     pub fn max_margin(&self) -> f64 {
-        let f = self.factor();
-        let worst = self
-            .curve
-            .spans()
-            .iter()
-            .map(|&(i, _, _)| self.spans[i])
-            .fold(0.0, f64::max);
-        (2.0 * f + 8.0 * f64::EPSILON) * worst + self.representation
+        self.max_margin
     }
 
     /// The resolution of the output: one ulp of the largest coordinate of the curve's control
     /// points. A cutting point is a rounded `f64`, so it is off the curve by up to about half
     /// of this per coordinate, and no chord error below it can be certified reliably.
     pub fn output_resolution(&self) -> f64 {
-        let scale = self
-            .curve
-            .control_points()
-            .iter()
-            .map(|p| p.coords.amax())
-            .fold(0.0, f64::max);
-        2.0 * f64::EPSILON * scale
+        self.output_resolution
     }
 
     /// Certifies the chord error of the curve on `[t0, t1]` against the chord `a b`; see
@@ -239,59 +269,129 @@ impl<'a> Certifier<'a> {
         limit: f64,
         want_lower: f64,
     ) -> Bound {
-        self.chord_error_hinted(scratch, t0, t1, a, b, None, limit, want_lower)
+        macro_rules! go {
+            ($p:literal, $m:expr) => {
+                self.chord_error_known::<$p, $m>(
+                    scratch,
+                    (t0, None),
+                    (t1, None),
+                    a,
+                    b,
+                    Question {
+                        limit,
+                        want_lower,
+                        settle: false,
+                    },
+                )
+            };
+        }
+        by_degree!(self.curve.degree(), go)
     }
 
-    /// [`Certifier::chord_error`] with, optionally, the span and homogeneous local point that
-    /// `b` was evaluated from (by [`Certifier::eval_d1_h`]), which saves evaluating it again.
+    /// [`Certifier::chord_error`] for a curve of degree `P` (0: any degree; `M >= P + 1` the
+    /// size of the work arrays), with, optionally, the span and homogeneous local point that
+    /// each end was evaluated from (by [`Certifier::eval`]), which saves evaluating them
+    /// again, and the question asked.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn chord_error_hinted(
+    #[inline]
+    pub(crate) fn chord_error_known<const P: usize, const M: usize>(
         &self,
         scratch: &mut Scratch,
-        t0: f64,
-        t1: f64,
+        (t0, start): (f64, Known),
+        (t1, end): (f64, Known),
         a: &Point3<f64>,
         b: &Point3<f64>,
-        end_hint: Option<(usize, Vector4<f64>)>,
-        limit: f64,
-        want_lower: f64,
+        question: Question,
     ) -> Bound {
+        let Question {
+            limit, want_lower, ..
+        } = question;
+        let (al, bl) = (a - self.origin, b - self.origin);
+        let chord = Segment::between(&al, &bl);
+        let margin = 8.0 * f64::EPSILON * al.coords.amax().max(bl.coords.amax());
+        let mut lower = 0.0f64;
+        let span = match start {
+            Some((s, _)) => s,
+            None => self.local.span(t0),
+        };
+        // Most segments lie in one span and are decided by the interpolation certificate
+        // without any subdivision.
+        if t1 <= self.local.knots()[span + 1] {
+            let f = self.factor();
+            let m =
+                margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span]) + self.representation;
+            let ends = &mut scratch.ends;
+            let (h0, keep) = match start.or_else(|| find(ends, t0, span)) {
+                Some((_, v)) => (v, ends.iter().position(|e| e.is_some_and(|e| e.0 == t0))),
+                None => {
+                    let v = self.span_point::<P, M>(span, self.local_u(span, t0).0);
+                    ends[0] = Some((t0, span, v));
+                    (v, Some(0))
+                }
+            };
+            let h1 = match end.filter(|e| e.0 == span) {
+                Some((_, v)) => v,
+                None => self.span_point::<P, M>(span, self.local_u(span, t1).0),
+            };
+            ends[if keep == Some(0) { 1 } else { 0 }] = Some((t1, span, h1));
+            if let Some(bd) = self.interpolation_bound::<P, M>(
+                span,
+                (t0, h0),
+                (t1, h1),
+                &chord,
+                &al.coords,
+                m,
+                question,
+            ) {
+                if question.settled(&bd) {
+                    return bd;
+                }
+                lower = bd.lower;
+            }
+        }
+        // The walk only needs to know whether the segment is certified.
+        let want_lower = if question.settle { 0.0 } else { want_lower };
         match self.curve.degree() {
-            0..=3 => self.chord_error_m(
+            0..=3 => self.hull_bound(
                 &mut scratch.small,
-                &mut scratch.ends,
-                end_hint,
                 t0,
                 t1,
-                a,
-                b,
+                &chord,
+                margin,
+                lower,
                 limit,
                 want_lower,
             ),
-            4..=7 => self.chord_error_m(
+            4..=7 => self.hull_bound(
                 &mut scratch.medium,
-                &mut scratch.ends,
-                end_hint,
                 t0,
                 t1,
-                a,
-                b,
+                &chord,
+                margin,
+                lower,
                 limit,
                 want_lower,
             ),
-            _ => self.chord_error_m(
+            _ => self.hull_bound(
                 &mut scratch.large,
-                &mut scratch.ends,
-                end_hint,
                 t0,
                 t1,
-                a,
-                b,
+                &chord,
+                margin,
+                lower,
                 limit,
                 want_lower,
             ),
         }
     }
+}
+
+/// The remembered homogeneous point at `t` in `span`, if any.
+fn find(ends: &Ends, t: f64, span: usize) -> Known {
+    ends.iter()
+        .flatten()
+        .find(|e| e.0 == t && e.1 == span)
+        .map(|e| (e.1, e.2))
 }
 
 /// Certifies the chord error of the curve on `[t0, t1]` against the chord `a b`, where `a` and

@@ -250,6 +250,7 @@ impl Job {
                 units: kerf_format::Units::Millimetres,
                 curves: Vec::new(),
                 surfaces: Vec::new(),
+                warnings: Vec::new(),
             },
             machine,
         )

@@ -47,7 +47,8 @@ mod input;
 mod measure;
 
 pub use check::{
-    check, CheckOptions, Defect, PathReport, Report, Violation, WorstSegment, ROUNDING_ALLOWANCE,
+    check, CheckOptions, Defect, PathReport, Report, Violation, WorstSegment, MAX_SAMPLES,
+    ROUNDING_ALLOWANCE,
 };
 pub use error::{CheckError, Result};
 pub use input::{RawPathRecord, RawToolpath};

@@ -455,6 +455,12 @@ pub(crate) struct RunArgs {
     #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
     pub(crate) max_rotary_step: Option<f64>,
 
+    /// Most cutting points of all curves together (default 1,000,000): a job that needs more
+    /// is refused before the points are made (every stage, the program and the plot grow with
+    /// them).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(2..=1_000_000_000))]
+    pub(crate) max_total_points: Option<u64>,
+
     /// Where the part goes on the machine: `auto` (every pose within the axis limits, the
     /// motion centred in the travel, contours turned to the side the head can reach, the part
     /// turned by quarter turns if it does not fit as modelled) or `X,Y,Z[,RX,RY,RZ]` (mm,

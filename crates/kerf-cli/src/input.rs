@@ -9,14 +9,26 @@ use kerf_pipeline::{Progress, Stage};
 
 use crate::error::CliError;
 
-/// Loads a curves file, or standard input for `-`.
+/// Loads a curves file, or standard input for `-`, and prints its near-miss keys as warnings
+/// ([`warn_unknown_keys`]).
 pub(crate) fn load_curves(path: &Path) -> Result<CurvesFile, CliError> {
     let loaded = if path == Path::new("-") {
         curves::from_reader(io::stdin().lock(), Path::new(".")).map_err(|e| e.in_file("<stdin>"))
     } else {
         curves::load(path)
-    };
-    Ok(loaded?)
+    }?;
+    warn_unknown_keys(path, &loaded);
+    Ok(loaded)
+}
+
+/// Prints the file's misspelt-looking keys on standard error, `warning: part.json:
+/// curves[0].weigths: unknown key, did you mean "weights"?`. Also under `--quiet`: the document
+/// was read without the key, which changes the result, and `--quiet` silences progress and
+/// summaries, not defects of the input.
+pub(crate) fn warn_unknown_keys(path: &Path, file: &CurvesFile) {
+    for w in &file.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
 }
 
 /// The job's progress as a bar on standard error, for batches long enough to wait for and

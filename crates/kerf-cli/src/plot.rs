@@ -53,6 +53,7 @@ pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
     inputs.extend(args.machine.as_deref());
     crate::guard::refuse_overwrite("--output", &dest, &inputs)?;
     let curves_file = curves::load(&args.curves)?;
+    crate::input::warn_unknown_keys(&args.curves, &curves_file);
     let tp = match toolpath::load(&args.toolpath) {
         Ok(tp) => tp,
         // A toolpath that breaks the format's rules (a chord error above the tolerance,

@@ -38,6 +38,12 @@ fn job_options(args: &RunArgs) -> JobOptions {
         .with_blend_tolerance_mm(args.blend_tolerance)
         .with_retract_mm(args.retract)
         .with_traverse(args.traverse_options())
+        .with_max_total_points(
+            args.max_total_points
+                .map_or(kerf_pipeline::DEFAULT_MAX_TOTAL_POINTS_RUN, |n| {
+                    usize::try_from(n).unwrap_or(usize::MAX)
+                }),
+        )
 }
 
 /// Runs `kerf run`.

@@ -21,6 +21,7 @@ pub(crate) fn run(args: &ValidateArgs) -> Result<(), CliError> {
     let mut out = stdout.lock();
     match loaded {
         Ok(file) => {
+            crate::input::warn_unknown_keys(path, &file);
             if args.json {
                 let summary = json_summary(path, &file);
                 writeln!(out, "{}", pretty(&summary))?;
@@ -97,6 +98,7 @@ fn json_summary(path: &Path, file: &CurvesFile) -> Value {
         "units": file.units.name(),
         "curves": curves,
         "surfaces": surfaces,
+        "warnings": file.warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),
     })
 }
 

@@ -187,3 +187,50 @@ fn usage_errors_exit_2_and_help_has_an_example() {
         "version"
     );
 }
+
+/// The review's `js/typo_weights.json`: `"weigths"` made the circle a non-rational spline with
+/// exit 0 and not a word. The key is still allowed (extensions are), but every command that
+/// reads the file warns, also under `-q`, and `--json` lists it.
+#[test]
+fn a_misspelt_key_is_warned_about_by_every_reader() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let circle = std::fs::read_to_string(fixture("circle.json")).expect("fixture");
+    assert!(circle.contains("\"weights\""), "the fixture is rational");
+    let typo = dir.path().join("typo.json");
+    std::fs::write(&typo, circle.replacen("\"weights\"", "\"weigths\"", 1)).expect("write");
+    let typo = typo.to_str().expect("UTF-8 path");
+    let tp = dir.path().join("typo.tp.json");
+    let warning = "typo.json: curves[0].weigths: unknown key, did you mean \"weights\"?";
+    for args in [
+        vec!["validate", typo],
+        vec!["validate", "--json", typo],
+        vec!["discretize", typo, "-q", "-o", tp.to_str().expect("UTF-8")],
+    ] {
+        let out = kerf(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+        assert!(
+            text(&out.stderr).contains(&format!("warning: {}", Path::new(typo).display()))
+                && text(&out.stderr).contains(warning),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+    }
+    let out = kerf(&["validate", "--json", typo]);
+    assert!(
+        text(&out.stdout).contains("did you mean"),
+        "{}",
+        text(&out.stdout)
+    );
+    // The correct key draws no warning.
+    let out = validate(&fixture("circle.json"));
+    assert!(
+        !text(&out.stderr).contains("warning"),
+        "{}",
+        text(&out.stderr)
+    );
+}

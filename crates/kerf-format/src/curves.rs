@@ -9,7 +9,10 @@
 //!   STL files loaded), which is what the rest of kerf uses.
 //!
 //! [`load`], [`from_str`] and [`from_reader`] do both. The first defect found is reported, with
-//! its JSON path: `curves[3].knots[5]: knots must be non-decreasing (0.5 after 0.7)`.
+//! its JSON path: `curves[3].knots[5]: knots must be non-decreasing (0.5 after 0.7)`. Unknown
+//! keys are allowed (extensions), but one that looks like a misspelt known key is reported in
+//! [`CurvesFile::warnings`] ([`UnknownKey`]): `curves[0].weigths: unknown key, did you mean
+//! "weights"?`.
 //!
 //! ```
 //! let json = r#"{
@@ -41,6 +44,10 @@ use serde_json::Value;
 
 use crate::error::{json_type_name, FormatError, MeshDefect, Result};
 use crate::{json, stl, Units, CURVES_FORMAT};
+
+mod keys;
+
+pub use keys::UnknownKey;
 
 // ---------------------------------------------------------------------------------------------
 // Raw layer: the JSON as written.
@@ -222,6 +229,11 @@ pub struct CurvesFile {
     pub curves: Vec<CurveRecord>,
     /// The surfaces, in file order.
     pub surfaces: Vec<SurfaceRecord>,
+    /// Unknown keys that look like misspellings of known ones (`"weigths"`, `"Surface"`), in
+    /// document order: the document was read without them, which is rarely what its author
+    /// meant. Empty for a document built from raw structs ([`from_raw`]), which have no unknown
+    /// keys; callers show them as warnings.
+    pub warnings: Vec<UnknownKey>,
 }
 
 /// One cut contour.
@@ -422,6 +434,11 @@ pub fn from_reader(reader: impl Read, base_dir: &Path) -> Result<CurvesFile> {
 /// [`FormatError::UnsupportedFormat`], [`FormatError::UnsupportedUnits`],
 /// [`FormatError::Shape`] or [`FormatError::UnknownSurfaceType`].
 pub fn raw_from_slice(bytes: &[u8]) -> Result<RawCurvesFile> {
+    raw_and_warnings(bytes).map(|(raw, _)| raw)
+}
+
+/// [`raw_from_slice`] with the near-miss keys of the document ([`CurvesFile::warnings`]).
+fn raw_and_warnings(bytes: &[u8]) -> Result<(RawCurvesFile, Vec<UnknownKey>)> {
     /// Everything but the surfaces, which are told apart by hand so that errors inside them
     /// keep their path (serde's internally tagged enums buffer their content and lose it).
     #[derive(Deserialize)]
@@ -433,6 +450,7 @@ pub fn raw_from_slice(bytes: &[u8]) -> Result<RawCurvesFile> {
         surfaces: Vec<Value>,
     }
     let map = json::parse_document(bytes, CURVES_FORMAT)?;
+    let warnings = keys::near_misses(&map);
     let body: Body = json::deserialize(Value::Object(map), "")?;
     let surfaces = body
         .surfaces
@@ -440,12 +458,13 @@ pub fn raw_from_slice(bytes: &[u8]) -> Result<RawCurvesFile> {
         .enumerate()
         .map(|(index, value)| raw_surface(index, value))
         .collect::<Result<_>>()?;
-    Ok(RawCurvesFile {
+    let raw = RawCurvesFile {
         format: body.format,
         units: body.units,
         curves: body.curves,
         surfaces,
-    })
+    };
+    Ok((raw, warnings))
 }
 
 fn raw_surface(index: usize, value: Value) -> Result<RawSurface> {
@@ -480,7 +499,9 @@ fn raw_surface(index: usize, value: Value) -> Result<RawSurface> {
 }
 
 fn from_slice(bytes: &[u8], base_dir: &Path) -> Result<CurvesFile> {
-    from_raw(raw_from_slice(bytes)?, base_dir)
+    let (raw, warnings) = raw_and_warnings(bytes)?;
+    let file = from_raw(raw, base_dir)?;
+    Ok(CurvesFile { warnings, ..file })
 }
 
 /// Checks raw data and builds the validated model. STL files are read, relative to
@@ -607,6 +628,7 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
         units,
         curves,
         surfaces,
+        warnings: Vec::new(),
     })
 }
 

@@ -350,8 +350,9 @@ pub enum MeshDefect {
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum StlProblem {
-    /// The file cannot be opened or read. Fix: the `path` is relative to the directory of the
-    /// JSON file; check that the STL file is there.
+    /// The file cannot be opened or read, or is not a regular file (a FIFO or a device is
+    /// refused without being read). Fix: the `path` is relative to the directory of the JSON
+    /// file; check that the STL file is there and is a plain file.
     #[error("cannot read: {error}")]
     Read {
         /// The operating system's error.

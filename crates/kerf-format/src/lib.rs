@@ -32,6 +32,7 @@ pub mod toolpath;
 
 pub use curves::{
     CurveRecord, CurvesFile, ScrapSide, SurfaceGeometry, SurfaceRecord, SurfaceRef, SurfaceSource,
+    UnknownKey,
 };
 pub use error::{FormatError, MeshDefect, Result, StlProblem};
 pub use toolpath::{ToolpathFile, ToolpathPoints, ToolpathRecord};

@@ -29,13 +29,15 @@ pub struct StlMesh {
     pub dropped_facets: usize,
 }
 
-/// Reads a binary or ASCII STL file.
+/// Reads a binary or ASCII STL file. It is named inside a curves file, so it must be a regular
+/// file ([`kerf_io::read_regular_file`]): a FIFO or device path is refused without waiting on
+/// it or reading it.
 ///
 /// # Errors
-/// [`StlProblem::Read`] if the file cannot be read or is larger than
+/// [`StlProblem::Read`] if the file is not a regular file, cannot be read or is larger than
 /// [`kerf_io::MAX_INPUT_BYTES`], else as [`parse`].
 pub fn read(path: &Path) -> Result<StlMesh, StlProblem> {
-    let bytes = kerf_io::read_file(path).map_err(|error| StlProblem::Read { error })?;
+    let bytes = kerf_io::read_regular_file(path).map_err(|error| StlProblem::Read { error })?;
     parse(bytes)
 }
 

@@ -223,3 +223,33 @@ fn each_broken_fixture_fails_with_its_message() {
         "{err}"
     );
 }
+
+/// The review's `surf/stl_fifo.json`: an STL path naming a FIFO hung forever in `open()`, and
+/// `/dev/zero` was read 1 GiB deep before the size limit refused it. Both are refused at once,
+/// naming the JSON path of the `path`.
+#[cfg(unix)]
+#[test]
+fn an_stl_path_that_is_a_fifo_or_a_device_is_refused_without_reading() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let made = std::process::Command::new("mkfifo")
+        .arg(dir.path().join("fifo"))
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success(), "mkfifo");
+    for path in ["fifo", "/dev/zero"] {
+        let json = dir.path().join("part.json");
+        std::fs::write(
+            &json,
+            format!(
+                r#"{{"format": "kerf.curves/1", "units": "mm",
+                "curves": [{{"id": "c", "degree": 1, "knots": [0, 0, 1, 1],
+                  "control_points": [[10, 10, 0], [90, 10, 0]], "surface": "m"}}],
+                "surfaces": [{{"id": "m", "type": "stl", "path": "{path}"}}]}}"#
+            ),
+        )
+        .expect("write");
+        let err = curves::load(&json).expect_err(path).to_string();
+        assert!(err.contains("surfaces[0].path"), "{err}");
+        assert!(err.contains("not a regular file"), "{err}");
+    }
+}

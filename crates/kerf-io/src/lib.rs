@@ -4,9 +4,11 @@
 //! every writer (toolpath, axes, SVG, set-points CSV, G-code, the `kerf run` directory) goes
 //! through this crate, so that the rules below hold for every file kerf touches:
 //!
-//! **Reading** ([`read_file`], [`read_to_end`], [`parse_json`]):
+//! **Reading** ([`read_file`], [`read_regular_file`], [`read_to_end`], [`parse_json`]):
 //! - at most [`MAX_INPUT_BYTES`] are read from any file or stream (`/dev/zero` as input is an
 //!   error after 1 GiB, not an endless read);
+//! - a file named inside a document (an STL surface's `path`) must be a regular file: a FIFO or
+//!   a device there is refused before it is read (a FIFO is never opened);
 //! - a UTF-8 byte-order mark is skipped ([`strip_bom`]);
 //! - a key given twice in one JSON object is refused with its JSON path
 //!   (`curves[0].id: key given twice in one object`), since readers disagree on which copy wins;
@@ -37,7 +39,7 @@ mod text;
 mod write;
 
 pub use json::{parse_json, path_at, JsonError};
-pub use read::{read_file, read_to_end, strip_bom, MAX_INPUT_BYTES};
+pub use read::{read_file, read_regular_file, read_to_end, strip_bom, MAX_INPUT_BYTES};
 pub use shape::{deserialize_at, duplicate_key_message, JsonProblem, ShapeError};
 pub use text::{check_text, TextDefect};
 pub use write::{same_file, write_dir_all_or_nothing, write_file, Contents, DirEntry, DirError};

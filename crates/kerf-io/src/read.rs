@@ -51,6 +51,72 @@ pub fn read_file(path: &Path) -> io::Result<Vec<u8>> {
     read_to_end(file, MAX_INPUT_BYTES)
 }
 
+/// Reads the file at `path` like [`read_file`], but only if it is a regular file (a symbolic
+/// link is followed): for files named *inside* a document (an STL surface's `path`), which the
+/// user did not hand to kerf on the command line and which must not make kerf wait or read
+/// without end. A FIFO is refused before it is opened (opening one blocks until a writer
+/// comes: the review's STL path naming a FIFO hung forever), a device without reading from it
+/// (`/dev/zero` was read 1 GiB deep before the limit refused it). The file is opened
+/// non-blocking and checked again, so one swapped for a FIFO in between cannot block either.
+///
+/// # Errors
+/// An error of kind [`io::ErrorKind::InvalidInput`] naming what the path is (a FIFO, a
+/// character device, ...) if it is not a regular file; else as [`read_file`].
+pub fn read_regular_file(path: &Path) -> io::Result<Vec<u8>> {
+    let not_regular = |meta: &std::fs::Metadata| -> io::Result<()> {
+        if meta.is_file() {
+            return Ok(());
+        }
+        Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "is {}, not a regular file (a file named inside a document must be a regular file)",
+                file_kind(meta)
+            ),
+        ))
+    };
+    not_regular(&std::fs::metadata(path)?)?;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    let meta = file.metadata()?;
+    not_regular(&meta)?;
+    if meta.len() > MAX_INPUT_BYTES {
+        return Err(too_large(MAX_INPUT_BYTES));
+    }
+    read_to_end(file, MAX_INPUT_BYTES)
+}
+
+/// What a file that is not a regular file is, for messages: `a FIFO`, `a directory`, ...
+fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    let t = meta.file_type();
+    if t.is_dir() {
+        return "a directory";
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    "not a file"
+}
+
 /// `bytes` without a leading UTF-8 byte-order mark (`EF BB BF`). Editors on Windows like to
 /// start UTF-8 files with one; JSON forbids it but it carries no information.
 pub fn strip_bom(bytes: &[u8]) -> &[u8] {
@@ -111,6 +177,39 @@ mod tests {
         assert_eq!(readable_bytes(MAX_INPUT_BYTES), "1 GiB", "limit");
         assert_eq!(readable_bytes(1536), "1.5 KiB", "fraction");
         assert_eq!(readable_bytes(12), "12 bytes", "small");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_referenced_file_must_be_regular() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let fifo = dir.path().join("fifo");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo runs");
+        assert!(made.success(), "mkfifo made {}", fifo.display());
+        // No writer ever comes: reading the FIFO as a file would block in open() forever.
+        let e = read_regular_file(&fifo).expect_err("a FIFO");
+        assert_eq!(e.kind(), io::ErrorKind::InvalidInput, "{e}");
+        assert!(
+            e.to_string().contains("is a FIFO, not a regular file"),
+            "{e}"
+        );
+        let e = read_regular_file(Path::new("/dev/zero")).expect_err("a device");
+        assert!(e.to_string().contains("a character device"), "{e}");
+        let e = read_regular_file(dir.path()).expect_err("a directory");
+        assert!(e.to_string().contains("a directory"), "{e}");
+        // A link to a regular file is followed.
+        let file = dir.path().join("part.stl");
+        std::fs::write(&file, b"solid x").expect("write");
+        let link = dir.path().join("link.stl");
+        std::os::unix::fs::symlink(&file, &link).expect("symlink");
+        assert_eq!(
+            read_regular_file(&link).expect("a link to a file"),
+            b"solid x",
+            "read"
+        );
     }
 
     #[test]

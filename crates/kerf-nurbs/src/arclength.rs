@@ -12,7 +12,11 @@
 //! The accuracy asked is never below the rounding noise of the curve's coordinates: the speed is
 //! computed from control points of magnitude `X`, so each span's length carries an error of
 //! order `(p + 1) eps X` whatever the rule does; asking `1e-13` of a 0.1 mm hole 1.4 m from the
-//! origin would otherwise split panels forever. `docs/nurbs.md` has the details.
+//! origin would otherwise split panels forever. Nor below the rounding of the parameter: a Gauss
+//! node `t` is off by up to half an ulp of `t`, which moves the rule's value by up to
+//! `eps |t| (max f - min f)` on a panel; on a curve of 100,000 short spans this noise exceeded
+//! `1e-13 L` and the quadrature split noise until its budget ran out. `docs/nurbs.md` has the
+//! details.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -66,12 +70,22 @@ pub struct Quadrature {
 /// The 10-point Gauss-Legendre rule on `[a, b]`.
 #[inline]
 pub fn gauss10(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    gauss10_range(f, a, b).0
+}
+
+/// [`gauss10`] with the smallest and largest integrand value at its nodes (NaN-free: a NaN
+/// value shows in the rule's value instead).
+#[inline]
+fn gauss10_range(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64, f64) {
     let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
-    let mut s = 0.0;
+    let (mut s, mut lo, mut hi) = (0.0, f64::INFINITY, f64::NEG_INFINITY);
     for i in 0..5 {
-        s += GL10_WEIGHTS[i] * (f(m - h * GL10_NODES[i]) + f(m + h * GL10_NODES[i]));
+        let (u, v) = (f(m - h * GL10_NODES[i]), f(m + h * GL10_NODES[i]));
+        s += GL10_WEIGHTS[i] * (u + v);
+        lo = lo.min(u).min(v);
+        hi = hi.max(u).max(v);
     }
-    s * h
+    (s * h, lo, hi)
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -81,6 +95,9 @@ struct Panel {
     left: f64,
     right: f64,
     error: f64,
+    /// What rounding the nodes' parameters can move the two rules' difference by (see
+    /// [`Panel::new`]): error estimates below it are noise, not quadrature error.
+    noise: f64,
 }
 
 /// Guaranteed bounds `(lower, upper)` of the integral over a panel, if the caller knows any.
@@ -95,7 +112,13 @@ impl Panel {
         whole: f64,
     ) -> Self {
         let m = 0.5 * (a + b);
-        let (left, right) = (gauss10(f, a, m), gauss10(f, m, b));
+        let ((left, lo_l, hi_l), (right, lo_r, hi_r)) =
+            (gauss10_range(f, a, m), gauss10_range(f, m, b));
+        // Each node `t` is rounded by up to eps |t| / 2, moving f by |f'| times that; summed
+        // with the weights over the panel that is at most (eps |t| / 2) (max f - min f) per
+        // rule (f varying by max f - min f across the panel), and the error estimate compares
+        // two rules.
+        let noise = f64::EPSILON * a.abs().max(b.abs()) * (hi_l.max(hi_r) - lo_l.min(lo_r));
         let mut e = (left + right - whole).abs();
         if let Some(br) = bracket {
             // The rule can miss a peak that none of its nodes sees (the speed of a heavy
@@ -111,6 +134,7 @@ impl Panel {
             right,
             // A NaN difference must be split first and never look converged.
             error: if e.is_nan() { f64::INFINITY } else { e },
+            noise: if noise.is_finite() { noise } else { 0.0 },
         }
     }
 }
@@ -136,15 +160,21 @@ impl Ord for Panel {
 }
 
 /// Integrates `f` over the union of the intervals `pieces` (each integrated separately, so `f`
-/// may have kinks at their ends) to the accuracy `max(relative * |value|, absolute)`, with at
-/// most `SPLITS_PER_SPAN`-like `max_splits` panel splits in all (each costs 40 evaluations; the
-/// start costs 30 per piece).
+/// may have kinks at their ends) to the accuracy `max(relative * |value|, absolute + noise)`,
+/// with at most `SPLITS_PER_SPAN`-like `max_splits` panel splits in all (each costs 40
+/// evaluations; the start costs 30 per piece). `noise` is what rounding the nodes' parameters
+/// alone can change the estimate by, summed over the panels: `eps |t| (max f - min f)` each.
 ///
 /// Globally adaptive: the panel with the largest error estimate is split next, so the budget
 /// goes where the integrand is hard (a peak of the speed at a heavy weight, a corner) instead
 /// of being spread over a recursion tree. Never loops beyond the budget, whatever `f` returns.
 /// With a `bracket` (guaranteed lower and upper bounds of the integral over any panel), a
 /// panel's error estimate is at least the distance of its value outside the bracket.
+///
+/// Besides the evaluations, the work is `O(log n)` per split for the priority queue and, in
+/// all, `O(splits + n)` for the exact sums that confirm convergence (`n` the panels): a
+/// confirmation that fails waits for `n / 8` further splits before the next one, so estimates
+/// hovering at the threshold cannot make it walk all panels on every split.
 pub fn integrate(
     f: impl Fn(f64) -> f64,
     bracket: Option<Bracket<'_>>,
@@ -163,17 +193,24 @@ pub fn integrate(
         }
     }
     let sums = |heap: &BinaryHeap<Panel>| {
-        heap.iter().fold((0.0, 0.0), |(v, e), p: &Panel| {
-            (v + p.left + p.right, e + p.error)
+        heap.iter().fold((0.0, 0.0, 0.0), |(v, e, n), p: &Panel| {
+            (v + p.left + p.right, e + p.error, n + p.noise)
         })
     };
-    let (mut value, mut error) = sums(&heap);
+    let met = |value: f64, error: f64, noise: f64| {
+        error <= relative * value.abs() || error <= absolute + noise
+    };
+    let (mut value, mut error, mut noise) = sums(&heap);
     let mut splits = 0;
+    let mut next_confirmation = 0;
     loop {
-        if error <= relative * value.abs() || error <= absolute {
-            // Running sums drift; confirm with exact sums before stopping.
-            (value, error) = sums(&heap);
-            if error <= relative * value.abs() || error <= absolute {
+        // Running sums drift (and an infinite estimate leaves NaN behind); confirm with exact
+        // sums before stopping, at most once per heap.len() / 8 splits.
+        let maybe = met(value, error, noise) || !(error.is_finite() && value.is_finite());
+        if maybe && splits >= next_confirmation {
+            (value, error, noise) = sums(&heap);
+            next_confirmation = splits + (heap.len() / 8).max(1);
+            if met(value, error, noise) {
                 return Quadrature {
                     value,
                     error,
@@ -186,7 +223,7 @@ pub fn integrate(
             .peek()
             .is_some_and(|p| 0.5 * (p.a + p.b) > p.a && 0.5 * (p.a + p.b) < p.b);
         if splits >= max_splits || !splittable {
-            (value, error) = sums(&heap);
+            (value, error, _) = sums(&heap);
             return Quadrature {
                 value,
                 error,
@@ -202,6 +239,7 @@ pub fn integrate(
         splits += 1;
         value += l.left + l.right + r.left + r.right - p.left - p.right;
         error += l.error + r.error - p.error;
+        noise += l.noise + r.noise - p.noise;
         heap.push(l);
         heap.push(r);
     }
@@ -219,23 +257,34 @@ impl NurbsCurve {
     /// `max |P_i|`, so its length carries an error of order `(p + 1) eps max |P_i|` that no
     /// quadrature can remove. Asking for less only burns the budget.
     pub fn length_floor(&self, spans: usize) -> f64 {
-        let scale = self
-            .homogeneous_points()
+        self.floor_of(self.homogeneous_points(), spans)
+    }
+
+    /// [`NurbsCurve::length_floor`] with the scale taken from `points` only.
+    fn floor_of(&self, points: &[nalgebra::Vector4<f64>], spans: usize) -> f64 {
+        let scale = points
             .iter()
             .map(|c| (c.xyz() / c.w).amax())
             .fold(0.0, f64::max);
         16.0 * (self.degree() + 1) as f64 * f64::EPSILON * scale * spans.max(1) as f64
     }
 
-    /// The knot-span pieces of `[t0, t1]` (clamped to the domain).
-    fn pieces(&self, t0: f64, t1: f64) -> Vec<(f64, f64)> {
+    /// The knot-span pieces of `[t0, t1]` (clamped to the domain) and the rounding floor of
+    /// their lengths, found from the spans of `t0` and `t1` (two binary searches), so one
+    /// span's length costs the same on a curve of 10 spans or of 100,000: walking every span
+    /// and every control point per call made [`NurbsCurve::param_at_length`] quadratic.
+    fn pieces(&self, t0: f64, t1: f64) -> (Vec<(f64, f64)>, f64) {
         let (a, b) = self.domain();
         let (t0, t1) = (t0.clamp(a, b), t1.clamp(a, b));
-        self.spans()
-            .into_iter()
-            .map(|(_, s0, s1)| (s0.max(t0), s1.min(t1)))
+        let (first, last) = (self.span(t0), self.span(t1));
+        let knots = self.knots();
+        let pieces: Vec<_> = (first..=last)
+            .map(|i| (knots[i].max(t0), knots[i + 1].min(t1)))
             .filter(|(lo, hi)| hi > lo)
-            .collect()
+            .collect();
+        let p = self.degree();
+        let floor = self.floor_of(&self.homogeneous_points()[first - p..=last], pieces.len());
+        (pieces, floor)
     }
 
     /// The length of the curve between `t0 <= t1` (clamped to the domain) with its error
@@ -245,7 +294,7 @@ impl NurbsCurve {
     /// so a speed peak that the Gauss nodes miss is split down to instead of being reported as
     /// converged.
     pub fn arc_length_quadrature(&self, t0: f64, t1: f64) -> Quadrature {
-        let pieces = self.pieces(t0, t1);
+        let (pieces, floor) = self.pieces(t0, t1);
         // The length of a rational Bezier piece lies between its chord and its control
         // polygon (subdivision in homogeneous space projects to corner cutting).
         let bracket = |a: f64, b: f64| {
@@ -261,7 +310,7 @@ impl NurbsCurve {
             Some(&bracket),
             &pieces,
             LENGTH_RELATIVE_ACCURACY,
-            self.length_floor(pieces.len()),
+            floor,
             SPLITS_PER_SPAN * pieces.len(),
         )
     }

@@ -4,9 +4,9 @@
 //! `kerf.toolpath/1` records.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use kerf_discretize::{Discretization, Options};
+use kerf_discretize::{Discretization, DiscretizeError, Options};
 use kerf_format::toolpath::{ToolpathFile, ToolpathPoints, ToolpathRecord};
 use kerf_format::{CurvesFile, SurfaceGeometry};
 use kerf_normals::{orient, Hint, MeshNormals, NormalSource, NurbsNormals, Oriented, Projection};
@@ -16,44 +16,124 @@ use crate::error::{Error, Result};
 use crate::job::{MissingSurface, OrientOptions};
 use crate::{Progress, Stage};
 
+/// The default limit on the cutting points of all curves of [`discretize_curves`] together
+/// (20 million, about 2 GB held as a `kerf.toolpath/1` document; `kerf discretize` of 100,000
+/// circles at 0.01 mm makes 15.7 million). A whole run costs far more per point: see
+/// [`crate::JobOptions::max_total_points`].
+pub const DEFAULT_MAX_TOTAL_POINTS: usize = 20_000_000;
+
 /// Discretizes every curve of `file` (in parallel, results in input order), calling
-/// `progress` as each curve is done. `source` names the file in errors.
+/// `progress` as each curve is done, with at most [`DEFAULT_MAX_TOTAL_POINTS`] cutting points
+/// in all ([`discretize_curves_within`]). `source` names the file in errors.
 ///
 /// # Errors
-/// [`Error::Options`] for an option out of range (before any work); [`Error::Discretize`]
-/// naming the first curve (in file order) that failed.
+/// As [`discretize_curves_within`].
 pub fn discretize_curves(
     file: &CurvesFile,
     opts: &Options,
     source: Option<&Path>,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Vec<Discretization>> {
+    discretize_curves_within(file, opts, DEFAULT_MAX_TOTAL_POINTS, source, progress)
+}
+
+/// [`discretize_curves`] with at most `max_total_points` cutting points over all curves
+/// together (`opts.max_points` still limits each curve). A curve whose estimate (the
+/// discretizer's own, before it allocates anything) is more than twice what the others have
+/// left is refused at once; the estimate is not a bound, so the total itself is then counted
+/// exactly: a curve that takes it past the limit fails the job and stops the curves not yet
+/// started. Memory stays within about three times the limit whatever the input; the error
+/// names the curve that passed it, which with several threads depends on their timing.
+///
+/// # Errors
+/// [`Error::Options`] for an option out of range (before any work); [`Error::TooManyPoints`]
+/// when the curves together need more than `max_total_points`; else [`Error::Discretize`]
+/// naming the first curve (in file order) that failed.
+pub fn discretize_curves_within(
+    file: &CurvesFile,
+    opts: &Options,
+    max_total_points: usize,
+    source: Option<&Path>,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Vec<Discretization>> {
     opts.validate().map_err(Error::Options)?;
+    /// Why one curve has no discretization.
+    enum Failed {
+        Curve(DiscretizeError),
+        /// The job's limit, passed with this total (reached or estimated).
+        Limit(f64),
+        /// Not started: another curve passed the limit.
+        Stopped,
+    }
     // The records are discretized in place (no copy of the curves), in parallel; results come
     // back in input order.
     let total = file.curves.len();
     let done = AtomicUsize::new(0);
+    let used = AtomicUsize::new(0);
+    let over = AtomicBool::new(false);
     progress(Progress::new(Stage::Discretize, 0, total));
     let results: Vec<_> = file
         .curves
         .par_iter()
         .map(|r| {
-            let d = kerf_discretize::discretize(&r.curve, opts);
+            if over.load(Ordering::Relaxed) {
+                return Err(Failed::Stopped);
+            }
+            let before = used.load(Ordering::Relaxed);
+            let left = max_total_points.saturating_sub(before);
+            let allowed = left.saturating_mul(2).max(1024);
+            let job_bound = allowed < opts.max_points;
+            let copts = opts.with_max_points(allowed.min(opts.max_points));
+            let d = match kerf_discretize::discretize(&r.curve, &copts) {
+                Ok(d) => {
+                    let n = d.points().len();
+                    let now = used.fetch_add(n, Ordering::Relaxed) + n;
+                    if now > max_total_points {
+                        over.store(true, Ordering::Relaxed);
+                        Err(Failed::Limit(now as f64))
+                    } else {
+                        Ok(d)
+                    }
+                }
+                Err(DiscretizeError::TooManyPoints { estimate, .. }) if job_bound => {
+                    over.store(true, Ordering::Relaxed);
+                    Err(Failed::Limit(before as f64 + estimate))
+                }
+                Err(e) => Err(Failed::Curve(e)),
+            };
             let n = done.fetch_add(1, Ordering::Relaxed) + 1;
             progress(Progress::new(Stage::Discretize, n, total));
             d
         })
         .collect();
+    let file_path = || source.map(Path::to_path_buf);
+    // The job's limit first: a curve stopped by it has no error of its own.
+    if let Some((index, reached)) = results.iter().enumerate().find_map(|(i, r)| match r {
+        Err(Failed::Limit(reached)) => Some((i, *reached)),
+        _ => None,
+    }) {
+        return Err(Error::TooManyPoints {
+            file: file_path(),
+            limit: max_total_points,
+            reached,
+            index,
+            id: file.curves[index].id.clone(),
+        });
+    }
     results
         .into_iter()
         .enumerate()
-        .map(|(i, r)| {
-            r.map_err(|error| Error::Discretize {
-                file: source.map(Path::to_path_buf),
+        .map(|(i, r)| match r {
+            Ok(d) => Ok(d),
+            Err(Failed::Curve(error)) => Err(Error::Discretize {
+                file: file_path(),
                 index: i,
                 id: file.curves[i].id.clone(),
                 source: error,
-            })
+            }),
+            Err(Failed::Limit(_) | Failed::Stopped) => Err(Error::Inconsistent(
+                "a curve was stopped by the job's point limit, but no curve passed it".into(),
+            )),
         })
         .collect()
 }

@@ -33,6 +33,27 @@ pub enum Error {
         #[source]
         source: kerf_discretize::DiscretizeError,
     },
+    /// The job needs more cutting points than its limit (`max_total_points` of
+    /// [`crate::JobOptions`] or [`crate::discretize_curves_within`]), found from the
+    /// discretizer's estimate before a curve's points are allocated or from the running total.
+    /// Nothing after discretization was computed. Fix: a coarser tolerance, fewer curves, or a
+    /// higher limit (`kerf run --max-total-points`).
+    #[error(
+        "{}the job needs more than {limit} cutting points (at least {reached:.0} by curves[{index}] ({id:?})); raise the limit (--max-total-points) or the tolerance",
+        at(file)
+    )]
+    TooManyPoints {
+        /// The curves file, when known.
+        file: Option<PathBuf>,
+        /// The job's limit on the total cutting points.
+        limit: usize,
+        /// The total reached or estimated when the limit was passed.
+        reached: f64,
+        /// Index of the curve that passed it (depends on the order the threads finished in).
+        index: usize,
+        /// Its id.
+        id: String,
+    },
     /// A curve's normals could not be found (a point off its surface, a reversed surface, ...),
     /// or a surface cannot give normals (a degenerate mesh). Fix: the surface or the curve.
     #[error("{}{place}: {source}", at(file))]

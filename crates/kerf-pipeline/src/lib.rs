@@ -46,9 +46,12 @@ mod post;
 mod run;
 
 pub use certify::CertifiedToolpath;
-pub use discretize::{discretize_curves, orient_curves, toolpath_of_points, toolpath_of_poses};
+pub use discretize::{
+    discretize_curves, discretize_curves_within, orient_curves, toolpath_of_points,
+    toolpath_of_poses, DEFAULT_MAX_TOTAL_POINTS,
+};
 pub use error::{Error, Result};
-pub use job::{Job, JobOptions, MissingSurface, OrientOptions};
+pub use job::{Job, JobOptions, MissingSurface, OrientOptions, DEFAULT_MAX_TOTAL_POINTS_RUN};
 pub use motion::{fit_options, path_report, plan_program, MotionInput, MotionOptions, Program};
 pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};
 pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};

@@ -15,7 +15,7 @@ use kerf_kinematics::{solve_paths, AxesFile, PathCurve, PathInput, Pose};
 use kerf_normals::Oriented;
 use serde_json::json;
 
-use crate::discretize::{discretize_curves, orient_curves, toolpath_of_poses};
+use crate::discretize::{discretize_curves_within, orient_curves, toolpath_of_poses};
 use crate::error::{interp, kin, Result};
 use crate::job::Job;
 use crate::output::{program_names, Output, SetupProgram};
@@ -51,7 +51,8 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     job.validate()?;
     let dopts = o.discretize;
     // 1. Cutting points with a certified chord error.
-    let mut discs: Vec<Discretization> = discretize_curves(file, &dopts, path, progress)?;
+    let mut discs: Vec<Discretization> =
+        discretize_curves_within(file, &dopts, o.max_total_points, path, progress)?;
     // 1b. Where closed cuts start when the file pins it (`start`) or only corners offer it (a
     // polygon: the middle of its longest edge), made a (certified) cutting point.
     let starts: Vec<Option<f64>> = discs

@@ -73,3 +73,53 @@ fn a_missing_curves_file_keeps_the_io_error() {
         .map(std::io::Error::kind);
     assert_eq!(io, Some(std::io::ErrorKind::NotFound), "{e:?}");
 }
+
+/// The review's 600-byte circle at `-t 1e-8`: 594,000 cutting points went through every stage
+/// (55 s, 1.9 GB). A job has a limit on its total cutting points: a curve the discretizer
+/// estimates above what is left is refused before its points are made, and curves that
+/// together pass the limit stop the job with the total they reached.
+#[test]
+fn a_job_above_its_point_limit_is_refused_before_the_points_are_made() {
+    use kerf_discretize::Options;
+    use kerf_nurbs::NurbsCurve;
+    let circle = |r: f64| NurbsCurve::circle(Point3::origin(), Vector3::z(), r).expect("circle");
+    // One circle of radius 700 at 1e-9 mm: about 1.85 million points, estimated.
+    let job = Job::on_machine(machine())
+        .with_curve("big", circle(700.0), None)
+        .with_options(
+            kerf_pipeline::JobOptions::default()
+                .with_tolerance_mm(1e-9)
+                .with_max_total_points(1000),
+        );
+    let e = job.run().expect_err("above the limit");
+    match &e {
+        Error::TooManyPoints {
+            limit, reached, id, ..
+        } => {
+            assert_eq!((*limit, id.as_str()), (1000, "big"), "{e}");
+            assert!(*reached > 1.8e6, "the discretizer's estimate: {e}");
+        }
+        other => panic!("not TooManyPoints: {other:?}"),
+    }
+    assert!(e.to_string().contains("--max-total-points"), "{e}");
+    // Forty circles of 50 mm at 0.01 mm: 157 points each, 6,280 in all. Each fits, together
+    // they do not.
+    let mut file = kerf_pipeline::Job::on_machine(machine());
+    for k in 0..40 {
+        file = file.with_curve(format!("c{k}"), circle(50.0), None);
+    }
+    let curves = file.curves();
+    let opts = Options::with_tolerance(0.01);
+    let all = kerf_pipeline::discretize_curves_within(curves, &opts, 10_000, None, &|_| {})
+        .expect("within the limit");
+    let total: usize = all.iter().map(|d| d.points().len()).sum();
+    assert!(total > 5_000 && total < 10_000, "{total} points");
+    let e = kerf_pipeline::discretize_curves_within(curves, &opts, total - 1, None, &|_| {})
+        .expect_err("one point short");
+    assert!(
+        matches!(e, Error::TooManyPoints { limit, .. } if limit == total - 1),
+        "{e:?}"
+    );
+    let exact = kerf_pipeline::discretize_curves_within(curves, &opts, total, None, &|_| {});
+    assert!(exact.is_ok(), "exactly the limit fits: {exact:?}");
+}

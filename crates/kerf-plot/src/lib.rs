@@ -25,6 +25,12 @@
 //! `<circle class="pierce" data-order="k">` and beside it `<text class="order">k</text>`, `k`
 //! from 1 in cutting order.
 //!
+//! The picture's size is bounded whatever the input: beyond [`MAX_DRAWN_SEGMENTS`] segments,
+//! [`MAX_DRAWN_PATHS`] paths or [`MAX_DRAWN_CURVE_SAMPLES`] curve samples or axis positions,
+//! every `k`-th cutting point of each path is drawn (ends kept, each drawn segment carrying the
+//! largest chord error of those it stands for), and a line under the title
+//! (`<text id="decimated">`) says so.
+//!
 //! The chord errors drawn are sampled estimates ([`sampled_chord_error`]), for display; the
 //! independent measurement is `kerf check` (crate `kerf-check`).
 //!
@@ -56,12 +62,14 @@ use std::io;
 use std::path::Path;
 
 mod charts;
+mod decimate;
 mod layout;
 mod scale;
 mod scene;
 mod svg;
 mod views;
 
+pub use decimate::{MAX_DRAWN_CURVE_SAMPLES, MAX_DRAWN_PATHS, MAX_DRAWN_SEGMENTS};
 pub use scene::{
     sample_curve, sampled_chord_error, AxesChart, CutPicture, PathPicture, ProcessPicture, Scene,
     SceneOptions,
@@ -100,8 +108,11 @@ const MARGIN: f64 = 20.0;
 /// Height of one view panel.
 const VIEW_H: f64 = 450.0;
 
-/// The picture of `scene` as SVG text (see the crate documentation for its content).
+/// The picture of `scene` as SVG text (see the crate documentation for its content), at most
+/// [`MAX_DRAWN_SEGMENTS`] segments of it.
 pub fn render(scene: &Scene) -> String {
+    let (scene, note) = decimate::bounded(scene);
+    let scene = scene.as_ref();
     let half = (WIDTH - 3.0 * MARGIN) / 2.0;
     let views_y = 84.0;
     let legend_y = views_y + 2.0 * VIEW_H + MARGIN;
@@ -124,6 +135,9 @@ pub fn render(scene: &Scene) -> String {
     doc.open("id=\"header\"");
     doc.text(MARGIN, 36.0, &scene.title, "class=\"h1\"");
     doc.text(MARGIN, 60.0, &scene.subtitle, "class=\"sub\"");
+    if let Some(note) = &note {
+        doc.text(MARGIN, 77.0, note, "id=\"decimated\" class=\"note\"");
+    }
     doc.close();
     let normal_len = views::normal_length(scene);
     let panel = |col: f64, row: f64| Rect {
@@ -548,6 +562,64 @@ mod tests {
         let bad = dir.path().join("missing").join("p.svg");
         assert!(write_svg(&bad, "<svg/>").is_err(), "no such directory");
         assert!(!bad.exists(), "nothing written");
+    }
+
+    /// The review's 600-byte circle at `-t 1e-8`: 594,000 cutting points made a 233 MB
+    /// `plot.svg`. The picture's size no longer grows with the points, and it says what it
+    /// left out.
+    #[test]
+    fn a_huge_scene_is_drawn_within_a_bounded_size_and_says_so() {
+        let size = |n: usize, paths: usize| {
+            let pt = |k: usize| {
+                let t = k as f64 / n as f64 * std::f64::consts::TAU;
+                Point3::new(700.0 * t.cos(), 700.0 * t.sin(), 0.0)
+            };
+            let scene = Scene {
+                title: "big".into(),
+                subtitle: String::new(),
+                tolerance: 0.01,
+                paths: (0..paths)
+                    .map(|i| PathPicture {
+                        id: format!("p{i}"),
+                        curve: (0..=n).map(pt).collect(),
+                        points: (0..=n).map(pt).collect(),
+                        normals: Some(vec![Vector3::z(); n + 1]),
+                        segment_errors: vec![0.005; n],
+                    })
+                    .collect(),
+                axes: Some(AxesChart {
+                    machine: "m".into(),
+                    names: ["X", "Y", "Z", "A", "C"].map(String::from),
+                    paths: (0..paths)
+                        .map(|i| (format!("p{i}"), vec![[0.0; 5]; n + 1]))
+                        .collect(),
+                    limits: [None; 5],
+                    limits_known: false,
+                }),
+                process: None,
+            };
+            let svg = render(&scene);
+            (svg.len(), svg.contains("id=\"decimated\""), svg)
+        };
+        let (small, noted, _) = size(1_000, 1);
+        assert!(!noted, "a small scene is drawn whole");
+        let (big, noted, svg) = size(600_000, 1);
+        assert!(noted, "the picture says it is thinned");
+        assert!(
+            svg.contains("Drawn: 20000 of 600000 segments"),
+            "the counts"
+        );
+        assert!(
+            big < 12_000_000,
+            "{big} bytes for 600,000 points ({small} for 1,000)"
+        );
+        let (many, noted, svg) = size(20, 10_000);
+        assert!(
+            noted && svg.contains("the first 2000 of 10000 paths"),
+            "paths"
+        );
+        assert!(many < 12_000_000, "{many} bytes for 10,000 paths");
+        well_formed(&svg).expect("well-formed");
     }
 
     #[test]

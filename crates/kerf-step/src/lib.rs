@@ -316,7 +316,16 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                     ));
                 }
                 note_join(&mut report, &format!("#{eid} {}", e.name()), &j);
-                let name = name_of(e);
+                let mut name = name_of(e);
+                if let Err(defect) = kerf_io::check_text(&name) {
+                    // Ids reach G-code comments: a line break in one would add blocks to the
+                    // program. Keep the contour under its #id alone, and say why.
+                    report.skipped.push(format!(
+                        "#{eid} {}: its name {defect}; the contour is named #{eid} alone",
+                        e.name()
+                    ));
+                    name.clear();
+                }
                 let base = if name.is_empty() {
                     format!("#{eid}")
                 } else {

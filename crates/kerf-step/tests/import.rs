@@ -306,6 +306,29 @@ fn errors_name_the_entity() {
     assert!(e.to_string().contains("close_gaps_mm"), "{e}");
 }
 
+/// The review's `step/x_nl.step`: a curve named `'a\X\0AG0 X1400 Y700\X\0AM30'` made the
+/// whole import fail, and the error named `curves[0].id`, not the STEP entity. The contour is
+/// kept under its `#id` and the report names the entity and the character.
+#[test]
+fn a_name_with_a_line_break_keeps_the_contour_under_its_id() {
+    let body = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(0.,0.,1.));\n#3=DIRECTION('',(1.,0.,0.));\n\
+        #4=AXIS2_PLACEMENT_3D('',#1,#2,#3);\n#5=CIRCLE('a\\X\\0AG0 X1400\\X\\0AM30',#4,2.);\n\
+        #6=CIRCLE('hole',#4,1.);\n#7=GEOMETRIC_CURVE_SET('',(#5,#6));\n";
+    let im = import(&step(body), &ImportOptions::default()).expect("reads");
+    let ids: Vec<&str> = im.file.curves.iter().map(|c| c.id.as_str()).collect();
+    assert_eq!(
+        ids,
+        ["#5", "hole #6"],
+        "both contours, the unsafe name dropped"
+    );
+    assert!(
+        im.report.skipped.iter().any(|s| s
+            .starts_with("#5 CIRCLE: its name contains the control character U+000A (line feed)")),
+        "{:?}",
+        im.report.skipped
+    );
+}
+
 #[test]
 fn a_line_trim_and_degree_units_in_a_hand_written_file() {
     // A circle trimmed from 0 to 90 in a file whose plane angles are degrees and lengths cm.

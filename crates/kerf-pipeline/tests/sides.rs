@@ -24,6 +24,7 @@ fn hole(side: ScrapSide) -> CurvesFile {
     let wall = NurbsSurface::cylinder(Point3::origin(), Vector3::z(), R, 2.0).expect("wall");
     let edge = NurbsCurve::circle(Point3::origin(), Vector3::z(), R).expect("edge");
     CurvesFile {
+        warnings: Vec::new(),
         units: kerf_format::Units::Millimetres,
         curves: vec![CurveRecord {
             id: "edge".into(),
@@ -163,6 +164,7 @@ fn a_contour_under_a_roof_keeps_its_side_when_the_head_cannot_reach_the_other() 
         flip: false,
     };
     let file = CurvesFile {
+        warnings: Vec::new(),
         units: kerf_format::Units::Millimetres,
         curves: vec![
             record(

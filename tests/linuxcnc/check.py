@@ -29,11 +29,17 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 MACHINES = ["ac_head", "gantry_ac", "fork_head", "table_table", "head_table"]
-# (fixture, machine, flat): the flat part must run within 10 % of kerf's predicted time.
+# (fixture, machine, flat, more `kerf run` arguments, cuts to run or None for all): the flat
+# part must run within 10 % of kerf's predicted time. The real propeller (placed by `--place
+# auto`, blade edges at up to 112 degrees of tilt) runs its first cuts only: all 47 take LinuxCNC
+# about 4 minutes.
 SIMS = [
-    ("sheet_metal_holes", "gantry_ac", True),
-    ("tube_saddle", "ac_head", False),
+    ("sheet_metal_holes", "gantry_ac", True, (), None),
+    ("tube_saddle", "ac_head", False, (), None),
+    ("realdata/occt_propeller", "gantry_ac", False, ("--place", "auto"), 12),
 ]
+# The real files, placed automatically on the gantry: every set-up's program through rs274.
+REAL = ["nori_sheetmetal", "occt_propeller"]
 USER = "kerfsim"
 failures = []
 
@@ -84,12 +90,32 @@ def ensure_user():
     return USER
 
 
-def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), traj=(), edit=None):
+def first_cuts(text, cuts, beam_on="M64 P0", beam_off="M65 P0"):
+    """The program cut short after its `cuts`-th cut (the beam-off line after its beam-on; the
+    preamble switches the beam off once before any cut), then ended."""
+    out, seen, on = [], 0, False
+    for line in text.splitlines():
+        out.append(line)
+        if line.strip() == beam_on:
+            on = True
+        elif line.strip() == beam_off and on:
+            on = False
+            seen += 1
+            if seen == cuts:
+                break
+    return "\n".join(out + ["M2", ""])
+
+
+def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), traj=(), edit=None,
+             cuts=None):
     """One simulator run; `extra` are more `kerf run` arguments, `traj` more [TRAJ] lines of
-    the INI, `edit` a function applied to the program text (for the experiments)."""
-    work = Path(tempfile.mkdtemp(prefix=f"kerf-sim-{fixture}-"))
+    the INI, `edit` a function applied to the program text (for the experiments), `cuts` the
+    number of cuts to run (a long real part cut short; all when None)."""
+    if cuts is not None:
+        edit = lambda text, e=edit: first_cuts(e(text) if e else text, cuts)
+    fixture_tag = fixture.replace("/", "-") + tag
+    work = Path(tempfile.mkdtemp(prefix=f"kerf-sim-{fixture_tag}-"))
     os.chmod(work, 0o777)
-    fixture_tag = fixture + tag
     kout = outdir / f"sim-{fixture_tag}"
     r = kerf_run(kerf, fixture, machine, "linuxcnc", kout, extra)
     if r.returncode != 0:
@@ -127,7 +153,7 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
     res = json.loads(res_path.read_text())
     shutil.copy(work / "samples.txt", outdir / f"sim-{fixture_tag}-samples.txt")
     m = run([str(measure), str(ROOT / "fixtures" / "machines" / f"{machine}.json"), str(kout),
-             str(work / "samples.txt"), "0.001"])
+             str(work / "samples.txt"), "0.001", *([str(cuts)] if cuts is not None else [])])
     if m.returncode != 0:
         fail(f"sim {fixture}: lcnc_measure: {m.stderr.strip()}")
         return None
@@ -180,7 +206,7 @@ def main():
     sims = SIMS
     if "--sim" in args:
         names = args[args.index("--sim") + 1:]
-        sims = [s for s in SIMS if s[0] in names]
+        sims = [s for s in SIMS if s[0] in names or s[0].split("/")[-1] in names]
     for tool in ("rs274", "linuxcnc", "halsampler"):
         if shutil.which(tool) is None:
             print(f"FAIL: {tool} not found: install LinuxCNC (apt-get install linuxcnc-uspace)")
@@ -216,13 +242,29 @@ def main():
                 shutil.rmtree(out, ignore_errors=True)
         if not ran:
             fail(f"{f}: no machine file holds it, nothing parsed")
+    for f in REAL:
+        out = outdir / f"real-{f}"
+        r = kerf_run(kerf, f"realdata/{f}", "gantry_ac", "linuxcnc", out, ("--place", "auto"))
+        if r.returncode != 0:
+            fail(f"{f}: kerf run --place auto: {r.stderr.strip()[:300]}")
+            continue
+        programs = sorted(out.glob("program*.nc"))
+        if not programs:
+            fail(f"{f}: no program written")
+        for prog in programs:
+            msgs = rs274(cfgs["gantry_ac"], prog)
+            if msgs:
+                fail(f"rs274 {f} {prog.name} on gantry_ac: {msgs[:5]}")
+            parsed.append({"fixture": f"realdata/{f}/{prog.name}", "machine": "gantry_ac",
+                           "dialect": "linuxcnc", "ok": not msgs})
+        shutil.rmtree(out, ignore_errors=True)
     print(f"rs274: {sum(p['ok'] for p in parsed)}/{len(parsed)} programs parse without error or warning "
-          f"({len(fixtures)} fixtures)", flush=True)
+          f"({len(fixtures)} fixtures, {len(REAL)} real parts)", flush=True)
     # 2. The simulator.
     figs = []
     if "--no-sim" not in args:
-        for f, m, flat in sims:
-            fig = simulate(kerf, measure, f, m, flat, outdir)
+        for f, m, flat, extra, cuts in sims:
+            fig = simulate(kerf, measure, f, m, flat, outdir, extra=extra, cuts=cuts)
             if fig:
                 figs.append(fig)
     summary = {"linuxcnc": run(["dpkg-query", "-W", "-f", "${Version}", "linuxcnc-uspace"]).stdout,

@@ -4,12 +4,14 @@
 //! and accelerations, and the time against kerf's plan. Prints one JSON object.
 //!
 //! ```sh
-//! cargo run --release -p kerf-cli --example lcnc_measure -- MACHINE.json KERF_OUT_DIR SAMPLES.txt [PERIOD_S]
+//! cargo run --release -p kerf-cli --example lcnc_measure -- MACHINE.json KERF_OUT_DIR SAMPLES.txt [PERIOD_S [CUTS]]
 //! ```
 //!
 //! `SAMPLES.txt` is `halsampler -t` output: the sample number, the five joint positions (the
 //! machine file's axis order) and the beam bit, one servo cycle per line. `KERF_OUT_DIR` holds
-//! `axes.json`, `toolpath.json` and `report.json` of the same `kerf run`.
+//! `axes.json`, `toolpath.json` and `report.json` of the same `kerf run`. With `CUTS` the
+//! program ran only its first `CUTS` cuts (a long real part cut short for CI): only those paths
+//! are measured, and kerf's time is theirs (the report's per-path durations).
 //!
 //! The tip is measured three ways while the beam is on: against the poses (the program's own
 //! path, lead-ins and the pierce descent included), against the cutting points (placed with
@@ -74,11 +76,19 @@ fn main() {
     let machine = Machine::read(&args[0]).unwrap_or_else(|e| fail(e.to_string()));
     let dir = Path::new(&args[1]);
     let period: f64 = args.get(3).map_or(0.001, |s| s.parse().unwrap_or(0.001));
+    // Measure only the first CUTS paths (a program cut short after its CUTS-th cut).
+    let only: Option<usize> = args.get(4).map(|s| {
+        s.parse()
+            .unwrap_or_else(|_| fail(format!("CUTS: not a count: {s}")))
+    });
     let read = |name: &str| {
         std::fs::read_to_string(dir.join(name))
             .unwrap_or_else(|e| fail(format!("{}: {e}", dir.join(name).display())))
     };
-    let axes = AxesFile::from_str(&read("axes.json")).unwrap_or_else(|e| fail(e.to_string()));
+    let mut axes = AxesFile::from_str(&read("axes.json")).unwrap_or_else(|e| fail(e.to_string()));
+    if let Some(k) = only {
+        axes.paths.truncate(k);
+    }
     let tp = kerf_format::toolpath::from_str(&read("toolpath.json"))
         .unwrap_or_else(|e| fail(e.to_string()));
     let report: Value =
@@ -91,9 +101,21 @@ fn main() {
     let budget = report["tolerance_budget_mm"]["total"]
         .as_f64()
         .unwrap_or(f64::NAN);
-    let duration = report["interpolation"]["duration_s"]
-        .as_f64()
-        .unwrap_or(f64::NAN);
+    let duration = match only {
+        None => report["interpolation"]["duration_s"]
+            .as_f64()
+            .unwrap_or(f64::NAN),
+        // Each path's duration includes the rapids that lead to it; the first path's lead-in
+        // rapid from the program start is outside the beam-on span measured.
+        Some(k) => report["interpolation"]["paths"]
+            .as_array()
+            .map_or(f64::NAN, |p| {
+                p.iter()
+                    .take(k)
+                    .map(|q| q["duration_s"].as_f64().unwrap_or(f64::NAN))
+                    .sum()
+            }),
+    };
     let feed = report["interpolation"]["feed_mm_per_min"]
         .as_f64()
         .unwrap_or(f64::NAN);

@@ -398,10 +398,14 @@ pub(crate) fn trapezoid_step(
 /// [`DiscretizeError::Discontinuous`].
 pub fn piece_ends(curve: &NurbsCurve, tolerance: f64) -> Result<Vec<f64>> {
     let (a, b) = curve.domain();
-    let breaks = curve.c0_breaks();
     let p = curve.degree();
-    for &u in &breaks {
-        if kerf_nurbs::multiplicity(curve.knots(), u) > p {
+    // One pass over the knots gives every break with its multiplicity (a scan per break was
+    // quadratic on a polyline with a break at each of its 200,000 knots).
+    let knots = kerf_nurbs::interior_knots(p, curve.knots(), curve.len());
+    let mut breaks = Vec::with_capacity(knots.len());
+    for (u, m) in knots.into_iter().filter(|&(_, m)| m >= p) {
+        breaks.push(u);
+        if m > p {
             let span = curve.span(u);
             // The span ending at u, to its left.
             let left_span = (p..span)

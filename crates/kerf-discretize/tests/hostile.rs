@@ -579,3 +579,84 @@ fn a_jump_among_many_breaks_is_still_found() {
         other => panic!("expected the jump at t = 600, got {other:?}"),
     }
 }
+
+/// A degree-2 curve 1e12 mm long: its rounding margin (~0.1 mm) is above half of 0.01 mm.
+fn too_long_to_certify() -> NurbsCurve {
+    NurbsCurve::new(
+        2,
+        vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        vec![
+            nalgebra::Point3::new(0.0, 0.0, 0.0),
+            nalgebra::Point3::new(1e12, 1.0, 0.0),
+            nalgebra::Point3::new(1e12, 1e12, 0.0),
+        ],
+        None,
+    )
+}
+
+#[test]
+fn check_tolerance_refuses_exactly_what_the_walk_would() {
+    // check_tolerance reads the control points only; discretize refuses the same tolerances
+    // with the same margin (its certifier's).
+    let mut curves: Vec<NurbsCurve> = fixture("mixed.json").into_iter().map(|r| r.1).collect();
+    curves.push(too_long_to_certify());
+    for c in &curves {
+        for tol in [1e-13, 1e-12, 1e-11, 1e-9, 1e-6, 0.01, 1.0] {
+            let early = kerf_discretize::check_tolerance(c, tol);
+            let cert = kerf_discretize::Certifier::new(c);
+            let margin = cert.max_margin() + cert.output_resolution();
+            match early {
+                Err(DiscretizeError::ToleranceBelowMargin { margin: m, .. }) => {
+                    assert_eq!(m, margin, "same margin");
+                    assert!(margin > 0.5 * tol);
+                    assert!(matches!(
+                        discretize(c, &Options::with_tolerance(tol)),
+                        Err(DiscretizeError::ToleranceBelowMargin { .. })
+                    ));
+                }
+                Ok(()) => assert!(margin <= 0.5 * tol, "{margin} at {tol}"),
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+    assert!(matches!(
+        kerf_discretize::check_tolerance(&curves[0], f64::NAN),
+        Err(DiscretizeError::BadOption { .. })
+    ));
+}
+
+#[test]
+fn discretize_all_refuses_a_batch_before_any_walk() {
+    // Review: a curve late in a batch whose tolerance cannot be certified was refused only
+    // after the walks of the curves before it (door_trim at 1e-10 mm: 110 s). On one thread,
+    // counted: no curve is walked.
+    let mut curves: Vec<NurbsCurve> = fixture("mixed.json").into_iter().map(|r| r.1).collect();
+    let bad = curves.len();
+    curves.push(too_long_to_certify());
+    curves.extend(fixture("mixed.json").into_iter().map(|r| r.1));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let (results, work) = pool.install(|| {
+        counted(|| kerf_discretize::discretize_all(&curves, &Options::with_tolerance(0.01)))
+    });
+    let work = work.expect("counted");
+    assert!(work < 100, "{work} evaluations before refusing");
+    for (i, r) in results.iter().enumerate() {
+        if i == bad {
+            assert!(
+                matches!(r, Err(DiscretizeError::ToleranceBelowMargin { .. })),
+                "{r:?}"
+            );
+        } else {
+            assert_eq!(r, &Err(DiscretizeError::NotWalked { index: bad }), "{i}");
+        }
+    }
+    // Without the bad curve the batch is discretized as curve by curve.
+    curves.remove(bad);
+    let all = kerf_discretize::discretize_all(&curves, &Options::with_tolerance(0.01));
+    for (c, r) in curves.iter().zip(all) {
+        assert_eq!(r, discretize(c, &Options::with_tolerance(0.01)));
+    }
+}

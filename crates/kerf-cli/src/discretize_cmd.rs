@@ -93,6 +93,23 @@ fn discretize_to_file(
     bar: &ProgressBar,
 ) -> Result<Totals, CliError> {
     opts.validate().map_err(kerf_pipeline::Error::Options)?;
+    // Refusals known from the control points come before any walk: a curve late in the file
+    // whose tolerance is below its rounding margin is refused at once, not after the walks of
+    // the curves before it (which took minutes at 1e-10 mm).
+    let checks: Vec<_> = file
+        .curves
+        .par_iter()
+        .map(|r| kerf_discretize::check_tolerance(&r.curve, opts.tolerance_mm))
+        .collect();
+    if let Some((index, Err(source))) = checks.into_iter().enumerate().find(|(_, r)| r.is_err()) {
+        return Err(kerf_pipeline::Error::Discretize {
+            file: Some(input.to_path_buf()),
+            index,
+            id: file.curves[index].id.clone(),
+            source,
+        }
+        .into());
+    }
     let total = file.curves.len();
     let mut totals = Totals::default();
     bar.update(Progress::new(Stage::Discretize, 0, total));
@@ -186,7 +203,8 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             "tolerance": opts.tolerance_mm,
             "max_chord_error": worst,
             "n_star": nstar,
-            "segments_over_n_star": if nstar > 0.0 { segments as f64 / nstar } else { f64::NAN },
+            // null when N* is 0 (no ratio; `n_star_text`).
+            "segments_over_n_star": (nstar > 0.0).then(|| segments as f64 / nstar),
             "seconds": elapsed,
             "normals": args.normals,
             "normal_points_added": added,
@@ -208,21 +226,30 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
         }
         eprintln!(
             "{}: {} curves, {points} points ({segments} segments from the discretizer, {breaks} C0 corners kept), \
-             worst certified chord error {worst:.3e} mm <= {} mm, N* {nstar:.1} \
-             (segments / N* = {:.3}), {:.3} s -> {}",
+             worst certified chord error {worst:.3e} mm <= {} mm, {}, {:.3} s -> {}",
             path.display(),
             file.curves.len(),
             opts.tolerance_mm,
-            if nstar > 0.0 {
-                segments as f64 / nstar
-            } else {
-                f64::NAN
-            },
+            n_star_text(segments, nstar),
             elapsed,
             dest.display()
         );
     }
     Ok(())
+}
+
+/// The summary's account of `N*`: with the ratio when `N*` is positive; when it is 0 (straight
+/// pieces, a retraced line, or a curvature too small for double precision to measure) there
+/// is no ratio to give, and the text says why instead of printing NaN.
+fn n_star_text(segments: usize, nstar: f64) -> String {
+    if nstar > 0.0 {
+        format!(
+            "N* {nstar:.1} (segments / N* = {:.3})",
+            segments as f64 / nstar
+        )
+    } else {
+        format!("N* {nstar:.1} (no curvature measured, so no segments / N* ratio)")
+    }
 }
 
 /// `dir/part.json` -> `part.toolpath.json` in the current directory (the input's folder may be

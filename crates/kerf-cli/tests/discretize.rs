@@ -114,3 +114,82 @@ fn usage_errors_exit_2() {
     let o = kerf().args(["discretize", "--tolerance"]).output().unwrap();
     assert_eq!(o.status.code(), Some(2), "missing value is a usage error");
 }
+
+/// Runs `kerf discretize` on a `kerf.curves/1` document with `args`; (exit code, stderr).
+fn discretize_doc(doc: &str, args: &[&str]) -> (Option<i32>, String) {
+    let (code, _, stderr) = discretize_doc_out(doc, args);
+    (code, stderr)
+}
+
+/// [`discretize_doc`] with standard output: (exit code, stdout, stderr).
+fn discretize_doc_out(doc: &str, args: &[&str]) -> (Option<i32>, String, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.json");
+    std::fs::write(&input, doc).unwrap();
+    let o = kerf()
+        .arg("discretize")
+        .arg(&input)
+        .args(args)
+        .arg("-o")
+        .arg(dir.path().join("out.json"))
+        .output()
+        .unwrap();
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_tolerance_no_curve_can_hold_is_refused_before_any_walk() {
+    // Review: door_trim at 1e-10 mm walked curves 0 and 1 for 110 s before refusing curve 2,
+    // whose rounding margin is known from its control points. Curve 0 here fails only in its
+    // walk (its estimate before the walk is 2 points, from a curvature too small to measure,
+    // and the walk needs 20, over --max-points 10); curve 1 is 1e12 mm long (margin ~0.1 mm).
+    // Checked before any walk, curve 1's refusal comes first.
+    let first = r#"{"id": "huge-span", "degree": 2, "knots": [0, 0, 0, 1e-300, 1e300, 1e300, 1e300],
+         "control_points": [[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0]]}"#;
+    let second = r#"{"id": "long", "degree": 2, "knots": [0, 0, 0, 1, 1, 1],
+         "control_points": [[0, 0, 0], [1e12, 1, 0], [1e12, 1e12, 0]]}"#;
+    let doc = |curves: &str| {
+        format!(r#"{{"format": "kerf.curves/1", "units": "mm", "curves": [{curves}]}}"#)
+    };
+    let args = ["-t", "0.01", "--max-points", "10"];
+    let (code, stderr) = discretize_doc(&doc(&format!("{first}, {second}")), &args);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("curves[1]") && stderr.contains("rounding margin"),
+        "{stderr}"
+    );
+    // Alone, curve 0 is refused by its walk when it passes the limit (so the order above is
+    // the check's doing).
+    let (code, stderr) = discretize_doc(&doc(first), &args);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("curves[0]")
+            && stderr.contains("more than 10 cutting points would be needed (estimated 11)"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn summary_without_curvature_gives_no_ratio() {
+    // Review: straight pieces have N* = 0 and the summary printed "segments / N* = NaN".
+    let doc = r#"{"format": "kerf.curves/1", "units": "mm", "curves": [
+        {"id": "zigzag", "degree": 1, "knots": [0, 0, 1, 2, 3, 3],
+         "control_points": [[0, 0, 0], [1, 1, 0], [2, 0, 0], [3, 1, 0]]}]}"#;
+    let (code, stderr) = discretize_doc(doc, &["-t", "0.01"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(!stderr.contains("NaN"), "{stderr}");
+    assert!(
+        stderr.contains("N* 0.0 (no curvature measured, so no segments / N* ratio)"),
+        "{stderr}"
+    );
+    let (code, stdout, stderr) = discretize_doc_out(doc, &["-t", "0.01", "--json"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(summary["n_star"], 0.0);
+    assert!(summary["segments_over_n_star"].is_null(), "{summary}");
+    assert_eq!(summary["segments"], 3);
+}

@@ -90,6 +90,14 @@ pub enum DiscretizeError {
         /// The certified bound reached (mm), or the parameter of a missing C0 break, or NaN.
         bound: f64,
     },
+    /// [`crate::discretize_all`] did not walk this curve because the tolerance cannot be
+    /// certified on another curve of the batch (known before any walk). Fix: raise the
+    /// tolerance for the curve `index`, or discretize it apart.
+    #[error("not discretized: the tolerance cannot be certified on curve {index} of the batch, so no curve was walked")]
+    NotWalked {
+        /// The first curve of the batch whose tolerance is below its rounding margin.
+        index: usize,
+    },
 }
 
 /// `Result` with [`DiscretizeError`].

@@ -139,10 +139,7 @@ impl Discretization {
     pub fn certify(curve: &NurbsCurve, params: &[f64], tolerance: f64) -> Result<Self> {
         Options::with_tolerance(tolerance).validate()?;
         let cert = Certifier::new(curve);
-        let margin = cert.max_margin() + cert.output_resolution();
-        if margin.is_nan() || margin > 0.5 * tolerance {
-            return Err(DiscretizeError::ToleranceBelowMargin { tolerance, margin });
-        }
+        margin_refusal(tolerance, cert.max_margin() + cert.output_resolution())?;
         let fail = |index: usize, reason: &'static str, bound: f64| {
             Err(DiscretizeError::NotCertified {
                 index,
@@ -223,10 +220,7 @@ impl Discretization {
     pub fn with_point(&self, curve: &NurbsCurve, t: f64, tolerance: f64) -> Result<Self> {
         Options::with_tolerance(tolerance).validate()?;
         let cert = Certifier::new(curve);
-        let margin = cert.max_margin() + cert.output_resolution();
-        if margin.is_nan() || margin > 0.5 * tolerance {
-            return Err(DiscretizeError::ToleranceBelowMargin { tolerance, margin });
-        }
+        margin_refusal(tolerance, cert.max_margin() + cert.output_resolution())?;
         let n = self.params.len();
         let i = self.params.partition_point(|&p| p < t);
         let (a, b) = curve.domain();
@@ -390,6 +384,30 @@ pub(crate) fn trapezoid_step(
     f0 * (first - t0) + 0.5 * (f0 + f1) * (last - first) + f1 * (t1 - last)
 }
 
+/// Refuses a tolerance that cannot be certified on `curve`, from its control points alone
+/// (one pass, no Bezier form, no walk): a tolerance that is not finite and positive, or one
+/// below twice the certificate's rounding margin plus the output resolution
+/// ([`Certifier::max_margin`], [`Certifier::output_resolution`]). [`discretize`] makes the
+/// same check before its walk; a caller that discretizes many curves and stops at the first
+/// failure should check every curve first, so that a curve late in the file that cannot be
+/// certified is refused before the walks of the curves before it.
+///
+/// # Errors
+/// [`DiscretizeError::BadOption`] (named `tolerance_mm`), [`DiscretizeError::ToleranceBelowMargin`].
+pub fn check_tolerance(curve: &NurbsCurve, tolerance: f64) -> Result<()> {
+    Options::with_tolerance(tolerance).validate()?;
+    let m = bound::Margins::of(curve, &kerf_nurbs::LocalCurve::new(curve));
+    margin_refusal(tolerance, m.max_margin + m.output_resolution)
+}
+
+/// The refusal of a tolerance below twice the `margin` (max margin plus output resolution).
+fn margin_refusal(tolerance: f64, margin: f64) -> Result<()> {
+    if margin.is_nan() || margin > 0.5 * tolerance {
+        return Err(DiscretizeError::ToleranceBelowMargin { tolerance, margin });
+    }
+    Ok(())
+}
+
 /// The ends of the C0 pieces: the domain ends and every C0 break in between. Fails if the
 /// curve jumps by more than half the tolerance at a knot of multiplicity `degree + 1`
 /// (smaller gaps are covered by the certified bound of the segment that ends there).
@@ -398,10 +416,14 @@ pub(crate) fn trapezoid_step(
 /// [`DiscretizeError::Discontinuous`].
 pub fn piece_ends(curve: &NurbsCurve, tolerance: f64) -> Result<Vec<f64>> {
     let (a, b) = curve.domain();
-    let breaks = curve.c0_breaks();
     let p = curve.degree();
-    for &u in &breaks {
-        if kerf_nurbs::multiplicity(curve.knots(), u) > p {
+    // One pass over the knots gives every break with its multiplicity (a scan per break was
+    // quadratic on a polyline with a break at each of its 200,000 knots).
+    let knots = kerf_nurbs::interior_knots(p, curve.knots(), curve.len());
+    let mut breaks = Vec::with_capacity(knots.len());
+    for (u, m) in knots.into_iter().filter(|&(_, m)| m >= p) {
+        breaks.push(u);
+        if m > p {
             let span = curve.span(u);
             // The span ending at u, to its left.
             let left_span = (p..span)
@@ -469,12 +491,7 @@ pub fn discretize_range(
     // margin (known from the control points), then the size of the output.
     let cert = Certifier::new(curve);
     let margin = cert.max_margin() + cert.output_resolution();
-    if margin.is_nan() || margin > 0.5 * opts.tolerance_mm {
-        return Err(DiscretizeError::ToleranceBelowMargin {
-            tolerance: opts.tolerance_mm,
-            margin,
-        });
-    }
+    margin_refusal(opts.tolerance_mm, margin)?;
     let estimate = minimum::estimate_count_with(curve, opts.tolerance_mm, |t| cert.eval_d2(t));
     let by_length = if opts.max_segment_length_mm.is_finite() {
         curve.size() / opts.max_segment_length_mm
@@ -553,7 +570,27 @@ pub fn discretize_range(
 }
 
 /// Discretizes many curves in parallel (rayon); results in input order, identical to calling
-/// [`discretize`] on each curve in turn.
+/// [`discretize`] on each curve in turn when every curve's tolerance can be certified.
+///
+/// Refusals known from the options and the control points come first, before any walk: if the
+/// options are invalid every result is that error, and if the tolerance is below the rounding
+/// margin of some curves ([`check_tolerance`]) no curve is walked: those curves' results are
+/// [`DiscretizeError::ToleranceBelowMargin`] and every other result is
+/// [`DiscretizeError::NotWalked`] naming the first refused curve (a batch at a tolerance that
+/// cannot hold for all of it is refused at once, not after the walks of the others).
 pub fn discretize_all(curves: &[NurbsCurve], opts: &Options) -> Vec<Result<Discretization>> {
+    if let Err(e) = opts.validate() {
+        return curves.iter().map(|_| Err(e.clone())).collect();
+    }
+    let checks: Vec<Result<()>> = curves
+        .par_iter()
+        .map(|c| check_tolerance(c, opts.tolerance_mm))
+        .collect();
+    if let Some(index) = checks.iter().position(Result::is_err) {
+        return checks
+            .into_iter()
+            .map(|r| r.and(Err(DiscretizeError::NotWalked { index })))
+            .collect();
+    }
     curves.par_iter().map(|c| discretize(c, opts)).collect()
 }

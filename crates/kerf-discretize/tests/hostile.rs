@@ -503,3 +503,160 @@ fn messages_print_readable_numbers() {
     };
     assert!(e.to_string().len() < 160, "no 300 digits: {e}");
 }
+
+/// A polyline of `n` points zigzagging in the plane, as a degree-1 curve whose every interior
+/// knot is a C0 break (`multiplicity` copies of each).
+fn zigzag(n: usize, multiplicity: usize) -> NurbsCurve {
+    let pts: Vec<_> = (0..n)
+        .flat_map(|i| {
+            let p = nalgebra::Point3::new(i as f64, (i % 2) as f64, 0.0);
+            // Interior points repeated so that a knot of multiplicity 2 keeps the curve
+            // continuous (degree 1: the limits on either side are the two copies).
+            let copies = if i == 0 || i == n - 1 {
+                1
+            } else {
+                multiplicity
+            };
+            std::iter::repeat_n(p, copies)
+        })
+        .collect();
+    let mut knots = vec![0.0, 0.0];
+    for i in 1..n - 1 {
+        knots.extend(std::iter::repeat_n(i as f64, multiplicity));
+    }
+    knots.extend([(n - 1) as f64; 2]);
+    NurbsCurve::new(1, knots, pts, None)
+}
+
+#[test]
+fn a_break_at_every_knot_costs_linear_work() {
+    // Review: the C0 pieces were found by one scan of the knot vector per break, quadratic on
+    // a polyline (200,000 points took 6 s). Counted: the knots read by the scans stay within a
+    // few passes over the knot vector, and the evaluations within a few per point.
+    for multiplicity in [1, 2] {
+        let n = 20_000;
+        let c = zigzag(n, multiplicity);
+        let before = kerf_nurbs::knot_reads().expect("counted");
+        let (r, work) = run(&c, &Options::with_tolerance(0.01));
+        let reads = kerf_nurbs::knot_reads().unwrap() - before;
+        let d = r.expect("a polyline is discretized");
+        // Independent truth: each piece is straight, so the cutting points are exactly the
+        // polyline's corners, and every interior one is a break.
+        assert_eq!(d.points().len(), n, "m = {multiplicity}");
+        assert_eq!(d.c0_breaks().len(), n - 2, "m = {multiplicity}");
+        for (i, p) in d.points().iter().enumerate() {
+            assert_eq!(
+                p.coords,
+                nalgebra::Vector3::new(i as f64, (i % 2) as f64, 0.0)
+            );
+        }
+        let knots = c.knots().len() as u64;
+        assert!(
+            reads <= 4 * knots,
+            "m = {multiplicity}: {reads} knots read for {knots} knots"
+        );
+        assert!(
+            work <= 20 * n as u64,
+            "m = {multiplicity}: {work} evaluations for {n} points"
+        );
+    }
+}
+
+#[test]
+fn a_jump_among_many_breaks_is_still_found() {
+    // The linear pass keeps the jump test of knots of multiplicity degree + 1: move the right
+    // copy of one interior point of the doubled-knot polyline 1 mm away.
+    let c = zigzag(1_000, 2);
+    let mut pts = c.control_points();
+    // Point 2 * 600 is the right copy of corner 600 (corner i > 0 has copies 2i - 1 and 2i).
+    pts[1_200].z += 1.0;
+    let jumpy = NurbsCurve::new(1, c.knots().to_vec(), pts, None);
+    match discretize(&jumpy, &Options::with_tolerance(0.01)) {
+        Err(DiscretizeError::Discontinuous { t, gap }) => {
+            assert_eq!(t, 600.0);
+            assert!((gap - 1.0).abs() < 1e-12, "gap {gap}");
+        }
+        other => panic!("expected the jump at t = 600, got {other:?}"),
+    }
+}
+
+/// A degree-2 curve 1e12 mm long: its rounding margin (~0.1 mm) is above half of 0.01 mm.
+fn too_long_to_certify() -> NurbsCurve {
+    NurbsCurve::new(
+        2,
+        vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        vec![
+            nalgebra::Point3::new(0.0, 0.0, 0.0),
+            nalgebra::Point3::new(1e12, 1.0, 0.0),
+            nalgebra::Point3::new(1e12, 1e12, 0.0),
+        ],
+        None,
+    )
+}
+
+#[test]
+fn check_tolerance_refuses_exactly_what_the_walk_would() {
+    // check_tolerance reads the control points only; discretize refuses the same tolerances
+    // with the same margin (its certifier's).
+    let mut curves: Vec<NurbsCurve> = fixture("mixed.json").into_iter().map(|r| r.1).collect();
+    curves.push(too_long_to_certify());
+    for c in &curves {
+        for tol in [1e-13, 1e-12, 1e-11, 1e-9, 1e-6, 0.01, 1.0] {
+            let early = kerf_discretize::check_tolerance(c, tol);
+            let cert = kerf_discretize::Certifier::new(c);
+            let margin = cert.max_margin() + cert.output_resolution();
+            match early {
+                Err(DiscretizeError::ToleranceBelowMargin { margin: m, .. }) => {
+                    assert_eq!(m, margin, "same margin");
+                    assert!(margin > 0.5 * tol);
+                    assert!(matches!(
+                        discretize(c, &Options::with_tolerance(tol)),
+                        Err(DiscretizeError::ToleranceBelowMargin { .. })
+                    ));
+                }
+                Ok(()) => assert!(margin <= 0.5 * tol, "{margin} at {tol}"),
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+    assert!(matches!(
+        kerf_discretize::check_tolerance(&curves[0], f64::NAN),
+        Err(DiscretizeError::BadOption { .. })
+    ));
+}
+
+#[test]
+fn discretize_all_refuses_a_batch_before_any_walk() {
+    // Review: a curve late in a batch whose tolerance cannot be certified was refused only
+    // after the walks of the curves before it (door_trim at 1e-10 mm: 110 s). On one thread,
+    // counted: no curve is walked.
+    let mut curves: Vec<NurbsCurve> = fixture("mixed.json").into_iter().map(|r| r.1).collect();
+    let bad = curves.len();
+    curves.push(too_long_to_certify());
+    curves.extend(fixture("mixed.json").into_iter().map(|r| r.1));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let (results, work) = pool.install(|| {
+        counted(|| kerf_discretize::discretize_all(&curves, &Options::with_tolerance(0.01)))
+    });
+    let work = work.expect("counted");
+    assert!(work < 100, "{work} evaluations before refusing");
+    for (i, r) in results.iter().enumerate() {
+        if i == bad {
+            assert!(
+                matches!(r, Err(DiscretizeError::ToleranceBelowMargin { .. })),
+                "{r:?}"
+            );
+        } else {
+            assert_eq!(r, &Err(DiscretizeError::NotWalked { index: bad }), "{i}");
+        }
+    }
+    // Without the bad curve the batch is discretized as curve by curve.
+    curves.remove(bad);
+    let all = kerf_discretize::discretize_all(&curves, &Options::with_tolerance(0.01));
+    for (c, r) in curves.iter().zip(all) {
+        assert_eq!(r, discretize(c, &Options::with_tolerance(0.01)));
+    }
+}

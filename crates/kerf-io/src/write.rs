@@ -123,6 +123,10 @@ fn atomic(
         contents(&mut w)?;
         w.flush()?;
     }
+    // The data reaches the disk before the rename does, so that after a crash or power loss
+    // `path` names the old file or the whole new one, never an empty or partial one (ext4's
+    // delayed allocation, XFS): part of the atomicity promised, not durability (the directory
+    // is not synced; docs/io.md, "Why the fsync before the rename stays").
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())

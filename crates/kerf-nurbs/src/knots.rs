@@ -124,12 +124,14 @@ pub fn find_span(degree: usize, knots: &[f64], n_points: usize, u: f64) -> usize
 
 /// How many times `u` occurs in `knots` (exact comparison).
 pub fn multiplicity(knots: &[f64], u: f64) -> usize {
+    crate::work::tick_knots(knots.len());
     knots.iter().filter(|&&k| k == u).count()
 }
 
 /// The distinct knot values strictly inside the domain `(start, end)` with their multiplicity.
 pub fn interior_knots(degree: usize, knots: &[f64], n_points: usize) -> Vec<(f64, usize)> {
     let (start, end) = (knots[degree], knots[n_points]);
+    crate::work::tick_knots(knots.len());
     let mut out: Vec<(f64, usize)> = Vec::new();
     for &k in knots {
         if k <= start || k >= end {

@@ -57,7 +57,7 @@ pub use local::{is_power_of_two, LocalCurve};
 #[cfg(feature = "samples")]
 pub use samples::{smooth_random_curves, Lcg};
 pub use surface::{NurbsSurface, SurfaceProjection};
-pub use work::{counted, evaluations, tick};
+pub use work::{counted, evaluations, knot_reads, tick, tick_knots};
 
 /// The largest degree kerf accepts. CAD systems use degree <= 11 in practice; the fixed-size
 /// scratch arrays of the evaluator are sized by this constant.

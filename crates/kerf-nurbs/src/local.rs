@@ -24,11 +24,17 @@ pub struct LocalCurve {
     curve: NurbsCurve,
     origin: Vector3<f64>,
     representation_mm: f64,
+    magnitudes: Vec<f64>,
+    max_coordinate: f64,
+    unit_weights: bool,
 }
 
 impl LocalCurve {
     /// Translates `curve` to its local origin (one pass over the control points).
     pub fn new(curve: &NurbsCurve) -> Self {
+        let hom = curve.homogeneous_points();
+        // The control points as the file gives them: (w P) / w, the curve's own projection.
+        let point = |c: &Vector4<f64>| crate::project(c).coords;
         let (lo, hi) = curve.bounding_box();
         let extent = (hi - lo).amax();
         let centre = (lo.coords + hi.coords) * 0.5;
@@ -41,33 +47,38 @@ impl LocalCurve {
         if !origin.iter().all(|c| c.is_finite()) {
             origin = Vector3::zeros();
         }
-        let points = curve.control_points();
-        let weights = curve.weights();
-        let mut shifted = Vec::with_capacity(points.len());
-        let mut exact = true;
-        for p in &points {
+        // One pass: the translated homogeneous points, whether every translation is exact,
+        // the largest coordinate, and the weights' kinds.
+        let mut cpw = Vec::with_capacity(hom.len());
+        let mut magnitudes = Vec::with_capacity(hom.len());
+        let (mut exact, mut max_coordinate) = (true, 0.0f64);
+        let (mut powers_of_two, mut unit_weights) = (true, true);
+        for c in hom {
+            let (p, w) = (point(c), c.w);
             let mut d = Vector3::zeros();
             for k in 0..3 {
                 let (v, ok) = exact_diff(p[k], origin[k]);
                 d[k] = v;
                 exact &= ok;
             }
-            shifted.push(d);
+            cpw.push(Vector4::new(d.x * w, d.y * w, d.z * w, w));
+            magnitudes.push(d.amax());
+            max_coordinate = max_coordinate.max(p.amax());
+            powers_of_two &= is_power_of_two(w);
+            unit_weights &= w == 1.0;
         }
         if !exact {
             origin = Vector3::zeros();
-            shifted = points.iter().map(|p| p.coords).collect();
+            for ((q, m), c) in cpw.iter_mut().zip(&mut magnitudes).zip(hom) {
+                let (p, w) = (point(c), c.w);
+                *q = Vector4::new(p.x * w, p.y * w, p.z * w, w);
+                *m = p.amax();
+            }
         }
-        let cpw: Vec<Vector4<f64>> = shifted
-            .iter()
-            .zip(&weights)
-            .map(|(d, &w)| Vector4::new(d.x * w, d.y * w, d.z * w, w))
-            .collect();
-        let representation_mm = if weights.iter().all(|&w| is_power_of_two(w)) {
+        let representation_mm = if powers_of_two {
             0.0
         } else {
-            let scale = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
-            4.0 * f64::EPSILON * scale
+            4.0 * f64::EPSILON * max_coordinate
         };
         Self {
             curve: NurbsCurve::from_homogeneous_unchecked(
@@ -77,12 +88,20 @@ impl LocalCurve {
             ),
             origin,
             representation_mm,
+            magnitudes,
+            max_coordinate,
+            unit_weights,
         }
     }
 
     /// The translated curve `C(t) - O`: same degree, knots, weights and domain.
     pub fn curve(&self) -> &NurbsCurve {
         &self.curve
+    }
+
+    /// The translated curve, moved out (no copy).
+    pub fn into_curve(self) -> NurbsCurve {
+        self.curve
     }
 
     /// The local origin `O` (zero when no exact translation exists).
@@ -101,6 +120,25 @@ impl LocalCurve {
     /// file's curve and a measurement on the stored one may differ by this much.
     pub fn representation_mm(&self) -> f64 {
         self.representation_mm
+    }
+
+    /// `|P_i - O|_inf` for each control point `i` (`P_i` as the file gives it, `(w P) / w`):
+    /// exact, since the translation is. The rounding of every convex combination of control
+    /// points is bounded by these magnitudes.
+    pub fn magnitudes(&self) -> &[f64] {
+        &self.magnitudes
+    }
+
+    /// `max_i |P_i|_inf` in the global frame (mm): one ulp of it is the resolution of a
+    /// point written in global coordinates.
+    pub fn max_coordinate(&self) -> f64 {
+        self.max_coordinate
+    }
+
+    /// Whether every weight is exactly 1 (a polynomial curve): every homogeneous weight a
+    /// convex combination of the control points produces is then exactly 1.
+    pub fn unit_weights(&self) -> bool {
+        self.unit_weights
     }
 }
 

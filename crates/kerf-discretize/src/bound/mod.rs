@@ -44,7 +44,7 @@ pub(crate) use by_degree;
 /// A curve value the caller already knows: the knot span and the homogeneous local point at a
 /// parameter (from [`Certifier::eval`]), so that the certificate does not evaluate it again.
 pub(crate) type Known = Option<(usize, Vector4<f64>)>;
-use kerf_nurbs::{NurbsCurve, Segment, MAX_ORDER};
+use kerf_nurbs::{LocalCurve, NurbsCurve, Segment, MAX_ORDER};
 use nalgebra::{Point3, Vector3, Vector4};
 
 /// The verdict on one segment.
@@ -132,81 +132,60 @@ pub struct Certifier<'a> {
     representation: f64,
 }
 
-/// `a - b` and whether it is exact (Knuth's TwoSum error term is zero).
-fn exact_diff(a: f64, b: f64) -> (f64, bool) {
-    let s = a - b;
-    let bb = s - a;
-    let err = (a - (s - bb)) + (-b - bb);
-    (s, err == 0.0)
+/// The rounding magnitudes of a curve, known from its control points alone (before any
+/// Bezier form or walk): what [`Certifier::max_margin`] and [`Certifier::output_resolution`]
+/// report, and what [`crate::check_tolerance`] compares with the tolerance.
+pub(crate) struct Margins {
+    /// Per knot span index: `L = max_i |P_i - O|_inf` over the span's `p + 1` control points
+    /// (0 for empty spans).
+    pub spans: Vec<f64>,
+    pub max_margin: f64,
+    pub output_resolution: f64,
+}
+
+impl Margins {
+    /// From the curve's translation to its local origin.
+    pub(crate) fn of(curve: &NurbsCurve, lc: &LocalCurve) -> Self {
+        let p = curve.degree();
+        let knots = curve.knots();
+        let mags = lc.magnitudes();
+        let mut spans = vec![0.0; curve.len()];
+        for i in (p..curve.len()).filter(|&i| knots[i] < knots[i + 1]) {
+            spans[i] = mags[i - p..=i].iter().copied().fold(0.0, f64::max);
+        }
+        let worst = spans.iter().copied().fold(0.0, f64::max);
+        let f = MARGIN_FACTOR * (p + 1) as f64 * f64::EPSILON;
+        Self {
+            spans,
+            max_margin: (2.0 * f + 8.0 * f64::EPSILON) * worst + lc.representation_mm(),
+            output_resolution: 2.0 * f64::EPSILON * lc.max_coordinate(),
+        }
+    }
 }
 
 impl<'a> Certifier<'a> {
     /// Prepares `curve` for certification.
     pub fn new(curve: &'a NurbsCurve) -> Self {
-        let hom = curve.homogeneous_points();
-        // The control points as the file gives them: (w P) / w, the curve's own projection.
-        let point = |c: &Vector4<f64>| kerf_nurbs::project(c).coords;
-        let (lo, hi) = curve.bounding_box();
-        let extent = (hi - lo).amax();
-        let centre = (lo.coords + hi.coords) * 0.5;
-        let g = if extent > 0.0 && extent.is_finite() {
-            2f64.powi(extent.log2().ceil() as i32)
-        } else {
-            1.0
-        };
-        let mut origin = centre.map(|c| (c / g).round() * g);
-        if !origin.iter().all(|c| c.is_finite()) {
-            origin = Vector3::zeros();
-        }
-        // One pass: the translated homogeneous points, whether every translation is exact,
-        // the largest coordinate, and the weights' kinds.
-        let mut cpw = Vec::with_capacity(hom.len());
-        // `|P_i - O|_inf` per control point.
-        let mut mags = Vec::with_capacity(hom.len());
-        let (mut exact, mut scale) = (true, 0.0f64);
-        let (mut powers_of_two, mut unit_weights) = (true, true);
-        for c in hom {
-            let (p, w) = (point(c), c.w);
-            let mut d = Vector3::zeros();
-            for k in 0..3 {
-                let (v, ok) = exact_diff(p[k], origin[k]);
-                d[k] = v;
-                exact &= ok;
-            }
-            cpw.push(Vector4::new(d.x * w, d.y * w, d.z * w, w));
-            mags.push(d.amax());
-            scale = scale.max(p.amax());
-            powers_of_two &= is_power_of_two(w);
-            unit_weights &= w == 1.0;
-        }
-        if !exact {
-            origin = Vector3::zeros();
-            for ((q, m), c) in cpw.iter_mut().zip(&mut mags).zip(hom) {
-                let (p, w) = (point(c), c.w);
-                *q = Vector4::new(p.x * w, p.y * w, p.z * w, w);
-                *m = p.amax();
-            }
-        }
+        // The exact translation to the local origin, the per-point magnitudes and the weights'
+        // kinds: one pass over the control points (kerf_nurbs::LocalCurve, shared with the
+        // checker).
+        let lc = LocalCurve::new(curve);
+        let (origin, unit_weights) = (lc.origin(), lc.unit_weights());
+        let representation = lc.representation_mm();
+        let Margins {
+            spans,
+            max_margin,
+            output_resolution,
+        } = Margins::of(curve, &lc);
         let p = curve.degree();
         let knots = curve.knots();
-        let mut spans = vec![0.0; curve.len()];
-        for i in (p..curve.len()).filter(|&i| knots[i] < knots[i + 1]) {
-            spans[i] = mags[i - p..=i].iter().copied().fold(0.0, f64::max);
-        }
-        let representation = if powers_of_two {
-            0.0
-        } else {
-            4.0 * f64::EPSILON * scale
-        };
-        let local = NurbsCurve::from_homogeneous_unchecked(p, knots.to_vec(), cpw);
+        let local = lc.into_curve();
         let mut span_bezier = vec![Vector4::zeros(); curve.len() * (p + 1)];
         for i in (p..curve.len()).filter(|&i| knots[i] < knots[i + 1]) {
             let out = &mut span_bezier[i * (p + 1)..(i + 1) * (p + 1)];
             local.bezier_in_span_into(i, knots[i], knots[i + 1], out);
         }
         let (span_h3, span_bounds) = span_derivative_bounds(p, &span_bezier, &spans);
-        let worst = spans.iter().copied().fold(0.0, f64::max);
-        let f = MARGIN_FACTOR * (p + 1) as f64 * f64::EPSILON;
         Self {
             curve,
             local,
@@ -217,8 +196,8 @@ impl<'a> Certifier<'a> {
             span_bounds,
             unit_weights,
             representation,
-            max_margin: (2.0 * f + 8.0 * f64::EPSILON) * worst + representation,
-            output_resolution: 2.0 * f64::EPSILON * scale,
+            max_margin,
+            output_resolution,
         }
     }
 
@@ -419,55 +398,4 @@ pub fn chord_error(
     want_lower: f64,
 ) -> Bound {
     Certifier::new(curve).chord_error(&mut Scratch::default(), t0, t1, a, b, limit, want_lower)
-}
-
-/// Whether `w` is exactly a power of two (then `(w P) / w == P` exactly, so the weighted
-/// points carry no representation error). Decided from the bits: a normal number with an
-/// empty mantissa, or a subnormal with one mantissa bit. (`log2().fract() == 0` is not
-/// enough: `log2` rounds, so `2^-5 (1 + 2^-52)` passed it.)
-fn is_power_of_two(w: f64) -> bool {
-    if !(w > 0.0 && w.is_finite()) {
-        return false;
-    }
-    let bits = w.to_bits();
-    let mantissa = bits & ((1u64 << 52) - 1);
-    if bits >> 52 == 0 {
-        mantissa.is_power_of_two()
-    } else {
-        mantissa == 0
-    }
-}
-
-#[cfg(test)]
-mod power_of_two_tests {
-    use super::is_power_of_two;
-
-    #[test]
-    fn only_exact_powers_of_two_count() {
-        for k in -1074i64..=1023 {
-            // 2^k built from its bits (powi would round the subnormal ones).
-            let w = if k >= -1022 {
-                f64::from_bits(((k + 1023) as u64) << 52)
-            } else {
-                f64::from_bits(1u64 << (k + 1074))
-            };
-            assert_eq!(w.log2(), k as f64, "2^{k} built right");
-            assert!(is_power_of_two(w), "2^{k}");
-        }
-        let near = 2f64.powi(-5) * (1.0 + f64::EPSILON);
-        assert!(near.log2().fract() == 0.0, "the old test took this one");
-        assert!(!is_power_of_two(near), "2^-5 (1 + 2^-52)");
-        for w in [
-            0.0,
-            -1.0,
-            -0.5,
-            3.0,
-            0.75,
-            f64::NAN,
-            f64::INFINITY,
-            f64::MIN_POSITIVE * 1.5,
-        ] {
-            assert!(!is_power_of_two(w), "{w}");
-        }
-    }
 }

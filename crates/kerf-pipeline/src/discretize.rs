@@ -57,6 +57,18 @@ pub fn discretize_curves_within(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Vec<Discretization>> {
     opts.validate().map_err(Error::Options)?;
+    // Every curve's rounding margin against the tolerance before any walk: a tolerance no
+    // curve can hold is refused at once, not after the curves before it were walked.
+    for (index, r) in file.curves.iter().enumerate() {
+        kerf_discretize::check_tolerance(&r.curve, opts.tolerance_mm).map_err(|error| {
+            Error::Discretize {
+                file: source.map(Path::to_path_buf),
+                index,
+                id: r.id.clone(),
+                source: error,
+            }
+        })?;
+    }
     /// Why one curve has no discretization.
     enum Failed {
         Curve(DiscretizeError),

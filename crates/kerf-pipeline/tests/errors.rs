@@ -123,3 +123,29 @@ fn a_job_above_its_point_limit_is_refused_before_the_points_are_made() {
     let exact = kerf_pipeline::discretize_curves_within(curves, &opts, total, None, &|_| {});
     assert!(exact.is_ok(), "exactly the limit fits: {exact:?}");
 }
+
+#[test]
+fn a_tolerance_a_later_curve_cannot_hold_is_refused_before_any_curve_is_walked() {
+    // door_trim's third curve cannot be certified at 1e-10 mm (its rounding margin is about
+    // 8.5e-11): the job used to walk the first two for about 110 s of CPU before refusing it.
+    // Now no curve is discretized: the progress never counts one done.
+    let curves = kerf_format::curves::load(fixture("door_trim.json")).expect("fixture");
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let opts = kerf_discretize::Options::with_tolerance(1e-10);
+    let e = kerf_pipeline::discretize_curves(&curves, &opts, None, &|p| {
+        done.fetch_max(p.done, std::sync::atomic::Ordering::Relaxed);
+    })
+    .expect_err("below the margin");
+    assert!(
+        matches!(
+            &e,
+            Error::Discretize {
+                index: 2,
+                source: kerf_discretize::DiscretizeError::ToleranceBelowMargin { .. },
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert_eq!(done.into_inner(), 0, "no curve walked");
+}

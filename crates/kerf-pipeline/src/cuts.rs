@@ -260,6 +260,7 @@ pub(crate) fn traverse_report(
     )],
     blocked: Vec<Value>,
     own: Vec<Value>,
+    searched: Vec<Value>,
 ) -> Value {
     let mut unchecked: Vec<&str> = Vec::new();
     for (_, _, absent) in rapids {
@@ -269,6 +270,19 @@ pub(crate) fn traverse_report(
             }
         }
     }
+    // How many traverses took each route.
+    let routes: serde_json::Map<String, Value> = [
+        kerf_process::Route::Straight,
+        kerf_process::Route::Lifted,
+        kerf_process::Route::SafePlane,
+        kerf_process::Route::Searched,
+    ]
+    .iter()
+    .map(|k| {
+        let n = rapids.iter().filter(|(t, _, _)| t.route == *k).count();
+        (k.name().to_string(), json!(n))
+    })
+    .collect();
     let Some(o) = opts else {
         return json!({ "checked": false, "note": "--clearance 0: retract along the tool axis, one straight move, approach; not checked against the part" });
     };
@@ -281,12 +295,15 @@ pub(crate) fn traverse_report(
         "checked_count": rapids.len(),
         "unchecked": blocked,
         "lifted": rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count(),
+        "routes": routes,
+        "searched": searched,
         "split_moves": rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>(),
         "length_mm": rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>(),
         "min_distance_mm": rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min),
         "surfaces_in_the_cuts_way": unchecked,
         "surfaces_note": "surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)",
         "own_surface_over_the_head": own,
-        "unchecked_note": "where no route keeps the clearance (unchecked, with the reason), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning",
+        "unchecked_note": "where no route keeps the clearance (unchecked, with the reason and the surfaces the routes were checked without), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning; a reason that starts 'proven' shows that no route can exist (the retract or approach line itself is blocked)",
+        "searched_note": "searched: the gaps where no route shape (straight, lifted, over the safe plane) cleared and a search around the part found a path, the head turned to one tool axis for the travel; lifted counts every route that is not straight",
     })
 }

@@ -163,6 +163,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let mut rapid_report = Vec::new();
     let mut blocked_report = Vec::new();
     let mut own_report = Vec::new();
+    let mut searched_report = Vec::new();
     // The traverses for the plot, part coordinates, and a cut's last pose.
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
@@ -218,10 +219,14 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                         // No checked route: the unchecked retract traverse, said loudly
                         // (`Output::warnings`, and `traverses.unchecked` in the report).
                         warnings.push(format!("{e}; this traverse is NOT checked"));
+                        // The surfaces the routes were checked without (the last attempt
+                        // leaves out all those in the cuts' way).
+                        let left_out = kerf_process::in_the_cuts_way(&obs, gap, topts);
                         blocked_report.push(json!({
                             "after": solved[w[0]].id,
                             "before": solved[w[1]].id,
                             "reason": e.to_string(),
+                            "surfaces_left_out": left_out,
                         }));
                         traverses.push(Vec::new());
                         // The plot: the unchecked retract, straight move and approach.
@@ -264,6 +269,15 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                         "after": solved[w[0]].id,
                         "before": solved[w[1]].id,
                         "surfaces": own,
+                    }));
+                }
+                if t.route == kerf_process::Route::Searched {
+                    searched_report.push(json!({
+                        "after": solved[w[0]].id,
+                        "before": solved[w[1]].id,
+                        "waypoints": t.waypoints.len(),
+                        "length_mm": t.length_mm,
+                        "surfaces_left_out": absent,
                     }));
                 }
                 rapid_report.push((t.clone(), r.clone(), absent.clone()));
@@ -415,7 +429,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         },
         "placement": placed.json(&id_refs),
         "process": crate::cuts::report(file, &cuts, &cut_plans),
-        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report, own_report),
+        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report, own_report, searched_report),
         "interpolation": {
             "feed_mm_per_min": o.feed_mm_per_min,
             "cycle_s": o.cycle_s,

@@ -38,6 +38,7 @@ fn job_options(args: &RunArgs) -> JobOptions {
         .with_blend_tolerance_mm(args.blend_tolerance)
         .with_retract_mm(args.retract)
         .with_traverse(args.traverse_options())
+        .with_wall_axis_max_mm(args.max_wall)
 }
 
 /// Runs `kerf run`.

@@ -10,14 +10,14 @@
 
 mod common;
 
-use common::{fixture, read_json, run_auto};
+use common::{fixture, read_json, run_auto_with};
 use kerf_kinematics::{Axes, Machine, Placement};
 use kerf_nurbs::NurbsSurface;
 use nalgebra::{Point3, Vector3};
 use serde_json::Value;
 
-fn run(curves: &str) -> (Value, Value, Value) {
-    let dir = run_auto(curves, "gantry_ac.json");
+fn run(curves: &str, more: &[&str]) -> (Value, Value, Value) {
+    let dir = run_auto_with(curves, "gantry_ac.json", more);
     let curves_file = read_json(&fixture(curves));
     (
         read_json(&dir.path().join("report.json")),
@@ -111,23 +111,67 @@ fn strings(v: &Value) -> Vec<String> {
 
 #[test]
 fn real_files_route_every_traverse_but_an_asserted_residue() {
-    // (file, gaps, unchecked, searched, own, turned, both): `searched` gaps are those where
-    // no route shape (straight, lifted over the nearby surfaces, over the safe plane, each at
-    // two heights and with five retract heights at each end) clears and the search around the
-    // part found a path (the head turned upright for the travel); the `unchecked` residue is
-    // proven impossible: the approach line to the pierce is blocked at every height (the
-    // reason says 'proven'). `own` gaps leave out a cut's own surface that curls over its
-    // head line (holes narrower than the clearance cut with the wall's radial normal as tool
-    // axis). `turned`: contours cut from the other side of the sheet because the nozzle's line
-    // meets the part from the given side and not from the other; `both`: contours kept
-    // although their nozzle's line meets the part from both sides (or the head cannot reach
-    // the clear side): most of the `own` residue.
+    // (file, extra arguments, gaps, unchecked, searched, walls, own, turned, both):
+    // `searched` gaps are those where no route shape (straight, lifted over the nearby
+    // surfaces, over the safe plane, each at two heights and with five retract heights at each
+    // end) clears and the search around the part found a path (the head turned upright for
+    // the travel); the `unchecked` residue is proven impossible: the approach line to the
+    // pierce is blocked at every height (the reason says 'proven'). `walls`: contours cut
+    // with the beam along their thin wall (hole walls up to 4 mm, `--max-wall`; `0` turns
+    // that off, and the sheet-metal file then keeps the walls' radial normals as tool axes,
+    // the case the proof and the search were made on). `own` gaps leave out a cut's own
+    // surface that curls over its head line (with the rule: holes cut from the other face of
+    // the sheet for reach, whose modelled nozzle runs through the hole from the focus on the
+    // far rim; bends; walls thicker than 4 mm; without it: holes narrower than the clearance
+    // cut with the wall's radial normal). `turned`: contours cut from the other side because
+    // the nozzle's line meets the part from the given side and not from the other; `both`:
+    // contours kept although their nozzle's line meets the part from both sides (or the
+    // head cannot reach the clear side).
     let machine = Machine::read(fixture("machines").join("gantry_ac.json")).expect("machine");
-    for (curves, gaps, unchecked, searched, own, turned, both) in [
-        ("realdata/nori_sheetmetal.json", 74, 1, 1, 9, 6, 13),
-        ("realdata/occt_propeller.json", 46, 0, 3, 1, 9, 13),
+    for (curves, more, gaps, unchecked, searched, walls, own, turned, both) in [
+        (
+            "realdata/nori_sheetmetal.json",
+            &[][..],
+            75,
+            0,
+            0,
+            35,
+            10,
+            0,
+            3,
+        ),
+        (
+            "realdata/nori_sheetmetal.json",
+            &["--max-wall", "0"][..],
+            74,
+            1,
+            1,
+            0,
+            9,
+            6,
+            13,
+        ),
+        (
+            "realdata/occt_propeller.json",
+            &[][..],
+            46,
+            0,
+            3,
+            0,
+            1,
+            9,
+            13,
+        ),
     ] {
-        let (report, axes, file) = run(curves);
+        let (report, axes, file) = run(curves, more);
+        assert_eq!(
+            report["placement"]["walls"]
+                .as_array()
+                .expect("walls")
+                .len(),
+            walls,
+            "{curves} {more:?}"
+        );
         let parsed = kerf_format::curves::load(fixture(curves)).expect("curves");
         let sides = report["placement"]["sides"].as_array().expect("sides");
         let reasons = |needle: &str| {

@@ -112,6 +112,11 @@ pub struct JobOptions {
     /// retract and straight traverse. Default `Some(TraverseOptions::default())`: 5 mm
     /// clearance, 20 mm nozzle; the retract is never shorter than `retract_mm`.
     pub traverse: Option<kerf_process::TraverseOptions>,
+    /// A contour whose only named surface is a wall at most this wide across it (a hole's or
+    /// a slot's wall, the sheet's edge face: [`kerf_process::wall_axis`]) is cut with the beam
+    /// along the wall, the scrap where the wall's normal points; 0 turns this off, mm.
+    /// Default 4.
+    pub wall_axis_max_mm: f64,
 }
 
 impl Default for JobOptions {
@@ -128,6 +133,7 @@ impl Default for JobOptions {
             blend_tolerance_mm: kerf_interp::DEFAULT_BLEND_TOLERANCE,
             retract_mm: 10.0,
             traverse: Some(kerf_process::TraverseOptions::default()),
+            wall_axis_max_mm: 4.0,
         }
     }
 }
@@ -196,6 +202,13 @@ impl JobOptions {
     /// With this retract between contours, mm.
     pub fn with_retract_mm(mut self, mm: f64) -> Self {
         self.retract_mm = mm;
+        self
+    }
+
+    /// With this widest wall cut along itself, mm (0: off; see
+    /// [`JobOptions::wall_axis_max_mm`]).
+    pub fn with_wall_axis_max_mm(mut self, mm: f64) -> Self {
+        self.wall_axis_max_mm = mm;
         self
     }
 

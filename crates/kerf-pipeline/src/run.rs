@@ -67,9 +67,16 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
     let popts = o.path;
     progress(Progress::new(Stage::Kinematics, 0, 1));
+    // 2b. Contours on a thin wall through the sheet (a hole's wall named instead of the sheet's
+    // face): the beam along the wall, the scrap where the wall's normal points.
+    let walls = crate::cuts::walls(file, &oriented, o.wall_axis_max_mm);
     let poses: Vec<Vec<Pose>> = oriented
         .iter()
-        .map(|o| o.poses().into_iter().map(Pose::from_array).collect())
+        .zip(&walls)
+        .map(|(o, w)| match w {
+            Some(w) => w.poses.iter().copied().map(Pose::from_array).collect(),
+            None => o.poses().into_iter().map(Pose::from_array).collect(),
+        })
         .collect();
     // Checked traverses (None: the unchecked retract); never a shorter retract than asked.
     let topts = o.traverse.map(|mut t| {
@@ -102,7 +109,8 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     };
     // 3c. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
     // outlines, the shortest traverse; in part coordinates, then placed.
-    let (cuts, cut_plans) = crate::cuts::plan(file, &oriented, &placed, &starts, &o.leads, path)?;
+    let (cuts, cut_plans) =
+        crate::cuts::plan(file, &oriented, &walls, &placed, &starts, &o.leads, path)?;
     let cut_poses: Vec<Vec<Pose>> = cuts
         .iter()
         .map(|c| {
@@ -392,6 +400,15 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         .map(|(k, v)| (k.to_string(), json!(v)))
         .collect();
     budget.insert("total".into(), json!(gopts.budget_total()));
+    let placement_json = {
+        let mut p = placed.json(&id_refs);
+        p["walls"] = crate::cuts::walls_json(file, &walls);
+        p["walls_note"] = json!(format!(
+            "contours whose only named surface is a wall at most {} mm wide across them (its control net's extent along n x t, the wall's direction across the contour; 0 = off): a hole's or slot's wall, the sheet's edge face, named instead of the sheet's face. The beam runs along the wall (side 'given' is the head on the face of the sheet that holds the contour, away from the wall), the lead-ins lie across it, on the side the wall's outward normal points to (the scrap); curves with a scrap key or several surfaces are not looked at",
+            o.wall_axis_max_mm
+        ));
+        p
+    };
     let report = json!({
         "input": source_name,
         "machine": machine.name,
@@ -427,7 +444,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
             "pole_points": solved.iter().map(|s| s.pole_points).sum::<usize>(),
             "pole_tip_error": solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
         },
-        "placement": placed.json(&id_refs),
+        "placement": placement_json,
         "process": crate::cuts::report(file, &cuts, &cut_plans),
         "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report, own_report, searched_report),
         "interpolation": {

@@ -481,6 +481,14 @@ pub(crate) struct RunArgs {
     #[arg(long, default_value_t = 5.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
     pub(crate) clearance: f64,
 
+    /// A contour whose only named surface is a wall at most this wide across it (a hole's or a
+    /// slot's wall, the sheet's edge face, named instead of the sheet's face) is cut with the
+    /// beam along the wall, through the sheet, and the lead-in on the side the wall's normal
+    /// points to; the report lists them (`placement.walls`). mm; 0 = the wall's normal is the
+    /// tool axis, as for any surface.
+    #[arg(long, default_value_t = 4.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
+    pub(crate) max_wall: f64,
+
     /// Lead-in of every cut: the straight part from the pierce point, then the radius of the
     /// quarter arc that joins the contour tangentially on the scrap side, mm (`0,0` pierces on
     /// the contour). Shrunk where the scrap is smaller (small holes).

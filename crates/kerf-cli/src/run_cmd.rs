@@ -44,6 +44,7 @@ fn job_options(args: &RunArgs) -> JobOptions {
                     usize::try_from(n).unwrap_or(usize::MAX)
                 }),
         )
+        .with_wall_axis_max_mm(args.max_wall)
 }
 
 /// Runs `kerf run`.

@@ -43,15 +43,79 @@ pub(crate) type SetupPlans = Vec<(Vec<usize>, CutPlan)>;
 
 /// The cuts of every contour in cutting order (set-up by set-up), with the plans that made
 /// them.
+/// The curves on a thin wall ([`kerf_process::wall_axis`], at most `max_wall_mm` wide; 0: none):
+/// one entry per curve, for those that name exactly one surface and no `scrap` key.
+pub(crate) fn walls(
+    file: &CurvesFile,
+    oriented: &[Oriented],
+    max_wall_mm: f64,
+) -> Vec<Option<kerf_process::Wall>> {
+    file.curves
+        .iter()
+        .zip(oriented)
+        .map(|(c, o)| {
+            if max_wall_mm.is_nan()
+                || max_wall_mm <= 0.0
+                || c.scrap.is_some()
+                || c.surfaces.len() != 1
+            {
+                return None;
+            }
+            let record = file.surface(&c.surfaces[0])?;
+            // NURBS surfaces only (a mesh's normals are per triangle).
+            let kerf_format::SurfaceGeometry::Nurbs(n) = &record.geometry else {
+                return None;
+            };
+            let hull: Vec<Point3<f64>> = n.control_points().iter().flatten().copied().collect();
+            let normal_near = |q: &Point3<f64>| {
+                let c = n.closest_point(q, None);
+                n.normal(c.u, c.v)
+            };
+            kerf_process::wall_axis(&hull, &o.poses(), max_wall_mm, &normal_near)
+        })
+        .collect()
+}
+
+/// The `walls` entries of the report: every curve cut along its wall, with the width found.
+pub(crate) fn walls_json(file: &CurvesFile, walls: &[Option<kerf_process::Wall>]) -> Value {
+    json!(file
+        .curves
+        .iter()
+        .zip(walls)
+        .filter_map(|(c, w)| {
+            let w = w.as_ref()?;
+            Some(json!({
+                "id": c.id,
+                "width_mm": w.width_mm,
+                "scrap": w.scrap.name(),
+                "reason": format!(
+                    "its surface is at most {:.3} mm wide across the contour: a wall through the sheet; the beam runs along the wall, the scrap is where the wall's normal points",
+                    w.width_mm
+                ),
+            }))
+        })
+        .collect::<Vec<_>>())
+}
+
+/// A contour on a thin wall ([`kerf_process::wall_axis`]) is planned with the tool axes along
+/// the wall and the scrap where the wall's normal points (`walls`, one entry per curve).
 pub(crate) fn plan(
     file: &CurvesFile,
     oriented: &[Oriented],
+    walls: &[Option<kerf_process::Wall>],
     placed: &Placed,
     starts: &[Option<f64>],
     options: &LeadOptions,
     source: Option<&std::path::Path>,
 ) -> Result<(Vec<CutPath>, SetupPlans), Error> {
-    let poses: Vec<Vec<PoseArray>> = oriented.iter().map(Oriented::poses).collect();
+    let poses: Vec<Vec<PoseArray>> = oriented
+        .iter()
+        .enumerate()
+        .map(|(i, o)| match walls.get(i) {
+            Some(Some(w)) => w.poses.clone(),
+            _ => o.poses(),
+        })
+        .collect();
     let mut cuts = Vec::new();
     let mut plans = Vec::new();
     for setup in &placed.plan.setups {
@@ -61,10 +125,13 @@ pub(crate) fn plan(
             .map(|&i| Contour {
                 id: &file.curves[i].id,
                 poses: &poses[i],
-                scrap: file.curves[i].scrap.map(|s| match s {
-                    kerf_format::ScrapSide::Left => kerf_process::Side::Left,
-                    kerf_format::ScrapSide::Right => kerf_process::Side::Right,
-                }),
+                scrap: match walls.get(i) {
+                    Some(Some(w)) => Some(w.scrap),
+                    _ => file.curves[i].scrap.map(|s| match s {
+                        kerf_format::ScrapSide::Left => kerf_process::Side::Left,
+                        kerf_format::ScrapSide::Right => kerf_process::Side::Right,
+                    }),
+                },
                 start: starts[i].map(|t| kerf_process::index_of_param(oriented[i].params(), t)),
             })
             .collect();
@@ -260,6 +327,7 @@ pub(crate) fn traverse_report(
     )],
     blocked: Vec<Value>,
     own: Vec<Value>,
+    searched: Vec<Value>,
 ) -> Value {
     let mut unchecked: Vec<&str> = Vec::new();
     for (_, _, absent) in rapids {
@@ -269,6 +337,19 @@ pub(crate) fn traverse_report(
             }
         }
     }
+    // How many traverses took each route.
+    let routes: serde_json::Map<String, Value> = [
+        kerf_process::Route::Straight,
+        kerf_process::Route::Lifted,
+        kerf_process::Route::SafePlane,
+        kerf_process::Route::Searched,
+    ]
+    .iter()
+    .map(|k| {
+        let n = rapids.iter().filter(|(t, _, _)| t.route == *k).count();
+        (k.name().to_string(), json!(n))
+    })
+    .collect();
     let Some(o) = opts else {
         return json!({ "checked": false, "note": "--clearance 0: retract along the tool axis, one straight move, approach; not checked against the part" });
     };
@@ -281,12 +362,15 @@ pub(crate) fn traverse_report(
         "checked_count": rapids.len(),
         "unchecked": blocked,
         "lifted": rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count(),
+        "routes": routes,
+        "searched": searched,
         "split_moves": rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>(),
         "length_mm": rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>(),
         "min_distance_mm": rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min),
         "surfaces_in_the_cuts_way": unchecked,
         "surfaces_note": "surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)",
         "own_surface_over_the_head": own,
-        "unchecked_note": "where no route keeps the clearance (unchecked, with the reason), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning",
+        "unchecked_note": "where no route keeps the clearance (unchecked, with the reason and the surfaces the routes were checked without), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning; a reason that starts 'proven' shows that no route can exist (the retract or approach line itself is blocked)",
+        "searched_note": "searched: the gaps where no route shape (straight, lifted, over the safe plane) cleared and a search around the part found a path, the head turned to one tool axis for the travel; lifted counts every route that is not straight",
     })
 }

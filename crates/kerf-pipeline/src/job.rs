@@ -119,6 +119,11 @@ pub struct JobOptions {
     /// about 3 KB each in all: the review's 600-byte circle at `-t 1e-8` made 594,000 points,
     /// 1.9 GB and 55 s. Default [`DEFAULT_MAX_TOTAL_POINTS_RUN`] (1,000,000).
     pub max_total_points: usize,
+    /// A contour whose only named surface is a wall at most this wide across it (a hole's or
+    /// a slot's wall, the sheet's edge face: [`kerf_process::wall_axis`]) is cut with the beam
+    /// along the wall, the scrap where the wall's normal points; 0 turns this off, mm.
+    /// Default 4.
+    pub wall_axis_max_mm: f64,
 }
 
 /// The default of [`JobOptions::max_total_points`]: one million cutting points, about 3 GB
@@ -141,6 +146,7 @@ impl Default for JobOptions {
             retract_mm: 10.0,
             traverse: Some(kerf_process::TraverseOptions::default()),
             max_total_points: DEFAULT_MAX_TOTAL_POINTS_RUN,
+            wall_axis_max_mm: 4.0,
         }
     }
 }
@@ -216,6 +222,13 @@ impl JobOptions {
     /// ([`JobOptions::max_total_points`]).
     pub fn with_max_total_points(mut self, points: usize) -> Self {
         self.max_total_points = points;
+        self
+    }
+
+    /// With this widest wall cut along itself, mm (0: off; see
+    /// [`JobOptions::wall_axis_max_mm`]).
+    pub fn with_wall_axis_max_mm(mut self, mm: f64) -> Self {
+        self.wall_axis_max_mm = mm;
         self
     }
 

@@ -68,9 +68,16 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
     let popts = o.path;
     progress(Progress::new(Stage::Kinematics, 0, 1));
+    // 2b. Contours on a thin wall through the sheet (a hole's wall named instead of the sheet's
+    // face): the beam along the wall, the scrap where the wall's normal points.
+    let walls = crate::cuts::walls(file, &oriented, o.wall_axis_max_mm);
     let poses: Vec<Vec<Pose>> = oriented
         .iter()
-        .map(|o| o.poses().into_iter().map(Pose::from_array).collect())
+        .zip(&walls)
+        .map(|(o, w)| match w {
+            Some(w) => w.poses.iter().copied().map(Pose::from_array).collect(),
+            None => o.poses().into_iter().map(Pose::from_array).collect(),
+        })
         .collect();
     // Checked traverses (None: the unchecked retract); never a shorter retract than asked.
     let topts = o.traverse.map(|mut t| {
@@ -103,7 +110,8 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     };
     // 3c. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
     // outlines, the shortest traverse; in part coordinates, then placed.
-    let (cuts, cut_plans) = crate::cuts::plan(file, &oriented, &placed, &starts, &o.leads, path)?;
+    let (cuts, cut_plans) =
+        crate::cuts::plan(file, &oriented, &walls, &placed, &starts, &o.leads, path)?;
     let cut_poses: Vec<Vec<Pose>> = cuts
         .iter()
         .map(|c| {
@@ -164,6 +172,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let mut rapid_report = Vec::new();
     let mut blocked_report = Vec::new();
     let mut own_report = Vec::new();
+    let mut searched_report = Vec::new();
     // The traverses for the plot, part coordinates, and a cut's last pose.
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
@@ -219,10 +228,14 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                         // No checked route: the unchecked retract traverse, said loudly
                         // (`Output::warnings`, and `traverses.unchecked` in the report).
                         warnings.push(format!("{e}; this traverse is NOT checked"));
+                        // The surfaces the routes were checked without (the last attempt
+                        // leaves out all those in the cuts' way).
+                        let left_out = kerf_process::in_the_cuts_way(&obs, gap, topts);
                         blocked_report.push(json!({
                             "after": solved[w[0]].id,
                             "before": solved[w[1]].id,
                             "reason": e.to_string(),
+                            "surfaces_left_out": left_out,
                         }));
                         traverses.push(Vec::new());
                         // The plot: the unchecked retract, straight move and approach.
@@ -265,6 +278,15 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                         "after": solved[w[0]].id,
                         "before": solved[w[1]].id,
                         "surfaces": own,
+                    }));
+                }
+                if t.route == kerf_process::Route::Searched {
+                    searched_report.push(json!({
+                        "after": solved[w[0]].id,
+                        "before": solved[w[1]].id,
+                        "waypoints": t.waypoints.len(),
+                        "length_mm": t.length_mm,
+                        "surfaces_left_out": absent,
                     }));
                 }
                 rapid_report.push((t.clone(), r.clone(), absent.clone()));
@@ -390,6 +412,15 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         .filter_map(|(_, v)| v)
         .sum::<f64>()
         + spline_bound;
+    let placement_json = {
+        let mut p = placed.json(&id_refs);
+        p["walls"] = crate::cuts::walls_json(file, &walls);
+        p["walls_note"] = json!(format!(
+            "contours whose only named surface is a wall at most {} mm wide across them (its control net's extent along n x t, the wall's direction across the contour; 0 = off): a hole's or slot's wall, the sheet's edge face, named instead of the sheet's face. The beam runs along the wall (side 'given' is the head on the face of the sheet that holds the contour, away from the wall), the lead-ins lie across it, on the side the wall's outward normal points to (the scrap); curves with a scrap key or several surfaces are not looked at",
+            o.wall_axis_max_mm
+        ));
+        p
+    };
     let report = json!({
         "input": source_name,
         "machine": machine.name,
@@ -425,9 +456,9 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
             "pole_points": solved.iter().map(|s| s.pole_points).sum::<usize>(),
             "pole_tip_error": solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
         },
-        "placement": placed.json(&id_refs),
+        "placement": placement_json,
         "process": crate::cuts::report(file, &cuts, &cut_plans),
-        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report, own_report),
+        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report, own_report, searched_report),
         "interpolation": {
             "feed_mm_per_min": o.feed_mm_per_min,
             "cycle_s": o.cycle_s,

@@ -196,3 +196,49 @@ fn a_contour_under_a_roof_keeps_its_side_when_the_head_cannot_reach_the_other() 
     let h = out.placement.head_lines[0];
     assert_eq!((h.given, h.other), (h.points, 0), "{h:?}");
 }
+
+#[test]
+fn a_hole_wall_without_a_scrap_key_is_cut_along_the_holes_axis() {
+    // The same hole, no scrap key: its wall (2 mm wide across the edge, straight across) is a
+    // wall through the sheet. The beam runs along the hole's axis (z), the lead-in lies in the
+    // sheet's face (z = 0) inside the hole, where the wall's normal points. With the rule off,
+    // the tool axis is the wall's radial normal, as before.
+    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    let mut file = hole(ScrapSide::Left);
+    file.curves[0].scrap = None;
+    for max_wall in [4.0, 0.0] {
+        let out = Job::new(file.clone(), machine.clone())
+            .with_options(
+                JobOptions::default()
+                    .with_place(PlaceMode::Auto)
+                    .with_wall_axis_max_mm(max_wall),
+            )
+            .run()
+            .expect("run");
+        let pl = out.placement.placement_of(0);
+        let r = pl.rotation().inverse();
+        let walls = out.report["placement"]["walls"].as_array().expect("walls");
+        for q in &out.axes.paths[0].poses {
+            let axis = r * Vector3::new(q[3], q[4], q[5]);
+            if max_wall > 0.0 {
+                // Either face of the sheet (the side is chosen for reach): along z.
+                assert!((axis.z.abs() - 1.0).abs() < 1e-9, "axis {axis}");
+            } else {
+                assert!(axis.z.abs() < 1e-9, "the wall's normal: {axis}");
+            }
+        }
+        if max_wall == 0.0 {
+            assert!(walls.is_empty(), "{walls:?}");
+            continue;
+        }
+        assert_eq!(walls.len(), 1, "{walls:?}");
+        assert_eq!(walls[0]["id"], "edge");
+        assert!((walls[0]["width_mm"].as_f64().unwrap() - 2.0).abs() < 1e-9);
+        let lead = lead_in(&out);
+        assert!(lead.len() > 2, "{} lead-in points", lead.len());
+        for (p, _) in &lead[..lead.len() - 1] {
+            assert!(p.z.abs() < 1e-9, "in the sheet's face: {p}");
+            assert!(p.coords.xy().norm() < R - 1e-6, "inside the hole: {p}");
+        }
+    }
+}

@@ -30,6 +30,7 @@ mod rapid;
 mod side;
 mod start;
 mod traverse;
+mod wall;
 
 pub use lead::{LeadIn, LeadOptions};
 pub use order::CutPlan;
@@ -41,6 +42,7 @@ pub use start::{index_of_param, prepare_start};
 pub use traverse::{
     check_move, plan_traverse, plan_traverse_within, Obstacles, Route, Traverse, TraverseOptions,
 };
+pub use wall::{wall_axis, Wall};
 
 use geometry::Projected;
 use thiserror::Error;

@@ -5,7 +5,7 @@
 //! comes too close is split into shorter ones along the straight line until it clears.
 
 use kerf_kinematics::{Axes, Kinematics, Pose};
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 
 use crate::traverse::{check_move, Obstacles, Traverse, TraverseOptions};
 use crate::{PoseArray, ProcessError, Result};
@@ -49,6 +49,77 @@ fn linear_at(kin: &dyn Kinematics, tip: &Point3<f64>, tilt: f64, c: f64) -> [f64
         c,
     );
     [q.x, q.y, q.z, tilt, c]
+}
+
+/// Where the tool axis is this close to the C axis (radians), C is free: a waypoint there keeps
+/// the C of its neighbours instead of the inverse's arbitrary one.
+const POLE_RAD: f64 = 1e-9;
+
+/// The rotary axes `[tilt, C]` (degrees) of every waypoint of a traverse: the first waypoints,
+/// as long as they keep the exit's tool axis, stand at `from`'s rotaries (the head backed off
+/// along that axis), the last ones, as long as they keep the pierce's tool axis, at `to`'s (it
+/// approaches along it); where every waypoint keeps one axis, the first half takes `from`'s and
+/// the rest `to`'s. A waypoint with another tool axis (a head turned upright or to an
+/// intermediate axis on the way) takes the inverse solution with the least rotary travel from
+/// the waypoint before it (within `tilt`, the tilt axis' range, where one is), and where its axis
+/// is along the C axis (C is then free) the C of the waypoint before it, except the last of
+/// such a run, which takes the C of the waypoint after it: the moves into and out of the upright
+/// run then turn the tilt alone, in the plane of the tool axes, as the traverse's check assumes.
+pub(crate) fn waypoint_rotaries(
+    kin: &dyn Kinematics,
+    way: &[PoseArray],
+    from: &[f64; 5],
+    to: &[f64; 5],
+    tilt: Option<(f64, f64)>,
+) -> Vec<[f64; 2]> {
+    let n = way.len();
+    let axis = |i: usize| Vector3::new(way[i][3], way[i][4], way[i][5]);
+    let same = |a: Vector3<f64>, b: Vector3<f64>| (a - b).norm() <= 1e-12 * (1.0 + a.norm());
+    let (rf, rt) = ([from[3], from[4]], [to[3], to[4]]);
+    if n == 0 {
+        return Vec::new();
+    }
+    // The waypoints 0..=p keep the first axis, s..n the last.
+    let mut p = 0;
+    while p + 1 < n && same(axis(p + 1), axis(0)) {
+        p += 1;
+    }
+    let mut s = n - 1;
+    while s > 0 && same(axis(s - 1), axis(n - 1)) {
+        s -= 1;
+    }
+    if s <= p {
+        return (0..n).map(|i| if i < n / 2 { rf } else { rt }).collect();
+    }
+    let mut rot: Vec<[f64; 2]> = (0..n).map(|i| if i <= p { rf } else { rt }).collect();
+    let fits = |t: f64| tilt.is_none_or(|(lo, hi)| t >= lo && t <= hi);
+    let mut pole = vec![false; n];
+    for i in p + 1..s {
+        let prev = rot[i - 1];
+        let pose = Pose {
+            position: Point3::new(way[i][0], way[i][1], way[i][2]),
+            axis: axis(i).normalize(),
+        };
+        if kin.pole_angle(&pose.axis) <= POLE_RAD {
+            let q = kin.inverse_with_c(&pose, prev[1]);
+            rot[i] = [kerf_kinematics::nearest_turn(q.tilt, prev[0]), prev[1]];
+            pole[i] = true;
+            continue;
+        }
+        let reference = Axes::new(0.0, 0.0, 0.0, prev[0], prev[1]);
+        let candidates = kin.inverse(&pose);
+        let q = kerf_kinematics::nearest_solution(candidates, &reference, |q| fits(q.tilt))
+            .or_else(|| kerf_kinematics::nearest_solution(candidates, &reference, |_| true))
+            .unwrap_or(candidates[0]);
+        rot[i] = [q.tilt, q.c];
+    }
+    // The last waypoint of an upright run takes the C of the one after it.
+    for i in p + 1..s {
+        if pole[i] && !pole[i + 1] {
+            rot[i][1] = rot[i + 1][1];
+        }
+    }
+    rot
 }
 
 /// The poses of the joint-linear move `a -> b`, sampled so that the tip moves at most
@@ -99,17 +170,28 @@ pub fn rapid_moves(
     traverse: &Traverse,
     opts: &TraverseOptions,
 ) -> Result<RapidMoves> {
-    let n = traverse.waypoints.len();
+    rapid_moves_within(kin, obs, end_axes, start_axes, traverse, opts, None)
+}
+
+/// [`rapid_moves`] with the waypoints' rotaries chosen within `tilt`, the tilt axis' range
+/// (where a waypoint turns the head to another tool axis, [`waypoint_rotaries`]).
+fn rapid_moves_within(
+    kin: &dyn Kinematics,
+    obs: &Obstacles,
+    end_axes: [f64; 5],
+    start_axes: [f64; 5],
+    traverse: &Traverse,
+    opts: &TraverseOptions,
+    tilt: Option<(f64, f64)>,
+) -> Result<RapidMoves> {
     let c = opts.clearance_mm;
     let step = c / 8.0;
+    let rot = waypoint_rotaries(kin, &traverse.waypoints, &end_axes, &start_axes, tilt);
     let waypoint_axes: Vec<[f64; 5]> = traverse
         .waypoints
         .iter()
-        .enumerate()
-        .map(|(i, w)| {
-            let r = if i < n / 2 { &end_axes } else { &start_axes };
-            linear_at(kin, &Point3::new(w[0], w[1], w[2]), r[3], r[4])
-        })
+        .zip(&rot)
+        .map(|(w, r)| linear_at(kin, &Point3::new(w[0], w[1], w[2]), r[0], r[1]))
         .collect();
     let mut axes = Vec::new();
     let mut least = f64::INFINITY;
@@ -352,7 +434,13 @@ pub fn plan_rapids(
             // axes as [`rapid_moves`] sets them).
             let reachable = |way: &[PoseArray]| {
                 let n = way.len();
-                let rot = |i: usize| if i < n / 2 { g.from_axes } else { g.to_axes };
+                let rots = waypoint_rotaries(kin, way, &g.from_axes, &g.to_axes, limits[3]);
+                let rot = |i: usize| {
+                    let mut r = g.from_axes;
+                    r[3] = rots[i][0];
+                    r[4] = rots[i][1];
+                    r
+                };
                 let inside = |q: &[f64; 5]| {
                     q.iter().zip(limits).all(|(v, l)| {
                         l.is_none_or(|(lo, hi)| {
@@ -398,14 +486,13 @@ pub fn plan_rapids(
                     opts,
                     &reachable,
                     &mut |t| {
-                        rapid_moves(kin, &here, g.from_axes, g.to_axes, t, opts).map_err(
-                            |e| match e {
+                        rapid_moves_within(kin, &here, g.from_axes, g.to_axes, t, opts, limits[3])
+                            .map_err(|e| match e {
                                 ProcessError::TraverseBlocked(b) => {
                                     (Point3::from(b.at), b.distance_mm)
                                 }
                                 _ => (Point3::from(g.from_contour), 0.0),
-                            },
-                        )
+                            })
                     },
                 )
             };

@@ -2,6 +2,8 @@
 //! the straight traverse between the retract points runs through the part, checked by an
 //! independent dense distance computation from the analytic cylinder.
 
+mod common;
+
 use kerf_nurbs::NurbsSurface;
 use kerf_process::{plan_traverse, Obstacles, PoseArray, ProcessError, Route, TraverseOptions};
 use nalgebra::{Point3, Vector3};
@@ -52,31 +54,10 @@ fn on_arch(deg: f64, y: f64) -> PoseArray {
     [R * a.cos(), y, R * a.sin(), a.cos(), 0.0, a.sin()]
 }
 
-/// The smallest exact distance over a dense sampling (0.05 mm) of the tip's polyline through
-/// the waypoints and of the nozzle along the interpolated axis.
+/// The smallest exact distance over a dense sampling of the route (0.05 mm along the tip's
+/// polyline, the nozzle at 41 points).
 fn dense_min(way: &[PoseArray], nozzle: f64) -> f64 {
-    let mut least = f64::INFINITY;
-    for w in way.windows(2) {
-        let (a, b) = (
-            Point3::new(w[0][0], w[0][1], w[0][2]),
-            Point3::new(w[1][0], w[1][1], w[1][2]),
-        );
-        let (na, nb) = (
-            Vector3::new(w[0][3], w[0][4], w[0][5]),
-            Vector3::new(w[1][3], w[1][4], w[1][5]),
-        );
-        let k = ((b - a).norm() / 0.05).ceil().max(1.0) as usize;
-        for j in 0..=k {
-            let f = j as f64 / k as f64;
-            let p = a + (b - a) * f;
-            let n = (na * (1.0 - f) + nb * f).normalize();
-            for s in 0..=40 {
-                let q = p + n * (nozzle * s as f64 / 40.0);
-                least = least.min(arch_distance(&q));
-            }
-        }
-    }
-    least
+    common::dense_min(way, nozzle, 40, &arch_distance)
 }
 
 fn obstacles() -> Obstacles {
@@ -363,6 +344,82 @@ fn the_machines_rapid_moves_clear_the_arch_as_the_machine_runs_them() {
     assert!(
         splits > 0,
         "at least one swing needed splitting (the split path is exercised)"
+    );
+}
+
+#[test]
+fn a_route_turning_the_head_upright_runs_on_the_machine_as_checked() {
+    // A route of the search's form: the exit's axis horizontal (+y), turned upright at the
+    // retract point, a travel upright, turned to the pierce's axis (-y, the other way) through
+    // the vertical. On an A/C head the rotaries must put the tool exactly on every waypoint,
+    // stand on the exit's and the pierce's solutions at the ends, and turn the tilt alone into
+    // and out of the upright stretch (as the traverse's check assumes), with C free there.
+    use kerf_kinematics::{AcHead, Axes, Kinematics, Pose};
+    use kerf_process::{rapid_moves, Traverse};
+    let kin = AcHead::try_new(180.0, 95.0).expect("head");
+    let exit = [0.0, 10.0, 0.0, 0.0, 1.0, 0.0];
+    let pierce = [40.0, -10.0, 5.0, 0.0, -1.0, 0.0];
+    let up = [0.0, 0.0, 1.0];
+    let way: Vec<PoseArray> = vec![
+        [0.0, 20.0, 0.0, 0.0, 1.0, 0.0],
+        [0.0, 20.0, 0.0, up[0], up[1], up[2]],
+        [0.0, 20.0, 30.0, up[0], up[1], up[2]],
+        [40.0, -20.0, 30.0, up[0], up[1], up[2]],
+        [40.0, -20.0, 5.0, up[0], up[1], up[2]],
+        [40.0, -20.0, 5.0, 0.0, -1.0, 0.0],
+    ];
+    let t = Traverse {
+        waypoints: way.clone(),
+        route: Route::Searched,
+        min_distance_mm: f64::INFINITY,
+        length_mm: 0.0,
+    };
+    let solve = |p: &PoseArray| {
+        let a = kin.inverse(&Pose::new(p[0], p[1], p[2], p[3], p[4], p[5]))[0];
+        [a.x, a.y, a.z, a.tilt, a.c]
+    };
+    let (end, start) = (solve(&exit), solve(&pierce));
+    assert!(
+        (end[4] - start[4]).abs() > 1.0 || (end[3] - start[3]).abs() > 1.0,
+        "the two solutions differ"
+    );
+    let r = rapid_moves(
+        &kin,
+        &Obstacles::new(),
+        end,
+        start,
+        &t,
+        &TraverseOptions::default(),
+    )
+    .expect("nothing in the way");
+    assert_eq!(r.split_moves, 0);
+    assert_eq!(r.axes.len(), way.len());
+    let forward = |v: &[f64; 5]| kin.forward(&Axes::new(v[0], v[1], v[2], v[3], v[4]));
+    for (a, w) in r.axes.iter().zip(&way) {
+        let p = forward(a);
+        assert!(
+            (p.position - Point3::new(w[0], w[1], w[2])).norm() < 1e-9,
+            "{a:?}"
+        );
+        assert!(
+            (p.axis - Vector3::new(w[3], w[4], w[5])).norm() < 1e-9,
+            "{a:?}"
+        );
+    }
+    assert_eq!(&r.axes[0][3..], &end[3..]);
+    assert_eq!(&r.axes[way.len() - 1][3..], &start[3..]);
+    // Into the upright stretch and out of it: the tilt alone turns.
+    assert_eq!(
+        r.axes[0][4], r.axes[1][4],
+        "C stands while the head turns upright"
+    );
+    assert_eq!(
+        r.axes[4][4], r.axes[5][4],
+        "and while it turns to the pierce's axis"
+    );
+    assert!(
+        r.axes[1][3].abs() < 1e-9 && r.axes[4][3].abs() < 1e-9,
+        "upright"
     );
 }
 

@@ -45,6 +45,11 @@ pub(crate) fn rows(v: &Value) -> Vec<Vec<f64>> {
 /// `kerf run CURVES --machine MACHINE --place auto --out DIR -q` on shipped fixtures (the
 /// machine under `fixtures/machines/`), asserted to succeed; the directory holds its outputs.
 pub(crate) fn run_auto(curves: &str, machine: &str) -> tempfile::TempDir {
+    run_auto_with(curves, machine, &[])
+}
+
+/// [`run_auto`] with more arguments.
+pub(crate) fn run_auto_with(curves: &str, machine: &str, more: &[&str]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("temporary directory");
     let out = kerf()
         .arg("run")
@@ -54,6 +59,7 @@ pub(crate) fn run_auto(curves: &str, machine: &str) -> tempfile::TempDir {
         .args(["--place", "auto", "--out"])
         .arg(dir.path())
         .arg("-q")
+        .args(more)
         .output()
         .expect("run kerf");
     assert!(

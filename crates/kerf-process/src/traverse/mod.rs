@@ -13,7 +13,9 @@
 mod check;
 mod obstacles;
 mod options;
+mod proof;
 mod routes;
+mod search;
 mod tessellated;
 
 pub use check::check_move;

@@ -21,6 +21,10 @@ pub struct TraverseOptions {
     /// free space): a lifted travel runs in the plane perpendicular to it above every
     /// surface (default +z).
     pub up: Vector3<f64>,
+    /// Where no route shape (straight, lifted, over the safe plane) clears, search for a path
+    /// around the part with the head turned to one tool axis for the travel, within a counted
+    /// work budget (default true; `docs/process.md`, "The search around the part").
+    pub search: bool,
 }
 
 impl Default for TraverseOptions {
@@ -30,6 +34,7 @@ impl Default for TraverseOptions {
             retract_mm: 7.5,
             nozzle_mm: 20.0,
             up: Vector3::z(),
+            search: true,
         }
     }
 }
@@ -61,6 +66,13 @@ impl TraverseOptions {
     /// the fixture, toward the free space).
     pub fn with_up(mut self, up: Vector3<f64>) -> Self {
         self.up = up;
+        self
+    }
+
+    /// Sets [`search`](Self::search): whether a search around the part runs where no route
+    /// shape clears.
+    pub fn with_search(mut self, search: bool) -> Self {
+        self.search = search;
         self
     }
 

@@ -20,15 +20,21 @@ pub enum Route {
     /// come near the travel (seen along the up direction), travel, descend, approach: lower
     /// than the safe plane, so often within the axis limits where that is not.
     Lifted,
+    /// Retract, turn the head to one tool axis (upright, the pierce's or the exit's) where
+    /// that turn keeps the clearance, follow a path found by a search around the part, turn
+    /// to the pierce's axis, approach: where no other route clears (an overhang, a pocket the
+    /// head leaves by another way than it came).
+    Searched,
 }
 
 impl Route {
-    /// `"straight"` or `"safe_plane"`.
+    /// `"straight"`, `"safe_plane"`, `"lifted"` or `"searched"`.
     pub fn name(self) -> &'static str {
         match self {
             Route::Straight => "straight",
             Route::SafePlane => "safe_plane",
             Route::Lifted => "lifted",
+            Route::Searched => "searched",
         }
     }
 }
@@ -108,6 +114,10 @@ pub fn plan_traverse_within(
 /// none clear.
 const FINE_SAMPLES: usize = 1 << 22;
 
+/// The work the search around the part may spend on one gap where no route shape clears
+/// (distance queries, expansions and samples, `search::route`).
+const SEARCH_WORK: usize = 1 << 19;
+
 /// How the routes of one gap failed.
 #[derive(Debug, Default)]
 struct Tally {
@@ -119,6 +129,43 @@ struct Tally {
     closer: usize,
     /// Not proven: within the finest margin, or the work budget ran out.
     undecided: usize,
+    /// The blockage of the route that came nearest to clearing (its offending sample farthest
+    /// from the part).
+    nearest: Option<Blocked>,
+}
+
+impl Tally {
+    fn note(&mut self, b: Blocked) {
+        if self.nearest.is_none_or(|n| b.distance > n.distance) {
+            self.nearest = Some(b);
+        }
+    }
+
+    /// A route whose check failed at `e`: measured closer than `need`, or not proven.
+    fn failed(&mut self, e: Blocked, need: f64) {
+        if e.distance < need && !e.exhausted {
+            self.closer += 1;
+        } else {
+            self.undecided += 1;
+        }
+        self.note(e);
+    }
+
+    /// Hands the clear route `t` to `accept`: its result, or `None` counted as refused.
+    fn offer<T>(
+        &mut self,
+        t: Traverse,
+        accept: &mut dyn FnMut(&Traverse) -> std::result::Result<T, Refusal>,
+    ) -> Option<(Traverse, T)> {
+        match accept(&t) {
+            Ok(v) => Some((t, v)),
+            Err((at, distance)) => {
+                self.refused += 1;
+                self.note(Blocked::at(at, distance));
+                None
+            }
+        }
+    }
 }
 
 /// Why a route was refused by the caller's own check (e.g. the machine's rapid swing): the
@@ -156,12 +203,18 @@ pub(crate) fn plan_traverse_accepting<T>(
     };
     let (from, to) = (unit(from), unit(to));
     // The retract (and the approach) along the tool axis: from 3/4 of the clearance to the
-    // retract height, the tip keeps half the clearance; raised where it does not.
+    // retract height, the tip and the nozzle (which slides along the same line, up to the
+    // height plus its length) keep half the clearance; raised where they do not. (The head
+    // at the retract point, where the travel starts, keeps the full clearance: the travel's
+    // check.)
     let axial = |p: &PoseArray, height: f64| -> std::result::Result<PoseArray, Blocked> {
         let (q, n) = (position(p), normal(p));
         let low = with_axis(q + n * (0.75 * c), n);
         let high = with_axis(q + n * height, n);
-        Trace::new(obs, &low, &high, 0.5 * c, 0.0).prove(floor, &mut Work::new(MOVE_SAMPLES))?;
+        // The tip and the nozzle sweep the one line from `low` to the height plus the
+        // nozzle: traced as the tip's.
+        let top = with_axis(q + n * (height + opts.nozzle_mm), n);
+        Trace::new(obs, &low, &top, 0.5 * c, 0.0).prove(floor, &mut Work::new(MOVE_SAMPLES))?;
         Ok(high)
     };
     let length_of = |way: &[PoseArray]| {
@@ -277,14 +330,6 @@ pub(crate) fn plan_traverse_accepting<T>(
     // routes that failed only within the margin again with finer margins (`prove`), within
     // the gap's budget of samples.
     let mut tally = Tally::default();
-    // The blockage of the route that came nearest to clearing (its offending sample farthest
-    // from the part).
-    let mut nearest: Option<Blocked> = None;
-    let mut note = |b: Blocked| {
-        if nearest.is_none_or(|n| b.distance > n.distance) {
-            nearest = Some(b);
-        }
-    };
     // The routes that failed only within the coarse margin, with that failure.
     let mut marginal: Vec<(usize, Blocked)> = Vec::new();
     let mut fine = Work::new(FINE_SAMPLES);
@@ -299,7 +344,7 @@ pub(crate) fn plan_traverse_accepting<T>(
             if let (Some(b), 0) = (coarse, fine.left) {
                 // No budget left to re-trace it: undecided at its coarse failure.
                 tally.undecided += 1;
-                note(b);
+                tally.note(b);
                 continue;
             }
             if pass == 0 && !reachable(waypoints) {
@@ -319,43 +364,108 @@ pub(crate) fn plan_traverse_accepting<T>(
                         route: *route,
                         min_distance_mm: least,
                     };
-                    match accept(&t) {
-                        Ok(v) => return Ok((t, v)),
-                        Err((at, distance)) => {
-                            tally.refused += 1;
-                            note(Blocked::at(at, distance));
-                        }
+                    if let Some(done) = tally.offer(t, accept) {
+                        return Ok(done);
                     }
                 }
-                Err(e) => {
-                    if pass == 0 && e.within_margin(c) {
-                        marginal.push((k, e));
-                        continue;
-                    }
-                    if e.distance < c && !e.exhausted {
-                        tally.closer += 1;
-                    } else {
-                        tally.undecided += 1;
-                    }
-                    note(e);
-                }
+                Err(e) if pass == 0 && e.within_margin(c) => marginal.push((k, e)),
+                Err(e) => tally.failed(e, c),
             }
         }
     }
-    let n = routes.len();
-    let why = if tally.unreachable == n {
-        format!("none of the {n} routes lies within the machine's axis limits")
-    } else {
-        format!(
-            "{} of {n} routes come too close ({} measured closer than the clearance, {} not proven within a margin of {:.4} mm or the work budget), {} of them only in the machine's rapid swing, {} leave the axis limits",
-            n - tally.unreachable,
-            tally.closer,
-            tally.undecided,
-            c * super::check::FINEST_MARGIN,
-            tally.refused,
-            tally.unreachable
-        )
+    // How the routes of the given shapes failed, in words.
+    let tally_text = |tally: &Tally, n: usize| {
+        if tally.unreachable == n {
+            format!("none of the {n} routes lies within the machine's axis limits")
+        } else {
+            format!(
+                "{} of {n} routes come too close ({} measured closer than the clearance, {} not proven within a margin of {:.4} mm or the work budget), {} of them only in the machine's rapid swing, {} leave the axis limits",
+                n - tally.unreachable,
+                tally.closer,
+                tally.undecided,
+                c * super::check::FINEST_MARGIN,
+                tally.refused,
+                tally.unreachable
+            )
+        }
     };
-    let b = nearest.unwrap_or(Blocked::at(position(&from), 0.0));
+    // No route shape clears. First, is one possible at all? Every route leaves the exit and
+    // reaches the pierce along their tool axes (`proof::line_blocked`).
+    for (p, what) in [
+        (&to, "the approach to the pierce"),
+        (&from, "the retract from the exit"),
+    ] {
+        if let Some((b, why)) = super::proof::line_blocked(obs, p, opts, what) {
+            let shapes = tally_text(&tally, routes.len());
+            return Err(blocked_err(
+                b,
+                format!("{why}; of the route shapes tried, {shapes}"),
+            ));
+        }
+    }
+    // Then a search around the part with the head turned to one tool axis for the travel:
+    // upright, the pierce's, the exit's (each once), sharing one work budget.
+    let mut axes: Vec<nalgebra::Vector3<f64>> = Vec::new();
+    for m in [up, normal(&to), normal(&from)] {
+        if axes.iter().all(|a| (a - m).norm() > 1e-9) {
+            axes.push(m);
+        }
+    }
+    let mut search = Work::new(if opts.search { SEARCH_WORK } else { 0 });
+    let mut searched = 0;
+    for (i, m) in axes.iter().enumerate() {
+        if !opts.search {
+            break;
+        }
+        let mut share = Work::new(search.left / (axes.len() - i));
+        let before = share.left;
+        let found = super::search::route(
+            obs,
+            &super::search::GapEnd {
+                at: &from,
+                retracts: &ends_a,
+            },
+            &super::search::GapEnd {
+                at: &to,
+                retracts: &ends_b,
+            },
+            m,
+            opts,
+            &mut share,
+        );
+        search.left -= before - share.left;
+        let Some(waypoints) = found else { continue };
+        searched += 1;
+        if !reachable(&waypoints) {
+            tally.unreachable += 1;
+            continue;
+        }
+        match tip_ends(&waypoints, None) {
+            Ok(least) => {
+                let t = Traverse {
+                    length_mm: length_of(&waypoints),
+                    waypoints,
+                    route: Route::Searched,
+                    min_distance_mm: least,
+                };
+                if let Some(done) = tally.offer(t, accept) {
+                    return Ok(done);
+                }
+            }
+            Err(e) => tally.failed(e, c),
+        }
+    }
+    let n = routes.len() + searched;
+    let search_note = if opts.search {
+        format!(
+            "; the search around the part (the head turned upright, to the pierce's or to the exit's tool axis) found {searched} path{} in {} of its {SEARCH_WORK} work units",
+            if searched == 1 { "" } else { "s" },
+            SEARCH_WORK - search.left
+        )
+    } else {
+        String::new()
+    };
+    let why = tally_text(&tally, n) + &search_note;
+    let b = tally.nearest.unwrap_or(Blocked::at(position(&from), 0.0));
     Err(blocked_err(b, why))
 }

@@ -302,7 +302,7 @@ pub(crate) struct Scaled {
 
 impl Scaled {
     /// From the first three derivatives with respect to the curve's parameter.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn new(d1: &Vector3<f64>, d2: &Vector3<f64>, d3: &Vector3<f64>) -> Self {
         let s = d1.norm();
         let inv = 1.0 / s;
@@ -320,7 +320,7 @@ impl Scaled {
     /// `f` is 0 where it is not finite (a removable or integrable singularity of the
     /// integrand); `df/dt` is NaN where it is not finite (`k = 0`, where `sqrt(k)` has no
     /// derivative).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn sqrt_curvature_speed(&self) -> (f64, f64) {
         let b = self.v.cross(&self.a);
         let bb = b.norm_squared();
@@ -357,7 +357,7 @@ fn trapezoid_sqrt_curvature(curve: &NurbsCurve, params: &[f64]) -> f64 {
 /// uses each end's value up to the nearest knot on its side (and the mean in between): the
 /// error is then of the order of the integrand's variation within a span, not of its jump.
 /// `span` and `span1` are the knot spans of `t0` and `t1` (`NurbsCurve::span`).
-#[inline]
+#[inline(always)]
 pub(crate) fn trapezoid_step(
     curve: &NurbsCurve,
     (t0, span): (f64, usize),

@@ -88,7 +88,7 @@ impl Taylor {
     /// the chord over `x` and `m = a / 8 + j x / 16` the middle point's offset from the chord's
     /// middle over `x^2`, the parts across the chord are `|m|^2 - (m.c)^2 / |c|^2` and so on.
     /// Where `cl <= n` the maximum is `n + cl^2 / (256 n)` to a relative `3e-5`.
-    #[inline]
+    #[inline(always)]
     fn error(&self, h: f64) -> f64 {
         const THIRD: f64 = 1.0 / 3.0;
         const SIXTH: f64 = 1.0 / 6.0;
@@ -126,7 +126,7 @@ impl Taylor {
     }
 
     /// The model's chord length for the step `h`.
-    #[inline]
+    #[inline(always)]
     fn length(&self, h: f64) -> f64 {
         let x = h * self.s;
         let cc = self.vv
@@ -141,6 +141,7 @@ impl Taylor {
     /// relative variation of `e / h^2` over the correction); without a guess, from the
     /// circle's estimate (the cubic term's where that dominates, at an inflection) by two.
     /// Infinite where the model has no error (straight).
+    #[inline(always)]
     fn step_for(&self, target: f64, guess: f64) -> f64 {
         let (mut h, iterations) = if guess > 0.0 && guess.is_finite() {
             (guess, 1)
@@ -176,6 +177,7 @@ impl Taylor {
 
     /// The step whose model chord is `length` (two fixed-point steps from `h`; the chord is
     /// nearly proportional to the step).
+    #[inline(always)]
     fn step_for_length(&self, mut h: f64, length: f64) -> f64 {
         for _ in 0..2 {
             let l = self.length(h);
@@ -208,7 +210,47 @@ pub(crate) struct Walker<'a> {
 
 impl Walker<'_> {
     /// Discretizes `[a, b]`, appending every cutting point after `a` (the last one is `b`).
+    ///
+    /// On an x86-64 processor with AVX2 and FMA (x86-64-v3: every x86-64 processor since
+    /// 2013-2015), the walk runs as code compiled for those instructions (the four lanes of a
+    /// homogeneous point in one 256-bit register), found at run time: the same IEEE operations
+    /// in the same order (Rust never fuses a multiply and an add on its own), so the same
+    /// bits, about 25 % faster (`docs/performance.md`). Elsewhere it runs as compiled.
     pub(crate) fn piece(
+        &mut self,
+        a: f64,
+        b: f64,
+        pb: Point3<f64>,
+        out: &mut Discretization,
+    ) -> Result<()> {
+        #[cfg(target_arch = "x86_64")]
+        if x86_64_v3() && !tests::generic_only() {
+            // SAFETY: `piece_v3` only needs the target features that `x86_64_v3` has just
+            // found on this processor.
+            return unsafe { self.piece_v3(a, b, pb, out) };
+        }
+        self.piece_any(a, b, pb, out)
+    }
+
+    /// [`Walker::piece`] compiled for x86-64-v3's vector and bit instructions.
+    ///
+    /// # Safety
+    /// The processor must have the features enabled here ([`x86_64_v3`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,movbe,popcnt,f16c")]
+    unsafe fn piece_v3(
+        &mut self,
+        a: f64,
+        b: f64,
+        pb: Point3<f64>,
+        out: &mut Discretization,
+    ) -> Result<()> {
+        self.piece_any(a, b, pb, out)
+    }
+
+    /// [`Walker::piece`] for the curve's degree, compiled for whatever the caller is.
+    #[inline(always)]
+    fn piece_any(
         &mut self,
         a: f64,
         b: f64,
@@ -224,7 +266,7 @@ impl Walker<'_> {
     }
 
     /// Certifies the segment from `start` to the trial end `(t1, p1, end)`.
-    #[inline]
+    #[inline(always)]
     fn certify<const P: usize, const M: usize>(
         &mut self,
         start: &Eval,
@@ -259,6 +301,7 @@ impl Walker<'_> {
         (bound, None)
     }
 
+    #[inline(always)]
     fn piece_of<const P: usize, const M: usize>(
         &mut self,
         a: f64,
@@ -511,6 +554,7 @@ impl Walker<'_> {
 /// target `target`: the model's own step with its bias measured at `h`, kept between the
 /// power laws `err ~ h^2` and `err ~ h^4` through the trial (where the model is poor, across a
 /// knot, the trial's own scaling decides); NaN-free.
+#[inline(always)]
 fn next_step(model: &Taylor, h: f64, err: f64, target: f64) -> f64 {
     let r = target / err;
     let (q2, q4) = (h * r.sqrt(), h * r.sqrt().sqrt());
@@ -528,6 +572,30 @@ fn next_step(model: &Taylor, h: f64, err: f64, target: f64) -> f64 {
     }
 }
 
+#[cfg(not(test))]
+mod tests {
+    /// Outside the tests, the walk always takes the fastest code the processor runs.
+    #[inline(always)]
+    pub(super) fn generic_only() -> bool {
+        false
+    }
+}
+
+/// Whether this processor has what [`Walker::piece_v3`] is compiled for (checked once, then
+/// cached by the standard library).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn x86_64_v3() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+        && std::arch::is_x86_feature_detected!("bmi1")
+        && std::arch::is_x86_feature_detected!("bmi2")
+        && std::arch::is_x86_feature_detected!("lzcnt")
+        && std::arch::is_x86_feature_detected!("movbe")
+        && std::arch::is_x86_feature_detected!("popcnt")
+        && std::arch::is_x86_feature_detected!("f16c")
+}
+
 /// The gap from `t` to the next larger double.
 fn next_float_gap(t: f64) -> f64 {
     let next = f64::from_bits(if t >= 0.0 {
@@ -536,4 +604,83 @@ fn next_float_gap(t: f64) -> f64 {
         t.to_bits() - 1
     });
     (next - t).abs()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+
+    use kerf_nurbs::NurbsCurve;
+    use nalgebra::{Point3, Vector3};
+
+    use crate::{discretize, Options};
+
+    thread_local! {
+        static GENERIC_ONLY: Cell<bool> = const { Cell::new(false) };
+    }
+
+    /// Whether this thread's walks are held to the code compiled for any processor.
+    pub(super) fn generic_only() -> bool {
+        GENERIC_ONLY.with(Cell::get)
+    }
+
+    /// The walk compiled for x86-64-v3 and the walk compiled for any x86-64 make the same
+    /// cutting points to the bit, and the same certified bound (the proof of
+    /// `docs/discretization.md` is about the IEEE operations, which target features do not
+    /// change: Rust never fuses a multiply and an add it was not told to). On a processor
+    /// without those features both runs take the generic walk and the test holds trivially,
+    /// which it says.
+    #[test]
+    fn the_vector_walk_and_the_generic_walk_agree_to_the_bit() {
+        let mut curves: Vec<NurbsCurve> = (1..=9)
+            .flat_map(|d| kerf_nurbs::smooth_random_curves(d, 4, 1000 + d as u64))
+            .collect();
+        // Rational: the same curves with uneven weights, and an exact circle far from the
+        // origin.
+        for c in kerf_nurbs::smooth_random_curves(4, 3, 77) {
+            let w: Vec<f64> = (0..c.len()).map(|i| 0.5 + (i % 3) as f64 * 0.75).collect();
+            curves.push(NurbsCurve::new(
+                c.degree(),
+                c.knots().to_vec(),
+                c.control_points(),
+                Some(w),
+            ));
+        }
+        curves.push(
+            NurbsCurve::circle(
+                Point3::new(1e4, -3e3, 250.0),
+                Vector3::new(1.0, 2.0, 3.0),
+                40.0,
+            )
+            .expect("circle"),
+        );
+        #[cfg(target_arch = "x86_64")]
+        if !super::x86_64_v3() {
+            eprintln!("this processor has no x86-64-v3: both walks are the generic one");
+        }
+        for tol in [0.01, 1e-4] {
+            let opts = Options::with_tolerance(tol);
+            for (i, c) in curves.iter().enumerate() {
+                GENERIC_ONLY.with(|g| g.set(false));
+                let fast = discretize(c, &opts).expect("walk");
+                GENERIC_ONLY.with(|g| g.set(true));
+                let generic = discretize(c, &opts).expect("walk");
+                GENERIC_ONLY.with(|g| g.set(false));
+                let bits = |d: &crate::Discretization| -> Vec<u64> {
+                    d.params()
+                        .iter()
+                        .map(|t| t.to_bits())
+                        .chain(
+                            d.points()
+                                .iter()
+                                .flat_map(|p| p.iter().map(|x| x.to_bits())),
+                        )
+                        .chain([d.max_chord_error().to_bits()])
+                        .collect()
+                };
+                assert!(fast.points().len() > 2, "curve {i}: a real walk");
+                assert_eq!(bits(&fast), bits(&generic), "curve {i} at {tol} mm");
+            }
+        }
+    }
 }

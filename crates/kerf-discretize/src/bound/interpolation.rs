@@ -126,7 +126,7 @@ pub(crate) struct Question {
 impl Question {
     /// Whether `bd` answers the question: certainly too long, or certified and either in the
     /// band, below it, or as tight as refining could make it.
-    #[inline]
+    #[inline(always)]
     pub(super) fn decided(&self, bd: &Bound) -> bool {
         let tight = bd.upper - bd.lower <= 0.002 * self.limit;
         bd.lower > self.limit
@@ -138,7 +138,7 @@ impl Question {
     /// walk, certified, or not certified by a bound within 5 % of the tolerance of a curve
     /// point's distance (the hull's subdivisions could move the answer only within that: the
     /// walk takes a slightly shorter step instead, for far less work).
-    #[inline]
+    #[inline(always)]
     pub(super) fn settled(&self, bd: &Bound) -> bool {
         self.decided(bd)
             || (self.settle && (bd.upper <= self.limit || bd.upper - bd.lower <= 0.05 * self.limit))
@@ -158,7 +158,7 @@ impl Certifier<'_> {
     /// (the weight changes too much over the step, or a curve point's foot might fall outside
     /// the chord): then only the hull certificate applies. Costs one evaluation.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     pub(super) fn interpolation_bound<const P: usize, const M: usize>(
         &self,
         span: usize,
@@ -336,7 +336,7 @@ impl Certifier<'_> {
     /// The distance to the chord of the curve point at `x = s - 1/2` (`|x| <= 1/2`) of the
     /// step `[u0, u1]` of span `span`, if the point is worth an evaluation (not within a
     /// twentieth of the step from the middle, where the middle point's distance is as good).
-    #[inline]
+    #[inline(always)]
     fn probe<const P: usize, const M: usize>(
         &self,
         span: usize,
@@ -356,7 +356,7 @@ impl Certifier<'_> {
 /// Replaces the Bezier control points `d` on `[0, 1]` by those of the piece on `[u0, u1]`
 /// (`0 <= u0 < u1 <= 1`): the left part at `u1`, then the right part of that at `u0 / u1`, as
 /// the hull certificate cuts its pieces (every level a convex combination).
-#[inline]
+#[inline(always)]
 pub(super) fn split_to(d: &mut [Vector4<f64>], u0: f64, u1: f64) {
     let q = d.len() - 1;
     if u1 < 1.0 {

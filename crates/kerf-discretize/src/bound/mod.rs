@@ -272,7 +272,7 @@ impl<'a> Certifier<'a> {
     /// each end was evaluated from (by [`Certifier::eval`]), which saves evaluating them
     /// again, and the question asked.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     pub(crate) fn chord_error_known<const P: usize, const M: usize>(
         &self,
         scratch: &mut Scratch,

@@ -62,7 +62,7 @@ impl Certifier<'_> {
 
     /// The knot span of `t`: `hint` if `t` lies in it (the walk mostly stays in one span),
     /// else by binary search (right-sided at a knot, the last span at the domain's end).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn span_at(&self, t: f64, hint: usize) -> usize {
         let knots = self.local.knots();
         if hint + 1 < knots.len() && knots[hint] <= t && t < knots[hint + 1] {
@@ -89,7 +89,7 @@ impl Certifier<'_> {
     /// The homogeneous point of span `span`'s Bezier form at the local parameter `u` in
     /// `[0, 1]`, by de Casteljau (`p` levels of convex combinations, like the splits of Step
     /// 1). Counts as one evaluation.
-    #[inline]
+    #[inline(always)]
     pub(super) fn span_point<const P: usize, const M: usize>(
         &self,
         span: usize,
@@ -147,7 +147,7 @@ impl Certifier<'_> {
     /// respect to `t` in knot span `span`, from the span's Bezier form: de Casteljau down to
     /// level `p - N`, whose forward differences give the homogeneous derivatives
     /// (`p! / (p - k)! Delta^k`), then the quotient rule. Counts as one evaluation.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn eval<const P: usize, const M: usize, const N: usize>(
         &self,
         span: usize,

@@ -5,6 +5,7 @@ use std::cell::RefCell;
 use std::fmt;
 
 use serde::de::{self, DeserializeSeed, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde::Deserialize;
 use serde_json::{Map, Number, Value};
 
 use crate::read::strip_bom;
@@ -107,6 +108,25 @@ pub fn parse_json(bytes: &[u8]) -> Result<Value, JsonError> {
                 message,
             })
         }
+    }
+}
+
+/// A [`Value`] read like [`parse_json`] reads one: a key given twice in one object is an error
+/// (here a plain deserialization error, without the path: a reader that wants the path reads
+/// the document again with [`parse_json`]). For typed readers that keep part of a document as
+/// JSON values in one pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StrictValue(pub Value);
+
+impl<'de> Deserialize<'de> for StrictValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let duplicate = RefCell::new(None);
+        Seed {
+            at: Seg::Root,
+            duplicate: &duplicate,
+        }
+        .deserialize(d)
+        .map(StrictValue)
     }
 }
 

@@ -38,7 +38,7 @@ mod shape;
 mod text;
 mod write;
 
-pub use json::{parse_json, path_at, JsonError};
+pub use json::{parse_json, path_at, JsonError, StrictValue};
 pub use read::{read_file, read_regular_file, read_to_end, strip_bom, MAX_INPUT_BYTES};
 pub use shape::{deserialize_at, duplicate_key_message, JsonProblem, ShapeError};
 pub use text::{check_text, TextDefect};

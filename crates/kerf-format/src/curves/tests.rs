@@ -680,3 +680,124 @@ fn bad_surface_lists_name_the_place() {
     let e = error(&doc(&object, &plane("p")));
     assert!(e.contains("expected a surface id or a list of ids"), "{e}");
 }
+
+/// Every `.json` under `dir`, recursively.
+fn json_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("fixtures dir") {
+        let path = entry.expect("entry").path();
+        if path.is_dir() {
+            json_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "json") {
+            out.push(path);
+        }
+    }
+}
+
+/// The one-pass reader gives exactly the careful reader's result wherever it accepts a
+/// document, and gives up (so that the careful reader explains) on every document the careful
+/// reader refuses or warns about: on every shipped fixture (good, bad, hostile, real) and on
+/// inline documents with each kind of defect it must not swallow.
+#[test]
+fn the_one_pass_reader_agrees_with_the_careful_one() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    let mut files = Vec::new();
+    json_files(&root, &mut files);
+    let mut texts: Vec<(String, Vec<u8>)> = files
+        .iter()
+        .map(|p| (p.display().to_string(), std::fs::read(p).expect("read")))
+        .collect();
+    let inline = [
+        (
+            "extension key",
+            doc(&line("a").replace("\"id\"", "\"vendor\": 1, \"id\""), ""),
+        ),
+        (
+            "near miss",
+            doc(
+                &line("a").replace("\"id\"", "\"weigths\": [1, 1], \"id\""),
+                "",
+            ),
+        ),
+        (
+            "repeated key",
+            doc(
+                &line("a").replace("\"id\": \"a\"", "\"id\": \"a\", \"id\": \"b\""),
+                "",
+            ),
+        ),
+        (
+            "repeated key in a surface",
+            doc(
+                &line("a"),
+                &plane("p").replace("\"id\": \"p\"", "\"id\": \"p\", \"id\": \"q\""),
+            ),
+        ),
+        (
+            "near miss in a surface",
+            doc(
+                &line("a"),
+                &plane("p").replace("\"id\"", "\"flipp\": true, \"id\""),
+            ),
+        ),
+        (
+            "top-level extension",
+            doc(&line("a"), "").replace("\"units\"", "\"comment\": \"x\", \"units\""),
+        ),
+        ("inches", doc(&line("a"), "").replace("\"mm\"", "\"in\"")),
+        (
+            "bad surface",
+            doc(&line("a"), r#"{"id": "s", "type": "nurbs"}"#),
+        ),
+        ("trailing text", doc(&line("a"), "") + " x"),
+        (
+            "byte-order mark",
+            format!("\u{feff}{}", doc(&line("a"), &plane("p"))),
+        ),
+        ("good", doc(&line("a"), &plane("p"))),
+    ];
+    texts.extend(
+        inline
+            .iter()
+            .map(|(n, t)| (n.to_string(), t.as_bytes().to_vec())),
+    );
+    let (mut fast, mut careful_only) = (0, 0);
+    let mut read_twice = Vec::new();
+    for (name, bytes) in &texts {
+        let careful = raw_and_warnings_careful(bytes);
+        match raw_in_one_pass(bytes) {
+            Some((raw, warnings)) => {
+                fast += 1;
+                let (c_raw, c_warnings) = careful.unwrap_or_else(|e| {
+                    panic!("{name}: one pass accepted what the careful reader refuses: {e}")
+                });
+                assert_eq!(raw, c_raw, "{name}");
+                assert_eq!(
+                    warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),
+                    c_warnings
+                        .iter()
+                        .map(ToString::to_string)
+                        .collect::<Vec<_>>(),
+                    "{name}"
+                );
+            }
+            None => {
+                careful_only += 1;
+                if careful.is_ok() {
+                    read_twice.push(name.as_str());
+                }
+            }
+        }
+    }
+    // Read twice only where a key the format does not name is written (every shipped
+    // fixture the careful reader accepts goes through in one pass, surfaces and all).
+    assert_eq!(
+        read_twice,
+        ["extension key", "near miss", "top-level extension"],
+        "documents the careful reader accepts that the one-pass reader gave up on"
+    );
+    assert!(fast >= 10, "the one-pass reader took {fast} documents");
+    assert!(
+        careful_only >= 10,
+        "the careful reader alone read {careful_only}"
+    );
+}

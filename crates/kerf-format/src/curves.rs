@@ -541,13 +541,15 @@ fn raw_and_warnings_careful(bytes: &[u8]) -> Result<(RawCurvesFile, Vec<UnknownK
     }
     let map = json::parse_document(bytes, CURVES_FORMAT)?;
     let warnings = keys::near_misses(&map);
-    let body: Body = json::deserialize(Value::Object(map), "")?;
+    let named = |e| keys::name_the_misspelling(e, &warnings);
+    let body: Body = json::deserialize(Value::Object(map), "").map_err(named)?;
     let surfaces = body
         .surfaces
         .into_iter()
         .enumerate()
         .map(|(index, value)| raw_surface(index, value))
-        .collect::<Result<_>>()?;
+        .collect::<Result<_>>()
+        .map_err(named)?;
     let raw = RawCurvesFile {
         format: body.format,
         units: body.units,

@@ -11,6 +11,8 @@ use std::fmt;
 
 use serde_json::{Map, Value};
 
+use crate::error::FormatError;
+
 /// The keys of the document's top level.
 const TOP: &[&str] = &["format", "units", "curves", "surfaces"];
 /// The keys of one entry of `curves`.
@@ -61,6 +63,36 @@ impl fmt::Display for UnknownKey {
         )
     }
 }
+
+/// A missing required key whose object holds a near miss of it (`knot` for `knots`) says so:
+/// `curves[0].knots: required key is missing (the object has "knot": a misspelling of it?)`.
+/// Any other error is returned as it is.
+pub(super) fn name_the_misspelling(error: FormatError, near: &[UnknownKey]) -> FormatError {
+    let FormatError::Shape { path, message } = error else {
+        return error;
+    };
+    let (parent, field) = match path.rsplit_once('.') {
+        Some((parent, field)) => (format!("{parent}."), field),
+        None => (String::new(), path.as_str()),
+    };
+    let found = (message == MISSING)
+        .then(|| {
+            near.iter().find_map(|w| {
+                w.path
+                    .strip_prefix(&parent)
+                    .filter(|_| w.resembles == field)
+            })
+        })
+        .flatten();
+    let message = match found {
+        Some(key) => format!("{MISSING} (the object has \"{key}\": a misspelling of it?)"),
+        None => message,
+    };
+    FormatError::Shape { path, message }
+}
+
+/// The message of a missing required key (`kerf_io::deserialize_at`'s wording).
+const MISSING: &str = "required key is missing";
 
 /// The near-miss keys of a parsed `kerf.curves/1` document, in document order.
 pub(super) fn near_misses(doc: &Map<String, Value>) -> Vec<UnknownKey> {

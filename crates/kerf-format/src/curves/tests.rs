@@ -465,6 +465,26 @@ fn wrong_shapes_are_reported_with_their_path() {
         "curves: required key is missing",
         "no curves"
     );
+    // A missing key whose object holds a near miss of it names the misspelling; a near miss
+    // in another object, or of another key, does not.
+    assert_eq!(
+        error(&doc(
+            r#"{"id": "x", "degree": 1, "knot": [0, 0, 1, 1], "control_points": [[0,0,0],[1,0,0]]}"#,
+            ""
+        )),
+        "curves[0].knots: required key is missing (the object has \"knot\": a misspelling of it?)"
+    );
+    assert_eq!(
+        error(r#"{"format": "kerf.curves/1", "units": "mm", "Curves": []}"#),
+        "curves: required key is missing (the object has \"Curves\": a misspelling of it?)"
+    );
+    assert_eq!(
+        error(&doc(
+            r#"{"id": "x", "degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0,0,0],[1,0,0]], "wieghts": [1, 1]}, {"id": "y", "degree": 1, "control_points": [[0,0,0],[1,0,0]]}"#,
+            ""
+        )),
+        "curves[1].knots: required key is missing"
+    );
     assert_eq!(
         error(r#"{"format": "kerf.curves/1", "units": "mm", "curves": {}}"#),
         "curves: invalid type: object, expected an array",

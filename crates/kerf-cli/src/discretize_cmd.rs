@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use kerf_discretize::{Discretization, Options};
 use kerf_format::toolpath;
-use kerf_format::CurvesFile;
+use kerf_format::{CurveRecord, CurvesFile};
 use kerf_normals::NormalOptions;
 use kerf_pipeline::{
     discretize_curves, orient_curves, toolpath_of_poses, MissingSurface, OrientOptions, Progress,
@@ -79,12 +79,17 @@ impl Totals {
 }
 
 /// Curves discretized together (in parallel) and then written, group after group, so that the
-/// points of a large file are never all in memory: the process holds the input and one group's
+/// points of a large file are never all in memory: the process holds the input and two groups'
 /// output, and the output goes to the file as it comes.
 const GROUP: usize = 256;
 
 /// Discretizes every curve and writes its cutting points to `dest` as they come (positions
 /// only), in input order; on any failure `dest` is untouched (`toolpath::write_with`).
+///
+/// Writing is serial (one file, in order), so it overlaps the discretization: while this
+/// thread formats and writes group `g`, the thread pool discretizes group `g + 1`. The bytes
+/// are those of discretizing and writing one group after the other; the CPU time is the same,
+/// the wall time on two cores drops by about the writing's share.
 fn discretize_to_file(
     file: &CurvesFile,
     input: &Path,
@@ -113,23 +118,42 @@ fn discretize_to_file(
     let total = file.curves.len();
     let mut totals = Totals::default();
     bar.update(Progress::new(Stage::Discretize, 0, total));
+    let discretize_group = |group: &[CurveRecord]| -> Vec<_> {
+        group
+            .par_iter()
+            .map(|r| kerf_discretize::discretize(&r.curve, opts))
+            .collect()
+    };
+    let groups: Vec<&[CurveRecord]> = file.curves.chunks(GROUP).collect();
     toolpath::write_with(dest, file.units, opts.tolerance_mm, |w| {
-        for (g, group) in file.curves.chunks(GROUP).enumerate() {
-            let discs: Vec<_> = group
-                .par_iter()
-                .map(|r| kerf_discretize::discretize(&r.curve, opts))
-                .collect();
-            for (k, (rec, d)) in group.iter().zip(discs).enumerate() {
-                let d = d.map_err(|source| kerf_pipeline::Error::Discretize {
-                    file: Some(input.to_path_buf()),
-                    index: g * GROUP + k,
-                    id: rec.id.clone(),
-                    source,
-                })?;
-                w.path(&rec.id, d.params(), d.points(), d.max_chord_error())
-                    .map_err(|e| e.in_file(dest))?;
-                totals.add(&d, opts.tolerance_mm);
-            }
+        let mut ready = groups.first().map(|g| discretize_group(g));
+        for (g, group) in groups.iter().enumerate() {
+            let discs = ready
+                .take()
+                .expect("the scope before this one discretized this group");
+            let mut next = None;
+            // The pool discretizes the next group while this thread writes this one; the scope
+            // waits for it, also when the writing fails.
+            let written = rayon::in_place_scope(|s| {
+                if let Some(following) = groups.get(g + 1) {
+                    let next = &mut next;
+                    s.spawn(move |_| *next = Some(discretize_group(following)));
+                }
+                for (k, (rec, d)) in group.iter().zip(discs).enumerate() {
+                    let d = d.map_err(|source| kerf_pipeline::Error::Discretize {
+                        file: Some(input.to_path_buf()),
+                        index: g * GROUP + k,
+                        id: rec.id.clone(),
+                        source,
+                    })?;
+                    w.path(&rec.id, d.params(), d.points(), d.max_chord_error())
+                        .map_err(|e| e.in_file(dest))?;
+                    totals.add(&d, opts.tolerance_mm);
+                }
+                Ok::<(), CliError>(())
+            });
+            written?;
+            ready = next;
             bar.update(Progress::new(
                 Stage::Discretize,
                 (g * GROUP + group.len()).min(total),

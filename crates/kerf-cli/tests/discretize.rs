@@ -193,3 +193,105 @@ fn summary_without_curvature_gives_no_ratio() {
     assert!(summary["segments_over_n_star"].is_null(), "{summary}");
     assert_eq!(summary["segments"], 3);
 }
+
+/// `n` cubic curves with 6 control points each, from a fixed linear congruential sequence;
+/// curve `wiggly` (if any) is 100 times larger, so that it needs far more points.
+fn many_curves(n: usize, wiggly: Option<usize>) -> String {
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let curves: Vec<String> = (0..n)
+        .map(|k| {
+            let scale = if Some(k) == wiggly { 1000.0 } else { 10.0 };
+            let points: Vec<String> = (0..6)
+                .map(|j| {
+                    let (x, y, z) = (next(), next(), next());
+                    format!(
+                        "[{}, {}, {}]",
+                        scale * (j as f64 + x),
+                        scale * y,
+                        scale * 0.2 * z
+                    )
+                })
+                .collect();
+            format!(
+                r#"{{"id": "c{k}", "degree": 3, "knots": [0, 0, 0, 0, 0.3, 0.6, 1, 1, 1, 1],
+                     "control_points": [{}]}}"#,
+                points.join(", ")
+            )
+        })
+        .collect();
+    format!(
+        r#"{{"format": "kerf.curves/1", "units": "mm", "curves": [{}]}}"#,
+        curves.join(",\n")
+    )
+}
+
+#[test]
+fn a_file_of_several_groups_is_the_library_output_in_order_to_the_bit() {
+    // The command discretizes groups of 256 curves in parallel and writes one group while it
+    // discretizes the next: 700 curves are three groups, the last one short.
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.json");
+    let out = dir.path().join("out.json");
+    std::fs::write(&input, many_curves(700, None)).unwrap();
+    let o = kerf()
+        .arg("discretize")
+        .arg(&input)
+        .args(["-t", "0.01", "-q", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let tp = kerf_format::toolpath::load(&out).unwrap();
+    let curves = kerf_format::curves::load(&input).unwrap();
+    assert_eq!(tp.paths.len(), 700);
+    let opts = kerf_discretize::Options::with_tolerance(0.01);
+    for (p, c) in tp.paths.iter().zip(&curves.curves) {
+        assert_eq!(p.id, c.id, "input order");
+        let d = kerf_discretize::discretize(&c.curve, &opts).unwrap();
+        assert_eq!(p.params, d.params(), "{}: the library's params", p.id);
+        for (n, q) in d.points().iter().enumerate() {
+            assert_eq!(
+                p.points.position(n),
+                *q,
+                "{}: point {n} as the library made it",
+                p.id
+            );
+        }
+        assert_eq!(p.max_chord_error, d.max_chord_error(), "{}", p.id);
+    }
+}
+
+#[test]
+fn a_curve_refused_in_a_later_group_names_itself_and_leaves_no_file() {
+    // Curve 600 (third group) needs more points than --max-points allows; the groups before
+    // it are written by then, and still nothing may be left behind.
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.json");
+    let out = dir.path().join("out.json");
+    std::fs::write(&input, many_curves(700, Some(600))).unwrap();
+    let o = kerf()
+        .arg("discretize")
+        .arg(&input)
+        .args(["-t", "0.01", "--max-points", "100", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("curves[600]") && stderr.contains("\"c600\""),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "no half-written toolpath");
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "only the input is left: {left:?}");
+}

@@ -109,6 +109,221 @@ fn all_finite(h3: &[Vector4<f64>], sb: &SpanBounds) -> bool {
         .all(|x| x.is_finite())
 }
 
+/// A step's derivative bounds multiplied by the powers of the step that the certificate's
+/// forms use, so that a step inside one span (in its local parameter) and a step across a knot
+/// (each span's bounds in its own local units, the larger taken) share one implementation.
+#[derive(Debug, Clone, Copy)]
+struct Scaled {
+    /// `h W1`: the step times the bound of `|w'|`.
+    hw1: f64,
+    /// `h^3` times the rounding slack of the third-derivative bounds.
+    slack3: f64,
+    /// `h^3 W3 + 3 h^2 W2`: the weights' part of `h^3 M3par` per unit of chord length.
+    par_w3: f64,
+    /// A bound of `|C'|` in local units (the ends' local parameters are rounded).
+    d1: f64,
+}
+
+/// What the interpolation certificate knows of one step once its ends and middle point are
+/// evaluated (`docs/discretization.md`, "The interpolation certificate").
+struct Step {
+    /// The chord's unit direction.
+    dir: Vector3<f64>,
+    /// The middle point's offset across the chord.
+    offset: Vector3<f64>,
+    /// The middle point's distance to the chord's line: a lower bound of the chord error.
+    lower: f64,
+    /// The middle point's weight and its reciprocal.
+    wm: f64,
+    inv_wm: f64,
+    /// `a' = a / (1 - a/2)`, `a = h W1 / w(um)`.
+    a2: f64,
+    /// How far the given chord ends are from the curve's ends, and that times `w_hi`.
+    e: f64,
+    e_w: f64,
+    /// `n = w(um) dm + w_hi e` and its reciprocal.
+    n: f64,
+    inv_n: f64,
+    /// `4 (|N_par(um)| + w_hi e)`, and `l w_lo / 2`, which it must stay below with the third
+    /// derivative's term for every foot to fall inside the chord.
+    along0: f64,
+    half_l_w_lo: f64,
+    /// The chord's length.
+    l: f64,
+    margin: f64,
+    scaled: Scaled,
+}
+
+impl Step {
+    /// From the projected ends `c`, the middle point (projected, and its weight), the chord
+    /// (its start `al` in local coordinates) and the margin; `None` for a degenerate chord, a
+    /// non-positive middle weight or a weight that changes too much over the step (`a > 1/2`).
+    #[inline(always)]
+    fn new(
+        c: [Vector3<f64>; 2],
+        (cm, wm): (Vector3<f64>, f64),
+        chord: &Segment<3>,
+        al: &Vector3<f64>,
+        margin: f64,
+        scaled: Scaled,
+    ) -> Option<Self> {
+        let ab = chord.direction();
+        let bl = al + ab;
+        // How far the given chord ends are from the curve's ends.
+        let e = (c[0] - al)
+            .norm_squared()
+            .max((c[1] - bl).norm_squared())
+            .sqrt();
+        let l = ab.norm();
+        if !(l > 0.0 && wm > 0.0 && e.is_finite()) {
+            return None;
+        }
+        let dir = ab * (1.0 / l);
+        let xm = cm - al;
+        let par = xm.dot(&dir);
+        let offset = xm - dir * par;
+        // w(u) >= w_m (1 - a |s - 1/2|) on the step.
+        let inv_wm = 1.0 / wm;
+        let a = scaled.hw1 * inv_wm;
+        if a.is_nan() || a > 0.5 {
+            return None;
+        }
+        let w_lo = wm * (1.0 - 0.5 * a);
+        let w_hi = wm * (1.0 + 0.5 * a);
+        let e_w = w_hi * e;
+        let dm = offset.norm();
+        let n = wm * dm + e_w;
+        Some(Self {
+            dir,
+            offset,
+            lower: dm,
+            wm,
+            inv_wm,
+            a2: a / (1.0 - 0.5 * a),
+            e,
+            e_w,
+            n,
+            inv_n: 1.0 / n,
+            along0: 4.0 * ((wm * (par - 0.5 * l)).abs() + e_w),
+            half_l_w_lo: 0.5 * l * w_lo,
+            l,
+            margin,
+            scaled,
+        })
+    }
+
+    /// Whether the foot of every curve point on the chord's line lies in the chord (up to the
+    /// ends' offset `e`), given `h^3` times a bound of the third derivative of N along the
+    /// chord: then the distance to the chord is that to its line.
+    #[inline(always)]
+    fn feet_inside(&self, h3_m3_par: f64) -> bool {
+        let s = &self.scaled;
+        let along = self.along0 + (h3_m3_par + s.slack3 + self.l * s.par_w3) * (1.0 / 12.0);
+        along <= self.half_l_w_lo
+    }
+
+    /// The scalar form's `cl` from `h^3` times a bound of `|N'''|` on the step:
+    /// `c = h^3 m3 / 6`, `cl = c + 4 n a' + c a' / 2`.
+    #[inline(always)]
+    fn scalar(&self, h3_m3: f64) -> f64 {
+        let c = (h3_m3 + self.scaled.slack3) * (1.0 / 6.0);
+        c + 4.0 * self.n * self.a2 + 0.5 * c * self.a2
+    }
+
+    /// The bound from `cl`, the coefficient of the term linear in x = |s - 1/2|:
+    /// |N_perp(u)| <= e_w + (1/4 - x^2) (4 n + cl x), divided by w(u) (whose variation is
+    /// inside `cl`); the maximum over x in [0, 1/2] is in closed form, and where
+    /// `cl <= 2 n` the bound `n + cl^2 / (256 n)` of it (dropping `-cl x^3`, the rest is a
+    /// parabola in x) is used instead, within 0.05 % of it and without a root. With `x`,
+    /// where the bound peaks.
+    #[inline(always)]
+    fn bound(&self, cl: f64, lower: f64) -> Option<(Bound, f64)> {
+        let n = self.n;
+        let (phi, x) = if n > 0.0 && cl <= 2.0 * n {
+            let r = cl * self.inv_n;
+            (n + cl * r * (1.0 / 256.0), r * (1.0 / 32.0))
+        } else {
+            let root = (64.0 * n * n + 3.0 * cl * cl).sqrt() + 8.0 * n;
+            let x = if root > 0.0 { cl / (2.0 * root) } else { 0.0 };
+            ((0.25 - x * x) * (4.0 * n + cl * x), x)
+        };
+        let upper = (phi * self.inv_wm
+            + 2.0 * self.e * (1.0 + self.a2)
+            + 4.0 * f64::EPSILON * self.scaled.d1)
+            * (1.0 + 64.0 * f64::EPSILON)
+            + self.margin;
+        if !upper.is_finite() {
+            return None;
+        }
+        Some((
+            Bound {
+                upper,
+                lower: lower.min(upper),
+            },
+            x,
+        ))
+    }
+
+    /// Level 2's `cl` (the smaller of the scalar and the vector form) and `t`, from the
+    /// control points of the third hodograph's pieces on the step, `A` removed and multiplied
+    /// by the step's cube in their span's local units (`h^3 (H_j - H_j^w A)`): projected across
+    /// the chord they enclose `h^3 N'''` on the step. `t` is the middle of the first and last,
+    /// `delta` the largest distance of one from it plus the rounding of the hodograph and of
+    /// the splits (`2 slack`); along the chord, `max |d . G_j|`. `None` if the feet may fall
+    /// outside the chord. Without control points (degree < 3) `N''' = 0` up to the slack.
+    #[inline(always)]
+    fn hodograph_cl(&self, pieces: &[&[Vector3<f64>]], margin: f64) -> Option<(f64, Vector3<f64>)> {
+        let slack3 = self.scaled.slack3;
+        let dir = self.dir;
+        let across = |v: &Vector3<f64>| v - dir * v.dot(&dir);
+        let first = pieces.iter().find_map(|g| g.first());
+        let last = pieces.iter().rev().find_map(|g| g.last());
+        let (t, delta, m3_par) = match (first, last) {
+            (Some(f), Some(l)) => {
+                let t = (across(f) + across(l)) * 0.5;
+                let (mut spread, mut m3_par) = (0.0f64, 0.0f64);
+                for v in pieces.iter().flat_map(|g| g.iter()) {
+                    spread = spread.max((across(v) - t).norm_squared());
+                    m3_par = m3_par.max(v.dot(&dir).abs());
+                }
+                (t, spread.sqrt() + 2.0 * slack3, m3_par + slack3)
+            }
+            _ => (Vector3::zeros(), slack3, 0.0),
+        };
+        if !self.feet_inside(m3_par) {
+            return None;
+        }
+        let tn = t.norm();
+        let mut cl = self.scalar(tn + delta);
+        let n = self.n;
+        if n > 0.0 {
+            // The vector form (docs/discretization.md): with c = h^3 t / 6,
+            // |4 D - x c| <= sqrt(16 n^2 + 8 x k + x^2 |c|^2) <= 4 n + x k / n + x^2 |c|^2 / (8 n)
+            // for k >= |D . c| (from the middle point's own offset), then x^2 <= x / 2.
+            let sixth = 1.0 / 6.0;
+            let c = tn * sixth;
+            let nm_t = self.offset.dot(&t) * self.wm * sixth;
+            let k = (nm_t.abs() + (self.e_w + self.wm * margin) * c).min(n * c);
+            let beta = k * self.inv_n + delta * sixth;
+            let gamma = 0.125 * c * c * self.inv_n;
+            let beta2 = beta + 4.0 * n * self.a2;
+            let gamma2 = gamma + beta * self.a2 + 0.5 * gamma * self.a2;
+            cl = cl.min(beta2 + 0.5 * gamma2);
+        }
+        Some((cl, t))
+    }
+
+    /// The scalar form with `h^3` times a bound of `|N'''|` on the step, also taken as the
+    /// bound along the chord (`None` if the feet may fall outside the chord).
+    #[inline(always)]
+    fn scalar_bound(&self, h3_m3: f64) -> Option<Bound> {
+        if !self.feet_inside(h3_m3) {
+            return None;
+        }
+        self.bound(self.scalar(h3_m3), self.lower).map(|(bd, _)| bd)
+    }
+}
+
 /// What a certificate is asked: the decision rules of the hull certificate
 /// (`docs/discretization.md`, Step 4), so that it refines only while the question is open.
 #[derive(Debug, Clone, Copy)]
@@ -177,144 +392,39 @@ impl Certifier<'_> {
         if h.is_nan() || h <= 0.0 {
             return None;
         }
-        let um = 0.5 * (u0 + u1);
-        let hm = self.span_point::<P, M>(span, um);
-        let (c0, c1, cm) = (self.project(&h0), self.project(&h1), self.project(&hm));
-        let bl = al + chord.direction();
-        // How far the given chord ends are from the curve's ends.
-        let e = (c0 - al)
-            .norm_squared()
-            .max((c1 - bl).norm_squared())
-            .sqrt();
-        let ab = chord.direction();
-        let l = ab.norm();
-        let wm = hm.w;
-        if !(l > 0.0 && wm > 0.0 && e.is_finite()) {
-            return None;
-        }
-        let dir = ab * (1.0 / l);
-        let xm = cm - al;
-        let par = xm.dot(&dir);
-        // The middle point's distance to the chord's line: a lower bound of the chord error
-        // (the distance to the chord is no smaller).
-        let dm = (xm - dir * par).norm();
-        let lower = dm;
-        // w(u) >= w_m (1 - a |s - 1/2|) on the step.
-        let inv_wm = 1.0 / wm;
-        let a = h * sb.w1 * inv_wm;
-        if a.is_nan() || a > 0.5 {
-            return None;
-        }
-        let w_lo = wm * (1.0 - 0.5 * a);
-        let w_hi = wm * (1.0 + 0.5 * a);
-        let slack = sb.slack + 64.0 * (p as f64).powi(4) * f64::EPSILON * sb.w_max * al.amax();
+        let hm = self.span_point::<P, M>(span, 0.5 * (u0 + u1));
         let h3 = h * h * h;
-        let e_w = w_hi * e;
-        let n = wm * dm + e_w;
-        // a' = a / (1 - a/2); w_hi / w_lo = 1 + a'.
-        let a2 = a / (1.0 - 0.5 * a);
-        let along0 = 4.0 * ((wm * (par - 0.5 * l)).abs() + w_hi * e);
-        let par_w = l * (sb.w3 + 3.0 * sb.w2 * (1.0 / h));
-        // The foot of every curve point on the chord's line lies in the chord (up to the ends'
-        // offset `e`), given a bound of the third derivative of N along the chord: then the
-        // distance to the chord is that to its line.
-        let feet_inside = |m3_par: f64| {
-            let along = along0 + h3 * (m3_par + slack + par_w) * (1.0 / 12.0);
-            along <= 0.5 * l * w_lo
+        let slack = sb.slack + 64.0 * (p as f64).powi(4) * f64::EPSILON * sb.w_max * al.amax();
+        let scaled = Scaled {
+            hw1: h * sb.w1,
+            slack3: h3 * slack,
+            par_w3: h3 * (sb.w3 + 3.0 * sb.w2 * (1.0 / h)),
+            d1: sb.d1,
         };
-        // The bound from `cl`, the coefficient of the term linear in x = |s - 1/2|:
-        // |N_perp(u)| <= e_w + (1/4 - x^2) (4 n + cl x), divided by w(u) (whose variation is
-        // inside `cl`); the maximum over x in [0, 1/2] is in closed form, and where
-        // `cl <= 2 n` the bound `n + cl^2 / (256 n)` of it (dropping `-cl x^3`, the rest is a
-        // parabola in x) is used instead, within 0.05 % of it and without a root. With `x`,
-        // where the bound peaks.
-        let inv_n = 1.0 / n;
-        let bound = |cl: f64, lower: f64| -> Option<(Bound, f64)> {
-            let (phi, x) = if n > 0.0 && cl <= 2.0 * n {
-                let r = cl * inv_n;
-                (n + cl * r * (1.0 / 256.0), r * (1.0 / 32.0))
-            } else {
-                let root = (64.0 * n * n + 3.0 * cl * cl).sqrt() + 8.0 * n;
-                let x = if root > 0.0 { cl / (2.0 * root) } else { 0.0 };
-                ((0.25 - x * x) * (4.0 * n + cl * x), x)
-            };
-            let upper = (phi * inv_wm + 2.0 * e * (1.0 + a2) + 4.0 * f64::EPSILON * sb.d1)
-                * (1.0 + 64.0 * f64::EPSILON)
-                + margin;
-            if !upper.is_finite() {
-                return None;
-            }
-            Some((
-                Bound {
-                    upper,
-                    lower: lower.min(upper),
-                },
-                x,
-            ))
-        };
-        // The scalar form: with |N'''| <= m3 on the step, c = h^3 m3 / 6 and
-        // cl = c + 4 n a' + c a' / 2.
-        let scalar = |m3: f64| {
-            let c = h3 * (m3 + slack) * (1.0 / 6.0);
-            c + 4.0 * n * a2 + 0.5 * c * a2
-        };
+        let ends = [self.project(&h0), self.project(&h1)];
+        let st = Step::new(ends, (self.project(&hm), hm.w), chord, al, margin, scaled)?;
+        let lower = st.lower;
         // Level 1, from the span's norms: |N'''| <= |H_j - H_j^w A| <= |H_j| + |A| |H_j^w| over
         // the third hodograph's control points (rounded up by `1 + 8 eps`).
-        let m3_span = (sb.h3 + al.norm() * sb.h3w) * (1.0 + 8.0 * f64::EPSILON);
-        if feet_inside(m3_span) {
-            if let Some((bd, _)) =
-                bound(scalar(m3_span), lower).filter(|(bd, _)| question.decided(bd))
-            {
-                return Some(bd);
-            }
+        let m3_span = h3 * (sb.h3 + al.norm() * sb.h3w) * (1.0 + 8.0 * f64::EPSILON);
+        if let Some(bd) = st.scalar_bound(m3_span).filter(|bd| question.decided(bd)) {
+            return Some(bd);
         }
         // Level 2: the third hodograph's piece on the step (two de Casteljau splits, as the
-        // hull certificate's pieces): its control points `g_j`, projected across the chord,
-        // enclose N''' on the step. `t` is the middle of the first and last, `delta` the
-        // largest distance of a `g_j` from it (plus the rounding of the hodograph and of
-        // the splits, `2 slack`); along the chord, `max |d . g_j|`.
-        let (t, delta, m3_par) = if p >= 3 {
-            let q = p - 3;
+        // hull certificate's pieces): its control points enclose N''' on the step.
+        let mut g = [Vector3::zeros(); M];
+        let q = p.saturating_sub(3);
+        if p >= 3 {
             let mut d = [Vector4::zeros(); M];
             d[..=q].copy_from_slice(&self.span_h3[span * (p + 1)..][..=q]);
             split_to(&mut d[..=q], u0, u1);
-            let mut g = [Vector3::zeros(); M];
-            let mut m3_par = 0.0f64;
             for j in 0..=q {
-                let v = d[j].xyz() - al * d[j].w;
-                let vp = v.dot(&dir);
-                m3_par = m3_par.max(vp.abs());
-                g[j] = v - dir * vp;
+                g[j] = (d[j].xyz() - al * d[j].w) * h3;
             }
-            let t = (g[0] + g[q]) * 0.5;
-            let spread = g[..=q]
-                .iter()
-                .map(|gj| (gj - t).norm_squared())
-                .fold(0.0, f64::max);
-            (t, spread.sqrt() + 2.0 * slack, m3_par + slack)
-        } else {
-            (Vector3::zeros(), slack, 0.0)
-        };
-        if !feet_inside(m3_par) {
-            return None;
         }
-        let tn = t.norm();
-        let mut cl = scalar(tn + delta);
-        if n > 0.0 {
-            // The vector form (docs/discretization.md): with c = h^3 t / 6,
-            // |4 D - x c| <= sqrt(16 n^2 + 8 x k + x^2 |c|^2) <= 4 n + x k / n + x^2 |c|^2 / (8 n)
-            // for k >= |D . c| (from the middle point's own offset), then x^2 <= x / 2.
-            let sixth = h3 * (1.0 / 6.0);
-            let c = tn * sixth;
-            let nm_t = (xm - dir * par).dot(&t) * wm * sixth;
-            let k = (nm_t.abs() + (e_w + wm * margin) * c).min(n * c);
-            let beta = k * inv_n + delta * sixth;
-            let gamma = 0.125 * c * c * inv_n;
-            let beta2 = beta + 4.0 * n * a2;
-            let gamma2 = gamma + beta * a2 + 0.5 * gamma * a2;
-            cl = cl.min(beta2 + 0.5 * gamma2);
-        }
-        let (bd, at) = bound(cl, lower)?;
+        let g: &[Vector3<f64>] = if p >= 3 { &g[..=q] } else { &[] };
+        let (cl, t) = st.hodograph_cl(&[g], margin)?;
+        let (bd, at) = st.bound(cl, lower)?;
         if question.settled(&bd) {
             return Some(bd);
         }
@@ -322,15 +432,100 @@ impl Certifier<'_> {
         // the cubic term dominating); the curve point where the bound peaks, on the side
         // where `|4 D - sigma x c|` is the larger (`sigma D . c < 0`), is a far better lower
         // bound, for one evaluation.
-        let side = if (xm - dir * par).dot(&t) > 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
+        let side = if st.offset.dot(&t) > 0.0 { -1.0 } else { 1.0 };
         match self.probe::<P, M>(span, (u0, u1), side * at, chord) {
-            Some(probe) => bound(cl, lower.max(probe)).map(|(bd, _)| bd),
+            Some(probe) => st.bound(cl, lower.max(probe)).map(|(bd, _)| bd),
             None => Some(bd),
         }
+    }
+
+    /// The interpolation certificate's first level for a segment `[t0, t1]` that crosses one
+    /// knot, from span `left` into span `right`, where the curve is at least `C^2`
+    /// (`docs/discretization.md`, "Across a knot"): the same identity on the nodes `t0`, `t1`
+    /// and the middle, with `N'''` (piecewise polynomial, `N''` continuous) bounded by the
+    /// larger of the two spans' norms, each in its own local units (`(t1 - t0) / (k_{i+1} -
+    /// k_i)` the step there), refined, while `question` is open, by the third hodograph's
+    /// pieces on both sides. `None` where its conditions fail (then only the hull certificate
+    /// applies). Costs one evaluation.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(super) fn interpolation_bound_across<const P: usize, const M: usize>(
+        &self,
+        (left, right): (usize, usize),
+        (t0, h0): (f64, Vector4<f64>),
+        (t1, h1): (f64, Vector4<f64>),
+        chord: &Segment<3>,
+        al: &Vector3<f64>,
+        margin: f64,
+        question: Question,
+    ) -> Option<Bound> {
+        let p = self.deg::<P>();
+        let knots = self.local.knots();
+        let h = t1 - t0;
+        if h.is_nan() || h <= 0.0 {
+            return None;
+        }
+        let tm = 0.5 * (t0 + t1);
+        let mid = if tm < knots[left + 1] { left } else { right };
+        let hm = self.span_point::<P, M>(mid, self.local_u(mid, tm).0);
+        let (a_norm, a_inf) = (al.norm(), al.amax());
+        let t_max = t0.abs().max(t1.abs());
+        let mut scaled = Scaled {
+            hw1: 0.0,
+            slack3: 0.0,
+            par_w3: 0.0,
+            d1: 0.0,
+        };
+        let mut m3 = 0.0f64;
+        for span in [left, right] {
+            let sb = &self.span_bounds[span];
+            // The step in the span's local parameter (rounded up), and its powers.
+            let hu = h * self.local_u(span, t0).1 * (1.0 + 4.0 * f64::EPSILON);
+            let (hu2, hu3) = (hu * hu, hu * hu * hu);
+            let slack = sb.slack + 64.0 * (p as f64).powi(4) * f64::EPSILON * sb.w_max * a_inf;
+            scaled.hw1 = scaled.hw1.max(hu * sb.w1);
+            scaled.slack3 = scaled.slack3.max(hu3 * slack);
+            scaled.par_w3 = scaled.par_w3.max(hu3 * sb.w3 + 3.0 * hu2 * sb.w2);
+            // The ends' and the middle's local parameters are rounded by about `eps` times
+            // `|t| / (k_{i+1} - k_i)` (the middle is rounded in `t`): `4 eps D1` covers it
+            // with `D1` scaled by that ratio where it exceeds 1.
+            scaled.d1 = scaled
+                .d1
+                .max(sb.d1 * (t_max * self.local_u(span, t0).1).max(1.0));
+            m3 = m3.max(hu3 * (sb.h3 + a_norm * sb.h3w) * (1.0 + 8.0 * f64::EPSILON));
+        }
+        if !(m3.is_finite() && scaled.par_w3.is_finite() && scaled.d1.is_finite()) {
+            return None;
+        }
+        let ends = [self.project(&h0), self.project(&h1)];
+        let st = Step::new(ends, (self.project(&hm), hm.w), chord, al, margin, scaled)?;
+        if let Some(bd) = st.scalar_bound(m3).filter(|bd| question.decided(bd)) {
+            return Some(bd);
+        }
+        // Level 2: the third hodograph's pieces on both sides of the knot, each multiplied by
+        // the cube of the step in its span's local units.
+        let q = p - 3;
+        let mut g = [[Vector3::zeros(); M]; 2];
+        for (side, (span, u0, u1)) in [
+            (left, self.local_u(left, t0).0, 1.0),
+            (right, 0.0, self.local_u(right, t1).0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let hu = h * self.local_u(span, t0).1 * (1.0 + 4.0 * f64::EPSILON);
+            let hu3 = hu * hu * hu;
+            let mut d = [Vector4::zeros(); M];
+            d[..=q].copy_from_slice(&self.span_h3[span * (p + 1)..][..=q]);
+            if u1 > u0 {
+                split_to(&mut d[..=q], u0, u1);
+            }
+            for j in 0..=q {
+                g[side][j] = (d[j].xyz() - al * d[j].w) * hu3;
+            }
+        }
+        let (cl, _) = st.hodograph_cl(&[&g[0][..=q], &g[1][..=q]], margin)?;
+        st.bound(cl, st.lower).map(|(bd, _)| bd)
     }
 
     /// The distance to the chord of the curve point at `x = s - 1/2` (`|x| <= 1/2`) of the

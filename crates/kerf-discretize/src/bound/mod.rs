@@ -327,6 +327,35 @@ impl<'a> Certifier<'a> {
                 }
                 lower = bd.lower;
             }
+        } else if let Some(right) = self.across_one_knot(span, t1) {
+            // A segment across one knot where the curve is C^2: the interpolation
+            // certificate's first level over both spans, before the hull.
+            let f = self.factor();
+            let m = margin
+                .max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span].max(self.spans[right]))
+                + self.representation;
+            let h0 = match start.or_else(|| find(&scratch.ends, t0, span)) {
+                Some((_, v)) => v,
+                None => self.span_point::<P, M>(span, self.local_u(span, t0).0),
+            };
+            let h1 = match end.filter(|e| e.0 == right) {
+                Some((_, v)) => v,
+                None => self.span_point::<P, M>(right, self.local_u(right, t1).0),
+            };
+            if let Some(bd) = self.interpolation_bound_across::<P, M>(
+                (span, right),
+                (t0, h0),
+                (t1, h1),
+                &chord,
+                &al.coords,
+                m,
+                question,
+            ) {
+                if question.settled(&bd) {
+                    return bd;
+                }
+                lower = bd.lower;
+            }
         }
         // The walk only needs to know whether the segment is certified.
         let want_lower = if question.settle { 0.0 } else { want_lower };
@@ -366,6 +395,24 @@ impl<'a> Certifier<'a> {
 }
 
 /// The remembered homogeneous point at `t` in `span`, if any.
+impl Certifier<'_> {
+    /// The knot span after the knot that ends `span`, if `t1` lies in it (up to its end) and
+    /// the curve is `C^2` at that knot (multiplicity `m <= p - 2`): a segment from `span` to
+    /// `t1` then crosses exactly one knot, where the interpolation certificate still applies.
+    #[inline(always)]
+    fn across_one_knot(&self, span: usize, t1: f64) -> Option<usize> {
+        let knots = self.local.knots();
+        let k = *knots.get(span + 1)?;
+        let mut right = span + 1;
+        while knots.get(right + 1) == Some(&k) {
+            right += 1;
+        }
+        let m = right - span;
+        (m + 2 <= self.curve.degree() && right < self.spans.len() && t1 <= *knots.get(right + 1)?)
+            .then_some(right)
+    }
+}
+
 fn find(ends: &Ends, t: f64, span: usize) -> Known {
     ends.iter()
         .flatten()

@@ -293,12 +293,12 @@ impl<'a> Certifier<'a> {
             Some((s, _)) => s,
             None => self.local.span(t0),
         };
-        // Most segments lie in one span and are decided by the interpolation certificate
-        // without any subdivision.
-        if t1 <= self.local.knots()[span + 1] {
-            let f = self.factor();
-            let m =
-                margin.max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span]) + self.representation;
+        // Most segments lie in one span, or cross one knot where the curve is C^2, and are
+        // decided by the interpolation certificate without any subdivision.
+        let span_margin = |l: f64| {
+            margin.max((2.0 * self.factor() + 8.0 * f64::EPSILON) * l) + self.representation
+        };
+        let interpolated = if t1 <= self.local.knots()[span + 1] {
             let ends = &mut scratch.ends;
             let (h0, keep) = match start.or_else(|| find(ends, t0, span)) {
                 Some((_, v)) => (v, ends.iter().position(|e| e.is_some_and(|e| e.0 == t0))),
@@ -313,27 +313,16 @@ impl<'a> Certifier<'a> {
                 None => self.span_point::<P, M>(span, self.local_u(span, t1).0),
             };
             ends[if keep == Some(0) { 1 } else { 0 }] = Some((t1, span, h1));
-            if let Some(bd) = self.interpolation_bound::<P, M>(
+            self.interpolation_bound::<P, M>(
                 span,
                 (t0, h0),
                 (t1, h1),
                 &chord,
                 &al.coords,
-                m,
+                span_margin(self.spans[span]),
                 question,
-            ) {
-                if question.settled(&bd) {
-                    return bd;
-                }
-                lower = bd.lower;
-            }
+            )
         } else if let Some(right) = self.across_one_knot(span, t1) {
-            // A segment across one knot where the curve is C^2: the interpolation
-            // certificate's first level over both spans, before the hull.
-            let f = self.factor();
-            let m = margin
-                .max((2.0 * f + 8.0 * f64::EPSILON) * self.spans[span].max(self.spans[right]))
-                + self.representation;
             let h0 = match start.or_else(|| find(&scratch.ends, t0, span)) {
                 Some((_, v)) => v,
                 None => self.span_point::<P, M>(span, self.local_u(span, t0).0),
@@ -342,20 +331,23 @@ impl<'a> Certifier<'a> {
                 Some((_, v)) => v,
                 None => self.span_point::<P, M>(right, self.local_u(right, t1).0),
             };
-            if let Some(bd) = self.interpolation_bound_across::<P, M>(
+            self.interpolation_bound_across::<P, M>(
                 (span, right),
                 (t0, h0),
                 (t1, h1),
                 &chord,
                 &al.coords,
-                m,
+                span_margin(self.spans[span].max(self.spans[right])),
                 question,
-            ) {
-                if question.settled(&bd) {
-                    return bd;
-                }
-                lower = bd.lower;
+            )
+        } else {
+            None
+        };
+        if let Some(bd) = interpolated {
+            if question.settled(&bd) {
+                return bd;
             }
+            lower = bd.lower;
         }
         // The walk only needs to know whether the segment is certified.
         let want_lower = if question.settle { 0.0 } else { want_lower };

@@ -5,6 +5,7 @@ use std::io;
 use std::path::Path;
 
 use kerf_format::{curves, CurvesFile};
+use kerf_kinematics::{KinematicsError, Machine};
 use kerf_pipeline::{Progress, Stage};
 
 use crate::error::CliError;
@@ -29,6 +30,16 @@ pub(crate) fn warn_unknown_keys(path: &Path, file: &CurvesFile) {
     for w in &file.warnings {
         eprintln!("warning: {}: {w}", path.display());
     }
+}
+
+/// Reads a machine file and prints its near-miss keys as warnings, like [`warn_unknown_keys`]
+/// (`warning: machine.json: max_jerks: unknown key, did you mean "max_jerk"?`).
+pub(crate) fn load_machine(path: &Path) -> Result<Machine, KinematicsError> {
+    let machine = Machine::read(path)?;
+    for w in &machine.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+    Ok(machine)
 }
 
 /// The job's progress as a bar on standard error, for batches long enough to wait for and

@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 
 use kerf_interp::{AxisModel, Dialect};
-use kerf_kinematics::Machine;
 use kerf_pipeline::{
     path_report, plan_program, CertifiedToolpath, MotionInput, MotionOptions, Program,
 };
@@ -16,7 +15,7 @@ use crate::error::CliError;
 /// Reads the input (axes or toolpath) and the machine, and plans the program with `options`
 /// (dialect, blending) and the arguments' feed, cycle and tolerances.
 fn program(args: &MotionArgs, options: MotionOptions) -> Result<Program, CliError> {
-    let machine = Machine::read(&args.machine)?;
+    let machine = crate::input::load_machine(&args.machine)?;
     let mut input = MotionInput::read(&args.input)?;
     if let Some(curves) = &args.curves {
         let MotionInput::Toolpath(tp) = input else {

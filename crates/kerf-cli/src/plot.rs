@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use kerf_format::{curves, toolpath, ToolpathFile, ToolpathPoints, ToolpathRecord};
-use kerf_kinematics::{AxesFile, Machine};
+use kerf_kinematics::AxesFile;
 use kerf_plot::{render, write_svg, AxesChart, Scene, SceneOptions};
 
 use crate::error::CliError;
@@ -92,7 +92,7 @@ pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
         let machine = args
             .machine
             .as_ref()
-            .map(Machine::read)
+            .map(|m| crate::input::load_machine(m))
             .transpose()
             .map_err(|e| CliError::Plot(e.to_string()))?;
         let chart = AxesChart::new(&axes, machine.as_ref())

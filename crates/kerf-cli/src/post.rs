@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use kerf_format::toolpath;
-use kerf_kinematics::{Machine, PathOptions};
+use kerf_kinematics::PathOptions;
 use kerf_pipeline::{post_toolpath, MissingNormals};
 use serde_json::json;
 
@@ -32,7 +32,7 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
         .clone()
         .unwrap_or_else(|| default_output(&args.toolpath));
     crate::guard::refuse_overwrite("--output", &dest, &[&args.toolpath, &args.machine])?;
-    let machine = Machine::read(&args.machine)?;
+    let machine = crate::input::load_machine(&args.machine)?;
     let tp = toolpath::load(&args.toolpath)?;
     let opts = options(args);
     let posted = post_toolpath(

@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use kerf_kinematics::{Machine, PathOptions};
+use kerf_kinematics::PathOptions;
 use kerf_normals::NormalOptions;
 use kerf_pipeline::{Job, JobOptions, OrientOptions};
 
@@ -70,7 +70,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     } else {
         load_curves(path)?
     };
-    let machine = Machine::read(&args.machine)?;
+    let machine = crate::input::load_machine(&args.machine)?;
     let job = Job::new(file, machine)
         .with_source(path)
         .with_options(job_options(args));

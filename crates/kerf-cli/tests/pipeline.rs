@@ -286,3 +286,41 @@ fn generic_gcode_keeps_the_non_linearity_within_its_tolerance() {
         "tip leaves the line by {worst} mm between two G1 lines"
     );
 }
+
+#[test]
+fn a_misspelt_machine_key_is_warned_about_even_when_quiet() {
+    // `max_jerks` is read as absent (no jerk limit): the run goes on, and says so.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(fixture("machines/ac_head.json")).unwrap();
+    let misspelt = text.replacen("\"max_jerk\"", "\"max_jerks\"", 1);
+    assert_ne!(misspelt, text, "the fixture has max_jerk");
+    let machine = dir.path().join("machine.json");
+    std::fs::write(&machine, misspelt).unwrap();
+    for command in [vec!["run", "-q", "--out"], vec!["post", "-o"]] {
+        let out_path = dir.path().join(format!("out-{}", command[0]));
+        let input = if command[0] == "run" {
+            fixture("dome.json")
+        } else {
+            let tp = dir.path().join("dome.tp.json");
+            ok(kerf()
+                .arg("discretize")
+                .arg(fixture("dome.json"))
+                .args(["--normals", "-q", "-o"])
+                .arg(&tp));
+            tp
+        };
+        let o = ok(kerf()
+            .arg(command[0])
+            .arg(&input)
+            .arg("--machine")
+            .arg(&machine)
+            .args(&command[1..])
+            .arg(&out_path));
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            stderr.contains("machine.json: max_jerks: unknown key, did you mean \"max_jerk\"?"),
+            "{}: {stderr}",
+            command[0]
+        );
+    }
+}

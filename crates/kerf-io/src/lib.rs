@@ -31,14 +31,19 @@
 //!   replaced regular file keeps its mode.
 //!
 //! [`same_file`] tells whether an output would overwrite an input (same device and inode).
+//!
+//! **Near misses** ([`near_misses_in`]): an unknown key that looks like a misspelt known one
+//! (`weigths`, `max_jerks`) is reported as an [`UnknownKey`] warning by every reader.
 
 mod json;
+mod keys;
 mod read;
 mod shape;
 mod text;
 mod write;
 
 pub use json::{parse_json, path_at, JsonError, StrictValue};
+pub use keys::{near_misses_in, UnknownKey};
 pub use read::{read_file, read_regular_file, read_to_end, strip_bom, MAX_INPUT_BYTES};
 pub use shape::{deserialize_at, duplicate_key_message, JsonProblem, ShapeError};
 pub use text::{check_text, TextDefect};

@@ -81,6 +81,10 @@ pub struct Machine {
     /// The laser process codes of the optional `process` object; every field `None` when the
     /// file has none (the G-code writer then uses its dialect's defaults).
     pub process: Process,
+    /// The file's unknown top-level keys that look like misspellings of the format's
+    /// (`max_jerks: unknown key, did you mean "max_jerk"?`): the machine was read without
+    /// them, so a misspelt optional limit is absent. Empty for a machine built in code.
+    pub warnings: Vec<kerf_io::UnknownKey>,
 }
 
 /// The optional `process` object of `kerf.machine/1`: how the program switches the beam and
@@ -364,6 +368,7 @@ impl Machine {
             max_acceleration,
             process: Process::default(),
             max_jerk: None,
+            warnings: Vec::new(),
         };
         machine.validate()?;
         Ok(machine)
@@ -491,7 +496,21 @@ impl Machine {
         Self::from_value(&crate::json::parse(bytes)?)
     }
 
-    /// Reads a machine from a parsed JSON document.
+    /// The top-level keys of `kerf.machine/1`.
+    pub const KEYS: &'static [&'static str] = &[
+        "format",
+        "name",
+        "kinematics",
+        "limits",
+        "max_velocity",
+        "max_acceleration",
+        "max_jerk",
+        "process",
+    ];
+
+    /// Reads a machine from a parsed JSON document. Unknown top-level keys are allowed
+    /// (extensions); those that look like misspellings of the format's are in
+    /// [`Machine::warnings`].
     ///
     /// # Errors
     /// [`KinematicsError::Document`] naming the JSON path of the first defect.
@@ -565,6 +584,7 @@ impl Machine {
         if let Some(p) = top.get("process") {
             machine.process = Process::from_value(p)?;
         }
+        kerf_io::near_misses_in(top, Self::KEYS, "", &mut machine.warnings);
         Ok(machine)
     }
 

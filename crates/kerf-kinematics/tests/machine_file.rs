@@ -306,3 +306,37 @@ fn optional_max_jerk_is_read_strictly_and_written_back() {
         .with_max_jerk(Some([1.0, 1.0, f64::NAN, 1.0, 1.0]))
         .is_err());
 }
+
+#[test]
+fn misspelt_optional_keys_are_warned_about_and_extensions_are_not() {
+    // A misspelt optional key is read as absent: the machine below has no jerk limit and
+    // default process codes. Each gets a warning naming the key it resembles.
+    let mut doc = ac_head();
+    doc["max_jerks"] = json!({ "X": 1e6, "Y": 1e6, "Z": 1e6, "A": 1e6, "C": 1e6 });
+    doc["Process"] = json!({ "pierce_dwell_s": 0.5 });
+    doc["vendor_notes"] = json!("an extension: not a near miss of anything");
+    let m = Machine::from_value(&doc).expect("extensions and near misses are allowed");
+    assert!(m.max_jerk.is_none(), "read without the misspelt key");
+    let shown: Vec<String> = m.warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        shown,
+        [
+            "Process: unknown key, did you mean \"process\"?",
+            "max_jerks: unknown key, did you mean \"max_jerk\"?",
+        ]
+    );
+    // Next to the real key, a near miss is taken for a deliberate extension.
+    doc["max_jerk"] = doc["max_jerks"].clone();
+    doc["process"] = json!({});
+    let m = Machine::from_value(&doc).expect("valid");
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    for file in [
+        "ac_head.json",
+        "fork_head.json",
+        "gantry_ac.json",
+        "table_table.json",
+        "head_table.json",
+    ] {
+        assert!(fixture(file).warnings.is_empty(), "{file}");
+    }
+}

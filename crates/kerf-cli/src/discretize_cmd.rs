@@ -126,18 +126,17 @@ fn discretize_to_file(
     };
     let groups: Vec<&[CurveRecord]> = file.curves.chunks(GROUP).collect();
     toolpath::write_with(dest, file.units, opts.tolerance_mm, |w| {
-        let mut ready = groups.first().map(|g| discretize_group(g));
+        let mut discs = groups
+            .first()
+            .map_or_else(Vec::new, |g| discretize_group(g));
         for (g, group) in groups.iter().enumerate() {
-            let discs = ready
-                .take()
-                .expect("the scope before this one discretized this group");
-            let mut next = None;
+            let mut next = Vec::new();
             // The pool discretizes the next group while this thread writes this one; the scope
             // waits for it, also when the writing fails.
             let written = rayon::in_place_scope(|s| {
                 if let Some(following) = groups.get(g + 1) {
                     let next = &mut next;
-                    s.spawn(move |_| *next = Some(discretize_group(following)));
+                    s.spawn(move |_| *next = discretize_group(following));
                 }
                 for (k, (rec, d)) in group.iter().zip(discs).enumerate() {
                     let d = d.map_err(|source| kerf_pipeline::Error::Discretize {
@@ -153,7 +152,7 @@ fn discretize_to_file(
                 Ok::<(), CliError>(())
             });
             written?;
-            ready = next;
+            discs = next;
             bar.update(Progress::new(
                 Stage::Discretize,
                 (g * GROUP + group.len()).min(total),

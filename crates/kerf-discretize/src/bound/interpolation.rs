@@ -477,11 +477,14 @@ impl Certifier<'_> {
             d1: 0.0,
         };
         let mut m3 = 0.0f64;
-        for span in [left, right] {
+        let mut hu3s = [0.0f64; 2];
+        for (side, span) in [left, right].into_iter().enumerate() {
             let sb = &self.span_bounds[span];
             // The step in the span's local parameter (rounded up), and its powers.
-            let hu = h * self.local_u(span, t0).1 * (1.0 + 4.0 * f64::EPSILON);
+            let rho = self.local_u(span, t0).1;
+            let hu = h * rho * (1.0 + 4.0 * f64::EPSILON);
             let (hu2, hu3) = (hu * hu, hu * hu * hu);
+            hu3s[side] = hu3;
             let slack = sb.slack + 64.0 * (p as f64).powi(4) * f64::EPSILON * sb.w_max * a_inf;
             scaled.hw1 = scaled.hw1.max(hu * sb.w1);
             scaled.slack3 = scaled.slack3.max(hu3 * slack);
@@ -489,9 +492,7 @@ impl Certifier<'_> {
             // The ends' and the middle's local parameters are rounded by about `eps` times
             // `|t| / (k_{i+1} - k_i)` (the middle is rounded in `t`): `4 eps D1` covers it
             // with `D1` scaled by that ratio where it exceeds 1.
-            scaled.d1 = scaled
-                .d1
-                .max(sb.d1 * (t_max * self.local_u(span, t0).1).max(1.0));
+            scaled.d1 = scaled.d1.max(sb.d1 * (t_max * rho).max(1.0));
             m3 = m3.max(hu3 * (sb.h3 + a_norm * sb.h3w) * (1.0 + 8.0 * f64::EPSILON));
         }
         if !(m3.is_finite() && scaled.par_w3.is_finite() && scaled.d1.is_finite()) {
@@ -513,15 +514,13 @@ impl Certifier<'_> {
         .into_iter()
         .enumerate()
         {
-            let hu = h * self.local_u(span, t0).1 * (1.0 + 4.0 * f64::EPSILON);
-            let hu3 = hu * hu * hu;
             let mut d = [Vector4::zeros(); M];
             d[..=q].copy_from_slice(&self.span_h3[span * (p + 1)..][..=q]);
             if u1 > u0 {
                 split_to(&mut d[..=q], u0, u1);
             }
             for j in 0..=q {
-                g[side][j] = (d[j].xyz() - al * d[j].w) * hu3;
+                g[side][j] = (d[j].xyz() - al * d[j].w) * hu3s[side];
             }
         }
         let (cl, _) = st.hodograph_cl(&[&g[0][..=q], &g[1][..=q]], margin)?;

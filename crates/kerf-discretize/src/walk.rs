@@ -373,6 +373,9 @@ impl Walker<'_> {
             let mut last_fail = Fail::Chord;
             let mut stuck = false;
             let mut trials_made = 0;
+            // The good trial before `good`, while the last two trials were both good: their
+            // bounds measure the certificate's own growth with the step (see `secant_step`).
+            let mut prev_good: Option<(f64, f64)>;
             for _ in 0..MAX_ITERS {
                 trials_made += 1;
                 let t1 = if h >= rest { b } else { t0 + h };
@@ -404,6 +407,7 @@ impl Walker<'_> {
                     fail,
                 };
                 if let Some(f) = fail {
+                    prev_good = None;
                     last_fail = f;
                     bad = Some(cand);
                     fails += 1;
@@ -411,6 +415,7 @@ impl Walker<'_> {
                         param_mode = true;
                     }
                 } else {
+                    prev_good = good.filter(|_| fails == 0).map(|g| (g.h, g.err));
                     good = Some(cand);
                     fails = 0;
                     if t1 >= b || bound.upper >= emin || cand.r >= max_len * (1.0 - LENGTH_TOL) {
@@ -423,7 +428,10 @@ impl Walker<'_> {
                         if param_mode {
                             2.0 * g.h
                         } else {
-                            let mut h = if g.err > 0.0 {
+                            let secant = prev_good.and_then(|pg| secant_step(pg, (g.h, g.err), hp));
+                            let mut h = if let Some(h) = secant {
+                                h.clamp(1.005 * g.h, 4.0 * g.h)
+                            } else if g.err > 0.0 {
                                 next_step(&model, g.h, g.err, hp).clamp(1.005 * g.h, 4.0 * g.h)
                             } else {
                                 4.0 * g.h
@@ -470,15 +478,21 @@ impl Walker<'_> {
                             0.5 * (g.h + bd.h)
                         } else {
                             let (eg, eb) = (g.err, bd.err);
-                            let next = match bd.fail {
+                            let secant = prev_good.and_then(|pg| secant_step(pg, (g.h, g.err), hp));
+                            let next = match (bd.fail, secant) {
+                                // The good end moved twice in a row: the bad end's bound is
+                                // off the power law near the good end (a loose bound, the far
+                                // side of a knot), and interpolating towards it would creep up
+                                // in ever smaller steps (regula falsi's stagnation).
+                                (Some(Fail::Chord), Some(h)) => h,
                                 // Power law e = c h^q through both ends of the bracket.
-                                Some(Fail::Chord) if eg > 0.0 && eb > eg => {
+                                (Some(Fail::Chord), _) if eg > 0.0 && eb > eg => {
                                     let q = (eb / eg).ln() / (bd.h / g.h).ln();
                                     g.h * (hp / eg).powf(1.0 / q)
                                 }
-                                Some(Fail::Chord) if eg > 0.0 => g.h * (hp / eg).sqrt(),
+                                (Some(Fail::Chord), _) if eg > 0.0 => g.h * (hp / eg).sqrt(),
                                 // The chord's length is nearly linear in the step.
-                                Some(Fail::Length) if bd.r > g.r => {
+                                (Some(Fail::Length), _) if bd.r > g.r => {
                                     let target = max_len * (1.0 - 0.5 * LENGTH_TOL);
                                     g.h + gap * (target - g.r) / (bd.r - g.r)
                                 }
@@ -518,7 +532,10 @@ impl Walker<'_> {
                 } else {
                     model.error(g.h)
                 };
-                if predicted > 0.0 {
+                // A step across a knot measures the model against the next span's third
+                // derivative, which the next step (mostly inside one span) does not meet.
+                let crossed = g.t > self.curve.knots()[cur.span + 1];
+                if predicted > 0.0 && !crossed {
                     bias = (g.err / predicted).clamp(0.25, 4.0);
                 }
                 warm = true;
@@ -548,6 +565,21 @@ impl Walker<'_> {
         }
         Ok(())
     }
+}
+
+/// The step where the power law `err = c h^q` through two good trials `(h, err)` (`a` the
+/// shorter, both certified, `err` their steering values) reaches `target`, the exponent measured from them
+/// and kept in `[1/2, 8]`: where the certificate's bound grows unlike the model's error (a
+/// loose bound level, a knot inside the step), the bound's own growth is the better guide.
+/// `None` where the bounds do not grow with the step.
+#[inline(always)]
+fn secant_step((ha, ea): (f64, f64), (hb, eb): (f64, f64), target: f64) -> Option<f64> {
+    if !(ea > 0.0 && eb > ea && hb > ha) {
+        return None;
+    }
+    let q = ((eb / ea).ln() / (hb / ha).ln()).clamp(0.5, 8.0);
+    let h = hb * (target / eb).powf(1.0 / q);
+    h.is_finite().then_some(h)
 }
 
 /// The next step after a one-sided trial of step `h` whose error came out `err`, for the

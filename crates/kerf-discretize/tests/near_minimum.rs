@@ -135,3 +135,28 @@ fn the_walks_n_star_survives_tiny_knot_ranges() {
     assert!(a > 100.0, "a curved curve: N* {a}");
     assert!((a - b).abs() <= 1e-3 * a, "N* {a} vs {b} with tiny knots");
 }
+
+/// The walk's work per segment: evaluations (each trial end, each certificate's middle point,
+/// probe and pieces), counted, on smooth curves of degrees 2 to 7 at the default band. The
+/// first trial comes from the Taylor model and lands in the band on most steps; the figure
+/// watches the steps that miss it. Measured: 2.72 at 0.01 mm and 2.16 at 0.001 mm; 2.82 and
+/// 2.17 before the search measured the bound's own growth from two good trials (a loose bound at
+/// the bad end made the bracket creep up by a few percent per trial, up to 80 trials for one
+/// point) and before steps across a knot stopped setting the model's bias for the steps after.
+#[test]
+fn the_walk_spends_few_evaluations_per_segment() {
+    for (tol, most) in [(0.01, 2.76), (0.001, 2.25)] {
+        let (mut segs, mut work) = (0usize, 0u64);
+        for degree in 2..=7 {
+            for c in smooth_curves(degree, 40, 500 + degree as u64) {
+                let (d, n) =
+                    kerf_nurbs::counted(|| discretize(&c, &Options::with_tolerance(tol)).unwrap());
+                segs += d.segments();
+                work += n.expect("kerf-nurbs is built with eval-counter for tests");
+            }
+        }
+        let per = work as f64 / segs as f64;
+        eprintln!("tol {tol}: {work} evaluations for {segs} segments ({per:.3} per segment)");
+        assert!(per <= most, "tol {tol}: {per:.3} evaluations per segment");
+    }
+}

@@ -324,3 +324,60 @@ fn a_misspelt_machine_key_is_warned_about_even_when_quiet() {
         );
     }
 }
+
+/// report.json goes with the program to whoever runs it, so it lists what the run warned about
+/// on standard error: the curves file's and the machine file's near-miss keys (each read
+/// without them), named by the file they came from.
+#[test]
+fn the_report_lists_the_input_files_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    let machine_text = std::fs::read_to_string(fixture("machines/ac_head.json")).unwrap();
+    let machine = dir.path().join("machine.json");
+    std::fs::write(
+        &machine,
+        machine_text.replacen("\"max_jerk\"", "\"max_jerks\"", 1),
+    )
+    .unwrap();
+    let curves_text = std::fs::read_to_string(fixture("dome.json")).unwrap();
+    // `scarp` (a swap away from `scrap`, which this curve lacks) on the first curve.
+    let misspelt = curves_text.replacen("\"degree\"", "\"scarp\": true, \"degree\"", 1);
+    assert_ne!(misspelt, curves_text);
+    let curves = dir.path().join("dome.json");
+    std::fs::write(&curves, misspelt).unwrap();
+    let out = dir.path().join("out");
+    ok(kerf()
+        .arg("run")
+        .arg(&curves)
+        .arg("--machine")
+        .arg(&machine)
+        .args(["-q", "--out"])
+        .arg(&out));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let warnings: Vec<&str> = report["warnings"]
+        .as_array()
+        .expect("a warnings list")
+        .iter()
+        .map(|w| w.as_str().expect("a string"))
+        .collect();
+    assert_eq!(
+        warnings,
+        [
+            "curves file: curves[0].scarp: unknown key, did you mean \"scrap\"?",
+            "machine file: max_jerks: unknown key, did you mean \"max_jerk\"?",
+        ],
+        "{report:#}"
+    );
+    // The same files spelt right: an empty list, not a missing key.
+    let clean = dir.path().join("clean");
+    ok(kerf()
+        .arg("run")
+        .arg(fixture("dome.json"))
+        .arg("--machine")
+        .arg(fixture("machines/ac_head.json"))
+        .args(["-q", "--out"])
+        .arg(&clean));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(clean.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["warnings"], serde_json::json!([]));
+}

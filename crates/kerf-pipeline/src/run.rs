@@ -421,9 +421,24 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         ));
         p
     };
+    // Everything the caller was warned about, where the report goes: the input files' near-miss
+    // keys (read without them) and the run's own warnings.
+    let all_warnings: Vec<String> = file
+        .warnings
+        .iter()
+        .map(|w| format!("curves file: {w}"))
+        .chain(
+            machine
+                .warnings
+                .iter()
+                .map(|w| format!("machine file: {w}")),
+        )
+        .chain(warnings.iter().cloned())
+        .collect();
     let report = json!({
         "input": source_name,
         "machine": machine.name,
+        "warnings": all_warnings,
         "tolerance_budget_mm": budget,
         "program": {
             "dialect": dialect.name(),

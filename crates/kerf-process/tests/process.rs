@@ -312,3 +312,53 @@ fn a_loop_around_a_tube_leads_in_on_its_scrap_side() {
         }
     }
 }
+
+/// The overcut ends inside a chord of the loop around a tube; its tool axis there is the chord's
+/// two axes interpolated at the same fraction as the point. On this loop the normals are the
+/// radial directions, so that axis is exactly the direction of the overcut's end point from
+/// the tube's axis (position = radius x normal at both ends of the chord). The exit keeps it.
+/// (With the far end's axis the beam stood off by up to a chord's turn, 3.75 deg here.)
+#[test]
+fn the_overcut_ends_with_the_axis_of_where_it_ends() {
+    let n = 96;
+    let ring: Vec<PoseArray> = (0..=n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+            [20.0 * a.cos(), 20.0 * a.sin(), 0.0, a.cos(), a.sin(), 0.0]
+        })
+        .collect();
+    let c = Contour {
+        id: "cut-off",
+        poses: &ring,
+        scrap: Some(Side::Left),
+        start: None,
+    };
+    let opts = LeadOptions::default();
+    let plan = plan_cuts(&[c], &opts).expect("plan");
+    let l = &plan.leads[0];
+    assert_eq!(l.lead_out.len(), 2, "the overcut's end and the exit: {l:?}");
+    let end = l.lead_out[0];
+    let (p, a) = (
+        nalgebra::Vector3::new(end[0], end[1], end[2]),
+        nalgebra::Vector3::new(end[3], end[4], end[5]),
+    );
+    // The overcut's end lies inside the first chord after the start, not on a cutting point.
+    let s = l.start;
+    let along = (p - nalgebra::Vector3::new(ring[s][0], ring[s][1], ring[s][2])).norm();
+    assert!(
+        (along - opts.overcut_mm).abs() < 1e-9,
+        "{along} mm past the start"
+    );
+    assert!(
+        ring.iter()
+            .all(|q| (nalgebra::Vector3::new(q[3], q[4], q[5]) - a).norm() > 1e-3),
+        "the axis is not a cutting point's: {a:?}"
+    );
+    let radial = nalgebra::Vector3::new(p.x, p.y, 0.0).normalize();
+    assert!(
+        (a - radial).norm() < 1e-12,
+        "axis {a:?}, radial at the overcut's end {radial:?}"
+    );
+    let exit = l.lead_out[1];
+    assert_eq!(exit[3..], end[3..], "the exit keeps the overcut's axis");
+}

@@ -278,19 +278,24 @@ fn island_in_a_hole_and_a_shorter_order_than_the_file() {
     );
 }
 
+/// `n` cutting points (and the first again) of a loop of radius 20 around the z axis, the tool
+/// axes radial.
+fn tube_loop(n: usize) -> Vec<PoseArray> {
+    (0..=n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+            [20.0 * a.cos(), 20.0 * a.sin(), 0.0, a.cos(), a.sin(), 0.0]
+        })
+        .collect()
+}
+
 /// A loop around a tube (radius 20 about the z axis, normals radial): the tool axes turn all
 /// the way round, so the projection along the (Newell) normal folds the sides onto the loop.
 /// With `scrap` on either side, the lead-in and lead-out lie on that side along the tube
 /// (`n x t` is +z for this loop, so left is +z), not on the contour.
 #[test]
 fn a_loop_around_a_tube_leads_in_on_its_scrap_side() {
-    let n = 96;
-    let ring: Vec<PoseArray> = (0..=n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
-            [20.0 * a.cos(), 20.0 * a.sin(), 0.0, a.cos(), a.sin(), 0.0]
-        })
-        .collect();
+    let ring = tube_loop(96);
     for (side, sign) in [(Side::Left, 1.0), (Side::Right, -1.0)] {
         let c = Contour {
             id: "cut-off",
@@ -320,13 +325,7 @@ fn a_loop_around_a_tube_leads_in_on_its_scrap_side() {
 /// (With the far end's axis the beam stood off by up to a chord's turn, 3.75 deg here.)
 #[test]
 fn the_overcut_ends_with_the_axis_of_where_it_ends() {
-    let n = 96;
-    let ring: Vec<PoseArray> = (0..=n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
-            [20.0 * a.cos(), 20.0 * a.sin(), 0.0, a.cos(), a.sin(), 0.0]
-        })
-        .collect();
+    let ring = tube_loop(96);
     let c = Contour {
         id: "cut-off",
         poses: &ring,

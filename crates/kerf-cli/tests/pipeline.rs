@@ -3,7 +3,7 @@
 
 use std::process::Command;
 mod common;
-use common::{fixture, kerf};
+use common::{fixture, kerf, read_json};
 
 fn ok(c: &mut Command) -> std::process::Output {
     let o = c.output().unwrap();
@@ -67,8 +67,7 @@ fn run_writes_every_stage_and_they_agree() {
         svg.starts_with("<?xml") || svg.starts_with("<svg"),
         "an SVG"
     );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report = read_json(&out.join("report.json"));
     assert_eq!(report["discretize"]["curves"], 2, "report counts curves");
     // The independent checker agrees with the toolpath.
     ok(kerf()
@@ -352,8 +351,7 @@ fn the_report_lists_the_input_files_warnings() {
         .arg(&machine)
         .args(["-q", "--out"])
         .arg(&out));
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report = read_json(&out.join("report.json"));
     let warnings: Vec<&str> = report["warnings"]
         .as_array()
         .expect("a warnings list")
@@ -377,7 +375,6 @@ fn the_report_lists_the_input_files_warnings() {
         .arg(fixture("machines/ac_head.json"))
         .args(["-q", "--out"])
         .arg(&clean));
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(clean.join("report.json")).unwrap()).unwrap();
+    let report = read_json(&clean.join("report.json"));
     assert_eq!(report["warnings"], serde_json::json!([]));
 }

@@ -127,8 +127,6 @@ pub struct Certifier<'a> {
     /// [`Certifier::max_margin`] and [`Certifier::output_resolution`], known on construction.
     max_margin: f64,
     output_resolution: f64,
-    /// `2 factor + 8 eps` ([`Certifier::factor`]): a span's margin per unit of its `L`.
-    span_factor: f64,
     /// `4 eps max |P_i|` for curves whose weights are not powers of two (the control points are
     /// recovered from `w P` by one division, within two ulps), else 0.
     representation: f64,
@@ -200,7 +198,6 @@ impl<'a> Certifier<'a> {
             representation,
             max_margin,
             output_resolution,
-            span_factor: 2.0 * MARGIN_FACTOR * (p + 1) as f64 * f64::EPSILON + 8.0 * f64::EPSILON,
         }
     }
 
@@ -298,7 +295,9 @@ impl<'a> Certifier<'a> {
         };
         // Most segments lie in one span, or cross one knot where the curve is C^2, and are
         // decided by the interpolation certificate without any subdivision.
-        let span_margin = |l: f64| margin.max(self.span_factor * l) + self.representation;
+        let span_margin = |l: f64| {
+            margin.max((2.0 * self.factor() + 8.0 * f64::EPSILON) * l) + self.representation
+        };
         let interpolated = if t1 <= self.local.knots()[span + 1] {
             let ends = &mut scratch.ends;
             let (h0, keep) = match start.or_else(|| find(ends, t0, span)) {

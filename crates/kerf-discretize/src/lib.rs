@@ -492,7 +492,15 @@ pub fn discretize_range(
     let cert = Certifier::new(curve);
     let margin = cert.max_margin() + cert.output_resolution();
     margin_refusal(opts.tolerance_mm, margin)?;
-    let estimate = minimum::estimate_count_with(curve, opts.tolerance_mm, |t| cert.eval_d2(t));
+    macro_rules! estimate {
+        ($p:literal, $m:expr) => {
+            minimum::estimate_count_with(curve, opts.tolerance_mm, |span, t| {
+                let e = cert.eval::<$p, $m, 2>(span, t);
+                (e.d[0], e.d[1])
+            })
+        };
+    }
+    let estimate = bound::by_degree!(curve.degree(), estimate);
     let by_length = if opts.max_segment_length_mm.is_finite() {
         curve.size() / opts.max_segment_length_mm
     } else {

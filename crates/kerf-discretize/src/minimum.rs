@@ -121,22 +121,23 @@ pub fn estimate_turning(curve: &NurbsCurve) -> f64 {
 /// magnitude; a finer rule would cost more evaluations than the walk itself at coarse
 /// tolerances.
 pub fn estimate_count(curve: &NurbsCurve, tol: f64) -> f64 {
-    estimate_count_with(curve, tol, |t| {
+    estimate_count_with(curve, tol, |_, t| {
         let (_, d1, d2) = curve.eval_d2(t);
         (d1, d2)
     })
 }
 
-/// [`estimate_count`] with the first two derivatives from `d12` (the discretizer passes its
-/// span-local evaluator, several times cheaper than the basis functions).
+/// [`estimate_count`] with the first two derivatives at `t` in knot span `span` from `d12`
+/// (the discretizer passes its span-local evaluator for the curve's degree, several times
+/// cheaper than the basis functions).
 pub(crate) fn estimate_count_with(
     curve: &NurbsCurve,
     tol: f64,
-    d12: impl Fn(f64) -> (Vector3<f64>, Vector3<f64>),
+    d12: impl Fn(usize, f64) -> (Vector3<f64>, Vector3<f64>),
 ) -> f64 {
     let x = 1.0 / 3f64.sqrt();
-    let f = |t: f64| {
-        let (d1, d2) = d12(t);
+    let f = |span: usize, t: f64| {
+        let (d1, d2) = d12(span, t);
         let v = curvature_of(&d1, &d2).sqrt() * d1.norm();
         if v.is_finite() {
             v
@@ -150,7 +151,7 @@ pub(crate) fn estimate_count_with(
         .map(|i| {
             let (a, b) = (knots[i], knots[i + 1]);
             let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
-            h * (f(m - h * x) + f(m + h * x))
+            h * (f(i, m - h * x) + f(i, m + h * x))
         })
         .sum::<f64>()
         / (8.0 * tol).sqrt()

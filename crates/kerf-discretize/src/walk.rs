@@ -277,8 +277,8 @@ impl Walker<'_> {
         let tol = self.opts.tolerance_mm;
         let bound = self.cert.chord_error_known::<P, M>(
             &mut self.scratch,
-            (start.t, Some((start.span, start.h))),
-            (t1, end.map(|e| (e.span, e.h))),
+            (start.t, Some((start.span, start.u, start.h))),
+            (t1, end.map(|e| (e.span, e.u, e.h))),
             &start.p,
             p1,
             Question {

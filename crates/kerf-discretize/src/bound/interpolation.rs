@@ -363,7 +363,8 @@ impl Question {
 impl Certifier<'_> {
     /// The interpolation certificate of a segment `[t0, t1]` inside knot span `span`
     /// (`docs/discretization.md`, "The interpolation certificate"): from the curve points at
-    /// both ends (`h0`, `h1`: the span's homogeneous values at `t0` and `t1`) and at the
+    /// both ends (`h0`, `h1`: the span's homogeneous values at its local parameters `u0` and
+    /// `u1`, those of `t0` and `t1` by [`Certifier::local_u`]) and at the
     /// middle and the span's third-derivative bounds, an upper bound of the chord error
     /// (margin included) and the middle point's distance (a lower bound). The bound of the
     /// third derivative is refined in three levels, each only while `question` is not
@@ -377,8 +378,8 @@ impl Certifier<'_> {
     pub(super) fn interpolation_bound<const P: usize, const M: usize>(
         &self,
         span: usize,
-        (t0, h0): (f64, Vector4<f64>),
-        (t1, h1): (f64, Vector4<f64>),
+        (u0, h0): (f64, Vector4<f64>),
+        (u1, h1): (f64, Vector4<f64>),
         chord: &Segment<3>,
         al: &Vector3<f64>,
         margin: f64,
@@ -386,8 +387,6 @@ impl Certifier<'_> {
     ) -> Option<Bound> {
         let p = self.deg::<P>();
         let sb = &self.span_bounds[span];
-        let (u0, _) = self.local_u(span, t0);
-        let (u1, _) = self.local_u(span, t1);
         let h = u1 - u0;
         if h.is_nan() || h <= 0.0 {
             return None;
@@ -452,8 +451,8 @@ impl Certifier<'_> {
     pub(super) fn interpolation_bound_across<const P: usize, const M: usize>(
         &self,
         (left, right): (usize, usize),
-        (t0, h0): (f64, Vector4<f64>),
-        (t1, h1): (f64, Vector4<f64>),
+        (t0, u0, h0): (f64, f64, Vector4<f64>),
+        (t1, u1, h1): (f64, f64, Vector4<f64>),
         chord: &Segment<3>,
         al: &Vector3<f64>,
         margin: f64,
@@ -507,13 +506,7 @@ impl Certifier<'_> {
         // the cube of the step in its span's local units.
         let q = p - 3;
         let mut g = [[Vector3::zeros(); M]; 2];
-        for (side, (span, u0, u1)) in [
-            (left, self.local_u(left, t0).0, 1.0),
-            (right, 0.0, self.local_u(right, t1).0),
-        ]
-        .into_iter()
-        .enumerate()
-        {
+        for (side, (span, u0, u1)) in [(left, u0, 1.0), (right, 0.0, u1)].into_iter().enumerate() {
             let mut d = [Vector4::zeros(); M];
             d[..=q].copy_from_slice(&self.span_h3[span * (p + 1)..][..=q]);
             if u1 > u0 {

@@ -41,9 +41,10 @@ macro_rules! by_degree {
 }
 pub(crate) use by_degree;
 
-/// A curve value the caller already knows: the knot span and the homogeneous local point at a
-/// parameter (from [`Certifier::eval`]), so that the certificate does not evaluate it again.
-pub(crate) type Known = Option<(usize, Vector4<f64>)>;
+/// A curve value the caller already knows: the knot span, the local parameter in it and the
+/// homogeneous local point at a parameter (from [`Certifier::eval`]), so that the certificate
+/// neither evaluates it nor divides by the span's width again.
+pub(crate) type Known = Option<(usize, f64, Vector4<f64>)>;
 use kerf_nurbs::{LocalCurve, NurbsCurve, Segment, MAX_ORDER};
 use nalgebra::{Point3, Vector3, Vector4};
 
@@ -80,8 +81,9 @@ pub struct Scratch {
     ends: Ends,
 }
 
-/// Two remembered homogeneous points of the local frame, by parameter and span.
-type Ends = [Option<(f64, usize, Vector4<f64>)>; 2];
+/// Two remembered homogeneous points of the local frame, by parameter and span (with the
+/// local parameter).
+type Ends = [Option<(f64, usize, f64, Vector4<f64>)>; 2];
 
 /// Subdivisions of one Bezier piece beyond which it is not refined further: the rounding
 /// margin covers the de Casteljau levels of this many halvings (see [`MARGIN_FACTOR`]).
@@ -290,7 +292,7 @@ impl<'a> Certifier<'a> {
         let margin = 8.0 * f64::EPSILON * al.coords.amax().max(bl.coords.amax());
         let mut lower = 0.0f64;
         let span = match start {
-            Some((s, _)) => s,
+            Some((s, _, _)) => s,
             None => self.local.span(t0),
         };
         // Most segments lie in one span, or cross one knot where the curve is C^2, and are
@@ -300,41 +302,51 @@ impl<'a> Certifier<'a> {
         };
         let interpolated = if t1 <= self.local.knots()[span + 1] {
             let ends = &mut scratch.ends;
-            let (h0, keep) = match start.or_else(|| find(ends, t0, span)) {
-                Some((_, v)) => (v, ends.iter().position(|e| e.is_some_and(|e| e.0 == t0))),
+            let (u0, h0, keep) = match start.or_else(|| find(ends, t0, span)) {
+                Some((_, u, v)) => (u, v, ends.iter().position(|e| e.is_some_and(|e| e.0 == t0))),
                 None => {
-                    let v = self.span_point::<P, M>(span, self.local_u(span, t0).0);
-                    ends[0] = Some((t0, span, v));
-                    (v, Some(0))
+                    let u = self.local_u(span, t0).0;
+                    let v = self.span_point::<P, M>(span, u);
+                    ends[0] = Some((t0, span, u, v));
+                    (u, v, Some(0))
                 }
             };
-            let h1 = match end.filter(|e| e.0 == span) {
-                Some((_, v)) => v,
-                None => self.span_point::<P, M>(span, self.local_u(span, t1).0),
+            let (u1, h1) = match end.filter(|e| e.0 == span) {
+                Some((_, u, v)) => (u, v),
+                None => {
+                    let u = self.local_u(span, t1).0;
+                    (u, self.span_point::<P, M>(span, u))
+                }
             };
-            ends[if keep == Some(0) { 1 } else { 0 }] = Some((t1, span, h1));
+            ends[if keep == Some(0) { 1 } else { 0 }] = Some((t1, span, u1, h1));
             self.interpolation_bound::<P, M>(
                 span,
-                (t0, h0),
-                (t1, h1),
+                (u0, h0),
+                (u1, h1),
                 &chord,
                 &al.coords,
                 span_margin(self.spans[span]),
                 question,
             )
         } else if let Some(right) = self.across_one_knot(span, t1) {
-            let h0 = match start.or_else(|| find(&scratch.ends, t0, span)) {
-                Some((_, v)) => v,
-                None => self.span_point::<P, M>(span, self.local_u(span, t0).0),
+            let (u0, h0) = match start.or_else(|| find(&scratch.ends, t0, span)) {
+                Some((_, u, v)) => (u, v),
+                None => {
+                    let u = self.local_u(span, t0).0;
+                    (u, self.span_point::<P, M>(span, u))
+                }
             };
-            let h1 = match end.filter(|e| e.0 == right) {
-                Some((_, v)) => v,
-                None => self.span_point::<P, M>(right, self.local_u(right, t1).0),
+            let (u1, h1) = match end.filter(|e| e.0 == right) {
+                Some((_, u, v)) => (u, v),
+                None => {
+                    let u = self.local_u(right, t1).0;
+                    (u, self.span_point::<P, M>(right, u))
+                }
             };
             self.interpolation_bound_across::<P, M>(
                 (span, right),
-                (t0, h0),
-                (t1, h1),
+                (t0, u0, h0),
+                (t1, u1, h1),
                 &chord,
                 &al.coords,
                 span_margin(self.spans[span].max(self.spans[right])),
@@ -409,7 +421,7 @@ fn find(ends: &Ends, t: f64, span: usize) -> Known {
     ends.iter()
         .flatten()
         .find(|e| e.0 == t && e.1 == span)
-        .map(|e| (e.1, e.2))
+        .map(|e| (e.1, e.2, e.3))
 }
 
 /// Certifies the chord error of the curve on `[t0, t1]` against the chord `a b`, where `a` and

@@ -19,6 +19,8 @@ pub(crate) struct Eval {
     pub t: f64,
     /// The knot span it was evaluated in (right-sided at a knot).
     pub span: usize,
+    /// The local parameter in that span ([`Certifier::local_u`]).
+    pub u: f64,
     /// The homogeneous point of the span's Bezier form, local frame.
     pub h: Vector4<f64>,
     /// The point, global frame.
@@ -132,17 +134,6 @@ impl Certifier<'_> {
         (e.p, e.d[0])
     }
 
-    /// The first two derivatives at `t`, as [`Certifier::point`] (right-sided at a knot).
-    pub(crate) fn eval_d2(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let span = self.local.span(t);
-        let e = match self.curve.degree() {
-            0..=3 => self.eval::<0, 4, 2>(span, t),
-            4..=7 => self.eval::<0, 8, 2>(span, t),
-            _ => self.eval::<0, MAX_ORDER, 2>(span, t),
-        };
-        (e.d[0], e.d[1])
-    }
-
     /// The point and the derivatives up to order `N` (`N <= 3`; higher entries zero) with
     /// respect to `t` in knot span `span`, from the span's Bezier form: de Casteljau down to
     /// level `p - N`, whose forward differences give the homogeneous derivatives
@@ -214,6 +205,7 @@ impl Certifier<'_> {
         Eval {
             t,
             span,
+            u,
             h,
             p: (c0 + self.origin).into(),
             d: out,

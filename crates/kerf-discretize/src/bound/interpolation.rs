@@ -35,6 +35,21 @@ pub(super) fn span_derivative_bounds(
     span_bezier: &[Vector4<f64>],
     spans: &[f64],
 ) -> (Vec<Vector4<f64>>, Vec<SpanBounds>) {
+    // Work arrays sized for the degree: clearing two 25-entry arrays per span cost more than
+    // the differences for the common degrees.
+    match p {
+        0..=3 => span_derivative_bounds_m::<4>(p, span_bezier, spans),
+        4..=7 => span_derivative_bounds_m::<8>(p, span_bezier, spans),
+        _ => span_derivative_bounds_m::<MAX_ORDER>(p, span_bezier, spans),
+    }
+}
+
+/// [`span_derivative_bounds`] with work arrays of `M >= p + 1` entries.
+fn span_derivative_bounds_m<const M: usize>(
+    p: usize,
+    span_bezier: &[Vector4<f64>],
+    spans: &[f64],
+) -> (Vec<Vector4<f64>>, Vec<SpanBounds>) {
     let n = spans.len();
     let mut h3 = vec![Vector4::zeros(); n * (p + 1)];
     let mut out = vec![SpanBounds::default(); n];
@@ -49,8 +64,8 @@ pub(super) fn span_derivative_bounds(
         let w_max = b.iter().map(|v| v.w).fold(0.0, f64::max);
         let slack = 64.0 * pf.powi(4) * eps * w_max * spans[i].max(f64::MIN_POSITIVE);
         let wslack = 64.0 * pf.powi(4) * eps * w_max;
-        let mut d1 = [Vector4::zeros(); MAX_ORDER];
-        let mut d2 = [Vector4::zeros(); MAX_ORDER];
+        let mut d1 = [Vector4::zeros(); M];
+        let mut d2 = [Vector4::zeros(); M];
         for j in 0..p {
             d1[j] = b[j + 1] - b[j];
         }

@@ -301,24 +301,34 @@ impl<'a> Certifier<'a> {
             margin.max((2.0 * self.factor() + 8.0 * f64::EPSILON) * l) + self.representation
         };
         let interpolated = if t1 <= self.local.knots()[span + 1] {
-            let ends = &mut scratch.ends;
-            let (u0, h0, keep) = match start.or_else(|| find(ends, t0, span)) {
-                Some((_, u, v)) => (u, v, ends.iter().position(|e| e.is_some_and(|e| e.0 == t0))),
-                None => {
-                    let u = self.local_u(span, t0).0;
-                    let v = self.span_point::<P, M>(span, u);
-                    ends[0] = Some((t0, span, u, v));
-                    (u, v, Some(0))
+            let known_end = end.filter(|e| e.0 == span);
+            let ((u0, h0), (u1, h1)) = match (start, known_end) {
+                // The walk knows both ends: nothing to remember.
+                (Some((_, u0, v0)), Some((_, u1, v1))) => ((u0, v0), (u1, v1)),
+                _ => {
+                    let ends = &mut scratch.ends;
+                    let (u0, h0, keep) = match start.or_else(|| find(ends, t0, span)) {
+                        Some((_, u, v)) => {
+                            (u, v, ends.iter().position(|e| e.is_some_and(|e| e.0 == t0)))
+                        }
+                        None => {
+                            let u = self.local_u(span, t0).0;
+                            let v = self.span_point::<P, M>(span, u);
+                            ends[0] = Some((t0, span, u, v));
+                            (u, v, Some(0))
+                        }
+                    };
+                    let (u1, h1) = match known_end {
+                        Some((_, u, v)) => (u, v),
+                        None => {
+                            let u = self.local_u(span, t1).0;
+                            (u, self.span_point::<P, M>(span, u))
+                        }
+                    };
+                    ends[if keep == Some(0) { 1 } else { 0 }] = Some((t1, span, u1, h1));
+                    ((u0, h0), (u1, h1))
                 }
             };
-            let (u1, h1) = match end.filter(|e| e.0 == span) {
-                Some((_, u, v)) => (u, v),
-                None => {
-                    let u = self.local_u(span, t1).0;
-                    (u, self.span_point::<P, M>(span, u))
-                }
-            };
-            ends[if keep == Some(0) { 1 } else { 0 }] = Some((t1, span, u1, h1));
             self.interpolation_bound::<P, M>(
                 span,
                 (u0, h0),

@@ -312,18 +312,14 @@ impl<'a> Certifier<'a> {
                             (u, v, ends.iter().position(|e| e.is_some_and(|e| e.0 == t0)))
                         }
                         None => {
-                            let u = self.local_u(span, t0).0;
-                            let v = self.span_point::<P, M>(span, u);
+                            let (u, v) = self.span_value::<P, M>(span, t0);
                             ends[0] = Some((t0, span, u, v));
                             (u, v, Some(0))
                         }
                     };
                     let (u1, h1) = match known_end {
                         Some((_, u, v)) => (u, v),
-                        None => {
-                            let u = self.local_u(span, t1).0;
-                            (u, self.span_point::<P, M>(span, u))
-                        }
+                        None => self.span_value::<P, M>(span, t1),
                     };
                     ends[if keep == Some(0) { 1 } else { 0 }] = Some((t1, span, u1, h1));
                     ((u0, h0), (u1, h1))
@@ -341,17 +337,11 @@ impl<'a> Certifier<'a> {
         } else if let Some(right) = self.across_one_knot(span, t1) {
             let (u0, h0) = match start.or_else(|| find(&scratch.ends, t0, span)) {
                 Some((_, u, v)) => (u, v),
-                None => {
-                    let u = self.local_u(span, t0).0;
-                    (u, self.span_point::<P, M>(span, u))
-                }
+                None => self.span_value::<P, M>(span, t0),
             };
             let (u1, h1) = match end.filter(|e| e.0 == right) {
                 Some((_, u, v)) => (u, v),
-                None => {
-                    let u = self.local_u(right, t1).0;
-                    (u, self.span_point::<P, M>(right, u))
-                }
+                None => self.span_value::<P, M>(right, t1),
             };
             self.interpolation_bound_across::<P, M>(
                 (span, right),

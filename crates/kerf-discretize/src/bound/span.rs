@@ -109,6 +109,19 @@ impl Certifier<'_> {
         d[0]
     }
 
+    /// The local parameter of `t` in span `span` ([`Certifier::local_u`]) and the span's
+    /// homogeneous value there ([`Certifier::span_point`]): what the certificate needs of an
+    /// end its caller did not evaluate. Counts as one evaluation.
+    #[inline(always)]
+    pub(super) fn span_value<const P: usize, const M: usize>(
+        &self,
+        span: usize,
+        t: f64,
+    ) -> (f64, Vector4<f64>) {
+        let u = self.local_u(span, t).0;
+        (u, self.span_point::<P, M>(span, u))
+    }
+
     /// The curve point at `t`, evaluated on the span's cached Bezier form by de Casteljau (`p`
     /// levels of convex combinations in the local frame, then translated back): the walk's
     /// cutting points. Within a few `eps` of the local magnitude of the curve's value (the

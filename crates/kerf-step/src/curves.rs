@@ -6,7 +6,7 @@ use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::error::Result;
-use crate::model::{boolean, err, int, list, real, reals, refs, Frame, Model};
+use crate::model::{boolean, err, int, list, real, reals, refs, Charge, Frame, Model};
 use crate::parser::{Instance, Value};
 
 /// A STEP curve before trimming: what it is and how to cut a piece of it.
@@ -63,16 +63,22 @@ impl Basis {
             Basis::Line { origin, step } => {
                 let a = origin + step * t1;
                 let b = origin + step * t2;
+                let far = |p: &Point3<f64>| !p.iter().all(|x| x.abs() <= crate::model::MAX_MM);
+                if far(&a) || far(&b) {
+                    return Err(err(
+                        inst,
+                        format!(
+                            "the line from parameter {t1:e} to {t2:e} ends beyond the {:e} mm kerf accepts",
+                            crate::model::MAX_MM
+                        ),
+                    ));
+                }
                 let len = (b - a).norm();
                 if !(len > 0.0) {
                     return Err(err(inst, "zero-length line piece"));
                 }
-                Ok(NurbsCurve::new(
-                    1,
-                    vec![0.0, 0.0, len, len],
-                    vec![a, b],
-                    None,
-                ))
+                NurbsCurve::try_new(1, vec![0.0, 0.0, len, len], vec![a, b], None)
+                    .map_err(|e| err(inst, e.to_string()))
             }
             Basis::Conic { frame, rx, ry } => Ok(conic_arc(frame, *rx, *ry, t1, t2)),
             Basis::Nurbs(c) => {
@@ -109,18 +115,17 @@ fn basis_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Basis> {
             format!("curves refer to curves more than {MAX_CURVE_DEPTH} deep (a cycle?)"),
         ));
     }
-    let s = m.units.mm_per_length;
     if let Some(p) = inst.record("LINE") {
-        let origin = m.point(m.param_ref(inst, p, 1)?)?;
-        let (d, mag) = m.vector(m.param_ref(inst, p, 2)?)?;
+        let origin = m.point(&m.param_ref(inst, p, 1)?)?;
+        let (d, mag) = m.vector(&m.param_ref(inst, p, 2)?)?;
         return Ok(Basis::Line {
             origin,
             step: d * mag,
         });
     }
     if let Some(p) = inst.record("CIRCLE") {
-        let frame = m.placement(m.param_ref(inst, p, 1)?)?;
-        let r = real(inst, p.get(2), "radius")? * s;
+        let frame = m.placement(&m.param_ref(inst, p, 1)?)?;
+        let r = m.length(inst, p.get(2), "radius")?;
         if !(r > 0.0) {
             return Err(err(inst, format!("radius must be > 0, found {r}")));
         }
@@ -131,9 +136,9 @@ fn basis_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Basis> {
         });
     }
     if let Some(p) = inst.record("ELLIPSE") {
-        let frame = m.placement(m.param_ref(inst, p, 1)?)?;
-        let rx = real(inst, p.get(2), "semi_axis_1")? * s;
-        let ry = real(inst, p.get(3), "semi_axis_2")? * s;
+        let frame = m.placement(&m.param_ref(inst, p, 1)?)?;
+        let rx = m.length(inst, p.get(2), "semi_axis_1")?;
+        let ry = m.length(inst, p.get(3), "semi_axis_2")?;
         if !(rx > 0.0 && ry > 0.0) {
             return Err(err(
                 inst,
@@ -143,9 +148,11 @@ fn basis_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Basis> {
         return Ok(Basis::Conic { frame, rx, ry });
     }
     if let Some(p) = inst.record("POLYLINE") {
-        let pts = refs(inst, p.get(1), "points")?
+        let ids = refs(inst, p.get(1), "points")?;
+        m.charge(inst, Charge::CurvePoints, ids.len())?;
+        let pts = ids
             .into_iter()
-            .map(|id| m.point(m.get(inst, id)?))
+            .map(|id| m.point(&m.get(inst, id)?))
             .collect::<Result<Vec<_>>>()?;
         if pts.len() < 2 {
             return Err(err(inst, "a polyline needs at least 2 points"));
@@ -166,7 +173,7 @@ fn basis_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Basis> {
         .or_else(|| inst.record("SEAM_CURVE"))
         .or_else(|| inst.record("INTERSECTION_CURVE"))
     {
-        return basis_at(m, m.param_ref(inst, p, 1)?, depth + 1);
+        return basis_at(m, &m.param_ref(inst, p, 1)?, depth + 1);
     }
     if inst.is("TRIMMED_CURVE") || inst.is("COMPOSITE_CURVE") {
         return Err(err(
@@ -202,9 +209,11 @@ fn bspline(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
             ),
         ));
     }
-    let pts = refs(inst, head.get(1), "control_points_list")?
+    let ids = refs(inst, head.get(1), "control_points_list")?;
+    m.charge(inst, Charge::CurvePoints, ids.len())?;
+    let pts = ids
         .into_iter()
-        .map(|id| m.point(m.get(inst, id)?))
+        .map(|id| m.point(&m.get(inst, id)?))
         .collect::<Result<Vec<_>>>()?;
     let knots = match knot_rec {
         Some(k) => expand_knots(inst, k)?,
@@ -352,7 +361,7 @@ pub(crate) fn arc_homogeneous(t1: f64, t2: f64) -> (Vec<f64>, Vec<Vector4<f64>>)
 /// it is the arc from trim_1 counter-clockwise to trim_2, reversed when sense is false.
 pub(crate) fn trimmed(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
     let p = m.rec(inst, "TRIMMED_CURVE")?;
-    let base_inst = m.param_ref(inst, p, 1)?;
+    let base_inst = &m.param_ref(inst, p, 1)?;
     let b = basis(m, base_inst)?;
     let sense = boolean(inst, p.get(4), "sense_agreement")?;
     let prefer_point = matches!(p.get(5), Some(Value::Enum(e)) if e == "CARTESIAN");
@@ -405,7 +414,7 @@ fn trim_param(
                 param = Some(real(inst, Some(inner), what)?);
             }
             Value::Real(_) | Value::Int(_) => param = Some(real(inst, Some(it), what)?),
-            Value::Ref(id) => point = Some(m.point(m.get(inst, *id)?)?),
+            Value::Ref(id) => point = Some(m.point(&m.get(inst, *id)?)?),
             _ => {}
         }
     }
@@ -430,11 +439,24 @@ fn trim_param(
 
 /// Any bounded curve entity as one NURBS curve per segment (a composite gives its segments,
 /// senses applied; others one). Full conics give the closed curve starting at angle 0.
+///
+/// A contour is a path, so each `COMPOSITE_CURVE` and each `COMPOSITE_CURVE_SEGMENT` may
+/// occur once in its expansion: one used again (a composite listing a segment twice, or
+/// reaching a sub-composite along two branches) is refused, naming both places. That bounds
+/// the expansion by the file's own entities (a "billion laughs" DAG of composites would
+/// otherwise grow exponentially with its depth), and the segments produced count against
+/// [`Charge::Segments`].
 pub(crate) fn bounded_segments(m: &Model<'_>, inst: &Instance) -> Result<Vec<(NurbsCurve, u64)>> {
-    segments_at(m, inst, 0)
+    let mut used = std::collections::HashMap::new();
+    segments_at(m, inst, 0, &mut used)
 }
 
-fn segments_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Vec<(NurbsCurve, u64)>> {
+fn segments_at(
+    m: &Model<'_>,
+    inst: &Instance,
+    depth: usize,
+    used: &mut std::collections::HashMap<u64, u64>,
+) -> Result<Vec<(NurbsCurve, u64)>> {
     if depth > MAX_CURVE_DEPTH {
         return Err(err(
             inst,
@@ -446,9 +468,18 @@ fn segments_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Vec<(Nurb
         if segs.is_empty() {
             return Err(err(inst, "a composite curve with no segment"));
         }
-        let mut out = Vec::with_capacity(segs.len());
+        let mut out = Vec::with_capacity(segs.len().min(1024));
         for (k, sid) in segs.into_iter().enumerate() {
-            let seg = m.get(inst, sid)?;
+            if let Some(first) = used.insert(sid, inst.id) {
+                return Err(err(
+                    inst,
+                    format!(
+                        "segment {} (#{sid}) is already used by #{first} in this contour: a contour runs each segment once",
+                        k + 1
+                    ),
+                ));
+            }
+            let seg = &m.get(inst, sid)?;
             let sp = m.rec(seg, "COMPOSITE_CURVE_SEGMENT").map_err(|_| {
                 err(
                     inst,
@@ -459,9 +490,23 @@ fn segments_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Vec<(Nurb
                 )
             })?;
             let same = boolean(seg, sp.get(1), "same_sense")?;
-            let parent = m.param_ref(seg, sp, 2)?;
-            let pieces = segments_at(m, parent, depth + 1)
-                .map_err(|e| err(inst, format!("segment {} (#{sid}): {e}", k + 1)))?;
+            let parent = &m.param_ref(seg, sp, 2)?;
+            if parent.is("COMPOSITE_CURVE") {
+                if let Some(first) = used.insert(parent.id, sid) {
+                    return Err(err(
+                        inst,
+                        format!(
+                            "segment {} (#{sid}) reaches composite #{} again (first through #{first}): a contour runs each piece once",
+                            k + 1,
+                            parent.id
+                        ),
+                    ));
+                }
+            }
+            let pieces = segments_at(m, parent, depth + 1, used).map_err(|e| match e {
+                e @ crate::error::StepError::Budget { .. } => e,
+                e => err(inst, format!("segment {} (#{sid}): {e}", k + 1)),
+            })?;
             if same {
                 out.extend(pieces);
             } else {
@@ -470,6 +515,7 @@ fn segments_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Vec<(Nurb
         }
         return Ok(out);
     }
+    m.charge(inst, Charge::Segments, 1)?;
     if inst.is("TRIMMED_CURVE") {
         return Ok(vec![(trimmed(m, inst)?, inst.id)]);
     }

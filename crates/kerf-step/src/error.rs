@@ -51,6 +51,19 @@ pub enum StepError {
         /// What was found instead, and what was skipped.
         reason: String,
     },
+    /// The file asks for more work or memory than the reader grants any file: more entity
+    /// instances, segments, control points or face tests than a budget allows. A real part
+    /// stays far below each (`docs/step.md` lists them). Fix: export only the part to cut, or
+    /// repair the entity named (a composite that uses its segments many times over).
+    #[error("{place}: more {what} than the reader's budget of {limit}")]
+    Budget {
+        /// What was counted.
+        what: String,
+        /// The budget.
+        limit: u64,
+        /// Where it was crossed: the entity (`#23805 COMPOSITE_CURVE`) or the line.
+        place: String,
+    },
     /// An option is out of range. Fix: pass a finite positive value.
     #[error("{0}")]
     Options(String),

@@ -8,8 +8,8 @@ use kerf_nurbs::{NurbsCurve, NurbsSurface};
 use nalgebra::Point3;
 
 use crate::curves::{basis, oriented_piece, Basis};
-use crate::error::Result;
-use crate::model::{boolean, err, name_of, refs, Model};
+use crate::error::{Result, StepError};
+use crate::model::{boolean, err, name_of, refs, Charge, Model};
 use crate::parser::{Instance, Value};
 use crate::surfaces::{angle_range, geometry, Geometry};
 
@@ -36,27 +36,33 @@ pub(crate) struct Face {
 
 /// The faces of the file, in file order; a face that cannot be converted is returned as an
 /// error message in the second list (it is skipped, not fatal).
-pub(crate) fn read_faces(m: &Model<'_>) -> (Vec<Face>, Vec<String>) {
-    let flipped = oriented_face_flips(m);
+///
+/// With `only`, just the faces with those ids are read (the others cost nothing). A
+/// [`StepError::Budget`] is fatal: it stops the import instead of skipping one face.
+pub(crate) fn read_faces(m: &Model<'_>, only: Option<&[u64]>) -> Result<(Vec<Face>, Vec<String>)> {
+    let flipped = oriented_face_flips(m)?;
     let mut faces = Vec::new();
     let mut skipped = Vec::new();
-    for inst in m
-        .all("ADVANCED_FACE")
-        .into_iter()
-        .chain(m.all("FACE_SURFACE"))
-    {
+    let mut ids = m.ex.ids_of("ADVANCED_FACE");
+    ids.extend(m.ex.ids_of("FACE_SURFACE"));
+    if let Some(only) = only {
+        ids.retain(|id| only.contains(id));
+    }
+    for id in ids {
+        let Some(inst) = m.ex.get(id)? else { continue };
         let flip = flipped.contains(&inst.id);
-        match face(m, inst, flip) {
+        match face(m, &inst, flip) {
             Ok(f) => faces.push(f),
+            Err(e @ StepError::Budget { .. }) => return Err(e),
             Err(e) => skipped.push(e.to_string()),
         }
     }
-    (faces, skipped)
+    Ok((faces, skipped))
 }
 
 /// The faces a shell uses through an `ORIENTED_FACE` with orientation `.F.` (reversed).
-fn oriented_face_flips(m: &Model<'_>) -> Vec<u64> {
-    m.all("ORIENTED_FACE")
+fn oriented_face_flips(m: &Model<'_>) -> Result<Vec<u64>> {
+    Ok(m.all("ORIENTED_FACE")?
         .into_iter()
         .filter_map(|i| {
             let p = i.record("ORIENTED_FACE")?;
@@ -65,7 +71,7 @@ fn oriented_face_flips(m: &Model<'_>) -> Vec<u64> {
                 _ => None,
             }
         })
-        .collect()
+        .collect())
 }
 
 fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
@@ -73,25 +79,34 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         .record("ADVANCED_FACE")
         .or_else(|| inst.record("FACE_SURFACE"))
         .ok_or_else(|| err(inst, "expected a face"))?;
-    let surf_inst = m.param_ref(inst, p, 2)?;
+    let surf_inst = &m.param_ref(inst, p, 2)?;
     let same_sense = boolean(inst, p.get(3), "same_sense")?;
     let g = geometry(m, surf_inst).map_err(|e| err(inst, format!("face_geometry: {e}")))?;
     let mut loops = Vec::new();
+    let mut sampled: Vec<NurbsCurve> = Vec::new();
     let mut vertices: Vec<Point3<f64>> = Vec::new();
     for bid in refs(inst, p.get(1), "bounds")? {
-        let b = m.get(inst, bid)?;
+        let b = &m.get(inst, bid)?;
         let bp = b
             .record("FACE_OUTER_BOUND")
             .or_else(|| b.record("FACE_BOUND"))
             .ok_or_else(|| err(b, "expected a FACE_BOUND"))?;
-        let lp_inst = m.param_ref(b, bp, 1)?;
+        let lp_inst = &m.param_ref(b, bp, 1)?;
         let orientation = boolean(b, bp.get(2), "orientation")?;
         if let Some(vl) = lp_inst.record("VERTEX_LOOP") {
-            let v = m.param_ref(lp_inst, vl, 1)?;
+            let v = &m.param_ref(lp_inst, vl, 1)?;
             vertices.push(vertex(m, v)?);
             continue;
         }
-        let mut edges = edge_loop(m, lp_inst)?;
+        let (mut edges, which) = edge_loop(m, lp_inst)?;
+        // The boundary samples come from each distinct edge once.
+        let mut first = vec![None; which.len()];
+        for (k, &d) in which.iter().enumerate() {
+            if first[d].is_none() {
+                first[d] = Some(k);
+                sampled.push(edges[k].clone());
+            }
+        }
         if !orientation {
             edges = edges.into_iter().rev().map(|c| c.reversed()).collect();
         }
@@ -105,12 +120,11 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         us.push(u);
         vs.push(v);
     };
-    for l in &loops {
-        for e in l {
-            let (a, b) = e.domain();
-            for k in 0..EDGE_SAMPLES {
-                add(&e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64));
-            }
+    m.charge(inst, Charge::FaceTests, sampled.len() * EDGE_SAMPLES)?;
+    for e in &sampled {
+        let (a, b) = e.domain();
+        for k in 0..EDGE_SAMPLES {
+            add(&e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64));
         }
     }
     for q in &vertices {
@@ -203,30 +217,57 @@ pub(crate) fn reverse_u(s: &NurbsSurface) -> NurbsSurface {
 
 fn vertex(m: &Model<'_>, v: &Instance) -> Result<Point3<f64>> {
     let p = m.rec(v, "VERTEX_POINT")?;
-    m.point(m.param_ref(v, p, 1)?)
+    m.point(&m.param_ref(v, p, 1)?)
 }
 
-/// The edges of an `EDGE_LOOP`, each as a NURBS curve running in loop order.
-fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<Vec<NurbsCurve>> {
+/// The edges of an `EDGE_LOOP`, each as a NURBS curve running in loop order, and for each
+/// the index of its `EDGE_CURVE` among the loop's distinct ones (a seam edge is used twice).
+///
+/// A loop runs each edge at most once in each direction (a seam: once each way); an edge
+/// used again in the same direction is refused, so a loop repeating one edge thousands of
+/// times costs one edge's work, not thousands, before it is refused.
+fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<(Vec<NurbsCurve>, Vec<usize>)> {
     let p = m.rec(inst, "EDGE_LOOP")?;
     let mut out = Vec::new();
-    for oid in refs(inst, p.get(1), "edge_list")? {
-        let oe = m.get(inst, oid)?;
+    let mut which = Vec::new();
+    // (EDGE_CURVE id, its curve as the edge runs, directions used so far)
+    let mut distinct: Vec<(u64, NurbsCurve, [bool; 2])> = Vec::new();
+    for (k, oid) in refs(inst, p.get(1), "edge_list")?.into_iter().enumerate() {
+        let oe = &m.get(inst, oid)?;
         let op = m.rec(oe, "ORIENTED_EDGE")?;
-        let ec = m.param_ref(oe, op, 3)?;
+        let ec = &m.param_ref(oe, op, 3)?;
         let orientation = boolean(oe, op.get(4), "orientation")?;
-        let c = edge_curve(m, ec)?;
-        out.push(if orientation { c } else { c.reversed() });
+        let d = match distinct.iter().position(|e| e.0 == ec.id) {
+            Some(d) => d,
+            None => {
+                distinct.push((ec.id, edge_curve(m, ec)?, [false; 2]));
+                distinct.len() - 1
+            }
+        };
+        let used = &mut distinct[d].2[usize::from(orientation)];
+        if *used {
+            return Err(err(
+                inst,
+                format!(
+                    "edge_list[{k}] (#{oid}) runs edge #{} a second time in the same direction: not a loop",
+                    ec.id
+                ),
+            ));
+        }
+        *used = true;
+        let c = &distinct[d].1;
+        out.push(if orientation { c.clone() } else { c.reversed() });
+        which.push(d);
     }
-    Ok(out)
+    Ok((out, which))
 }
 
 /// An `EDGE_CURVE` from its start vertex to its end vertex along its geometry.
 pub(crate) fn edge_curve(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
     let p = m.rec(inst, "EDGE_CURVE")?;
-    let start = vertex(m, m.param_ref(inst, p, 1)?)?;
-    let end = vertex(m, m.param_ref(inst, p, 2)?)?;
-    let geom = m.param_ref(inst, p, 3)?;
+    let start = vertex(m, &m.param_ref(inst, p, 1)?)?;
+    let end = vertex(m, &m.param_ref(inst, p, 2)?)?;
+    let geom = &m.param_ref(inst, p, 3)?;
     let same = boolean(inst, p.get(4), "same_sense")?;
     let c = if geom.is("TRIMMED_CURVE") {
         crate::curves::trimmed(m, geom)?

@@ -57,7 +57,7 @@ use kerf_format::curves::{RawCurve, RawCurvesFile, RawNurbsSurface, RawSurface, 
 use kerf_nurbs::{NurbsCurve, NurbsSurface};
 
 pub use error::{FileError, Result, StepError};
-pub use model::Units;
+pub use model::{Units, Work};
 
 use crate::faces::Face;
 use crate::model::{name_of, refs, Model};
@@ -163,6 +163,10 @@ pub struct Report {
     pub faces_read: usize,
     /// One line per surface written: its id, kind and the face's name.
     pub surfaces: Vec<String>,
+    /// What the reader assumed (a file with no unit context is read in mm).
+    pub warnings: Vec<String>,
+    /// The work done, counted against the reader's budgets.
+    pub work: Work,
 }
 
 /// Reads a STEP file from disk through kerf's one reader (`kerf_io::read_file`: at most 1 GiB,
@@ -184,6 +188,18 @@ pub fn import_file(
     })?;
     let text = String::from_utf8_lossy(kerf_io::strip_bom(&bytes));
     import(&text, opts).map_err(|e| e.in_file(path))
+}
+
+/// Checks the Part 21 syntax of a whole file without interpreting any entity: the number of
+/// entity instances in its `DATA` sections. This is the reader's first pass alone (what the
+/// parser fuzz target exercises); [`import`] runs it too.
+///
+/// # Errors
+/// [`StepError::Syntax`] naming the line, [`StepError::DuplicateId`], or
+/// [`StepError::Budget`] for a file with more instances than the reader accepts.
+pub fn check_syntax(text: &str) -> Result<usize> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    Ok(parser::parse(text)?.len())
 }
 
 /// Reads the text of a STEP file into a `kerf.curves/1` document (a leading byte-order mark,
@@ -214,7 +230,13 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         ..Report::default()
     };
     check_no_placed_parts(&m)?;
-    let (faces, face_errors) = faces::read_faces(&m);
+    report.warnings = m.warnings.clone();
+    let only = if opts.edges && !opts.all_faces {
+        opts.faces.as_deref()
+    } else {
+        None
+    };
+    let (faces, face_errors) = faces::read_faces(&m, only)?;
     report.faces_read = faces.len();
     report
         .skipped
@@ -256,19 +278,26 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
             }
         }
     } else {
-        let mut sets = m.all("GEOMETRIC_SET");
-        for s in m.all("GEOMETRIC_CURVE_SET") {
+        let mut sets = m.all("GEOMETRIC_SET")?;
+        for s in m.all("GEOMETRIC_CURVE_SET")? {
             if !sets.iter().any(|x| x.id == s.id) {
                 sets.push(s);
             }
         }
-        for set in sets {
+        let mut taken = std::collections::HashSet::new();
+        for set in &sets {
             let p = set
                 .record("GEOMETRIC_CURVE_SET")
                 .or_else(|| set.record("GEOMETRIC_SET"))
                 .unwrap_or(&[]);
             for eid in refs(set, p.get(1), "elements")? {
-                let e = m.get(set, eid)?;
+                if !taken.insert(eid) {
+                    report
+                        .skipped
+                        .push(format!("#{eid}: listed again in #{}: taken once", set.id));
+                    continue;
+                }
+                let e = &m.get(set, eid)?;
                 if e.is("CARTESIAN_POINT") || e.is("POINT_ON_CURVE") || e.is("POINT_ON_SURFACE") {
                     report
                         .skipped
@@ -426,16 +455,18 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         curves: raw_curves,
         surfaces,
     };
+    report.work = m.work();
     Ok(Import { file, report })
 }
 
 /// Assembly placements are not applied: refuse a file that places a part anywhere but where
 /// its own coordinates put it, rather than write its geometry in the wrong place.
 fn check_no_placed_parts(m: &Model<'_>) -> Result<()> {
-    for inst in m.all("ITEM_DEFINED_TRANSFORMATION") {
+    for inst in m.all("ITEM_DEFINED_TRANSFORMATION")? {
+        let inst = &inst;
         let p = m.rec(inst, "ITEM_DEFINED_TRANSFORMATION")?;
-        let a = m.placement(m.param_ref(inst, p, 2)?)?;
-        let b = m.placement(m.param_ref(inst, p, 3)?)?;
+        let a = m.placement(&m.param_ref(inst, p, 2)?)?;
+        let b = m.placement(&m.param_ref(inst, p, 3)?)?;
         let same = (a.origin - b.origin).norm() <= 1e-9 * (1.0 + a.origin.coords.norm())
             && (a.x - b.x).norm() <= 1e-12
             && (a.z - b.z).norm() <= 1e-12;

@@ -4,7 +4,19 @@
 use nalgebra::{Point3, Vector3};
 
 use crate::error::{Result, StepError};
-use crate::parser::{Exchange, Instance, Value};
+use crate::parser::{clip, Exchange, Instance, Value};
+
+/// The largest coordinate, radius or length accepted, mm (1000 km): a machine's part is
+/// metres across, and the geometry's squared lengths stay far from overflow.
+pub(crate) const MAX_MM: f64 = 1e9;
+
+/// The range of a length unit, mm per unit: a nanometre to 1000 km. Outside it a unit is a
+/// mistake (a factor of 1E300) or a hostile file, and every length would overflow or vanish.
+pub(crate) const LENGTH_UNIT_MM: (f64, f64) = (1e-9, 1e9);
+
+/// The range of a plane-angle unit, radians per unit: a microradian to 10 radians (the
+/// radian, degree, grad and turn-based units of real files lie inside).
+pub(crate) const ANGLE_UNIT_RAD: (f64, f64) = (1e-6, 10.0);
 
 /// A right-handed frame: origin, unit axes `x`, `y = z x x`, `z`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,38 +52,136 @@ impl Default for Units {
     }
 }
 
+/// A quantity of work the reader counts against a budget ([`Charge::limit`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Charge {
+    /// Curve segments produced for contours (composites expanded).
+    Segments,
+    /// Control points of the curves read (contours and face edges).
+    CurvePoints,
+    /// Control points of the surfaces read.
+    SurfacePoints,
+    /// Points projected onto surfaces: face boundary samples, contour samples tested
+    /// against faces.
+    FaceTests,
+}
+
+impl Charge {
+    /// The budget: far above a real part (docs/step.md), far below what exhausts the machine.
+    pub(crate) fn limit(self) -> u64 {
+        match self {
+            Charge::Segments => 1_000_000,
+            Charge::CurvePoints => 4_000_000,
+            Charge::SurfacePoints => 10_000_000,
+            Charge::FaceTests => 10_000_000,
+        }
+    }
+
+    fn what(self) -> &'static str {
+        match self {
+            Charge::Segments => "contour segments",
+            Charge::CurvePoints => "curve control points",
+            Charge::SurfacePoints => "surface control points",
+            Charge::FaceTests => "points projected onto faces",
+        }
+    }
+}
+
+/// The work an import did, counted against the reader's budgets: what a test holds a hostile
+/// file to, and what a user reads to see where an import's time went.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct Work {
+    /// Entity instances in the file (each parsed once for the syntax check).
+    pub instances: u64,
+    /// Curve segments produced for contours.
+    pub segments: u64,
+    /// Control points of the curves read.
+    pub curve_points: u64,
+    /// Control points of the surfaces read.
+    pub surface_points: u64,
+    /// Points projected onto surfaces (face boundaries, contour samples against faces).
+    pub face_tests: u64,
+}
+
 /// The entity table with the file's units applied on access.
 pub(crate) struct Model<'a> {
     /// The parsed file.
-    pub(crate) ex: &'a Exchange,
+    pub(crate) ex: &'a Exchange<'a>,
     /// Its units.
     pub(crate) units: Units,
+    /// What was assumed about the units (a file with no unit context).
+    pub(crate) warnings: Vec<String>,
+    /// The work done so far, per [`Charge`].
+    spent: [std::cell::Cell<u64>; 4],
 }
 
 /// Builds the error of an entity.
 pub(crate) fn err(inst: &Instance, message: impl Into<String>) -> StepError {
     StepError::Entity {
         id: inst.id,
-        name: inst.name(),
+        name: clip(&inst.name()),
         message: message.into(),
     }
 }
 
 impl<'a> Model<'a> {
     /// Wraps the table, reading the units.
-    pub(crate) fn new(ex: &'a Exchange) -> Result<Self> {
-        let units = read_units(ex)?;
-        Ok(Self { ex, units })
+    pub(crate) fn new(ex: &'a Exchange<'a>) -> Result<Self> {
+        let (units, warnings) = read_units(ex)?;
+        Ok(Self {
+            ex,
+            units,
+            warnings,
+            spent: Default::default(),
+        })
     }
 
-    /// The instance `#id`, or an error on `from` naming the dangling reference.
-    pub(crate) fn get(&self, from: &Instance, id: u64) -> Result<&'a Instance> {
-        self.ex.instances.get(&id).ok_or_else(|| {
-            err(
-                from,
-                format!("refers to #{id}, which the file does not define"),
-            )
-        })
+    /// Counts `n` units of `what` on behalf of `inst`, refusing the file once the total
+    /// passes the budget (checked before the work is done, so the budget bounds it).
+    pub(crate) fn charge(&self, inst: &Instance, what: Charge, n: usize) -> Result<()> {
+        let cell = &self.spent[what as usize];
+        let total = cell.get().saturating_add(n as u64);
+        cell.set(total);
+        if total > what.limit() {
+            return Err(StepError::Budget {
+                what: what.what().into(),
+                limit: what.limit(),
+                place: format!("#{} {}", inst.id, clip(&inst.name())),
+            });
+        }
+        Ok(())
+    }
+
+    /// The work counted so far.
+    pub(crate) fn work(&self) -> Work {
+        let get = |c: Charge| self.spent[c as usize].get();
+        Work {
+            instances: self.ex.len() as u64,
+            segments: get(Charge::Segments),
+            curve_points: get(Charge::CurvePoints),
+            surface_points: get(Charge::SurfacePoints),
+            face_tests: get(Charge::FaceTests),
+        }
+    }
+
+    /// The instance `#id` (parsed from the file's text now: keep it while you use it), or an
+    /// error on `from` naming the dangling reference.
+    pub(crate) fn get(&self, from: &Instance, id: u64) -> Result<Instance> {
+        lookup(self.ex, from, id)
+    }
+
+    /// A length parameter in mm: the file's number times its unit, finite and at most
+    /// [`MAX_MM`] in size.
+    pub(crate) fn length(&self, inst: &Instance, v: Option<&Value>, what: &str) -> Result<f64> {
+        let x = real(inst, v, what)? * self.units.mm_per_length;
+        if !(x.abs() <= MAX_MM) {
+            return Err(err(
+                inst,
+                format!("{what} is {x:e} mm, beyond the {MAX_MM:e} mm kerf accepts"),
+            ));
+        }
+        Ok(x)
     }
 
     /// The parameters of record `name` of `inst`.
@@ -86,7 +196,7 @@ impl<'a> Model<'a> {
         inst: &Instance,
         params: &[Value],
         k: usize,
-    ) -> Result<&'a Instance> {
+    ) -> Result<Instance> {
         match params.get(k) {
             Some(Value::Ref(id)) => self.get(inst, *id),
             other => Err(err(
@@ -103,16 +213,18 @@ impl<'a> Model<'a> {
     /// A `CARTESIAN_POINT` in mm (2D points get z = 0).
     pub(crate) fn point(&self, inst: &Instance) -> Result<Point3<f64>> {
         let p = self.rec(inst, "CARTESIAN_POINT")?;
-        let c = reals(inst, p.get(1), "coordinates")?;
-        let s = self.units.mm_per_length;
-        match c.as_slice() {
-            [x, y, z] => Ok(Point3::new(x * s, y * s, z * s)),
-            [x, y] => Ok(Point3::new(x * s, y * s, 0.0)),
-            _ => Err(err(
+        let c = list(inst, p.get(1), "coordinates")?;
+        if !(2..=3).contains(&c.len()) {
+            return Err(err(
                 inst,
                 format!("expected 2 or 3 coordinates, found {}", c.len()),
-            )),
+            ));
         }
+        let mut xyz = [0.0; 3];
+        for (k, v) in c.iter().enumerate() {
+            xyz[k] = self.length(inst, Some(v), &format!("coordinates[{k}]"))?;
+        }
+        Ok(Point3::from(xyz))
     }
 
     /// A `DIRECTION`, normalised.
@@ -139,8 +251,8 @@ impl<'a> Model<'a> {
     /// A `VECTOR`: unit direction and magnitude in mm.
     pub(crate) fn vector(&self, inst: &Instance) -> Result<(Vector3<f64>, f64)> {
         let p = self.rec(inst, "VECTOR")?;
-        let d = self.direction(self.param_ref(inst, p, 1)?)?;
-        let m = real(inst, p.get(2), "magnitude")? * self.units.mm_per_length;
+        let d = self.direction(&self.param_ref(inst, p, 1)?)?;
+        let m = self.length(inst, p.get(2), "magnitude")?;
         if !(m > 0.0) {
             return Err(err(inst, format!("magnitude must be > 0, found {m}")));
         }
@@ -152,9 +264,9 @@ impl<'a> Model<'a> {
     /// so that angles measured from it agree with the files' other readers.
     pub(crate) fn placement(&self, inst: &Instance) -> Result<Frame> {
         if let Some(p) = inst.record("AXIS2_PLACEMENT_2D") {
-            let origin = self.point(self.param_ref(inst, p, 1)?)?;
+            let origin = self.point(&self.param_ref(inst, p, 1)?)?;
             let x = match p.get(2) {
-                Some(Value::Ref(_)) => self.direction(self.param_ref(inst, p, 2)?)?,
+                Some(Value::Ref(_)) => self.direction(&self.param_ref(inst, p, 2)?)?,
                 _ => Vector3::x(),
             };
             let z = Vector3::z();
@@ -166,13 +278,13 @@ impl<'a> Model<'a> {
             });
         }
         let p = self.rec(inst, "AXIS2_PLACEMENT_3D")?;
-        let origin = self.point(self.param_ref(inst, p, 1)?)?;
+        let origin = self.point(&self.param_ref(inst, p, 1)?)?;
         let z = match p.get(2) {
-            Some(Value::Ref(_)) => self.direction(self.param_ref(inst, p, 2)?)?,
+            Some(Value::Ref(_)) => self.direction(&self.param_ref(inst, p, 2)?)?,
             _ => Vector3::z(),
         };
         let reference = match p.get(3) {
-            Some(Value::Ref(_)) => Some(self.direction(self.param_ref(inst, p, 3)?)?),
+            Some(Value::Ref(_)) => Some(self.direction(&self.param_ref(inst, p, 3)?)?),
             _ => None,
         };
         let x = reference
@@ -188,14 +300,27 @@ impl<'a> Model<'a> {
     }
 
     /// Every instance that is (or contains) entity `name`, in file order.
-    pub(crate) fn all(&self, name: &str) -> Vec<&'a Instance> {
-        self.ex
-            .order
-            .iter()
-            .filter_map(|id| self.ex.instances.get(id))
-            .filter(|i| i.is(name))
-            .collect()
+    pub(crate) fn all(&self, name: &str) -> Result<Vec<Instance>> {
+        all(self.ex, name)
     }
+}
+
+/// The instance `#id`, or an error on `from` naming the dangling reference.
+fn lookup(ex: &Exchange<'_>, from: &Instance, id: u64) -> Result<Instance> {
+    ex.get(id)?.ok_or_else(|| {
+        err(
+            from,
+            format!("refers to #{id}, which the file does not define"),
+        )
+    })
+}
+
+/// Every instance of `ex` that is (or contains) entity `name`, in file order.
+fn all(ex: &Exchange<'_>, name: &str) -> Result<Vec<Instance>> {
+    ex.ids_of(name)
+        .into_iter()
+        .filter_map(|id| ex.get(id).transpose())
+        .collect()
 }
 
 /// The x direction Open CASCADE's `gp_Ax2(P, N)` derives from the axis `n` alone: a unit
@@ -328,29 +453,68 @@ pub(crate) fn name_of(inst: &Instance) -> String {
     String::new()
 }
 
+/// What a unit measures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    /// Lengths: an SI metre or a conversion of a length unit; mm per unit.
+    Length,
+    /// Plane angles: an SI radian or a conversion of an angle unit; radians per unit.
+    Angle,
+}
+
+impl Kind {
+    fn si_name(self) -> &'static str {
+        match self {
+            Kind::Length => "METRE",
+            Kind::Angle => "RADIAN",
+        }
+    }
+
+    fn entity(self) -> &'static str {
+        match self {
+            Kind::Length => "LENGTH_UNIT",
+            Kind::Angle => "PLANE_ANGLE_UNIT",
+        }
+    }
+}
+
 /// The units of the geometry: from every `GLOBAL_UNIT_ASSIGNED_CONTEXT`, which must agree.
-fn read_units(ex: &Exchange) -> Result<Units> {
+/// A file with none is read in mm and radians, and the assumption is returned as a warning.
+fn read_units(ex: &Exchange<'_>) -> Result<(Units, Vec<String>)> {
     let mut found: Option<(Units, u64)> = None;
-    for id in &ex.order {
-        let inst = &ex.instances[id];
-        let Some(p) = inst.record("GLOBAL_UNIT_ASSIGNED_CONTEXT") else {
-            continue;
-        };
+    let mut warnings = Vec::new();
+    for inst in all(ex, "GLOBAL_UNIT_ASSIGNED_CONTEXT")? {
+        let p = inst.record("GLOBAL_UNIT_ASSIGNED_CONTEXT").unwrap_or(&[]);
         let mut u = Units::default();
-        for uid in refs(inst, p.first(), "units")? {
-            let unit = ex.instances.get(&uid).ok_or_else(|| {
-                err(
-                    inst,
-                    format!("refers to #{uid}, which the file does not define"),
-                )
-            })?;
-            if unit.is("LENGTH_UNIT") {
-                let (f, name) = unit_factor(ex, unit, 0)?;
-                u.mm_per_length = f;
-                u.length_name = name;
-            } else if unit.is("PLANE_ANGLE_UNIT") {
-                u.rad_per_angle = unit_factor(ex, unit, 0)?.0;
+        let mut length_given = false;
+        for uid in refs(&inst, p.first(), "units")? {
+            let unit = lookup(ex, &inst, uid)?;
+            let kind = match (unit.is("LENGTH_UNIT"), unit.is("PLANE_ANGLE_UNIT")) {
+                (true, false) => Kind::Length,
+                (false, true) => Kind::Angle,
+                (true, true) => {
+                    return Err(err(
+                        &unit,
+                        "a unit cannot be both a LENGTH_UNIT and a PLANE_ANGLE_UNIT",
+                    ))
+                }
+                (false, false) => continue,
+            };
+            let (f, name) = unit_factor(ex, &unit, kind, 0)?;
+            match kind {
+                Kind::Length => {
+                    u.mm_per_length = f;
+                    u.length_name = name;
+                    length_given = true;
+                }
+                Kind::Angle => u.rad_per_angle = f,
             }
+        }
+        if !length_given {
+            warnings.push(format!(
+                "#{} GLOBAL_UNIT_ASSIGNED_CONTEXT names no length unit: lengths read as mm",
+                inst.id
+            ));
         }
         match found {
             Some((prev, pid))
@@ -358,7 +522,7 @@ fn read_units(ex: &Exchange) -> Result<Units> {
                     || (prev.rad_per_angle - u.rad_per_angle).abs() > 1e-12 =>
             {
                 return Err(err(
-                    inst,
+                    &inst,
                     format!(
                         "its units ({} mm per length unit) differ from those of #{pid} ({} mm); \
                          files with several unit systems are not supported",
@@ -370,45 +534,101 @@ fn read_units(ex: &Exchange) -> Result<Units> {
             None => found = Some((u, inst.id)),
         }
     }
-    Ok(found.map(|f| f.0).unwrap_or_default())
+    if found.is_none() {
+        warnings.push(
+            "the file has no GLOBAL_UNIT_ASSIGNED_CONTEXT: lengths read as mm and angles as \
+             radians (an inch or metre file without its units would come out 25.4 or 1000 \
+             times too small)"
+                .into(),
+        );
+    }
+    Ok((found.map(|f| f.0).unwrap_or_default(), warnings))
 }
 
-/// For a length unit: mm per unit; for a plane-angle unit: radians per unit. Also a name.
-fn unit_factor(ex: &Exchange, unit: &Instance, depth: usize) -> Result<(f64, &'static str)> {
+/// mm per unit for a length unit, radians per unit for a plane-angle unit, and a name. The
+/// unit must measure `kind` (an SI unit of the kind's base, or a conversion of such a unit),
+/// its SI prefix must be an enumeration, and the factor must lie in the kind's range.
+fn unit_factor(
+    ex: &Exchange<'_>,
+    unit: &Instance,
+    kind: Kind,
+    depth: usize,
+) -> Result<(f64, &'static str)> {
     if depth > 8 {
         return Err(err(unit, "conversion-based units nested too deeply"));
     }
-    if let Some(p) = unit.record("SI_UNIT") {
-        let prefix = match p.first() {
-            Some(Value::Enum(e)) => match e.as_str() {
-                "MILLI" => 1e-3,
-                "CENTI" => 1e-2,
-                "DECI" => 1e-1,
-                "KILO" => 1e3,
-                "MICRO" => 1e-6,
-                "NANO" => 1e-9,
-                "DECA" => 1e1,
-                "HECTO" => 1e2,
-                other => return Err(err(unit, format!("SI prefix .{other}. is not supported"))),
-            },
-            _ => 1.0,
-        };
-        return match p.get(1) {
-            Some(Value::Enum(e)) if e == "METRE" => Ok((
-                prefix * 1e3,
-                match p.first() {
-                    Some(Value::Enum(e)) if e == "MILLI" => "mm",
-                    Some(Value::Enum(e)) if e == "CENTI" => "cm",
-                    Some(Value::Enum(e)) if e == "MICRO" => "um",
-                    Some(Value::Enum(e)) if e == "KILO" => "km",
-                    _ => "m",
-                },
-            )),
-            Some(Value::Enum(e)) if e == "RADIAN" => Ok((prefix, "rad")),
-            other => Err(err(unit, format!("unit {} is not supported", show(other)))),
-        };
+    // A unit that says what it measures must say the kind it is used for.
+    for other in [Kind::Length, Kind::Angle] {
+        if other != kind && unit.is(other.entity()) {
+            return Err(err(
+                unit,
+                format!(
+                    "is a {} where a {} is needed",
+                    other.entity(),
+                    kind.entity()
+                ),
+            ));
+        }
     }
-    if let Some(p) = unit.record("CONVERSION_BASED_UNIT") {
+    let (f, name) = if let Some(p) = unit.record("SI_UNIT") {
+        let prefix_name = match p.first() {
+            Some(Value::Enum(e)) => Some(e.as_str()),
+            None | Some(Value::Null | Value::Derived) => None,
+            Some(other) => {
+                return Err(err(
+                    unit,
+                    format!(
+                        "SI prefix must be an enumeration like .MILLI. or $, found {}",
+                        show(Some(other))
+                    ),
+                ))
+            }
+        };
+        let prefix = match prefix_name {
+            None => 1.0,
+            Some("MILLI") => 1e-3,
+            Some("CENTI") => 1e-2,
+            Some("DECI") => 1e-1,
+            Some("KILO") => 1e3,
+            Some("MICRO") => 1e-6,
+            Some("NANO") => 1e-9,
+            Some("DECA") => 1e1,
+            Some("HECTO") => 1e2,
+            Some(other) => {
+                return Err(err(
+                    unit,
+                    format!("SI prefix .{}. is not supported", clip(other)),
+                ))
+            }
+        };
+        match p.get(1) {
+            Some(Value::Enum(e)) if e == kind.si_name() => match kind {
+                Kind::Length => (
+                    prefix * 1e3,
+                    match prefix_name {
+                        Some("MILLI") => "mm",
+                        Some("CENTI") => "cm",
+                        Some("MICRO") => "um",
+                        Some("KILO") => "km",
+                        None => "m",
+                        _ => "converted",
+                    },
+                ),
+                Kind::Angle => (prefix, "rad"),
+            },
+            Some(Value::Enum(e)) if e == "METRE" || e == "RADIAN" => {
+                return Err(err(
+                    unit,
+                    format!(
+                        "a {} must be based on the {}, found .{e}.",
+                        kind.entity(),
+                        kind.si_name().to_ascii_lowercase()
+                    ),
+                ))
+            }
+            other => return Err(err(unit, format!("unit {} is not supported", show(other)))),
+        }
+    } else if let Some(p) = unit.record("CONVERSION_BASED_UNIT") {
         let label = match p.first() {
             Some(Value::Str(s)) => s.to_ascii_lowercase(),
             _ => String::new(),
@@ -416,45 +636,44 @@ fn unit_factor(ex: &Exchange, unit: &Instance, depth: usize) -> Result<(f64, &'s
         let Some(Value::Ref(mid)) = p.get(1) else {
             return Err(err(unit, "conversion-based unit without a measure"));
         };
-        let m = ex.instances.get(mid).ok_or_else(|| {
-            err(
-                unit,
-                format!("refers to #{mid}, which the file does not define"),
-            )
-        })?;
+        let m = lookup(ex, unit, *mid)?;
         let mp = m
             .records
             .iter()
             .find(|(n, _)| n.ends_with("MEASURE_WITH_UNIT"))
             .map(|(_, p)| p.as_slice())
-            .ok_or_else(|| err(m, "expected a MEASURE_WITH_UNIT"))?;
-        let value = real(m, mp.first(), "value_component")?;
+            .ok_or_else(|| err(&m, "expected a MEASURE_WITH_UNIT"))?;
+        let value = real(&m, mp.first(), "value_component")?;
         let Some(Value::Ref(base)) = mp.get(1) else {
-            return Err(err(m, "unit_component must be a reference"));
+            return Err(err(&m, "unit_component must be a reference"));
         };
-        let b = ex.instances.get(base).ok_or_else(|| {
-            err(
-                m,
-                format!("refers to #{base}, which the file does not define"),
-            )
-        })?;
-        let (f, _) = unit_factor(ex, b, depth + 1)?;
-        let name = match label.as_str() {
-            "inch" | "in" => "inch",
-            "foot" | "ft" => "foot",
-            "degree" | "deg" => "degree",
+        let b = lookup(ex, &m, *base)?;
+        let (f, _) = unit_factor(ex, &b, kind, depth + 1)?;
+        let name = match (kind, label.as_str()) {
+            (Kind::Length, "inch" | "in") => "inch",
+            (Kind::Length, "foot" | "ft") => "foot",
+            (Kind::Angle, "degree" | "deg") => "degree",
             _ => "converted",
         };
-        if !(value * f > 0.0) || !(value * f).is_finite() {
-            return Err(err(
-                unit,
-                format!("conversion factor must be > 0, found {}", value * f),
-            ));
-        }
-        return Ok((value * f, name));
+        (value * f, name)
+    } else {
+        return Err(err(
+            unit,
+            "unit must be an SI_UNIT or a CONVERSION_BASED_UNIT",
+        ));
+    };
+    let (lo, hi, what) = match kind {
+        Kind::Length => (LENGTH_UNIT_MM.0, LENGTH_UNIT_MM.1, "mm"),
+        Kind::Angle => (ANGLE_UNIT_RAD.0, ANGLE_UNIT_RAD.1, "rad"),
+    };
+    if !(f >= lo && f <= hi) {
+        return Err(err(
+            unit,
+            format!(
+                "a {} of {f:e} {what} is outside the range {lo:e} to {hi:e} {what} kerf accepts",
+                kind.entity()
+            ),
+        ));
     }
-    Err(err(
-        unit,
-        "unit must be an SI_UNIT or a CONVERSION_BASED_UNIT",
-    ))
+    Ok((f, name))
 }

@@ -74,29 +74,99 @@ impl Instance {
     }
 }
 
-/// A parsed exchange structure.
+/// The most entity instances one file may hold. The index costs 20 bytes per instance, so a
+/// file at kerf's 1 GiB input limit made of the shortest instances (`#1=A();`, 7 bytes) would
+/// need 3 GB for it alone; real files hold a few million (a 100 MB assembly: ~2 M).
+pub(crate) const MAX_INSTANCES: usize = 20_000_000;
+
+/// One instance in the index: where its text starts and which record names it has.
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    /// The `#id`.
+    id: u64,
+    /// Byte offset of its `#` in the text.
+    start: u32,
+    /// Index into [`Exchange::kinds`].
+    kind: u32,
+}
+
+/// A parsed exchange structure: the whole file's syntax checked once, and an index of its
+/// instances (id, offset, record names) instead of their values. An instance's values are
+/// parsed again from the text each time it is asked for ([`Exchange::get`]), so the memory
+/// is the text plus ~20 bytes per instance, whatever the instances hold, and the work of
+/// reading an entity the contours never reach is one syntax pass.
 #[derive(Debug, Clone, Default)]
-pub(crate) struct Exchange {
+pub(crate) struct Exchange<'t> {
     /// The schema names of `FILE_SCHEMA`.
     pub(crate) schemas: Vec<String>,
-    /// Every instance of the `DATA` sections, by id.
-    pub(crate) instances: HashMap<u64, Instance>,
-    /// The ids in file order.
-    pub(crate) order: Vec<u64>,
+    text: &'t [u8],
+    /// Every instance of the `DATA` sections, in file order.
+    slots: Vec<Slot>,
+    /// Indices into `slots`, sorted by id.
+    by_id: Vec<u32>,
+    /// The distinct lists of record names (`[CIRCLE]`, `[LENGTH_UNIT, NAMED_UNIT, SI_UNIT]`).
+    kinds: Vec<Box<[String]>>,
+}
+
+impl<'t> Exchange<'t> {
+    /// The number of instances.
+    pub(crate) fn len(&self) -> usize {
+        self.slots.len()
+    }
+
+    fn slot_of(&self, id: u64) -> Option<Slot> {
+        self.by_id
+            .binary_search_by_key(&id, |&k| self.slots[k as usize].id)
+            .ok()
+            .map(|k| self.slots[self.by_id[k] as usize])
+    }
+
+    /// The instance `#id` (parsed from the text now), `None` if the file does not define it.
+    ///
+    /// # Errors
+    /// Only if the text no longer parses, which the first pass rules out.
+    pub(crate) fn get(&self, id: u64) -> Result<Option<Instance>> {
+        self.slot_of(id).map(|s| self.parse_slot(s)).transpose()
+    }
+
+    fn parse_slot(&self, s: Slot) -> Result<Instance> {
+        let mut p = Parser {
+            s: self.text,
+            i: s.start as usize,
+            scanned: std::cell::Cell::new(0),
+        };
+        p.instance()
+    }
+
+    /// The ids of every instance that is (or, complex, contains) entity `name`, in file order;
+    /// decided from the index, without parsing any instance.
+    pub(crate) fn ids_of(&self, name: &str) -> Vec<u64> {
+        let hit: Vec<bool> = self
+            .kinds
+            .iter()
+            .map(|k| k.iter().any(|n| n == name))
+            .collect();
+        self.slots
+            .iter()
+            .filter(|s| hit[s.kind as usize])
+            .map(|s| s.id)
+            .collect()
+    }
 }
 
 /// Parses a whole Part 21 file.
 ///
 /// # Errors
-/// [`StepError::Syntax`] naming the line and what was expected; [`StepError::DuplicateId`].
-pub(crate) fn parse(text: &str) -> Result<Exchange> {
+/// [`StepError::Syntax`] naming the line and what was expected; [`StepError::DuplicateId`];
+/// [`StepError::Budget`] past [`MAX_INSTANCES`] or a text of 4 GiB or more.
+pub(crate) fn parse(text: &str) -> Result<Exchange<'_>> {
     parse_counted(text).0
 }
 
 /// [`parse`], also returning the work done: the bytes the parser stepped over plus those it
 /// scanned again to number lines. A linear parser keeps this within a small multiple of the
 /// file size whatever the file holds.
-fn parse_counted(text: &str) -> (Result<Exchange>, usize) {
+fn parse_counted(text: &str) -> (Result<Exchange<'_>>, usize) {
     let mut p = Parser {
         s: text.as_bytes(),
         i: 0,
@@ -106,8 +176,19 @@ fn parse_counted(text: &str) -> (Result<Exchange>, usize) {
     (r, p.i + p.scanned.get())
 }
 
-fn parse_with(p: &mut Parser<'_>) -> Result<Exchange> {
-    let mut ex = Exchange::default();
+fn parse_with<'t>(p: &mut Parser<'t>) -> Result<Exchange<'t>> {
+    if u32::try_from(p.s.len()).is_err() {
+        return Err(StepError::Budget {
+            what: "file size".into(),
+            limit: u32::MAX as u64,
+            place: format!("{} bytes", p.s.len()),
+        });
+    }
+    let mut ex = Exchange {
+        text: p.s,
+        ..Exchange::default()
+    };
+    let mut kind_index: HashMap<String, u32> = HashMap::new();
     p.skip_ws()?;
     p.expect_keyword("ISO-10303-21")?;
     p.expect_byte(b';')?;
@@ -119,15 +200,28 @@ fn parse_with(p: &mut Parser<'_>) -> Result<Exchange> {
             return Err(p.error("the file ends before END-ISO-10303-21;"));
         }
         if p.peek() == Some(b'#') && in_data {
-            let inst = p.instance()?;
-            if ex.instances.contains_key(&inst.id) {
-                return Err(StepError::DuplicateId {
-                    id: inst.id,
-                    line: p.line(),
+            if ex.slots.len() >= MAX_INSTANCES {
+                return Err(StepError::Budget {
+                    what: "entity instances".into(),
+                    limit: MAX_INSTANCES as u64,
+                    place: format!("line {}", p.line()),
                 });
             }
-            ex.order.push(inst.id);
-            ex.instances.insert(inst.id, inst);
+            let start = p.i as u32;
+            // The values are checked and dropped: the index keeps where they are.
+            let inst = p.instance()?;
+            let key = inst.name();
+            let next = ex.kinds.len() as u32;
+            let kind = *kind_index.entry(key).or_insert_with(|| {
+                ex.kinds
+                    .push(inst.records.iter().map(|(n, _)| n.clone()).collect());
+                next
+            });
+            ex.slots.push(Slot {
+                id: inst.id,
+                start,
+                kind,
+            });
             continue;
         }
         let word = p.keyword()?;
@@ -167,14 +261,20 @@ fn parse_with(p: &mut Parser<'_>) -> Result<Exchange> {
                         ex.schemas = l
                             .iter()
                             .filter_map(|v| match v {
-                                Value::Str(s) => Some(s.clone()),
+                                Value::Str(s) => Some(clip(s)),
                                 _ => None,
                             })
+                            .take(16)
                             .collect();
                     }
                 }
             }
-            _ => return Err(p.error(&format!("expected #id=... or ENDSEC, found {word}"))),
+            _ => {
+                return Err(p.error(&format!(
+                    "expected #id=... or ENDSEC, found {}",
+                    clip(&word)
+                )))
+            }
         }
     }
     if !seen_data {
@@ -183,7 +283,34 @@ fn parse_with(p: &mut Parser<'_>) -> Result<Exchange> {
             message: "no DATA section".into(),
         });
     }
+    ex.by_id = (0..ex.slots.len() as u32).collect();
+    let slots = &ex.slots;
+    ex.by_id
+        .sort_unstable_by_key(|&k| (slots[k as usize].id, slots[k as usize].start));
+    if let Some(w) = ex
+        .by_id
+        .windows(2)
+        .find(|w| slots[w[0] as usize].id == slots[w[1] as usize].id)
+    {
+        let second = slots[w[1] as usize];
+        return Err(StepError::DuplicateId {
+            id: second.id,
+            line: p.line_at(second.start as usize),
+        });
+    }
     Ok(ex)
+}
+
+/// At most this many characters of file text are quoted in a message.
+pub(crate) const QUOTE_CHARS: usize = 64;
+
+/// `s` as quoted in a message: whole if short, else its first [`QUOTE_CHARS`] characters and
+/// the length (an error must not echo megabytes of input).
+pub(crate) fn clip(s: &str) -> String {
+    match s.char_indices().nth(QUOTE_CHARS) {
+        None => s.to_owned(),
+        Some((k, _)) => format!("{}... ({} bytes)", &s[..k], s.len()),
+    }
 }
 
 struct Parser<'a> {
@@ -284,7 +411,7 @@ impl Parser<'_> {
         if k == word {
             Ok(())
         } else {
-            Err(self.error(&format!("expected {word}, found {k}")))
+            Err(self.error(&format!("expected {word}, found {}", clip(&k))))
         }
     }
 
@@ -457,7 +584,7 @@ impl Parser<'_> {
             }
         }
         let text = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("");
-        let bad = || self.error(&format!("not a number: {text:?}"));
+        let bad = || self.error(&format!("not a number: {:?}", clip(text)));
         if real {
             // Part 21 allows "1." and "1.E5"; Rust parses both.
             let v: f64 = text.parse().map_err(|_| bad())?;
@@ -552,7 +679,7 @@ mod tests {
             ENDSEC;\nEND-ISO-10303-21;\n";
         let ex = parse(text).expect("valid file");
         assert_eq!(ex.schemas, vec!["AUTOMOTIVE_DESIGN".to_string()], "schema");
-        let p = &ex.instances[&1];
+        let p = ex.get(1).expect("parses").expect("defined");
         assert_eq!(
             p.records[0].1,
             vec![
@@ -562,12 +689,12 @@ mod tests {
             "point parameters"
         );
         assert_eq!(
-            ex.instances[&2].name(),
+            ex.get(2).expect("parses").expect("defined").name(),
             "LENGTH_UNIT+NAMED_UNIT+SI_UNIT",
             "complex"
         );
         assert_eq!(
-            ex.instances[&3].records[0].1[0],
+            ex.get(3).expect("parses").expect("defined").records[0].1[0],
             Value::Typed("LENGTH_MEASURE".into(), Box::new(Value::Real(1e-7))),
             "typed"
         );
@@ -603,7 +730,7 @@ mod tests {
         for n in [1_000, 20_000] {
             let text = file(n);
             let (r, work) = parse_counted(&text);
-            assert_eq!(r.expect("valid file").order.len(), n, "all points parsed");
+            assert_eq!(r.expect("valid file").len(), n, "all points indexed");
             assert!(
                 work <= 2 * text.len(),
                 "{n} points: {work} bytes of work for a {}-byte file",

@@ -12,8 +12,8 @@ use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::curves::{arc_homogeneous, basis, expand_knots, sub_curve, Basis};
 use crate::error::Result;
-use crate::model::{err, int, list, real, reals, refs, Frame, Model};
-use crate::parser::Instance;
+use crate::model::{err, int, list, real, reals, refs, Charge, Frame, Model};
+use crate::parser::{Instance, Value};
 
 /// A STEP surface with its natural parametrization.
 pub(crate) enum Geometry {
@@ -369,7 +369,6 @@ fn cut(s: &NurbsSurface, u: (f64, f64), v: (f64, f64)) -> kerf_nurbs::Result<Nur
 
 /// Reads a supported surface entity.
 pub(crate) fn geometry(m: &Model<'_>, inst: &Instance) -> Result<Geometry> {
-    let s = m.units.mm_per_length;
     let positive = |x: f64, what: &str| {
         if x > 0.0 && x.is_finite() {
             Ok(x)
@@ -378,16 +377,16 @@ pub(crate) fn geometry(m: &Model<'_>, inst: &Instance) -> Result<Geometry> {
         }
     };
     if let Some(p) = inst.record("PLANE") {
-        return Ok(Geometry::Plane(m.placement(m.param_ref(inst, p, 1)?)?));
+        return Ok(Geometry::Plane(m.placement(&m.param_ref(inst, p, 1)?)?));
     }
     if let Some(p) = inst.record("CYLINDRICAL_SURFACE") {
-        let f = m.placement(m.param_ref(inst, p, 1)?)?;
-        let r = positive(real(inst, p.get(2), "radius")? * s, "radius")?;
+        let f = m.placement(&m.param_ref(inst, p, 1)?)?;
+        let r = positive(m.length(inst, p.get(2), "radius")?, "radius")?;
         return Ok(Geometry::Cylinder(f, r));
     }
     if let Some(p) = inst.record("CONICAL_SURFACE") {
-        let f = m.placement(m.param_ref(inst, p, 1)?)?;
-        let r = real(inst, p.get(2), "radius")? * s;
+        let f = m.placement(&m.param_ref(inst, p, 1)?)?;
+        let r = m.length(inst, p.get(2), "radius")?;
         let a = real(inst, p.get(3), "semi_angle")? * m.units.rad_per_angle;
         if !(r >= 0.0) || !(a.abs() < PI / 2.0) || a == 0.0 {
             return Err(err(
@@ -398,28 +397,28 @@ pub(crate) fn geometry(m: &Model<'_>, inst: &Instance) -> Result<Geometry> {
         return Ok(Geometry::Cone(f, r, a));
     }
     if let Some(p) = inst.record("SPHERICAL_SURFACE") {
-        let f = m.placement(m.param_ref(inst, p, 1)?)?;
-        let r = positive(real(inst, p.get(2), "radius")? * s, "radius")?;
+        let f = m.placement(&m.param_ref(inst, p, 1)?)?;
+        let r = positive(m.length(inst, p.get(2), "radius")?, "radius")?;
         return Ok(Geometry::Sphere(f, r));
     }
     if let Some(p) = inst.record("TOROIDAL_SURFACE") {
-        let f = m.placement(m.param_ref(inst, p, 1)?)?;
-        let big = positive(real(inst, p.get(2), "major_radius")? * s, "major_radius")?;
-        let r = positive(real(inst, p.get(3), "minor_radius")? * s, "minor_radius")?;
+        let f = m.placement(&m.param_ref(inst, p, 1)?)?;
+        let big = positive(m.length(inst, p.get(2), "major_radius")?, "major_radius")?;
+        let r = positive(m.length(inst, p.get(3), "minor_radius")?, "minor_radius")?;
         return Ok(Geometry::Torus(f, big, r));
     }
     if let Some(p) = inst.record("SURFACE_OF_LINEAR_EXTRUSION") {
-        let c = whole_curve(m, m.param_ref(inst, p, 1)?)?;
-        let (d, _) = m.vector(m.param_ref(inst, p, 2)?)?;
+        let c = whole_curve(m, &m.param_ref(inst, p, 1)?)?;
+        let (d, _) = m.vector(&m.param_ref(inst, p, 2)?)?;
         return Ok(Geometry::Extrusion(c, d));
     }
     if let Some(p) = inst.record("SURFACE_OF_REVOLUTION") {
-        let profile = whole_curve(m, m.param_ref(inst, p, 1)?)?;
-        let ax = m.param_ref(inst, p, 2)?;
+        let profile = whole_curve(m, &m.param_ref(inst, p, 1)?)?;
+        let ax = &m.param_ref(inst, p, 2)?;
         let ap = m.rec(ax, "AXIS1_PLACEMENT")?;
-        let origin = m.point(m.param_ref(ax, ap, 1)?)?;
+        let origin = m.point(&m.param_ref(ax, ap, 1)?)?;
         let axis = match ap.get(2) {
-            Some(crate::parser::Value::Ref(_)) => m.direction(m.param_ref(ax, ap, 2)?)?,
+            Some(crate::parser::Value::Ref(_)) => m.direction(&m.param_ref(ax, ap, 2)?)?,
             _ => Vector3::z(),
         };
         // The profile's radial direction: from its control points (a profile entirely on the
@@ -475,12 +474,20 @@ fn bspline_surface(m: &Model<'_>, inst: &Instance) -> Result<NurbsSurface> {
     let du = int(inst, head.first(), "u_degree")?;
     let dv = int(inst, head.get(1), "v_degree")?;
     let rows = list(inst, head.get(2), "control_points_list")?;
+    let count: usize = rows
+        .iter()
+        .map(|r| match r {
+            Value::List(l) => l.len(),
+            _ => 1,
+        })
+        .sum();
+    m.charge(inst, Charge::SurfacePoints, count)?;
     let mut net = Vec::with_capacity(rows.len());
     for (a, row) in rows.iter().enumerate() {
         let ids = refs(inst, Some(row), &format!("control_points_list[{a}]"))?;
         net.push(
             ids.into_iter()
-                .map(|id| m.point(m.get(inst, id)?))
+                .map(|id| m.point(&m.get(inst, id)?))
                 .collect::<Result<Vec<_>>>()?,
         );
     }

@@ -145,8 +145,8 @@ pub(crate) struct DiscretizeArgs {
     #[arg(value_name = "CURVES.json")]
     pub(crate) curves: PathBuf,
 
-    /// Chord tolerance in mm: every segment's chord error is at most this.
-    #[arg(short, long, default_value_t = 0.01, value_name = "MM", value_parser = crate::guard::length_mm)]
+    /// Chord tolerance in mm (> 0, at most 10): every segment's chord error is at most this.
+    #[arg(short, long, default_value_t = 0.01, value_name = "MM", value_parser = crate::guard::tolerance_mm)]
     pub(crate) tolerance: f64,
 
     /// Output kerf.toolpath/1 file (`-` for standard output). Default: `<input stem>.toolpath.json`
@@ -160,11 +160,11 @@ pub(crate) struct DiscretizeArgs {
     pub(crate) band: Option<f64>,
 
     /// Longest chord allowed, in mm (machines limit block length).
-    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::segment_length_mm)]
     pub(crate) max_segment_length: Option<f64>,
 
     /// Shortest sphere radius the search proposes, in mm (the tolerance still wins).
-    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::segment_length_mm)]
     pub(crate) min_segment_length: Option<f64>,
 
     /// Most cutting points per curve (default 50,000,000); a curve that needs more is refused
@@ -188,12 +188,12 @@ pub(crate) struct DiscretizeArgs {
 
     /// With --normals: a cutting point farther than this from its surface is an error (mm,
     /// default 0.01).
-    #[arg(long, value_name = "MM", requires = "normals", value_parser = crate::guard::length_mm)]
+    #[arg(long, value_name = "MM", requires = "normals", value_parser = crate::guard::tolerance_mm)]
     pub(crate) on_surface_tolerance: Option<f64>,
 
     /// With --normals: the largest angle between neighbouring normals; points are inserted
     /// until it holds (degrees, default 1).
-    #[arg(long, value_name = "DEG", requires = "normals", value_parser = crate::guard::angle_deg)]
+    #[arg(long, value_name = "DEG", requires = "normals", value_parser = crate::guard::normal_step_deg)]
     pub(crate) max_normal_step: Option<f64>,
 
     /// With --normals, for meshes: faces meeting at more than this angle form a sharp edge
@@ -253,7 +253,7 @@ pub(crate) struct PostArgs {
 
     /// Largest tool-tip deviation from the straight segment while the axes move linearly, in
     /// mm (default 0.005).
-    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::tolerance_mm)]
     pub(crate) linearization_tolerance: Option<f64>,
 
     /// Largest rotary-axis move between two points, in degrees (default: no limit).
@@ -300,26 +300,26 @@ pub(crate) struct MotionArgs {
     pub(crate) cycle: f64,
 
     /// Arc-fit tolerance, mm (default: the toolpath's tolerance, else 0.001).
-    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::tolerance_mm)]
     pub(crate) fit_tolerance: Option<f64>,
 
     /// Chord error allowed between two set-points on an arc, mm (caps the feed on small
     /// radii; default 0.001).
-    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::tolerance_mm)]
     pub(crate) chord_tolerance: Option<f64>,
 
     /// Between two contours the head backs off this far along the tool axis, traverses, and
-    /// approaches the next start along its tool axis (mm; 0 = one straight rapid at cutting
-    /// height). Choose it so that the traverse clears the part.
-    #[arg(long, default_value_t = 10.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
+    /// approaches the next start along its tool axis (mm, 0 to 1000; 0 = one straight rapid at
+    /// cutting height). Choose it so that the traverse clears the part.
+    #[arg(long, default_value_t = 10.0, value_name = "MM", value_parser = crate::guard::retract_mm)]
     pub(crate) retract: f64,
 
     /// The traverses between cuts: > 0 runs each through the waypoints the axes file records
     /// for it (its `traverse` key, checked by `kerf run` to keep this clearance from the part),
     /// as `kerf run`'s own program does; 0 = the unchecked retract and straight traverse
     /// everywhere. The axes file's traverses were planned for the clearance `kerf run` was
-    /// given: without the part's surfaces they cannot be planned again here (mm).
-    #[arg(long, default_value_t = 5.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
+    /// given: without the part's surfaces they cannot be planned again here (mm, 0 to 1000).
+    #[arg(long, default_value_t = 5.0, value_name = "MM", value_parser = crate::guard::clearance_mm)]
     pub(crate) clearance: f64,
 
     /// The kerf.curves/1 file a toolpath input was made from: every segment is certified
@@ -364,9 +364,9 @@ pub(crate) struct GcodeArgs {
     #[arg(long, value_enum, default_value_t = DialectArg::Generic)]
     pub(crate) dialect: DialectArg,
 
-    /// The controller's blending tolerance, mm: a term of the tolerance budget (LinuxCNC
-    /// `G64 P`, Sinumerik `CTOL`/`OTOL`).
-    #[arg(long, default_value_t = kerf_interp::DEFAULT_BLEND_TOLERANCE, value_name = "MM")]
+    /// The controller's blending tolerance, mm (> 0, at most 10): a term of the tolerance budget
+    /// (LinuxCNC `G64 P`, Sinumerik `CTOL`/`OTOL`).
+    #[arg(long, default_value_t = kerf_interp::DEFAULT_BLEND_TOLERANCE, value_name = "MM", value_parser = crate::guard::blend_tolerance_mm)]
     pub(crate) blend_tolerance: f64,
 
     /// Print the summary as one JSON object.
@@ -414,8 +414,8 @@ pub(crate) struct RunArgs {
     #[arg(short, long, value_name = "MACHINE.json")]
     pub(crate) machine: PathBuf,
 
-    /// Chord tolerance in mm (every segment's chord error is at most this).
-    #[arg(short, long, default_value_t = 0.01, value_name = "MM", value_parser = crate::guard::length_mm)]
+    /// Chord tolerance in mm (> 0, at most 10; every segment's chord error is at most this).
+    #[arg(short, long, default_value_t = 0.01, value_name = "MM", value_parser = crate::guard::tolerance_mm)]
     pub(crate) tolerance: f64,
 
     /// Output directory (created if needed).
@@ -434,21 +434,21 @@ pub(crate) struct RunArgs {
     #[arg(long, value_enum, default_value_t = DialectArg::Generic)]
     pub(crate) dialect: DialectArg,
 
-    /// The controller's blending tolerance, mm: a term of the tolerance budget (LinuxCNC
-    /// `G64 P`, Sinumerik `CTOL`/`OTOL`).
-    #[arg(long, default_value_t = kerf_interp::DEFAULT_BLEND_TOLERANCE, value_name = "MM")]
+    /// The controller's blending tolerance, mm (> 0, at most 10): a term of the tolerance budget
+    /// (LinuxCNC `G64 P`, Sinumerik `CTOL`/`OTOL`).
+    #[arg(long, default_value_t = kerf_interp::DEFAULT_BLEND_TOLERANCE, value_name = "MM", value_parser = crate::guard::blend_tolerance_mm)]
     pub(crate) blend_tolerance: f64,
 
     /// Longest chord allowed, in mm.
-    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::segment_length_mm)]
     pub(crate) max_segment_length: Option<f64>,
 
     /// Largest angle between neighbouring normals, degrees (default 1).
-    #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
+    #[arg(long, value_name = "DEG", value_parser = crate::guard::normal_step_deg)]
     pub(crate) max_normal_step: Option<f64>,
 
     /// Largest tool-tip deviation while the axes move linearly, mm (default 0.005).
-    #[arg(long, value_name = "MM", value_parser = crate::guard::length_mm)]
+    #[arg(long, value_name = "MM", value_parser = crate::guard::tolerance_mm)]
     pub(crate) linearization_tolerance: Option<f64>,
 
     /// Largest rotary-axis move between two points, degrees (default: no limit).
@@ -469,35 +469,35 @@ pub(crate) struct RunArgs {
     pub(crate) place: Option<kerf_pipeline::PlaceMode>,
 
     /// Between two contours the head backs off this far along the tool axis, traverses, and
-    /// approaches the next start along its tool axis (mm; 0 = one straight rapid at cutting
-    /// height). Choose it so that the traverse clears the part.
-    #[arg(long, default_value_t = 10.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
+    /// approaches the next start along its tool axis (mm, 0 to 1000; 0 = one straight rapid at
+    /// cutting height). Choose it so that the traverse clears the part.
+    #[arg(long, default_value_t = 10.0, value_name = "MM", value_parser = crate::guard::retract_mm)]
     pub(crate) retract: f64,
 
     /// No traverse between cuts comes closer than this to the part's surfaces (the tool tip
     /// and a 20 mm nozzle along the tool axis, checked against the NURBS and mesh surfaces
     /// as the machine runs its rapids); the travel is lifted over the part where the straight
-    /// one is not clear (mm; 0 = the unchecked retract and straight traverse).
-    #[arg(long, default_value_t = 5.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
+    /// one is not clear (mm, 0 to 1000; 0 = the unchecked retract and straight traverse).
+    #[arg(long, default_value_t = 5.0, value_name = "MM", value_parser = crate::guard::clearance_mm)]
     pub(crate) clearance: f64,
 
     /// A contour whose only named surface is a wall at most this wide across it (a hole's or a
     /// slot's wall, the sheet's edge face, named instead of the sheet's face) is cut with the
     /// beam along the wall, through the sheet, and the lead-in on the side the wall's normal
-    /// points to; the report lists them (`placement.walls`). mm; 0 = the wall's normal is the
-    /// tool axis, as for any surface.
-    #[arg(long, default_value_t = 4.0, value_name = "MM", value_parser = crate::guard::distance_mm)]
+    /// points to; the report lists them (`placement.walls`). mm, 0 to 100; 0 = the wall's
+    /// normal is the tool axis, as for any surface.
+    #[arg(long, default_value_t = 4.0, value_name = "MM", value_parser = crate::guard::wall_mm)]
     pub(crate) max_wall: f64,
 
     /// Lead-in of every cut: the straight part from the pierce point, then the radius of the
-    /// quarter arc that joins the contour tangentially on the scrap side, mm (`0,0` pierces on
-    /// the contour). Shrunk where the scrap is smaller (small holes).
-    #[arg(long, value_name = "LINE,RADIUS", default_value = "2,1", value_parser = parse_pair)]
+    /// quarter arc that joins the contour tangentially on the scrap side, mm, each 0 to 1000
+    /// (`0,0` pierces on the contour). Shrunk where the scrap is smaller (small holes).
+    #[arg(long, value_name = "LINE,RADIUS", default_value = "2,1", value_parser = crate::guard::lead_in)]
     pub(crate) lead_in: (f64, f64),
 
     /// Lead-out: how far the cut runs on past its start on a closed contour, then the exit
-    /// into the scrap, mm.
-    #[arg(long, value_name = "OVERCUT,EXIT", default_value = "0.5,1", value_parser = parse_pair)]
+    /// into the scrap, mm, each 0 to 1000.
+    #[arg(long, value_name = "OVERCUT,EXIT", default_value = "0.5,1", value_parser = crate::guard::lead_out)]
     pub(crate) lead_out: (f64, f64),
 
     /// Print the report as JSON on standard output.
@@ -507,23 +507,6 @@ pub(crate) struct RunArgs {
     /// Print no summary.
     #[arg(short, long)]
     pub(crate) quiet: bool,
-}
-
-/// `A,B`: two finite lengths in mm, each in [0, 1000].
-fn parse_pair(text: &str) -> Result<(f64, f64), String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let [a, b] = parts.as_slice() else {
-        return Err(format!("expected two values A,B in mm, got {text:?}"));
-    };
-    let num = |v: &str| -> Result<f64, String> {
-        let x: f64 = v.parse().map_err(|_| format!("not a number: {v:?}"))?;
-        if x.is_finite() && (0.0..=1000.0).contains(&x) {
-            Ok(x)
-        } else {
-            Err(format!("{v} mm is outside [0, 1000]"))
-        }
-    };
-    Ok((num(a)?, num(b)?))
 }
 
 impl RunArgs {

@@ -1,110 +1,181 @@
 //! Guards of the command line: value parsers that turn an option out of range into a usage
-//! error (exit 2, from clap, naming the option), and the refusal to write an output over an
-//! input.
+//! error (exit 2, from clap, naming the option, the value and the range), and the refusal to
+//! write an output over an input.
 //!
-//! The ranges, in one place:
+//! The ranges, in one place: those of the options a job or the motion stage takes are
+//! `kerf_pipeline::ranges` (which `JobOptions::validate` and `MotionOptions::validate` apply to
+//! library callers too); the others are the command line's own, below. Every numeric option
+//! has a finite upper end: a value above it is never a real job, and used to be accepted and
+//! then misbehave quietly (issue 35: `--clearance 2e4` left every traverse unchecked).
 //!
 //! | kind | range | options |
 //! |---|---|---|
-//! | length | finite, > 0 mm | `--tolerance`, `--max-segment-length`, `--min-segment-length`, `--on-surface-tolerance`, `--linearization-tolerance`, `--fit-tolerance`, `--chord-tolerance` |
-//! | distance | finite, >= 0 mm | `--retract` |
-//! | fraction | 0 < x < 1 | `--band` |
-//! | angle | 0 < x <= 180 degrees | `--max-turn`, `--max-normal-step`, `--crease-angle`, `--max-rotary-step` |
-//! | small angle | 0 < x <= 0.1 rad | `--pole-tolerance` |
-//! | feed | 0 < x <= 1,000,000 mm/min | `--feed` |
-//! | cycle | 1e-5 s <= x <= 0.1 s | `--cycle` (10 microseconds to 100 milliseconds: every real interpolator; `1e9` would collapse the path into one step) |
-//! | samples | 2 <= n <= 10,000 (`kerf_check::MAX_SAMPLES`) | `kerf check --samples` (the work is samples x spans x segments: 1,000,000 took 47 s on a 700-segment toolpath) |
+//! | tolerance | `0 < x <= 10` mm | `--tolerance`, `--on-surface-tolerance`, `--linearization-tolerance`, `--fit-tolerance`, `--chord-tolerance` |
+//! | blending | `0 < x <= 10` mm | `--blend-tolerance` |
+//! | segment | `0 < x <= 1e4` mm | `--max-segment-length`, `--min-segment-length` |
+//! | retract | `0 <= x <= 1000` mm | `--retract` |
+//! | clearance | `0 <= x <= 1000` mm (0: unchecked traverses) | `--clearance` |
+//! | lead | `0 <= x <= 1000` mm, each of the pair | `--lead-in LINE,RADIUS`, `--lead-out OVERCUT,EXIT` |
+//! | wall | `0 <= x <= 100` mm | `--max-wall` |
+//! | feed | `0 < x <= 1e6` mm/min | `--feed` |
+//! | cycle | `1e-5 <= x <= 0.1` s | `--cycle` (10 microseconds to 100 milliseconds: every real interpolator; `1e9` would collapse the path into one step) |
+//! | fraction | `0 < x < 1` | `--band` |
+//! | angle | `0 < x <= 180` degrees | `--max-turn`, `--crease-angle`, `--max-rotary-step` |
+//! | normal step | `0 < x < 180` degrees | `--max-normal-step` (the normals stage needs a step below a half turn) |
+//! | small angle | `0 < x <= 0.1` rad | `--pole-tolerance` |
+//! | STEP gaps | `0 <= x <= 10` mm | `--close-gaps` (0: close none) |
+//! | STEP faces | `0 < x <= 10` mm | `--face-tolerance` |
+//! | samples | `2 <= n <= 10,000` (`kerf_check::MAX_SAMPLES`) | `kerf check --samples` (the work is samples x spans x segments: 1,000,000 took 47 s on a 700-segment toolpath) |
+//! | points | `2 <= n <= 1e9` | `--max-points`, `--max-total-points` |
+//! | placement | each value finite, `abs <= 1e7` | `--place X,Y,Z[,RX,RY,RZ]` (`kerf_kinematics::Placement::parse`) |
 
 use std::path::Path;
 
+use kerf_pipeline::ranges::{self, OptionRange};
+
 use crate::error::CliError;
 
-fn number(s: &str) -> Result<f64, String> {
+/// `s` as a number within `range` (NaN and infinities never are); `-0` reads as 0.
+fn within(s: &str, range: OptionRange) -> Result<f64, String> {
     let v: f64 = s
         .trim()
         .parse()
         .map_err(|_| format!("{s:?} is not a number"))?;
-    if !v.is_finite() {
-        return Err(format!("{s} is not a finite number"));
+    if range.contains(v) {
+        Ok(v + 0.0)
+    } else {
+        Err(range.refusal(v))
     }
-    Ok(v)
 }
 
-/// A length in mm: finite and > 0.
-pub(crate) fn length_mm(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if v <= 0.0 {
-        return Err(format!("must be > 0 mm (got {v})"));
+/// A range of the command line's own, with no note.
+const fn own(
+    min: f64,
+    min_included: bool,
+    max: f64,
+    max_included: bool,
+    unit: &'static str,
+) -> OptionRange {
+    OptionRange {
+        min,
+        min_included,
+        max,
+        max_included,
+        unit,
+        why: "",
     }
-    Ok(v)
 }
 
-/// A distance in mm: finite and >= 0.
-pub(crate) fn distance_mm(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if v < 0.0 {
-        return Err(format!("must be >= 0 mm (got {v})"));
-    }
-    Ok(v + 0.0)
+/// `--clearance`: the job's range, and 0 for unchecked traverses.
+pub(crate) const CLEARANCE_MM: OptionRange = OptionRange {
+    min_included: true,
+    ..ranges::CLEARANCE_MM
+};
+/// `--band`.
+const FRACTION: OptionRange = own(0.0, false, 1.0, false, "");
+/// `--max-turn`, `--crease-angle`, `--max-rotary-step`.
+const ANGLE_DEG: OptionRange = own(0.0, false, 180.0, true, "degrees");
+/// `--max-normal-step`: the normals stage needs a step below a half turn.
+const NORMAL_STEP_DEG: OptionRange = own(0.0, false, 180.0, false, "degrees");
+/// `--pole-tolerance` (0.1 rad is 5.7 degrees).
+const POLE_RAD: OptionRange = own(0.0, false, 0.1, true, "rad");
+/// `--close-gaps` of a STEP import: a gap of more than 10 mm between two segments is no
+/// modelling slack but an opening.
+pub(crate) const CLOSE_GAPS_MM: OptionRange = own(0.0, true, 10.0, true, "mm");
+/// `--face-tolerance` of a STEP import.
+pub(crate) const FACE_TOLERANCE_MM: OptionRange = own(0.0, false, 10.0, true, "mm");
+
+/// A tolerance in mm ([`ranges::TOLERANCE_MM`]).
+pub(crate) fn tolerance_mm(s: &str) -> Result<f64, String> {
+    within(s, ranges::TOLERANCE_MM)
+}
+
+/// The controller's blending tolerance in mm ([`ranges::BLEND_TOLERANCE_MM`]).
+pub(crate) fn blend_tolerance_mm(s: &str) -> Result<f64, String> {
+    within(s, ranges::BLEND_TOLERANCE_MM)
+}
+
+/// A segment length in mm ([`ranges::SEGMENT_LENGTH_MM`]).
+pub(crate) fn segment_length_mm(s: &str) -> Result<f64, String> {
+    within(s, ranges::SEGMENT_LENGTH_MM)
+}
+
+/// The retract in mm ([`ranges::RETRACT_MM`]).
+pub(crate) fn retract_mm(s: &str) -> Result<f64, String> {
+    within(s, ranges::RETRACT_MM)
+}
+
+/// The traverses' clearance in mm ([`CLEARANCE_MM`]).
+pub(crate) fn clearance_mm(s: &str) -> Result<f64, String> {
+    within(s, CLEARANCE_MM)
+}
+
+/// The widest wall cut along itself, mm ([`ranges::WALL_MM`]).
+pub(crate) fn wall_mm(s: &str) -> Result<f64, String> {
+    within(s, ranges::WALL_MM)
+}
+
+/// `A,B`: two lengths of a lead in mm, each in [`ranges::LEAD_MM`], named `names`.
+fn lead_pair(text: &str, names: [&str; 2]) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [a, b] = parts.as_slice() else {
+        return Err(format!(
+            "expected two values {},{} in mm, got {text:?}",
+            names[0], names[1]
+        ));
+    };
+    let one = |name: &str, v: &str| within(v, ranges::LEAD_MM).map_err(|e| format!("{name}: {e}"));
+    Ok((one(names[0], a)?, one(names[1], b)?))
+}
+
+/// `--lead-in LINE,RADIUS`.
+pub(crate) fn lead_in(text: &str) -> Result<(f64, f64), String> {
+    lead_pair(text, ["LINE", "RADIUS"])
+}
+
+/// `--lead-out OVERCUT,EXIT`.
+pub(crate) fn lead_out(text: &str) -> Result<(f64, f64), String> {
+    lead_pair(text, ["OVERCUT", "EXIT"])
 }
 
 /// A fraction strictly between 0 and 1.
 pub(crate) fn fraction(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if !(v > 0.0 && v < 1.0) {
-        return Err(format!("must be between 0 and 1, both excluded (got {v})"));
-    }
-    Ok(v)
+    within(s, FRACTION)
 }
 
 /// An angle in degrees: 0 < x <= 180.
 pub(crate) fn angle_deg(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if !(v > 0.0 && v <= 180.0) {
-        return Err(format!("must be > 0 and <= 180 degrees (got {v})"));
-    }
-    Ok(v)
+    within(s, ANGLE_DEG)
+}
+
+/// The largest angle between neighbouring normals, degrees: 0 < x < 180.
+pub(crate) fn normal_step_deg(s: &str) -> Result<f64, String> {
+    within(s, NORMAL_STEP_DEG)
 }
 
 /// A small angle in radians: 0 < x <= 0.1.
 pub(crate) fn small_angle_rad(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if !(v > 0.0 && v <= 0.1) {
-        return Err(format!(
-            "must be > 0 and <= 0.1 rad (5.7 degrees) (got {v})"
-        ));
-    }
-    Ok(v)
+    within(s, POLE_RAD)
 }
 
-/// The largest programmed feed, mm/min (16.7 m/s: above any laser cutting machine).
-pub(crate) const MAX_FEED_MM_PER_MIN: f64 = 1e6;
-
-/// A feed in mm/min: 0 < x <= [`MAX_FEED_MM_PER_MIN`].
+/// A feed in mm/min ([`ranges::FEED_MM_PER_MIN`]).
 pub(crate) fn feed_mm_per_min(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if !(v > 0.0 && v <= MAX_FEED_MM_PER_MIN) {
-        return Err(format!(
-            "must be > 0 and <= {MAX_FEED_MM_PER_MIN:e} mm/min (got {v})"
-        ));
-    }
-    Ok(v)
+    within(s, ranges::FEED_MM_PER_MIN)
 }
 
-/// The shortest and longest interpolation cycle, s.
-pub(crate) const CYCLE_RANGE_S: (f64, f64) = (1e-5, 0.1);
-
-/// An interpolation cycle in seconds, within [`CYCLE_RANGE_S`].
+/// An interpolation cycle in seconds ([`ranges::CYCLE_S`]).
 pub(crate) fn cycle_s(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    let (lo, hi) = CYCLE_RANGE_S;
-    if !(lo..=hi).contains(&v) {
-        return Err(format!(
-            "must be between {lo:e} s and {hi} s (10 microseconds to 100 milliseconds, the \
-             range of real interpolators; got {v} s)"
-        ));
-    }
-    Ok(v)
+    within(s, ranges::CYCLE_S)
+}
+
+/// `--close-gaps` of a STEP import, mm ([`CLOSE_GAPS_MM`]).
+pub(crate) fn close_gaps_mm(s: &str) -> Result<f64, String> {
+    within(s, CLOSE_GAPS_MM)
+}
+
+/// `--face-tolerance` of a STEP import, mm ([`FACE_TOLERANCE_MM`]).
+pub(crate) fn face_tolerance_mm(s: &str) -> Result<f64, String> {
+    within(s, FACE_TOLERANCE_MM)
 }
 
 /// A sample count for `kerf check`: 2 to [`kerf_check::MAX_SAMPLES`].
@@ -149,12 +220,13 @@ mod tests {
 
     #[test]
     fn parsers_accept_their_range_and_refuse_the_rest() {
-        assert_eq!(length_mm("0.01"), Ok(0.01), "length");
-        for bad in ["0", "-1", "nan", "inf", "1e400", "x", ""] {
-            assert!(length_mm(bad).is_err(), "length {bad:?}");
+        assert_eq!(tolerance_mm("0.01"), Ok(0.01), "tolerance");
+        for bad in ["0", "-1", "nan", "inf", "1e400", "x", "", "10.5", "1e300"] {
+            assert!(tolerance_mm(bad).is_err(), "tolerance {bad:?}");
         }
-        assert_eq!(distance_mm("0"), Ok(0.0), "zero retract");
-        assert!(distance_mm("-0.1").is_err(), "negative retract");
+        assert_eq!(retract_mm("0"), Ok(0.0), "zero retract");
+        assert_eq!(retract_mm("-0"), Ok(0.0), "-0 reads as 0");
+        assert!(retract_mm("-0.1").is_err(), "negative retract");
         assert!(
             fraction("1").is_err() && fraction("0").is_err(),
             "open interval"
@@ -165,6 +237,11 @@ mod tests {
             angle_deg("181").is_err() && angle_deg("0").is_err(),
             "angle range"
         );
+        assert!(
+            normal_step_deg("180").is_err(),
+            "the normal step is below a half turn"
+        );
+        assert_eq!(normal_step_deg("179.9"), Ok(179.9), "normal step");
         assert!(small_angle_rad("0.2").is_err(), "pole tolerance");
         assert_eq!(cycle_s("0.001"), Ok(0.001), "1 ms");
         assert_eq!(cycle_s("1e-5"), Ok(1e-5), "lower end");
@@ -174,6 +251,44 @@ mod tests {
             feed_mm_per_min("0").is_err() && feed_mm_per_min("1e7").is_err(),
             "feed"
         );
+        // Issue 35: every length has an upper end, stated with the value.
+        assert_eq!(clearance_mm("0"), Ok(0.0), "0: unchecked traverses");
+        assert_eq!(clearance_mm("1000"), Ok(1000.0), "the largest clearance");
+        assert_eq!(
+            clearance_mm("2e4"),
+            Err("must be between 0 mm and 1000 mm (got 2e4)".to_owned()),
+            "clearance"
+        );
+        assert!(retract_mm("1e5").is_err(), "retract");
+        assert!(wall_mm("100").is_ok() && wall_mm("1000").is_err(), "wall");
+        assert!(
+            segment_length_mm("1e4").is_ok() && segment_length_mm("1e300").is_err(),
+            "segment"
+        );
+        assert!(
+            blend_tolerance_mm("0.001").is_ok()
+                && blend_tolerance_mm("0").is_err()
+                && blend_tolerance_mm("-1").is_err()
+                && blend_tolerance_mm("nan").is_err()
+                && blend_tolerance_mm("1e300").is_err(),
+            "blend"
+        );
+        assert_eq!(lead_in("2,1"), Ok((2.0, 1.0)), "lead-in");
+        assert_eq!(
+            lead_out("0.5,2000"),
+            Err("EXIT: must be between 0 mm and 1000 mm (got 2000)".to_owned()),
+            "lead-out"
+        );
+        assert!(
+            lead_in("2").is_err() && lead_in("2,-1").is_err(),
+            "lead shape"
+        );
+        assert_eq!(close_gaps_mm("0"), Ok(0.0), "close no gap");
+        for bad in ["-1", "nan", "inf", "11"] {
+            assert!(close_gaps_mm(bad).is_err(), "close gaps {bad}");
+            assert!(face_tolerance_mm(bad).is_err(), "face tolerance {bad}");
+        }
+        assert!(face_tolerance_mm("0").is_err(), "a face tolerance is > 0");
         assert_eq!(samples("64"), Ok(64), "samples");
         // The review's --samples 1000000 took 47 s on a 700-segment toolpath.
         assert_eq!(samples("10000"), Ok(10_000), "the largest");

@@ -23,13 +23,14 @@ pub(crate) struct StepArgs {
     #[arg(long, value_delimiter = ',', value_name = "ID,...", requires = "edges")]
     pub(crate) faces: Vec<String>,
 
-    /// STEP: close gaps between a contour's segments up to this (mm) by moving the shared pole;
-    /// larger gaps open the contour.
-    #[arg(long, default_value_t = 0.1, value_name = "MM")]
+    /// STEP: close gaps between a contour's segments up to this (mm, 0 to 10) by moving the
+    /// shared pole; larger gaps open the contour.
+    #[arg(long, default_value_t = 0.1, value_name = "MM", value_parser = crate::guard::close_gaps_mm)]
     pub(crate) close_gaps: f64,
 
-    /// STEP: a contour lies on the faces within this distance (mm) of every dense sample.
-    #[arg(long, default_value_t = 0.01, value_name = "MM")]
+    /// STEP: a contour lies on the faces within this distance (mm, > 0, at most 10) of every
+    /// dense sample.
+    #[arg(long, default_value_t = 0.01, value_name = "MM", value_parser = crate::guard::face_tolerance_mm)]
     pub(crate) face_tolerance: f64,
 
     /// STEP: write every face read as a surface, not only those a contour lies on.
@@ -69,7 +70,25 @@ pub(crate) fn is_step(path: &Path) -> bool {
         .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "step" | "stp" | "p21"))
 }
 
+/// The import options the arguments ask for. The numbers were checked by their parsers
+/// (`crate::guard`: a usage error, exit 2, before the file is read); a defensive check here
+/// keeps a `StepArgs` built otherwise to the same ranges.
 fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
+    for (option, range, v) in [
+        ("--close-gaps", crate::guard::CLOSE_GAPS_MM, a.close_gaps),
+        (
+            "--face-tolerance",
+            crate::guard::FACE_TOLERANCE_MM,
+            a.face_tolerance,
+        ),
+    ] {
+        if !range.contains(v) {
+            return Err(CliError::Usage(format!(
+                "invalid value for {option}: {}",
+                range.refusal(v)
+            )));
+        }
+    }
     let mut o = ImportOptions::default()
         .with_close_gaps_mm(a.close_gaps)
         .with_face_tolerance_mm(a.face_tolerance)
@@ -83,7 +102,7 @@ fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
                     .trim_start_matches('#')
                     .parse::<u64>()
                     .map_err(|_| {
-                        CliError::Input(format!(
+                        CliError::Usage(format!(
                             "--faces: {s:?} is not an entity number like 120 or #120"
                         ))
                     })

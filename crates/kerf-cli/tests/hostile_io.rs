@@ -149,6 +149,227 @@ fn option_values_out_of_range_are_usage_errors_naming_the_option() {
     );
 }
 
+/// Issue 35: `--clearance 2e4` was accepted (exit 0) and left every traverse unchecked, while
+/// other values out of range were usage errors. Every numeric option has an upper end: above
+/// it (and below the lower end, and not finite) the value is a usage error, exit 2, naming the
+/// option, the value and the range, before any input is read. The ranges are
+/// `kerf_pipeline::ranges` and `crate::guard` of the binary.
+#[test]
+fn every_numeric_option_has_an_upper_end_and_says_its_range() {
+    let circle = fixture("circle.json");
+    let axes = bad("axes_bom.json");
+    let m = fixture(MACHINE);
+    let step = fixture("step/composite_mm.step");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    let c = circle.to_str().expect("UTF-8");
+    let a = axes.to_str().expect("UTF-8");
+    let mm = m.to_str().expect("UTF-8");
+    let st = step.to_str().expect("UTF-8");
+    let o = out.to_str().expect("UTF-8");
+    let whole: Vec<&str> = vec!["run", c, "-m", mm, "--out", o, "-q"];
+    let whole_step: Vec<&str> = vec!["run", st, "-m", mm, "--out", o, "-q"];
+    let disc: Vec<&str> = vec!["discretize", c, "-o", o, "-q"];
+    let post: Vec<&str> = vec!["post", a, "-m", mm, "-o", o, "-q"];
+    let gcode: Vec<&str> = vec!["gcode", a, "-m", mm, "-f", "1000", "-o", o, "-q"];
+    let interp: Vec<&str> = vec!["interpolate", a, "-m", mm, "-f", "1000", "-q"];
+    let import: Vec<&str> = vec!["import", st, "-o", o, "-q"];
+    // (command, option=value, the range the message states)
+    let cases: Vec<(&Vec<&str>, &str, &str)> = vec![
+        (
+            &whole,
+            "--clearance=2e4",
+            "must be between 0 mm and 1000 mm (got 2e4)",
+        ),
+        (
+            &whole,
+            "--clearance=1e300",
+            "must be between 0 mm and 1000 mm (got 1e300)",
+        ),
+        (
+            &gcode,
+            "--clearance=2e4",
+            "must be between 0 mm and 1000 mm (got 2e4)",
+        ),
+        (
+            &whole,
+            "--retract=1e5",
+            "must be between 0 mm and 1000 mm (got 1e5)",
+        ),
+        (
+            &interp,
+            "--retract=1e5",
+            "must be between 0 mm and 1000 mm (got 1e5)",
+        ),
+        (
+            &whole,
+            "--max-wall=1000",
+            "must be between 0 mm and 100 mm (got 1000",
+        ),
+        (
+            &whole,
+            "--tolerance=1e300",
+            "must be > 0 mm and <= 10 mm (got 1e300)",
+        ),
+        (
+            &disc,
+            "--tolerance=11",
+            "must be > 0 mm and <= 10 mm (got 11)",
+        ),
+        (
+            &whole,
+            "--feed=2e6",
+            "must be > 0 mm/min and <= 1e6 mm/min (got 2e6",
+        ),
+        (
+            &whole,
+            "--cycle=1",
+            "must be between 1e-5 s and 0.1 s (got 1",
+        ),
+        (
+            &whole,
+            "--blend-tolerance=-1",
+            "must be > 0 mm and <= 10 mm (got -1)",
+        ),
+        (
+            &gcode,
+            "--blend-tolerance=1e300",
+            "must be > 0 mm and <= 10 mm (got 1e300)",
+        ),
+        (
+            &gcode,
+            "--blend-tolerance=nan",
+            "must be > 0 mm and <= 10 mm (got NaN)",
+        ),
+        (
+            &whole,
+            "--max-segment-length=1e300",
+            "must be > 0 mm and <= 1e4 mm (got 1e300)",
+        ),
+        (
+            &disc,
+            "--min-segment-length=1e5",
+            "must be > 0 mm and <= 1e4 mm (got 1e5)",
+        ),
+        (
+            &whole,
+            "--linearization-tolerance=100",
+            "must be > 0 mm and <= 10 mm (got 100)",
+        ),
+        (
+            &post,
+            "--linearization-tolerance=100",
+            "must be > 0 mm and <= 10 mm (got 100)",
+        ),
+        (
+            &gcode,
+            "--fit-tolerance=100",
+            "must be > 0 mm and <= 10 mm (got 100)",
+        ),
+        (
+            &interp,
+            "--chord-tolerance=100",
+            "must be > 0 mm and <= 10 mm (got 100)",
+        ),
+        (
+            &whole,
+            "--lead-in=2,2000",
+            "RADIUS: must be between 0 mm and 1000 mm (got 2000)",
+        ),
+        (
+            &whole,
+            "--lead-out=1e9,1",
+            "OVERCUT: must be between 0 mm and 1000 mm (got 1e9)",
+        ),
+        // The normals stage needs a step below a half turn: 180 used to pass the command line
+        // and fail the stage (exit 1).
+        (
+            &whole,
+            "--max-normal-step=180",
+            "must be > 0 degrees and < 180 degrees (got 180)",
+        ),
+        (
+            &whole,
+            "--max-rotary-step=1000",
+            "must be > 0 degrees and <= 180 degrees (got 1000)",
+        ),
+        (
+            &post,
+            "--pole-tolerance=1",
+            "must be > 0 rad and <= 0.1 rad (got 1)",
+        ),
+        // STEP options were checked by the reader (exit 1); now by the command line, for
+        // `import` and for `run` on a STEP file alike.
+        (
+            &import,
+            "--close-gaps=-1",
+            "must be between 0 mm and 10 mm (got -1)",
+        ),
+        (
+            &import,
+            "--close-gaps=inf",
+            "must be between 0 mm and 10 mm (got inf)",
+        ),
+        (
+            &import,
+            "--close-gaps=11",
+            "must be between 0 mm and 10 mm (got 11)",
+        ),
+        (
+            &import,
+            "--face-tolerance=nan",
+            "must be > 0 mm and <= 10 mm (got NaN)",
+        ),
+        (
+            &import,
+            "--face-tolerance=20",
+            "must be > 0 mm and <= 10 mm (got 20)",
+        ),
+        (
+            &whole_step,
+            "--face-tolerance=-0.1",
+            "must be > 0 mm and <= 10 mm (got -0.1)",
+        ),
+        (
+            &whole_step,
+            "--close-gaps=1e9",
+            "must be between 0 mm and 10 mm (got 1e9)",
+        ),
+    ];
+    for (command, arg, range) in cases {
+        let (option, value) = arg.split_once('=').expect("OPTION=VALUE");
+        let (code, _, err) = run(kerf().args(command).arg(arg));
+        assert_eq!(
+            code, 2,
+            "{command:?} {arg}: a usage error, got {code}: {err}"
+        );
+        assert!(
+            err.contains(&format!("invalid value '{value}' for '{option} ")),
+            "{arg}: names the option and the value: {err}"
+        );
+        assert!(
+            err.contains(range),
+            "{arg}: states the range {range:?}: {err}"
+        );
+        assert!(!out.exists(), "{arg}: nothing written");
+    }
+    // `--faces` that is not an entity number is a usage error too.
+    let (code, _, err) = run(kerf().args(&import).args(["--edges", "--faces", "abc"]));
+    assert_eq!(code, 2, "--faces abc: {err}");
+    assert!(err.contains("--faces: \"abc\""), "{err}");
+    // The ends of the ranges are accepted.
+    for arg in [
+        "--tolerance=10",
+        "--blend-tolerance=10",
+        "--max-wall=100",
+        "--clearance=0",
+        "--max-normal-step=179",
+    ] {
+        let (code, _, err) = run(kerf().args(&whole).arg(arg));
+        assert_eq!(code, 0, "{arg}: {err}");
+    }
+}
+
 #[test]
 fn an_output_that_is_an_input_is_refused_and_the_input_kept() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -458,4 +679,39 @@ fn a_long_set_points_csv_streams_in_bounded_memory() {
         "one row per 1 ms cycle over 1200 s: {rows}"
     );
     assert!(text.starts_with("t,X,Y,Z,A,C\n"), "header");
+}
+
+/// Issue 35: a beam code of 5 MB was accepted and would be written into every cut. Each line
+/// of a process code is at most 255 characters (LinuxCNC's longest line): the machine is
+/// refused with the key, the count and the limit, and the message does not quote the line.
+#[test]
+fn a_beam_code_of_megabytes_is_refused_by_name() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut machine: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(fixture(MACHINE)).expect("read")).expect("JSON");
+    let huge = format!("M64 P{}", "0".repeat(5_000_000 - 5));
+    machine["process"] = serde_json::json!({ "beam_on": [huge] });
+    let m = dir.path().join("machine.json");
+    fs::write(&m, machine.to_string()).expect("write");
+    let out = dir.path().join("out");
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(fixture("circle.json"))
+        .arg("-m")
+        .arg(&m)
+        .arg("--out")
+        .arg(&out)
+        .arg("-q"));
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("process.beam_on[0]: 5000000 characters, at most 255"),
+        "{}",
+        &err[..err.len().min(500)]
+    );
+    assert!(
+        err.len() < 1000,
+        "the line is not quoted: {} bytes",
+        err.len()
+    );
+    assert!(!out.exists(), "nothing written");
 }

@@ -15,15 +15,24 @@ use kerf_nurbs::counted;
 use kerf_nurbs::NurbsCurve;
 use kerf_nurbs::SPLITS_PER_SPAN;
 
+/// The curves of a fixture, as the discretizer's library callers may build them: every
+/// valid NURBS curve, through the raw layer (the reader also refuses curves that are points,
+/// `kerf_format::curves::is_a_point`, which `hostile_coincident.json` holds on purpose).
 fn fixture(name: &str) -> Vec<(String, NurbsCurve)> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../fixtures")
         .join(name);
-    kerf_format::curves::load(&path)
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+    kerf_format::curves::raw_from_slice(&bytes)
         .unwrap_or_else(|e| panic!("{name}: {e}"))
         .curves
         .into_iter()
-        .map(|r| (r.id, r.curve))
+        .map(|r| {
+            let points = r.control_points.iter().map(|&p| p.into()).collect();
+            let c = NurbsCurve::try_new(r.degree, r.knots, points, r.weights)
+                .unwrap_or_else(|e| panic!("{name}: {}: {e}", r.id));
+            (r.id, c)
+        })
         .collect()
 }
 

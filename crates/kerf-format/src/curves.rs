@@ -600,14 +600,14 @@ fn from_slice(bytes: &[u8], base_dir: &Path) -> Result<CurvesFile> {
 /// `base_dir`.
 ///
 /// Checks, in this order, stopping at the first defect: `format` and `units`; each curve (id,
-/// then the NURBS data); each surface (id, then its geometry); each curve's `surface`
-/// reference.
+/// then the NURBS data, then that it is not a point: [`is_a_point`]); each surface (id, then
+/// its geometry); each curve's `surface` reference.
 ///
 /// # Errors
 /// [`FormatError::UnsupportedFormat`], [`FormatError::UnsupportedUnits`],
 /// [`FormatError::EmptyId`], [`FormatError::UnsafeText`], [`FormatError::DuplicateId`], [`FormatError::Curve`],
-/// [`FormatError::Surface`], [`FormatError::Mesh`], [`FormatError::Stl`] or
-/// [`FormatError::UnknownSurface`].
+/// [`FormatError::PointCurve`], [`FormatError::Surface`], [`FormatError::Mesh`],
+/// [`FormatError::Stl`] or [`FormatError::UnknownSurface`].
 pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
     let units = json::check_header(&raw.format, &raw.units, CURVES_FORMAT)?;
 
@@ -618,6 +618,9 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
         let points = c.control_points.iter().map(|&p| Point3::from(p)).collect();
         let curve = NurbsCurve::try_new(c.degree, c.knots, points, c.weights)
             .map_err(|error| FormatError::Curve { index, error })?;
+        if is_a_point(&curve) {
+            return Err(FormatError::PointCurve { index, id: c.id });
+        }
         let named = c.surface.as_ref().map(SurfaceRef::ids).unwrap_or_default();
         if matches!(&c.surface, Some(SurfaceRef::Many(v)) if v.is_empty()) {
             return Err(FormatError::Shape {
@@ -722,6 +725,28 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
         surfaces,
         warnings: Vec::new(),
     })
+}
+
+pub use crate::error::POINT_CURVE;
+
+/// The smallest control-point spread, mm, that is a contour wherever the coordinates are
+/// small; see [`is_a_point`].
+pub const POINT_SPREAD_MM: f64 = 1e-12;
+
+/// Whether `curve` is a point, not a contour: the diagonal of its control points' bounding
+/// box ([`NurbsCurve::size`]; the curve lies in that box) is at most
+/// `max(POINT_SPREAD_MM, 16 eps m)`, where `m` is the largest magnitude of any control point's
+/// coordinate and `eps = 2^-52` ([`f64::EPSILON`]). The second term is the round-off of the
+/// coordinates themselves (16 units in the last place of the largest): control points that
+/// differ by less than that differ by how they were computed, not by geometry. A curve whose
+/// control points are not all at one place has a length, however small: a circle of radius
+/// 1e-8 mm is a contour (its box is 2.8e-8 mm across) anywhere within 1e6 mm (a kilometre) of
+/// the origin. A non-finite box (impossible for a checked curve) is not called a point.
+pub fn is_a_point(curve: &NurbsCurve) -> bool {
+    let (lo, hi) = curve.bounding_box();
+    let m = lo.coords.amax().max(hi.coords.amax());
+    let spread = POINT_SPREAD_MM.max(16.0 * f64::EPSILON * m);
+    spread.is_finite() && curve.size() <= spread
 }
 
 /// Checks an inline mesh: finite vertices, indices in range, no repeated corner, at least one

@@ -159,6 +159,18 @@ pub enum FormatError {
         /// What is wrong with it; its message starts with the field (`knots[5]: ...`).
         error: NurbsError,
     },
+    /// Every control point of curve `index` lies at one place (`curves::is_a_point`):
+    /// the curve is a point, with no length and no side, and a cut of it would be only its
+    /// lead-in and lead-out (or nothing at all). Fix: remove the curve, or give it the control
+    /// points of the contour it was meant to be (a unit mistake can shrink a real contour to
+    /// this).
+    #[error("curves[{index}] ({id:?}): {}", POINT_CURVE)]
+    PointCurve {
+        /// Index of the curve.
+        index: usize,
+        /// Its id.
+        id: String,
+    },
     /// The data of surface `index` (of type `nurbs`) does not make a valid NURBS surface.
     /// Fix: see the [`NurbsError`] in the message.
     #[error("surfaces[{index}].{error}")]
@@ -441,3 +453,7 @@ pub(crate) fn json_type_name(value: &serde_json::Value) -> &'static str {
         Value::Object(_) => "an object",
     }
 }
+
+/// What [`FormatError::PointCurve`] says of a curve that `curves::is_a_point` finds: the same words for a
+/// file and for a curve built in code (`kerf_pipeline::Job::validate`).
+pub const POINT_CURVE: &str = "all control points coincide: a point, not a contour";

@@ -93,7 +93,8 @@ pub struct Machine {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Process {
     /// Program lines that switch the beam on, written as given (e.g. `["M64 P0"]`); never
-    /// empty, each line non-empty, printable, without `;` or parentheses (they would start a
+    /// empty, at most [`MAX_PROCESS_LINES`] lines of at most [`MAX_PROCESS_LINE_CHARS`]
+    /// characters, each line non-empty, printable, without `;` or parentheses (they would start a
     /// comment in some dialects), and only process words ([`process_line_defect`]): no motion,
     /// feed, tool or program-flow word can enter a program through them.
     pub beam_on: Option<Vec<String>>,
@@ -107,6 +108,15 @@ pub struct Process {
     /// height with the beam on.
     pub pierce_standoff: Option<f64>,
 }
+
+/// The longest program line of a process code (`beam_on`, `beam_off`), characters: the
+/// longest line LinuxCNC reads (255). A code is written as given into every cut of every
+/// program, so its length is bounded like any other input: a 5 MB line was accepted before.
+pub const MAX_PROCESS_LINE_CHARS: usize = 255;
+
+/// The most program lines of one process code (`beam_on`, `beam_off`): switching a beam takes
+/// a few output words; the list is written at every cut.
+pub const MAX_PROCESS_LINES: usize = 64;
 
 /// The longest pierce dwell a machine file may ask for, s: thick plate pierces in seconds; a
 /// minute is beyond any process and keeps the program's timing meaningful.
@@ -230,8 +240,22 @@ impl Process {
                     "must list at least one program line",
                 ));
             }
+            if lines.len() > MAX_PROCESS_LINES {
+                return Err(KinematicsError::doc(
+                    format!("process.{key}"),
+                    format!("{} lines, at most {MAX_PROCESS_LINES}", lines.len()),
+                ));
+            }
             for (i, line) in lines.iter().enumerate() {
                 let path = format!("process.{key}[{i}]");
+                // First, so that no later message quotes a huge line.
+                let chars = line.chars().count();
+                if chars > MAX_PROCESS_LINE_CHARS {
+                    return Err(KinematicsError::doc(
+                        path,
+                        format!("{chars} characters, at most {MAX_PROCESS_LINE_CHARS}"),
+                    ));
+                }
                 if line.trim().is_empty() {
                     return Err(KinematicsError::doc(path, "must not be empty"));
                 }

@@ -99,3 +99,58 @@ fn bad_process_values_are_named_errors() {
         assert_eq!(e.to_string(), want, "{process}");
     }
 }
+
+/// Issue 35: a 5 MB beam code was accepted and written into every cut. Each line is at most
+/// `MAX_PROCESS_LINE_CHARS` (LinuxCNC's longest line), each list at most `MAX_PROCESS_LINES`;
+/// the refusal names the key and the count, never quotes the line.
+#[test]
+fn process_codes_have_a_length_limit() {
+    use kerf_kinematics::{MAX_PROCESS_LINES, MAX_PROCESS_LINE_CHARS};
+    assert_eq!(
+        (MAX_PROCESS_LINE_CHARS, MAX_PROCESS_LINES),
+        (255, 64),
+        "limits"
+    );
+    // The longest allowed line: an M word with a long parameter list is still a process line.
+    let longest = format!("M64 P{}", "0".repeat(MAX_PROCESS_LINE_CHARS - 5));
+    assert_eq!(longest.len(), MAX_PROCESS_LINE_CHARS, "at the limit");
+    Machine::from_str(&machine(&format!(
+        r#", "process": {{"beam_on": [{longest:?}]}}"#
+    )))
+    .expect("a line of 255 characters");
+    let huge = format!("M64 P{}", "0".repeat(5_000_000 - 5));
+    let cases = [
+        (
+            format!(r#"{{"beam_on": [{huge:?}]}}"#),
+            "process.beam_on[0]: 5000000 characters, at most 255".to_owned(),
+        ),
+        (
+            format!(r#"{{"beam_off": ["M65 P0", "{longest}0"]}}"#),
+            "process.beam_off[1]: 256 characters, at most 255".to_owned(),
+        ),
+        (
+            format!(
+                r#"{{"beam_on": [{}]}}"#,
+                vec![r#""M64 P0""#; 100_000].join(",")
+            ),
+            "process.beam_on: 100000 lines, at most 64".to_owned(),
+        ),
+    ];
+    for (process, want) in cases {
+        let e = Machine::from_str(&machine(&format!(r#", "process": {process}"#)))
+            .expect_err("too long");
+        assert_eq!(e.to_string(), want, "message");
+    }
+    // A process built in code is held to the same limits (`Process::validate`, which the
+    // G-code writer runs too).
+    let p = Process {
+        beam_off: Some(vec!["M5".to_owned(); MAX_PROCESS_LINES + 1]),
+        ..Process::default()
+    };
+    let e = p.validate().expect_err("65 lines");
+    assert_eq!(
+        e.to_string(),
+        "process.beam_off: 65 lines, at most 64",
+        "built in code"
+    );
+}

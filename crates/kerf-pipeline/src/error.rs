@@ -18,6 +18,18 @@ pub enum Error {
     /// A discretizer option is out of range; nothing was computed. Fix: the option named.
     #[error(transparent)]
     Options(kerf_discretize::DiscretizeError),
+    /// An option of the job or of the motion stage lies outside its documented range
+    /// ([`crate::ranges`]): `option feed_mm_per_min: must be > 0 mm/min and <= 1e6 mm/min (got
+    /// 2e6; ...)`. Nothing was computed. Fix: a value within the range the message states.
+    #[error("option {name}: {requirement}")]
+    BadOption {
+        /// The option, as its field is named (`traverse.clearance_mm`).
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// The range and the value: `must be > 0 mm and <= 1000 mm (got 2e4)`.
+        requirement: String,
+    },
     /// A curve could not be discretized (too many points for the tolerance, a tolerance below
     /// the precision of the curve's coordinates, the work budget). Fix: the tolerance or
     /// `max_points`.

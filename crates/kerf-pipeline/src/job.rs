@@ -237,6 +237,71 @@ impl JobOptions {
         self.traverse = traverse;
         self
     }
+
+    /// Checks every option against its documented range ([`crate::ranges`]) and the stages'
+    /// own checks, before any work ([`Job::validate`] runs it, and so [`Job::run`]): the
+    /// discretizer's ([`Options::validate`]), the chord tolerance and the segment lengths, the
+    /// on-surface and linearization tolerances (the kinematics' [`PathOptions::validate`];
+    /// an infinite linearization tolerance, no points inserted, stays allowed), the feed, the
+    /// cycle, the blending tolerance, the retract, the wall width, the leads (and
+    /// [`LeadOptions::validate`]) and the traverse checks' clearance (and
+    /// [`kerf_process::TraverseOptions::validate`], with the retract raised to
+    /// [`JobOptions::retract_mm`] as the run does). Out of range used to mean quiet
+    /// misbehaviour: a clearance of 2e4 mm failed every traverse's check, and every traverse
+    /// fell back to the unchecked straight rapid with only a warning.
+    ///
+    /// # Errors
+    /// [`Error::BadOption`] naming the option, its value and its range; [`Error::Options`],
+    /// [`Error::Kinematics`] or [`Error::Process`] for what a stage's own check refuses.
+    pub fn validate(&self) -> Result<()> {
+        use crate::ranges::{
+            BLEND_TOLERANCE_MM, CLEARANCE_MM, CYCLE_S, FEED_MM_PER_MIN, LEAD_MM, RETRACT_MM,
+            SEGMENT_LENGTH_MM, TOLERANCE_MM, WALL_MM,
+        };
+        let process = |source| Error::Process { file: None, source };
+        let d = &self.discretize;
+        d.validate().map_err(Error::Options)?;
+        TOLERANCE_MM.check("tolerance_mm", d.tolerance_mm)?;
+        if d.max_segment_length_mm.is_finite() {
+            SEGMENT_LENGTH_MM.check("max_segment_length_mm", d.max_segment_length_mm)?;
+        }
+        if d.min_segment_length_mm > 0.0 {
+            SEGMENT_LENGTH_MM.check("min_segment_length_mm", d.min_segment_length_mm)?;
+        }
+        TOLERANCE_MM.check(
+            "on_surface_tolerance_mm",
+            self.orient.normals.on_surface_tolerance_mm,
+        )?;
+        self.path.validate()?;
+        if self.path.linearization_tolerance_mm.is_finite() {
+            TOLERANCE_MM.check(
+                "linearization_tolerance_mm",
+                self.path.linearization_tolerance_mm,
+            )?;
+        }
+        FEED_MM_PER_MIN.check("feed_mm_per_min", self.feed_mm_per_min)?;
+        CYCLE_S.check("cycle_s", self.cycle_s)?;
+        BLEND_TOLERANCE_MM.check("blend_tolerance_mm", self.blend_tolerance_mm)?;
+        RETRACT_MM.check("retract_mm", self.retract_mm)?;
+        WALL_MM.check("wall_axis_max_mm", self.wall_axis_max_mm)?;
+        let l = &self.leads;
+        for (name, v) in [
+            ("leads.lead_in_mm", l.lead_in_mm),
+            ("leads.lead_in_radius_mm", l.lead_in_radius_mm),
+            ("leads.overcut_mm", l.overcut_mm),
+            ("leads.lead_out_mm", l.lead_out_mm),
+        ] {
+            LEAD_MM.check(name, v)?;
+        }
+        l.validate().map_err(process)?;
+        if let Some(t) = self.traverse {
+            CLEARANCE_MM.check("traverse.clearance_mm", t.clearance_mm)?;
+            // As the run uses them: never a shorter retract than `retract_mm`.
+            let t = t.with_retract_mm(t.retract_mm.max(self.retract_mm));
+            t.validate().map_err(process)?;
+        }
+        Ok(())
+    }
 }
 
 /// A job: the curves (with their surfaces), the machine and the options of every stage.
@@ -325,12 +390,17 @@ impl Job {
         self
     }
 
-    /// Checks what the reader checks of a file but a model built in code may lack: at least
-    /// one curve, unique ids without control characters, every surface named present.
+    /// Checks the options ([`JobOptions::validate`]), then what the reader checks of a file
+    /// but a model built in code may lack: at least one curve, unique ids without control
+    /// characters, no curve that is a point ([`kerf_format::curves::is_a_point`]: all its
+    /// control points at one place; it would be cut as a slit of its lead-in and lead-out),
+    /// every surface named present. [`Job::run`] runs it first.
     ///
     /// # Errors
-    /// [`Error::NoCurves`], [`Error::Invalid`], [`Error::UnknownSurface`].
+    /// As [`JobOptions::validate`]; [`Error::NoCurves`], [`Error::Invalid`],
+    /// [`Error::UnknownSurface`].
     pub fn validate(&self) -> Result<()> {
+        self.options.validate()?;
         let file = || self.source.clone();
         if self.curves.curves.is_empty() {
             return Err(Error::NoCurves { file: file() });
@@ -363,6 +433,15 @@ impl Job {
                     "a second {} with this id",
                     &list[..list.len() - 1]
                 )));
+            }
+        }
+        for (i, c) in self.curves.curves.iter().enumerate() {
+            if kerf_format::curves::is_a_point(&c.curve) {
+                return Err(Error::Invalid {
+                    file: file(),
+                    place: format!("curves[{i}] ({:?})", c.id),
+                    message: kerf_format::curves::POINT_CURVE.to_owned(),
+                });
             }
         }
         for (i, c) in self.curves.curves.iter().enumerate() {

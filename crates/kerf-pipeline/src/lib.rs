@@ -43,6 +43,7 @@ mod motion;
 mod output;
 mod place;
 mod post;
+pub mod ranges;
 mod run;
 
 pub use certify::CertifiedToolpath;
@@ -56,6 +57,7 @@ pub use motion::{fit_options, path_report, plan_program, MotionInput, MotionOpti
 pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};
 pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};
 pub use post::{post_toolpath, toolpath_poses, MissingNormals, Posted};
+pub use ranges::OptionRange;
 
 /// A stage of a job, as [`Progress`] reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

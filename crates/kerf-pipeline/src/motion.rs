@@ -176,6 +176,29 @@ impl MotionOptions {
         self.recorded_traverses = recorded;
         self
     }
+
+    /// Checks every option against its documented range ([`crate::ranges`]): the feed, the
+    /// cycle, the arc-fit and set-point chord tolerances (when given), the retract and the
+    /// blending tolerance. [`plan_program`] runs it before any work.
+    ///
+    /// # Errors
+    /// [`Error::BadOption`] naming the option, its value and its range.
+    pub fn validate(&self) -> Result<()> {
+        use crate::ranges::{
+            BLEND_TOLERANCE_MM, CYCLE_S, FEED_MM_PER_MIN, RETRACT_MM, TOLERANCE_MM,
+        };
+        FEED_MM_PER_MIN.check("feed_mm_per_min", self.feed_mm_per_min)?;
+        CYCLE_S.check("cycle_s", self.cycle_s)?;
+        if let Some(v) = self.fit_tolerance_mm {
+            TOLERANCE_MM.check("fit_tolerance_mm", v)?;
+        }
+        if let Some(v) = self.chord_tolerance_mm {
+            TOLERANCE_MM.check("chord_tolerance_mm", v)?;
+        }
+        RETRACT_MM.check("retract_mm", self.retract_mm)?;
+        BLEND_TOLERANCE_MM.check("blend_tolerance_mm", self.blend_tolerance_mm)?;
+        Ok(())
+    }
 }
 
 /// A planned program: the machine model, the path ids and the motion, with what it was
@@ -204,14 +227,16 @@ pub struct Program {
 /// file in errors and in the program's comments.
 ///
 /// # Errors
-/// [`Error::Kinematics`] for a machine or path that cannot be solved, [`Error::Interp`] for
-/// options out of range or a path the interpolator refuses.
+/// [`Error::BadOption`] for options out of their range ([`MotionOptions::validate`]),
+/// [`Error::Kinematics`] for a machine or path that cannot be solved, [`Error::Interp`] for a
+/// path the interpolator refuses.
 pub fn plan_program(
     machine: &Machine,
     input: &MotionInput,
     options: &MotionOptions,
     source: Option<&Path>,
 ) -> Result<Program> {
+    options.validate()?;
     let model = MachineModel::new(machine.clone()).map_err(interp(source))?;
     let mut linearization = None;
     let mut traverses: Vec<Vec<kerf_interp::Station>> = Vec::new();

@@ -149,3 +149,150 @@ fn a_tolerance_a_later_curve_cannot_hold_is_refused_before_any_curve_is_walked()
     );
     assert_eq!(done.into_inner(), 0, "no curve walked");
 }
+
+/// Issue 35: options out of their documented range (`kerf_pipeline::ranges`) are refused
+/// before any work with [`Error::BadOption`] naming the option, the value and the range. A
+/// clearance of 2e4 mm used to fail every traverse's own check, so that every traverse fell
+/// back to the unchecked straight rapid with only a warning.
+#[test]
+fn job_options_out_of_range_are_refused_before_any_work() {
+    use kerf_pipeline::JobOptions;
+    use kerf_process::{LeadOptions, TraverseOptions};
+    let d = JobOptions::default();
+    d.validate().expect("the defaults are in range");
+    let cases: Vec<(JobOptions, &str, &str)> = vec![
+        (
+            d.clone()
+                .with_traverse(Some(TraverseOptions::default().with_clearance(2e4))),
+            "traverse.clearance_mm",
+            "option traverse.clearance_mm: must be > 0 mm and <= 1000 mm (got 2e4)",
+        ),
+        (
+            d.clone().with_retract_mm(1e5),
+            "retract_mm",
+            "option retract_mm: must be between 0 mm and 1000 mm (got 1e5)",
+        ),
+        (
+            d.clone().with_feed_mm_per_min(2e6),
+            "feed_mm_per_min",
+            "option feed_mm_per_min: must be > 0 mm/min and <= 1e6 mm/min (got 2e6; 16.7 m/s, above any laser cutting machine)",
+        ),
+        (
+            d.clone().with_cycle_s(1e9),
+            "cycle_s",
+            "option cycle_s: must be between 1e-5 s and 0.1 s (got 1e9; 10 microseconds to 100 milliseconds, the range of real interpolators)",
+        ),
+        (
+            d.clone().with_blend_tolerance_mm(f64::NAN),
+            "blend_tolerance_mm",
+            "option blend_tolerance_mm: must be > 0 mm and <= 10 mm (got NaN)",
+        ),
+        (
+            d.clone().with_wall_axis_max_mm(1000.0),
+            "wall_axis_max_mm",
+            "option wall_axis_max_mm: must be between 0 mm and 100 mm (got 1000; a wall through the sheet is as wide as the sheet is thick)",
+        ),
+        (
+            d.clone().with_tolerance_mm(1e300),
+            "tolerance_mm",
+            "option tolerance_mm: must be > 0 mm and <= 10 mm (got 1e300)",
+        ),
+        (
+            d.clone()
+                .with_leads(LeadOptions::default().with_lead_in(2.0, 2000.0)),
+            "leads.lead_in_radius_mm",
+            "option leads.lead_in_radius_mm: must be between 0 mm and 1000 mm (got 2000)",
+        ),
+    ];
+    for (options, name, message) in cases {
+        let e = options.validate().expect_err(name);
+        assert!(
+            matches!(&e, Error::BadOption { name: n, .. } if *n == name),
+            "{name}: {e:?}"
+        );
+        assert_eq!(e.to_string(), message, "{name}");
+        // Job::run refuses them before the first stage, whatever the curves.
+        let job = Job::on_machine(machine())
+            .with_curve(
+                "c",
+                kerf_nurbs::NurbsCurve::circle(Point3::origin(), Vector3::z(), 50.0)
+                    .expect("circle"),
+                None,
+            )
+            .with_options(options);
+        let e = job.run().expect_err(name);
+        assert_eq!(e.to_string(), message, "{name}: through run");
+    }
+    // A stage's own check is run up front too: a retract below 1.25 times the clearance.
+    let e = d
+        .clone()
+        .with_retract_mm(0.0)
+        .with_traverse(Some(TraverseOptions::default().with_retract_mm(1.0)))
+        .validate()
+        .expect_err("retract below the clearance");
+    assert!(
+        matches!(&e, Error::Process { .. }) && e.to_string().contains("retract_mm"),
+        "{e}"
+    );
+    // An infinite linearization tolerance (insert no points) and no segment limit stay allowed.
+    let mut open = d.clone();
+    open.path.linearization_tolerance_mm = f64::INFINITY;
+    open.discretize.max_segment_length_mm = f64::INFINITY;
+    open.validate().expect("no limits");
+}
+
+/// The motion stage alone checks its options the same way ([`MotionOptions::validate`]).
+#[test]
+fn motion_options_out_of_range_are_refused() {
+    use kerf_pipeline::{plan_program, MotionInput, MotionOptions};
+    let d = MotionOptions::default();
+    d.validate().expect("the defaults are in range");
+    for (options, name) in [
+        (d.with_feed_mm_per_min(2e6), "feed_mm_per_min"),
+        (d.with_cycle_s(0.0), "cycle_s"),
+        (d.with_fit_tolerance_mm(Some(100.0)), "fit_tolerance_mm"),
+        (d.with_chord_tolerance_mm(Some(-1.0)), "chord_tolerance_mm"),
+        (d.with_retract_mm(1e5), "retract_mm"),
+        (d.with_blend_tolerance_mm(1e300), "blend_tolerance_mm"),
+    ] {
+        let e = options.validate().expect_err(name);
+        assert!(
+            matches!(&e, Error::BadOption { name: n, .. } if *n == name),
+            "{name}: {e:?}"
+        );
+        let input = MotionInput::read(fixture("bad/io/axes_bom.json")).expect("axes");
+        let e = plan_program(&machine(), &input, &options, None).expect_err(name);
+        assert!(
+            e.to_string().starts_with(&format!("option {name}: ")),
+            "{e}"
+        );
+    }
+}
+
+/// A curve built in code is held to the reader's rule: a curve whose control points all lie
+/// at one place is a point, refused by index and id before any work
+/// (`kerf_format::curves::is_a_point`), not cut as a slit of its lead-in and lead-out.
+#[test]
+fn a_point_curve_built_in_code_is_refused_by_name() {
+    use kerf_nurbs::NurbsCurve;
+    let p = Point3::new(5.0, 5.0, 0.0);
+    let dot = NurbsCurve::try_new(1, vec![0.0, 0.0, 1.0, 1.0], vec![p, p], None).expect("valid");
+    let circle = NurbsCurve::circle(Point3::origin(), Vector3::z(), 50.0).expect("circle");
+    let job = Job::on_machine(machine())
+        .with_curve("outline", circle, None)
+        .with_curve("dot", dot, None)
+        .with_source("part.json");
+    let e = job.run().expect_err("a point");
+    assert!(matches!(&e, Error::Invalid { .. }), "{e:?}");
+    assert_eq!(
+        e.to_string(),
+        r#"part.json: curves[1] ("dot"): all control points coincide: a point, not a contour"#,
+        "message"
+    );
+    // A tiny real circle is a contour: validation passes (planning it is another issue's).
+    let tiny = NurbsCurve::circle(Point3::origin(), Vector3::z(), 1e-8).expect("circle");
+    Job::on_machine(machine())
+        .with_curve("tiny", tiny, None)
+        .validate()
+        .expect("a circle of radius 1e-8 mm is a contour");
+}

@@ -117,7 +117,13 @@ impl LeadOptions {
         self
     }
 
-    pub(crate) fn validate(&self) -> Result<()> {
+    /// Checks every option: the four lengths of the leads finite and in `[0, 1e4]` mm, the
+    /// arc and closed tolerances, the corner angle and the smallest lead finite and in
+    /// `(0, 1e4]`. [`crate::plan_cuts`] runs it; a caller may run it before any work.
+    ///
+    /// # Errors
+    /// [`ProcessError::BadOption`] naming the first option out of range.
+    pub fn validate(&self) -> Result<()> {
         for (name, v, zero_ok) in [
             ("lead_in_mm", self.lead_in_mm, true),
             ("lead_in_radius_mm", self.lead_in_radius_mm, true),

@@ -170,6 +170,82 @@ fn other_curve_defects_have_paths() {
     }
 }
 
+/// A curve whose control points all lie at one place is a point, not a contour: refused by
+/// index and id (issue 35: it passed `kerf validate` and was cut as a slit of its lead-in and
+/// lead-out, or vanished from the program with leads `0,0`).
+#[test]
+fn a_curve_whose_control_points_coincide_is_refused_as_a_point() {
+    let point = |id: &str, p: &str| {
+        format!(
+            r#"{{"id": "{id}", "degree": 1, "knots": [0, 0, 1, 1], "control_points": [{p}, {p}]}}"#
+        )
+    };
+    let text = doc(
+        &format!(
+            "{}, {}, {}",
+            line("a"),
+            line("b"),
+            point("dot", "[5, 5, 0]")
+        ),
+        "",
+    );
+    assert_eq!(
+        error(&text),
+        r#"curves[2] ("dot"): all control points coincide: a point, not a contour"#,
+        "message"
+    );
+    // A rational cubic with five equal points, and two points one unit in the last place
+    // apart far from the origin (their difference is round-off, not geometry).
+    let cubic = r#"{"id": "c", "degree": 3, "knots": [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
+        "control_points": [[12.5, -3, 7], [12.5, -3, 7], [12.5, -3, 7], [12.5, -3, 7], [12.5, -3, 7]],
+        "weights": [1, 2, 0.5, 1, 3]}"#;
+    let ulp = r#"{"id": "u", "degree": 1, "knots": [0, 0, 1, 1],
+        "control_points": [[1000000, 0, 0], [1000000.0000000001, 0, 0]]}"#;
+    for (curve, id) in [(cubic, "c"), (ulp, "u")] {
+        let e = error(&doc(curve, ""));
+        assert_eq!(e, format!("curves[0] ({id:?}): {POINT_CURVE}"), "{curve}");
+    }
+}
+
+/// The rule's edge: a tiny but real contour is a contour (another issue plans a circle of
+/// radius 1e-8 mm, a unit mistake, rather than refusing it), near the origin and far from it,
+/// and so is a line of 1e-11 mm.
+#[test]
+fn a_tiny_real_contour_is_not_a_point() {
+    for centre in [[0.0, 0.0, 0.0], [1400.0, -250.0, 3.0], [1e6, 1e6, 0.0]] {
+        let c =
+            NurbsCurve::circle(Point3::from(centre), nalgebra::Vector3::z(), 1e-8).expect("circle");
+        assert!(!is_a_point(&c), "radius 1e-8 at {centre:?}");
+    }
+    let short = NurbsCurve::try_new(
+        1,
+        vec![0.0, 0.0, 1.0, 1.0],
+        vec![Point3::origin(), Point3::new(1e-11, 0.0, 0.0)],
+        None,
+    )
+    .expect("line");
+    assert!(!is_a_point(&short), "1e-11 mm near the origin");
+    let dot = NurbsCurve::try_new(
+        1,
+        vec![0.0, 0.0, 1.0, 1.0],
+        vec![Point3::origin(), Point3::new(1e-13, 0.0, 0.0)],
+        None,
+    )
+    .expect("line");
+    assert!(is_a_point(&dot), "1e-13 mm: below POINT_SPREAD_MM");
+    // Through the reader, by id, as `kerf validate` reads it.
+    let text = doc(
+        r#"{"id": "tiny", "degree": 1, "knots": [0, 0, 1, 1],
+            "control_points": [[0, 0, 0], [1e-11, 0, 0]]}"#,
+        "",
+    );
+    assert_eq!(
+        parse(&text).expect("a contour").curves[0].id,
+        "tiny",
+        "read"
+    );
+}
+
 /// JSON text cannot hold NaN or infinity, but raw data built in memory can.
 #[test]
 fn non_finite_values_built_in_memory_are_refused_with_a_path() {

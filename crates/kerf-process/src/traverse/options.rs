@@ -76,14 +76,24 @@ impl TraverseOptions {
         self
     }
 
-    /// With this clearance, mm; the retract becomes 1.5 times it.
+    /// With this clearance, mm; the retract becomes 1.5 times it (so that [`Self::validate`]
+    /// holds, the clearance is at most 1e4 / 1.5 mm; `kerf_pipeline` allows 1000 mm).
     pub fn with_clearance(mut self, clearance_mm: f64) -> Self {
         self.clearance_mm = clearance_mm;
         self.retract_mm = 1.5 * clearance_mm;
         self
     }
 
-    pub(crate) fn validate(&self) -> Result<()> {
+    /// Checks every option: clearance and retract finite, > 0 and <= 1e4 mm with the retract
+    /// at least 1.25 times the clearance, the nozzle in `[0, 1e4]` mm, `up` finite and not
+    /// zero. Every traverse check runs it (and a traverse whose options fail is not checked);
+    /// a caller should run it once before any work, as `kerf_pipeline::JobOptions::validate`
+    /// does, so that options out of range are refused instead of leaving every traverse
+    /// unchecked.
+    ///
+    /// # Errors
+    /// [`ProcessError::BadOption`] naming the first option out of range.
+    pub fn validate(&self) -> Result<()> {
         let check = |name: &'static str, v: f64, ok: bool| {
             if ok {
                 Ok(())

@@ -82,8 +82,8 @@ pub use output::{
     Dialect, GcodeOptions, ProcessCodes,
 };
 pub use plan::{
-    link_paths, link_paths_through, link_paths_with_retract, plan, Cycles, Motion, PathStats,
-    PlanOptions,
+    link_paths, link_paths_through, link_paths_with_retract, plan, plan_owned, Cycles, Motion,
+    PathStats, PlanOptions,
 };
 pub use plan::{ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_FILTER_WIDTH, JERK_STATIC_SHARE};
 #[cfg(feature = "research")]
@@ -151,7 +151,7 @@ pub fn interpolate_through<M: AxisModel + ?Sized>(
         all.push(fit_blocks(model, &p.stations, p.curve, n, fit)?);
     }
     let blocks = plan::link_paths_through(model, all, traverses, fit.retract_mm);
-    plan(model, &blocks, plan_options)
+    plan::plan_owned(model, blocks, plan_options)
 }
 
 /// What `kerf interpolate` does once its inputs are read: [`fit_program`] then [`plan()`].
@@ -167,5 +167,5 @@ pub fn interpolate<M: AxisModel + ?Sized>(
     plan_options: &PlanOptions,
 ) -> Result<Motion> {
     let blocks = fit_program(model, paths, fit)?;
-    plan(model, &blocks, plan_options)
+    plan::plan_owned(model, blocks, plan_options)
 }

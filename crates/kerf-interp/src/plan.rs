@@ -42,7 +42,7 @@ pub use link::{link_paths, link_paths_through, link_paths_with_retract};
 pub use motion::{Cycles, Motion, PathStats};
 
 use assemble::assemble;
-use profile::{run_grid, time_run, RunGrid, Timed};
+use profile::{run_feeds, run_grid, time_run, Timed};
 use verify::{check_ranges, verify};
 
 use crate::block::Block;
@@ -207,6 +207,26 @@ pub fn plan<M: AxisModel + ?Sized>(
     blocks: &[Block],
     opts: &PlanOptions,
 ) -> Result<Motion> {
+    plan_owned(model, blocks.to_vec(), opts)
+}
+
+/// [`plan`] on blocks the caller gives up: they move into the [`Motion`] instead of being
+/// copied (what [`crate::interpolate`] and [`crate::interpolate_through`] do, so that a
+/// program's blocks are held once).
+///
+/// Memory: the planner holds the blocks, the runs' splines and the timed profile of every run
+/// (5 numbers a grid point, which the [`Motion`] keeps for its set-points), one [`Motion`] at a
+/// time; a run's grid constraints (15 numbers a grid point) only while that run is timed (a
+/// refinement rebuilds the grid of each run it touches), and what the refinements lowered only
+/// at the grid points they reached.
+///
+/// # Errors
+/// As [`plan`].
+pub fn plan_owned<M: AxisModel + ?Sized>(
+    model: &M,
+    mut blocks: Vec<Block>,
+    opts: &PlanOptions,
+) -> Result<Motion> {
     opts.validate()?;
     let limits = model.limits();
     limits.validate()?;
@@ -220,11 +240,9 @@ pub fn plan<M: AxisModel + ?Sized>(
             return Err(InterpError::NonFinite { index: bi });
         }
     }
-    let blocks: Vec<Block> = blocks
-        .iter()
-        .filter(|b| b.length() > 0.0)
-        .copied()
-        .collect();
+    blocks.retain(|b| b.length() > 0.0);
+    // Held to the end of the program's life: no room to spare.
+    blocks.shrink_to_fit();
     let names = model.axis_names().map(str::to_string);
     let path = PathOptions {
         rotary_ranges: [limits.range[3], limits.range[4]],
@@ -234,7 +252,7 @@ pub fn plan<M: AxisModel + ?Sized>(
             0.0
         },
     };
-    let runs = runs(&blocks, &path);
+    let mut runs = runs(&blocks, &path);
     let total_len: f64 = runs.iter().map(Run::len).sum();
     // The work budget: a coarser grid for very long programs.
     let step = opts
@@ -260,23 +278,35 @@ pub fn plan<M: AxisModel + ?Sized>(
             .map(|k| JERK_FILTER_WIDTH * acc[k] / j[k])
             .fold(0.0, f64::max)
     });
-    let mut grids: Vec<RunGrid> = runs
-        .iter()
-        .map(|r| run_grid(model, r, step, opts))
-        .collect();
-    let mut timed: Vec<Timed> = grids
-        .iter()
-        .map(|g| time_run(g, acc, limits.max_jerk, tau))
-        .collect();
+    let feed = opts.feed_mm_per_min / 60.0;
+    // Each run's grid, its timed profile and its blocks' `F` words. The grid's constraints
+    // (15 numbers a grid point, three times the profile) are dropped once the run is timed: a
+    // refinement rebuilds the grid of each run it touches (`run_grid` is a function of the run
+    // and the options alone, so the rebuilt grid is the same to the bit) and applies the caps
+    // the refinements lowered, which are kept by grid point for the few points they reached.
+    let mut timed: Vec<Timed> = Vec::with_capacity(runs.len());
+    let mut block_feeds = vec![0.0; blocks.len()];
+    let mut grid_points = 0;
+    for run in &runs {
+        let (s, g) = run_grid(model, run, step, opts);
+        grid_points += s.len();
+        let tm = time_run(s, &g, acc, limits.max_jerk, tau);
+        run_feeds(run, &g, &tm, feed, &mut block_feeds[run.first..=run.last]);
+        timed.push(tm);
+    }
+    // By run, sorted by grid point: the cap on `x` the refinements set there (infinite: none)
+    // and the factor on the accelerations.
+    let mut lowered: Vec<Vec<Lowered>> = vec![Vec::new(); runs.len()];
     let mut refinements = 0;
     loop {
         // Block times, feeds and statistics only when needed (the block clock) or final.
         let full = opts.block_ends_on_cycles;
         let motion = assemble(
-            &blocks,
-            &runs,
-            &grids,
-            timed.clone(),
+            blocks,
+            runs,
+            timed,
+            &block_feeds,
+            grid_points,
             opts,
             &names,
             refinements,
@@ -287,11 +317,18 @@ pub fn plan<M: AxisModel + ?Sized>(
             let motion = if full {
                 motion
             } else {
-                assemble(
-                    &blocks,
-                    &runs,
-                    &grids,
+                let Motion {
+                    blocks,
+                    runs,
                     timed,
+                    ..
+                } = motion;
+                assemble(
+                    blocks,
+                    runs,
+                    timed,
+                    &block_feeds,
+                    grid_points,
                     opts,
                     &names,
                     refinements,
@@ -312,10 +349,9 @@ pub fn plan<M: AxisModel + ?Sized>(
             });
         }
         // Lower the caps of the grid points whose motion the bad cycle sees (the cycle's
-        // stencil and, when filtered, the filter's reach), by the excess and a 2 % margin.
-        let mut touched = vec![false; runs.len()];
-        let mut fxs: Vec<Vec<f64>> = grids.iter().map(|g| vec![1.0; g.s.len()]).collect();
-        let mut fas = fxs.clone();
+        // stencil and, when filtered, the filter's reach), by the excess and a 2 % margin:
+        // `(grid point, factor on x, factor on the accelerations)` by run, for the runs touched.
+        let mut factors: Vec<Vec<(usize, f64, f64)>> = vec![Vec::new(); motion.runs.len()];
         for v in &worst {
             let f = 0.98 / (v.value / v.limit).max(1.0);
             let (fx, fa) = match v.kind {
@@ -332,40 +368,116 @@ pub fn plan<M: AxisModel + ?Sized>(
                 lo = lo.min(bt[b.saturating_sub(1)][0]);
                 hi = hi.max(bt[(b + 1).min(bt.len() - 1)][1]);
             }
-            for (r, tm) in timed.iter().enumerate() {
+            for (r, tm) in motion.timed.iter().enumerate() {
                 let (r0, r1) = (motion.starts[r], motion.starts[r] + tm.duration);
                 if r1 < lo || r0 > hi {
                     continue;
                 }
-                touched[r] = true;
-                let (a, b) = (lo - r0 - tm.tau, hi - r0);
                 let n = tm.t.len();
+                let (a, b) = (lo - r0 - tm.tau, hi - r0);
                 let i0 = tm.t.partition_point(|&t| t < a).saturating_sub(1);
                 let i1 = (tm.t.partition_point(|&t| t <= b) + 1).min(n);
-                for i in i0..i1 {
-                    fxs[r][i] = fxs[r][i].min(fx);
-                    fas[r][i] = fas[r][i].min(fa);
+                if i0 < i1 {
+                    factors[r].extend((i0..i1).map(|i| (i, fx, fa)));
+                } else {
+                    // Touched, nothing lowered: planned again all the same.
+                    factors[r].push((usize::MAX, 1.0, 1.0));
                 }
             }
         }
-        for (r, t) in touched.iter().enumerate() {
-            if *t {
-                // Relative to the profile as planned, so that every refinement changes it.
-                // (The largest x of the point and its neighbours: the rest at a run's end is no
-                // cap.)
-                let g = &mut grids[r];
-                let x = &timed[r].x;
-                let n = x.len();
-                for i in 0..n {
-                    if fxs[r][i] < 1.0 {
-                        let near = x[i.saturating_sub(1)].max(x[i]).max(x[(i + 1).min(n - 1)]);
-                        g.xlim[i] = g.xlim[i].min(near * fxs[r][i]);
-                    }
-                    g.mult_a[i] *= fas[r][i];
+        Motion {
+            blocks,
+            runs,
+            timed,
+            ..
+        } = motion;
+        for (r, mut f) in factors.into_iter().enumerate() {
+            if f.is_empty() {
+                continue;
+            }
+            // The smallest factors of each grid point.
+            f.sort_by_key(|e| e.0);
+            f.dedup_by(|b, a| {
+                if a.0 == b.0 {
+                    a.1 = a.1.min(b.1);
+                    a.2 = a.2.min(b.2);
+                    true
+                } else {
+                    false
                 }
-                timed[r] = time_run(&grids[r], acc, limits.max_jerk, tau);
+            });
+            // Relative to the profile as planned, so that every refinement changes it.
+            // (The largest x of the point and its neighbours: the rest at a run's end is no
+            // cap.)
+            let x = &timed[r].x;
+            let n = x.len();
+            let near = |i: usize| x[i.saturating_sub(1)].max(x[i]).max(x[(i + 1).min(n - 1)]);
+            lowered[r] = merge_lowered(&lowered[r], &f, near);
+            let run = &runs[r];
+            let (_, mut g) = run_grid(model, run, step, opts);
+            for l in &lowered[r] {
+                g.cap[l.point] = g.cap[l.point].min(l.cap);
+                g.mult_a[l.point] = l.mult_a;
+            }
+            let s = std::mem::take(&mut timed[r].s);
+            timed[r] = time_run(s, &g, acc, limits.max_jerk, tau);
+            if !(run.cutting && run.moves_tip) {
+                // A cutting run's `F` words come from the limits alone: unchanged.
+                run_feeds(
+                    run,
+                    &g,
+                    &timed[r],
+                    feed,
+                    &mut block_feeds[run.first..=run.last],
+                );
             }
         }
         refinements += 1;
     }
+}
+
+/// What the refinements set at one grid point of a run: a cap on `x` (infinite: none) and the
+/// factor on the accelerations.
+#[derive(Debug, Clone, Copy)]
+struct Lowered {
+    point: usize,
+    cap: f64,
+    mult_a: f64,
+}
+
+/// `old` (sorted by grid point) with this refinement's factors `new` (sorted, one per grid
+/// point; a point past the grid touches nothing): the cap at a point becomes the smaller of
+/// its cap and `near(point)` times the factor on `x` where that factor is below 1, and its
+/// factor on the accelerations is multiplied by the new one, as the whole-grid refinement
+/// did point by point.
+fn merge_lowered(
+    old: &[Lowered],
+    new: &[(usize, f64, f64)],
+    near: impl Fn(usize) -> f64,
+) -> Vec<Lowered> {
+    let mut out = Vec::with_capacity(old.len() + new.len());
+    let mut a = 0;
+    for &(point, fx, fa) in new.iter().take_while(|e| e.0 != usize::MAX) {
+        while a < old.len() && old[a].point < point {
+            out.push(old[a]);
+            a += 1;
+        }
+        let mut l = if a < old.len() && old[a].point == point {
+            a += 1;
+            old[a - 1]
+        } else {
+            Lowered {
+                point,
+                cap: f64::INFINITY,
+                mult_a: 1.0,
+            }
+        };
+        if fx < 1.0 {
+            l.cap = l.cap.min(near(point) * fx);
+        }
+        l.mult_a *= fa;
+        out.push(l);
+    }
+    out.extend_from_slice(&old[a..]);
+    out
 }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use kerf_discretize::Discretization;
 use kerf_format::toolpath::{self, ToolpathFile};
+use kerf_format::FormatError;
 use kerf_interp::{write_csv_to, AxisModel, MachineModel, Motion};
 use kerf_io::DirEntry;
 use kerf_kinematics::{AxesFile, SolvedPath};
@@ -178,28 +179,45 @@ impl Output {
 
     /// Writes every file ([`Output::file_names`]) into `dir` (created if needed), all or
     /// nothing (through [`kerf_io::write_dir_all_or_nothing`]): a failed write leaves `dir` as
-    /// it was. The set-points are streamed from the plan into their files.
+    /// it was. Nothing is copied on the way: the toolpath, the axes, the report and the
+    /// set-points are streamed into their files (the documents checked first, so that an
+    /// invalid one is refused before any file is written), the program and the picture written
+    /// from the texts held.
     ///
     /// # Errors
-    /// [`Error::Write`] naming the file that failed.
+    /// [`Error::Format`] or [`Error::Kinematics`] for a toolpath or axes document its format
+    /// refuses; [`Error::Write`] naming the file that failed.
     pub fn write_dir(&self, dir: impl AsRef<Path>) -> Result<()> {
         let dir = dir.as_ref();
-        let toolpath_text = toolpath::to_string(&self.toolpath)?;
-        let axes_text = self.axes.to_json()?;
-        let report_text = self.report_text();
-        let text = |s: &str| {
-            let bytes = s.as_bytes().to_vec();
-            Box::new(move |w: &mut dyn std::io::Write| w.write_all(&bytes)) as kerf_io::Contents<'_>
-        };
+        self.toolpath.validate()?;
+        self.axes.validate()?;
+        fn text(s: &str) -> kerf_io::Contents<'_> {
+            Box::new(move |w| w.write_all(s.as_bytes()))
+        }
         let axis_names = self.model.axis_names();
+        let toolpath = &self.toolpath;
+        let axes = &self.axes;
+        let report = &self.report;
         let mut entries = vec![
             DirEntry {
                 name: OUTPUTS[0],
-                contents: text(&toolpath_text),
+                contents: Box::new(move |w| {
+                    toolpath::to_writer(toolpath, w).map_err(|e| match e {
+                        FormatError::Write { error } => error,
+                        e => std::io::Error::other(e),
+                    })
+                }),
             },
             DirEntry {
                 name: OUTPUTS[1],
-                contents: text(&axes_text),
+                contents: Box::new(move |w| {
+                    axes.to_writer(w).map_err(|e| match e {
+                        kerf_kinematics::KinematicsError::Io { source, .. } => {
+                            std::io::Error::new(source.kind(), source.to_string())
+                        }
+                        e => std::io::Error::other(e),
+                    })
+                }),
             },
         ];
         for p in &self.programs {
@@ -218,7 +236,10 @@ impl Output {
         }
         entries.push(DirEntry {
             name: OUTPUTS[4],
-            contents: text(&report_text),
+            // The text of `report_text`, streamed.
+            contents: Box::new(move |w| {
+                serde_json::to_writer_pretty(w, report).map_err(std::io::Error::from)
+            }),
         });
         entries.push(DirEntry {
             name: OUTPUTS[5],

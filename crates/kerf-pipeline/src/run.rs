@@ -9,7 +9,6 @@ use std::time::Instant;
 use kerf_discretize::Discretization;
 use kerf_interp::{
     gcode_motion, stations_from_solved, ChordTerm, MachineModel, Motion, PlanOptions,
-    ProgramPath as InterpPath,
 };
 use kerf_kinematics::{solve_paths, AxesFile, PathCurve, PathInput, Pose};
 use kerf_normals::Oriented;
@@ -112,6 +111,11 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     // outlines, the shortest traverse; in part coordinates, then placed.
     let (cuts, cut_plans) =
         crate::cuts::plan(file, &oriented, &walls, &placed, &starts, &o.leads, path)?;
+    // Memory: what no later stage reads is dropped as soon as it is done with (the poses for
+    // the placement here, the placed cut poses after the kinematics, every path's stations
+    // once its blocks are fitted), so that the plan of the motion, the largest part of a run,
+    // is not made beside them.
+    drop(poses);
     let cut_poses: Vec<Vec<Pose>> = cuts
         .iter()
         .map(|c| {
@@ -141,6 +145,8 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         })
         .collect();
     let solved = solve_paths(machine, &inputs, &popts).map_err(kin(path))?;
+    drop(inputs);
+    drop(cut_poses);
     let mut axes = AxesFile::new(machine, &solved);
     crate::cuts::split_axes(&mut axes, &cuts, &solved);
     // 4. Interpolation and G-code, one program per set-up.
@@ -178,7 +184,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
     let mut warnings: Vec<String> = Vec::new();
     for setup in 0..placed.plan.setups.len() {
-        let mut ipaths = Vec::new();
+        let mut fitted = Vec::new();
         let mut ids: Vec<String> = Vec::new();
         let in_setup: Vec<usize> = (0..solved.len())
             .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
@@ -310,15 +316,18 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                 continue;
             }
             let curve: &(dyn Fn(f64) -> nalgebra::Point3<f64> + Sync) = points[k].as_ref();
-            ipaths.push(InterpPath {
-                id: s.id.clone(),
-                stations: stations_from_solved(s, Some(&cuts[k].params)).map_err(interp(path))?,
-                curve: Some(curve),
-            });
+            // What `kerf_interp::interpolate_through` does, path by path: the stations are
+            // dropped once the path's blocks are fitted.
+            let stations = stations_from_solved(s, Some(&cuts[k].params)).map_err(interp(path))?;
+            fitted.push(
+                kerf_interp::fit_blocks(&model, &stations, Some(curve), fitted.len(), &fit)
+                    .map_err(interp(path))?,
+            );
             ids.push(s.id.clone());
         }
-        let motion = kerf_interp::interpolate_through(&model, &ipaths, &traverses, &fit, &plan)
-            .map_err(interp(path))?;
+        let blocks = kerf_interp::link_paths_through(&model, fitted, &traverses, fit.retract_mm);
+        drop(traverses);
+        let motion = kerf_interp::plan_owned(&model, blocks, &plan).map_err(interp(path))?;
         let mut gopts_k = gopts.clone();
         gopts_k.header = vec![
             format!(
@@ -330,7 +339,9 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
             ),
             "work offset: none; every coordinate is in the machine's workpiece frame with the placement applied: clamp the part there".to_string(),
         ];
-        programs.push(gcode_motion(&model, &motion, &ids, &gopts_k).map_err(interp(path))?);
+        let mut text = gcode_motion(&model, &motion, &ids, &gopts_k).map_err(interp(path))?;
+        text.shrink_to_fit();
+        programs.push(text);
         setup_ids.push(ids);
         motions.push(motion);
     }
@@ -380,7 +391,9 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
             .collect(),
         traverses: plot_traverses,
     });
-    let svg = kerf_plot::render(&scene);
+    let mut svg = kerf_plot::render(&scene);
+    drop(scene);
+    svg.shrink_to_fit();
     let mut counts = motions[0].counts();
     for m in &motions[1..] {
         let c = m.counts();

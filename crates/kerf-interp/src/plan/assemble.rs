@@ -2,20 +2,23 @@
 //! the block clock, statistics.
 
 use super::motion::{BlockClock, Motion, PathStats};
-use super::profile::{RunGrid, Timed};
+use super::profile::Timed;
 use super::PlanOptions;
 use crate::block::Block;
 use crate::error::{InterpError, Result};
 use crate::smooth::Run;
 
 /// Puts the runs' profiles together into a program: start times, block times and feeds, the
-/// block clock, statistics.
+/// block clock, statistics. The blocks, runs and profiles are moved into the [`Motion`], not
+/// copied (a refinement takes them back out); `block_feeds` are the blocks' `F` words before
+/// the modal stretches ([`super::profile::run_feeds`]), `grid_points` the size of the grid.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn assemble(
-    blocks: &[Block],
-    runs: &[Run],
-    grids: &[RunGrid],
+    blocks: Vec<Block>,
+    runs: Vec<Run>,
     timed: Vec<Timed>,
+    block_feeds: &[f64],
+    grid_points: usize,
     opts: &PlanOptions,
     names: &[String; 5],
     refinements: usize,
@@ -42,7 +45,7 @@ pub(super) fn assemble(
         if !full {
             break;
         }
-        let (tm, g) = (&timed[r], &grids[r]);
+        let tm = &timed[r];
         for b in run.first..=run.last {
             let j = b - run.first;
             let (s0, s1) = (run.starts[j], run.starts[j + 1]);
@@ -53,24 +56,8 @@ pub(super) fn assemble(
                 tm.time_of(s1)
             };
             block_times[b] = [starts[r] + t0, starts[r] + t1];
-            let i0 = g.s.partition_point(|&s| s < s0);
-            let i1 = g.s.partition_point(|&s| s <= s1).max(i0 + 1).min(g.s.len());
-            let range = i0.min(g.s.len() - 1)..i1;
-            feeds[b] = if run.cutting && run.moves_tip {
-                let speeds = range.map(|i| g.static_mv[i].sqrt() * g.tip_speed[i]);
-                let (low, best) =
-                    speeds.fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
-                if best >= feed * 0.999 {
-                    feed
-                } else {
-                    low
-                }
-            } else {
-                range
-                    .map(|i| tm.x[i].sqrt() * g.tip_speed[i])
-                    .fold(0.0, f64::max)
-            };
         }
+        feeds[run.first..=run.last].copy_from_slice(&block_feeds[run.first..=run.last]);
         if run.cutting && run.moves_tip {
             modal_feeds(&mut feeds[run.first..=run.last], feed);
         }
@@ -134,14 +121,14 @@ pub(super) fn assemble(
         });
     }
     Ok(Motion {
-        blocks: blocks.to_vec(),
-        runs: runs.to_vec(),
+        blocks,
+        runs,
         timed,
         starts,
         duration,
         cycle: opts.cycle_s,
         refinements,
-        grid_points: grids.iter().map(|g| g.s.len()).sum(),
+        grid_points,
         axis_names: names.clone(),
         block_times,
         feeds,

@@ -1,27 +1,27 @@
-//! The planning grid of one run (its constraints, computed once) and the timed profile
-//! planned on it: the time-optimal `x(s)`, the time of every grid point, and the jerk filter.
+//! The planning grid of one run (its constraints, held while the run is timed) and the timed
+//! profile planned on it: the time-optimal `x(s)`, the time of every grid point, and the jerk
+//! filter.
 
 use super::{PlanOptions, ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_STATIC_SHARE};
 use crate::model::AxisModel;
 use crate::smooth::Run;
 use crate::topp;
 
-/// The grid of one run and its constraints, computed once.
+/// The constraints of one run at its grid points (the grid's `s` itself is [`Timed::s`]):
+/// 15 numbers a grid point (120 bytes, three times the profile), so the planner holds a run's
+/// grid only while it times the run (a refinement rebuilds it).
 #[derive(Debug, Clone)]
 pub(super) struct RunGrid {
-    pub(super) s: Vec<f64>,
     pub(super) d1: Vec<[f64; 5]>,
     pub(super) d2: Vec<[f64; 5]>,
     /// `|tip'(s)|`.
     pub(super) tip_speed: Vec<f64>,
-    /// The static cap on `x` (velocity, feed, chord, jerk).
+    /// The cap on `x`: the static cap (velocity, feed, chord, jerk), lowered by refinements.
     pub(super) cap: Vec<f64>,
-    /// `|q''|` of each axis (for the jerk budget of the path acceleration).
-    pub(super) d2_abs_max: Vec<[f64; 5]>,
-    /// The maximum velocity curve of the limits alone (no refinement): what the `F` words say.
+    /// The maximum velocity curve of the limits alone (no refinement): what the `F` words of
+    /// a cutting run say.
     pub(super) static_mv: Vec<f64>,
-    /// Caps on `x` set by refinements, and factors on the accelerations.
-    pub(super) xlim: Vec<f64>,
+    /// Factors on the accelerations, set by refinements.
     pub(super) mult_a: Vec<f64>,
 }
 
@@ -157,13 +157,14 @@ impl Timed {
 
 /// The grid of one run: nodes subdivided to at most `step`, at least two intervals each, and
 /// at every grid point `q'`, `q''` (and `q'''` for the jerk cap) by central differences of the
-/// machine axes along the smooth path, with the static caps on `x`.
+/// machine axes along the smooth path, with the static caps on `x`: the grid's `s` and its
+/// constraints.
 pub(super) fn run_grid<M: AxisModel + ?Sized>(
     model: &M,
     run: &Run,
     step: f64,
     opts: &PlanOptions,
-) -> RunGrid {
+) -> (Vec<f64>, RunGrid) {
     let lim = model.limits();
     let mut s = Vec::new();
     for w in run.nodes.windows(2) {
@@ -215,7 +216,9 @@ pub(super) fn run_grid<M: AxisModel + ?Sized>(
         }
     }
     first.clear();
-    let s = fine_s;
+    let mut s = fine_s;
+    // Kept in the run's profile for the program's life: no room to spare.
+    s.shrink_to_fit();
     let n = s.len();
     let mut d1 = Vec::with_capacity(n);
     let mut d2 = Vec::with_capacity(n);
@@ -260,30 +263,36 @@ pub(super) fn run_grid<M: AxisModel + ?Sized>(
         tip_speed.push(speed);
         cap.push(x);
     }
-    RunGrid {
-        xlim: vec![f64::INFINITY; n],
-        d2_abs_max: d2.iter().map(|b: &[f64; 5]| b.map(f64::abs)).collect(),
+    let grid = RunGrid {
         static_mv,
         mult_a: vec![1.0; n],
-        s,
         d1,
         d2,
         tip_speed,
         cap,
-    }
+    };
+    (s, grid)
 }
 
-/// Plans one run on its grid (rest to rest) and times it.
-pub(super) fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: f64) -> Timed {
-    let n = g.s.len();
+/// Plans one run on its grid `s` with the constraints `g` (rest to rest) and times it (the
+/// profile keeps `s`).
+pub(super) fn time_run(
+    s: Vec<f64>,
+    g: &RunGrid,
+    acc: [f64; 5],
+    jerk: Option<[f64; 5]>,
+    tau: f64,
+) -> Timed {
+    let n = s.len();
     let mut pts: Vec<topp::Point> = (0..n)
         .map(|i| {
-            let cap = g.cap[i].min(g.xlim[i]);
+            let cap = g.cap[i];
             let mut path_acc = f64::INFINITY;
             if let Some(j) = jerk {
                 let v = cap.sqrt();
                 for k in 0..5 {
-                    let c = 3.0 * g.d2_abs_max[i][k] * v;
+                    // `|q''|` of the axis: the jerk budget of the path acceleration.
+                    let c = 3.0 * g.d2[i][k].abs() * v;
                     if c > 0.0 {
                         path_acc = path_acc.min(JERK_CROSS_SHARE * j[k] / c);
                     }
@@ -305,19 +314,19 @@ pub(super) fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: 
         // the unfiltered optimum (an upper bound of the final speed, so the reach is not too
         // short; measured with the maximum velocity curve instead, a fast straight would drag
         // the slow junction it leads to far back along itself).
-        let (first, _) = topp::solve(&g.s, &pts);
+        let (first, _) = topp::solve(&s, &pts);
         let raw = mv.clone();
         let mut mv = mv;
         for i in 0..n {
             let w = FILTER_REACH * first[i].sqrt() * tau;
             let mut low = raw[i];
             let mut j = i;
-            while j > 0 && g.s[i] - g.s[j - 1] <= w {
+            while j > 0 && s[i] - s[j - 1] <= w {
                 j -= 1;
                 low = low.min(raw[j]);
             }
             let mut j = i;
-            while j + 1 < n && g.s[j + 1] - g.s[i] <= w {
+            while j + 1 < n && s[j + 1] - s[i] <= w {
                 j += 1;
                 low = low.min(raw[j]);
             }
@@ -327,17 +336,17 @@ pub(super) fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: 
             p.cap = p.cap.min(*m);
         }
     }
-    let (mut x, mut u) = topp::solve(&g.s, &pts);
+    let (mut x, mut u) = topp::solve(&s, &pts);
     if let (Some(j), true) = (jerk, tau > 0.0) {
         // Reversals of the path acceleration (a triangular speed profile: accelerating, then
         // at once braking) get a plateau of at least `tau` at their peak, so that the filter
         // never sees the whole reversal in one window (see `reversal_caps`).
-        let caps = reversal_caps(g, &x, &u, j, tau);
+        let caps = reversal_caps(&s, g, &x, &u, j, tau);
         if !caps.is_empty() {
             for (i, c) in caps {
                 pts[i].cap = pts[i].cap.min(c);
             }
-            (x, u) = topp::solve(&g.s, &pts);
+            (x, u) = topp::solve(&s, &pts);
         }
     }
     let mut t = Vec::with_capacity(n);
@@ -347,7 +356,7 @@ pub(super) fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: 
         t.push(tt);
         area.push(aa);
         if i + 1 < n {
-            let d = g.s[i + 1] - g.s[i];
+            let d = s[i + 1] - s[i];
             let den = x[i].sqrt() + x[i + 1].sqrt();
             let dt = if den > 0.0 {
                 2.0 * d / den
@@ -355,18 +364,48 @@ pub(super) fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: 
                 f64::INFINITY
             };
             let v = x[i].sqrt();
-            aa += dt * (g.s[i] + dt * (0.5 * v + dt * u[i] / 6.0));
+            aa += dt * (s[i] + dt * (0.5 * v + dt * u[i] / 6.0));
             tt += dt;
         }
     }
     Timed {
-        s: g.s.clone(),
+        s,
         duration: tt + tau,
         x,
         u,
         t,
         area,
         tau,
+    }
+}
+
+/// The `F` words of the blocks of `run` (`out[j]` for block `run.first + j`), before the stretches
+/// below the programmed feed share their lowest ([`super::assemble::modal_feeds`]): for a
+/// cutting block the programmed feed `feed` (mm/s) if the limits allow it somewhere in the
+/// block, else the lowest tip speed they allow along it; for any other block its planned peak
+/// tip speed. Computed when the run is timed, while its grid is at hand.
+pub(super) fn run_feeds(run: &Run, g: &RunGrid, tm: &Timed, feed: f64, out: &mut [f64]) {
+    let s = &tm.s;
+    for b in run.first..=run.last {
+        let j = b - run.first;
+        let (s0, s1) = (run.starts[j], run.starts[j + 1]);
+        let i0 = s.partition_point(|&v| v < s0);
+        let i1 = s.partition_point(|&v| v <= s1).max(i0 + 1).min(s.len());
+        let range = i0.min(s.len() - 1)..i1;
+        out[j] = if run.cutting && run.moves_tip {
+            let speeds = range.map(|i| g.static_mv[i].sqrt() * g.tip_speed[i]);
+            let (low, best) =
+                speeds.fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
+            if best >= feed * 0.999 {
+                feed
+            } else {
+                low
+            }
+        } else {
+            range
+                .map(|i| tm.x[i].sqrt() * g.tip_speed[i])
+                .fold(0.0, f64::max)
+        };
     }
 }
 
@@ -390,12 +429,19 @@ pub(super) fn time_run(g: &RunGrid, acc: [f64; 5], jerk: Option<[f64; 5]>, tau: 
 /// window, `J_path tau` with `J_path = min_k J_k / |q'_k|` at the peak, within less than `tau`
 /// from the last accelerating to the first braking interval. Valleys need nothing here: they lie
 /// on minima of the maximum velocity curve, which the filter's reach already flattened.
-fn reversal_caps(g: &RunGrid, x: &[f64], u: &[f64], jerk: [f64; 5], tau: f64) -> Vec<(usize, f64)> {
+fn reversal_caps(
+    s: &[f64],
+    g: &RunGrid,
+    x: &[f64],
+    u: &[f64],
+    jerk: [f64; 5],
+    tau: f64,
+) -> Vec<(usize, f64)> {
     let n = x.len();
     let dt = |i: usize| {
         let den = x[i].sqrt() + x[i + 1].sqrt();
         if den > 0.0 {
-            2.0 * (g.s[i + 1] - g.s[i]) / den
+            2.0 * (s[i + 1] - s[i]) / den
         } else {
             f64::INFINITY
         }
@@ -452,7 +498,7 @@ fn reversal_caps(g: &RunGrid, x: &[f64], u: &[f64], jerk: [f64; 5], tau: f64) ->
         };
         let lasts = |c: f64| {
             let (lo, hi) = plateau(c);
-            c > 0.0 && (g.s[hi] - g.s[lo]) >= PLATEAU_MARGIN * tau * c.sqrt()
+            c > 0.0 && (s[hi] - s[lo]) >= PLATEAU_MARGIN * tau * c.sqrt()
         };
         let (mut lo_c, mut hi_c) = (0.0, x[top]);
         if lasts(hi_c) {

@@ -3,7 +3,8 @@
 //! (`fuzz/src/lib.rs`, included here), so that what fuzzing found stays fixed without
 //! libFuzzer or a nightly toolchain. A harness asserts more than "no panic": see its
 //! documentation (round trips, sampled chord error within the tolerance, normals parallel to
-//! the plane's, forward kinematics giving back every pose).
+//! the plane's, forward kinematics giving back every pose, a STEP import accepted only where
+//! the parser accepts and giving a valid curves document).
 
 #[allow(dead_code)]
 #[path = "../fuzz/src/lib.rs"]
@@ -103,4 +104,14 @@ fn kinematics_corpus() {
             harness::kinematics(&case);
         }
     });
+}
+
+#[test]
+fn step_syntax_corpus() {
+    replay("step_syntax", 10, harness::step_syntax);
+}
+
+#[test]
+fn step_import_corpus() {
+    replay("step_import", 10, harness::step_import);
 }

@@ -10,7 +10,12 @@
 //! - normals (a planar curve on a tilted NURBS plane): every normal a unit vector parallel to
 //!   the plane's normal;
 //! - kinematics (a valid machine of every type, poses within 75 degrees of +z): forward
-//!   kinematics of every solved axis set gives back its pose.
+//!   kinematics of every solved axis set gives back its pose;
+//! - STEP (bytes read as lossy UTF-8, as `kerf_step::import_file` does): the Part 21 parser
+//!   alone (`check_syntax`) gives the same verdict with a byte-order mark in front, and no more
+//!   instances than the text could hold; the whole import accepts only what the parser
+//!   accepts (and refuses with the parser's own error what it refuses), and what it accepts is
+//!   a valid `kerf.curves/1` document (`curves::from_raw`) of finite numbers and safe ids.
 #![allow(missing_docs, unreachable_pub)]
 
 use std::path::Path;
@@ -411,5 +416,147 @@ pub fn kinematics(case: &MachineCase) {
             machine.violation(axes, 1e-9).is_none(),
             "poses[{i}]: axes {axes:?} outside the limits"
         );
+    }
+}
+
+/// The Part 21 parser alone: `kerf_step::check_syntax` on the bytes as lossy UTF-8.
+pub fn step_syntax(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let verdict = kerf_step::check_syntax(&text);
+    if let Ok(n) = verdict {
+        // An instance takes at least `#1=` and a `;`.
+        assert!(
+            n.saturating_mul(4) <= text.len(),
+            "{n} instances in {} bytes",
+            text.len()
+        );
+    }
+    // One leading byte-order mark is skipped: the same verdict with one in front.
+    if !text.starts_with('\u{feff}') {
+        let again = kerf_step::check_syntax(&format!("\u{feff}{text}"));
+        match (&verdict, &again) {
+            (Ok(a), Ok(b)) => assert_eq!(a, b, "instance count with a byte-order mark"),
+            (Err(a), Err(b)) => {
+                assert_eq!(a.to_string(), b.to_string(), "error with a byte-order mark")
+            }
+            _ => panic!("a byte-order mark changes the verdict: {verdict:?} then {again:?}"),
+        }
+    }
+}
+
+/// The options of a `step_import` input, chosen by a leading selector byte (removed before
+/// the text is read): `0x01` the boundary loops of every face (`--edges`), `0x02` the
+/// geometric sets with every face written as a surface (`--all-faces`); any other first byte
+/// (a STEP file starts with `I`) is part of the text, read with the default options.
+pub fn step_options(data: &[u8]) -> (kerf_step::ImportOptions, &[u8]) {
+    let defaults = kerf_step::ImportOptions::default();
+    match data.split_first() {
+        Some((1, rest)) => (defaults.with_edges(None), rest),
+        Some((2, rest)) => (defaults.with_all_faces(true), rest),
+        _ => (defaults, data),
+    }
+}
+
+fn finite_weights(what: &str, w: &[f64]) {
+    for (i, x) in w.iter().enumerate() {
+        assert!(
+            x.is_finite() && *x > 0.0,
+            "{what}: weight {i} = {x} is not finite and positive"
+        );
+    }
+}
+
+fn finite(what: &str, values: impl IntoIterator<Item = f64>) {
+    for (i, x) in values.into_iter().enumerate() {
+        assert!(x.is_finite(), "{what}: value {i} = {x} is not finite");
+    }
+}
+
+fn safe_id(what: &str, id: &str) {
+    if let Err(defect) = kerf_io::check_text(id) {
+        panic!("{what} {id:?}: {defect}");
+    }
+}
+
+/// The whole STEP import (`kerf_step::import`), options chosen by [`step_options`].
+pub fn step_import(data: &[u8]) {
+    use kerf_format::curves::{RawSurface, SurfaceRef};
+    use kerf_step::StepError;
+
+    let (opts, body) = step_options(data);
+    let text = String::from_utf8_lossy(body);
+    let syntax = kerf_step::check_syntax(&text);
+    let result = kerf_step::import(&text, &opts);
+    // The import runs the parser first: it accepts only what the parser accepts, refuses with
+    // the parser's error what the parser refuses, and finds no syntax error the parser missed.
+    match (&syntax, &result) {
+        (Err(s), Ok(_)) => panic!("import accepts a file check_syntax refuses: {s}"),
+        (Err(s), Err(i)) => assert_eq!(
+            s.to_string(),
+            i.to_string(),
+            "import and check_syntax refuse for different reasons"
+        ),
+        (Ok(n), Err(e @ (StepError::Syntax { .. } | StepError::DuplicateId { .. }))) => {
+            panic!(
+                "import finds a syntax error in a file check_syntax accepts ({n} instances): {e}"
+            )
+        }
+        _ => {}
+    }
+    let Ok(import) = result else {
+        return;
+    };
+    let instances = syntax.expect("accepted above");
+    assert!(instances >= 1, "a contour from a file of no instance");
+    let file = &import.file;
+    assert!(!file.curves.is_empty(), "an accepted import has a contour");
+    for c in &file.curves {
+        safe_id("curve id", &c.id);
+        finite(&format!("curve {:?} knots", c.id), c.knots.iter().copied());
+        finite(
+            &format!("curve {:?} control points", c.id),
+            c.control_points.iter().flatten().copied(),
+        );
+        if let Some(w) = &c.weights {
+            finite_weights(&format!("curve {:?}", c.id), w);
+        }
+        match &c.surface {
+            Some(SurfaceRef::One(s)) => safe_id("surface ref", s),
+            Some(SurfaceRef::Many(v)) => v.iter().for_each(|s| safe_id("surface ref", s)),
+            None => {}
+        }
+    }
+    for s in &file.surfaces {
+        let RawSurface::Nurbs(n) = s else {
+            panic!("the STEP reader writes NURBS surfaces only, got {s:?}");
+        };
+        safe_id("surface id", &n.id);
+        finite(
+            &format!("surface {:?} knots", n.id),
+            n.knots_u.iter().chain(&n.knots_v).copied(),
+        );
+        finite(
+            &format!("surface {:?} control points", n.id),
+            n.control_points.iter().flatten().flatten().copied(),
+        );
+        if let Some(w) = &n.weights {
+            let all: Vec<f64> = w.iter().flatten().copied().collect();
+            finite_weights(&format!("surface {:?}", n.id), &all);
+        }
+    }
+    let report = &import.report;
+    assert_eq!(
+        report.surfaces.len(),
+        file.surfaces.len(),
+        "one report line per surface written"
+    );
+    assert!(
+        report.largest_move >= 0.0 && report.largest_move <= opts.close_gaps_mm,
+        "largest pole move {} mm outside [0, close_gaps_mm = {}]",
+        report.largest_move,
+        opts.close_gaps_mm
+    );
+    if let Err(e) = kerf_format::curves::from_raw(file.clone(), Path::new(NO_DIR)) {
+        panic!("the imported document is not valid kerf.curves/1: {e}");
     }
 }

@@ -154,6 +154,9 @@ pub(crate) fn print_account(path: &Path, import: &Import) {
     for o in &r.opened {
         eprintln!("  opened {o}");
     }
+    for w in &r.warnings {
+        eprintln!("  warning: {w}");
+    }
     for s in &r.skipped {
         eprintln!("  skipped {s}");
     }
@@ -185,6 +188,7 @@ pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
             "faces_read": r.faces_read,
             "taken": r.taken,
             "skipped": r.skipped,
+            "warnings": r.warnings,
             "gaps_closed": r.gaps_closed,
             "largest_pole_move_mm": r.largest_move,
             "opened": r.opened,

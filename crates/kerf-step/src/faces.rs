@@ -83,7 +83,6 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
     let same_sense = boolean(inst, p.get(3), "same_sense")?;
     let g = geometry(m, surf_inst).map_err(|e| err(inst, format!("face_geometry: {e}")))?;
     let mut loops = Vec::new();
-    let mut sampled: Vec<NurbsCurve> = Vec::new();
     let mut vertices: Vec<Point3<f64>> = Vec::new();
     for bid in refs(inst, p.get(1), "bounds")? {
         let b = &m.get(inst, bid)?;
@@ -98,15 +97,7 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
             vertices.push(vertex(m, v)?);
             continue;
         }
-        let (mut edges, which) = edge_loop(m, lp_inst)?;
-        // The boundary samples come from each distinct edge once.
-        let mut first = vec![None; which.len()];
-        for (k, &d) in which.iter().enumerate() {
-            if first[d].is_none() {
-                first[d] = Some(k);
-                sampled.push(edges[k].clone());
-            }
-        }
+        let mut edges = edge_loop(m, lp_inst)?;
         if !orientation {
             edges = edges.into_iter().rev().map(|c| c.reversed()).collect();
         }
@@ -120,11 +111,14 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         us.push(u);
         vs.push(v);
     };
-    m.charge(inst, Charge::FaceTests, sampled.len() * EDGE_SAMPLES)?;
-    for e in &sampled {
-        let (a, b) = e.domain();
-        for k in 0..EDGE_SAMPLES {
-            add(&e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64));
+    let uses: usize = loops.iter().map(Vec::len).sum();
+    m.charge(inst, Charge::FaceTests, uses * EDGE_SAMPLES)?;
+    for l in &loops {
+        for e in l {
+            let (a, b) = e.domain();
+            for k in 0..EDGE_SAMPLES {
+                add(&e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64));
+            }
         }
     }
     for q in &vertices {
@@ -220,16 +214,17 @@ fn vertex(m: &Model<'_>, v: &Instance) -> Result<Point3<f64>> {
     m.point(&m.param_ref(v, p, 1)?)
 }
 
-/// The edges of an `EDGE_LOOP`, each as a NURBS curve running in loop order, and for each
-/// the index of its `EDGE_CURVE` among the loop's distinct ones (a seam edge is used twice).
+/// The edges of an `EDGE_LOOP`, each as a NURBS curve running in loop order (each distinct
+/// `EDGE_CURVE` converted once; a seam edge is used twice).
 ///
 /// A loop runs each edge at most once in each direction (a seam: once each way); an edge
 /// used again in the same direction is refused, so a loop repeating one edge thousands of
-/// times costs one edge's work, not thousands, before it is refused.
-fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<(Vec<NurbsCurve>, Vec<usize>)> {
+/// times costs one edge's work, not thousands, before it is refused; so a loop has at most
+/// twice as many uses as distinct edges, and its boundary samples (every use, as before)
+/// are bounded by the file's own edges.
+fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<Vec<NurbsCurve>> {
     let p = m.rec(inst, "EDGE_LOOP")?;
     let mut out = Vec::new();
-    let mut which = Vec::new();
     // (EDGE_CURVE id, its curve as the edge runs, directions used so far)
     let mut distinct: Vec<(u64, NurbsCurve, [bool; 2])> = Vec::new();
     for (k, oid) in refs(inst, p.get(1), "edge_list")?.into_iter().enumerate() {
@@ -257,9 +252,8 @@ fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<(Vec<NurbsCurve>, Vec<usi
         *used = true;
         let c = &distinct[d].1;
         out.push(if orientation { c.clone() } else { c.reversed() });
-        which.push(d);
     }
-    Ok((out, which))
+    Ok(out)
 }
 
 /// An `EDGE_CURVE` from its start vertex to its end vertex along its geometry.

@@ -260,6 +260,12 @@ pub(crate) struct PostArgs {
     #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
     pub(crate) max_rotary_step: Option<f64>,
 
+    /// How far the tool axis may tilt from the surface normal to save rotary motion, degrees
+    /// (default 1; 0 keeps the exact normal): C is held near the pole, creases are turned
+    /// over a distance, small wiggles of the normal are not followed.
+    #[arg(long, value_name = "DEG", value_parser = crate::guard::tilt_deg)]
+    pub(crate) tilt_tolerance: Option<f64>,
+
     /// Where the part goes on the machine: `auto` (every pose within the axis limits, the
     /// motion centred in the travel, contours turned to the side the head can reach, the part
     /// turned by quarter turns if it does not fit as modelled) or `X,Y,Z[,RX,RY,RZ]` (mm,
@@ -454,6 +460,12 @@ pub(crate) struct RunArgs {
     /// Largest rotary-axis move between two points, degrees (default: no limit).
     #[arg(long, value_name = "DEG", value_parser = crate::guard::angle_deg)]
     pub(crate) max_rotary_step: Option<f64>,
+
+    /// How far the tool axis may tilt from the surface normal to save rotary motion, degrees
+    /// (default 1; 0 keeps the exact normal): C is held near the pole, creases are turned
+    /// over a distance, small wiggles of the normal are not followed.
+    #[arg(long, value_name = "DEG", value_parser = crate::guard::tilt_deg)]
+    pub(crate) tilt_tolerance: Option<f64>,
 
     /// Most cutting points of all curves together (default 1,000,000): a job that needs more
     /// is refused before the points are made (every stage, the program and the plot grow with

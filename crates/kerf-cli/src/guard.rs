@@ -23,6 +23,7 @@
 //! | angle | `0 < x <= 180` degrees | `--max-turn`, `--crease-angle`, `--max-rotary-step` |
 //! | normal step | `0 < x < 180` degrees | `--max-normal-step` (the normals stage needs a step below a half turn) |
 //! | small angle | `0 < x <= 0.1` rad | `--pole-tolerance` |
+//! | tilt | `0 <= x <= 10` degrees (`kerf_kinematics::MAX_TILT_TOLERANCE_DEG`; 0: the exact normal) | `--tilt-tolerance` |
 //! | STEP gaps | `0 <= x <= 10` mm | `--close-gaps` (0: close none) |
 //! | STEP faces | `0 < x <= 10` mm | `--face-tolerance` |
 //! | samples | `2 <= n <= 10,000` (`kerf_check::MAX_SAMPLES`) | `kerf check --samples` (the work is samples x spans x segments: 1,000,000 took 47 s on a 700-segment toolpath) |
@@ -77,6 +78,14 @@ const FRACTION: OptionRange = own(0.0, false, 1.0, false, "");
 const ANGLE_DEG: OptionRange = own(0.0, false, 180.0, true, "degrees");
 /// `--max-normal-step`: the normals stage needs a step below a half turn.
 const NORMAL_STEP_DEG: OptionRange = own(0.0, false, 180.0, false, "degrees");
+/// `--tilt-tolerance`: 0 is the exact normal; the upper end is the kinematics' own.
+const TILT_DEG: OptionRange = own(
+    0.0,
+    true,
+    kerf_kinematics::MAX_TILT_TOLERANCE_DEG,
+    true,
+    "degrees",
+);
 /// `--pole-tolerance` (0.1 rad is 5.7 degrees).
 const POLE_RAD: OptionRange = own(0.0, false, 0.1, true, "rad");
 /// `--close-gaps` of a STEP import: a gap of more than 10 mm between two segments is no
@@ -146,6 +155,11 @@ pub(crate) fn fraction(s: &str) -> Result<f64, String> {
 /// An angle in degrees: 0 < x <= 180.
 pub(crate) fn angle_deg(s: &str) -> Result<f64, String> {
     within(s, ANGLE_DEG)
+}
+
+/// The tilt tolerance, degrees ([`TILT_DEG`]).
+pub(crate) fn tilt_deg(s: &str) -> Result<f64, String> {
+    within(s, TILT_DEG)
 }
 
 /// The largest angle between neighbouring normals, degrees: 0 < x < 180.

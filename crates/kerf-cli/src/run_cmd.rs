@@ -25,7 +25,11 @@ fn job_options(args: &RunArgs) -> JobOptions {
             args.linearization_tolerance
                 .unwrap_or(d.linearization_tolerance_mm),
         )
-        .with_max_rotary_step_deg(args.max_rotary_step.unwrap_or(f64::INFINITY));
+        .with_max_rotary_step_deg(args.max_rotary_step.unwrap_or(f64::INFINITY))
+        .with_tilt_tolerance_deg(
+            args.tilt_tolerance
+                .unwrap_or(kerf_pipeline::DEFAULT_TILT_TOLERANCE_DEG),
+        );
     JobOptions::default()
         .with_discretize(discretize)
         .with_orient(OrientOptions::default().with_normals(normals))

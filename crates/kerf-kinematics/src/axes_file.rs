@@ -68,6 +68,10 @@ pub struct AxesPath {
     /// Optional: the largest tip error of the pole rule (mm).
     #[serde(default)]
     pub pole_tip_error: Option<f64>,
+    /// Optional: the largest angle (degrees) between a pose's tool axis and the surface normal
+    /// at its point, when a tilt tolerance was in force.
+    #[serde(default)]
+    pub tilt_max_deg: Option<f64>,
     /// Optional: the index into the curve's toolpath `points` where the cut begins (a closed
     /// path runs round to it again).
     #[serde(default)]
@@ -138,6 +142,7 @@ impl AxesFile {
                     max_rotary_step: Some(p.max_rotary_step),
                     max_linearization_error: Some(p.max_linearization_error),
                     pole_tip_error: Some(p.pole_tip_error),
+                    tilt_max_deg: p.tilt.map(|t| t.max_deviation_deg),
                     start_point: None,
                     lead_in: None,
                     lead_out: None,
@@ -235,6 +240,7 @@ impl AxesFile {
                 ("max_rotary_step", p.max_rotary_step),
                 ("max_linearization_error", p.max_linearization_error),
                 ("pole_tip_error", p.pole_tip_error),
+                ("tilt_max_deg", p.tilt_max_deg),
             ] {
                 if let Some(v) = v.filter(|v| !v.is_finite()) {
                     return Err(KinematicsError::doc(
@@ -359,6 +365,7 @@ impl AxesFile {
                 ("max_rotary_step", p.max_rotary_step),
                 ("max_linearization_error", p.max_linearization_error),
                 ("pole_tip_error", p.pole_tip_error),
+                ("tilt_max_deg", p.tilt_max_deg),
             ] {
                 if let Some(v) = v {
                     write!(w, ",\n      \"{key}\": {v}")?;

@@ -49,6 +49,7 @@ mod pose;
 mod registry;
 mod rotation;
 mod table_table;
+mod tilt;
 
 pub use ac_head::AcHead;
 pub use axes_file::{AxesFile, AxesMove, AxesPath, AXES_FORMAT};
@@ -63,7 +64,7 @@ pub use machine::{
 };
 pub use nonlinear::{interpolate, linearization_error, slerp, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
-pub use path::{LIMIT_SLACK, UNIT_AXIS_TOLERANCE};
+pub use path::{LIMIT_SLACK, MAX_TILT_TOLERANCE_DEG, UNIT_AXIS_TOLERANCE};
 pub use placement::{
     auto_place, auto_setups, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement,
     Placement, Setup, SetupPlan,
@@ -71,3 +72,4 @@ pub use placement::{
 pub use pose::{Axes, Axis, Pose};
 pub use registry::kinematics_types;
 pub use table_table::TableTable;
+pub use tilt::{tilt_within_cone, TiltChoice, TiltReport, TILT_WORKING_FRACTION};

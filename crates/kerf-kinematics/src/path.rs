@@ -43,6 +43,7 @@ use rayon::prelude::*;
 use crate::error::{KinematicsError, Result};
 use crate::machine::Machine;
 use crate::pose::{Axes, Pose};
+use crate::tilt::{tilt_within_cone, TiltReport};
 
 mod walk;
 
@@ -75,7 +76,15 @@ pub struct PathOptions {
     /// Refuse a path that needs more inserted points than this (protects against a tolerance
     /// typed in the wrong unit). Default 1,000,000.
     pub max_inserted: usize,
+    /// The tilt tolerance (degrees): the tool axis may deviate this much from each pose's
+    /// axis (its surface normal) so that the rotary axes move least ([`crate::tilt_within_cone`]).
+    /// In `[0, MAX_TILT_TOLERANCE_DEG]`; 0 (the default here) keeps the normals exactly.
+    pub tilt_tolerance_deg: f64,
 }
+
+/// The largest tilt tolerance (degrees): beyond it the beam no longer cuts the edge the CAD
+/// model draws (a 10-degree tilt puts the bottom edge of a 2 mm sheet 0.35 mm off).
+pub const MAX_TILT_TOLERANCE_DEG: f64 = 10.0;
 
 impl Default for PathOptions {
     fn default() -> Self {
@@ -84,6 +93,7 @@ impl Default for PathOptions {
             max_rotary_step_deg: f64::INFINITY,
             linearization_tolerance_mm: 0.005,
             max_inserted: 1_000_000,
+            tilt_tolerance_deg: 0.0,
         }
     }
 }
@@ -114,6 +124,13 @@ impl PathOptions {
     /// points than this (protects against a tolerance typed in the wrong unit).
     pub fn with_max_inserted(mut self, max_inserted: usize) -> Self {
         self.max_inserted = max_inserted;
+        self
+    }
+
+    /// Sets [`tilt_tolerance_deg`](Self::tilt_tolerance_deg): how far (degrees) the tool axis
+    /// may deviate from the surface normal to save rotary motion.
+    pub fn with_tilt_tolerance_deg(mut self, tilt_tolerance_deg: f64) -> Self {
+        self.tilt_tolerance_deg = tilt_tolerance_deg;
         self
     }
 
@@ -148,6 +165,13 @@ impl PathOptions {
                 "linearization_tolerance_mm",
                 self.linearization_tolerance_mm,
                 "must be > 0 (mm; infinity to insert no points)",
+            );
+        }
+        if !(0.0..=MAX_TILT_TOLERANCE_DEG).contains(&self.tilt_tolerance_deg) {
+            return bad(
+                "tilt_tolerance_deg",
+                self.tilt_tolerance_deg,
+                "must be in [0, 10] (degrees)",
             );
         }
         Ok(())
@@ -216,6 +240,10 @@ pub struct SolvedPath {
     /// The largest `pivot_length * angle` over the pole points, `angle` being the angle
     /// between the pose's tool axis and the one the axes give (mm).
     pub pole_tip_error: f64,
+    /// What the tilt tolerance did, when one was in force: the largest angle between a
+    /// chosen tool axis and the surface normal (`max_deviation_at` indexes the cutting
+    /// points) and the rotary travel with and without it. `None` with a tolerance of 0.
+    pub tilt: Option<TiltReport>,
 }
 
 impl SolvedPath {
@@ -255,7 +283,15 @@ pub fn solve_path(
     options: &PathOptions,
 ) -> Result<SolvedPath> {
     options.validate()?;
-    let poses = checked_poses(input)?;
+    let mut poses = checked_poses(input)?;
+    let mut tilt = None;
+    if options.tilt_tolerance_deg > 0.0 {
+        let choice = tilt_within_cone(&poses, options.tilt_tolerance_deg);
+        for (pose, axis) in poses.iter_mut().zip(&choice.axes) {
+            pose.axis = *axis;
+        }
+        tilt = Some(choice.report);
+    }
     let ctx = Ctx {
         machine,
         kin: machine.kinematics.as_ref(),
@@ -267,7 +303,9 @@ pub fn solve_path(
     if poses.is_empty() {
         return Ok(ctx.empty());
     }
-    ctx.walk()
+    let mut solved = ctx.walk()?;
+    solved.tilt = tilt;
+    Ok(solved)
 }
 
 /// Checks the poses (finite, unit tool axes) and the curve's params; returns the poses with

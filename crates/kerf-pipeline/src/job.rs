@@ -85,8 +85,8 @@ pub struct JobOptions {
     /// The normals stage. Default [`OrientOptions::default`] (vertical beam for curves without
     /// a surface).
     pub orient: OrientOptions,
-    /// The kinematics. Default [`PathOptions::default`]: linearization tolerance 0.005 mm, no
-    /// rotary step limit.
+    /// The kinematics. Default [`PathOptions::default`] with the tilt tolerance
+    /// [`DEFAULT_TILT_TOLERANCE_DEG`]: linearization tolerance 0.005 mm, no rotary step limit.
     pub path: PathOptions,
     /// Where the part goes on the machine. Default [`PlaceMode::AsModelled`].
     pub place: PlaceMode,
@@ -126,6 +126,14 @@ pub struct JobOptions {
     pub wall_axis_max_mm: f64,
 }
 
+/// The tilt tolerance of a job unless it sets another (degrees): the tool axis may deviate
+/// this far from the surface normal to save rotary motion (`kerf_kinematics::tilt_within_cone`).
+/// One degree leans the bottom edge of a 3 mm sheet 0.05 mm, within the trim tolerances of
+/// sheet-metal parts (+-0.1 mm and wider), and puts the beam 0.009 mm off the point where the
+/// surface stands 0.5 mm off the focus; it lets C stand still wherever the normal is within
+/// a degree of the pole (`docs/kinematics.md`, "Tilt tolerance").
+pub const DEFAULT_TILT_TOLERANCE_DEG: f64 = 1.0;
+
 /// The default of [`JobOptions::max_total_points`]: one million cutting points, about 3 GB
 /// through every stage of a run (a sheet-metal part with hundreds of holes at 0.01 mm needs
 /// tens of thousands).
@@ -136,7 +144,7 @@ impl Default for JobOptions {
         Self {
             discretize: Options::default(),
             orient: OrientOptions::default(),
-            path: PathOptions::default(),
+            path: PathOptions::default().with_tilt_tolerance_deg(DEFAULT_TILT_TOLERANCE_DEG),
             place: PlaceMode::AsModelled,
             leads: LeadOptions::default(),
             feed_mm_per_min: 6000.0,

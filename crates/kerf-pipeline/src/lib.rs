@@ -52,7 +52,10 @@ pub use discretize::{
     toolpath_of_poses, DEFAULT_MAX_TOTAL_POINTS,
 };
 pub use error::{Error, Result};
-pub use job::{Job, JobOptions, MissingSurface, OrientOptions, DEFAULT_MAX_TOTAL_POINTS_RUN};
+pub use job::{
+    Job, JobOptions, MissingSurface, OrientOptions, DEFAULT_MAX_TOTAL_POINTS_RUN,
+    DEFAULT_TILT_TOLERANCE_DEG,
+};
 pub use motion::{fit_options, path_report, plan_program, MotionInput, MotionOptions, Program};
 pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};
 pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};

@@ -279,7 +279,10 @@ pub fn plan_program(
                 MotionInput::Toolpath(tp) => (tp, ChordTerm::Claimed(tp.tolerance)),
                 MotionInput::Axes(_) => unreachable!("matched above"),
             };
-            let path_options = PathOptions::default();
+            // The job's default tilt tolerance, so that `kerf gcode TOOLPATH` and `kerf post`
+            // then `kerf gcode AXES` make the same program.
+            let path_options =
+                PathOptions::default().with_tilt_tolerance_deg(crate::DEFAULT_TILT_TOLERANCE_DEG);
             linearization = Some(path_options.linearization_tolerance_mm);
             let posted = crate::post::post_toolpath(
                 machine,

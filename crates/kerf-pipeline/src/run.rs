@@ -483,6 +483,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
             "max_linearization_error": solved.iter().map(|s| s.max_linearization_error).fold(0.0, f64::max),
             "pole_points": solved.iter().map(|s| s.pole_points).sum::<usize>(),
             "pole_tip_error": solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
+            "tilt": tilt_report(&solved, popts.tilt_tolerance_deg),
         },
         "placement": placement_json,
         "process": crate::cuts::report(file, &cuts, &cut_plans),
@@ -533,5 +534,55 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         warnings,
         model,
         cycle_s: o.cycle_s,
+    })
+}
+
+/// What the tilt tolerance did (`kinematics.tilt` of the report): the tolerance, the largest
+/// angle between a tool axis and its surface normal with the path and the place, and the
+/// rotary travel `sum |d tilt| + |d C|` (degrees) of the exact normals and of the chosen axes,
+/// in all and per path. `null` without a tolerance.
+fn tilt_report(solved: &[kerf_kinematics::SolvedPath], tolerance_deg: f64) -> serde_json::Value {
+    if tolerance_deg <= 0.0 {
+        return serde_json::Value::Null;
+    }
+    let mut worst: Option<(f64, &str, [f64; 3])> = None;
+    let mut paths = Vec::new();
+    let (mut exact, mut chosen) = (0.0, 0.0);
+    for s in solved {
+        let Some(t) = s.tilt else { continue };
+        // Where: the tip of the cutting point (lead-ins count: they are poses of the cut).
+        let at = s
+            .source
+            .iter()
+            .position(|v| *v == Some(t.max_deviation_at))
+            .map_or([f64::NAN; 3], |j| {
+                let p = s.poses[j].position;
+                [p.x, p.y, p.z]
+            });
+        if worst.is_none_or(|w| t.max_deviation_deg > w.0) {
+            worst = Some((t.max_deviation_deg, &s.id, at));
+        }
+        exact += t.rotary_travel_exact_deg;
+        chosen += t.rotary_travel_deg;
+        paths.push(json!({
+            "id": s.id,
+            "max_deg": t.max_deviation_deg,
+            "at_mm": at,
+            "rotary_travel_exact_deg": t.rotary_travel_exact_deg,
+            "rotary_travel_deg": t.rotary_travel_deg,
+            "strings_over_budget": t.strings_over_budget,
+        }));
+    }
+    let (max_deg, max_path, max_at) = worst.map_or((0.0, None, None), |(d, id, at)| {
+        (d, Some(id.to_owned()), Some(at))
+    });
+    json!({
+        "tolerance_deg": tolerance_deg,
+        "max_deg": max_deg,
+        "max_path": max_path,
+        "max_at_mm": max_at,
+        "rotary_travel_exact_deg": exact,
+        "rotary_travel_deg": chosen,
+        "paths": paths,
     })
 }

@@ -75,6 +75,7 @@ impl Ctx<'_> {
             max_linearization_error: 0.0,
             pole_points: 0,
             pole_tip_error: 0.0,
+            tilt: None,
         }
     }
 

@@ -1,6 +1,8 @@
 //! Writes the "real work" fixtures of `fixtures/`: a car door trim on a doubly curved panel, a
-//! tube saddle on the exact cylinder and on an STL of it, a 3.5 m turbine-blade edge and a
-//! sheet-metal part with holes on an STL of the plate.
+//! tube saddle on the exact cylinder and on an STL of it, a 3.5 m turbine-blade edge, a
+//! sheet-metal part with holes on an STL of the plate, and the two trim lines of issue 26 (one
+//! over a stamped panel whose normal passes near the vertical again and again, one over creases
+//! and up a vertical flange).
 //!
 //! ```text
 //! cargo run --release --example make_fixtures            # rewrites fixtures/*.json, *.stl
@@ -12,7 +14,10 @@
 //!
 //! - exactly where the geometry allows it: conics on planes (rational quadratics), the blade
 //!   edge as the `v = 0` boundary row of its ruled surface (same knots, control points and
-//!   weights, so the isoparametric curve *is* the edge);
+//!   weights, so the isoparametric curve *is* the edge), the stamped panel's trim line as a
+//!   parameter-space curve composed into the panel (a polynomial B-spline of degree 12), the
+//!   creased trim line as lines and arcs drawn in the flat pattern and folded with its faces
+//!   (these two are measured within 1e-9 mm of their surfaces, their points rounded to 1e-12);
 //! - otherwise (a contour drawn on a free-form panel, the intersection of two cylinders, which
 //!   is no rational curve) by interpolating many points computed *on* the surface with a cubic
 //!   B-spline; the generator then measures the curve's largest distance from the surface
@@ -44,6 +49,8 @@ fn main() {
     tube_saddle(&out);
     turbine_blade_edge(&out);
     sheet_metal_holes(&out);
+    trim_panel(&out);
+    trim_creases(&out);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1014,4 +1021,893 @@ fn sheet_metal_holes(out: &Path) {
         worst,
         &format!(" (to the top face; {} facets)", tris.len()),
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// trim_panel.json: exact composition of a parameter-space curve into a bicubic panel
+// ---------------------------------------------------------------------------------------------
+
+/// Rounds to 1e-12 mm: the exact fixtures (`trim_panel`, `trim_creases`) keep their curves on
+/// their surfaces within 1e-9 mm, which rounding to 1e-9 could not guarantee.
+fn r12(x: f64) -> f64 {
+    (x * 1e12).round() / 1e12 + 0.0
+}
+
+fn r12p(p: Point3<f64>) -> [f64; 3] {
+    [r12(p.x), r12(p.y), r12(p.z)]
+}
+
+/// A clamped uniform knot vector of `spans` spans on [0, 1].
+fn uniform_clamped(spans: usize, p: usize) -> Vec<f64> {
+    let mut k = vec![0.0; p + 1];
+    k.extend((1..spans).map(|i| i as f64 / spans as f64));
+    k.extend(vec![1.0; p + 1]);
+    k
+}
+
+/// The blossom of the B-spline (`degree`, `knots`, `ctrl`) restricted to knot span `span`, at
+/// `args` (de Boor's algorithm with a different parameter at each level). With `args` all
+/// equal it is the curve's point; with `a` and `b` the span's ends it gives its Bezier points.
+fn blossom_bspline(
+    degree: usize,
+    knots: &[f64],
+    ctrl: &[Vector3<f64>],
+    span: usize,
+    args: &[f64],
+) -> Vector3<f64> {
+    let p = degree;
+    let mut d: Vec<Vector3<f64>> = (0..=p).map(|j| ctrl[span - p + j]).collect();
+    for r in 1..=p {
+        for j in (r..=p).rev() {
+            let i = span - p + j;
+            let alpha = (args[r - 1] - knots[i]) / (knots[i + p + 1 - r] - knots[i]);
+            d[j] = d[j - 1] * (1.0 - alpha) + d[j] * alpha;
+        }
+    }
+    d[p]
+}
+
+/// The blossom of a Bezier piece (control points `b` on the parameter interval `[a0, a1]`) at
+/// `args` (de Casteljau with a different parameter at each level).
+fn blossom_bezier(b: &[Vector3<f64>], a0: f64, a1: f64, args: &[f64]) -> Vector3<f64> {
+    let mut d = b.to_vec();
+    let n = b.len() - 1;
+    for (r, &x) in args.iter().enumerate() {
+        let s = (x - a0) / (a1 - a0);
+        for j in 0..n - r {
+            d[j] = d[j] * (1.0 - s) + d[j + 1] * s;
+        }
+    }
+    d[0]
+}
+
+/// The product of two polynomials in Bernstein form on [0, 1].
+fn bern_mul(a: &[f64], b: &[f64]) -> Vec<f64> {
+    let (m, n) = (a.len() - 1, b.len() - 1);
+    let c = |n: usize, k: usize| kerf::nurbs::binomial(n, k);
+    let mut out = vec![0.0; m + n + 1];
+    for i in 0..=m {
+        for j in 0..=n {
+            out[i + j] += c(m, i) * c(n, j) / c(m + n, i + j) * a[i] * b[j];
+        }
+    }
+    out
+}
+
+/// `C(3, i) s^i (1 - s)^(3 - i)` for `i = 0..=3`, where `s` is a polynomial in Bernstein form.
+fn cubic_basis_of(s: &[f64]) -> Vec<Vec<f64>> {
+    let one_minus: Vec<f64> = s.iter().map(|x| 1.0 - x).collect();
+    (0..=3)
+        .map(|i| {
+            let mut acc = vec![kerf::nurbs::binomial(3, i)];
+            for _ in 0..i {
+                acc = bern_mul(&acc, s);
+            }
+            for _ in i..3 {
+                acc = bern_mul(&acc, &one_minus);
+            }
+            acc
+        })
+        .collect()
+}
+
+/// A bicubic (polynomial) B-spline surface as Bezier patches, for exact composition.
+struct BicubicPatches {
+    ku: Vec<f64>,
+    kv: Vec<f64>,
+    net: Vec<Vec<Vector3<f64>>>,
+}
+
+impl BicubicPatches {
+    /// The span indices (as in `find_span`) of the patch holding `(u, v)`.
+    fn spans(&self, u: f64, v: f64) -> (usize, usize) {
+        (
+            find_span(3, &self.ku, self.net.len(), u),
+            find_span(3, &self.kv, self.net[0].len(), v),
+        )
+    }
+
+    /// The 4 x 4 Bezier net of patch `(su, sv)`, by blossoming in u then v.
+    fn bezier(&self, su: usize, sv: usize) -> [[Vector3<f64>; 4]; 4] {
+        let (ua, ub) = (self.ku[su], self.ku[su + 1]);
+        let (va, vb) = (self.kv[sv], self.kv[sv + 1]);
+        let args = |a: f64, b: f64, k: usize| -> Vec<f64> {
+            (0..3).map(|r| if r < 3 - k { a } else { b }).collect()
+        };
+        let cols = self.net[0].len();
+        // Bezier in u for every v column.
+        let rows: Vec<Vec<Vector3<f64>>> = (0..4)
+            .map(|k| {
+                (0..cols)
+                    .map(|j| {
+                        let col: Vec<Vector3<f64>> = self.net.iter().map(|r| r[j]).collect();
+                        blossom_bspline(3, &self.ku, &col, su, &args(ua, ub, k))
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut out = [[Vector3::zeros(); 4]; 4];
+        for (k, row) in rows.iter().enumerate() {
+            for l in 0..4 {
+                out[k][l] = blossom_bspline(3, &self.kv, row, sv, &args(va, vb, l));
+            }
+        }
+        out
+    }
+
+    /// The exact degree-12 Bezier piece `S(q(s))` of the quadratic parameter-space Bezier `q`
+    /// (lying inside patch `(su, sv)`).
+    fn compose(&self, q: &[Vector2<f64>; 3], su: usize, sv: usize) -> Vec<Vector3<f64>> {
+        let (ua, ub) = (self.ku[su], self.ku[su + 1]);
+        let (va, vb) = (self.kv[sv], self.kv[sv + 1]);
+        let s: Vec<f64> = q.iter().map(|p| (p.x - ua) / (ub - ua)).collect();
+        let r: Vec<f64> = q.iter().map(|p| (p.y - va) / (vb - va)).collect();
+        let (bu, bv) = (cubic_basis_of(&s), cubic_basis_of(&r));
+        let net = self.bezier(su, sv);
+        let mut out = vec![Vector3::zeros(); 13];
+        for i in 0..4 {
+            for j in 0..4 {
+                let prod = bern_mul(&bu[i], &bv[j]);
+                for (o, c) in out.iter_mut().zip(&prod) {
+                    *o += net[i][j] * *c;
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Joins Bezier pieces (`(t0, t1, control points)`, all of one degree, consecutive) into one
+/// clamped B-spline whose interior knot at each joint has multiplicity `degree - continuity`
+/// (`continuity[k]` for the joint after piece `k`): each control point is the blossom of a
+/// piece at its knots, which is exact where the pieces do join with that continuity.
+fn join_bezier_pieces(
+    pieces: &[(f64, f64, Vec<Vector3<f64>>)],
+    continuity: &[usize],
+) -> (Vec<f64>, Vec<Vector3<f64>>) {
+    let d = pieces[0].2.len() - 1;
+    let mut kn = vec![pieces[0].0; d + 1];
+    for (k, piece) in pieces.iter().enumerate().skip(1) {
+        kn.extend(vec![piece.0; d - continuity[k - 1]]);
+    }
+    kn.extend(vec![pieces[pieces.len() - 1].1; d + 1]);
+    let n = kn.len() - d - 1;
+    let cps = (0..n)
+        .map(|i| {
+            let args = &kn[i + 1..=i + d];
+            // The piece that needs the least extrapolation: the most arguments inside it.
+            let best = pieces
+                .iter()
+                .max_by_key(|(a, b, _)| args.iter().filter(|&&x| x >= *a && x <= *b).count())
+                .expect("pieces");
+            blossom_bezier(&best.2, best.0, best.1, args)
+        })
+        .collect();
+    (kn, cps)
+}
+
+/// The stamped panel of `trim_panel.json`: a bicubic B-spline graph over
+/// `[-300, 300] x [-200, 200]` (10 x 8 uniform spans, control x and y at the Greville
+/// abscissae, so x(u) and y(v) are linear up to the 1e-9 rounding of the net), a shallow dome
+/// with dents and humps sampled onto the net.
+const TP_X: (f64, f64) = (-300.0, 600.0);
+const TP_Y: (f64, f64) = (-200.0, 400.0);
+
+/// Humps (positive) and dents (negative) of the panel: centre x, y, height mm, width (sigma) mm.
+const TP_BUMPS: [(f64, f64, f64, f64); 6] = [
+    (215.0, 10.0, 8.0, 45.0),
+    (110.0, 125.0, -7.0, 45.0),
+    (-110.0, 120.0, 8.0, 45.0),
+    (-215.0, -10.0, -6.5, 45.0),
+    (-100.0, -120.0, 7.5, 45.0),
+    (110.0, -125.0, 7.0, 45.0),
+];
+
+fn tp_height(x: f64, y: f64) -> f64 {
+    let mut z = 40.0 - x * x / (2.0 * 4500.0) - y * y / (2.0 * 4000.0) + 0.01 * x;
+    for (bx, by, a, s) in TP_BUMPS {
+        z += a * (-((x - bx).powi(2) + (y - by).powi(2)) / (2.0 * s * s)).exp();
+    }
+    z
+}
+
+fn tp_surface() -> (NurbsSurface, RawNurbsSurface, BicubicPatches) {
+    let (ku, kv) = (uniform_clamped(10, 3), uniform_clamped(8, 3));
+    let (gu, gv) = (greville(&ku, 13, 3), greville(&kv, 11, 3));
+    let cps: Vec<Vec<[f64; 3]>> = gu
+        .iter()
+        .map(|&u| {
+            gv.iter()
+                .map(|&v| {
+                    let (x, y) = (TP_X.0 + TP_X.1 * u, TP_Y.0 + TP_Y.1 * v);
+                    [r9(x) + 0.0, r9(y) + 0.0, r9(tp_height(x, y))]
+                })
+                .collect()
+        })
+        .collect();
+    let pts: Vec<Vec<Point3<f64>>> = cps
+        .iter()
+        .map(|r| r.iter().map(|p| Point3::from(*p)).collect())
+        .collect();
+    let patches = BicubicPatches {
+        ku: ku.clone(),
+        kv: kv.clone(),
+        net: pts
+            .iter()
+            .map(|r| r.iter().map(|p| p.coords).collect())
+            .collect(),
+    };
+    (
+        NurbsSurface::new(3, 3, ku.clone(), kv.clone(), pts, None),
+        RawNurbsSurface {
+            id: "stamped-panel".into(),
+            degree_u: 3,
+            degree_v: 3,
+            knots_u: ku,
+            knots_v: kv,
+            control_points: cps,
+            weights: None,
+            flip: false,
+        },
+        patches,
+    )
+}
+
+fn tp_uv(p: Point2<f64>) -> Vector2<f64> {
+    Vector2::new((p.x - TP_X.0) / TP_X.1, (p.y - TP_Y.0) / TP_Y.1)
+}
+
+/// The angle between the panel's normal at plan point `p` and the vertical, degrees.
+fn tp_tilt(s: &NurbsSurface, p: Point2<f64>) -> f64 {
+    let uv = tp_uv(p);
+    let (_, su, sv) = s.eval_d1(uv.x, uv.y);
+    let n = su.cross(&sv);
+    n.xy().norm().atan2(n.z).to_degrees()
+}
+
+/// The points where the panel's normal is vertical (`z_u = z_v = 0`), in plan: local minima
+/// of the tilt on a 4 mm grid, refined by Newton's method.
+fn tp_critical_points(s: &NurbsSurface) -> Vec<(Point2<f64>, f64)> {
+    let step = 4.0;
+    let (nx, ny) = (146, 96);
+    let at = |i: usize, j: usize| Point2::new(-292.0 + step * i as f64, -192.0 + step * j as f64);
+    let grid: Vec<Vec<f64>> = (0..=nx)
+        .map(|i| (0..=ny).map(|j| tp_tilt(s, at(i, j))).collect())
+        .collect();
+    let mut out: Vec<(Point2<f64>, f64)> = Vec::new();
+    for i in 1..nx {
+        for j in 1..ny {
+            let t = grid[i][j];
+            let lower = (0..9).all(|k| {
+                let (a, b) = (i + k / 3 - 1, j + k % 3 - 1);
+                (a, b) == (i, j) || grid[a][b] > t
+            });
+            if !lower || t > 1.0 {
+                continue;
+            }
+            let mut uv = tp_uv(at(i, j));
+            for _ in 0..30 {
+                let d = s.derivatives(uv.x, uv.y);
+                let g = Vector2::new(d[1][0].z, d[0][1].z);
+                let h = nalgebra::Matrix2::new(d[2][0].z, d[1][1].z, d[1][1].z, d[0][2].z);
+                uv -= h.lu().solve(&g).expect("regular critical point");
+            }
+            let p = Point2::new(TP_X.0 + TP_X.1 * uv.x, TP_Y.0 + TP_Y.1 * uv.y);
+            let d = s.derivatives(uv.x, uv.y);
+            let det = d[2][0].z * d[0][2].z - d[1][1].z * d[1][1].z;
+            let kind = if det < 0.0 {
+                0.0
+            } else if d[2][0].z < 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            if !out.iter().any(|(q, _)| (q - p).norm() < 1.0) {
+                out.push((p, kind));
+            }
+        }
+    }
+    out
+}
+
+/// A quadratic Bezier in the plane at `s`.
+fn quad_at(q: &[Point2<f64>; 3], s: f64) -> Point2<f64> {
+    let m = 1.0 - s;
+    Point2::from(q[0].coords * (m * m) + q[1].coords * (2.0 * m * s) + q[2].coords * (s * s))
+}
+
+/// The pieces of the closed uniform quadratic B-spline with control polygon `q`: piece `i` is
+/// the Bezier `[mid(q[i-1], q[i]), q[i], mid(q[i], q[i+1])]`; consecutive pieces join C1.
+fn closed_quadratic_pieces(q: &[Point2<f64>]) -> Vec<[Point2<f64>; 3]> {
+    let n = q.len();
+    (0..n)
+        .map(|i| {
+            let (a, b, c) = (q[(i + n - 1) % n], q[i], q[(i + 1) % n]);
+            [nalgebra::center(&a, &b), b, nalgebra::center(&b, &c)]
+        })
+        .collect()
+}
+
+/// The control polygon of the trim line: around each pass point `p[k]` two control points
+/// `p[k] -+ a[k] e[k]`, so that the curve runs through `p[k]` along `e[k]`.
+fn tp_polygon(p: &[Point2<f64>], e: &[Vector2<f64>], a: &[f64]) -> Vec<Point2<f64>> {
+    (0..p.len())
+        .flat_map(|k| [p[k] - e[k] * a[k], p[k] + e[k] * a[k]])
+        .collect()
+}
+
+/// The smallest tilt on the two pieces that meet at pass point `k`, degrees.
+fn tp_pass_tilt(s: &NurbsSurface, pieces: &[[Point2<f64>; 3]], k: usize) -> f64 {
+    let mut best = f64::INFINITY;
+    for (h, piece) in pieces[2 * k..2 * k + 2].iter().enumerate() {
+        for i in 0..=200 {
+            let f = 0.5 * (1.0 - h as f64 + i as f64 / 200.0);
+            best = best.min(tp_tilt(s, quad_at(piece, f)));
+        }
+    }
+    best
+}
+
+/// Where the quadratic Bezier `f(s)` (scalar control values `c`) crosses `level` in (0, 1):
+/// sign changes on a fine grid, refined by bisection.
+fn quad_crossings(c: [f64; 3], level: f64) -> Vec<f64> {
+    let f = |s: f64| {
+        let m = 1.0 - s;
+        c[0] * m * m + c[1] * 2.0 * m * s + c[2] * s * s - level
+    };
+    let n = 64;
+    let mut out = Vec::new();
+    for i in 0..n {
+        let (mut a, mut b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+        if f(a) == 0.0 && i > 0 {
+            out.push(a);
+            continue;
+        }
+        if (f(a) < 0.0) == (f(b) < 0.0) {
+            continue;
+        }
+        for _ in 0..200 {
+            let m = 0.5 * (a + b);
+            if m <= a || m >= b {
+                break;
+            }
+            if (f(a) < 0.0) == (f(m) < 0.0) {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        out.push(0.5 * (a + b));
+    }
+    out
+}
+
+fn trim_panel(out: &Path) {
+    let (surface, raw, patches) = tp_surface();
+    let crit = tp_critical_points(&surface);
+    // The trim line runs past six of the panel's points of vertical normal (hump tops, the
+    // bottom of a dent, a saddle), each at the offset (at most 30 mm) that makes its smallest
+    // tilt near there the target in degrees where the panel allows it, and through one via
+    // point (no target) over a dent. The points are found on the surface, then matched here.
+    let passes: [((f64, f64), Option<f64>); 7] = [
+        ((190.0, 2.0), Some(0.5)),
+        ((124.0, 153.0), Some(1.0)),
+        ((-91.0, 103.0), Some(3.0)),
+        ((-205.0, -5.0), None),
+        ((-75.0, -102.0), Some(0.7)),
+        ((105.0, -103.0), Some(2.0)),
+        ((140.0, -43.0), Some(4.0)),
+    ];
+    let n = passes.len();
+    let c: Vec<Point2<f64>> = passes
+        .iter()
+        .map(|&((x, y), target)| {
+            let want = Point2::new(x, y);
+            if target.is_none() {
+                return want;
+            }
+            let (p, _) = crit
+                .iter()
+                .min_by(|a, b| (a.0 - want).norm().total_cmp(&(b.0 - want).norm()))
+                .expect("critical points");
+            assert!(
+                (p - want).norm() < 10.0,
+                "no critical point near ({x}, {y})"
+            );
+            *p
+        })
+        .collect();
+    let e: Vec<Vector2<f64>> = (0..n)
+        .map(|k| (c[(k + 1) % n] - c[(k + n - 1) % n]).normalize())
+        .collect();
+    let a: Vec<f64> = (0..n)
+        .map(|k| {
+            0.3 * (c[(k + 1) % n] - c[k])
+                .norm()
+                .min((c[k] - c[(k + n - 1) % n]).norm())
+        })
+        .collect();
+    // Offsets to the left of the direction, by bisection, in a few Gauss-Seidel sweeps (each
+    // pass point's pieces also depend on its neighbours').
+    let mut d = vec![0.0; n];
+    for _ in 0..4 {
+        for k in 0..n {
+            let Some(target) = passes[k].1 else { continue };
+            let (mut lo, mut hi) = (0.0, 30.0);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                d[k] = mid;
+                let p: Vec<Point2<f64>> = (0..n)
+                    .map(|j| c[j] + Vector2::new(-e[j].y, e[j].x) * d[j])
+                    .collect();
+                let pieces = closed_quadratic_pieces(&tp_polygon(&p, &e, &a));
+                if tp_pass_tilt(&surface, &pieces, k) < target {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            d[k] = 0.5 * (lo + hi);
+        }
+    }
+    let p: Vec<Point2<f64>> = (0..n)
+        .map(|j| c[j] + Vector2::new(-e[j].y, e[j].x) * d[j])
+        .collect();
+    let plan = closed_quadratic_pieces(&tp_polygon(&p, &e, &a));
+    // In parameter space (the plan mapped by the nominal linear x(u), y(v): still quadratic),
+    // split where the pieces cross the panel's knot lines, each part composed exactly.
+    let m = plan.len();
+    let mut pieces: Vec<(f64, f64, Vec<Vector3<f64>>)> = Vec::new();
+    let mut continuity = Vec::new();
+    let uv_plan: Vec<[Vector2<f64>; 3]> = plan.iter().map(|q| q.map(tp_uv)).collect();
+    for (i, q) in uv_plan.iter().enumerate() {
+        let mut cuts: Vec<f64> = Vec::new();
+        for (axis, knots) in [(0, &patches.ku), (1, &patches.kv)] {
+            for &k in &knots[4..knots.len() - 4] {
+                cuts.extend(quad_crossings([q[0][axis], q[1][axis], q[2][axis]], k));
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        let mut bounds = vec![0.0];
+        bounds.extend(cuts);
+        bounds.push(1.0);
+        for w in bounds.windows(2) {
+            let (s0, s1) = (w[0], w[1]);
+            assert!(s1 - s0 > 1e-6, "a crossing at a joint");
+            // The sub-piece by blossoming: q(s0, s0), q(s0, s1), q(s1, s1).
+            let bl = |x: f64, y: f64| {
+                q[0] * ((1.0 - x) * (1.0 - y))
+                    + q[1] * ((1.0 - x) * y + x * (1.0 - y))
+                    + q[2] * (x * y)
+            };
+            let sub = [bl(s0, s0), bl(s0, s1), bl(s1, s1)];
+            let mid = bl(0.5 * (s0 + s1), 0.5 * (s0 + s1));
+            let (su, sv) = patches.spans(mid.x, mid.y);
+            let t0 = (i as f64 + s0) / m as f64;
+            let t1 = (i as f64 + s1) / m as f64;
+            if !pieces.is_empty() {
+                continuity.push(if s0 == 0.0 { 1 } else { 2 });
+            }
+            pieces.push((t0, t1, patches.compose(&sub, su, sv)));
+        }
+    }
+    let (kn, cps) = join_bezier_pieces(&pieces, &continuity);
+    let mut cps: Vec<[f64; 3]> = cps.into_iter().map(|v| r12p(Point3::from(v))).collect();
+    let last = cps.len() - 1;
+    cps[last] = cps[0];
+    let line = curve("trim-line", 12, kn, cps, None, "stamped-panel");
+    let path = out.join("trim_panel.json");
+    write_json(&path, &document(vec![line], vec![RawSurface::Nurbs(raw)]));
+    let file = reload(&path);
+    let written = &file.curves[0].curve;
+    // The written curve against S(u(t), v(t)), and the tilt along it.
+    let mut worst: f64 = 0.0;
+    let samples = 20000;
+    let mut tilts = Vec::with_capacity(samples + 1);
+    for k in 0..=samples {
+        let t = k as f64 / samples as f64;
+        let i = ((t * m as f64) as usize).min(m - 1);
+        let s = t * m as f64 - i as f64;
+        let uv = quad_at(&plan[i].map(|p| Point2::from(tp_uv(p))), s);
+        worst = worst.max((written.point(t) - surface.point(uv.x, uv.y)).norm());
+        tilts.push(tp_tilt(&surface, quad_at(&plan[i], s)));
+    }
+    let minima: Vec<f64> = (0..samples)
+        .filter(|&k| {
+            let prev = tilts[(k + samples - 1) % samples];
+            tilts[k] < prev && tilts[k] <= tilts[k + 1] && tilts[k] < 5.0
+        })
+        .map(|k| tilts[k])
+        .collect();
+    let mut at = Vec::new();
+    for k in 0..samples {
+        let prev = tilts[(k + samples - 1) % samples];
+        if tilts[k] < prev && tilts[k] <= tilts[k + 1] && tilts[k] < 5.0 {
+            let pt = written.point(k as f64 / samples as f64);
+            at.push(format!("{:.2} at ({:.0}, {:.0})", tilts[k], pt.x, pt.y));
+        }
+    }
+    let max_tilt = tilts.iter().copied().fold(0.0, f64::max);
+    let mut slope: f64 = 0.0;
+    for i in 0..=300 {
+        for j in 0..=200 {
+            let q = Point2::new(-300.0 + 2.0 * i as f64, -200.0 + 2.0 * j as f64);
+            slope = slope.max(tp_tilt(&surface, q));
+        }
+    }
+    report(
+        &path,
+        &file,
+        worst,
+        &format!(
+            " (against S(u(t), v(t)); {} pieces; panel slope up to {slope:.2} deg, along the \
+             line {:.2} to {max_tilt:.2} deg, {} local minima of the tilt: {})",
+            pieces.len(),
+            tilts.iter().copied().fold(90.0, f64::min),
+            minima.len(),
+            minima
+                .iter()
+                .map(|t| format!("{t:.2}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    );
+    assert!(worst <= 1e-9, "trim_panel: {worst:e} mm off the panel");
+    println!("  tilt minima, deg: {}", at.join(", "));
+    println!("  pass offsets, mm: {d:.3?}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// trim_creases.json: a trim line over folded faces, a bend and a vertical flange
+// ---------------------------------------------------------------------------------------------
+
+/// One face of the folded panel, in its flat pattern: `s` runs across the folds, `y` along
+/// them. A flat face starts at profile point `p` (x, z) with direction angle `phi`; the bend
+/// turns counter-clockwise (concave up) about centre `p` with radius `r` from angle `phi`.
+#[derive(Debug, Clone, Copy)]
+enum FoldFace {
+    Flat {
+        s0: f64,
+        s1: f64,
+        p: Vector2<f64>,
+        phi: f64,
+    },
+    Bend {
+        s0: f64,
+        s1: f64,
+        c: Vector2<f64>,
+        r: f64,
+        phi: f64,
+    },
+}
+
+const FOLD_Y: (f64, f64) = (-120.0, 120.0);
+
+impl FoldFace {
+    fn range(&self) -> (f64, f64) {
+        match *self {
+            FoldFace::Flat { s0, s1, .. } | FoldFace::Bend { s0, s1, .. } => (s0, s1),
+        }
+    }
+
+    /// The profile point (x, z) at `s` (extended beyond the face by its own formula).
+    fn profile(&self, s: f64) -> Vector2<f64> {
+        match *self {
+            FoldFace::Flat { s0, p, phi, .. } => p + Vector2::new(phi.cos(), phi.sin()) * (s - s0),
+            FoldFace::Bend { s0, c, r, phi, .. } => {
+                let a = phi + (s - s0) / r;
+                c + Vector2::new(a.sin(), -a.cos()) * r
+            }
+        }
+    }
+
+    fn at(&self, s: f64, y: f64) -> Point3<f64> {
+        let q = self.profile(s);
+        Point3::new(q.x, y, q.y)
+    }
+
+    /// The outward (upper) unit normal at `s`.
+    fn normal(&self, s: f64) -> Vector3<f64> {
+        let a = match *self {
+            FoldFace::Flat { phi, .. } => phi,
+            FoldFace::Bend { s0, r, phi, .. } => phi + (s - s0) / r,
+        };
+        Vector3::new(-a.sin(), 0.0, a.cos())
+    }
+
+    /// The face as a NURBS surface: u across (s), v along y; `Su x Sv` is the upper normal.
+    fn raw(&self, id: &str) -> RawNurbsSurface {
+        let (s0, s1) = self.range();
+        let row = |p: Point3<f64>| {
+            vec![
+                r12p(Point3::new(p.x, FOLD_Y.0, p.z)),
+                r12p(Point3::new(p.x, FOLD_Y.1, p.z)),
+            ]
+        };
+        let (degree_u, control_points, weights) = match *self {
+            FoldFace::Flat { .. } => (1, vec![row(self.at(s0, 0.0)), row(self.at(s1, 0.0))], None),
+            FoldFace::Bend { c, r, phi, .. } => {
+                let half = 0.5 * (s1 - s0) / r;
+                let m =
+                    c + Vector2::new((phi + half).sin(), -(phi + half).cos()) * (r / half.cos());
+                let w = half.cos();
+                (
+                    2,
+                    vec![
+                        row(self.at(s0, 0.0)),
+                        row(Point3::new(m.x, 0.0, m.y)),
+                        row(self.at(s1, 0.0)),
+                    ],
+                    Some(vec![vec![1.0, 1.0], vec![w, w], vec![1.0, 1.0]]),
+                )
+            }
+        };
+        let mut knots_u = vec![0.0; degree_u + 1];
+        knots_u.extend(vec![1.0; degree_u + 1]);
+        RawNurbsSurface {
+            id: id.into(),
+            degree_u,
+            degree_v: 1,
+            knots_u,
+            knots_v: vec![0.0, 0.0, 1.0, 1.0],
+            control_points,
+            weights,
+            flip: false,
+        }
+    }
+
+    /// The distance of `p` from the face's surface (plane or cylinder), mm.
+    fn distance(&self, p: &Point3<f64>) -> f64 {
+        match *self {
+            FoldFace::Flat { s0, .. } => (p - self.at(s0, p.y)).dot(&self.normal(s0)).abs(),
+            FoldFace::Bend { c, r, .. } => ((Vector2::new(p.x, p.z) - c).norm() - r).abs(),
+        }
+    }
+}
+
+/// The folded panel: four flat faces rising at 20, 10, -15 and 25 degrees (creases of 10, 25
+/// and 40 degrees), a bend of radius 10 up to the vertical, and a 50 mm flange.
+fn fold_faces() -> Vec<(&'static str, FoldFace)> {
+    let mut out = Vec::new();
+    let mut p = Vector2::new(-200.0, 10.0);
+    let mut s = 0.0;
+    for (id, deg, len) in [
+        ("face-1", 20.0f64, 120.0),
+        ("face-2", 10.0, 100.0),
+        ("face-3", -15.0, 110.0),
+        ("face-4", 25.0, 90.0),
+    ] {
+        let f = FoldFace::Flat {
+            s0: s,
+            s1: s + len,
+            p,
+            phi: deg.to_radians(),
+        };
+        p = f.profile(s + len);
+        s += len;
+        out.push((id, f));
+    }
+    let (phi, r) = (25f64.to_radians(), 10.0);
+    let sweep = 90f64.to_radians() - phi;
+    let bend = FoldFace::Bend {
+        s0: s,
+        s1: s + r * sweep,
+        c: p + Vector2::new(-phi.sin(), phi.cos()) * r,
+        r,
+        phi,
+    };
+    s += r * sweep;
+    p = bend.profile(s);
+    out.push(("bend", bend));
+    out.push((
+        "flange",
+        FoldFace::Flat {
+            s0: s,
+            s1: s + 50.0,
+            p,
+            phi: 90f64.to_radians(),
+        },
+    ));
+    out
+}
+
+fn trim_creases(out: &Path) {
+    let faces = fold_faces();
+    let s_wall = faces[5].1.range().0;
+    let face_of = |s: f64| {
+        faces
+            .iter()
+            .position(|(_, f)| f.range().0 <= s && s <= f.range().1)
+            .expect("on the panel")
+    };
+    // The trim line in the flat pattern, counter-clockwise: along y = -90 over every crease,
+    // the bend and 35 mm up the flange, along the flange, back down over the bend at y = 70,
+    // then obliquely (about 10 degrees to the s direction) over the three creases, and down
+    // on face 1. Fillets stay inside one face.
+    let outline = rounded_polygon(&[
+        (20.0, -90.0, 15.0),
+        (s_wall + 35.0, -90.0, 8.0),
+        (s_wall + 35.0, 70.0, 8.0),
+        (370.0, 70.0, 15.0),
+        (20.0, 10.0, 15.0),
+    ]);
+    // Rational quadratic Bezier pieces in 3D, each with its face: (P0, P1, P2, w1, length, face).
+    type Piece = (Point3<f64>, Point3<f64>, Point3<f64>, f64, f64, usize);
+    let mut pieces: Vec<Piece> = Vec::new();
+    let bounds: Vec<f64> = faces.iter().map(|(_, f)| f.range().1).collect();
+    for (seg, _) in &outline {
+        match *seg {
+            Seg2::Line(a, b) => {
+                let mut cuts = vec![0.0, 1.0];
+                for &sb in &bounds[..bounds.len() - 1] {
+                    let f = (sb - a.x) / (b.x - a.x);
+                    if f > 1e-9 && f < 1.0 - 1e-9 {
+                        cuts.push(f);
+                    }
+                }
+                cuts.sort_by(f64::total_cmp);
+                for w in cuts.windows(2) {
+                    let (p, q) = (a + (b - a) * w[0], a + (b - a) * w[1]);
+                    let k = face_of(0.5 * (p.x + q.x));
+                    let face = faces[k].1;
+                    match face {
+                        FoldFace::Flat { .. } => {
+                            let (p3, q3) = (face.at(p.x, p.y), face.at(q.x, q.y));
+                            pieces.push((
+                                p3,
+                                nalgebra::center(&p3, &q3),
+                                q3,
+                                1.0,
+                                (q3 - p3).norm(),
+                                k,
+                            ));
+                        }
+                        FoldFace::Bend { c, r, phi, s0, .. } => {
+                            assert!(p.y == q.y, "the line crosses the bend square");
+                            let (ap, aq) = (phi + (p.x - s0) / r, phi + (q.x - s0) / r);
+                            let half = 0.5 * (aq - ap);
+                            let am = 0.5 * (ap + aq);
+                            let m = c + Vector2::new(am.sin(), -am.cos()) * (r / half.cos());
+                            pieces.push((
+                                face.at(p.x, p.y),
+                                Point3::new(m.x, p.y, m.y),
+                                face.at(q.x, q.y),
+                                half.cos(),
+                                r * (aq - ap).abs(),
+                                k,
+                            ));
+                        }
+                    }
+                }
+            }
+            Seg2::Arc(c, r, a0, sweep) => {
+                let k = face_of(c.x);
+                let face = faces[k].1;
+                let (lo, hi) = face.range();
+                assert!(
+                    c.x - r >= lo && c.x + r <= hi && matches!(face, FoldFace::Flat { .. }),
+                    "a fillet inside one flat face"
+                );
+                let parts = (sweep.abs() / (0.5 * PI) - 1e-9).ceil() as usize;
+                let d = sweep / parts as f64;
+                for m in 0..parts {
+                    let (b0, b1) = (a0 + d * m as f64, a0 + d * (m + 1) as f64);
+                    let mid = c + dir(0.5 * (b0 + b1)) * (r / (0.5 * d).cos());
+                    let (p0, p2) = (c + dir(b0) * r, c + dir(b1) * r);
+                    pieces.push((
+                        face.at(p0.x, p0.y),
+                        face.at(mid.x, mid.y),
+                        face.at(p2.x, p2.y),
+                        (0.5 * d).cos(),
+                        r * d.abs(),
+                        k,
+                    ));
+                }
+            }
+        }
+    }
+    let total: f64 = pieces.iter().map(|p| p.4).sum();
+    let mut kn = vec![0.0; 3];
+    let mut cps = Vec::new();
+    let mut w = Vec::new();
+    let mut acc = 0.0;
+    for (i, piece) in pieces.iter().enumerate() {
+        if i > 0 {
+            acc += pieces[i - 1].4;
+            let k = r9(acc / total);
+            kn.extend([k, k]);
+        }
+        cps.extend([r12p(piece.0), r12p(piece.1)]);
+        w.extend([1.0, piece.3]);
+    }
+    cps.push(cps[0]);
+    w.push(1.0);
+    kn.extend([1.0; 3]);
+    let ids: Vec<String> = faces.iter().map(|(id, _)| (*id).to_string()).collect();
+    let line = RawCurve {
+        id: "trim-over-creases".into(),
+        degree: 2,
+        knots: kn,
+        control_points: cps,
+        weights: Some(w),
+        surface: Some(curves::SurfaceRef::Many(ids)),
+        start: None,
+        scrap: None,
+    };
+    let surfaces = faces
+        .iter()
+        .map(|(id, f)| RawSurface::Nurbs(f.raw(id)))
+        .collect();
+    let path = out.join("trim_creases.json");
+    write_json(&path, &document(vec![line], surfaces));
+    let file = reload(&path);
+    let written = &file.curves[0].curve;
+    // Every piece against its own face, and the tilt along the line.
+    let spans = written.spans();
+    assert_eq!(spans.len(), pieces.len(), "one span per piece");
+    let (mut worst, mut max_tilt): (f64, f64) = (0.0, 0.0);
+    for ((_, a, b), piece) in spans.iter().zip(&pieces) {
+        let face = faces[piece.5].1;
+        for k in 0..=64 {
+            let p = written.point(a + (b - a) * k as f64 / 64.0);
+            worst = worst.max(face.distance(&p));
+            let s = match face {
+                FoldFace::Flat { .. } => face.range().0,
+                FoldFace::Bend { c, r, phi, s0, .. } => {
+                    let v = Vector2::new(p.x, p.z) - c;
+                    s0 + r * (v.x.atan2(-v.y) - phi)
+                }
+            };
+            max_tilt = max_tilt.max(face.normal(s).z.clamp(-1.0, 1.0).acos().to_degrees());
+        }
+    }
+    // Crease angles (between neighbouring flat faces' normals) and the line's turn there.
+    let creases: Vec<String> = (0..3)
+        .map(|k| {
+            let (f, g) = (faces[k].1, faces[k + 1].1);
+            let a = f.normal(0.0).angle(&g.normal(0.0)).to_degrees();
+            format!("{a:.1}")
+        })
+        .collect();
+    let mut turns = Vec::new();
+    for pair in pieces.windows(2) {
+        if pair[0].5 != pair[1].5 && pair[0].5 < 4 && pair[1].5 < 4 {
+            let t_in = (pair[0].2 - pair[0].1).normalize();
+            let t_out = (pair[1].1 - pair[1].0).normalize();
+            turns.push(format!("{:.1}", t_in.angle(&t_out).to_degrees()));
+        }
+    }
+    report(
+        &path,
+        &file,
+        worst,
+        &format!(
+            " (each piece to its face; {} pieces; creases {} deg; the line turns {} deg at \
+             them; tilt up to {max_tilt:.1} deg)",
+            pieces.len(),
+            creases.join(", "),
+            turns.join(", ")
+        ),
+    );
+    assert!(worst <= 1e-9, "trim_creases: {worst:e} mm off a face");
 }

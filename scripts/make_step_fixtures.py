@@ -20,6 +20,16 @@ Files:
 - faces.step: one solid or face of every kind: box (planes), cylinder, cone, sphere, torus,
   extrusion of a B-spline, revolution of a B-spline, rational B-spline surface; read with
   --edges (every face's boundary loops).
+- trim_composite.step: the folded panel and trim line of fixtures/trim_creases.json (written by
+  examples/make_fixtures.rs; run that first): the panel's profile (four lines meeting at
+  creases of 10, 25 and 40 degrees, a bend arc of radius 10 up to the vertical, the flange's
+  line) extruded along y into a shell of planes and a cylinder, and the trim line as one closed
+  COMPOSITE_CURVE of its 20 pieces (lines and circular arcs through the same points, joined C0
+  at the creases). Its header's time stamp is fixed, so that it is the same bytes on every run.
+
+With names after OUTDIR (`python3 scripts/make_step_fixtures.py fixtures/step
+trim_composite.step`) only those files are written: the other files' headers carry the time
+they were written.
 """
 
 import re
@@ -27,7 +37,7 @@ import sys
 from pathlib import Path
 
 from OCP.BRep import BRep_Builder
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
 from OCP.BRepPrimAPI import (
     BRepPrimAPI_MakeBox,
     BRepPrimAPI_MakeCone,
@@ -37,6 +47,9 @@ from OCP.BRepPrimAPI import (
     BRepPrimAPI_MakeSphere,
     BRepPrimAPI_MakeTorus,
 )
+import json
+
+from OCP.GC import GC_MakeArcOfCircle
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface, Geom_Circle, Geom_TrimmedCurve
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Pnt, gp_Vec
 from OCP.Interface import Interface_Static
@@ -258,10 +271,58 @@ def make_faces(out: Path):
     write(compound(shapes), out / "faces.step")
 
 
+def make_trim_composite(out: Path):
+    """The folded panel of fixtures/trim_creases.json as a shell, its trim line as one closed
+    composite curve of lines and arcs."""
+    src = json.loads((Path(__file__).resolve().parent.parent / "fixtures" / "trim_creases.json").read_text())
+    y0 = src["surfaces"][0]["control_points"][0][0][1]
+    y1 = src["surfaces"][0]["control_points"][0][1][1]
+
+    def arc3(a, b, c):
+        return BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(gp_Pnt(*a), gp_Pnt(*b), gp_Pnt(*c)).Value()).Edge()
+
+    def on_arc(p0, p1, p2, w):
+        """The middle (t = 1/2) of the rational quadratic Bezier p0, p1 (weight w), p2."""
+        return [(a + 2 * w * b + c) / (2 + 2 * w) for a, b, c in zip(p0, p1, p2)]
+
+    # The profile at y = y0: each face's first column (u across the folds).
+    profile = BRepBuilderAPI_MakeWire()
+    for f in src["surfaces"]:
+        col = [row[0] for row in f["control_points"]]
+        if f["degree_u"] == 1:
+            profile.Add(line(col[0], col[1]))
+        else:
+            w = f["weights"][1][0]
+            profile.Add(arc3(col[0], on_arc(col[0], col[1], col[2], w), col[2]))
+    shell = BRepPrimAPI_MakePrism(profile.Wire(), gp_Vec(0, y1 - y0, 0)).Shape()
+    # The trim line: one rational quadratic Bezier per span (every joint is a double knot).
+    c = src["curves"][0]
+    cps, ws = c["control_points"], c["weights"]
+    edges = []
+    for k in range(0, len(cps) - 1, 2):
+        p0, p1, p2, w = cps[k], cps[k + 1], cps[k + 2], ws[k + 1]
+        edges.append(line(p0, p2) if w == 1.0 else arc3(p0, on_arc(p0, p1, p2, w), p2))
+    path = out / "trim_composite.step"
+    write(compound([shell, wire(edges)]), path)
+    text = composite_text(path.read_text(), [([True] * len(edges), False)])
+    text = re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", r"\1'2026-12-03T00:00:00'", text, count=1)
+    path.write_text(text)
+
+
+MAKERS = {
+    "composite_mm.step": lambda out: make_composites(out, "MM", "composite_mm.step"),
+    "composite_inch.step": lambda out: make_composites(out, "INCH", "composite_inch.step"),
+    "faces.step": make_faces,
+    "trim_composite.step": make_trim_composite,
+}
+
+
 if __name__ == "__main__":
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "fixtures/step")
     out.mkdir(parents=True, exist_ok=True)
-    make_composites(out, "MM", "composite_mm.step")
-    make_composites(out, "INCH", "composite_inch.step")
-    make_faces(out)
-    print("wrote", ", ".join(sorted(p.name for p in out.glob("*.step"))))
+    names = sys.argv[2:] or list(MAKERS)
+    for name in names:
+        if name not in MAKERS:
+            raise SystemExit(f"unknown file {name} (known: {', '.join(MAKERS)})")
+        MAKERS[name](out)
+    print("wrote", ", ".join(sorted(names)))

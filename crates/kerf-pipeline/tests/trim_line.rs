@@ -1,0 +1,162 @@
+//! Issue 26's trim lines on every shipped machine, every dialect, placed by `--place auto`:
+//! the domed panel whose normal passes within 0.5 degrees of vertical (the pole of every head),
+//! the creases of 10 to 40 degrees with a wall up to 90 degrees, and the same as a STEP
+//! composite curve. Each program is checked independently of the planner: every set-point of
+//! the CSV within every axis' range, velocity and acceleration (finite differences of the
+//! written numbers), and every cutting pose's tool axis, found by forward kinematics of its
+//! axes, within the tilt tolerance of the true surface normal at the tip it gives (the
+//! closest point on the curve's own NURBS faces).
+
+use std::path::Path;
+
+use kerf_format::curves::{self, CurvesFile, SurfaceGeometry};
+use kerf_interp::Dialect;
+use kerf_kinematics::{Axes, Machine};
+use kerf_pipeline::{Job, JobOptions, Output, PlaceMode, DEFAULT_TILT_TOLERANCE_DEG};
+
+mod common;
+use common::fixture;
+
+const MACHINES: [&str; 5] = [
+    "ac_head.json",
+    "gantry_ac.json",
+    "fork_head.json",
+    "head_table.json",
+    "table_table.json",
+];
+const DIALECTS: [Dialect; 3] = [Dialect::Generic, Dialect::Sinumerik, Dialect::Linuxcnc];
+
+fn step(name: &str) -> CurvesFile {
+    let import = kerf_step::import_file(fixture(name), &kerf_step::ImportOptions::default())
+        .expect("STEP import");
+    curves::from_raw(import.file, Path::new(".")).expect("valid document")
+}
+
+/// Every set-point of every program within the machine's ranges, velocities and
+/// accelerations, read back from the CSV text.
+fn assert_setpoints_within_limits(what: &str, machine: &Machine, out: &Output, cycle: f64) {
+    for setup in 0..out.programs.len() {
+        let mut text = Vec::new();
+        out.write_setpoints(setup, &mut text).expect("csv");
+        let text = String::from_utf8(text).expect("utf-8");
+        let rows: Vec<[f64; 5]> = text
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let v: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
+                [v[1], v[2], v[3], v[4], v[5]]
+            })
+            .collect();
+        assert!(rows.len() > 10, "{what}: a real program");
+        for (i, r) in rows.iter().enumerate() {
+            for k in 0..5 {
+                if let Some(range) = machine.limits[k] {
+                    assert!(
+                        r[k] >= range.min - 1e-9 && r[k] <= range.max + 1e-9,
+                        "{what}: cycle {i} axis {k} = {} outside [{}, {}]",
+                        r[k],
+                        range.min,
+                        range.max
+                    );
+                }
+                if i > 0 {
+                    let v = (r[k] - rows[i - 1][k]) / cycle;
+                    let vmax = machine.max_velocity[k] / 60.0;
+                    assert!(
+                        v.abs() <= vmax * (1.0 + 1e-9) + 1e-9,
+                        "{what}: cycle {i} axis {k} velocity {v} > {vmax}"
+                    );
+                }
+                if i > 0 && i + 1 < rows.len() {
+                    let a = (rows[i + 1][k] - 2.0 * r[k] + rows[i - 1][k]) / (cycle * cycle);
+                    let amax = machine.max_acceleration[k];
+                    assert!(
+                        a.abs() <= amax * (1.0 + 1e-6),
+                        "{what}: cycle {i} axis {k} acceleration {a} > {amax}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Every cutting pose's tool axis within `tol_deg` of the line of the surface normal at its
+/// tip (the sides stage may cut from the other side of the sheet), measured on the faces the
+/// curve names.
+fn assert_in_the_cone(what: &str, file: &CurvesFile, machine: &Machine, out: &Output, tol_deg: f64) {
+    for path in &out.axes.paths {
+        let k = file
+            .curves
+            .iter()
+            .position(|c| c.id == path.id)
+            .expect("curve of the path");
+        let placement = out.placement.placement_of(k);
+        let r_inv = placement.rotation().inverse();
+        let faces: Vec<_> = file.curves[k]
+            .surfaces
+            .iter()
+            .filter_map(|id| file.surfaces.iter().find(|s| &s.id == id))
+            .filter_map(|s| match &s.geometry {
+                SurfaceGeometry::Nurbs(n) => Some(n),
+                _ => None,
+            })
+            .collect();
+        assert!(!faces.is_empty(), "{what}: {} has its faces", path.id);
+        let mut worst: f64 = 0.0;
+        for (n, q) in path.positions.iter().enumerate() {
+            let pose = machine.kinematics.forward(&Axes::from_array(*q));
+            let tip = r_inv * (pose.position - placement.translation_mm);
+            let axis = r_inv * pose.axis;
+            let best = faces
+                .iter()
+                .filter_map(|f| {
+                    let p = f.closest_point(&tip, None);
+                    if p.distance > 0.02 {
+                        return None;
+                    }
+                    let normal = f.normal(p.u, p.v)?;
+                    let a = axis.angle(&normal).to_degrees();
+                    Some(a.min(180.0 - a))
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(best.is_finite(), "{what}: {} pose {n} is on no face", path.id);
+            worst = worst.max(best);
+        }
+        assert!(worst <= tol_deg + 1e-6, "{what}: {}: {worst} deg off the normal", path.id);
+    }
+}
+
+fn trim_line(name: &str, file: CurvesFile) {
+    for m in MACHINES {
+        let machine = Machine::read(fixture(&format!("machines/{m}"))).expect("machine");
+        for dialect in DIALECTS {
+            let what = format!("{name} on {m}, {}", dialect.name());
+            let options = JobOptions::default()
+                .with_place(PlaceMode::Auto)
+                .with_dialect(dialect);
+            let out = Job::new(file.clone(), machine.clone())
+                .with_options(options)
+                .run()
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
+            assert_setpoints_within_limits(&what, &machine, &out, 0.001);
+            assert_in_the_cone(&what, &file, &machine, &out, DEFAULT_TILT_TOLERANCE_DEG);
+        }
+    }
+}
+
+#[test]
+fn the_domed_panel_through_the_pole_on_every_machine() {
+    let file = curves::load(fixture("trim_panel.json")).expect("fixture");
+    trim_line("trim_panel.json", file);
+}
+
+#[test]
+fn the_creases_and_the_wall_on_every_machine() {
+    let file = curves::load(fixture("trim_creases.json")).expect("fixture");
+    trim_line("trim_creases.json", file);
+}
+
+#[test]
+fn the_step_composite_over_six_faces_on_every_machine() {
+    trim_line("step/trim_composite.step", step("step/trim_composite.step"));
+}

@@ -39,7 +39,7 @@ mod profile;
 mod verify;
 
 pub use link::{link_paths, link_paths_through, link_paths_with_retract};
-pub use motion::{Cycles, Motion, PathStats};
+pub use motion::{Cycles, Motion, PathStats, PlanWork};
 
 use assemble::assemble;
 use profile::{run_feeds, run_grid, time_run, Timed};
@@ -244,7 +244,16 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
     // Held to the end of the program's life: no room to spare.
     blocks.shrink_to_fit();
     let names = model.axis_names().map(str::to_string);
+    // A degree of a rotary axis counts for as many mm of path parameter as the slowest
+    // linear axis moves while that axis turns a degree at its limit.
+    let v_lin = limits.max_velocity[..3]
+        .iter()
+        .fold(f64::INFINITY, |m, &v| m.min(v));
     let path = PathOptions {
+        rotary_mm_per_deg: [
+            v_lin / limits.max_velocity[3],
+            v_lin / limits.max_velocity[4],
+        ],
         rotary_ranges: [limits.range[3], limits.range[4]],
         blend_tolerance: if limits.max_jerk.is_some() && !opts.block_ends_on_cycles {
             opts.blend_tolerance_mm
@@ -287,6 +296,7 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
     let mut timed: Vec<Timed> = Vec::with_capacity(runs.len());
     let mut block_feeds = vec![0.0; blocks.len()];
     let mut grid_points = 0;
+    let mut work = PlanWork::default();
     for run in &runs {
         let (s, g) = run_grid(model, run, step, opts);
         grid_points += s.len();
@@ -313,6 +323,8 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
             full,
         )?;
         let worst = verify(&motion, model);
+        work.verified_cycles += motion.cycles() + 1;
+        work.refinements = refinements;
         if worst.is_empty() {
             let motion = if full {
                 motion
@@ -336,6 +348,9 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
                 )?
             };
             check_ranges(&motion, model)?;
+            let mut motion = motion;
+            work.grid_points += grid_points;
+            motion.work = work;
             return Ok(motion);
         }
         if refinements >= opts.max_refinements {
@@ -420,6 +435,7 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
                 g.mult_a[l.point] = l.mult_a;
             }
             let s = std::mem::take(&mut timed[r].s);
+            work.grid_points += s.len();
             timed[r] = time_run(s, &g, acc, limits.max_jerk, tau);
             if !(run.cutting && run.moves_tip) {
                 // A cutting run's `F` words come from the limits alone: unchanged.

@@ -73,7 +73,7 @@ pub(super) fn assemble(
         st.duration += tm.duration;
         if run.cutting && run.moves_tip {
             st.cutting_time += tm.duration;
-            st.cutting_length += run.len();
+            st.cutting_length += run.tip_len;
             // Sample the run at half a cycle.
             let dt = opts.cycle_s / 2.0;
             let steps = (tm.duration / dt).ceil() as usize;
@@ -129,6 +129,7 @@ pub(super) fn assemble(
         cycle: opts.cycle_s,
         refinements,
         grid_points,
+        work: super::motion::PlanWork::default(),
         axis_names: names.clone(),
         block_times,
         feeds,

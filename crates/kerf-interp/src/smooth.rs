@@ -323,11 +323,16 @@ impl Run {
         self.axes_raw(model, s)
     }
 
-    /// Tip derivatives `(t', t'')` with respect to `s` (of the blended tip by central
-    /// differences, step 1e-3 mm).
+    /// Tip derivatives `(t', t'')` with respect to `s`: of the blended tip by central
+    /// differences, step 1e-3 mm or a quarter of the window, whichever is smaller, so that
+    /// the differences stay inside the run (the window is at most `min(s, len - s)`); of the
+    /// spline itself where the window is narrower than [`BLEND_MIN_MM`] (near a run's ends,
+    /// where the mean is the spline to within `w^2 max |p''| / 6`, and differences over such a
+    /// step would be rounding).
     pub(crate) fn tip_derivatives(&self, s: f64) -> (Vector3<f64>, Vector3<f64>) {
-        if self.blend_width(s) > 0.0 {
-            let h = 1e-3;
+        let w = self.blend_width(s);
+        if w >= BLEND_MIN_MM {
+            let h = (0.25 * w).min(1e-3);
             let (a, b, c) = (self.tip_at(s - h), self.tip_at(s), self.tip_at(s + h));
             let d1 = Vector3::from(std::array::from_fn(|d| (c[d] - a[d]) / (2.0 * h)));
             let d2 = Vector3::from(std::array::from_fn(|d| {
@@ -441,10 +446,24 @@ fn chord_of_curve(run: &[Block], j: usize, n: usize) -> bool {
     k_n > 0.0 && k_j >= 0.5 * k_n
 }
 
+/// Two neighbouring blocks whose lengths (in the run's parameter) differ by more than this
+/// factor do not share a run: no grading of nodes (at most 4096 a block) can make the spacing
+/// of an interpolating spline's nodes change gently across such a jump, and the C2 spline rings
+/// (a 1 mm lead-in arc's 0.087 mm chord followed by a 1e-8 mm hole's chord swung the tip's
+/// derivative to 9e5 and the run planned for 1,299 s).
+pub(crate) const SPACING_BREAK: f64 = 1e5;
+
 /// True when blocks `a` and `a + 1` meet at a true corner (or must not share a run).
-fn breaks(blocks: &[Block], a: usize) -> bool {
+fn breaks(blocks: &[Block], a: usize, opts: &PathOptions) -> bool {
     let (x, y) = (&blocks[a], &blocks[a + 1]);
     if x.rapid != y.rapid || x.path != y.path {
+        return true;
+    }
+    let (lx, ly) = (
+        block_param_length(x, opts.rotary_mm_per_deg),
+        block_param_length(y, opts.rotary_mm_per_deg),
+    );
+    if lx.max(ly) > SPACING_BREAK * lx.min(ly) {
         return true;
     }
     let (Some(t0), Some(t1)) = (tangent(blocks, a, true), tangent(blocks, a + 1, false)) else {
@@ -509,7 +528,7 @@ pub(crate) fn runs(blocks: &[Block], opts: &PathOptions) -> Vec<Run> {
     let mut out = Vec::new();
     let mut first = 0;
     for b in 0..blocks.len() {
-        if b + 1 == blocks.len() || breaks(blocks, b) {
+        if b + 1 == blocks.len() || breaks(blocks, b, opts) {
             out.push(build(blocks, first, b, opts));
             first = b + 1;
         }
@@ -667,10 +686,18 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
     // (Taylor: |p(s + x) - p(s) - x p'(s)| <= x^2 / 2 max |p''|, the linear term averages out).
     let blend = if moves_tip && opts.blend_tolerance > 0.0 {
         let m = tip.max_second_derivative();
-        if m > 0.0 {
+        let w = if m > 0.0 {
             (6.0 * opts.blend_tolerance / m).sqrt().min(BLEND_MAX_MM)
         } else {
             BLEND_MAX_MM
+        };
+        // A narrower window blends nothing: it belongs to curvatures of over `6 e / W^2`
+        // (radii under a nanometre at 5 um), and the derivatives of the mean by differences
+        // would be rounding (a 1e-8 mm hole's window was 5e-20 mm).
+        if w >= BLEND_MIN_MM {
+            w
+        } else {
+            0.0
         }
     } else {
         0.0
@@ -697,6 +724,8 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
 
 /// Largest half-width of the blend, mm (bounds the pieces one mean spans).
 const BLEND_MAX_MM: f64 = 10.0;
+/// Smallest half-width of the blend, mm: below it the tip follows its spline unblended.
+const BLEND_MIN_MM: f64 = 1e-4;
 /// Width of the soft band inside a rotary axis' limits, degrees (at most a quarter of the range).
 pub(crate) const ROTARY_SOFT_DEG: f64 = 0.5;
 

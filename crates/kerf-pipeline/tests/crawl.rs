@@ -4,12 +4,10 @@
 
 mod common;
 
-use common::{fixture, machine};
+use common::{circle, fixture, machine};
 use kerf_interp::{AxisModel, MachineModel, Motion};
 use kerf_kinematics::Machine;
-use kerf_nurbs::NurbsCurve;
 use kerf_pipeline::Job;
-use nalgebra::Point3;
 
 /// The largest ratio over every cycle and axis of the set-points' velocity, acceleration and jerk
 /// (finite differences, at rest before the first and after the last) to the machine's limits.
@@ -36,31 +34,25 @@ fn ratios(m: &MachineModel, motion: &Motion) -> [f64; 3] {
     r
 }
 
-/// A full circle of radius `r` about `(cx, cy, 0)` (exact rational quadratic).
-fn circle(r: f64, cx: f64, cy: f64) -> NurbsCurve {
-    let h = std::f64::consts::FRAC_1_SQRT_2;
-    let sq = [
-        (1., 0.),
-        (1., 1.),
-        (0., 1.),
-        (-1., 1.),
-        (-1., 0.),
-        (-1., -1.),
-        (0., -1.),
-        (1., -1.),
-        (1., 0.),
-    ];
-    let pts = sq
-        .iter()
-        .map(|(x, y)| Point3::new(cx + r * x, cy + r * y, 0.0))
-        .collect();
-    let w = (0..9).map(|i| if i % 2 == 0 { 1.0 } else { h }).collect();
-    NurbsCurve::new(
-        2,
-        vec![0., 0., 0., 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1., 1., 1.],
-        pts,
-        Some(w),
-    )
+/// Prints what planning `motion` cost, checks every set-point against every limit by its own
+/// finite differences and the work against `max_grid_points`, and returns the motion's
+/// duration.
+fn check(m: &MachineModel, motion: &Motion, max_grid_points: usize) -> f64 {
+    let w = motion.work();
+    let cut: f64 = motion.path_stats().iter().map(|p| p.cutting_length).sum();
+    println!(
+        "{} cycles ({:.3} s), {cut:.2} mm cut, {w:?}",
+        motion.cycles(),
+        motion.duration()
+    );
+    assert!(w.grid_points <= max_grid_points, "{w:?}");
+    assert!(w.refinements <= 5, "{w:?}");
+    let r = ratios(m, motion);
+    assert!(
+        r.iter().all(|&v| v <= 1.0 + 1e-9),
+        "within every limit: {r:?}"
+    );
+    motion.duration()
 }
 
 #[test]
@@ -70,26 +62,12 @@ fn a_hole_of_ten_nanometres_with_the_default_lead_in_is_planned_in_a_fraction_of
     // blend's window fell to 5e-20 mm and its derivatives by differences over 1e-3 mm were
     // taken outside the run: a 1,299 s program after 29 s of planning. Such a jump of the node
     // spacing now ends the run, and a window under 1e-4 mm blends nothing.
-    let job = Job::on_machine(machine()).with_curve("tiny", circle(1e-8, 100.0, 50.0), None);
+    let job = Job::on_machine(machine()).with_curve("tiny", circle(100.0, 50.0, 1e-8), None);
     let out = job.run().expect("run");
     let m = MachineModel::new(machine()).expect("model");
-    let motion = &out.programs[0].motion;
-    let w = motion.work();
-    let cut: f64 = motion.path_stats().iter().map(|p| p.cutting_length).sum();
-    println!(
-        "{} cycles ({:.3} s), {cut:.4} mm cut, {w:?}",
-        motion.cycles(),
-        motion.duration()
-    );
     // The lead-in and lead-out are a few mm at 100 mm/s: well under a second with every stop.
-    assert!(motion.duration() < 1.0, "{}", motion.duration());
-    assert!(w.grid_points <= 5_000, "{w:?}");
-    assert!(w.refinements <= 5, "{w:?}");
-    let r = ratios(&m, motion);
-    assert!(
-        r.iter().all(|&v| v <= 1.0 + 1e-9),
-        "within every limit: {r:?}"
-    );
+    let duration = check(&m, &out.programs[0].motion, 5_000);
+    assert!(duration < 1.0, "{duration}");
 }
 
 #[test]
@@ -116,26 +94,12 @@ fn a_pure_rotation_at_a_point_is_planned_at_the_rotary_limits() {
     let out = Job::new(curves, zero.clone()).run().expect("run");
     let m = MachineModel::new(zero).expect("model");
     let motion = &out.programs[0].motion;
-    let w = motion.work();
-    let stats = motion.path_stats();
-    let cut: f64 = stats.iter().map(|p| p.cutting_length).sum();
+    let cut: f64 = motion.path_stats().iter().map(|p| p.cutting_length).sum();
     // The 90 degree turn of A and C at their limits (600 deg/s, 20,000 deg/s^2, 10 ms jerk
-    // time) takes about 0.2 s; the 54.5 mm at 100 mm/s 0.55 s; a few stops more.
-    println!(
-        "{} cycles ({:.3} s), {cut:.2} mm cut, {w:?}",
-        motion.cycles(),
-        motion.duration()
-    );
+    // time) takes about 0.2 s, the 54.5 mm at 100 mm/s 0.55 s; a few stops more.
+    let duration = check(&m, motion, 20_000);
     assert!(
-        motion.duration() < cut / 100.0 + 1.0,
-        "bounded by the geometry: {} s",
-        motion.duration()
-    );
-    assert!(w.grid_points <= 20_000, "{w:?}");
-    assert!(w.refinements <= 5, "{w:?}");
-    let r = ratios(&m, motion);
-    assert!(
-        r.iter().all(|&v| v <= 1.0 + 1e-9),
-        "within every limit: {r:?}"
+        duration < cut / 100.0 + 1.0,
+        "bounded by the geometry: {duration} s"
     );
 }

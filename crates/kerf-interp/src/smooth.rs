@@ -481,7 +481,8 @@ pub(crate) struct PathOptions {
     pub(crate) blend_tolerance: f64,
     /// Millimetres of path parameter one degree of each rotary axis (tilt, C) counts for
     /// ([`block_param_length`]): the slowest linear axis' velocity limit over the rotary axis'
-    /// own, so that a degree counts for as long as that axis takes to turn it at its limit.
+    /// own, over `plan::ROTATION_DOMINANCE` (5), so that the rotation counts only where it
+    /// would take 5 times longer at its limit than the tip's travel at the linear one.
     pub(crate) rotary_mm_per_deg: [f64; 2],
 }
 

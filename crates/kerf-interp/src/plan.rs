@@ -427,7 +427,14 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
         // excess: the check allows for the set-points' rounding, `verify::ROUNDING_ULPS`).
         let boost = REPAIR_ESCALATION.powi((refinements / 4) as i32);
         for v in &worst {
-            let f = |r: f64| 0.98 * boost / r.max(1.0);
+            // Per kind over its limit: 2 % under the excess; a kind not over it: no factor.
+            let f = |r: f64| {
+                if r > 0.0 {
+                    0.98 * boost / r.max(1.0)
+                } else {
+                    1.0
+                }
+            };
             let [fv, fa, fj] = v.ratios.map(f);
             let (fx, fa) = ((fv * fv).min(fa).min(fj.powf(1.0 / 3.0)), fa.min(fj));
             let (mut lo, mut hi) = (

@@ -31,9 +31,9 @@ pub(super) struct Violation {
     pub(super) limit: f64,
 }
 
-/// Every cycle over a limit, worst first, bad cycles less than [`MERGE_CYCLES`] apart merged into
-/// one window (so memory stays bounded by the windows, not the bad cycles: a plan over its jerk
-/// in 18 M cycles held 18 M violations). A cycle is over a limit when its value exceeds the limit
+/// Every cycle over a limit, worst first, each its own window up to [`MAX_WINDOWS`], then bad
+/// cycles less than [`MERGE_CYCLES`] apart merged into one window (so memory stays bounded: a
+/// plan over its jerk in 18 M cycles held 18 M violations). A cycle is over a limit when its value exceeds the limit
 /// (1e-6 relative slack) by more than the rounding of the set-points can
 /// ([`ROUNDING_ULPS`]). Velocity at cycle `i` is
 /// `(q_i - q_{i-1}) / T`, acceleration `(q_{i+1} - 2 q_i + q_{i-1}) / T^2`, jerk
@@ -112,10 +112,11 @@ pub(super) fn verify<M: AxisModel + ?Sized>(
                 }
             }
         }
+        let out_len = out.len();
         if let Some(mut w) = worst {
             w.ratios = cycle_ratios;
             match out.last_mut() {
-                Some(last) if w.time - last.window[1] <= gap => {
+                Some(last) if out_len >= MAX_WINDOWS && w.time - last.window[1] <= gap => {
                     last.window[1] = w.time;
                     for k in 0..3 {
                         last.ratios[k] = last.ratios[k].max(w.ratios[k]);
@@ -158,5 +159,11 @@ fn out_of_range<M: AxisModel + ?Sized>(
     })
 }
 
-/// Bad cycles at most this many cycles apart share one window ([`verify`]).
+/// Once [`MAX_WINDOWS`] windows are held, bad cycles at most this many cycles apart share one
+/// window ([`verify`]).
 pub(super) const MERGE_CYCLES: usize = 6;
+/// Windows of one bad cycle each, each slowed by its own excess, up to this many; beyond,
+/// neighbouring bad cycles share a window slowed by the worst excess among them (which slows
+/// more than needed, so only where memory asks for it: merged from the first, a jerk-limited
+/// tilted slot planned 2 % longer).
+pub(super) const MAX_WINDOWS: usize = 100_000;

@@ -100,29 +100,44 @@ pub enum InterpError {
         /// Upper limit.
         max: f64,
     },
-    /// The feed plan did not bring every axis within its velocity and acceleration limits after
-    /// the allowed number of refinements. This does not happen with consistent limits; fix:
-    /// check that the machine's limits are positive and finite, or lower the feed.
+    /// The feed plan did not bring every axis within its velocity, acceleration and jerk
+    /// limits within [`crate::PlanOptions::max_refinements`] rounds of slowing the offending
+    /// windows (each round slows harder, so a motion that slowing can bring within the limits
+    /// is found well before): the path cannot be followed at any speed there, e.g. a jump of
+    /// the axes between two poses, or limits so small against the cycle that the set-points'
+    /// rounding exceeds them. Fix: check the poses around the block named and the machine's
+    /// limits against the cycle.
     #[error(
-        "feed plan: axis {axis} exceeds its {what} limit at cycle {cycle} ({value} > {limit})"
+        "feed plan: axis {axis} exceeds its {what} limit at cycle {cycle} (t = {time_s} s, block {block} of path {path}: {value} > {limit}) after {refinements} rounds of slowing it"
     )]
     LimitsNotMet {
         /// Axis name.
         axis: String,
-        /// "velocity" or "acceleration".
+        /// "velocity", "acceleration" or "jerk".
         what: &'static str,
         /// Cycle index.
         cycle: usize,
-        /// Measured value (per second or per second squared).
+        /// Program time of the cycle, s.
+        time_s: f64,
+        /// Index of the block (of the planned program) the cycle falls in.
+        block: usize,
+        /// Index of that block's path.
+        path: usize,
+        /// Measured value (per second, second squared or second cubed).
         value: f64,
         /// The limit.
         limit: f64,
+        /// The rounds of slowing done.
+        refinements: usize,
     },
-    /// The program would have more cycles than [`crate::PlanOptions::max_cycles`]. Fix: raise
-    /// the feed or the cycle time, or raise the limit.
-    #[error("program needs {cycles} cycles, more than the limit {limit}")]
+    /// The program would have more cycles than [`crate::PlanOptions::max_cycles`]: refused
+    /// before any planning when even a lower bound of its time (its tip travel at the feed,
+    /// each axis' travel at its velocity limit) is too long, else as soon as the plan is
+    /// timed, before the set-points are computed. Fix: raise the feed or the cycle time, or
+    /// raise the limit.
+    #[error("program needs {cycles:.0} cycles, more than the limit {limit}")]
     TooManyCycles {
-        /// Cycles needed (estimated).
+        /// Cycles needed: the plan's, or the lower bound's when refused before planning.
         cycles: f64,
         /// The limit.
         limit: usize,

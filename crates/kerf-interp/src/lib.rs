@@ -83,7 +83,7 @@ pub use output::{
 };
 pub use plan::{
     link_paths, link_paths_through, link_paths_with_retract, plan, plan_owned, Cycles, Motion,
-    PathStats, PlanOptions,
+    PathStats, PlanOptions, PlanWork,
 };
 pub use plan::{ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_FILTER_WIDTH, JERK_STATIC_SHARE};
 #[cfg(feature = "research")]

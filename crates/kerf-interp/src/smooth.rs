@@ -8,7 +8,9 @@
 //!
 //! Along a run the tip is a clamped C2 cubic spline through the block ends, the arcs'
 //! intermediate points and points of every arc at most [`ARC_NODE_DEG`] apart (so the spline
-//! follows the arcs within a few micrometres), parameterized by the blocks' own arc length `s`;
+//! follows the arcs within a few micrometres), parameterized by `s`, which counts each block's
+//! tip travel or, where larger, its rotary travel in millimetre equivalents
+//! ([`block_param_length`]);
 //! the rotary axes are a second clamped C2 cubic spline through the stations (block ends and arc
 //! intermediate points). The linear axes follow from the machine model at every `s`. The ends
 //! are clamped to the tangent of the first and last block, and a run's ends, and every block's
@@ -210,6 +212,12 @@ pub(crate) struct Run {
     pub(crate) last: usize,
     /// Path parameter of each block's start along the run, and the run's length at the end.
     pub(crate) starts: Vec<f64>,
+    /// Each block's own parameter (tip mm, degrees for a turn) per unit of the run's parameter:
+    /// 1 where the tip's travel dominates, less where the rotary axes' does
+    /// ([`block_param_length`]).
+    pub(crate) ratio: Vec<f64>,
+    /// Tip travel along the run, mm.
+    pub(crate) tip_len: f64,
     /// True for cutting runs: the programmed feed caps the tip speed.
     pub(crate) cutting: bool,
     /// The tip moves (false for pure rotations: no feed or chord cap).
@@ -315,11 +323,16 @@ impl Run {
         self.axes_raw(model, s)
     }
 
-    /// Tip derivatives `(t', t'')` with respect to `s` (of the blended tip by central
-    /// differences, step 1e-3 mm).
+    /// Tip derivatives `(t', t'')` with respect to `s`: of the blended tip by central
+    /// differences, step 1e-3 mm or a quarter of the window, whichever is smaller, so that
+    /// the differences stay inside the run (the window is at most `min(s, len - s)`); of the
+    /// spline itself where the window is narrower than [`BLEND_MIN_MM`] (near a run's ends,
+    /// where the mean is the spline to within `w^2 max |p''| / 6`, and differences over such a
+    /// step would be rounding).
     pub(crate) fn tip_derivatives(&self, s: f64) -> (Vector3<f64>, Vector3<f64>) {
-        if self.blend_width(s) > 0.0 {
-            let h = 1e-3;
+        let w = self.blend_width(s);
+        if w >= BLEND_MIN_MM {
+            let h = (0.25 * w).min(1e-3);
             let (a, b, c) = (self.tip_at(s - h), self.tip_at(s), self.tip_at(s + h));
             let d1 = Vector3::from(std::array::from_fn(|d| (c[d] - a[d]) / (2.0 * h)));
             let d2 = Vector3::from(std::array::from_fn(|d| {
@@ -331,14 +344,18 @@ impl Run {
         (Vector3::from(d[0]), Vector3::from(d[1]))
     }
 
-    /// The block index (program) and the parameter within it at run parameter `s`.
+    /// The block index (program) and the block's own parameter ([`Block::pose_at`]: tip mm,
+    /// degrees for a turn) at run parameter `s`.
     pub(crate) fn block_at(&self, s: f64) -> (usize, f64) {
         let j = self
             .starts
             .partition_point(|&v| v <= s)
             .clamp(1, self.starts.len() - 1)
             - 1;
-        (self.first + j, (s - self.starts[j]).max(0.0))
+        (
+            self.first + j,
+            ((s - self.starts[j]) * self.ratio[j]).max(0.0),
+        )
     }
 }
 
@@ -429,10 +446,24 @@ fn chord_of_curve(run: &[Block], j: usize, n: usize) -> bool {
     k_n > 0.0 && k_j >= 0.5 * k_n
 }
 
+/// Two neighbouring blocks whose lengths (in the run's parameter) differ by more than this
+/// factor do not share a run: no grading of nodes (at most 4096 a block) can make the spacing
+/// of an interpolating spline's nodes change gently across such a jump, and the C2 spline rings
+/// (a 1 mm lead-in arc's 0.087 mm chord followed by a 1e-8 mm hole's chord swung the tip's
+/// derivative to 9e5 and the run planned for 1,299 s).
+pub(crate) const SPACING_BREAK: f64 = 1e5;
+
 /// True when blocks `a` and `a + 1` meet at a true corner (or must not share a run).
-fn breaks(blocks: &[Block], a: usize) -> bool {
+fn breaks(blocks: &[Block], a: usize, opts: &PathOptions) -> bool {
     let (x, y) = (&blocks[a], &blocks[a + 1]);
     if x.rapid != y.rapid || x.path != y.path {
+        return true;
+    }
+    let (lx, ly) = (
+        block_param_length(x, opts.rotary_mm_per_deg),
+        block_param_length(y, opts.rotary_mm_per_deg),
+    );
+    if lx.max(ly) > SPACING_BREAK * lx.min(ly) {
         return true;
     }
     let (Some(t0), Some(t1)) = (tangent(blocks, a, true), tangent(blocks, a + 1, false)) else {
@@ -448,6 +479,49 @@ pub(crate) struct PathOptions {
     pub(crate) rotary_ranges: [Option<[f64; 2]>; 2],
     /// Largest distance of the blended tip from the tip spline, mm; 0 for no blend.
     pub(crate) blend_tolerance: f64,
+    /// Millimetres of path parameter one degree of each rotary axis (tilt, C) counts for
+    /// ([`block_param_length`]): the slowest linear axis' velocity limit over the rotary axis'
+    /// own, over `plan::ROTATION_DOMINANCE` (5), so that the rotation counts only where it
+    /// would take 5 times longer at its limit than the tip's travel at the linear one.
+    pub(crate) rotary_mm_per_deg: [f64; 2],
+}
+
+/// The length of a block in the run's path parameter: the larger of its tip travel and its
+/// rotary travel in millimetre equivalents (`max_k |dtheta_k| rotary_mm_per_deg_k`).
+///
+/// The tip's arc length alone is no parameter where the tool turns about a nearly fixed tip (a
+/// pole, an edge the tool axis turns over): a block of 1e-6 mm that turns C by a degree has
+/// `dC/ds` = 1e6 degrees per mm, its splines ring across the neighbouring blocks and the
+/// planner crawls (a 201-pose trim line asked for 114 M cycles). Counting the rotation keeps
+/// every axis' derivative bounded (`|q'_rot| <= 1 / rotary_mm_per_deg`), and the time-optimal
+/// profile does not depend on the parameter. A rotation-free block keeps its tip length, so
+/// programs whose tip travel dominates are planned as before.
+pub(crate) fn block_param_length(b: &Block, rotary_mm_per_deg: [f64; 2]) -> f64 {
+    let rot = (0..2)
+        .map(|k| (b.end_axes[3 + k] - b.start_axes[3 + k]).abs() * rotary_mm_per_deg[k])
+        .fold(0.0, f64::max);
+    let rot = if b.is_arc() {
+        // Piecewise through the middle station: the travel of both halves.
+        (0..2)
+            .map(|k| {
+                ((b.mid_axes[3 + k] - b.start_axes[3 + k]).abs()
+                    + (b.end_axes[3 + k] - b.mid_axes[3 + k]).abs())
+                    * rotary_mm_per_deg[k]
+            })
+            .fold(rot, f64::max)
+    } else {
+        rot
+    };
+    match b.geometry {
+        Geometry::Turn { .. } => {
+            if rot > 0.0 {
+                rot
+            } else {
+                b.length()
+            }
+        }
+        _ => b.length().max(rot),
+    }
 }
 
 /// Cuts the blocks into runs and builds each run's splines.
@@ -455,7 +529,7 @@ pub(crate) fn runs(blocks: &[Block], opts: &PathOptions) -> Vec<Run> {
     let mut out = Vec::new();
     let mut first = 0;
     for b in 0..blocks.len() {
-        if b + 1 == blocks.len() || breaks(blocks, b) {
+        if b + 1 == blocks.len() || breaks(blocks, b, opts) {
             out.push(build(blocks, first, b, opts));
             first = b + 1;
         }
@@ -466,10 +540,16 @@ pub(crate) fn runs(blocks: &[Block], opts: &PathOptions) -> Vec<Run> {
 fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run {
     let run = &blocks[first..=last];
     let mut starts = Vec::with_capacity(run.len() + 1);
+    let mut ratio = Vec::with_capacity(run.len());
+    let plen: Vec<f64> = run
+        .iter()
+        .map(|b| block_param_length(b, opts.rotary_mm_per_deg))
+        .collect();
     let mut s = 0.0;
-    for b in run {
+    for (b, &l) in run.iter().zip(&plen) {
         starts.push(s);
-        s += b.length();
+        ratio.push(b.length() / l);
+        s += l;
     }
     starts.push(s);
     // Node spacing of each block (before line subdivision).
@@ -487,7 +567,8 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
     let is_line = |b: &Block| matches!(b.geometry, Geometry::Line { .. });
     let own: Vec<f64> = run
         .iter()
-        .map(|b| b.length() / arc_parts(b) as f64)
+        .zip(&plen)
+        .map(|(b, l)| l / arc_parts(b) as f64)
         .collect();
     let mut spacing = own.clone();
     for j in 0..run.len() {
@@ -545,14 +626,15 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
             Geometry::Line { .. } if spacing[j] > 0.0 => {
                 // Lines longer than their graded spacing get nodes on the line, so that the
                 // spline does not bulge between far-apart nodes.
-                ((b.length() / spacing[j] * (1.0 - 1e-12)).ceil() as usize).clamp(1, 4096)
+                ((plen[j] / spacing[j] * (1.0 - 1e-12)).ceil() as usize).clamp(1, 4096)
             }
             Geometry::Line { .. } => 1,
             Geometry::Turn { .. } => 1,
         };
         for k in 0..parts {
-            let sk = s0 + b.length() * k as f64 / parts as f64;
-            let (tip, _, _) = b.pose_at(sk - s0);
+            let f = k as f64 / parts as f64;
+            let sk = s0 + plen[j] * f;
+            let (tip, _, _) = b.pose_at(b.length() * f);
             ts.push(sk);
             ty.push([tip.x, tip.y, tip.z]);
         }
@@ -560,7 +642,7 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         ry.push([b.start_axes[3], b.start_axes[4]]);
         let mid = b.mid_length();
         if b.is_arc() && mid > 0.0 && mid < b.length() {
-            rs.push(s0 + mid);
+            rs.push(s0 + mid / ratio[j]);
             ry.push([b.mid_axes[3], b.mid_axes[4]]);
         }
     }
@@ -582,8 +664,9 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
                 tangent(blocks, b, at_end)
             }
         };
-        let a = end_tangent(first, false).unwrap_or_else(Vector3::zeros);
-        let b = end_tangent(last, true).unwrap_or_else(Vector3::zeros);
+        // Unit tangents per tip mm, times the tip mm per unit of the run's parameter.
+        let a = end_tangent(first, false).unwrap_or_else(Vector3::zeros) * ratio[0];
+        let b = end_tangent(last, true).unwrap_or_else(Vector3::zeros) * ratio[ratio.len() - 1];
         ([a.x, a.y, a.z], [b.x, b.y, b.z])
     } else {
         ([0.0; 3], [0.0; 3])
@@ -604,10 +687,18 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
     // (Taylor: |p(s + x) - p(s) - x p'(s)| <= x^2 / 2 max |p''|, the linear term averages out).
     let blend = if moves_tip && opts.blend_tolerance > 0.0 {
         let m = tip.max_second_derivative();
-        if m > 0.0 {
+        let w = if m > 0.0 {
             (6.0 * opts.blend_tolerance / m).sqrt().min(BLEND_MAX_MM)
         } else {
             BLEND_MAX_MM
+        };
+        // A narrower window blends nothing: it belongs to curvatures of over `6 e / W^2`
+        // (radii under a nanometre at 5 um), and the derivatives of the mean by differences
+        // would be rounding (a 1e-8 mm hole's window was 5e-20 mm).
+        if w >= BLEND_MIN_MM {
+            w
+        } else {
+            0.0
         }
     } else {
         0.0
@@ -623,11 +714,19 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         soft,
         blend,
         starts,
+        ratio,
+        tip_len: if moves_tip {
+            run.iter().map(Block::length).sum()
+        } else {
+            0.0
+        },
     }
 }
 
 /// Largest half-width of the blend, mm (bounds the pieces one mean spans).
 const BLEND_MAX_MM: f64 = 10.0;
+/// Smallest half-width of the blend, mm: below it the tip follows its spline unblended.
+const BLEND_MIN_MM: f64 = 1e-4;
 /// Width of the soft band inside a rotary axis' limits, degrees (at most a quarter of the range).
 pub(crate) const ROTARY_SOFT_DEG: f64 = 0.5;
 

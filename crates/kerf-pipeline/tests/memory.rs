@@ -24,9 +24,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-use kerf_nurbs::NurbsCurve;
 use kerf_pipeline::{Job, JobOptions};
-use nalgebra::Point3;
 
 mod common;
 
@@ -94,33 +92,6 @@ static ALLOCATOR: Counting = Counting;
 /// One measurement at a time: the counters are global.
 static SERIAL: Mutex<()> = Mutex::new(());
 
-/// A circle of radius `r` about `(cx, cy, 0)`: the exact rational quadratic, nine control
-/// points.
-fn circle(cx: f64, cy: f64, r: f64) -> NurbsCurve {
-    let w = 0.5f64.sqrt();
-    let corners = [
-        (1., 0.),
-        (1., 1.),
-        (0., 1.),
-        (-1., 1.),
-        (-1., 0.),
-        (-1., -1.),
-        (0., -1.),
-        (1., -1.),
-        (1., 0.),
-    ];
-    NurbsCurve::try_new(
-        2,
-        vec![0., 0., 0., 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1., 1., 1.],
-        corners
-            .iter()
-            .map(|(a, b)| Point3::new(cx + r * a, cy + r * b, 0.0))
-            .collect(),
-        Some(vec![1., w, 1., w, 1., w, 1., w, 1.]),
-    )
-    .expect("a circle")
-}
-
 /// `n` circles of radius 2 to 4 mm on a 10 mm grid centred on the origin, twice as wide as
 /// deep (20,000 fit the AC head's travel), with `kerf run`'s defaults at 0.01 mm.
 fn circles(n: usize) -> Job {
@@ -131,7 +102,7 @@ fn circles(n: usize) -> Job {
         let r = 2.0 + 2.0 * ((i * 7919) % 1000) as f64 / 1000.0;
         let cx = (i % cols) as f64 * 10.0 - (cols - 1) as f64 * 5.0;
         let cy = (i / cols) as f64 * 10.0 - (rows - 1) as f64 * 5.0;
-        job = job.with_curve(format!("c{i}"), circle(cx, cy, r), None);
+        job = job.with_curve(format!("c{i}"), common::circle(cx, cy, r), None);
     }
     job.with_options(JobOptions::default().with_tolerance_mm(0.01))
 }

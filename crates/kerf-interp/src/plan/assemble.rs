@@ -73,10 +73,12 @@ pub(super) fn assemble(
         st.duration += tm.duration;
         if run.cutting && run.moves_tip {
             st.cutting_time += tm.duration;
-            st.cutting_length += run.len();
-            // Sample the run at half a cycle.
+            st.cutting_length += run.tip_len;
+            // Sample the run at half a cycle, at most 64 samples a grid point (the profile is
+            // one polynomial per grid interval): a 10 us cycle would otherwise sample a 189 s
+            // circle 38 M times for a share.
             let dt = opts.cycle_s / 2.0;
-            let steps = (tm.duration / dt).ceil() as usize;
+            let steps = ((tm.duration / dt).ceil() as usize).min(64 * tm.s.len());
             let dt = tm.duration / steps.max(1) as f64;
             for k in 0..steps {
                 let t = (k as f64 + 0.5) * dt;
@@ -129,6 +131,7 @@ pub(super) fn assemble(
         cycle: opts.cycle_s,
         refinements,
         grid_points,
+        work: super::motion::PlanWork::default(),
         axis_names: names.clone(),
         block_times,
         feeds,

@@ -23,6 +23,20 @@ pub struct PathStats {
     pub length_at_feed: f64,
 }
 
+/// The work of one plan, counted (see [`Motion::work`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub struct PlanWork {
+    /// Grid points the time-optimal solver worked on, summed over the first plan and every
+    /// re-plan of a run after a refinement.
+    pub grid_points: usize,
+    /// Set-points computed by the verifications (each verification computes every cycle of the
+    /// program once).
+    pub verified_cycles: usize,
+    /// Refinements (re-plans after a verification found a cycle over a limit).
+    pub refinements: usize,
+}
+
 /// A planned program: blocks, their feed profile, and the set-points it gives.
 #[derive(Debug, Clone)]
 pub struct Motion {
@@ -35,6 +49,8 @@ pub struct Motion {
     pub(super) cycle: f64,
     pub(super) refinements: usize,
     pub(super) grid_points: usize,
+    /// The planner's work, counted (set once the plan is verified).
+    pub(super) work: PlanWork,
     pub(super) axis_names: [String; 5],
     /// Start and end time of each block.
     pub(super) block_times: Vec<[f64; 2]>,
@@ -93,6 +109,13 @@ impl Motion {
     /// Grid points the time-optimal planner worked on (the first plan; a measure of work).
     pub fn grid_points(&self) -> usize {
         self.grid_points
+    }
+
+    /// What planning this motion cost, counted: grid points over every plan and re-plan, and
+    /// set-points computed by the verifications. Bounded by the program, not by how the
+    /// rounding falls: the tests hold these counts, never a time.
+    pub fn work(&self) -> PlanWork {
+        self.work
     }
 
     /// How many runs (smooth stretches between true corners, rapid moves and turns) the plan

@@ -61,6 +61,7 @@ pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};
 pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};
 pub use post::{post_toolpath, toolpath_poses, MissingNormals, Posted};
 pub use ranges::OptionRange;
+pub use run::PLACEMENT_RETRIES;
 
 /// A stage of a job, as [`Progress`] reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -40,8 +40,91 @@ impl Job {
     }
 }
 
-/// The stages of [`Job::run_with_progress`], in order.
+/// How many times `--place auto` is tried again with a wider margin when the program's motion
+/// (a retract, traverse, pierce point or blend) leaves a linear axis' travel.
+pub const PLACEMENT_RETRIES: usize = 3;
+
+/// The stages of [`Job::run_with_progress`], in order. A placement that `auto` chose must hold
+/// every move of the program, not only the cutting poses it was checked with: the search keeps
+/// the retract (or the pierce standoff, if longer) plus 1 mm from every linear limit, and if
+/// the motion still leaves a linear axis' range by `d` mm (a lead's pose, a set-point or a
+/// pierce point), the placement is searched
+/// again keeping `d + 1` mm more, at most [`PLACEMENT_RETRIES`] times; then the search's own
+/// refusal ("no placement fits") or the range error stands. A placement the user gave is never
+/// moved: its range error is reported as it is.
 fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
+    let mut extra = 0.0;
+    let mut attempt = 0;
+    loop {
+        match run_placed(job, progress, extra, attempt) {
+            Err(e)
+                if job.options.place == crate::PlaceMode::Auto && attempt < PLACEMENT_RETRIES =>
+            {
+                match linear_overshoot(&e) {
+                    Some(d) => {
+                        extra += d + 1.0;
+                        attempt += 1;
+                    }
+                    None => return Err(e),
+                }
+            }
+            r => return r,
+        }
+    }
+}
+
+/// How far (mm) the program's motion leaves a linear axis' range, if that is the error: a
+/// set-point or pierce point of the plan, or a pose of a lead the placement search did not see.
+fn linear_overshoot(e: &crate::Error) -> Option<f64> {
+    let over = |axis: &str, value: f64, min: f64, max: f64| {
+        let over = (min - value).max(value - max);
+        (matches!(axis, "X" | "Y" | "Z") && over.is_finite() && over > 0.0).then_some(over)
+    };
+    let source = match e {
+        crate::Error::Interp { source, .. } => source,
+        // A lead-in, lead-out or inserted pose the search did not see.
+        crate::Error::Kinematics { source, .. } => {
+            return match source.without_file() {
+                kerf_kinematics::KinematicsError::OutOfLimits {
+                    axis,
+                    value,
+                    min,
+                    max,
+                    ..
+                } => over(axis, *value, *min, *max),
+                _ => None,
+            };
+        }
+        _ => return None,
+    };
+    let (axis, value, min, max) = match source {
+        kerf_interp::InterpError::OutOfRange {
+            axis,
+            value,
+            min,
+            max,
+            ..
+        }
+        | kerf_interp::InterpError::PierceOutOfRange {
+            axis,
+            value,
+            min,
+            max,
+            ..
+        } => (axis, *value, *min, *max),
+        _ => return None,
+    };
+    over(axis, value, min, max)
+}
+
+/// The stages once, the placement search keeping `extra_margin_mm` more from the linear
+/// limits (`attempt` is reported).
+fn run_placed(
+    job: &Job,
+    progress: &(dyn Fn(Progress) + Sync),
+    extra_margin_mm: f64,
+    attempt: usize,
+) -> Result<Output> {
     let start = Instant::now();
     let path = job.source.as_deref();
     let file = &job.curves;
@@ -92,7 +175,11 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         }
         _ => None,
     };
-    // 3b. Where the part goes on the machine; from here on, workpiece coordinates.
+    // 3b. Where the part goes on the machine; from here on, workpiece coordinates. The search
+    // keeps the longest move off the cut along the tool axis (the retract or the pierce
+    // standoff) and 1 mm of blending from every linear limit.
+    let standoff = machine.process.pierce_standoff.unwrap_or(0.0);
+    let placement_margin = o.retract_mm.max(standoff).max(0.0) + 1.0 + extra_margin_mm;
     let id_refs: Vec<&str> = file.curves.iter().map(|c| c.id.as_str()).collect();
     let placed = crate::place::place(
         machine,
@@ -100,7 +187,7 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
         head_lines.as_ref().map_or(&poses, |(_, turned)| turned),
         o.place,
         &popts,
-        o.retract_mm.max(0.0) + 1.0,
+        placement_margin,
         path,
     )?;
     let placed = match head_lines {
@@ -428,6 +515,12 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let placement_json = {
         let mut p = placed.json(&id_refs);
         p["walls"] = crate::cuts::walls_json(file, &walls);
+        if placed.auto {
+            // The margin the search kept from the linear limits, and how many searches it took
+            // for every move of the program to stay within the travel.
+            p["margin_mm"] = json!(placement_margin);
+            p["searches"] = json!(attempt + 1);
+        }
         p["walls_note"] = json!(format!(
             "contours whose only named surface is a wall at most {} mm wide across them (its control net's extent along n x t, the wall's direction across the contour; 0 = off): a hole's or slot's wall, the sheet's edge face, named instead of the sheet's face. The beam runs along the wall (side 'given' is the head on the face of the sheet that holds the contour, away from the wall), the lead-ins lie across it, on the side the wall's outward normal points to (the scrap); curves with a scrap key or several surfaces are not looked at",
             o.wall_axis_max_mm

@@ -16,7 +16,7 @@ use kerf_pipeline::{Job, JobOptions, Output, PlaceMode, DEFAULT_TILT_TOLERANCE_D
 use nalgebra::Vector3;
 
 mod common;
-use common::fixture;
+use common::{assert_setpoints_within_limits, fixture};
 
 const MACHINES: [&str; 5] = [
     "ac_head.json",
@@ -31,54 +31,6 @@ fn step(name: &str) -> CurvesFile {
     let import = kerf_step::import_file(fixture(name), &kerf_step::ImportOptions::default())
         .expect("STEP import");
     curves::from_raw(import.file, Path::new(".")).expect("valid document")
-}
-
-/// Every set-point of every program within the machine's ranges, velocities and
-/// accelerations, read back from the CSV text.
-fn assert_setpoints_within_limits(what: &str, machine: &Machine, out: &Output, cycle: f64) {
-    for setup in 0..out.programs.len() {
-        let mut text = Vec::new();
-        out.write_setpoints(setup, &mut text).expect("csv");
-        let text = String::from_utf8(text).expect("utf-8");
-        let rows: Vec<[f64; 5]> = text
-            .lines()
-            .skip(1)
-            .map(|l| {
-                let v: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
-                [v[1], v[2], v[3], v[4], v[5]]
-            })
-            .collect();
-        assert!(rows.len() > 10, "{what}: a real program");
-        for (i, r) in rows.iter().enumerate() {
-            for k in 0..5 {
-                if let Some(range) = machine.limits[k] {
-                    assert!(
-                        r[k] >= range.min - 1e-9 && r[k] <= range.max + 1e-9,
-                        "{what}: cycle {i} axis {k} = {} outside [{}, {}]",
-                        r[k],
-                        range.min,
-                        range.max
-                    );
-                }
-                if i > 0 {
-                    let v = (r[k] - rows[i - 1][k]) / cycle;
-                    let vmax = machine.max_velocity[k] / 60.0;
-                    assert!(
-                        v.abs() <= vmax * (1.0 + 1e-9) + 1e-9,
-                        "{what}: cycle {i} axis {k} velocity {v} > {vmax}"
-                    );
-                }
-                if i > 0 && i + 1 < rows.len() {
-                    let a = (rows[i + 1][k] - 2.0 * r[k] + rows[i - 1][k]) / (cycle * cycle);
-                    let amax = machine.max_acceleration[k];
-                    assert!(
-                        a.abs() <= amax * (1.0 + 1e-6),
-                        "{what}: cycle {i} axis {k} acceleration {a} > {amax}"
-                    );
-                }
-            }
-        }
-    }
 }
 
 /// Every cutting pose's tool axis within `tol_deg` of the line of the surface normal at its

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use kerf_kinematics::Machine;
 use kerf_nurbs::NurbsCurve;
+use kerf_pipeline::Output;
 use nalgebra::Point3;
 
 /// A file under `fixtures/`.
@@ -45,4 +46,57 @@ pub(crate) fn circle(cx: f64, cy: f64, r: f64) -> NurbsCurve {
         Some(vec![1., w, 1., w, 1., w, 1., w, 1.]),
     )
     .expect("a circle")
+}
+
+/// Every set-point of every program within the machine's ranges, velocities and
+/// accelerations, read back from the CSV text.
+pub(crate) fn assert_setpoints_within_limits(
+    what: &str,
+    machine: &Machine,
+    out: &Output,
+    cycle: f64,
+) {
+    for setup in 0..out.programs.len() {
+        let mut text = Vec::new();
+        out.write_setpoints(setup, &mut text).expect("csv");
+        let text = String::from_utf8(text).expect("utf-8");
+        let rows: Vec<[f64; 5]> = text
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let v: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
+                [v[1], v[2], v[3], v[4], v[5]]
+            })
+            .collect();
+        assert!(rows.len() > 10, "{what}: a real program");
+        for (i, r) in rows.iter().enumerate() {
+            for k in 0..5 {
+                if let Some(range) = machine.limits[k] {
+                    assert!(
+                        r[k] >= range.min - 1e-9 && r[k] <= range.max + 1e-9,
+                        "{what}: cycle {i} axis {k} = {} outside [{}, {}]",
+                        r[k],
+                        range.min,
+                        range.max
+                    );
+                }
+                if i > 0 {
+                    let v = (r[k] - rows[i - 1][k]) / cycle;
+                    let vmax = machine.max_velocity[k] / 60.0;
+                    assert!(
+                        v.abs() <= vmax * (1.0 + 1e-9) + 1e-9,
+                        "{what}: cycle {i} axis {k} velocity {v} > {vmax}"
+                    );
+                }
+                if i > 0 && i + 1 < rows.len() {
+                    let a = (rows[i + 1][k] - 2.0 * r[k] + rows[i - 1][k]) / (cycle * cycle);
+                    let amax = machine.max_acceleration[k];
+                    assert!(
+                        a.abs() <= amax * (1.0 + 1e-6),
+                        "{what}: cycle {i} axis {k} acceleration {a} > {amax}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -141,3 +141,52 @@ fn near_the_pole_c_stands_still_and_the_cut_is_faster() {
     );
     assert!(after < before - 300.0, "{t}");
 }
+
+/// The shipped propeller's blade edge `prop-propeller-e40` on a fork head with a B tilt, a
+/// 200 mm pivot, no offsets and no limits: with the exact normals C spins where the edge's
+/// normal passes near vertical (11 degrees of C for 0.03 degrees of tool axis); within the
+/// 1-degree cone no move turns C by more than 2 degrees and 5 times the tool axis' turn.
+#[test]
+fn the_propeller_edge_makes_no_rotary_jumps_within_the_cone() {
+    let mut v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(fixture("machines/fork_head.json")).expect("machine"),
+    )
+    .expect("json");
+    v["kinematics"] = serde_json::json!({
+        "type": "fork-head", "tilt": "B", "L": 200.0, "d": [0.0, 0.0, 0.0], "tool_lateral": [0.0, 0.0]
+    });
+    for axis in ["X", "Y", "Z", "B", "C"] {
+        v["limits"][axis] = serde_json::Value::Null;
+    }
+    let machine = kerf_kinematics::Machine::from_value(&v).expect("machine");
+    let jumps = |tilt_deg: f64| {
+        let curves =
+            kerf_format::curves::load(fixture("realdata/occt_propeller.json")).expect("part");
+        let out = Job::new(curves, machine.clone())
+            .with_options(
+                JobOptions::default()
+                    .with_tolerance_mm(0.01)
+                    .with_path(PathOptions::default().with_tilt_tolerance_deg(tilt_deg)),
+            )
+            .run()
+            .expect("run");
+        let p = out
+            .axes
+            .paths
+            .iter()
+            .find(|p| p.id == "prop-propeller-e40")
+            .expect("path");
+        (1..p.positions.len())
+            .filter(|&i| {
+                let d_c = (p.positions[i][4] - p.positions[i - 1][4]).abs();
+                let (a, b) = (&p.poses[i - 1], &p.poses[i]);
+                let turn = Vector3::new(a[3], a[4], a[5])
+                    .angle(&Vector3::new(b[3], b[4], b[5]))
+                    .to_degrees();
+                d_c > 2.0 && d_c > 5.0 * turn
+            })
+            .count()
+    };
+    assert!(jumps(0.0) >= 5, "the exact normals spin C");
+    assert_eq!(jumps(1.0), 0);
+}

@@ -483,11 +483,33 @@ fn breaks(blocks: &[Block], a: usize, opts: &PathOptions) -> bool {
     if rotation(x, lx) != rotation(y, ly) && lx.max(ly) > GRADE_RATIO * lx.min(ly) {
         return true;
     }
+    // A corner of the rotary axes where the tip runs on smoothly: a bend of the surface ending
+    // in a plane (the tilt turning 5.7 degrees per mm, then not at all). The C2 splines of a
+    // run through such a kink overshoot the rotaries (measured: A to 113 degrees on a path
+    // whose poses reach 90, the tool axis 66 degrees off them). The rotary axes' derivatives
+    // along the path parameter, each in `[-1, 1]` in its millimetre equivalents, jumping by
+    // more than ROTARY_KINK between two blocks end the run.
+    let share = |b: &Block, l: f64| -> [f64; 2] {
+        if l <= 0.0 {
+            return [0.0; 2];
+        }
+        std::array::from_fn(|k| {
+            (b.end_axes[3 + k] - b.start_axes[3 + k]) * opts.rotary_mm_per_deg[k] / l
+        })
+    };
+    let (sx, sy) = (share(x, lx), share(y, ly));
+    if (0..2).any(|k| (sx[k] - sy[k]).abs() > ROTARY_KINK) {
+        return true;
+    }
     let (Some(t0), Some(t1)) = (tangent(blocks, a, true), tangent(blocks, a + 1, false)) else {
         return true;
     };
     t0.dot(&t1) < CORNER_DEG.to_radians().cos()
 }
+
+/// The jump of a rotary axis' derivative along the path parameter (millimetre equivalents per
+/// millimetre, at most 1 in size) between two blocks that ends a run (`breaks`).
+const ROTARY_KINK: f64 = 0.5;
 
 /// How the path is built: the rotary axes' ranges and the blend tolerance.
 #[derive(Debug, Clone, Copy)]

@@ -102,6 +102,47 @@ fn assert_in_the_cone(
     }
 }
 
+/// The set-points' tilt and C within the range the program's positions span (cuts, leads and
+/// traverses), up to 0.1 degree: the planner's splines do not swing the rotary axes past the
+/// poses (a bend ending in a plane once made A overshoot by 23 degrees, the tool axis 66
+/// degrees off the poses, with the tip on the path).
+fn assert_rotaries_within_the_poses(what: &str, out: &Output) {
+    let mut range = [(f64::INFINITY, f64::NEG_INFINITY); 2];
+    for p in &out.axes.paths {
+        let parts = [Some(&p.positions), p.lead_in.as_ref().map(|m| &m.positions)]
+            .into_iter()
+            .chain([
+                p.lead_out.as_ref().map(|m| &m.positions),
+                p.traverse.as_ref().map(|m| &m.positions),
+            ]);
+        for q in parts.flatten().flatten() {
+            for k in 0..2 {
+                range[k] = (range[k].0.min(q[3 + k]), range[k].1.max(q[3 + k]));
+            }
+        }
+    }
+    for setup in 0..out.programs.len() {
+        let mut text = Vec::new();
+        out.write_setpoints(setup, &mut text).expect("csv");
+        for (i, l) in String::from_utf8(text)
+            .expect("utf-8")
+            .lines()
+            .skip(1)
+            .enumerate()
+        {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
+            for k in 0..2 {
+                let (lo, hi) = range[k];
+                assert!(
+                    v[4 + k] >= lo - 0.1 && v[4 + k] <= hi + 0.1,
+                    "{what}: cycle {i}: rotary axis {k} at {} beyond the poses' [{lo}, {hi}]",
+                    v[4 + k]
+                );
+            }
+        }
+    }
+}
+
 /// The angle (degrees) from the unit vector `u` to the shorter great-circle arc from `a` to `b`
 /// (unit vectors; `a == b` is the angle to `a`).
 fn angle_to_arc(u: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
@@ -138,6 +179,7 @@ fn trim_line(name: &str, file: CurvesFile) {
                 .run()
                 .unwrap_or_else(|e| panic!("{what}: {e}"));
             assert_setpoints_within_limits(&what, &machine, &out, 0.001);
+            assert_rotaries_within_the_poses(&what, &out);
             assert_in_the_cone(&what, &file, &machine, &out, DEFAULT_TILT_TOLERANCE_DEG);
         }
     }

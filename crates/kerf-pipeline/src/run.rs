@@ -41,17 +41,17 @@ impl Job {
 }
 
 /// How many times `--place auto` is tried again with a wider margin when the program's motion
-/// (a retract, traverse, pierce point or blend) leaves a linear axis' travel.
+/// (a lead, a retract, a traverse, a pierce point or a blend) leaves a linear axis' travel.
 pub const PLACEMENT_RETRIES: usize = 3;
 
 /// The stages of [`Job::run_with_progress`], in order. A placement that `auto` chose must hold
 /// every move of the program, not only the cutting poses it was checked with: the search keeps
 /// the retract (or the pierce standoff, if longer) plus 1 mm from every linear limit, and if
 /// the motion still leaves a linear axis' range by `d` mm (a lead's pose, a set-point or a
-/// pierce point), the placement is searched
-/// again keeping `d + 1` mm more, at most [`PLACEMENT_RETRIES`] times; then the search's own
-/// refusal ("no placement fits") or the range error stands. A placement the user gave is never
-/// moved: its range error is reported as it is.
+/// pierce point), the placement is searched again keeping `d + 1` mm more, at most
+/// [`PLACEMENT_RETRIES`] times; then the search's own refusal ("no placement fits") or the
+/// range error stands. Each search runs the whole job again (a failure case only). A placement
+/// the user gave is never moved: its range error is reported as it is.
 fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let mut extra = 0.0;
     let mut attempt = 0;

@@ -261,8 +261,8 @@ pub(crate) struct PostArgs {
     pub(crate) max_rotary_step: Option<f64>,
 
     /// How far the tool axis may tilt from the surface normal to save rotary motion, degrees
-    /// (default 1; 0 keeps the exact normal): C is held near the pole, creases are turned
-    /// over a distance, small wiggles of the normal are not followed.
+    /// (default 0, the exact normal; 1 suits sheet metal): C is held near the pole, creases are
+    /// turned over a distance, small wiggles of the normal are not followed.
     #[arg(long, value_name = "DEG", value_parser = crate::guard::tilt_deg)]
     pub(crate) tilt_tolerance: Option<f64>,
 
@@ -462,8 +462,8 @@ pub(crate) struct RunArgs {
     pub(crate) max_rotary_step: Option<f64>,
 
     /// How far the tool axis may tilt from the surface normal to save rotary motion, degrees
-    /// (default 1; 0 keeps the exact normal): C is held near the pole, creases are turned
-    /// over a distance, small wiggles of the normal are not followed.
+    /// (default 0, the exact normal; 1 suits sheet metal): C is held near the pole, creases are
+    /// turned over a distance, small wiggles of the normal are not followed.
     #[arg(long, value_name = "DEG", value_parser = crate::guard::tilt_deg)]
     pub(crate) tilt_tolerance: Option<f64>,
 

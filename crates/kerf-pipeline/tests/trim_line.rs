@@ -11,8 +11,9 @@ use std::path::Path;
 
 use kerf_format::curves::{self, CurvesFile, SurfaceGeometry};
 use kerf_interp::Dialect;
+use kerf_kinematics::PathOptions;
 use kerf_kinematics::{Axes, Machine};
-use kerf_pipeline::{Job, JobOptions, Output, PlaceMode, DEFAULT_TILT_TOLERANCE_DEG};
+use kerf_pipeline::{Job, JobOptions, Output, PlaceMode};
 use nalgebra::Vector3;
 
 mod common;
@@ -25,6 +26,8 @@ const MACHINES: [&str; 5] = [
     "head_table.json",
     "table_table.json",
 ];
+/// The tilt tolerance the trim lines are cut with (degrees).
+const TILT_DEG: f64 = 1.0;
 const DIALECTS: [Dialect; 3] = [Dialect::Generic, Dialect::Sinumerik, Dialect::Linuxcnc];
 
 fn step(name: &str) -> CurvesFile {
@@ -173,14 +176,15 @@ fn trim_line(name: &str, file: CurvesFile) {
             let what = format!("{name} on {m}, {}", dialect.name());
             let options = JobOptions::default()
                 .with_place(PlaceMode::Auto)
-                .with_dialect(dialect);
+                .with_dialect(dialect)
+                .with_path(PathOptions::default().with_tilt_tolerance_deg(TILT_DEG));
             let out = Job::new(file.clone(), machine.clone())
                 .with_options(options)
                 .run()
                 .unwrap_or_else(|e| panic!("{what}: {e}"));
             assert_setpoints_within_limits(&what, &machine, &out, 0.001);
             assert_rotaries_within_the_poses(&what, &out);
-            assert_in_the_cone(&what, &file, &machine, &out, DEFAULT_TILT_TOLERANCE_DEG);
+            assert_in_the_cone(&what, &file, &machine, &out, TILT_DEG);
         }
     }
 }

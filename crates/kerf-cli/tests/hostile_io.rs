@@ -298,6 +298,16 @@ fn every_numeric_option_has_an_upper_end_and_says_its_range() {
             "--pole-tolerance=1",
             "must be > 0 rad and <= 0.1 rad (got 1)",
         ),
+        (
+            &post,
+            "--tilt-tolerance=45",
+            "must be between 0 degrees and 10 degrees (got 45)",
+        ),
+        (
+            &whole,
+            "--tilt-tolerance=-1",
+            "must be between 0 degrees and 10 degrees (got -1)",
+        ),
         // STEP options were checked by the reader (exit 1); now by the command line, for
         // `import` and for `run` on a STEP file alike.
         (

@@ -149,7 +149,8 @@ fn run_placed(curves: &str, machine: &str, place: &str) -> Value {
                 let tilt = ap["tilt_max_deg"].as_f64();
                 assert_eq!(
                     tilt.is_some(),
-                    kerf_pipeline::DEFAULT_TILT_TOLERANCE_DEG > 0.0
+                    kerf_pipeline::DEFAULT_TILT_TOLERANCE_DEG > 0.0,
+                    "{id}: tilt_max_deg reported exactly when a tolerance is in force"
                 );
                 let angle = gu.angle(&want_u).to_degrees();
                 let allowed = tilt.map_or(1e-7, |t| t + 1e-9);

@@ -132,7 +132,7 @@ pub struct JobOptions {
 /// `kerf_kinematics::tilt_within_cone`) is the user's choice for now: the taut strings bend C
 /// and the tilt at points, and LinuxCNC's joint-space blends round those bends with the tool
 /// axis up to 1.9 degrees off kerf's poses (tube_saddle and the propeller in
-/// `tests/linuxcnc/check.py`, 0.007 and 0.27 degrees with the exact normals; kerf's own
+/// `tests/linuxcnc/check.py`, 0.007 and 0.19 degrees with the exact normals; kerf's own
 /// set-points stay within 0.06 degrees). The default becomes 1 degree once the strings' bends are
 /// rounded (`docs/kinematics.md`, "Tilt tolerance").
 pub const DEFAULT_TILT_TOLERANCE_DEG: f64 = 0.0;

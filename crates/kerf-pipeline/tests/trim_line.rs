@@ -17,7 +17,7 @@ use kerf_pipeline::{Job, JobOptions, Output, PlaceMode};
 use nalgebra::Vector3;
 
 mod common;
-use common::{assert_setpoints_within_limits, fixture};
+use common::{assert_setpoints_within_limits, fixture, setpoint_rows};
 
 const MACHINES: [&str; 5] = [
     "ac_head.json",
@@ -125,21 +125,13 @@ fn assert_rotaries_within_the_poses(what: &str, out: &Output) {
         }
     }
     for setup in 0..out.programs.len() {
-        let mut text = Vec::new();
-        out.write_setpoints(setup, &mut text).expect("csv");
-        for (i, l) in String::from_utf8(text)
-            .expect("utf-8")
-            .lines()
-            .skip(1)
-            .enumerate()
-        {
-            let v: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
+        for (i, v) in setpoint_rows(out, setup).iter().enumerate() {
             for k in 0..2 {
                 let (lo, hi) = range[k];
                 assert!(
-                    v[4 + k] >= lo - 0.1 && v[4 + k] <= hi + 0.1,
+                    v[3 + k] >= lo - 0.1 && v[3 + k] <= hi + 0.1,
                     "{what}: cycle {i}: rotary axis {k} at {} beyond the poses' [{lo}, {hi}]",
-                    v[4 + k]
+                    v[3 + k]
                 );
             }
         }

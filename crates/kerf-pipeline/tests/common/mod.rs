@@ -57,17 +57,7 @@ pub(crate) fn assert_setpoints_within_limits(
     cycle: f64,
 ) {
     for setup in 0..out.programs.len() {
-        let mut text = Vec::new();
-        out.write_setpoints(setup, &mut text).expect("csv");
-        let text = String::from_utf8(text).expect("utf-8");
-        let rows: Vec<[f64; 5]> = text
-            .lines()
-            .skip(1)
-            .map(|l| {
-                let v: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
-                [v[1], v[2], v[3], v[4], v[5]]
-            })
-            .collect();
+        let rows = setpoint_rows(out, setup);
         assert!(rows.len() > 10, "{what}: a real program");
         for (i, r) in rows.iter().enumerate() {
             for k in 0..5 {
@@ -99,4 +89,20 @@ pub(crate) fn assert_setpoints_within_limits(
             }
         }
     }
+}
+
+/// The set-points of set-up `setup` as the CSV writes them: `[X, Y, Z, tilt, C]` per cycle,
+/// read back from the text.
+pub(crate) fn setpoint_rows(out: &Output, setup: usize) -> Vec<[f64; 5]> {
+    let mut text = Vec::new();
+    out.write_setpoints(setup, &mut text).expect("csv");
+    String::from_utf8(text)
+        .expect("utf-8")
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
+            [v[1], v[2], v[3], v[4], v[5]]
+        })
+        .collect()
 }

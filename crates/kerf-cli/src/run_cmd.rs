@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use kerf_kinematics::PathOptions;
 use kerf_normals::NormalOptions;
-use kerf_pipeline::{Job, JobOptions, OrientOptions};
+use kerf_pipeline::{Job, JobOptions, Lap, OrientOptions, Timings};
 
 use crate::cli::RunArgs;
 use crate::error::CliError;
@@ -65,6 +65,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         })
     };
     refuse(&kerf_pipeline::OUTPUTS.map(str::to_owned))?;
+    let mut read = Timings::default();
+    let lap = Lap::start();
     let file = if crate::import::is_step(path) {
         let (file, import) = crate::import::load_step(path, &args.step_args)?;
         if !args.quiet && !args.json {
@@ -75,13 +77,15 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         load_curves(path)?
     };
     let machine = crate::input::load_machine(&args.machine)?;
+    lap.stop(&mut read, "read");
     let job = Job::new(file, machine)
         .with_source(path)
         .with_options(job_options(args));
     let bar = ProgressBar::new(job.curves().curves.len());
     let out = job.run_with_progress(&|p| bar.update(p));
     bar.finish();
-    let out = out?;
+    let mut out = out?;
+    out.prepend_timings(read);
     if !args.quiet {
         for w in &out.warnings {
             eprintln!("warning: {}: {w}", path.display());
@@ -89,7 +93,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     }
     // Several set-ups number their programs: check those names too.
     refuse(&out.file_names())?;
+    let lap = Lap::start();
     out.write_dir(&args.out)?;
+    // The whole write, report and picture included (`report.json` states what came before it).
+    lap.stop(&mut out.timings, "write");
+    out.report["timings"] = out.timings.to_json();
     let r = &out.report;
     if args.json {
         println!("{r}");
@@ -98,7 +106,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         let int = |v: &serde_json::Value| v.as_u64().unwrap_or(0);
         eprintln!(
             "{}: {} curves -> {} cutting points (N* {:.1}), {} poses on {:?}, {} lines + {} arcs, \
-             {:.2} s of motion at {} mm/min; wrote {} in {:.2} s{}",
+             {:.2} s of motion at {} mm/min; wrote {} in {:.2} s (CPU {:.2} s: {}){}",
             path.display(),
             job.curves().curves.len(),
             out.toolpath
@@ -115,6 +123,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             args.feed,
             args.out.display(),
             start.elapsed().as_secs_f64(),
+            out.timings.cpu_s(),
+            out.timings.summary(3),
             if out.placement.is_identity() {
                 String::new()
             } else {

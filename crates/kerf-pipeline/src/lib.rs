@@ -45,6 +45,7 @@ mod place;
 mod post;
 pub mod ranges;
 mod run;
+mod timing;
 
 pub use certify::CertifiedToolpath;
 pub use discretize::{
@@ -62,6 +63,7 @@ pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};
 pub use post::{post_toolpath, toolpath_poses, MissingNormals, Posted};
 pub use ranges::OptionRange;
 pub use run::PLACEMENT_RETRIES;
+pub use timing::{process_cpu_time, Lap, StageTime, Timings};
 
 /// A stage of a job, as [`Progress`] reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

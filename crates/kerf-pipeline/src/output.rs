@@ -14,6 +14,7 @@ use kerf_normals::Oriented;
 
 use crate::error::{Error, Result};
 use crate::place::Placed;
+use crate::timing::{Lap, Timings};
 
 /// One set-up's program: the part is clamped anew between set-ups, so each is a job of its
 /// own for the machine.
@@ -86,11 +87,23 @@ pub struct Output {
     /// What the caller should be told: traverses that could not be checked against the part
     /// (they fall back to the unchecked retract traverse; `traverses.unchecked` in the report).
     pub warnings: Vec<String>,
+    /// Wall and CPU seconds of each stage (`report.json`'s `timings`; the CLI adds `read` before
+    /// them with [`Output::prepend_timings`], and [`Output::write_dir`] adds `write`).
+    pub timings: Timings,
     pub(crate) model: MachineModel,
     pub(crate) cycle_s: f64,
 }
 
 impl Output {
+    /// Puts `earlier` (stages that ran before the job, such as reading its files) before the
+    /// run's own stage times, in the report too.
+    pub fn prepend_timings(&mut self, earlier: Timings) {
+        let mut t = earlier;
+        t.merge(&self.timings);
+        self.timings = t;
+        self.report["timings"] = self.timings.to_json();
+    }
+
     /// The names of the files [`Output::write_dir`] writes, in order.
     pub fn file_names(&self) -> Vec<String> {
         let mut names = vec![OUTPUTS[0].to_string(), OUTPUTS[1].to_string()];
@@ -198,6 +211,10 @@ impl Output {
         let toolpath = &self.toolpath;
         let axes = &self.axes;
         let report = &self.report;
+        let timings = &self.timings;
+        // The files before `report.json` are written (in order) by the time its contents are
+        // made: their time is the `write` stage it states.
+        let lap = Lap::start();
         let mut entries = vec![
             DirEntry {
                 name: OUTPUTS[0],
@@ -238,7 +255,11 @@ impl Output {
             name: OUTPUTS[4],
             // The text of `report_text`, streamed.
             contents: Box::new(move |w| {
-                serde_json::to_writer_pretty(w, report).map_err(std::io::Error::from)
+                let mut t = timings.clone();
+                lap.stop(&mut t, "write");
+                let mut report = report.clone();
+                report["timings"] = t.to_json();
+                serde_json::to_writer_pretty(w, &report).map_err(std::io::Error::from)
             }),
         });
         entries.push(DirEntry {

@@ -18,6 +18,7 @@ use crate::discretize::{discretize_curves_within, orient_curves, toolpath_of_pos
 use crate::error::{interp, kin, Result};
 use crate::job::Job;
 use crate::output::{program_names, Output, SetupProgram};
+use crate::timing::{Lap, Timings};
 use crate::{Progress, Stage};
 
 impl Job {
@@ -55,7 +56,10 @@ pub const PLACEMENT_RETRIES: usize = 3;
 fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
     let mut extra = 0.0;
     let mut attempt = 0;
+    // The searches a wider margin replaced, timed as one stage before the others.
+    let mut earlier = Timings::default();
     loop {
+        let lap = Lap::start();
         match run_placed(job, progress, extra, attempt) {
             Err(e)
                 if job.options.place == crate::PlaceMode::Auto && attempt < PLACEMENT_RETRIES =>
@@ -64,9 +68,16 @@ fn run(job: &Job, progress: &(dyn Fn(Progress) + Sync)) -> Result<Output> {
                     Some(d) => {
                         extra += d + 1.0;
                         attempt += 1;
+                        lap.stop(&mut earlier, "earlier placements");
                     }
                     None => return Err(e),
                 }
+            }
+            Ok(mut out) => {
+                if !earlier.stages.is_empty() {
+                    out.prepend_timings(earlier);
+                }
+                return Ok(out);
             }
             r => return r,
         }
@@ -126,6 +137,8 @@ fn run_placed(
     attempt: usize,
 ) -> Result<Output> {
     let start = Instant::now();
+    let mut timings = Timings::default();
+    let mut lap = Lap::start();
     let path = job.source.as_deref();
     let file = &job.curves;
     let machine = &job.machine;
@@ -144,9 +157,11 @@ fn run_placed(
             kerf_process::prepare_start(&r.curve, d, r.start, &o.leads, dopts.tolerance_mm)
         })
         .collect();
+    lap.split(&mut timings, "discretize");
     // 2. Normals (+z for curves that name no surface, unless the options refuse them).
     let oriented: Vec<Oriented> = orient_curves(file, &discs, &dopts, &o.orient, path, progress)?;
     let tp = toolpath_of_poses(file, dopts.tolerance_mm, &oriented);
+    lap.split(&mut timings, "normals");
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
     let popts = o.path;
     progress(Progress::new(Stage::Kinematics, 0, 1));
@@ -175,6 +190,7 @@ fn run_placed(
         }
         _ => None,
     };
+    lap.split(&mut timings, "sides");
     // 3b. Where the part goes on the machine; from here on, workpiece coordinates. The search
     // keeps the longest move off the cut along the tool axis (the retract or the pierce
     // standoff) and 1 mm of blending from every linear limit.
@@ -194,6 +210,7 @@ fn run_placed(
         Some((h, _)) => placed.with_head_lines(h),
         None => placed,
     };
+    lap.split(&mut timings, "place");
     // 3c. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
     // outlines, the shortest traverse; in part coordinates, then placed.
     let (cuts, cut_plans) =
@@ -231,6 +248,7 @@ fn run_placed(
             }),
         })
         .collect();
+    lap.split(&mut timings, "cuts");
     let solved = solve_paths(machine, &inputs, &popts).map_err(kin(path))?;
     drop(inputs);
     drop(cut_poses);
@@ -270,6 +288,7 @@ fn run_placed(
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
     let mut warnings: Vec<String> = Vec::new();
+    lap.split(&mut timings, "kinematics");
     for setup in 0..placed.plan.setups.len() {
         let mut fitted = Vec::new();
         let mut ids: Vec<String> = Vec::new();
@@ -398,6 +417,7 @@ fn run_placed(
                 plot_traverses.push(line);
             }
         }
+        lap.split(&mut timings, "traverses");
         for (k, s) in solved.iter().enumerate() {
             if placed.plan.setup_of(cuts[k].curve) != setup {
                 continue;
@@ -415,6 +435,7 @@ fn run_placed(
         let blocks = kerf_interp::link_paths_through(&model, fitted, &traverses, fit.retract_mm);
         drop(traverses);
         let motion = kerf_interp::plan_owned(&model, blocks, &plan).map_err(interp(path))?;
+        lap.split(&mut timings, "plan");
         let mut gopts_k = gopts.clone();
         gopts_k.header = vec![
             format!(
@@ -431,6 +452,7 @@ fn run_placed(
         programs.push(text);
         setup_ids.push(ids);
         motions.push(motion);
+        lap.split(&mut timings, "gcode");
     }
     let process =
         kerf_interp::ProcessCodes::resolve(dialect, &machine.process).map_err(interp(path))?;
@@ -541,6 +563,7 @@ fn run_placed(
         )
         .chain(warnings.iter().cloned())
         .collect();
+    lap.split(&mut timings, "report");
     let report = json!({
         "input": source_name,
         "machine": machine.name,
@@ -612,6 +635,7 @@ fn run_placed(
                 .collect::<Vec<_>>(),
         },
         "seconds": start.elapsed().as_secs_f64(),
+        "timings": timings.to_json(),
     });
     let programs = SetupProgram::numbered(motions, programs, setup_ids);
     Ok(Output {
@@ -625,6 +649,7 @@ fn run_placed(
         report,
         plot_svg: svg,
         warnings,
+        timings,
         model,
         cycle_s: o.cycle_s,
     })

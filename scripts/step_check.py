@@ -177,7 +177,7 @@ def check_file(kerf, step, edges, failures, counts):
         out = Path(tmp) / "part.curves.json"
         cmd = [kerf, "import", str(step), "-o", str(out), "--all-faces", "--json"]
         if edges:
-            cmd.append("--edges")
+            cmd += ["--edges", "--every-face-loop"]
         res = subprocess.run(cmd, capture_output=True, text=True)
         if res.returncode != 0:
             failures.append(f"{step}: kerf import failed: {res.stderr.strip()}")

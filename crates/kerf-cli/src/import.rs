@@ -36,6 +36,11 @@ pub(crate) struct StepArgs {
     /// STEP: write every face read as a surface, not only those a contour lies on.
     #[arg(long)]
     pub(crate) all_faces: bool,
+
+    /// STEP, with --edges: cut every face loop, even where the faces form one sheet (by
+    /// default a sheet-metal solid's through-features are cut once each, on one side).
+    #[arg(long, requires = "edges")]
+    pub(crate) every_face_loop: bool,
 }
 
 /// Arguments of `kerf import`.
@@ -92,7 +97,8 @@ fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
     let mut o = ImportOptions::default()
         .with_close_gaps_mm(a.close_gaps)
         .with_face_tolerance_mm(a.face_tolerance)
-        .with_all_faces(a.all_faces);
+        .with_all_faces(a.all_faces)
+        .with_sheet(!a.every_face_loop);
     if a.edges {
         let ids = a
             .faces
@@ -139,6 +145,24 @@ pub(crate) fn print_account(path: &Path, import: &Import) {
         import.file.surfaces.len(),
         r.faces_read
     );
+    if let Some(s) = &r.sheet {
+        match &s.not_a_sheet {
+            Some(why) => eprintln!("  not one sheet ({why}): every face loop is cut"),
+            None => {
+                eprintln!(
+                    "  one sheet {:.3} mm thick: {} features, each cut once on the side of faces {} ({} faces on the other side, {} walls not cut)",
+                    s.thickness_mm,
+                    s.features.len(),
+                    ids(&s.side),
+                    s.other_side.len(),
+                    s.walls.len()
+                );
+                for f in &s.features {
+                    eprintln!("  {f}");
+                }
+            }
+        }
+    }
     for t in &r.taken {
         eprintln!("  took {t}");
     }
@@ -159,6 +183,30 @@ pub(crate) fn print_account(path: &Path, import: &Import) {
     }
     for s in &r.skipped {
         eprintln!("  skipped {s}");
+    }
+}
+
+/// Face ids as `#1, #2, ...`.
+fn ids(v: &[u64]) -> String {
+    v.iter()
+        .map(|i| format!("#{i}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// `kerf import --json`'s `sheet`: what sheet recognition found, or why the faces are not one
+/// sheet; `null` when it did not run.
+fn sheet_json(s: Option<&kerf_step::SheetReport>) -> serde_json::Value {
+    match s {
+        None => serde_json::Value::Null,
+        Some(s) => json!({
+            "not_a_sheet": s.not_a_sheet,
+            "thickness_mm": s.thickness_mm,
+            "side": s.side,
+            "other_side": s.other_side,
+            "walls": s.walls,
+            "features": s.features,
+        }),
     }
 }
 
@@ -191,7 +239,8 @@ pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
             "warnings": r.warnings,
             "gaps_closed": r.gaps_closed,
             "largest_pole_move_mm": r.largest_move,
-            "opened": r.opened,
+        "opened": r.opened,
+            "sheet": sheet_json(r.sheet.as_ref()),
             "seconds": start.elapsed().as_secs_f64(),
         });
         if dest == Path::new("-") {

@@ -6,6 +6,17 @@ use std::process::Command;
 mod common;
 use common::{fixture, kerf};
 
+/// `../shared/realdata/step` (the real STEP parts), if present; says so when it is not.
+fn real_step_dir() -> Option<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("skipped: {} not present", dir.display());
+        None
+    }
+}
+
 fn run(c: &mut Command) -> (i32, String, String) {
     let o = c.output().unwrap();
     (
@@ -112,11 +123,9 @@ fn run_takes_a_step_file_and_normals_come_from_the_nearest_face() {
 
 #[test]
 fn real_parts_import_with_edges_and_discretize_with_normals() {
-    let dir_real = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
-    if !dir_real.is_dir() {
-        eprintln!("skipped: {} not present", dir_real.display());
+    let Some(dir_real) = real_step_dir() else {
         return;
-    }
+    };
     let dir = tempfile::tempdir().unwrap();
     for name in ["S01094.stp", "S06298.stp"] {
         let curves = dir.path().join(format!("{name}.json"));
@@ -162,4 +171,68 @@ fn run_cuts_the_boundary_loops_of_chosen_faces() {
             "{f} cut: {ids:?}"
         );
     }
+}
+
+#[test]
+fn a_real_sheet_metal_part_is_cut_once_per_feature_and_every_loop_on_request() {
+    // S06298.stp, a 3 mm tray with lips: sheet recognition (the default with --edges) gives
+    // two features (the outline in pieces, the 100 mm hole) where every face loop gives 78;
+    // `kerf run --place auto` cuts them on the gantry, each once.
+    let Some(dir_real) = real_step_dir() else {
+        return;
+    };
+    let part = dir_real.join("S06298.stp");
+    let dir = tempfile::tempdir().unwrap();
+    let curves = dir.path().join("sheet.json");
+    let (code, out, err) = run(kerf()
+        .arg("import")
+        .arg(&part)
+        .args(["--edges", "--json", "-o"])
+        .arg(&curves));
+    assert_eq!(code, 0, "{err}");
+    let summary: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let sheet = &summary["sheet"];
+    assert_eq!(sheet["not_a_sheet"], serde_json::Value::Null, "{sheet}");
+    assert!(
+        (sheet["thickness_mm"].as_f64().unwrap() - 3.0).abs() < 1e-6,
+        "{sheet}"
+    );
+    assert_eq!(sheet["features"].as_array().unwrap().len(), 2, "{sheet}");
+    assert_eq!(
+        summary["surfaces"], 75,
+        "every face is an obstacle: {summary}"
+    );
+    let every = dir.path().join("every.json");
+    let (code, out, err) = run(kerf()
+        .arg("import")
+        .arg(&part)
+        .args(["--edges", "--every-face-loop", "--json", "-o"])
+        .arg(&every));
+    assert_eq!(code, 0, "{err}");
+    let summary: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(summary["curves"], 78, "{summary}");
+    assert_eq!(summary["sheet"], serde_json::Value::Null);
+    // --every-face-loop needs --edges.
+    let (code, _, err) = run(kerf().arg("import").arg(&part).arg("--every-face-loop"));
+    assert_eq!(code, 2, "{err}");
+    // The whole run: one cut per contour of the import, every one of them planned.
+    let out_dir = dir.path().join("run");
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(&part)
+        .args(["--edges", "--place", "auto", "-m"])
+        .arg(fixture("machines/gantry_ac.json"))
+        .arg("--out")
+        .arg(&out_dir));
+    assert_eq!(code, 0, "{err}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("report.json")).unwrap())
+            .unwrap();
+    let imported = kerf_format::curves::load(&curves).unwrap();
+    assert_eq!(
+        report["program"]["cuts"].as_u64().unwrap() as usize,
+        imported.curves.len(),
+        "{}",
+        report["program"]
+    );
 }

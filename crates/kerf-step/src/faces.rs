@@ -32,6 +32,9 @@ pub(crate) struct Face {
     pub(crate) surface: NurbsSurface,
     /// The boundary loops (outer first where marked), each as its edges in loop order.
     pub(crate) loops: Vec<Vec<NurbsCurve>>,
+    /// The `EDGE_CURVE` `#id` of each edge of `loops` (the same edge in two faces' loops is
+    /// the edge they share).
+    pub(crate) edge_ids: Vec<Vec<u64>>,
 }
 
 /// The faces of the file, in file order; a face that cannot be converted is returned as an
@@ -83,6 +86,7 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
     let same_sense = boolean(inst, p.get(3), "same_sense")?;
     let g = geometry(m, surf_inst).map_err(|e| err(inst, format!("face_geometry: {e}")))?;
     let mut loops = Vec::new();
+    let mut edge_ids = Vec::new();
     let mut vertices: Vec<Point3<f64>> = Vec::new();
     for bid in refs(inst, p.get(1), "bounds")? {
         let b = &m.get(inst, bid)?;
@@ -99,9 +103,14 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         }
         let mut edges = edge_loop(m, lp_inst)?;
         if !orientation {
-            edges = edges.into_iter().rev().map(|c| c.reversed()).collect();
+            edges = edges
+                .into_iter()
+                .rev()
+                .map(|(id, c)| (id, c.reversed()))
+                .collect();
         }
-        loops.push(edges);
+        edge_ids.push(edges.iter().map(|e| e.0).collect());
+        loops.push(edges.into_iter().map(|e| e.1).collect());
     }
     // The parameter range: every boundary sample mapped to natural parameters.
     let mut us = Vec::new();
@@ -187,6 +196,7 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         kind: g.kind(),
         surface,
         loops,
+        edge_ids,
     })
 }
 
@@ -222,7 +232,7 @@ fn vertex(m: &Model<'_>, v: &Instance) -> Result<Point3<f64>> {
 /// times costs one edge's work, not thousands, before it is refused; so a loop has at most
 /// twice as many uses as distinct edges, and its boundary samples (every use, as before)
 /// are bounded by the file's own edges.
-fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<Vec<NurbsCurve>> {
+fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<Vec<(u64, NurbsCurve)>> {
     let p = m.rec(inst, "EDGE_LOOP")?;
     let mut out = Vec::new();
     // (EDGE_CURVE id, its curve as the edge runs, directions used so far)
@@ -251,7 +261,7 @@ fn edge_loop(m: &Model<'_>, inst: &Instance) -> Result<Vec<NurbsCurve>> {
         }
         *used = true;
         let c = &distinct[d].1;
-        out.push(if orientation { c.clone() } else { c.reversed() });
+        out.push((ec.id, if orientation { c.clone() } else { c.reversed() }));
     }
     Ok(out)
 }

@@ -49,6 +49,7 @@ mod error;
 mod faces;
 mod model;
 mod parser;
+mod sheet;
 mod surfaces;
 
 use std::path::Path;
@@ -80,6 +81,9 @@ pub struct ImportOptions {
     pub faces: Option<Vec<u64>>,
     /// Write every face read as a surface, not only those a contour lies on (default false).
     pub all_faces: bool,
+    /// With `edges` and every face: recognise a solid sheet-metal part and cut each
+    /// through-feature once (default true; `false` cuts every face loop).
+    pub sheet: bool,
 }
 
 impl Default for ImportOptions {
@@ -117,7 +121,15 @@ impl ImportOptions {
         edges: false,
         faces: None,
         all_faces: false,
+        sheet: true,
     };
+
+    /// Sets [`sheet`](Self::sheet): with `edges` and every face, recognise a sheet and cut each
+    /// through-feature once (`false`: every face loop).
+    pub fn with_sheet(mut self, sheet: bool) -> Self {
+        self.sheet = sheet;
+        self
+    }
 
     /// Write every face read as a surface, used or not.
     pub fn with_all_faces(mut self, all: bool) -> Self {
@@ -167,6 +179,29 @@ pub struct Report {
     pub warnings: Vec<String>,
     /// The work done, counted against the reader's budgets.
     pub work: Work,
+    /// With `edges` and every face: the sheet the faces form, its features each cut once
+    /// (`None` when no face loop was asked for or `--faces` chose them).
+    pub sheet: Option<SheetReport>,
+}
+
+/// What sheet recognition found (`--edges` on a solid).
+#[derive(Debug, Clone, Default)]
+#[non_exhaustive]
+pub struct SheetReport {
+    /// Why the faces are not one sheet (then every face loop is a contour, as with `--faces`);
+    /// `None` when they are.
+    pub not_a_sheet: Option<String>,
+    /// The sheet's thickness, mm.
+    pub thickness_mm: f64,
+    /// The faces of the side that is cut, the other side and the walls, as `#id`s.
+    pub side: Vec<u64>,
+    /// The faces of the other side.
+    pub other_side: Vec<u64>,
+    /// The wall faces (the edges of the sheet, the walls of holes and cut-outs).
+    pub walls: Vec<u64>,
+    /// One line per feature: its contour id, length, the face loops it joins and its twin's
+    /// faces on the other side (which it replaces).
+    pub features: Vec<String>,
 }
 
 /// Reads a STEP file from disk through kerf's one reader (`kerf_io::read_file`: at most 1 GiB,
@@ -242,9 +277,88 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         .skipped
         .extend(face_errors.into_iter().map(|e| format!("face {e}")));
 
-    // (id, curve, faces named)
-    let mut contours: Vec<(String, NurbsCurve, Vec<usize>)> = Vec::new();
-    if opts.edges {
+    // (id, curve, faces named, scrap side)
+    let mut contours: Vec<(String, NurbsCurve, Vec<usize>, Option<&'static str>)> = Vec::new();
+    // Sheet recognition: every face of a solid, no face chosen by hand.
+    let sheet = if opts.edges && opts.faces.is_none() && opts.sheet {
+        Some(sheet::recognise(&m, &faces)?)
+    } else {
+        None
+    };
+    if let Some(Ok(s)) = &sheet {
+        let ids = |fs: &[usize]| fs.iter().map(|&f| faces[f].id).collect::<Vec<_>>();
+        let mut r = SheetReport {
+            thickness_mm: s.thickness_mm,
+            side: ids(&s.side),
+            other_side: ids(&s.other),
+            walls: ids(&s.walls),
+            ..SheetReport::default()
+        };
+        for (k, f) in s.features.iter().enumerate() {
+            let id = format!("feature {} face #{}", k + 1, faces[f.faces[0]].id);
+            let scrap = match f.scrap {
+                sheet::ScrapSide::Left => "left",
+                sheet::ScrapSide::Right => "right",
+            };
+            let closed = f.pieces.len() == 1;
+            for (p, piece) in f.pieces.iter().enumerate() {
+                let pid = if closed {
+                    id.clone()
+                } else {
+                    format!("{id} piece {}", p + 1)
+                };
+                let edges: Vec<NurbsCurve> = piece.iter().map(|&e| f.edges[e].clone()).collect();
+                let j = contour::join(&edges, opts.close_gaps_mm, closed);
+                note_join(&mut report, &pid, &j);
+                let n = j.contours.len();
+                for (i, c) in j.contours.into_iter().enumerate() {
+                    let cid = if n == 1 {
+                        pid.clone()
+                    } else {
+                        format!("{pid}.{}", i + 1)
+                    };
+                    // The faces this piece runs along.
+                    let mut named: Vec<usize> = Vec::new();
+                    for &e in piece {
+                        let fi = f.edge_faces[e];
+                        if !named.contains(&fi) {
+                            named.push(fi);
+                        }
+                    }
+                    contours.push((cid, c.curve, named, Some(scrap)));
+                }
+            }
+            let loops: Vec<String> = f
+                .loops
+                .iter()
+                .map(|&(fi, li)| format!("#{} loop {}", faces[fi].id, li + 1))
+                .collect();
+            let twins: Vec<String> = f
+                .twin_faces
+                .iter()
+                .map(|&fi| format!("#{}", faces[fi].id))
+                .collect();
+            r.features.push(format!(
+                "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut",
+                f.length_mm,
+                if closed {
+                    "one closed cut".to_string()
+                } else {
+                    format!("{} open pieces (the side's normal turns between up and down along it)", f.pieces.len())
+                },
+                f.edges.len(),
+                loops.join(", "),
+                twins.join(", ")
+            ));
+        }
+        report.sheet = Some(r);
+    } else if opts.edges {
+        if let Some(Err(why)) = &sheet {
+            report.sheet = Some(SheetReport {
+                not_a_sheet: Some(why.clone()),
+                ..SheetReport::default()
+            });
+        }
         for (fi, f) in faces.iter().enumerate() {
             if let Some(only) = &opts.faces {
                 if !only.contains(&f.id) {
@@ -261,7 +375,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                     } else {
                         format!("face #{} loop {}.{}", f.id, li + 1, k + 1)
                     };
-                    contours.push((id, c.curve, vec![fi]));
+                    contours.push((id, c.curve, vec![fi], None));
                 }
             }
         }
@@ -383,7 +497,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                             Vec::new()
                         }
                     };
-                    contours.push((id, c.curve, named));
+                    contours.push((id, c.curve, named, None));
                 }
             }
         }
@@ -405,7 +519,9 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     }
     // Surfaces: the faces named, in file order.
     let mut used: Vec<usize> = contours.iter().flat_map(|c| c.2.iter().copied()).collect();
-    if opts.all_faces {
+    // A sheet's cuts name only the side they run on; the other side and the walls are part of
+    // the solid the head must clear (traverses), so every face goes in.
+    if opts.all_faces || matches!(sheet, Some(Ok(_))) {
         used = (0..faces.len()).collect();
     }
     used.sort_unstable();
@@ -429,7 +545,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         .map(|&fi| RawSurface::Nurbs(raw_surface(&face_id(&faces[fi]), &faces[fi].surface)))
         .collect();
     let mut raw_curves = Vec::with_capacity(contours.len());
-    for (id, c, named) in contours {
+    for (id, c, named, scrap) in contours {
         let surface = match named.len() {
             0 => None,
             1 => Some(SurfaceRef::One(face_id(&faces[named[0]]))),
@@ -447,7 +563,9 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                 Some(s) => format!(" on {}", s.ids().join(", ")),
             }
         ));
-        raw_curves.push(raw_curve(id, &c, surface));
+        let mut raw = raw_curve(id, &c, surface);
+        raw.scrap = scrap.map(str::to_owned);
+        raw_curves.push(raw);
     }
     let file = RawCurvesFile {
         format: kerf_format::CURVES_FORMAT.into(),

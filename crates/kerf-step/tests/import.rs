@@ -44,6 +44,17 @@ fn surface(s: &RawSurface) -> NurbsSurface {
     .expect("valid surface")
 }
 
+/// `../shared/realdata/step` (the real STEP parts), if present; says so when it is not.
+fn real_step_dir() -> Option<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("skipped: {} not present", dir.display());
+        None
+    }
+}
+
 fn samples(c: &NurbsCurve, n: usize) -> Vec<Point3<f64>> {
     let (a, b) = c.domain();
     (0..=n)
@@ -378,25 +389,159 @@ fn gaps_above_the_threshold_open_the_contour() {
 
 #[test]
 fn real_sheet_metal_parts_read_with_edges() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
-    if !dir.is_dir() {
-        eprintln!("skipped: {} not present", dir.display());
+    // Every face loop (`with_sheet(false)`): every face read, every loop closed.
+    let Some(dir) = real_step_dir() else {
         return;
-    }
+    };
     for (name, faces) in [("S01094.stp", 24), ("S06298.stp", 75)] {
-        let im =
-            import_file(dir.join(name), &ImportOptions::default().with_edges(None)).expect(name);
+        let opts = ImportOptions::default().with_edges(None).with_sheet(false);
+        let im = import_file(dir.join(name), &opts).expect(name);
         assert_eq!(im.report.faces_read, faces, "{name}: every face read");
         assert!(
             im.report.skipped.is_empty(),
             "{name}: {:?}",
             im.report.skipped
         );
+        assert!(im.report.sheet.is_none(), "{name}: no sheet asked for");
         let file = from_raw(im.file, Path::new(".")).expect("valid");
         assert!(
             file.curves.iter().all(|c| c.curve.is_closed()),
             "{name}: loops closed"
         );
+    }
+}
+
+/// The distance from `p` to the nearest of `surfaces`.
+fn distance_to(surfaces: &[&NurbsSurface], p: &Point3<f64>) -> f64 {
+    surfaces
+        .iter()
+        .map(|s| s.closest_point(p, None).distance)
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn a_sheet_metal_solid_has_each_feature_cut_once() {
+    // The real bent parts as solids: sheet recognition finds one sheet of the thickness their
+    // walls have, and cuts each through-feature once. Independent truths: the file's own face
+    // loops (read with `with_sheet(false)`): every stretch of a loop on the cut side that
+    // borders a wall is cut (within 1e-6 mm of a contour), and no contour runs beside another
+    // at the sheet's thickness (its twin on the other face); the hole of S06298 is a circle of
+    // radius 50 mm.
+    let Some(dir) = real_step_dir() else {
+        return;
+    };
+    for (name, thickness, features) in [("S01094.stp", 2.65, 2), ("S06298.stp", 3.0, 2)] {
+        let im =
+            import_file(dir.join(name), &ImportOptions::default().with_edges(None)).expect(name);
+        let sheet = im.report.sheet.clone().expect("sheet recognition ran");
+        assert_eq!(sheet.not_a_sheet, None, "{name}");
+        assert!(
+            (sheet.thickness_mm - thickness).abs() < 1e-6,
+            "{name}: {}",
+            sheet.thickness_mm
+        );
+        assert_eq!(
+            sheet.features.len(),
+            features,
+            "{name}: {:?}",
+            sheet.features
+        );
+        let surf: std::collections::HashMap<String, NurbsSurface> = im
+            .file
+            .surfaces
+            .iter()
+            .map(|s| {
+                let RawSurface::Nurbs(n) = s else {
+                    panic!("NURBS")
+                };
+                (n.id.clone(), surface(s))
+            })
+            .collect();
+        let by_ids = |ids: &[u64]| -> Vec<&NurbsSurface> {
+            ids.iter().map(|i| &surf[&format!("face #{i}")]).collect()
+        };
+        let (side, walls) = (by_ids(&sheet.side), by_ids(&sheet.walls));
+        let cut: Vec<NurbsCurve> = im.file.curves.iter().map(curve).collect();
+        let cut_samples: Vec<Vec<Point3<f64>>> = cut.iter().map(|c| samples(c, 200)).collect();
+        // Every contour runs on the cut side, along a wall, with the scrap given.
+        for (c, s) in im.file.curves.iter().zip(&cut_samples) {
+            assert!(c.scrap.is_some(), "{name}: {} has a scrap side", c.id);
+            for p in s {
+                assert!(
+                    distance_to(&side, p) < 1e-6,
+                    "{name}: {} off the side at {p}",
+                    c.id
+                );
+                assert!(
+                    distance_to(&walls, p) < 1e-6,
+                    "{name}: {} off the walls at {p}",
+                    c.id
+                );
+            }
+        }
+        // No twins: no contour's middle is at the thickness from another contour.
+        let near = |p: &Point3<f64>, other: usize| cut[other].closest_point(p).distance;
+        for a in 0..cut.len() {
+            for b in 0..cut.len() {
+                if a == b {
+                    continue;
+                }
+                let twin = cut_samples[a]
+                    .iter()
+                    .filter(|p| (near(p, b) - thickness).abs() < 0.05 * thickness)
+                    .count();
+                assert!(
+                    twin < cut_samples[a].len() / 2,
+                    "{name}: {} runs beside {} at the thickness",
+                    im.file.curves[a].id,
+                    im.file.curves[b].id
+                );
+            }
+        }
+        // Coverage: the file's own loops on the cut side, wherever they border a wall.
+        let every = import_file(
+            dir.join(name),
+            &ImportOptions::default().with_edges(None).with_sheet(false),
+        )
+        .expect(name);
+        let side_ids: Vec<String> = sheet.side.iter().map(|i| format!("face #{i}")).collect();
+        let mut checked = 0;
+        for l in &every.file.curves {
+            let Some(SurfaceRef::One(face)) = &l.surface else {
+                continue;
+            };
+            if !side_ids.contains(face) {
+                continue;
+            }
+            for p in samples(&curve(l), 400) {
+                if distance_to(&walls, &p) > 1e-9 {
+                    continue;
+                }
+                checked += 1;
+                let d = cut
+                    .iter()
+                    .map(|c| c.closest_point(&p).distance)
+                    .fold(f64::INFINITY, f64::min);
+                assert!(d < 1e-6, "{name}: {} at {p} is not cut ({d} mm)", l.id);
+            }
+        }
+        assert!(checked > 400, "{name}: {checked} points checked");
+        if name == "S06298.stp" {
+            let hole = im
+                .file
+                .curves
+                .iter()
+                .map(curve)
+                .find(|c| (c.arc_length() - 100.0 * std::f64::consts::PI).abs() < 1e-6)
+                .expect("the hole");
+            let s = samples(&hole, 64);
+            let centre = s[..64].iter().fold(Vector3::zeros(), |a, p| a + p.coords) / 64.0;
+            assert!(
+                s.iter()
+                    .all(|p| ((p.coords - centre).norm() - 50.0).abs() < 1e-6),
+                "{name}: the hole is a circle of radius 50"
+            );
+        }
     }
 }
 

@@ -1,0 +1,548 @@
+//! Sheet recognition for `--edges`: a solid sheet-metal part as one sheet with its
+//! through-features, each cut once.
+//!
+//! A sheet-metal solid is two *sides* (the faces of the sheet, flat and bent, each side one
+//! smooth surface: its faces meet tangentially at the bends) joined by *walls* as wide as the
+//! sheet is thick (the edge faces of the outline, the walls of holes and cut-outs), which meet
+//! the sides at sharp edges. Every through-feature is a closed chain of sharp edges between one
+//! side and the walls, with a twin chain on the other side. kerf cuts each chain of the chosen
+//! side once, on that side's faces (the beam along their normal, through the sheet), with the
+//! scrap where the wall's outward normal points. The derivation and its limits are in
+//! `docs/step.md` ("Sheet-metal solids").
+
+use std::collections::HashMap;
+
+use kerf_nurbs::{NurbsCurve, NurbsSurface};
+use nalgebra::{Point3, Vector3};
+
+use crate::faces::Face;
+use crate::model::{Charge, Model};
+use crate::Result;
+
+/// Largest angle between the two faces' outward normals along an edge for the faces to meet
+/// tangentially (a bend's edge, the same side of the sheet), degrees. Sheet-metal bends are
+/// tangent to within the file's precision; walls meet the sides at tens of degrees.
+pub(crate) const SMOOTH_DEG: f64 = 2.0;
+
+/// Points per edge where the faces' normals are compared.
+const EDGE_TESTS: usize = 3;
+
+/// Points per feature edge where the distance to the other side is measured.
+const THICKNESS_TESTS: usize = 4;
+
+/// Largest angle between a side's normal and the direction to the other side's nearest point
+/// for that point to be the twin across the thickness, degrees.
+const AXIAL_DEG: f64 = 5.0;
+
+/// Relative spread of the thickness over the features' edges above which the part is not taken
+/// for one sheet of constant thickness (beyond `THICKNESS_SLACK_MM`).
+const THICKNESS_SPREAD: f64 = 0.02;
+/// Absolute slack of the thickness, mm (file precision).
+const THICKNESS_SLACK_MM: f64 = 1e-3;
+
+/// Which side of a contour is scrap, seen along it with the face's normal toward the viewer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ScrapSide {
+    Left,
+    Right,
+}
+
+/// One through-feature: a closed chain of sharp edges between the cut side and the walls.
+pub(crate) struct Feature {
+    /// The chain's edges as the side's face loops run them (material on the left).
+    pub(crate) edges: Vec<NurbsCurve>,
+    /// The faces of the cut side it runs along (indices into the faces), in order of first use.
+    pub(crate) faces: Vec<usize>,
+    /// The face of the cut side each edge bounds.
+    pub(crate) edge_faces: Vec<usize>,
+    /// The face loops the chain takes edges from, `(face index, loop index)`.
+    pub(crate) loops: Vec<(usize, usize)>,
+    /// The faces of the other side its twin chain runs along.
+    pub(crate) twin_faces: Vec<usize>,
+    /// Where the scrap is.
+    pub(crate) scrap: ScrapSide,
+    /// Length of the chain, mm.
+    pub(crate) length_mm: f64,
+    /// The chain cut into pieces whose side's normals face one way along z (indices into
+    /// `edges`, in chain order): one piece for a feature the head reaches from one side, more
+    /// where the side's normal turns from up to down (a flange's lip): each piece is then an
+    /// open contour, cut from the side the placement chooses for it.
+    pub(crate) pieces: Vec<Vec<usize>>,
+}
+
+/// A recognised sheet.
+pub(crate) struct Sheet {
+    /// Thickness, mm (the median of the features' distances to the other side).
+    pub(crate) thickness_mm: f64,
+    /// The faces of the side that is cut (its normals point toward the head).
+    pub(crate) side: Vec<usize>,
+    /// The faces of the other side.
+    pub(crate) other: Vec<usize>,
+    /// The wall faces.
+    pub(crate) walls: Vec<usize>,
+    /// The features, longest first.
+    pub(crate) features: Vec<Feature>,
+}
+
+/// One use of an edge by a face loop.
+#[derive(Clone, Copy)]
+struct Use {
+    face: usize,
+    lp: usize,
+    pos: usize,
+}
+
+/// Recognises the faces as one sheet, or says why they are not (the caller then cuts every face
+/// loop as before).
+///
+/// The work is charged to the reader's face-test budget: `EDGE_TESTS` x 2 projections per
+/// edge and `THICKNESS_TESTS` per feature edge and nearby face of the other side.
+///
+/// # Errors
+/// Only [`crate::StepError::Budget`]; a part that is not a sheet is `Ok(Err(reason))`.
+pub(crate) fn recognise(
+    m: &Model<'_>,
+    faces: &[Face],
+) -> Result<std::result::Result<Sheet, String>> {
+    if faces.len() < 4 {
+        return Ok(Err(format!(
+            "{} faces: a sheet has at least four",
+            faces.len()
+        )));
+    }
+    // Every edge's uses.
+    let mut uses: HashMap<u64, Vec<Use>> = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        for (lp, ids) in face.edge_ids.iter().enumerate() {
+            for (pos, &e) in ids.iter().enumerate() {
+                uses.entry(e).or_default().push(Use { face: f, lp, pos });
+            }
+        }
+    }
+    let mut edges: Vec<(u64, Vec<Use>)> = uses.into_iter().collect();
+    edges.sort_unstable_by_key(|e| e.0);
+    let inst = |f: usize| m.ex.get(faces[f].id);
+    // Regions of faces joined by tangent edges (union-find).
+    let mut parent: Vec<usize> = (0..faces.len()).collect();
+    fn root(parent: &mut [usize], mut a: usize) -> usize {
+        while parent[a] != a {
+            parent[a] = parent[parent[a]];
+            a = parent[a];
+        }
+        a
+    }
+    let mut sharp: Vec<(u64, Use, Use)> = Vec::new();
+    for (id, u) in &edges {
+        match u.as_slice() {
+            [a, b] if a.face == b.face => {} // a seam: inside the face
+            [a, b] => {
+                if let Some(i) = inst(a.face)? {
+                    m.charge(&i, Charge::FaceTests, 2 * EDGE_TESTS)?;
+                }
+                let curve = &faces[a.face].loops[a.lp][a.pos];
+                if tangent(curve, &faces[a.face].surface, &faces[b.face].surface) {
+                    let (ra, rb) = (root(&mut parent, a.face), root(&mut parent, b.face));
+                    parent[ra] = rb;
+                } else {
+                    sharp.push((*id, *a, *b));
+                }
+            }
+            other => {
+                return Ok(Err(format!(
+                    "edge #{id} bounds {} face loops: not a closed solid (each edge bounds two)",
+                    other.len()
+                )));
+            }
+        }
+    }
+    let region: Vec<usize> = (0..faces.len()).map(|f| root(&mut parent, f)).collect();
+    // Each region's area and area-weighted normal.
+    let mut area: HashMap<usize, (f64, Vector3<f64>)> = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        let (a, n) = area_and_normal(&face.surface);
+        let e = area.entry(region[f]).or_insert((0.0, Vector3::zeros()));
+        e.0 += a;
+        e.1 += n;
+    }
+    let mut by_area: Vec<(usize, f64, Vector3<f64>)> =
+        area.iter().map(|(&r, &(a, n))| (r, a, n)).collect();
+    by_area.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
+    if by_area.len() < 3 {
+        return Ok(Err(format!(
+            "{} smooth regions: a sheet has two sides and walls",
+            by_area.len()
+        )));
+    }
+    // The two largest regions are the sides; the cut side is the one facing +z most.
+    let (mut a, mut b) = (by_area[0], by_area[1]);
+    if b.2.z > a.2.z {
+        std::mem::swap(&mut a, &mut b);
+    }
+    let (ra, rb) = (a.0, b.0);
+    let class = |f: usize| {
+        if region[f] == ra {
+            0
+        } else if region[f] == rb {
+            1
+        } else {
+            2
+        }
+    };
+    // Every wall region touches both sides; no edge joins the two sides.
+    let mut touches: HashMap<usize, [bool; 2]> = HashMap::new();
+    for (id, x, y) in &sharp {
+        match (class(x.face), class(y.face)) {
+            (0, 1) | (1, 0) => {
+                return Ok(Err(format!(
+                    "edge #{id} joins face #{} and face #{} of the two sides directly",
+                    faces[x.face].id, faces[y.face].id
+                )));
+            }
+            (s @ (0 | 1), 2) => touches.entry(region[y.face]).or_default()[s] = true,
+            (2, s @ (0 | 1)) => touches.entry(region[x.face]).or_default()[s] = true,
+            _ => {}
+        }
+    }
+    for (f, face) in faces.iter().enumerate() {
+        if class(f) == 2 && touches.get(&region[f]).is_none_or(|t| !(t[0] && t[1])) {
+            return Ok(Err(format!(
+                "face #{} is neither side of a sheet nor a wall between them",
+                face.id
+            )));
+        }
+    }
+    // The chains: sharp edges between a side and a wall, as the side's loops run them.
+    let chains = |s: usize| -> std::result::Result<Vec<Vec<Use>>, String> {
+        let mut on: Vec<Use> = sharp
+            .iter()
+            .filter_map(|(_, x, y)| match (class(x.face), class(y.face)) {
+                (c, 2) if c == s => Some(*x),
+                (2, c) if c == s => Some(*y),
+                _ => None,
+            })
+            .collect();
+        on.sort_by_key(|u| (u.face, u.lp, u.pos));
+        chain(faces, on)
+    };
+    let ours = match chains(0) {
+        Ok(c) => c,
+        Err(e) => return Ok(Err(e)),
+    };
+    let theirs = match chains(1) {
+        Ok(c) => c,
+        Err(e) => return Ok(Err(e)),
+    };
+    if ours.len() != theirs.len() {
+        return Ok(Err(format!(
+            "{} edge chains on one side, {} on the other: not one sheet",
+            ours.len(),
+            theirs.len()
+        )));
+    }
+    let side: Vec<usize> = (0..faces.len()).filter(|&f| class(f) == 0).collect();
+    let other: Vec<usize> = (0..faces.len()).filter(|&f| class(f) == 1).collect();
+    let walls: Vec<usize> = (0..faces.len()).filter(|&f| class(f) == 2).collect();
+    // The thickness: every feature edge's distance to the other side, along the side's normal
+    // (a face of the other side nearer in another direction, an untrimmed surface reaching
+    // round a corner, is not the twin).
+    let boxes: Vec<(Point3<f64>, Point3<f64>)> = other
+        .iter()
+        .map(|&f| faces[f].surface.bounding_box())
+        .collect();
+    let along = AXIAL_DEG.to_radians().cos();
+    let mut thickness: Vec<f64> = Vec::new();
+    let mut samples = 0usize;
+    for c in &ours {
+        for u in c {
+            let e = &faces[u.face].loops[u.lp][u.pos];
+            let (t0, t1) = e.domain();
+            for k in 0..THICKNESS_TESTS {
+                samples += 1;
+                let p = e.point(t0 + (t1 - t0) * (k as f64 + 0.5) / THICKNESS_TESTS as f64);
+                let Some(n) = normal_at(&faces[u.face].surface, &p) else {
+                    continue;
+                };
+                let mut best = f64::INFINITY;
+                let mut order: Vec<(f64, usize)> = boxes
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (lo, hi))| (box_distance(&p, lo, hi), i))
+                    .collect();
+                order.sort_by(|x, y| x.0.total_cmp(&y.0));
+                for (gap, i) in order {
+                    if gap >= best {
+                        break;
+                    }
+                    if let Some(inst) = inst(other[i])? {
+                        m.charge(&inst, Charge::FaceTests, 1)?;
+                    }
+                    let pr = faces[other[i]].surface.closest_point(&p, None);
+                    let d = p - pr.point;
+                    if pr.distance > 0.0 && d.dot(&n) >= along * pr.distance {
+                        best = best.min(pr.distance);
+                    }
+                }
+                if best.is_finite() {
+                    thickness.push(best);
+                }
+            }
+        }
+    }
+    if thickness.len() * 2 < samples {
+        return Ok(Err(format!(
+            "{} of {samples} points of the features have the other side along their normal: not one sheet",
+            thickness.len()
+        )));
+    }
+    thickness.sort_by(f64::total_cmp);
+    let t = thickness[thickness.len() / 2];
+    let (lo, hi) = (thickness[0], thickness[thickness.len() - 1]);
+    if !(t > 0.0) || hi - lo > THICKNESS_SPREAD * t + THICKNESS_SLACK_MM {
+        return Ok(Err(format!(
+            "the features' distance to the other side runs from {lo:.4} to {hi:.4} mm: not one sheet of constant thickness (or beveled walls)"
+        )));
+    }
+    let mut features: Vec<Feature> = ours.iter().map(|c| feature(faces, &sharp, c)).collect();
+    // Twins by the nearest chain centroid (for the report).
+    let centroid = |c: &[Use]| -> Point3<f64> {
+        // Length-weighted mean of points along every edge (a one-edge hole's middle point is
+        // on the circle, not at its centre).
+        let (mut s, mut w) = (Vector3::zeros(), 0.0);
+        for u in c {
+            let e = &faces[u.face].loops[u.lp][u.pos];
+            let (t0, t1) = e.domain();
+            let l = e.arc_length() / 8.0;
+            for k in 0..8 {
+                s += e.point(t0 + (t1 - t0) * (k as f64 + 0.5) / 8.0).coords * l;
+                w += l;
+            }
+        }
+        Point3::from(s / w.max(f64::MIN_POSITIVE))
+    };
+    let twin_centroids: Vec<Point3<f64>> = theirs.iter().map(|c| centroid(c)).collect();
+    for (f, c) in features.iter_mut().zip(&ours) {
+        let p = centroid(c);
+        if let Some((k, _)) = twin_centroids
+            .iter()
+            .enumerate()
+            .min_by(|x, y| (x.1 - p).norm().total_cmp(&(y.1 - p).norm()))
+        {
+            let mut fs: Vec<usize> = Vec::new();
+            for u in &theirs[k] {
+                if !fs.contains(&u.face) {
+                    fs.push(u.face);
+                }
+            }
+            f.twin_faces = fs;
+        }
+    }
+    features.sort_by(|x, y| y.length_mm.total_cmp(&x.length_mm));
+    Ok(Ok(Sheet {
+        thickness_mm: t,
+        side,
+        other,
+        walls,
+        features,
+    }))
+}
+
+/// True if the two surfaces' outward normals agree within [`SMOOTH_DEG`] at `EDGE_TESTS`
+/// points of the edge.
+fn tangent(edge: &NurbsCurve, a: &NurbsSurface, b: &NurbsSurface) -> bool {
+    let (t0, t1) = edge.domain();
+    let cos = SMOOTH_DEG.to_radians().cos();
+    (0..EDGE_TESTS).all(|k| {
+        let p = edge.point(t0 + (t1 - t0) * (k as f64 + 1.0) / (EDGE_TESTS as f64 + 1.0));
+        match (normal_at(a, &p), normal_at(b, &p)) {
+            (Some(na), Some(nb)) => na.dot(&nb) >= cos,
+            _ => false,
+        }
+    })
+}
+
+/// The outward unit normal of `s` at its point nearest `p`.
+fn normal_at(s: &NurbsSurface, p: &Point3<f64>) -> Option<Vector3<f64>> {
+    let pr = s.closest_point(p, None);
+    s.normal(pr.u, pr.v)
+}
+
+/// The surface's area over its parameter range and the area-weighted normal (an 8 x 8
+/// midpoint rule: enough to tell a sheet's sides from its walls).
+fn area_and_normal(s: &NurbsSurface) -> (f64, Vector3<f64>) {
+    const N: usize = 8;
+    let ((u0, u1), (v0, v1)) = (s.domain_u(), s.domain_v());
+    let (du, dv) = ((u1 - u0) / N as f64, (v1 - v0) / N as f64);
+    let mut area = 0.0;
+    let mut normal = Vector3::zeros();
+    for i in 0..N {
+        for j in 0..N {
+            let (u, v) = (u0 + (i as f64 + 0.5) * du, v0 + (j as f64 + 0.5) * dv);
+            let d = s.derivatives(u, v);
+            let n = d[1][0].cross(&d[0][1]) * (du * dv);
+            area += n.norm();
+            normal += n;
+        }
+    }
+    (area, normal)
+}
+
+/// The distance from `p` to the box `lo hi` (0 inside).
+fn box_distance(p: &Point3<f64>, lo: &Point3<f64>, hi: &Point3<f64>) -> f64 {
+    let d = Vector3::from_fn(|i, _| (lo[i] - p[i]).max(p[i] - hi[i]).max(0.0));
+    d.norm()
+}
+
+/// Chains the side's sharp edges into closed loops: each edge is followed by the edge that
+/// starts where it ends (the nearest start, which is the shared vertex).
+fn chain(faces: &[Face], mut on: Vec<Use>) -> std::result::Result<Vec<Vec<Use>>, String> {
+    let curve = |u: &Use| &faces[u.face].loops[u.lp][u.pos];
+    let ends = |u: &Use| {
+        let c = curve(u);
+        let (t0, t1) = c.domain();
+        (c.point(t0), c.point(t1))
+    };
+    let mut out = Vec::new();
+    while let Some(first) = on.pop() {
+        let (start, mut end) = ends(&first);
+        let mut loop_ = vec![first];
+        let scale = 1e-6 * (1.0 + start.coords.norm());
+        let mut guard = on.len() + 1;
+        while (end - start).norm() > scale.max(1e-6) {
+            guard -= 1;
+            let next = on
+                .iter()
+                .enumerate()
+                .map(|(i, u)| (i, (ends(u).0 - end).norm()))
+                .min_by(|x, y| x.1.total_cmp(&y.1));
+            match next {
+                Some((i, d)) if d <= 1e-3 && guard > 0 => {
+                    let u = on.swap_remove(i);
+                    end = ends(&u).1;
+                    loop_.push(u);
+                }
+                _ => {
+                    return Err(format!(
+                        "the sharp edges of face #{} do not close into a loop at ({:.3}, {:.3}, {:.3})",
+                        faces[first.face].id, end.x, end.y, end.z
+                    ));
+                }
+            }
+        }
+        out.push(loop_);
+    }
+    Ok(out)
+}
+
+/// A chain as a feature: its edges, faces, loops, length and scrap side.
+fn feature(faces: &[Face], sharp: &[(u64, Use, Use)], c: &[Use]) -> Feature {
+    let edges: Vec<NurbsCurve> = c
+        .iter()
+        .map(|u| faces[u.face].loops[u.lp][u.pos].clone())
+        .collect();
+    let mut fs: Vec<usize> = Vec::new();
+    let mut loops: Vec<(usize, usize)> = Vec::new();
+    for u in c {
+        if !fs.contains(&u.face) {
+            fs.push(u.face);
+        }
+        if !loops.contains(&(u.face, u.lp)) {
+            loops.push((u.face, u.lp));
+        }
+    }
+    let lengths: Vec<f64> = edges.iter().map(NurbsCurve::arc_length).collect();
+    // The scrap: where the wall's outward normal points, at the middle of the longest edge.
+    let (k, _) = lengths
+        .iter()
+        .enumerate()
+        .max_by(|x, y| x.1.total_cmp(y.1))
+        .unwrap_or((0, &0.0));
+    let u = c[k];
+    let wall = sharp
+        .iter()
+        .find_map(|(_, x, y)| {
+            if (x.face, x.lp, x.pos) == (u.face, u.lp, u.pos) {
+                Some(y.face)
+            } else if (y.face, y.lp, y.pos) == (u.face, u.lp, u.pos) {
+                Some(x.face)
+            } else {
+                None
+            }
+        })
+        .unwrap_or(u.face);
+    let e = &edges[k];
+    let (t0, t1) = e.domain();
+    let tm = 0.5 * (t0 + t1);
+    let (p, tangent) = (e.point(tm), e.tangent(tm).unwrap_or_else(Vector3::zeros));
+    let n = normal_at(&faces[u.face].surface, &p).unwrap_or_else(Vector3::z);
+    let w = normal_at(&faces[wall].surface, &p).unwrap_or_else(Vector3::zeros);
+    let scrap = if n.cross(&tangent).dot(&w) > 0.0 {
+        ScrapSide::Left
+    } else {
+        ScrapSide::Right
+    };
+    // Which way each edge's side normal faces along z (0: sideways, either way).
+    let facing: Vec<i8> = c
+        .iter()
+        .zip(&edges)
+        .map(|(u, e)| {
+            let (t0, t1) = e.domain();
+            let n = normal_at(&faces[u.face].surface, &e.point(0.5 * (t0 + t1)))
+                .unwrap_or_else(Vector3::zeros);
+            if n.z > SIDEWAYS_Z {
+                1
+            } else if n.z < -SIDEWAYS_Z {
+                -1
+            } else {
+                0
+            }
+        })
+        .collect();
+    Feature {
+        pieces: pieces(&facing),
+        edge_faces: c.iter().map(|u| u.face).collect(),
+        edges,
+        faces: fs,
+        loops,
+        twin_faces: Vec::new(),
+        scrap,
+        length_mm: lengths.iter().sum(),
+    }
+}
+
+/// `|n_z|` below which an edge's side normal counts as sideways (reachable from either side of
+/// the sheet): within about 11.5 degrees of horizontal.
+const SIDEWAYS_Z: f64 = 0.2;
+
+/// The runs of a closed chain whose edges face one way along z (`facing`: +1 up, -1 down, 0
+/// sideways, which joins the run before it): one run of every edge when they all agree,
+/// otherwise runs starting where the facing turns.
+fn pieces(facing: &[i8]) -> Vec<Vec<usize>> {
+    let n = facing.len();
+    let Some(first) = facing.iter().position(|&f| f != 0) else {
+        return vec![(0..n).collect()];
+    };
+    // Sideways edges take the facing of the last edge before them that has one.
+    let mut f = vec![0i8; n];
+    let mut last = facing[first];
+    for k in 0..n {
+        let i = (first + k) % n;
+        if facing[i] != 0 {
+            last = facing[i];
+        }
+        f[i] = last;
+    }
+    let Some(turn) = (0..n).find(|&i| f[i] != f[(i + n - 1) % n]) else {
+        return vec![(0..n).collect()];
+    };
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    for k in 0..n {
+        let i = (turn + k) % n;
+        if k == 0 || f[i] != f[(i + n - 1) % n] {
+            out.push(Vec::new());
+        }
+        if let Some(run) = out.last_mut() {
+            run.push(i);
+        }
+    }
+    out
+}

@@ -577,6 +577,14 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     Ok(Import { file, report })
 }
 
+/// True if two placements are one frame (to rounding): a transformation between them is the
+/// identity.
+fn same_frame(a: &model::Frame, b: &model::Frame) -> bool {
+    (a.origin - b.origin).norm() <= 1e-9 * (1.0 + a.origin.coords.norm())
+        && (a.x - b.x).norm() <= 1e-12
+        && (a.z - b.z).norm() <= 1e-12
+}
+
 /// Assembly placements are not applied: refuse a file that places a part anywhere but where
 /// its own coordinates put it, rather than write its geometry in the wrong place.
 fn check_no_placed_parts(m: &Model<'_>) -> Result<()> {
@@ -585,14 +593,42 @@ fn check_no_placed_parts(m: &Model<'_>) -> Result<()> {
         let p = m.rec(inst, "ITEM_DEFINED_TRANSFORMATION")?;
         let a = m.placement(&m.param_ref(inst, p, 2)?)?;
         let b = m.placement(&m.param_ref(inst, p, 3)?)?;
-        let same = (a.origin - b.origin).norm() <= 1e-9 * (1.0 + a.origin.coords.norm())
-            && (a.x - b.x).norm() <= 1e-12
-            && (a.z - b.z).norm() <= 1e-12;
-        if !same {
+        if !same_frame(&a, &b) {
             return Err(model::err(
                 inst,
                 "places a part with a transformation that is not the identity; assemblies \
                  are not supported (export the part alone, or as one body in its place)",
+            ));
+        }
+    }
+    // The other form: a MAPPED_ITEM places a REPRESENTATION_MAP's items from its origin
+    // (`mapping_origin`) at `mapping_target`; a CARTESIAN_TRANSFORMATION_OPERATOR target may
+    // also scale or mirror, and is refused whatever it holds.
+    for inst in m.all("MAPPED_ITEM")? {
+        let inst = &inst;
+        let p = m.rec(inst, "MAPPED_ITEM")?;
+        let map = &m.param_ref(inst, p, 1)?;
+        let mp = m.rec(map, "REPRESENTATION_MAP")?;
+        let origin = &m.param_ref(map, mp, 0)?;
+        let target = &m.param_ref(inst, p, 2)?;
+        let placed = |i: &parser::Instance| {
+            i.record("AXIS2_PLACEMENT_3D").is_some() || i.record("AXIS2_PLACEMENT_2D").is_some()
+        };
+        let same = placed(origin)
+            && placed(target)
+            && same_frame(&m.placement(origin)?, &m.placement(target)?);
+        if !same {
+            return Err(model::err(
+                inst,
+                format!(
+                    "places the items of #{} from #{} at #{} {}: mapped (instanced) parts are \
+                     not supported unless in place (export the part alone, or as one body in \
+                     its place)",
+                    map.id,
+                    origin.id,
+                    target.id,
+                    target.name()
+                ),
             ));
         }
     }

@@ -568,6 +568,44 @@ fn a_placed_assembly_part_is_refused_not_misplaced() {
 }
 
 #[test]
+fn a_mapped_item_placed_elsewhere_is_refused_not_read_unplaced() {
+    // A MAPPED_ITEM placing a geometric set's circle 500 mm away was read where the map's own
+    // coordinates put it (exit 0, the contour 500 mm off). Refused, naming the item; in place
+    // (the same frame as origin and target) it is read.
+    let body = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=CARTESIAN_POINT('',(500.,0.,0.));\n\
+        #3=AXIS2_PLACEMENT_3D('',#1,$,$);\n#4=AXIS2_PLACEMENT_3D('',#2,$,$);\n\
+        #6=CIRCLE('',#3,5.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n\
+        #8=GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION('',(#7),$);\n\
+        #9=REPRESENTATION_MAP(#3,#8);\n#10=MAPPED_ITEM('',#9,#4);\n";
+    let e = import(&step(body), &ImportOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("#10 MAPPED_ITEM: places the items of #9 from #3 at #4"),
+        "{e}"
+    );
+    let same = body.replace("#10=MAPPED_ITEM('',#9,#4)", "#10=MAPPED_ITEM('',#9,#3)");
+    let im = import(&step(&same), &ImportOptions::default()).expect("in place");
+    let c = curve(&im.file.curves[0]);
+    assert!(
+        samples(&c, 16)
+            .iter()
+            .all(|p| (p.coords.norm() - 5.0).abs() < 1e-9),
+        "the circle where the file puts it"
+    );
+    // A transformation operator as the target (it may scale or mirror): refused.
+    let op = body.replace(
+        "#10=MAPPED_ITEM('',#9,#4)",
+        "#11=CARTESIAN_TRANSFORMATION_OPERATOR_3D('','','',$,$,#1,1.,$);\n#10=MAPPED_ITEM('',#9,#11)",
+    );
+    let e = import(&step(&op), &ImportOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("CARTESIAN_TRANSFORMATION_OPERATOR_3D"),
+        "{e}"
+    );
+}
+
+#[test]
 fn hostile_files_give_errors_not_hangs_or_panics() {
     let circle = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(0.,0.,1.));\n#3=DIRECTION('',(1.,0.,0.));\n\
         #4=AXIS2_PLACEMENT_3D('',#1,#2,#3);\n#5=CIRCLE('',#4,2.);\n";

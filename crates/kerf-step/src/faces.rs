@@ -5,7 +5,7 @@
 use std::f64::consts::TAU;
 
 use kerf_nurbs::{NurbsCurve, NurbsSurface};
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 
 use crate::curves::{basis, oriented_piece, Basis};
 use crate::error::{Result, StepError};
@@ -310,24 +310,77 @@ pub(crate) fn edge_curve(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
 
 /// Which faces a contour lies on: sample it densely, keep the faces within `tolerance` mm of
 /// some sample, and choose greedily the fewest faces that together are within tolerance of
-/// every sample. `None` if some sample is farther than `tolerance` from every face (the
-/// contour is not on the part), with the worst distance.
+/// every sample. `Ok(Err(worst))` if some sample is farther than `tolerance` from every face
+/// (the contour is not on the part), with the worst distance.
+///
+/// Only the faces whose box, widened by `tolerance`, meets the samples' box are looked at,
+/// each surface once (`same_as`: [`first_with_same_surface`]), and only the samples inside a
+/// face's widened box are projected onto it; `charge` is told how many projections the contour
+/// will cost before any is made (the reader's budget: a file of a thousand faces over one plane
+/// and a thousand contours asked for 2e8 projections and took minutes).
+///
+/// # Errors
+/// What `charge` returns (a budget crossed).
 pub(crate) fn associate(
     curve: &NurbsCurve,
     faces: &[Face],
+    same_as: &[usize],
     tolerance: f64,
-) -> std::result::Result<Vec<usize>, f64> {
+    mut charge: impl FnMut(usize) -> Result<()>,
+) -> Result<std::result::Result<Vec<usize>, f64>> {
     let samples = sample(curve);
+    let (mut clo, mut chi) = (samples[0], samples[0]);
+    for p in &samples {
+        for i in 0..3 {
+            clo[i] = clo[i].min(p[i]);
+            chi[i] = chi[i].max(p[i]);
+        }
+    }
+    // The faces to look at (their widened box meets the samples' box, and no earlier face has
+    // the same surface), and the projections they cost, charged before any is made.
+    let widened = |f: &Face| {
+        let (lo, hi) = f.surface.bounding_box();
+        (
+            lo - Vector3::repeat(tolerance),
+            hi + Vector3::repeat(tolerance),
+        )
+    };
+    let inside = |p: &Point3<f64>, (lo, hi): &(Point3<f64>, Point3<f64>)| {
+        (0..3).all(|i| p[i] >= lo[i] && p[i] <= hi[i])
+    };
+    let boxes: Vec<Option<(Point3<f64>, Point3<f64>)>> = faces
+        .iter()
+        .enumerate()
+        .map(|(fi, f)| {
+            let b = widened(f);
+            let apart = (0..3).any(|i| clo[i] > b.1[i] || chi[i] < b.0[i]);
+            (same_as[fi] == fi && !apart).then_some(b)
+        })
+        .collect();
+    let cost: usize = boxes
+        .iter()
+        .flatten()
+        .map(|b| samples.iter().filter(|p| inside(p, b)).count())
+        .sum();
+    charge(cost)?;
     // near[f][k]: face f is within tolerance of sample k.
     let mut near: Vec<Vec<bool>> = Vec::with_capacity(faces.len());
     let mut best = vec![f64::INFINITY; samples.len()];
-    for f in faces {
-        let (lo, hi) = f.surface.bounding_box();
+    for (fi, f) in faces.iter().enumerate() {
+        if same_as[fi] != fi {
+            // The same surface as an earlier face: the same distances (a file that repeats one
+            // face a thousand times costs one face's projections).
+            near.push(near[same_as[fi]].clone());
+            continue;
+        }
         let mut row = vec![false; samples.len()];
+        let Some(b) = &boxes[fi] else {
+            near.push(row);
+            continue;
+        };
         let mut warm = None;
         for (k, p) in samples.iter().enumerate() {
-            let outside = (0..3).any(|i| p[i] < lo[i] - tolerance || p[i] > hi[i] + tolerance);
-            if outside {
+            if !inside(p, b) {
                 warm = None;
                 continue;
             }
@@ -340,7 +393,7 @@ pub(crate) fn associate(
     }
     let worst = best.iter().copied().fold(0.0, f64::max);
     if worst > tolerance {
-        return Err(worst);
+        return Ok(Err(worst));
     }
     let mut covered = vec![false; samples.len()];
     let mut chosen = Vec::new();
@@ -368,7 +421,28 @@ pub(crate) fn associate(
         }
     }
     chosen.sort_unstable();
-    Ok(chosen)
+    Ok(Ok(chosen))
+}
+
+/// For each face, the first face with the same surface (itself if none): [`associate`]
+/// projects onto each surface once.
+pub(crate) fn first_with_same_surface(faces: &[Face]) -> Vec<usize> {
+    let mut first: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();
+    faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let s = &f.surface;
+            let mut key: Vec<u64> = vec![s.degree_u() as u64, s.degree_v() as u64];
+            key.extend(s.knots_u().iter().chain(s.knots_v()).map(|v| v.to_bits()));
+            for (row, w) in s.control_points().iter().zip(s.weights()) {
+                for (p, w) in row.iter().zip(w) {
+                    key.extend([p.x.to_bits(), p.y.to_bits(), p.z.to_bits(), w.to_bits()]);
+                }
+            }
+            *first.entry(key).or_insert(i)
+        })
+        .collect()
 }
 
 /// Dense samples of a curve: 16 per knot span and at least 200.

@@ -399,6 +399,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
             }
         }
         let mut taken = std::collections::HashSet::new();
+        let same_surface = faces::first_with_same_surface(&faces);
         for set in &sets {
             let p = set
                 .record("GEOMETRIC_CURVE_SET")
@@ -487,7 +488,14 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                     } else {
                         format!("{base}.{}", k + 1)
                     };
-                    let named = match faces::associate(&c.curve, &faces, opts.face_tolerance_mm) {
+                    let charge = |n: usize| m.charge(e, model::Charge::FaceTests, n);
+                    let named = match faces::associate(
+                        &c.curve,
+                        &faces,
+                        &same_surface,
+                        opts.face_tolerance_mm,
+                        charge,
+                    )? {
                         Ok(f) => f,
                         Err(worst) => {
                             report.skipped.push(format!(

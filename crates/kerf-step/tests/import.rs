@@ -605,6 +605,136 @@ fn a_mapped_item_placed_elsewhere_is_refused_not_read_unplaced() {
     );
 }
 
+/// A square face 100 mm across on the plane `z = height`, entity numbers from `base`: the
+/// plane, its loop and the face (`#base+30`).
+fn square_face(base: usize, height: f64) -> String {
+    let b = |k: usize| base + k;
+    let mut s = format!(
+        "#{}=CARTESIAN_POINT('',(0.,0.,{height:.4}));\n#{}=AXIS2_PLACEMENT_3D('',#{},$,$);\n#{}=PLANE('',#{});\n",
+        b(0),
+        b(1),
+        b(0),
+        b(2),
+        b(1)
+    );
+    let corners = [(-50.0, -50.0), (50.0, -50.0), (50.0, 50.0), (-50.0, 50.0)];
+    for (k, (x, y)) in corners.iter().enumerate() {
+        s += &format!(
+            "#{}=CARTESIAN_POINT('',({x:.1},{y:.1},{height:.4}));\n",
+            b(3 + k)
+        );
+        s += &format!("#{}=VERTEX_POINT('',#{});\n", b(7 + k), b(3 + k));
+    }
+    for k in 0..4 {
+        let (p, q) = (b(3 + k), b(3 + (k + 1) % 4));
+        let (v, w) = (b(7 + k), b(7 + (k + 1) % 4));
+        s += &format!("#{}=POLYLINE('',(#{p},#{q}));\n", b(11 + k));
+        s += &format!(
+            "#{}=EDGE_CURVE('',#{v},#{w},#{},.T.);\n",
+            b(15 + k),
+            b(11 + k)
+        );
+        s += &format!("#{}=ORIENTED_EDGE('',*,*,#{},.T.);\n", b(19 + k), b(15 + k));
+    }
+    s += &format!(
+        "#{}=EDGE_LOOP('',(#{},#{},#{},#{}));\n#{}=FACE_OUTER_BOUND('',#{},.T.);\n#{}=ADVANCED_FACE('',(#{}),#{},.T.);\n",
+        b(23),
+        b(19),
+        b(20),
+        b(21),
+        b(22),
+        b(24),
+        b(23),
+        b(30),
+        b(24),
+        b(2)
+    );
+    s
+}
+
+#[test]
+fn face_association_works_on_the_faces_a_contour_passes_within_a_budget() {
+    // 200 square faces stacked 10 mm apart and one circle on the 8th: the projections are the
+    // circle's samples on that face alone (the others' boxes miss the circle's), counted in the
+    // report's work beside the faces' own boundary samples.
+    let mut body = String::new();
+    for k in 0..200 {
+        body += &square_face(1000 + 100 * k, 10.0 * k as f64);
+    }
+    body += "#1=CARTESIAN_POINT('',(0.,0.,70.));\n#2=AXIS2_PLACEMENT_3D('',#1,$,$);\n\
+             #3=CIRCLE('',#2,20.);\n#4=GEOMETRIC_CURVE_SET('',(#3));\n";
+    let im = import(&step(&body), &ImportOptions::default()).expect("reads");
+    assert_eq!(
+        im.file.curves[0].surface,
+        Some(SurfaceRef::One("face #1730".into()))
+    );
+    let boundary = 200 * 4 * 181; // EDGE_SAMPLES per edge use
+    let projected = im.report.work.face_tests as usize - boundary;
+    assert!(projected > 0 && projected <= 201, "{projected} projections");
+    // A thousand faces over one plane and a thousand circles on it: each surface is projected
+    // onto once (it asked for 2e8 projections and minutes before); every circle on the first.
+    let mut body = square_face(1000, 0.0);
+    for k in 1..1000 {
+        body += &format!("#{}=ADVANCED_FACE('',(#1024),#1002,.T.);\n", 200_000 + k);
+    }
+    let mut set = Vec::new();
+    for k in 0..1000 {
+        body += &format!(
+            "#{}=CIRCLE('',#1001,{:.2});\n",
+            300_000 + k,
+            1.0 + 0.04 * k as f64
+        );
+        set.push(format!("#{}", 300_000 + k));
+    }
+    body += &format!("#9=GEOMETRIC_CURVE_SET('',({}));\n", set.join(","));
+    let im = import(&step(&body), &ImportOptions::default()).expect("reads");
+    assert_eq!(im.file.curves.len(), 1000);
+    assert!(im
+        .file
+        .curves
+        .iter()
+        .all(|c| c.surface == Some(SurfaceRef::One("face #1030".into()))));
+    let projected = im.report.work.face_tests as usize - 1000 * 4 * 181;
+    assert!(projected <= 1000 * 201, "{projected} projections");
+    // Eleven different faces over one another and a polyline of 62,500 spans (a million
+    // samples) on them: 11 M projections, over the budget of 10 M: refused before any is made,
+    // naming the curve.
+    let mut body = String::new();
+    for k in 0..11 {
+        body += &square_face(1000 + 100 * k, 1e-3 * k as f64);
+    }
+    let n = 62_501;
+    let mut pts = Vec::with_capacity(n);
+    for i in 0..n {
+        let (x, y) = (
+            -40.0 + 80.0 * (i % 2) as f64,
+            -40.0 + 80.0 * i as f64 / n as f64,
+        );
+        body += &format!("#{}=CARTESIAN_POINT('',({x:.4},{y:.4},0.));\n", 100_000 + i);
+        pts.push(format!("#{}", 100_000 + i));
+    }
+    let mults: Vec<String> = (0..n)
+        .map(|i| if i == 0 || i == n - 1 { "2" } else { "1" }.to_string())
+        .collect();
+    let knots: Vec<String> = (0..n).map(|i| format!("{i}.")).collect();
+    body += &format!(
+        "#5=B_SPLINE_CURVE_WITH_KNOTS('zigzag',1,({}),.UNSPECIFIED.,.F.,.F.,({}),({}),.UNSPECIFIED.);\n#6=GEOMETRIC_CURVE_SET('',(#5));\n",
+        pts.join(","),
+        mults.join(","),
+        knots.join(",")
+    );
+    let Err(e) = import(&step(&body), &ImportOptions::default()) else {
+        panic!("the zigzag over eleven faces is over the budget");
+    };
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with("#5 B_SPLINE_CURVE_WITH_KNOTS")
+            && msg
+                .contains("more points projected onto faces than the reader's budget of 10000000"),
+        "{msg}"
+    );
+}
+
 #[test]
 fn hostile_files_give_errors_not_hangs_or_panics() {
     let circle = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(0.,0.,1.));\n#3=DIRECTION('',(1.,0.,0.));\n\

@@ -67,11 +67,15 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     refuse(&kerf_pipeline::OUTPUTS.map(str::to_owned))?;
     let mut read = Timings::default();
     let lap = Lap::start();
+    let mut input_warnings = Vec::new();
     let file = if crate::import::is_step(path) {
         let (file, import) = crate::import::load_step(path, &args.step_args)?;
         if !args.quiet && !args.json {
             crate::import::print_account(path, &import);
         }
+        // What the import had to assume (units) belongs in the report too: with -q or --json
+        // nothing else would say it.
+        input_warnings = import.report.warnings.clone();
         file
     } else {
         load_curves(path)?
@@ -80,6 +84,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     lap.stop(&mut read, "read");
     let job = Job::new(file, machine)
         .with_source(path)
+        .with_input_warnings(input_warnings)
         .with_options(job_options(args));
     let bar = ProgressBar::new(job.curves().curves.len());
     let out = job.run_with_progress(&|p| bar.update(p));

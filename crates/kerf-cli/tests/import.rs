@@ -236,3 +236,41 @@ fn a_real_sheet_metal_part_is_cut_once_per_feature_and_every_loop_on_request() {
         report["program"]
     );
 }
+
+#[test]
+fn what_the_step_import_assumed_is_in_the_run_report_even_when_quiet() {
+    // A file with no unit context is read as mm with a warning; under -q nothing is printed,
+    // so report.json's warnings must carry it.
+    let dir = tempfile::tempdir().unwrap();
+    let part = dir.path().join("nounits.step");
+    std::fs::write(
+        &part,
+        "ISO-10303-21;\nHEADER;\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\nDATA;\n\
+         #1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=AXIS2_PLACEMENT_3D('',#1,$,$);\n\
+         #3=CIRCLE('hole',#2,10.);\n#4=GEOMETRIC_CURVE_SET('cut',(#3));\nENDSEC;\nEND-ISO-10303-21;\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(&part)
+        .args(["-q", "-m"])
+        .arg(fixture("machines/ac_head.json"))
+        .arg("--out")
+        .arg(&out));
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        !err.contains("GLOBAL_UNIT_ASSIGNED_CONTEXT"),
+        "quiet: {err}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let warnings = report["warnings"].as_array().unwrap();
+    assert!(
+        warnings.iter().any(|w| w
+            .as_str()
+            .unwrap()
+            .starts_with("input: the file has no GLOBAL_UNIT_ASSIGNED_CONTEXT")),
+        "{warnings:?}"
+    );
+}

@@ -324,6 +324,9 @@ pub struct Job {
     pub(crate) machine: Machine,
     pub(crate) options: JobOptions,
     pub(crate) source: Option<PathBuf>,
+    /// What reading the input said that the user must see (a STEP file's assumed units), for
+    /// the report's `warnings`.
+    pub(crate) input_warnings: Vec<String>,
 }
 
 impl Job {
@@ -335,6 +338,7 @@ impl Job {
             machine,
             options: JobOptions::default(),
             source: None,
+            input_warnings: Vec::new(),
         }
     }
 
@@ -480,6 +484,13 @@ impl Job {
     /// program's comments.
     pub fn with_source(mut self, path: impl AsRef<Path>) -> Self {
         self.source = Some(path.as_ref().to_path_buf());
+        self
+    }
+
+    /// With `warnings` from reading the input (a STEP import's, such as units it had to
+    /// assume) listed first among the report's `warnings`, each prefixed `input: `.
+    pub fn with_input_warnings(mut self, warnings: Vec<String>) -> Self {
+        self.input_warnings = warnings;
         self
     }
 

@@ -551,10 +551,11 @@ fn run_placed(
     };
     // Everything the caller was warned about, where the report goes: the input files' near-miss
     // keys (read without them) and the run's own warnings.
-    let all_warnings: Vec<String> = file
-        .warnings
+    let all_warnings: Vec<String> = job
+        .input_warnings
         .iter()
-        .map(|w| format!("curves file: {w}"))
+        .map(|w| format!("input: {w}"))
+        .chain(file.warnings.iter().map(|w| format!("curves file: {w}")))
         .chain(
             machine
                 .warnings

@@ -184,3 +184,34 @@ fn the_integrator_axes_give_back_the_poses_by_forward_kinematics() {
     }
     assert!(checked > 10, "{checked} poses checked");
 }
+
+#[test]
+fn a_step_part_runs_through_the_library_in_a_few_lines() {
+    // fixtures/step/composite_mm.step: five composite contours on their faces (checked against
+    // Open CASCADE by scripts/step_check.py). Through `Job::from_step`: one cut per contour,
+    // each on the faces the import named, the file named in the program.
+    let step =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/step/composite_mm.step");
+    let out = integrator::cut_step(&step, false).expect("the example runs");
+    assert_eq!(out.toolpath.paths.len(), 5);
+    assert_eq!(
+        out.report["program"]["cuts"], 5,
+        "{}",
+        out.report["program"]
+    );
+    assert!(
+        out.programs[0].text.contains("composite_mm.step"),
+        "the program names its source"
+    );
+    // A defect names the file and the entity, through the pipeline's error.
+    let bad = std::env::temp_dir().join(format!("kerf-bad-{}.step", std::process::id()));
+    std::fs::write(
+        &bad,
+        "ISO-10303-21;\nHEADER;\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\nDATA;\n#1=CIRCLE('',#9,5.);\n#2=GEOMETRIC_CURVE_SET('',(#1));\nENDSEC;\nEND-ISO-10303-21;\n",
+    )
+    .expect("temp file");
+    let e = integrator::cut_step(&bad, false).unwrap_err();
+    std::fs::remove_file(&bad).ok();
+    assert!(matches!(e, kerf::Error::Step(_)), "{e:?}");
+    assert!(e.to_string().contains("#1 CIRCLE"), "{e}");
+}

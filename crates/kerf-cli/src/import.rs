@@ -78,7 +78,7 @@ pub(crate) fn is_step(path: &Path) -> bool {
 /// The import options the arguments ask for. The numbers were checked by their parsers
 /// (`crate::guard`: a usage error, exit 2, before the file is read); a defensive check here
 /// keeps a `StepArgs` built otherwise to the same ranges.
-fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
+pub(crate) fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
     for (option, range, v) in [
         ("--close-gaps", crate::guard::CLOSE_GAPS_MM, a.close_gaps),
         (
@@ -132,17 +132,16 @@ pub(crate) fn load_step(path: &Path, a: &StepArgs) -> Result<(CurvesFile, Import
     Ok((file, import))
 }
 
-/// Prints what an import took and skipped, to standard error.
-pub(crate) fn print_account(path: &Path, import: &Import) {
-    let r = &import.report;
+/// Prints what an import took and skipped (`file`: the curves it gave), to standard error.
+pub(crate) fn print_account(path: &Path, r: &kerf_step::Report, file: &CurvesFile) {
     eprintln!(
         "{}: {} ({}; lengths x{} to mm): {} contours on {} faces ({} faces read)",
         path.display(),
         r.schemas.join(", "),
         r.units.length_name,
         r.units.mm_per_length,
-        import.file.curves.len(),
-        import.file.surfaces.len(),
+        file.curves.len(),
+        file.surfaces.len(),
         r.faces_read
     );
     if let Some(s) = &r.sheet {
@@ -213,7 +212,7 @@ fn sheet_json(s: Option<&kerf_step::SheetReport>) -> serde_json::Value {
 /// Runs `kerf import`.
 pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
     let start = Instant::now();
-    let (_, import) = load_step(&args.step, &args.step_args)?;
+    let (file, import) = load_step(&args.step, &args.step_args)?;
     let dest = args.output.clone().unwrap_or_else(|| {
         let stem = args
             .step
@@ -249,7 +248,7 @@ pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
             println!("{summary}");
         }
     } else if !args.quiet {
-        print_account(&args.step, &import);
+        print_account(&args.step, &import.report, &file);
         eprintln!(
             "wrote {} in {:.3} s",
             dest.display(),

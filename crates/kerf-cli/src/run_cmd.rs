@@ -67,25 +67,23 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     refuse(&kerf_pipeline::OUTPUTS.map(str::to_owned))?;
     let mut read = Timings::default();
     let lap = Lap::start();
-    let mut input_warnings = Vec::new();
-    let file = if crate::import::is_step(path) {
-        let (file, import) = crate::import::load_step(path, &args.step_args)?;
+    let job = if crate::import::is_step(path) {
+        let machine = crate::input::load_machine(&args.machine)?;
+        // The library reads the STEP file (and puts what it had to assume among the report's
+        // warnings); the account is printed here.
+        let opts = crate::import::options(&args.step_args)?;
+        let (job, report) = Job::from_step(path, machine, &opts)?;
         if !args.quiet && !args.json {
-            crate::import::print_account(path, &import);
+            crate::import::print_account(path, &report, job.curves());
         }
-        // What the import had to assume (units) belongs in the report too: with -q or --json
-        // nothing else would say it.
-        input_warnings = import.report.warnings.clone();
-        file
+        job
     } else {
-        load_curves(path)?
+        let file = load_curves(path)?;
+        let machine = crate::input::load_machine(&args.machine)?;
+        Job::new(file, machine).with_source(path)
     };
-    let machine = crate::input::load_machine(&args.machine)?;
     lap.stop(&mut read, "read");
-    let job = Job::new(file, machine)
-        .with_source(path)
-        .with_input_warnings(input_warnings)
-        .with_options(job_options(args));
+    let job = job.with_options(job_options(args));
     let bar = ProgressBar::new(job.curves().curves.len());
     let out = job.run_with_progress(&|p| bar.update(p));
     bar.finish();

@@ -15,6 +15,21 @@ pub enum Error {
     /// the defect. Fix: the file (see `shared/formats.md`).
     #[error(transparent)]
     Format(#[from] kerf_format::FormatError),
+    /// A STEP file could not be read into contours ([`crate::Job::from_step`]); the message names
+    /// the file and the entity (`#23805 COMPOSITE_CURVE: segment 12 (#23790): ...`). Fix: the
+    /// file, or the import options (`--edges` for a solid without cut curves).
+    #[error(transparent)]
+    Step(#[from] kerf_step::FileError),
+    /// A STEP import gave a curves document that does not pass `kerf.curves/1`'s checks (a
+    /// reader defect, reported rather than run). Fix: report the file.
+    #[error("{}: the import is not valid kerf.curves/1: {source}", file.display())]
+    StepDocument {
+        /// The STEP file.
+        file: PathBuf,
+        /// Why the document is invalid.
+        #[source]
+        source: kerf_format::FormatError,
+    },
     /// A discretizer option is out of range; nothing was computed. Fix: the option named.
     #[error(transparent)]
     Options(kerf_discretize::DiscretizeError),

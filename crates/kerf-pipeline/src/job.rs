@@ -355,6 +355,36 @@ impl Job {
         Ok(Self::new(file, machine).with_source(path))
     }
 
+    /// A job on the contours of a STEP file (AP203, AP214, AP242) read with `opts`
+    /// ([`kerf_step::import_file`]: geometric sets' curves, or with
+    /// [`kerf_step::ImportOptions::with_edges`] the faces' boundary loops, a sheet-metal solid's
+    /// features once each) and `machine`; errors name the STEP file, and what the import had to
+    /// assume (units) is among the report's warnings. The import's account (what was taken,
+    /// skipped, closed; the sheet found) is returned beside the job.
+    ///
+    /// # Errors
+    /// [`crate::Error::Step`] naming the file and the entity,
+    /// [`crate::Error::StepDocument`] if the import's document fails `kerf.curves/1`'s checks.
+    pub fn from_step(
+        step: impl AsRef<Path>,
+        machine: Machine,
+        opts: &kerf_step::ImportOptions,
+    ) -> Result<(Self, kerf_step::Report)> {
+        let path = step.as_ref();
+        let import = kerf_step::import_file(path, opts)?;
+        let file =
+            kerf_format::curves::from_raw(import.file, Path::new(".")).map_err(|source| {
+                crate::Error::StepDocument {
+                    file: path.to_path_buf(),
+                    source,
+                }
+            })?;
+        let job = Self::new(file, machine)
+            .with_source(path)
+            .with_input_warnings(import.report.warnings.clone());
+        Ok((job, import.report))
+    }
+
     /// A job on `machine` with no curves yet: add them with [`Job::with_surface`] and
     /// [`Job::with_curve`] (geometry built in code).
     pub fn on_machine(machine: Machine) -> Self {

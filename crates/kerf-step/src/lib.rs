@@ -278,80 +278,15 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         .extend(face_errors.into_iter().map(|e| format!("face {e}")));
 
     // (id, curve, faces named, scrap side)
-    let mut contours: Vec<(String, NurbsCurve, Vec<usize>, Option<&'static str>)> = Vec::new();
+    let mut contours: Vec<Contour> = Vec::new();
     // Sheet recognition: every face of a solid, no face chosen by hand.
-    let sheet = if opts.edges && opts.faces.is_none() && opts.sheet {
+    let mut sheet = if opts.edges && opts.faces.is_none() && opts.sheet {
         Some(sheet::recognise(&m, &faces)?)
     } else {
         None
     };
     if let Some(Ok(s)) = &sheet {
-        let ids = |fs: &[usize]| fs.iter().map(|&f| faces[f].id).collect::<Vec<_>>();
-        let mut r = SheetReport {
-            thickness_mm: s.thickness_mm,
-            side: ids(&s.side),
-            other_side: ids(&s.other),
-            walls: ids(&s.walls),
-            ..SheetReport::default()
-        };
-        for (k, f) in s.features.iter().enumerate() {
-            let id = format!("feature {} face #{}", k + 1, faces[f.faces[0]].id);
-            let scrap = match f.scrap {
-                sheet::ScrapSide::Left => "left",
-                sheet::ScrapSide::Right => "right",
-            };
-            let closed = f.pieces.len() == 1;
-            for (p, piece) in f.pieces.iter().enumerate() {
-                let pid = if closed {
-                    id.clone()
-                } else {
-                    format!("{id} piece {}", p + 1)
-                };
-                let edges: Vec<NurbsCurve> = piece.iter().map(|&e| f.edges[e].clone()).collect();
-                let j = contour::join(&edges, opts.close_gaps_mm, closed);
-                note_join(&mut report, &pid, &j);
-                let n = j.contours.len();
-                for (i, c) in j.contours.into_iter().enumerate() {
-                    let cid = if n == 1 {
-                        pid.clone()
-                    } else {
-                        format!("{pid}.{}", i + 1)
-                    };
-                    // The faces this piece runs along.
-                    let mut named: Vec<usize> = Vec::new();
-                    for &e in piece {
-                        let fi = f.edge_faces[e];
-                        if !named.contains(&fi) {
-                            named.push(fi);
-                        }
-                    }
-                    contours.push((cid, c.curve, named, Some(scrap)));
-                }
-            }
-            let loops: Vec<String> = f
-                .loops
-                .iter()
-                .map(|&(fi, li)| format!("#{} loop {}", faces[fi].id, li + 1))
-                .collect();
-            let twins: Vec<String> = f
-                .twin_faces
-                .iter()
-                .map(|&fi| format!("#{}", faces[fi].id))
-                .collect();
-            r.features.push(format!(
-                "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut",
-                f.length_mm,
-                if closed {
-                    "one closed cut".to_string()
-                } else {
-                    format!("{} open pieces (the side's normal turns between up and down along it)", f.pieces.len())
-                },
-                f.edges.len(),
-                loops.join(", "),
-                twins.join(", ")
-            ));
-        }
-        report.sheet = Some(r);
+        contours.extend(sheet_contours(s, &faces, opts, &mut report));
     } else if opts.edges {
         if let Some(Err(why)) = &sheet {
             report.sheet = Some(SheetReport {
@@ -510,6 +445,24 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
             }
         }
     }
+    // A solid with no cut curves that is one sheet: its features are what there is to cut (as
+    // with --edges), said in a warning; any other solid still asks for --edges.
+    let mut not_a_sheet = None;
+    if contours.is_empty() && !opts.edges && opts.sheet && !faces.is_empty() {
+        match sheet::recognise(&m, &faces)? {
+            Ok(s) => {
+                report.warnings.push(format!(
+                    "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET: the {} faces form one sheet {:.3} mm thick, whose {} features are cut (as with --edges)",
+                    faces.len(),
+                    s.thickness_mm,
+                    s.features.len()
+                ));
+                contours.extend(sheet_contours(&s, &faces, opts, &mut report));
+                sheet = Some(Ok(s));
+            }
+            Err(why) => not_a_sheet = Some(why),
+        }
+    }
     if contours.is_empty() {
         let reason = if opts.edges {
             format!(
@@ -519,8 +472,9 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
             )
         } else {
             format!(
-                "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET ({} faces read; try --edges to cut their boundary loops)",
-                faces.len()
+                "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET ({} faces read{}; try --edges to cut their boundary loops)",
+                faces.len(),
+                not_a_sheet.map_or_else(String::new, |why| format!(", not one sheet: {why}"))
             )
         };
         return Err(StepError::NoContour { reason });
@@ -583,6 +537,87 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     };
     report.work = m.work();
     Ok(Import { file, report })
+}
+
+/// One contour of the import: its id, curve, the faces it names (indices) and its scrap side.
+type Contour = (String, NurbsCurve, Vec<usize>, Option<&'static str>);
+
+/// The contours of a recognised sheet (each feature once, in pieces where it must be), with
+/// the sheet's account in `report.sheet`.
+fn sheet_contours(
+    s: &sheet::Sheet,
+    faces: &[Face],
+    opts: &ImportOptions,
+    report: &mut Report,
+) -> Vec<Contour> {
+    let mut out = Vec::new();
+    let ids = |fs: &[usize]| fs.iter().map(|&f| faces[f].id).collect::<Vec<_>>();
+    let mut r = SheetReport {
+        thickness_mm: s.thickness_mm,
+        side: ids(&s.side),
+        other_side: ids(&s.other),
+        walls: ids(&s.walls),
+        ..SheetReport::default()
+    };
+    for (k, f) in s.features.iter().enumerate() {
+        let id = format!("feature {} face #{}", k + 1, faces[f.faces[0]].id);
+        let scrap = match f.scrap {
+            sheet::ScrapSide::Left => "left",
+            sheet::ScrapSide::Right => "right",
+        };
+        let closed = f.pieces.len() == 1;
+        for (p, piece) in f.pieces.iter().enumerate() {
+            let pid = if closed {
+                id.clone()
+            } else {
+                format!("{id} piece {}", p + 1)
+            };
+            let edges: Vec<NurbsCurve> = piece.iter().map(|&e| f.edges[e].clone()).collect();
+            let j = contour::join(&edges, opts.close_gaps_mm, closed);
+            note_join(report, &pid, &j);
+            let n = j.contours.len();
+            for (i, c) in j.contours.into_iter().enumerate() {
+                let cid = if n == 1 {
+                    pid.clone()
+                } else {
+                    format!("{pid}.{}", i + 1)
+                };
+                // The faces this piece runs along.
+                let mut named: Vec<usize> = Vec::new();
+                for &e in piece {
+                    let fi = f.edge_faces[e];
+                    if !named.contains(&fi) {
+                        named.push(fi);
+                    }
+                }
+                out.push((cid, c.curve, named, Some(scrap)));
+            }
+        }
+        let loops: Vec<String> = f
+            .loops
+            .iter()
+            .map(|&(fi, li)| format!("#{} loop {}", faces[fi].id, li + 1))
+            .collect();
+        let twins: Vec<String> = f
+            .twin_faces
+            .iter()
+            .map(|&fi| format!("#{}", faces[fi].id))
+            .collect();
+        r.features.push(format!(
+            "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut",
+            f.length_mm,
+            if closed {
+                "one closed cut".to_string()
+            } else {
+                format!("{} open pieces (the side's normal turns between up and down along it)", f.pieces.len())
+            },
+            f.edges.len(),
+            loops.join(", "),
+            twins.join(", ")
+        ));
+    }
+    report.sheet = Some(r);
+    out
 }
 
 /// True if two placements are one frame (to rounding): a transformation between them is the

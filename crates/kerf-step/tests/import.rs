@@ -433,6 +433,19 @@ fn a_sheet_metal_solid_has_each_feature_cut_once() {
     for (name, thickness, features) in [("S01094.stp", 2.65, 2), ("S06298.stp", 3.0, 2)] {
         let im =
             import_file(dir.join(name), &ImportOptions::default().with_edges(None)).expect(name);
+        // Without --edges: the file has no cut curves, its faces form one sheet, so the same
+        // features are cut, said in a warning.
+        let plain = import_file(dir.join(name), &ImportOptions::default()).expect(name);
+        assert_eq!(plain.file.curves, im.file.curves, "{name}: as with --edges");
+        assert!(
+            plain
+                .report
+                .warnings
+                .iter()
+                .any(|w| w.contains("form one sheet")),
+            "{name}: {:?}",
+            plain.report.warnings
+        );
         let sheet = im.report.sheet.clone().expect("sheet recognition ran");
         assert_eq!(sheet.not_a_sheet, None, "{name}");
         assert!(

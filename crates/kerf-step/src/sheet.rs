@@ -232,7 +232,7 @@ pub(crate) fn recognise(
         Ok(c) => c,
         Err(e) => return Ok(Err(e)),
     };
-    if ours.len() != theirs.len() {
+    if ours.is_empty() || ours.len() != theirs.len() {
         return Ok(Err(format!(
             "{} edge chains on one side, {} on the other: not one sheet",
             ours.len(),
@@ -288,7 +288,7 @@ pub(crate) fn recognise(
             }
         }
     }
-    if thickness.len() * 2 < samples {
+    if thickness.is_empty() || thickness.len() * 2 < samples {
         return Ok(Err(format!(
             "{} of {samples} points of the features have the other side along their normal: not one sheet",
             thickness.len()

@@ -262,6 +262,12 @@ pub(crate) fn recognise(
                 let Some(n) = normal_at(&faces[u.face].surface, &p) else {
                     continue;
                 };
+                // The boxes' distances, charged at 1/64 of a projection each (a box test costs
+                // about that): a sheet of thousands of faces stays far below the budget, a
+                // hostile one crosses it in bounded time.
+                if let Some(i) = inst(u.face)? {
+                    m.charge(&i, Charge::FaceTests, boxes.len().div_ceil(64))?;
+                }
                 let mut best = f64::INFINITY;
                 let mut order: Vec<(f64, usize)> = boxes
                     .iter()
@@ -392,38 +398,65 @@ fn box_distance(p: &Point3<f64>, lo: &Point3<f64>, hi: &Point3<f64>) -> f64 {
     d.norm()
 }
 
-/// Chains the side's sharp edges into closed loops: each edge is followed by the edge that
-/// starts where it ends (the nearest start, which is the shared vertex).
-fn chain(faces: &[Face], mut on: Vec<Use>) -> std::result::Result<Vec<Vec<Use>>, String> {
-    let curve = |u: &Use| &faces[u.face].loops[u.lp][u.pos];
-    let ends = |u: &Use| {
-        let c = curve(u);
-        let (t0, t1) = c.domain();
-        (c.point(t0), c.point(t1))
-    };
+/// Chains the side's sharp edges into closed loops: each edge is followed by the unused edge
+/// whose start is nearest its end (the shared vertex, within 1e-3 mm). Starts are sorted by x
+/// and searched in a window of +-1e-3 mm, `O(n log n)` for edges in general position; the
+/// window scans are counted, and a file whose edge ends pile up at one x beyond
+/// `64 n + 2^20` scans is not taken for a sheet (bounded work, whatever the file).
+fn chain(faces: &[Face], on: Vec<Use>) -> std::result::Result<Vec<Vec<Use>>, String> {
+    const NEAR: f64 = 1e-3;
+    let n = on.len();
+    let ends: Vec<(Point3<f64>, Point3<f64>)> = on
+        .iter()
+        .map(|u| {
+            let c = &faces[u.face].loops[u.lp][u.pos];
+            let (t0, t1) = c.domain();
+            (c.point(t0), c.point(t1))
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| ends[a].0.x.total_cmp(&ends[b].0.x).then(a.cmp(&b)));
+    let xs: Vec<f64> = order.iter().map(|&i| ends[i].0.x).collect();
+    let mut used = vec![false; n];
+    let mut scans = 0usize;
+    let budget = 64 * n + (1 << 20);
     let mut out = Vec::new();
-    while let Some(first) = on.pop() {
-        let (start, mut end) = ends(&first);
-        let mut loop_ = vec![first];
-        let scale = 1e-6 * (1.0 + start.coords.norm());
-        let mut guard = on.len() + 1;
-        while (end - start).norm() > scale.max(1e-6) {
-            guard -= 1;
-            let next = on
-                .iter()
-                .enumerate()
-                .map(|(i, u)| (i, (ends(u).0 - end).norm()))
-                .min_by(|x, y| x.1.total_cmp(&y.1));
-            match next {
-                Some((i, d)) if d <= 1e-3 && guard > 0 => {
-                    let u = on.swap_remove(i);
-                    end = ends(&u).1;
-                    loop_.push(u);
+    for first in (0..n).rev() {
+        if used[first] {
+            continue;
+        }
+        used[first] = true;
+        let (start, mut end) = ends[first];
+        let mut loop_ = vec![on[first]];
+        let close = (1e-6 * (1.0 + start.coords.norm())).max(1e-6);
+        while (end - start).norm() > close {
+            let lo = xs.partition_point(|&x| x < end.x - NEAR);
+            let mut best: Option<(usize, f64)> = None;
+            for &i in order[lo..].iter().take_while(|&&i| ends[i].0.x <= end.x + NEAR) {
+                scans += 1;
+                if used[i] {
+                    continue;
+                }
+                let d = (ends[i].0 - end).norm();
+                if best.is_none_or(|b| d < b.1) {
+                    best = Some((i, d));
+                }
+            }
+            if scans > budget {
+                return Err(format!(
+                    "{n} sharp edges whose ends pile up ({scans} comparisons): not taken for a sheet"
+                ));
+            }
+            match best {
+                Some((i, d)) if d <= NEAR => {
+                    used[i] = true;
+                    end = ends[i].1;
+                    loop_.push(on[i]);
                 }
                 _ => {
                     return Err(format!(
                         "the sharp edges of face #{} do not close into a loop at ({:.3}, {:.3}, {:.3})",
-                        faces[first.face].id, end.x, end.y, end.z
+                        faces[on[first].face].id, end.x, end.y, end.z
                     ));
                 }
             }

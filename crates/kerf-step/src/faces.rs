@@ -64,9 +64,24 @@ pub(crate) fn read_faces(m: &Model<'_>, only: Option<&[u64]>) -> Result<(Vec<Fac
 }
 
 /// The faces a shell uses through an `ORIENTED_FACE` with orientation `.F.` (reversed).
+///
+/// Only the `ORIENTED_FACE`s a shell lists count: one that nothing uses must not turn its face
+/// (a file with such dangling entities on its walls had every scrap side reversed).
 fn oriented_face_flips(m: &Model<'_>) -> Result<Vec<u64>> {
+    let mut in_shells: std::collections::HashSet<u64> = std::collections::HashSet::new();
+    for name in ["CLOSED_SHELL", "OPEN_SHELL"] {
+        for s in m.all(name)? {
+            if let Some(Value::List(items)) = s.record(name).and_then(|p| p.get(1)) {
+                in_shells.extend(items.iter().filter_map(|v| match v {
+                    Value::Ref(r) => Some(*r),
+                    _ => None,
+                }));
+            }
+        }
+    }
     Ok(m.all("ORIENTED_FACE")?
         .into_iter()
+        .filter(|i| in_shells.contains(&i.id))
         .filter_map(|i| {
             let p = i.record("ORIENTED_FACE")?;
             match (p.get(2), p.get(3)) {

@@ -487,6 +487,7 @@ fn read_units(ex: &Exchange<'_>) -> Result<(Units, Vec<String>)> {
         let p = inst.record("GLOBAL_UNIT_ASSIGNED_CONTEXT").unwrap_or(&[]);
         let mut u = Units::default();
         let mut length_given = false;
+        let mut angle_given = false;
         for uid in refs(&inst, p.first(), "units")? {
             let unit = lookup(ex, &inst, uid)?;
             let kind = match (unit.is("LENGTH_UNIT"), unit.is("PLANE_ANGLE_UNIT")) {
@@ -501,13 +502,32 @@ fn read_units(ex: &Exchange<'_>) -> Result<(Units, Vec<String>)> {
                 (false, false) => continue,
             };
             let (f, name) = unit_factor(ex, &unit, kind, 0)?;
+            // One context, one unit of each kind: with two, which one the geometry means is a
+            // guess (the last listed won, silently: mm and inch gave a 25.4 x error either way).
+            let twice = |what: &str| {
+                err(
+                    &inst,
+                    format!(
+                        "lists a second {what} unit (#{uid}); a context has one unit of each kind"
+                    ),
+                )
+            };
             match kind {
                 Kind::Length => {
+                    if length_given {
+                        return Err(twice("length"));
+                    }
                     u.mm_per_length = f;
                     u.length_name = name;
                     length_given = true;
                 }
-                Kind::Angle => u.rad_per_angle = f,
+                Kind::Angle => {
+                    if angle_given {
+                        return Err(twice("plane angle"));
+                    }
+                    u.rad_per_angle = f;
+                    angle_given = true;
+                }
             }
         }
         if !length_given {

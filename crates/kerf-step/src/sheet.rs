@@ -37,6 +37,11 @@ const AXIAL_DEG: f64 = 5.0;
 /// Relative spread of the thickness over the features' edges above which the part is not taken
 /// for one sheet of constant thickness (beyond `THICKNESS_SLACK_MM`).
 const THICKNESS_SPREAD: f64 = 0.02;
+/// Largest distance, as a share of the thickness (plus `THICKNESS_SLACK_MM`), of a feature
+/// point moved the thickness through the sheet from an edge of the other side: 1 % (a wall 0.6
+/// degrees off square).
+const TWIN_SLACK: f64 = 0.01;
+
 /// Absolute slack of the thickness, mm (file precision).
 const THICKNESS_SLACK_MM: f64 = 1e-3;
 
@@ -308,6 +313,58 @@ pub(crate) fn recognise(
             "the features' distance to the other side runs from {lo:.4} to {hi:.4} mm: not one sheet of constant thickness (or beveled walls)"
         )));
     }
+    // The walls are at right angles to the sheet: every feature point, moved the thickness
+    // against its side's normal, lies on a sharp edge of the other side (its twin). The
+    // distance above is to the other side's untrimmed surfaces, which reach under a beveled
+    // hole and past a slanted outline: this is the test that refuses them.
+    let twin_edges: Vec<(&NurbsCurve, Point3<f64>, Point3<f64>)> = theirs
+        .iter()
+        .flatten()
+        .map(|u| {
+            let c = &faces[u.face].loops[u.lp][u.pos];
+            let (lo, hi) = curve_box(c);
+            (c, lo, hi)
+        })
+        .collect();
+    let slack = TWIN_SLACK * t + THICKNESS_SLACK_MM;
+    for c in &ours {
+        for u in c {
+            let e = &faces[u.face].loops[u.lp][u.pos];
+            let (t0, t1) = e.domain();
+            if let Some(i) = inst(u.face)? {
+                m.charge(
+                    &i,
+                    Charge::FaceTests,
+                    THICKNESS_TESTS * (1 + twin_edges.len().div_ceil(64)),
+                )?;
+            }
+            for k in 0..THICKNESS_TESTS {
+                let p = e.point(t0 + (t1 - t0) * (k as f64 + 0.5) / THICKNESS_TESTS as f64);
+                let Some(n) = normal_at(&faces[u.face].surface, &p) else {
+                    return Ok(Err(format!(
+                        "face #{} has no normal at ({:.3}, {:.3}, {:.3})",
+                        faces[u.face].id, p.x, p.y, p.z
+                    )));
+                };
+                let q = p - n * t;
+                let mut best = f64::INFINITY;
+                for (c, lo, hi) in &twin_edges {
+                    if box_distance(&q, lo, hi) <= slack {
+                        best = best.min(c.closest_point(&q).distance);
+                        if best <= slack {
+                            break;
+                        }
+                    }
+                }
+                if best > slack {
+                    return Ok(Err(format!(
+                        "a wall of face #{} is not at right angles to the sheet: no edge of the other side within {slack:.4} mm of ({:.3}, {:.3}, {:.3}), {t:.3} mm behind its edge point ({:.3}, {:.3}, {:.3}): beveled or slanted walls are not cut as a sheet",
+                        faces[u.face].id, q.x, q.y, q.z, p.x, p.y, p.z
+                    )));
+                }
+            }
+        }
+    }
     let mut features: Vec<Feature> = ours.iter().map(|c| feature(faces, &sharp, c)).collect();
     // Twins by the nearest chain centroid (for the report).
     let centroid = |c: &[Use]| -> Point3<f64> {
@@ -392,6 +449,20 @@ fn area_and_normal(s: &NurbsSurface) -> (f64, Vector3<f64>) {
     (area, normal)
 }
 
+/// The box of a curve's control points (which holds the curve).
+fn curve_box(c: &NurbsCurve) -> (Point3<f64>, Point3<f64>) {
+    let pts = c.control_points();
+    let mut lo = pts[0];
+    let mut hi = pts[0];
+    for p in pts {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    (lo, hi)
+}
+
 /// The distance from `p` to the box `lo hi` (0 inside).
 fn box_distance(p: &Point3<f64>, lo: &Point3<f64>, hi: &Point3<f64>) -> f64 {
     let d = Vector3::from_fn(|i, _| (lo[i] - p[i]).max(p[i] - hi[i]).max(0.0));
@@ -432,7 +503,10 @@ fn chain(faces: &[Face], on: Vec<Use>) -> std::result::Result<Vec<Vec<Use>>, Str
         while (end - start).norm() > close {
             let lo = xs.partition_point(|&x| x < end.x - NEAR);
             let mut best: Option<(usize, f64)> = None;
-            for &i in order[lo..].iter().take_while(|&&i| ends[i].0.x <= end.x + NEAR) {
+            for &i in order[lo..]
+                .iter()
+                .take_while(|&&i| ends[i].0.x <= end.x + NEAR)
+            {
                 scans += 1;
                 if used[i] {
                     continue;

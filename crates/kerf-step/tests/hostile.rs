@@ -201,3 +201,23 @@ fn a_loop_repeating_an_edge_is_refused_with_bounded_work() {
         "{e}"
     );
 }
+
+#[test]
+fn a_context_with_two_length_units_is_refused_whichever_comes_first() {
+    // mm and inch in one context: the last listed won silently (a 25.4 x error either way).
+    let inch = "#905=(CONVERSION_BASED_UNIT('INCH',#906)LENGTH_UNIT()NAMED_UNIT(*));\n\
+                #906=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#900);\n";
+    let mm = "#900=(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT(.MILLI.,.METRE.));\n\
+              #901=(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.));\n";
+    for order in ["#900,#905,#901", "#905,#900,#901"] {
+        let text = file(&format!(
+            "{mm}{inch}#902=(GEOMETRIC_REPRESENTATION_CONTEXT(3)GLOBAL_UNIT_ASSIGNED_CONTEXT(({order}))REPRESENTATION_CONTEXT('',''));\n{}#99=GEOMETRIC_CURVE_SET('',(#1));\n",
+            line(1, "1.", "10.")
+        ));
+        let e = import(&text, &ImportOptions::default()).unwrap_err();
+        assert!(
+            e.to_string().contains("lists a second length unit"),
+            "{order}: {e}"
+        );
+    }
+}

@@ -581,6 +581,70 @@ fn a_placed_assembly_part_is_refused_not_misplaced() {
 }
 
 #[test]
+fn sheet_features_have_the_scrap_where_the_material_is_not() {
+    // fixtures/step/sheet (scripts/make_sheet_steps.py): a 100 x 60 x 2 mm plate with a 12-gon
+    // hole of circumradius 10 about (50, 30). Truth from the geometry alone: a point 0.5 mm to
+    // the scrap side of each feature (left = n x t, n the cut side's normal, +z or -z) is off
+    // the plate: outside the rectangle for the outline, inside the hole for the hole. The same
+    // plate with unused ORIENTED_FACE(.F.) entities on its walls reads the same (they flipped
+    // every scrap side); a 45-degree beveled hole is not taken for a sheet.
+    let in_material = |p: &Point3<f64>| {
+        let inside_rect = p.x > 0.0 && p.x < 100.0 && p.y > 0.0 && p.y < 60.0;
+        // The 12-gon's inscribed radius is 10 cos 15 deg = 9.66: beyond 10 is material.
+        let off_hole = ((p.x - 50.0).powi(2) + (p.y - 30.0).powi(2)).sqrt() > 10.0;
+        inside_rect && off_hole
+    };
+    for name in ["plate.step", "dangling_orient.step"] {
+        let im = import_file(
+            fixture(&format!("sheet/{name}")),
+            &ImportOptions::default().with_edges(None),
+        )
+        .expect(name);
+        let sheet = im.report.sheet.clone().expect("ran");
+        assert_eq!(sheet.not_a_sheet, None, "{name}");
+        assert!((sheet.thickness_mm - 2.0).abs() < 1e-9, "{name}");
+        assert_eq!(im.file.curves.len(), 2, "{name}: the outline and the hole");
+        for c in &im.file.curves {
+            let curve = curve(c);
+            let z = curve.point(curve.domain().0).z;
+            let n = if z > 1.0 { Vector3::z() } else { -Vector3::z() };
+            let scrap_left = c.scrap.as_deref() == Some("left");
+            let (a, b) = curve.domain();
+            for k in 0..40 {
+                // Off the corners (the knots at 100/320 etc. are sample fractions of 0.5).
+                let u = a + (b - a) * (k as f64 + 0.37) / 40.0;
+                let p = curve.point(u);
+                let t = curve.tangent(u).expect("tangent");
+                let left = n.cross(&t).normalize();
+                let scrap = p + if scrap_left { left } else { -left } * 0.5;
+                let part = p - if scrap_left { left } else { -left } * 0.5;
+                assert!(
+                    !in_material(&scrap),
+                    "{name}: {} scrap at {scrap} is material",
+                    c.id
+                );
+                assert!(
+                    in_material(&part),
+                    "{name}: {} part side at {part} is not",
+                    c.id
+                );
+            }
+        }
+    }
+    let im = import_file(
+        fixture("sheet/bevel_hole.step"),
+        &ImportOptions::default().with_edges(None),
+    )
+    .expect("every face loop instead");
+    let why = im
+        .report
+        .sheet
+        .and_then(|s| s.not_a_sheet)
+        .expect("not a sheet");
+    assert!(why.contains("not at right angles"), "{why}");
+}
+
+#[test]
 fn a_mapped_item_placed_elsewhere_is_refused_not_read_unplaced() {
     // A MAPPED_ITEM placing a geometric set's circle 500 mm away was read where the map's own
     // coordinates put it (exit 0, the contour 500 mm off). Refused, naming the item; in place

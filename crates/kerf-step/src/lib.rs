@@ -405,6 +405,16 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                     ));
                     name.clear();
                 }
+                if name.chars().count() > MAX_NAME_CHARS {
+                    // An id is written into every output (toolpath, axes, report, picture): a
+                    // 20 MB name made 140 MB of files. Its head identifies it.
+                    report.skipped.push(format!(
+                        "#{eid} {}: its name of {} characters is cut to its first {MAX_NAME_CHARS}",
+                        e.name(),
+                        name.chars().count()
+                    ));
+                    name = name.chars().take(MAX_NAME_CHARS).collect();
+                }
                 let base = if name.is_empty() {
                     format!("#{eid}")
                 } else {
@@ -538,6 +548,9 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     report.work = m.work();
     Ok(Import { file, report })
 }
+
+/// The most characters of a STEP entity's name kept in a contour's id.
+pub const MAX_NAME_CHARS: usize = 120;
 
 /// One contour of the import: its id, curve, the faces it names (indices) and its scrap side.
 type Contour = (String, NurbsCurve, Vec<usize>, Option<&'static str>);

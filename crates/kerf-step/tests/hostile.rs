@@ -221,3 +221,24 @@ fn a_context_with_two_length_units_is_refused_whichever_comes_first() {
         );
     }
 }
+
+#[test]
+fn a_long_name_is_cut_in_the_contour_id() {
+    // Ids reach every output; a 20 MB name made 140 MB of files. Kept: the first 120
+    // characters, and the cut reported.
+    let long = "N".repeat(10_000);
+    let text = file(&format!(
+        "{MM}#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=AXIS2_PLACEMENT_3D('',#1,$,$);\n#3=CIRCLE('{long}',#2,5.);\n#99=GEOMETRIC_CURVE_SET('',(#3));\n"
+    ));
+    let im = import(&text, &ImportOptions::default()).expect("reads");
+    let id = &im.file.curves[0].id;
+    assert_eq!(id, &format!("{} #3", "N".repeat(kerf_step::MAX_NAME_CHARS)));
+    assert!(
+        im.report
+            .skipped
+            .iter()
+            .any(|s| s.contains("10000 characters")),
+        "{:?}",
+        im.report.skipped
+    );
+}

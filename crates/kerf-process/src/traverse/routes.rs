@@ -110,6 +110,16 @@ pub fn plan_traverse_within(
     plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(())).map(|(t, ())| t)
 }
 
+/// A straight move's two poses, bit for bit: the key under which its coarse outcome is kept.
+type MoveKey = [u64; 12];
+
+/// The coarse outcomes of the moves of one gap's routes, by their poses.
+type MoveOutcomes = std::collections::HashMap<MoveKey, std::result::Result<f64, Blocked>>;
+
+fn move_key(a: &PoseArray, b: &PoseArray) -> MoveKey {
+    std::array::from_fn(|k| if k < 6 { a[k] } else { b[k - 6] }.to_bits())
+}
+
 /// Samples the finer margins may take over one gap's routes, after the coarse pass found
 /// none clear.
 const FINE_SAMPLES: usize = 1 << 22;
@@ -225,7 +235,12 @@ pub(crate) fn plan_traverse_accepting<T>(
     };
     // The travel between the waypoints, tip and nozzle keeping the clearance: with the
     // coarse margin (each move within its own budget), or with `Trace::prove`'s finer margins
-    // within the gap's budget `fine`.
+    // within the gap's budget `fine`. A coarse move's outcome depends on nothing but its two
+    // poses (the obstacles, the clearance, the nozzle and the margin are the gap's, the budget
+    // its own), and the routes of a gap share many moves (every safe-plane route from one
+    // retract point rises along the same move; half the moves checked on the real files are
+    // repeats): each is traced once per gap.
+    let traced: std::cell::RefCell<MoveOutcomes> = Default::default();
     let tip_ends =
         |w: &[PoseArray], fine: Option<&mut Work>| -> std::result::Result<f64, Blocked> {
             let mut least = f64::INFINITY;
@@ -233,7 +248,15 @@ pub(crate) fn plan_traverse_accepting<T>(
             for s in w.windows(2) {
                 let trace = Trace::new(obs, &s[0], &s[1], c, opts.nozzle_mm);
                 least = least.min(match fine.as_deref_mut() {
-                    None => trace.certify_or_witness(floor, &mut Work::new(MOVE_SAMPLES))?,
+                    None => {
+                        let key = move_key(&s[0], &s[1]);
+                        let known = traced.borrow().get(&key).copied();
+                        let outcome = known.unwrap_or_else(|| {
+                            trace.certify_or_witness(floor, &mut Work::new(MOVE_SAMPLES))
+                        });
+                        traced.borrow_mut().insert(key, outcome);
+                        outcome?
+                    }
                     Some(work) => trace.prove(floor, work)?,
                 });
             }

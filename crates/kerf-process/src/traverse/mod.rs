@@ -13,6 +13,7 @@
 mod check;
 mod obstacles;
 mod options;
+mod probe;
 mod proof;
 mod routes;
 mod search;

@@ -107,7 +107,7 @@ pub fn plan_traverse_within(
     opts: &TraverseOptions,
     reachable: &dyn Fn(&[PoseArray]) -> bool,
 ) -> Result<Traverse> {
-    plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(())).map(|(t, ())| t)
+    plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(()), true).map(|(t, ())| t)
 }
 
 /// A straight move's two poses, bit for bit: the key under which its coarse outcome is kept.
@@ -118,6 +118,49 @@ type MoveOutcomes = std::collections::HashMap<MoveKey, std::result::Result<f64, 
 
 fn move_key(a: &PoseArray, b: &PoseArray) -> MoveKey {
     std::array::from_fn(|k| if k < 6 { a[k] } else { b[k - 6] }.to_bits())
+}
+
+/// What the coarse pass made of one route.
+#[derive(Debug, Clone, Copy)]
+enum Coarse {
+    /// Outside the machine's axis limits (not checked).
+    Unreachable,
+    /// Clear, but refused by the caller's check, at this point.
+    Refused(Blocked),
+    /// Its check failed so.
+    Failed(Blocked),
+    /// A point of it was measured closer than the clearance: its check cannot pass, and is
+    /// put off until its outcome is needed.
+    Deferred,
+}
+
+/// True if the route through `way` cannot pass the travel's check: one of its moves already
+/// failed it (`traced`), or a point of one of them is measured closer than the clearance
+/// (`probe`; the first and the last move first, where the routes of the real files fail).
+fn fails_for_sure(
+    traced: &MoveOutcomes,
+    probe: &mut super::probe::Probe<'_>,
+    way: &[PoseArray],
+) -> bool {
+    let moves = way.len().saturating_sub(1);
+    let known = |i: usize| traced.get(&move_key(&way[i], &way[i + 1]));
+    if (0..moves).any(|i| matches!(known(i), Some(Err(_)))) {
+        return true;
+    }
+    let order = [0, moves.saturating_sub(1)]
+        .into_iter()
+        .chain(1..moves.saturating_sub(1));
+    let mut seen = Vec::with_capacity(moves);
+    for i in order.take(moves) {
+        if seen.contains(&i) || known(i).is_some() {
+            continue;
+        }
+        seen.push(i);
+        if probe.violated(&way[i], &way[i + 1]) {
+            return true;
+        }
+    }
+    false
 }
 
 /// Samples the finer margins may take over one gap's routes, after the coarse pass found
@@ -185,6 +228,11 @@ pub(crate) type Refusal = (Point3<f64>, f64);
 /// [`plan_traverse_within`], where a route that is clear is also handed to `accept` (e.g.
 /// the check of the machine's own rapid moves); the first route both accept is returned with
 /// `accept`'s result, the next shortest tried otherwise.
+///
+/// With `explain` false the caller does not want the reason where no route clears (it tries
+/// again with fewer surfaces): the error then says so instead of counting the routes, and
+/// the routes put off for a point measured closer than the clearance are not traced for it.
+/// Which route is found, if any, does not depend on `explain`.
 pub(crate) fn plan_traverse_accepting<T>(
     obs: &Obstacles,
     from: &PoseArray,
@@ -192,6 +240,7 @@ pub(crate) fn plan_traverse_accepting<T>(
     opts: &TraverseOptions,
     reachable: &dyn Fn(&[PoseArray]) -> bool,
     accept: &mut dyn FnMut(&Traverse) -> std::result::Result<T, Refusal>,
+    explain: bool,
 ) -> Result<(Traverse, T)> {
     opts.validate()?;
     for (name, p) in [("from", from), ("to", to)] {
@@ -271,6 +320,14 @@ pub(crate) fn plan_traverse_accepting<T>(
             clearance_mm: c,
             why,
         }))
+    };
+    // The error of a gap whose reason the caller does not want (it tries again with fewer
+    // surfaces): the routes put off are not traced for it.
+    let unexplained = |b: Blocked| {
+        blocked_err(
+            b,
+            "no route clears (the routes were not all traced: the reason was not asked for)".into(),
+        )
     };
     // The retract heights tried at each end (doubling), those whose axial move is clear.
     let heights: Vec<f64> = (0..5)
@@ -352,48 +409,113 @@ pub(crate) fn plan_traverse_accepting<T>(
     // First every route with the coarse margin, shortest first; then, if none clears, the
     // routes that failed only within the margin again with finer margins (`prove`), within
     // the gap's budget of samples.
+    //
+    // A route on which a point closer than the clearance is measured first (`Probe`) cannot
+    // pass its check: its trace is put off. Where a later route is taken, it is never needed;
+    // otherwise the routes put off are traced then, and every route's outcome is counted in
+    // the order of the routes, as if each had been traced in turn (a route put off that did
+    // clear would be offered then, before any other: none of the routes after it was taken).
+    let mut probe = super::probe::Probe::new(obs, c, opts.nozzle_mm);
+    let mut outcomes: Vec<Coarse> = Vec::with_capacity(routes.len());
+    for (length_mm, route, waypoints) in &routes {
+        if !reachable(waypoints) {
+            outcomes.push(Coarse::Unreachable);
+            continue;
+        }
+        if fails_for_sure(&traced.borrow(), &mut probe, waypoints) {
+            outcomes.push(Coarse::Deferred);
+            continue;
+        }
+        let checked = tip_ends(waypoints, None);
+        match checked {
+            Ok(least) => {
+                let t = Traverse {
+                    length_mm: *length_mm,
+                    waypoints: waypoints.clone(),
+                    route: *route,
+                    min_distance_mm: least,
+                };
+                match accept(&t) {
+                    Ok(v) => return Ok((t, v)),
+                    Err((at, distance)) => {
+                        outcomes.push(Coarse::Refused(Blocked::at(at, distance)));
+                    }
+                }
+            }
+            Err(e) => {
+                probe.learn(e.at, e.distance);
+                outcomes.push(Coarse::Failed(e));
+            }
+        }
+    }
+    // No route clears with the coarse margin. The finer margins need the routes that failed
+    // only within it, in order, and the error counts every route: both need the routes put
+    // off, unless this gap's error is not wanted and no route traced failed within the margin
+    // (then the finer margins could only re-trace routes that cannot pass).
     let mut tally = Tally::default();
     // The routes that failed only within the coarse margin, with that failure.
     let mut marginal: Vec<(usize, Blocked)> = Vec::new();
-    let mut fine = Work::new(FINE_SAMPLES);
-    for pass in 0..2 {
-        let candidates: Vec<(usize, Option<Blocked>)> = if pass == 0 {
-            (0..routes.len()).map(|k| (k, None)).collect()
-        } else {
-            marginal.drain(..).map(|(k, b)| (k, Some(b))).collect()
-        };
-        for (k, coarse) in candidates {
-            let (length_mm, route, waypoints) = &routes[k];
-            if let (Some(b), 0) = (coarse, fine.left) {
-                // No budget left to re-trace it: undecided at its coarse failure.
-                tally.undecided += 1;
-                tally.note(b);
-                continue;
-            }
-            if pass == 0 && !reachable(waypoints) {
-                tally.unreachable += 1;
-                continue;
-            }
-            let checked = if pass == 0 {
-                tip_ends(waypoints, None)
-            } else {
-                tip_ends(waypoints, Some(&mut fine))
-            };
-            match checked {
-                Ok(least) => {
-                    let t = Traverse {
-                        length_mm: *length_mm,
-                        waypoints: waypoints.clone(),
-                        route: *route,
-                        min_distance_mm: least,
-                    };
-                    if let Some(done) = tally.offer(t, accept) {
-                        return Ok(done);
+    let resolve = explain
+        || outcomes
+            .iter()
+            .any(|o| matches!(o, Coarse::Failed(e) if e.within_margin(c)));
+    if resolve {
+        for (k, outcome) in outcomes.into_iter().enumerate() {
+            let outcome = match outcome {
+                Coarse::Deferred => {
+                    let (length_mm, route, waypoints) = &routes[k];
+                    match tip_ends(waypoints, None) {
+                        Ok(least) => {
+                            let t = Traverse {
+                                length_mm: *length_mm,
+                                waypoints: waypoints.clone(),
+                                route: *route,
+                                min_distance_mm: least,
+                            };
+                            match accept(&t) {
+                                Ok(v) => return Ok((t, v)),
+                                Err((at, distance)) => Coarse::Refused(Blocked::at(at, distance)),
+                            }
+                        }
+                        Err(e) => Coarse::Failed(e),
                     }
                 }
-                Err(e) if pass == 0 && e.within_margin(c) => marginal.push((k, e)),
-                Err(e) => tally.failed(e, c),
+                other => other,
+            };
+            match outcome {
+                Coarse::Unreachable => tally.unreachable += 1,
+                Coarse::Refused(b) => {
+                    tally.refused += 1;
+                    tally.note(b);
+                }
+                Coarse::Failed(e) if e.within_margin(c) => marginal.push((k, e)),
+                Coarse::Failed(e) => tally.failed(e, c),
+                Coarse::Deferred => unreachable!("traced above"),
             }
+        }
+    }
+    let mut fine = Work::new(FINE_SAMPLES);
+    for (k, b) in marginal.drain(..) {
+        let (length_mm, route, waypoints) = &routes[k];
+        if fine.left == 0 {
+            // No budget left to re-trace it: undecided at its coarse failure.
+            tally.undecided += 1;
+            tally.note(b);
+            continue;
+        }
+        match tip_ends(waypoints, Some(&mut fine)) {
+            Ok(least) => {
+                let t = Traverse {
+                    length_mm: *length_mm,
+                    waypoints: waypoints.clone(),
+                    route: *route,
+                    min_distance_mm: least,
+                };
+                if let Some(done) = tally.offer(t, accept) {
+                    return Ok(done);
+                }
+            }
+            Err(e) => tally.failed(e, c),
         }
     }
     // How the routes of the given shapes failed, in words.
@@ -419,6 +541,9 @@ pub(crate) fn plan_traverse_accepting<T>(
         (&from, "the retract from the exit"),
     ] {
         if let Some((b, why)) = super::proof::line_blocked(obs, p, opts, what) {
+            if !explain {
+                return Err(unexplained(b));
+            }
             let shapes = tally_text(&tally, routes.len());
             return Err(blocked_err(
                 b,
@@ -477,6 +602,9 @@ pub(crate) fn plan_traverse_accepting<T>(
             }
             Err(e) => tally.failed(e, c),
         }
+    }
+    if !explain {
+        return Err(unexplained(Blocked::at(position(&from), 0.0)));
     }
     let n = routes.len() + searched;
     let search_note = if opts.search {

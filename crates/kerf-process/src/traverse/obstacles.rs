@@ -26,11 +26,49 @@ struct Item {
 }
 
 /// The part's surfaces in the workpiece frame, for distance queries.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct Obstacles {
     items: Vec<Item>,
     /// How many exact distance queries have been made (the work the checks cost).
     queries: std::sync::atomic::AtomicUsize,
+    /// This set of surfaces, as the recent queries' cache knows it: never the same for two
+    /// sets (a new one for every set made and every surface added).
+    generation: u64,
+}
+
+impl Default for Obstacles {
+    fn default() -> Self {
+        Self {
+            items: Vec::new(),
+            queries: Default::default(),
+            generation: next_generation(),
+        }
+    }
+}
+
+/// A number no set of surfaces had before.
+fn next_generation() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// One entry of the recent queries' cache: the set of surfaces, the point and the limit (bit
+/// for bit), and the answer.
+#[derive(Debug, Clone, Copy, Default)]
+struct Recent {
+    generation: u64,
+    key: [u64; 4],
+    value: f64,
+}
+
+/// Entries of each thread's cache of recent queries (a power of two).
+const RECENT: usize = 1 << 13;
+
+thread_local! {
+    /// The answers of this thread's recent [`Obstacles::distance_below`] queries, by a hash of
+    /// the query (direct-mapped: a query replaces the one before it in its slot).
+    static RECENT_QUERIES: std::cell::RefCell<Vec<Recent>> =
+        std::cell::RefCell::new(vec![Recent::default(); RECENT]);
 }
 
 impl Obstacles {
@@ -47,6 +85,7 @@ impl Obstacles {
 
     fn add_nurbs_named(&mut self, surface: NurbsSurface, id: String) {
         let (lo, hi) = surface.bounding_box();
+        self.generation = next_generation();
         self.items.push(Item {
             shape: std::sync::Arc::new(Obstacle::Nurbs(Box::new(Tessellated::new(surface)))),
             lo,
@@ -70,6 +109,7 @@ impl Obstacles {
                 })
                 .collect(),
             queries: Default::default(),
+            generation: next_generation(),
         }
     }
 
@@ -144,6 +184,7 @@ impl Obstacles {
         if mesh.indices().is_empty() {
             return Err(bad("mesh: no triangle with a non-zero area".into()));
         }
+        self.generation = next_generation();
         self.items.push(Item {
             shape: std::sync::Arc::new(Obstacle::Mesh(Box::new(mesh))),
             lo,
@@ -303,7 +344,33 @@ impl Obstacles {
 
     /// The distance from `p` to the nearest surface if it is below `limit`; otherwise some
     /// value `>= limit` (surfaces whose box is at least `limit` away are not queried).
+    ///
+    /// The answer is a function of the surfaces, `p` and `limit` alone, so each thread keeps
+    /// the answers of its recent queries and gives the same one again for the same query (bit
+    /// for bit): the checks ask again for many points (the nozzle where one traced move ends is
+    /// where the next starts, the head at a retract point starts every route from it).
     pub fn distance_below(&self, p: &Point3<f64>, limit: f64) -> f64 {
+        let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits(), limit.to_bits()];
+        let slot = recent_slot(self.generation, &key);
+        let known = RECENT_QUERIES.with(|r| {
+            let e = r.borrow()[slot];
+            (e.generation == self.generation && e.key == key).then_some(e.value)
+        });
+        if let Some(value) = known {
+            return value;
+        }
+        let value = self.distance_below_uncached(p, limit);
+        RECENT_QUERIES.with(|r| {
+            r.borrow_mut()[slot] = Recent {
+                generation: self.generation,
+                key,
+                value,
+            }
+        });
+        value
+    }
+
+    fn distance_below_uncached(&self, p: &Point3<f64>, limit: f64) -> f64 {
         // Skipped surfaces are at least their box's distance away: the result is exact below
         // `limit` and a lower bound of the distance (itself >= limit) above it.
         let mut best = f64::INFINITY;
@@ -321,6 +388,15 @@ impl Obstacles {
         }
         best.min(floor)
     }
+}
+
+/// The slot of a query in the cache of recent queries.
+fn recent_slot(generation: u64, key: &[u64; 4]) -> usize {
+    let mut h = generation.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    for k in key {
+        h = (h ^ k).wrapping_mul(0x9e37_79b9_7f4a_7c15).rotate_left(29);
+    }
+    (h >> 32) as usize & (RECENT - 1)
 }
 
 fn shape_distance(o: &Obstacle, p: &Point3<f64>) -> f64 {

@@ -132,6 +132,8 @@ enum Coarse {
     /// A point of it was measured closer than the clearance: its check cannot pass, and is
     /// put off until its outcome is needed.
     Deferred,
+    /// An axial move to one of its retract points is not clear: the route does not exist.
+    Absent,
 }
 
 /// True if the route through `way` cannot pass the travel's check: one of its moves already
@@ -333,46 +335,32 @@ pub(crate) fn plan_traverse_accepting<T>(
     let heights: Vec<f64> = (0..5)
         .map(|k| opts.retract_mm * f64::from(1 << k))
         .collect();
-    let ends = |p: &PoseArray| -> std::result::Result<Vec<PoseArray>, Blocked> {
-        let mut last = None;
-        let ok: Vec<PoseArray> = heights
-            .iter()
-            .filter_map(|&hh| match axial(p, hh) {
-                Ok(q) => Some(q),
-                Err(e) => {
-                    last = Some(e);
-                    None
-                }
-            })
-            .collect();
-        match (ok.is_empty(), last) {
-            (true, Some(e)) => Err(e),
-            _ => Ok(ok),
+    // The axial moves, each checked once and only where needed: a route is taken only if
+    // both its retract points' axial moves are clear, but a route put off (below) needs
+    // neither, and where a route is taken the higher retract points are seldom reached.
+    // Every end's axial moves are checked before the routes are counted or searched.
+    let axial_done: std::cell::RefCell<[[Option<std::result::Result<PoseArray, Blocked>>; 5]; 2]> =
+        Default::default();
+    let axial_at = |side: usize, k: usize| -> std::result::Result<PoseArray, Blocked> {
+        if let Some(known) = axial_done.borrow()[side][k] {
+            return known;
         }
+        let outcome = axial(if side == 0 { &from } else { &to }, heights[k]);
+        axial_done.borrow_mut()[side][k] = Some(outcome);
+        outcome
     };
-    let top = heights[heights.len() - 1];
-    let ends_a = ends(&from).map_err(|b| {
-        blocked_err(
-            b,
-            format!(
-                "the retract along the tool axis from the exit is blocked at every height from {:.1} to {top:.1} mm",
-                heights[0]
-            ),
-        )
-    })?;
-    let ends_b = ends(&to).map_err(|b| {
-        blocked_err(
-            b,
-            format!(
-                "the approach along the tool axis to the pierce is blocked at every height from {:.1} to {top:.1} mm",
-                heights[0]
-            ),
-        )
-    })?;
+    // The retract point at height `k` of an end, whether or not its axial move is clear.
+    let retract_point = |p: &PoseArray, k: usize| {
+        let (q, n) = (position(p), normal(p));
+        with_axis(q + n * heights[k], n)
+    };
     // Every route: straight between any two retract points, lifted along `up` over the
     // surfaces near the travel, or over the safe plane above every surface; checked shortest
-    // first.
+    // first. Built for every pair of retract heights; a route whose retract points' axial
+    // moves are not both clear does not exist (sorting is stable, so the order of the others
+    // is that of the routes built from the clear retract points alone).
     let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::new();
+    let mut route_ends: Vec<(usize, usize)> = Vec::new();
     let lift_to = |level: f64| {
         move |p: &PoseArray| {
             let q = position(p);
@@ -383,10 +371,13 @@ pub(crate) fn plan_traverse_accepting<T>(
     let global_top = obs
         .bounding_box()
         .map(|(lo, hi)| top_along(&lo, &hi, &up) + c + 2.0 * h);
-    for a in &ends_a {
-        for b in &ends_b {
+    for ka in 0..heights.len() {
+        let a = &retract_point(&from, ka);
+        for kb in 0..heights.len() {
+            let b = &retract_point(&to, kb);
             let straight = vec![*a, *b];
             routes.push((length_of(&straight), Route::Straight, straight));
+            route_ends.push((ka, kb));
             let (pa, pb) = (position(a), position(b));
             // Each lift at a clearance and two steps above the boxes' top, and a clearance
             // higher (where a tilted nozzle reaches down past the first).
@@ -396,16 +387,38 @@ pub(crate) fn plan_traverse_accepting<T>(
                     let lift = lift_to(level + c + 2.0 * h + extra);
                     let way = vec![*a, lift(a), lift(b), *b];
                     routes.push((length_of(&way), Route::Lifted, way));
+                    route_ends.push((ka, kb));
                 }
                 if let Some(level) = global_top {
                     let lift = lift_to(level + extra);
                     let plane = vec![*a, lift(a), lift(b), *b];
                     routes.push((length_of(&plane), Route::SafePlane, plane));
+                    route_ends.push((ka, kb));
                 }
             }
         }
     }
-    routes.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut order: Vec<usize> = (0..routes.len()).collect();
+    order.sort_by(|&x, &y| routes[x].0.total_cmp(&routes[y].0));
+    let mut sorted: Vec<Option<(f64, Route, Vec<PoseArray>)>> =
+        routes.into_iter().map(Some).collect();
+    let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::with_capacity(order.len());
+    let mut ends_of: Vec<(usize, usize)> = Vec::with_capacity(order.len());
+    for &k in &order {
+        routes.extend(sorted[k].take());
+        ends_of.push(route_ends[k]);
+    }
+    // True if both retract points' axial moves of route `k` are clear (checking them).
+    let exists = |k: usize| {
+        let (ka, kb) = ends_of[k];
+        axial_at(0, ka).is_ok() && axial_at(1, kb).is_ok()
+    };
+    // Known not to exist: an axial move of it already failed.
+    let gone = |k: usize| {
+        let (ka, kb) = ends_of[k];
+        let done = axial_done.borrow();
+        matches!(done[0][ka], Some(Err(_))) || matches!(done[1][kb], Some(Err(_)))
+    };
     // First every route with the coarse margin, shortest first; then, if none clears, the
     // routes that failed only within the margin again with finer margins (`prove`), within
     // the gap's budget of samples.
@@ -417,13 +430,21 @@ pub(crate) fn plan_traverse_accepting<T>(
     // clear would be offered then, before any other: none of the routes after it was taken).
     let mut probe = super::probe::Probe::new(obs, c, opts.nozzle_mm);
     let mut outcomes: Vec<Coarse> = Vec::with_capacity(routes.len());
-    for (length_mm, route, waypoints) in &routes {
+    for (k, (length_mm, route, waypoints)) in routes.iter().enumerate() {
+        if gone(k) {
+            outcomes.push(Coarse::Absent);
+            continue;
+        }
         if !reachable(waypoints) {
             outcomes.push(Coarse::Unreachable);
             continue;
         }
         if fails_for_sure(&traced.borrow(), &mut probe, waypoints) {
             outcomes.push(Coarse::Deferred);
+            continue;
+        }
+        if !exists(k) {
+            outcomes.push(Coarse::Absent);
             continue;
         }
         let checked = tip_ends(waypoints, None);
@@ -448,6 +469,40 @@ pub(crate) fn plan_traverse_accepting<T>(
             }
         }
     }
+    // No route clears with the coarse margin. Every end's axial moves now, as they were
+    // checked before any route: where all of one end's fail, that is the gap's error.
+    let top = heights[heights.len() - 1];
+    let mut retracts: [Vec<PoseArray>; 2] = [Vec::new(), Vec::new()];
+    for (side, what) in [
+        (0, "the retract along the tool axis from the exit"),
+        (1, "the approach along the tool axis to the pierce"),
+    ] {
+        let mut last = None;
+        for k in 0..heights.len() {
+            match axial_at(side, k) {
+                Ok(q) => retracts[side].push(q),
+                Err(e) => last = Some(e),
+            }
+        }
+        if let (true, Some(b)) = (retracts[side].is_empty(), last) {
+            return Err(blocked_err(
+                b,
+                format!(
+                    "{what} is blocked at every height from {:.1} to {top:.1} mm",
+                    heights[0]
+                ),
+            ));
+        }
+    }
+    let [ends_a, ends_b] = retracts;
+    // The routes that exist, with what the coarse pass made of them.
+    let (routes, outcomes): (Vec<_>, Vec<_>) = routes
+        .into_iter()
+        .zip(outcomes)
+        .enumerate()
+        .filter(|(k, _)| exists(*k))
+        .map(|(_, r)| r)
+        .unzip();
     // No route clears with the coarse margin. The finer margins need the routes that failed
     // only within it, in order, and the error counts every route: both need the routes put
     // off, unless this gap's error is not wanted and no route traced failed within the margin
@@ -490,7 +545,7 @@ pub(crate) fn plan_traverse_accepting<T>(
                 }
                 Coarse::Failed(e) if e.within_margin(c) => marginal.push((k, e)),
                 Coarse::Failed(e) => tally.failed(e, c),
-                Coarse::Deferred => unreachable!("traced above"),
+                Coarse::Deferred | Coarse::Absent => unreachable!("traced or left out above"),
             }
         }
     }

@@ -210,6 +210,17 @@ impl Tessellated {
         if floor >= limit {
             return floor;
         }
+        self.exact(p)
+    }
+
+    /// [`Tessellated::lower_bound`]: the distance to the nearest piece's box where that is
+    /// below `enough`, else a value `>= enough` that is a lower bound of it.
+    pub(super) fn piece_bound(&self, p: &Point3<f64>, enough: f64) -> f64 {
+        self.lower_bound(p, enough)
+    }
+
+    /// The exact distance from `p` (the closest point, warm-started from the tessellation).
+    pub(super) fn exact(&self, p: &Point3<f64>) -> f64 {
         let Some(m) = &self.mesh else {
             return self.surface.closest_point(p, None).distance;
         };

@@ -10,6 +10,7 @@
 //! the control points for a NURBS surface, which contains it) is farther than the threshold
 //! are not queried. The derivation and the routes are in `docs/process.md`.
 
+mod boxes;
 mod check;
 mod obstacles;
 mod options;

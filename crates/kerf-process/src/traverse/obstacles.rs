@@ -6,6 +6,7 @@ use parry3d_f64::shape::{TriMesh, TriMeshFlags};
 
 use kerf_nurbs::NurbsSurface;
 
+use super::boxes::BoxTree;
 use super::tessellated::{box_distance, Tessellated};
 use crate::{ProcessError, Result};
 
@@ -34,6 +35,8 @@ pub struct Obstacles {
     /// This set of surfaces, as the recent queries' cache knows it: never the same for two
     /// sets (a new one for every set made and every surface added).
     generation: u64,
+    /// The tree of the surfaces' boxes (built at the first query after a surface is added).
+    tree: std::sync::OnceLock<BoxTree>,
 }
 
 impl Default for Obstacles {
@@ -42,6 +45,7 @@ impl Default for Obstacles {
             items: Vec::new(),
             queries: Default::default(),
             generation: next_generation(),
+            tree: Default::default(),
         }
     }
 }
@@ -86,6 +90,7 @@ impl Obstacles {
     fn add_nurbs_named(&mut self, surface: NurbsSurface, id: String) {
         let (lo, hi) = surface.bounding_box();
         self.generation = next_generation();
+        self.tree = Default::default();
         self.items.push(Item {
             shape: std::sync::Arc::new(Obstacle::Nurbs(Box::new(Tessellated::new(surface)))),
             lo,
@@ -110,6 +115,7 @@ impl Obstacles {
                 .collect(),
             queries: Default::default(),
             generation: next_generation(),
+            tree: Default::default(),
         }
     }
 
@@ -185,6 +191,7 @@ impl Obstacles {
             return Err(bad("mesh: no triangle with a non-zero area".into()));
         }
         self.generation = next_generation();
+        self.tree = Default::default();
         self.items.push(Item {
             shape: std::sync::Arc::new(Obstacle::Mesh(Box::new(mesh))),
             lo,
@@ -383,27 +390,25 @@ impl Obstacles {
         let mut cands = [(0.0_f64, 0.0_f64, 0usize, f64::NAN); NEAREST_CANDIDATES];
         let mut n = 0;
         // Above the limit: the least box distance, and the least pieces' bound.
-        let mut far = f64::INFINITY;
         let mut above = f64::INFINITY;
-        for (i, item) in self.items.iter().enumerate() {
-            let g = box_distance(p, &item.lo, &item.hi);
-            if g >= limit {
-                far = far.min(g);
-                continue;
-            }
-            let m = match &*item.shape {
+        let mut overflow = false;
+        let tree = self.tree();
+        tree.within(p, limit, |i, g| {
+            let m = match &*self.items[i].shape {
                 Obstacle::Nurbs(t) => t.piece_bound(p, limit),
                 Obstacle::Mesh(_) => g,
             };
             if m >= limit {
                 above = above.min(m);
-                continue;
+            } else if n == NEAREST_CANDIDATES {
+                overflow = true;
+            } else {
+                cands[n] = (m, g, i, f64::NAN);
+                n += 1;
             }
-            if n == NEAREST_CANDIDATES {
-                return self.distance_below_in_order(p, limit);
-            }
-            cands[n] = (m, g, i, f64::NAN);
-            n += 1;
+        });
+        if overflow {
+            return self.distance_below_in_order(p, limit);
         }
         let cands = &mut cands[..n];
         cands.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
@@ -428,8 +433,10 @@ impl Obstacles {
         }
         if best >= limit || nearest == usize::MAX {
             // Nothing below the limit: every candidate's exact distance was taken (each at or
-            // above it), as the scan in order does.
-            return best.min(above).min(far);
+            // above it), as the scan in order does, and the surfaces at least the limit away
+            // count with their boxes' distance.
+            let near = best.min(above);
+            return near.min(tree.nearest_beyond(p, limit, near));
         }
         // The scan in order takes the nearest surface's distance if every surface before it
         // stays above both of the bounds it is passed over by (its box's distance and its
@@ -445,6 +452,12 @@ impl Obstacles {
         } else {
             self.distance_below_in_order(p, limit)
         }
+    }
+
+    /// The tree of the surfaces' boxes.
+    fn tree(&self) -> &BoxTree {
+        self.tree
+            .get_or_init(|| BoxTree::new(self.items.iter().map(|i| (i.lo, i.hi)).collect()))
     }
 
     fn count_query(&self) {

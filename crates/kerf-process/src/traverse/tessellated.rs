@@ -219,30 +219,38 @@ impl Tessellated {
     /// [`Tessellated::lower_bound`], bit for bit: the distance to the nearest piece's box
     /// where that is below `enough`, else the value `>= enough` that `lower_bound` gives.
     ///
-    /// The strips nearest first, each passed over once its box is at least the best cell so
-    /// far or `enough` away: a cell is at least as far as its strip's box (which holds it,
-    /// coordinate by coordinate, so also in floating point), so the least cell below
-    /// `enough`, if there is one, is found, and that is what `lower_bound` returns then.
-    /// Otherwise `lower_bound` itself gives its value (a bound whose exact value depends on
-    /// its order).
+    /// The nearest strip first, then the others in order, each passed over where its box is
+    /// at least the best cell so far or `enough` away: a cell is at least as far as its strip's
+    /// box (which holds it, coordinate by coordinate, so also in floating point), so the least
+    /// cell below `enough`, if there is one, is found, and that is what `lower_bound` returns
+    /// then. Otherwise `lower_bound` itself gives its value (a bound whose exact value depends
+    /// on its order).
     pub(super) fn piece_bound(&self, p: &Point3<f64>, enough: f64) -> f64 {
         let n = self.strips.len();
         if n > NEAREST_STRIPS {
             return self.lower_bound(p, enough);
         }
-        let mut order = [(0.0_f64, 0usize); NEAREST_STRIPS];
+        let mut ds = [0.0_f64; NEAREST_STRIPS];
+        let mut first = 0;
         for (k, s) in self.strips.iter().enumerate() {
-            order[k] = (box_distance(p, &s.lo, &s.hi), k);
-        }
-        let order = &mut order[..n];
-        order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        let mut best = f64::INFINITY;
-        for &(d, k) in order.iter() {
-            if d >= best.min(enough) {
-                break;
+            ds[k] = box_distance(p, &s.lo, &s.hi);
+            if ds[k] < ds[first] {
+                first = k;
             }
-            for (lo, hi) in &self.strips[k].cells {
-                best = best.min(box_distance(p, lo, hi));
+        }
+        let cells = |k: usize, best: f64| {
+            self.strips[k]
+                .cells
+                .iter()
+                .fold(best, |b, (lo, hi)| b.min(box_distance(p, lo, hi)))
+        };
+        let mut best = f64::INFINITY;
+        if n > 0 && ds[first] < enough {
+            best = cells(first, best);
+            for k in (0..n).filter(|&k| k != first) {
+                if ds[k] < best.min(enough) {
+                    best = cells(k, best);
+                }
             }
         }
         if best < enough {

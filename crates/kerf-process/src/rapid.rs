@@ -476,8 +476,11 @@ pub fn plan_rapids(
                     })
                 })
             };
+            // Where no route clears with `first` left out and more surfaces are in the cuts'
+            // way, the reason is not reported (the gap is tried again without them).
+            let all = cuts_way(obs, g, opts, true);
             // A route is taken only if the machine's own rapid moves along it clear too.
-            let plan = |absent: &[String]| {
+            let plan = |absent: &[String], explain: bool| {
                 let here = obs.without(absent);
                 crate::traverse::plan_traverse_accepting(
                     &here,
@@ -494,16 +497,16 @@ pub fn plan_rapids(
                                 _ => (Point3::from(g.from_contour), 0.0),
                             })
                     },
+                    explain,
                 )
             };
-            match plan(&first) {
+            match plan(&first, all.len() == first.len()) {
                 Ok((t, r)) => Ok((t, r, first)),
                 Err(e) => {
-                    let all = cuts_way(obs, g, opts, true);
                     if all.len() == first.len() {
                         return Err(e);
                     }
-                    let (t, r) = plan(&all)?;
+                    let (t, r) = plan(&all, true)?;
                     Ok((t, r, all))
                 }
             }

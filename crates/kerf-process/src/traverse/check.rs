@@ -61,6 +61,11 @@ pub(super) const MOVE_SAMPLES: usize = 1 << 21;
 /// closest sample comes within this of the need stays unproven.
 pub(super) const FINEST_MARGIN: f64 = 1.0 / 4096.0;
 
+/// The least `cos(theta / 2)` the swept surface's speed takes (`theta` the angle between the
+/// move's tool axes): beyond a turn of about 174 degrees the speed is that of a 174-degree turn,
+/// which is less than the interpolated axis' true speed near the middle of the move.
+const LEAST_HALF_COS: f64 = 0.05;
+
 /// One straight move `a -> b` of the tip and the nozzle (`nozzle` mm from the tip along the
 /// tool axis, which turns as the normalised linear interpolation of `a`'s and `b`'s), to be
 /// kept `need` from the surfaces of `obs`.
@@ -87,7 +92,10 @@ impl<'a> Trace<'a> {
     ) -> Self {
         let (pa, pb) = (position(a), position(b));
         let (na, nb) = (normal(a).normalize(), normal(b).normalize());
-        let half_cos = (0.5 * (1.0 + na.dot(&nb))).max(0.0).sqrt().max(0.05);
+        let half_cos = (0.5 * (1.0 + na.dot(&nb)))
+            .max(0.0)
+            .sqrt()
+            .max(LEAST_HALF_COS);
         let speed = (pb - pa).norm() + nozzle * (nb - na).norm() / half_cos;
         Self {
             obs,
@@ -102,11 +110,37 @@ impl<'a> Trace<'a> {
     }
 
     /// The point of the swept surface at interpolation parameter `f` and nozzle offset `s`.
-    fn point(&self, f: f64, s: f64) -> Point3<f64> {
+    pub(super) fn point(&self, f: f64, s: f64) -> Point3<f64> {
         let n = (self.na * (1.0 - f) + self.nb * f)
             .try_normalize(1e-12)
             .unwrap_or(if f < 0.5 { self.na } else { self.nb });
         self.pa + (self.pb - self.pa) * f + n * s
+    }
+
+    /// How fast a point of the swept surface moves with the interpolation parameter, at most
+    /// (mm per unit of it).
+    pub(super) fn speed(&self) -> f64 {
+        self.speed
+    }
+
+    /// How far along the move (interpolation parameter) [`Trace::speed`] bounds the speed of
+    /// every point of the swept surface, so that [`Trace::certify`] passes the move only if
+    /// every point of [`Trace::point`]'s surface up to there keeps the need: 1 where the tool
+    /// axis turns by less than about 173 degrees; for a larger turn, up to where the
+    /// interpolated axis, whose length `|m(f)|` falls to `cos(theta / 2)` at the middle,
+    /// is still `1.2` times the speed's least half-cosine long (a larger turn is traced with
+    /// the speed of a 174-degree one, and the axis `m / |m|` turns at `|n_b - n_a| / |m|`, so
+    /// near the middle the trace steps over parts of the nozzle's sweep). The samples before
+    /// `f` all lie in `[0, f]`, where the bound holds, so the trace's argument covers it.
+    pub(super) fn covered_until(&self) -> f64 {
+        let h = 1.2 * LEAST_HALF_COS;
+        let c = self.na.dot(&self.nb);
+        // |m(f)|^2 = 1 - 2 f (1 - f) (1 - c), falling on [0, 1/2].
+        let r = (1.0 - h * h) / (2.0 * (1.0 - c));
+        if !(r.is_finite() && (0.0..0.25).contains(&r)) {
+            return 1.0;
+        }
+        0.5 * (1.0 - (1.0 - 4.0 * r).sqrt())
     }
 
     /// Certifies the move: every point of the tip's segment and of the nozzle keeps at least

@@ -10,9 +10,11 @@
 //! the control points for a NURBS surface, which contains it) is farther than the threshold
 //! are not queried. The derivation and the routes are in `docs/process.md`.
 
+mod boxes;
 mod check;
 mod obstacles;
 mod options;
+mod probe;
 mod proof;
 mod routes;
 mod search;

@@ -6,6 +6,7 @@ use parry3d_f64::shape::{TriMesh, TriMeshFlags};
 
 use kerf_nurbs::NurbsSurface;
 
+use super::boxes::BoxTree;
 use super::tessellated::{box_distance, Tessellated};
 use crate::{ProcessError, Result};
 
@@ -26,11 +27,52 @@ struct Item {
 }
 
 /// The part's surfaces in the workpiece frame, for distance queries.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct Obstacles {
     items: Vec<Item>,
     /// How many exact distance queries have been made (the work the checks cost).
     queries: std::sync::atomic::AtomicUsize,
+    /// This set of surfaces, as the recent queries' cache knows it: never the same for two
+    /// sets (a new one for every set made and every surface added).
+    generation: u64,
+    /// The tree of the surfaces' boxes (built at the first query after a surface is added).
+    tree: std::sync::OnceLock<BoxTree>,
+}
+
+impl Default for Obstacles {
+    fn default() -> Self {
+        Self {
+            items: Vec::new(),
+            queries: Default::default(),
+            generation: next_generation(),
+            tree: Default::default(),
+        }
+    }
+}
+
+/// A number no set of surfaces had before.
+fn next_generation() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// One entry of the recent queries' cache: the set of surfaces, the point and the limit (bit
+/// for bit), and the answer.
+#[derive(Debug, Clone, Copy, Default)]
+struct Recent {
+    generation: u64,
+    key: [u64; 4],
+    value: f64,
+}
+
+/// Entries of each thread's cache of recent queries (a power of two).
+const RECENT: usize = 1 << 13;
+
+thread_local! {
+    /// The answers of this thread's recent [`Obstacles::distance_below`] queries, by a hash of
+    /// the query (direct-mapped: a query replaces the one before it in its slot).
+    static RECENT_QUERIES: std::cell::RefCell<Vec<Recent>> =
+        std::cell::RefCell::new(vec![Recent::default(); RECENT]);
 }
 
 impl Obstacles {
@@ -47,6 +89,8 @@ impl Obstacles {
 
     fn add_nurbs_named(&mut self, surface: NurbsSurface, id: String) {
         let (lo, hi) = surface.bounding_box();
+        self.generation = next_generation();
+        self.tree = Default::default();
         self.items.push(Item {
             shape: std::sync::Arc::new(Obstacle::Nurbs(Box::new(Tessellated::new(surface)))),
             lo,
@@ -70,6 +114,8 @@ impl Obstacles {
                 })
                 .collect(),
             queries: Default::default(),
+            generation: next_generation(),
+            tree: Default::default(),
         }
     }
 
@@ -144,6 +190,8 @@ impl Obstacles {
         if mesh.indices().is_empty() {
             return Err(bad("mesh: no triangle with a non-zero area".into()));
         }
+        self.generation = next_generation();
+        self.tree = Default::default();
         self.items.push(Item {
             shape: std::sync::Arc::new(Obstacle::Mesh(Box::new(mesh))),
             lo,
@@ -291,7 +339,9 @@ impl Obstacles {
         }))
     }
 
-    /// How many exact distance queries (one surface, one point) the checks have made so far.
+    /// How many exact distance queries (one surface, one point: a closest point on a NURBS
+    /// surface, a projection onto a mesh) the checks have made so far; a surface passed over
+    /// by its boxes, or a query answered from the cache of recent ones, costs none.
     pub fn queries(&self) -> usize {
         self.queries.load(std::sync::atomic::Ordering::Relaxed)
     }
@@ -303,24 +353,164 @@ impl Obstacles {
 
     /// The distance from `p` to the nearest surface if it is below `limit`; otherwise some
     /// value `>= limit` (surfaces whose box is at least `limit` away are not queried).
+    ///
+    /// The answer is a function of the surfaces, `p` and `limit` alone, so each thread keeps
+    /// the answers of its recent queries and gives the same one again for the same query (bit
+    /// for bit): the checks ask again for many points (the nozzle where one traced move ends is
+    /// where the next starts, the head at a retract point starts every route from it).
     pub fn distance_below(&self, p: &Point3<f64>, limit: f64) -> f64 {
+        let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits(), limit.to_bits()];
+        let slot = recent_slot(self.generation, &key);
+        let known = RECENT_QUERIES.with(|r| {
+            let e = r.borrow()[slot];
+            (e.generation == self.generation && e.key == key).then_some(e.value)
+        });
+        if let Some(value) = known {
+            return value;
+        }
+        let value = self.distance_below_uncached(p, limit);
+        RECENT_QUERIES.with(|r| {
+            r.borrow_mut()[slot] = Recent {
+                generation: self.generation,
+                key,
+                value,
+            }
+        });
+        value
+    }
+
+    /// [`Obstacles::distance_below`] without the cache: the surfaces nearest first (by the
+    /// distance to their pieces' boxes), each surface's exact distance only while that bound
+    /// is below the best so far, and the same answer, bit for bit, as the scan in the order
+    /// the surfaces were added ([`Obstacles::distance_below_in_order`]), which it falls back
+    /// to where it cannot show that (`docs/process.md`, "The nearest surface first").
+    fn distance_below_uncached(&self, p: &Point3<f64>, limit: f64) -> f64 {
+        // Each candidate: the lower bound `m` (pieces' boxes, or the box for a mesh), the
+        // box's distance `g`, its index, and its exact distance once known.
+        let mut cands = [(0.0_f64, 0.0_f64, 0usize, f64::NAN); NEAREST_CANDIDATES];
+        let mut n = 0;
+        // Above the limit: the least box distance, and the least pieces' bound.
+        let mut above = f64::INFINITY;
+        let mut overflow = false;
+        let tree = self.tree();
+        tree.within(p, limit, |i, g| {
+            let m = match &*self.items[i].shape {
+                Obstacle::Nurbs(t) => t.piece_bound(p, limit),
+                Obstacle::Mesh(_) => g,
+            };
+            if m >= limit {
+                above = above.min(m);
+            } else if n == NEAREST_CANDIDATES {
+                overflow = true;
+            } else {
+                cands[n] = (m, g, i, f64::NAN);
+                n += 1;
+            }
+        });
+        if overflow {
+            return self.distance_below_in_order(p, limit);
+        }
+        let cands = &mut cands[..n];
+        cands.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+        // Rounding slack between a computed lower bound and a computed exact distance.
+        let eps = 1e-6 + 1e-9 * p.coords.amax();
+        let mut best = f64::INFINITY;
+        let mut nearest = usize::MAX;
+        for (k, cand) in cands.iter_mut().enumerate() {
+            if cand.0 >= limit.min(best + 2.0 * eps) {
+                break;
+            }
+            self.count_query();
+            let c = match &*self.items[cand.2].shape {
+                Obstacle::Nurbs(t) => t.exact(p),
+                Obstacle::Mesh(mesh) => mesh.distance_to_local_point(p, false),
+            };
+            cand.3 = c;
+            if c < best {
+                best = c;
+                nearest = k;
+            }
+        }
+        if best >= limit || nearest == usize::MAX {
+            // Nothing below the limit: every candidate's exact distance was taken (each at or
+            // above it), as the scan in order does, and the surfaces at least the limit away
+            // count with their boxes' distance.
+            let near = best.min(above);
+            return near.min(tree.nearest_beyond(p, limit, near));
+        }
+        // The scan in order takes the nearest surface's distance if every surface before it
+        // stays above both of the bounds it is passed over by (its box's distance and its
+        // pieces' bound): then its threshold there is above them.
+        let (m, g, i, c) = cands[nearest];
+        let t = m.max(g);
+        let clear = t + eps < limit
+            && cands
+                .iter()
+                .all(|&(mk, _, k, ck)| k >= i || if ck.is_nan() { mk > t + eps } else { ck > t });
+        if clear {
+            c
+        } else {
+            self.distance_below_in_order(p, limit)
+        }
+    }
+
+    /// The tree of the surfaces' boxes.
+    fn tree(&self) -> &BoxTree {
+        self.tree
+            .get_or_init(|| BoxTree::new(self.items.iter().map(|i| (i.lo, i.hi)).collect()))
+    }
+
+    fn count_query(&self) {
+        self.queries
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// The scan of the surfaces in the order they were added, each passed over where its box
+    /// (then its pieces' boxes) is at least the best so far or the limit away.
+    fn distance_below_in_order(&self, p: &Point3<f64>, limit: f64) -> f64 {
         // Skipped surfaces are at least their box's distance away: the result is exact below
         // `limit` and a lower bound of the distance (itself >= limit) above it.
         let mut best = f64::INFINITY;
         let mut floor = f64::INFINITY;
         for item in &self.items {
             let gap = box_distance(p, &item.lo, &item.hi);
-            if gap >= limit.min(best) {
+            let below = limit.min(best);
+            if gap >= below {
                 floor = floor.min(gap);
                 continue;
             }
-            self.queries
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let d = shape_distance_below(&item.shape, p, limit.min(best));
+            // As `shape_distance_below`, counting the exact queries.
+            let d = match &*item.shape {
+                Obstacle::Nurbs(t) => {
+                    let bound = t.piece_bound(p, below);
+                    if bound >= below {
+                        bound
+                    } else {
+                        self.count_query();
+                        t.exact(p)
+                    }
+                }
+                Obstacle::Mesh(m) => {
+                    self.count_query();
+                    m.distance_to_local_point(p, false)
+                }
+            };
             best = best.min(d);
         }
         best.min(floor)
     }
+}
+
+/// Most surfaces within the limit one query orders nearest first (beyond, the scan in order).
+const NEAREST_CANDIDATES: usize = 32;
+
+/// The slot of a query in the cache of recent queries.
+fn recent_slot(generation: u64, key: &[u64; 4]) -> usize {
+    let mut h = generation.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    for k in key {
+        h = (h ^ k).wrapping_mul(0x9e37_79b9_7f4a_7c15).rotate_left(29);
+    }
+    (h >> 32) as usize & (RECENT - 1)
 }
 
 fn shape_distance(o: &Obstacle, p: &Point3<f64>) -> f64 {
@@ -346,4 +536,89 @@ pub(super) fn top_along(lo: &Point3<f64>, hi: &Point3<f64>, up: &Vector3<f64>) -
             corner.coords.dot(up)
         })
         .fold(f64::NEG_INFINITY, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sheet-metal-like part: faces meeting at edges (a box of six planes, one face split in
+    /// two coplanar halves), a cylinder, a sphere and a mesh, whose nearest surface is often
+    /// one of two at exactly the same distance (points beyond an edge, over a split).
+    fn part() -> Obstacles {
+        let mut o = Obstacles::new();
+        let (x, y, z) = (Vector3::x(), Vector3::y(), Vector3::z());
+        let at = Point3::new;
+        for (origin, u, v, lu, lv) in [
+            (at(0.0, 0.0, 0.0), x, y, 50.0, 80.0),
+            (at(50.0, 0.0, 0.0), x, y, 50.0, 80.0),
+            (at(0.0, 0.0, 30.0), x, y, 100.0, 80.0),
+            (at(0.0, 0.0, 0.0), x, z, 100.0, 30.0),
+            (at(0.0, 80.0, 0.0), x, z, 100.0, 30.0),
+            (at(0.0, 0.0, 0.0), y, z, 80.0, 30.0),
+            (at(100.0, 0.0, 0.0), y, z, 80.0, 30.0),
+        ] {
+            o.add_nurbs(NurbsSurface::plane(origin, u, v, lu, lv).unwrap());
+        }
+        o.add_nurbs(NurbsSurface::cylinder(at(100.0, 40.0, 45.0), y, 15.0, 40.0).unwrap());
+        o.add_nurbs(NurbsSurface::sphere(at(30.0, 40.0, 50.0), 12.0).unwrap());
+        o.add_mesh(
+            vec![
+                at(-20.0, 0.0, 0.0),
+                at(-20.0, 80.0, 0.0),
+                at(-20.0, 0.0, 30.0),
+            ],
+            vec![[0, 1, 2]],
+        )
+        .unwrap();
+        o
+    }
+
+    /// The nearest-first query gives the scan in order's answer bit for bit, at points on a
+    /// grid through the part's edges and faces (many at the same distance from two surfaces)
+    /// and pseudo-random ones, for limits below, near and above the distances.
+    #[test]
+    fn nearest_first_answers_as_the_scan_in_order_bit_for_bit() {
+        let o = part();
+        let mut points = Vec::new();
+        for i in -2..=14 {
+            for j in -2..=11 {
+                for k in -2i32..=7 {
+                    points.push(Point3::new(
+                        f64::from(i) * 10.0 - 10.0 * 0.5_f64.powi(k.abs()),
+                        f64::from(j) * 10.0,
+                        f64::from(k) * 7.5,
+                    ));
+                }
+            }
+        }
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..3000 {
+            points.push(Point3::new(
+                140.0 * next() - 20.0,
+                120.0 * next() - 20.0,
+                70.0 * next() - 20.0,
+            ));
+        }
+        let mut below = 0;
+        for p in &points {
+            for limit in [0.5, 2.5, 5.0, 12.5, 40.0, f64::INFINITY] {
+                let fast = o.distance_below_uncached(p, limit);
+                let scan = o.distance_below_in_order(p, limit);
+                assert_eq!(
+                    fast.to_bits(),
+                    scan.to_bits(),
+                    "{p} below {limit}: {fast} {scan}"
+                );
+                below += usize::from(fast < limit);
+            }
+        }
+        assert!(below > 10_000, "{below}");
+    }
 }

@@ -107,7 +107,62 @@ pub fn plan_traverse_within(
     opts: &TraverseOptions,
     reachable: &dyn Fn(&[PoseArray]) -> bool,
 ) -> Result<Traverse> {
-    plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(())).map(|(t, ())| t)
+    plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(()), true).map(|(t, ())| t)
+}
+
+/// A straight move's two poses, bit for bit: the key under which its coarse outcome is kept.
+type MoveKey = [u64; 12];
+
+/// The coarse outcomes of the moves of one gap's routes, by their poses.
+type MoveOutcomes = std::collections::HashMap<MoveKey, std::result::Result<f64, Blocked>>;
+
+fn move_key(a: &PoseArray, b: &PoseArray) -> MoveKey {
+    std::array::from_fn(|k| if k < 6 { a[k] } else { b[k - 6] }.to_bits())
+}
+
+/// What the coarse pass made of one route.
+#[derive(Debug, Clone, Copy)]
+enum Coarse {
+    /// Outside the machine's axis limits (not checked).
+    Unreachable,
+    /// Clear, but refused by the caller's check, at this point.
+    Refused(Blocked),
+    /// Its check failed so.
+    Failed(Blocked),
+    /// A point of it was measured closer than the clearance: its check cannot pass, and is
+    /// put off until its outcome is needed.
+    Deferred,
+    /// An axial move to one of its retract points is not clear: the route does not exist.
+    Absent,
+}
+
+/// True if the route through `way` cannot pass the travel's check: one of its moves already
+/// failed it (`traced`), or a point of one of them is measured closer than the clearance
+/// (`probe`; the first and the last move first, where the routes of the real files fail).
+fn fails_for_sure(
+    traced: &MoveOutcomes,
+    probe: &mut super::probe::Probe<'_>,
+    way: &[PoseArray],
+) -> bool {
+    let moves = way.len().saturating_sub(1);
+    let known = |i: usize| traced.get(&move_key(&way[i], &way[i + 1]));
+    if (0..moves).any(|i| matches!(known(i), Some(Err(_)))) {
+        return true;
+    }
+    let order = [0, moves.saturating_sub(1)]
+        .into_iter()
+        .chain(1..moves.saturating_sub(1));
+    let mut seen = Vec::with_capacity(moves);
+    for i in order.take(moves) {
+        if seen.contains(&i) || known(i).is_some() {
+            continue;
+        }
+        seen.push(i);
+        if probe.violated(&way[i], &way[i + 1]) {
+            return true;
+        }
+    }
+    false
 }
 
 /// Samples the finer margins may take over one gap's routes, after the coarse pass found
@@ -175,6 +230,11 @@ pub(crate) type Refusal = (Point3<f64>, f64);
 /// [`plan_traverse_within`], where a route that is clear is also handed to `accept` (e.g.
 /// the check of the machine's own rapid moves); the first route both accept is returned with
 /// `accept`'s result, the next shortest tried otherwise.
+///
+/// With `explain` false the caller does not want the reason where no route clears (it tries
+/// again with fewer surfaces): the error then says so instead of counting the routes, and
+/// the routes put off for a point measured closer than the clearance are not traced for it.
+/// Which route is found, if any, does not depend on `explain`.
 pub(crate) fn plan_traverse_accepting<T>(
     obs: &Obstacles,
     from: &PoseArray,
@@ -182,6 +242,7 @@ pub(crate) fn plan_traverse_accepting<T>(
     opts: &TraverseOptions,
     reachable: &dyn Fn(&[PoseArray]) -> bool,
     accept: &mut dyn FnMut(&Traverse) -> std::result::Result<T, Refusal>,
+    explain: bool,
 ) -> Result<(Traverse, T)> {
     opts.validate()?;
     for (name, p) in [("from", from), ("to", to)] {
@@ -225,7 +286,12 @@ pub(crate) fn plan_traverse_accepting<T>(
     };
     // The travel between the waypoints, tip and nozzle keeping the clearance: with the
     // coarse margin (each move within its own budget), or with `Trace::prove`'s finer margins
-    // within the gap's budget `fine`.
+    // within the gap's budget `fine`. A coarse move's outcome depends on nothing but its two
+    // poses (the obstacles, the clearance, the nozzle and the margin are the gap's, the budget
+    // its own), and the routes of a gap share many moves (every safe-plane route from one
+    // retract point rises along the same move; half the moves checked on the real files are
+    // repeats): each is traced once per gap.
+    let traced: std::cell::RefCell<MoveOutcomes> = Default::default();
     let tip_ends =
         |w: &[PoseArray], fine: Option<&mut Work>| -> std::result::Result<f64, Blocked> {
             let mut least = f64::INFINITY;
@@ -233,7 +299,15 @@ pub(crate) fn plan_traverse_accepting<T>(
             for s in w.windows(2) {
                 let trace = Trace::new(obs, &s[0], &s[1], c, opts.nozzle_mm);
                 least = least.min(match fine.as_deref_mut() {
-                    None => trace.certify_or_witness(floor, &mut Work::new(MOVE_SAMPLES))?,
+                    None => {
+                        let key = move_key(&s[0], &s[1]);
+                        let known = traced.borrow().get(&key).copied();
+                        let outcome = known.unwrap_or_else(|| {
+                            trace.certify_or_witness(floor, &mut Work::new(MOVE_SAMPLES))
+                        });
+                        traced.borrow_mut().insert(key, outcome);
+                        outcome?
+                    }
                     Some(work) => trace.prove(floor, work)?,
                 });
             }
@@ -249,50 +323,44 @@ pub(crate) fn plan_traverse_accepting<T>(
             why,
         }))
     };
+    // The error of a gap whose reason the caller does not want (it tries again with fewer
+    // surfaces): the routes put off are not traced for it.
+    let unexplained = |b: Blocked| {
+        blocked_err(
+            b,
+            "no route clears (the routes were not all traced: the reason was not asked for)".into(),
+        )
+    };
     // The retract heights tried at each end (doubling), those whose axial move is clear.
     let heights: Vec<f64> = (0..5)
         .map(|k| opts.retract_mm * f64::from(1 << k))
         .collect();
-    let ends = |p: &PoseArray| -> std::result::Result<Vec<PoseArray>, Blocked> {
-        let mut last = None;
-        let ok: Vec<PoseArray> = heights
-            .iter()
-            .filter_map(|&hh| match axial(p, hh) {
-                Ok(q) => Some(q),
-                Err(e) => {
-                    last = Some(e);
-                    None
-                }
-            })
-            .collect();
-        match (ok.is_empty(), last) {
-            (true, Some(e)) => Err(e),
-            _ => Ok(ok),
+    // The axial moves, each checked once and only where needed: a route is taken only if
+    // both its retract points' axial moves are clear, but a route put off (below) needs
+    // neither, and where a route is taken the higher retract points are seldom reached.
+    // Every end's axial moves are checked before the routes are counted or searched.
+    let axial_done: std::cell::RefCell<[[Option<std::result::Result<PoseArray, Blocked>>; 5]; 2]> =
+        Default::default();
+    let axial_at = |side: usize, k: usize| -> std::result::Result<PoseArray, Blocked> {
+        if let Some(known) = axial_done.borrow()[side][k] {
+            return known;
         }
+        let outcome = axial(if side == 0 { &from } else { &to }, heights[k]);
+        axial_done.borrow_mut()[side][k] = Some(outcome);
+        outcome
     };
-    let top = heights[heights.len() - 1];
-    let ends_a = ends(&from).map_err(|b| {
-        blocked_err(
-            b,
-            format!(
-                "the retract along the tool axis from the exit is blocked at every height from {:.1} to {top:.1} mm",
-                heights[0]
-            ),
-        )
-    })?;
-    let ends_b = ends(&to).map_err(|b| {
-        blocked_err(
-            b,
-            format!(
-                "the approach along the tool axis to the pierce is blocked at every height from {:.1} to {top:.1} mm",
-                heights[0]
-            ),
-        )
-    })?;
+    // The retract point at height `k` of an end, whether or not its axial move is clear.
+    let retract_point = |p: &PoseArray, k: usize| {
+        let (q, n) = (position(p), normal(p));
+        with_axis(q + n * heights[k], n)
+    };
     // Every route: straight between any two retract points, lifted along `up` over the
     // surfaces near the travel, or over the safe plane above every surface; checked shortest
-    // first.
+    // first. Built for every pair of retract heights; a route whose retract points' axial
+    // moves are not both clear does not exist (sorting is stable, so the order of the others
+    // is that of the routes built from the clear retract points alone).
     let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::new();
+    let mut route_ends: Vec<(usize, usize)> = Vec::new();
     let lift_to = |level: f64| {
         move |p: &PoseArray| {
             let q = position(p);
@@ -303,10 +371,13 @@ pub(crate) fn plan_traverse_accepting<T>(
     let global_top = obs
         .bounding_box()
         .map(|(lo, hi)| top_along(&lo, &hi, &up) + c + 2.0 * h);
-    for a in &ends_a {
-        for b in &ends_b {
+    for ka in 0..heights.len() {
+        let a = &retract_point(&from, ka);
+        for kb in 0..heights.len() {
+            let b = &retract_point(&to, kb);
             let straight = vec![*a, *b];
             routes.push((length_of(&straight), Route::Straight, straight));
+            route_ends.push((ka, kb));
             let (pa, pb) = (position(a), position(b));
             // Each lift at a clearance and two steps above the boxes' top, and a clearance
             // higher (where a tilted nozzle reaches down past the first).
@@ -316,61 +387,190 @@ pub(crate) fn plan_traverse_accepting<T>(
                     let lift = lift_to(level + c + 2.0 * h + extra);
                     let way = vec![*a, lift(a), lift(b), *b];
                     routes.push((length_of(&way), Route::Lifted, way));
+                    route_ends.push((ka, kb));
                 }
                 if let Some(level) = global_top {
                     let lift = lift_to(level + extra);
                     let plane = vec![*a, lift(a), lift(b), *b];
                     routes.push((length_of(&plane), Route::SafePlane, plane));
+                    route_ends.push((ka, kb));
                 }
             }
         }
     }
-    routes.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut order: Vec<usize> = (0..routes.len()).collect();
+    order.sort_by(|&x, &y| routes[x].0.total_cmp(&routes[y].0));
+    let mut sorted: Vec<Option<(f64, Route, Vec<PoseArray>)>> =
+        routes.into_iter().map(Some).collect();
+    let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::with_capacity(order.len());
+    let mut ends_of: Vec<(usize, usize)> = Vec::with_capacity(order.len());
+    for &k in &order {
+        routes.extend(sorted[k].take());
+        ends_of.push(route_ends[k]);
+    }
+    // True if both retract points' axial moves of route `k` are clear (checking them).
+    let exists = |k: usize| {
+        let (ka, kb) = ends_of[k];
+        axial_at(0, ka).is_ok() && axial_at(1, kb).is_ok()
+    };
+    // Known not to exist: an axial move of it already failed.
+    let gone = |k: usize| {
+        let (ka, kb) = ends_of[k];
+        let done = axial_done.borrow();
+        matches!(done[0][ka], Some(Err(_))) || matches!(done[1][kb], Some(Err(_)))
+    };
     // First every route with the coarse margin, shortest first; then, if none clears, the
     // routes that failed only within the margin again with finer margins (`prove`), within
     // the gap's budget of samples.
+    //
+    // A route on which a point closer than the clearance is measured first (`Probe`) cannot
+    // pass its check: its trace is put off. Where a later route is taken, it is never needed;
+    // otherwise the routes put off are traced then, and every route's outcome is counted in
+    // the order of the routes, as if each had been traced in turn (a route put off that did
+    // clear would be offered then, before any other: none of the routes after it was taken).
+    let mut probe = super::probe::Probe::new(obs, c, opts.nozzle_mm);
+    let mut outcomes: Vec<Coarse> = Vec::with_capacity(routes.len());
+    for (k, (length_mm, route, waypoints)) in routes.iter().enumerate() {
+        if gone(k) {
+            outcomes.push(Coarse::Absent);
+            continue;
+        }
+        if !reachable(waypoints) {
+            outcomes.push(Coarse::Unreachable);
+            continue;
+        }
+        if fails_for_sure(&traced.borrow(), &mut probe, waypoints) {
+            outcomes.push(Coarse::Deferred);
+            continue;
+        }
+        if !exists(k) {
+            outcomes.push(Coarse::Absent);
+            continue;
+        }
+        let checked = tip_ends(waypoints, None);
+        match checked {
+            Ok(least) => {
+                let t = Traverse {
+                    length_mm: *length_mm,
+                    waypoints: waypoints.clone(),
+                    route: *route,
+                    min_distance_mm: least,
+                };
+                match accept(&t) {
+                    Ok(v) => return Ok((t, v)),
+                    Err((at, distance)) => {
+                        outcomes.push(Coarse::Refused(Blocked::at(at, distance)));
+                    }
+                }
+            }
+            Err(e) => {
+                probe.learn(e.at, e.distance);
+                outcomes.push(Coarse::Failed(e));
+            }
+        }
+    }
+    // No route clears with the coarse margin. Every end's axial moves now, as they were
+    // checked before any route: where all of one end's fail, that is the gap's error.
+    let top = heights[heights.len() - 1];
+    let mut retracts: [Vec<PoseArray>; 2] = [Vec::new(), Vec::new()];
+    for (side, what) in [
+        (0, "the retract along the tool axis from the exit"),
+        (1, "the approach along the tool axis to the pierce"),
+    ] {
+        let mut last = None;
+        for k in 0..heights.len() {
+            match axial_at(side, k) {
+                Ok(q) => retracts[side].push(q),
+                Err(e) => last = Some(e),
+            }
+        }
+        if let (true, Some(b)) = (retracts[side].is_empty(), last) {
+            return Err(blocked_err(
+                b,
+                format!(
+                    "{what} is blocked at every height from {:.1} to {top:.1} mm",
+                    heights[0]
+                ),
+            ));
+        }
+    }
+    let [ends_a, ends_b] = retracts;
+    // The routes that exist, with what the coarse pass made of them.
+    let (routes, outcomes): (Vec<_>, Vec<_>) = routes
+        .into_iter()
+        .zip(outcomes)
+        .enumerate()
+        .filter(|(k, _)| exists(*k))
+        .map(|(_, r)| r)
+        .unzip();
+    // No route clears with the coarse margin. The finer margins need the routes that failed
+    // only within it, in order, and the error counts every route: both need the routes put
+    // off, unless this gap's error is not wanted and no route traced failed within the margin
+    // (then the finer margins could only re-trace routes that cannot pass).
     let mut tally = Tally::default();
     // The routes that failed only within the coarse margin, with that failure.
     let mut marginal: Vec<(usize, Blocked)> = Vec::new();
-    let mut fine = Work::new(FINE_SAMPLES);
-    for pass in 0..2 {
-        let candidates: Vec<(usize, Option<Blocked>)> = if pass == 0 {
-            (0..routes.len()).map(|k| (k, None)).collect()
-        } else {
-            marginal.drain(..).map(|(k, b)| (k, Some(b))).collect()
-        };
-        for (k, coarse) in candidates {
-            let (length_mm, route, waypoints) = &routes[k];
-            if let (Some(b), 0) = (coarse, fine.left) {
-                // No budget left to re-trace it: undecided at its coarse failure.
-                tally.undecided += 1;
-                tally.note(b);
-                continue;
-            }
-            if pass == 0 && !reachable(waypoints) {
-                tally.unreachable += 1;
-                continue;
-            }
-            let checked = if pass == 0 {
-                tip_ends(waypoints, None)
-            } else {
-                tip_ends(waypoints, Some(&mut fine))
-            };
-            match checked {
-                Ok(least) => {
-                    let t = Traverse {
-                        length_mm: *length_mm,
-                        waypoints: waypoints.clone(),
-                        route: *route,
-                        min_distance_mm: least,
-                    };
-                    if let Some(done) = tally.offer(t, accept) {
-                        return Ok(done);
+    let resolve = explain
+        || outcomes
+            .iter()
+            .any(|o| matches!(o, Coarse::Failed(e) if e.within_margin(c)));
+    if resolve {
+        for (k, outcome) in outcomes.into_iter().enumerate() {
+            let outcome = match outcome {
+                Coarse::Deferred => {
+                    let (length_mm, route, waypoints) = &routes[k];
+                    match tip_ends(waypoints, None) {
+                        Ok(least) => {
+                            let t = Traverse {
+                                length_mm: *length_mm,
+                                waypoints: waypoints.clone(),
+                                route: *route,
+                                min_distance_mm: least,
+                            };
+                            match accept(&t) {
+                                Ok(v) => return Ok((t, v)),
+                                Err((at, distance)) => Coarse::Refused(Blocked::at(at, distance)),
+                            }
+                        }
+                        Err(e) => Coarse::Failed(e),
                     }
                 }
-                Err(e) if pass == 0 && e.within_margin(c) => marginal.push((k, e)),
-                Err(e) => tally.failed(e, c),
+                other => other,
+            };
+            match outcome {
+                Coarse::Unreachable => tally.unreachable += 1,
+                Coarse::Refused(b) => {
+                    tally.refused += 1;
+                    tally.note(b);
+                }
+                Coarse::Failed(e) if e.within_margin(c) => marginal.push((k, e)),
+                Coarse::Failed(e) => tally.failed(e, c),
+                Coarse::Deferred | Coarse::Absent => unreachable!("traced or left out above"),
             }
+        }
+    }
+    let mut fine = Work::new(FINE_SAMPLES);
+    for (k, b) in marginal.drain(..) {
+        let (length_mm, route, waypoints) = &routes[k];
+        if fine.left == 0 {
+            // No budget left to re-trace it: undecided at its coarse failure.
+            tally.undecided += 1;
+            tally.note(b);
+            continue;
+        }
+        match tip_ends(waypoints, Some(&mut fine)) {
+            Ok(least) => {
+                let t = Traverse {
+                    length_mm: *length_mm,
+                    waypoints: waypoints.clone(),
+                    route: *route,
+                    min_distance_mm: least,
+                };
+                if let Some(done) = tally.offer(t, accept) {
+                    return Ok(done);
+                }
+            }
+            Err(e) => tally.failed(e, c),
         }
     }
     // How the routes of the given shapes failed, in words.
@@ -396,6 +596,9 @@ pub(crate) fn plan_traverse_accepting<T>(
         (&from, "the retract from the exit"),
     ] {
         if let Some((b, why)) = super::proof::line_blocked(obs, p, opts, what) {
+            if !explain {
+                return Err(unexplained(b));
+            }
             let shapes = tally_text(&tally, routes.len());
             return Err(blocked_err(
                 b,
@@ -454,6 +657,9 @@ pub(crate) fn plan_traverse_accepting<T>(
             }
             Err(e) => tally.failed(e, c),
         }
+    }
+    if !explain {
+        return Err(unexplained(Blocked::at(position(&from), 0.0)));
     }
     let n = routes.len() + searched;
     let search_note = if opts.search {

@@ -100,6 +100,9 @@ fn cell_boxes(
     strips
 }
 
+/// Most strips [`Tessellated::piece_bound`] orders nearest first (beyond, the strips in order).
+const NEAREST_STRIPS: usize = 64;
+
 /// Cells per knot span in each direction of a tessellation (at least 12 over the domain).
 const CELLS_PER_SPAN: usize = 6;
 
@@ -206,10 +209,59 @@ impl Tessellated {
     /// The exact distance from `p` where it may be below `limit`; else a value `>= limit`
     /// that is a proven lower bound of it (the distance to the nearest piece's box).
     pub(super) fn distance(&self, p: &Point3<f64>, limit: f64) -> f64 {
-        let floor = self.lower_bound(p, limit);
+        let floor = self.piece_bound(p, limit);
         if floor >= limit {
             return floor;
         }
+        self.exact(p)
+    }
+
+    /// [`Tessellated::lower_bound`], bit for bit: the distance to the nearest piece's box
+    /// where that is below `enough`, else the value `>= enough` that `lower_bound` gives.
+    ///
+    /// The nearest strip first, then the others in order, each passed over where its box is
+    /// at least the best cell so far or `enough` away: a cell is at least as far as its strip's
+    /// box (which holds it, coordinate by coordinate, so also in floating point), so the least
+    /// cell below `enough`, if there is one, is found, and that is what `lower_bound` returns
+    /// then. Otherwise `lower_bound` itself gives its value (a bound whose exact value depends
+    /// on its order).
+    pub(super) fn piece_bound(&self, p: &Point3<f64>, enough: f64) -> f64 {
+        let n = self.strips.len();
+        if n > NEAREST_STRIPS {
+            return self.lower_bound(p, enough);
+        }
+        let mut ds = [0.0_f64; NEAREST_STRIPS];
+        let mut first = 0;
+        for (k, s) in self.strips.iter().enumerate() {
+            ds[k] = box_distance(p, &s.lo, &s.hi);
+            if ds[k] < ds[first] {
+                first = k;
+            }
+        }
+        let cells = |k: usize, best: f64| {
+            self.strips[k]
+                .cells
+                .iter()
+                .fold(best, |b, (lo, hi)| b.min(box_distance(p, lo, hi)))
+        };
+        let mut best = f64::INFINITY;
+        if n > 0 && ds[first] < enough {
+            best = cells(first, best);
+            for k in (0..n).filter(|&k| k != first) {
+                if ds[k] < best.min(enough) {
+                    best = cells(k, best);
+                }
+            }
+        }
+        if best < enough {
+            best
+        } else {
+            self.lower_bound(p, enough)
+        }
+    }
+
+    /// The exact distance from `p` (the closest point, warm-started from the tessellation).
+    pub(super) fn exact(&self, p: &Point3<f64>) -> f64 {
         let Some(m) = &self.mesh else {
             return self.surface.closest_point(p, None).distance;
         };
@@ -272,6 +324,15 @@ mod tests {
                     let (th, ph) = (0.52 * f64::from(i), 0.26 * f64::from(j) - 1.5);
                     let dir = Vector3::new(ph.cos() * th.cos(), ph.cos() * th.sin(), ph.sin());
                     let p = c + dir * r;
+                    for enough in [1.0, 5.0, 12.5, 45.0, f64::INFINITY] {
+                        for (t, x) in [
+                            (&ts, &p),
+                            (&tc, &Point3::new(p.x - 10.0, p.y + 5.0, p.z + 27.0)),
+                        ] {
+                            let (fast, scan) = (t.piece_bound(x, enough), t.lower_bound(x, enough));
+                            assert_eq!(fast.to_bits(), scan.to_bits(), "{x} {enough}");
+                        }
+                    }
                     let lb = ts.lower_bound(&p, f64::INFINITY);
                     assert!(lb <= exact_sphere(&p) + 1e-9, "sphere at {p}: {lb}");
                     worst_gap = worst_gap.max(exact_sphere(&p) - lb);

@@ -227,6 +227,9 @@ impl Tally {
 /// first offending point and its distance, mm.
 pub(crate) type Refusal = (Point3<f64>, f64);
 
+/// An axial move's check: the retract point reached, or why it is blocked.
+type AxialOutcome = std::result::Result<PoseArray, Blocked>;
+
 /// [`plan_traverse_within`], where a route that is clear is also handed to `accept` (e.g.
 /// the check of the machine's own rapid moves); the first route both accept is returned with
 /// `accept`'s result, the next shortest tried otherwise.
@@ -339,8 +342,7 @@ pub(crate) fn plan_traverse_accepting<T>(
     // both its retract points' axial moves are clear, but a route put off (below) needs
     // neither, and where a route is taken the higher retract points are seldom reached.
     // Every end's axial moves are checked before the routes are counted or searched.
-    let axial_done: std::cell::RefCell<[[Option<std::result::Result<PoseArray, Blocked>>; 5]; 2]> =
-        Default::default();
+    let axial_done: std::cell::RefCell<[[Option<AxialOutcome>; 5]; 2]> = Default::default();
     let axial_at = |side: usize, k: usize| -> std::result::Result<PoseArray, Blocked> {
         if let Some(known) = axial_done.borrow()[side][k] {
             return known;

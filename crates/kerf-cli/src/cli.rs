@@ -501,6 +501,14 @@ pub(crate) struct RunArgs {
     #[arg(long, default_value_t = 4.0, value_name = "MM", value_parser = crate::guard::wall_mm)]
     pub(crate) max_wall: f64,
 
+    /// The kerf width: every path moves half of it toward its scrap side (inside a hole,
+    /// outside an outline, the curve's `scrap` key), so that the cut edge lands on the
+    /// contour; outside corners get an arc, inside corners are cut back, and a hole or slot
+    /// smaller than the kerf is refused by name. mm, above 0 and at most 20. Without it the
+    /// machine file's `process.kerf_width_mm` is used; with neither, the path is the contour.
+    #[arg(long, value_name = "MM", value_parser = crate::guard::kerf_width_mm)]
+    pub(crate) kerf_width: Option<f64>,
+
     /// Lead-in of every cut: the straight part from the pierce point, then the radius of the
     /// quarter arc that joins the contour tangentially on the scrap side, mm, each 0 to 1000
     /// (`0,0` pierces on the contour). Shrunk where the scrap is smaller (small holes).

@@ -124,6 +124,11 @@ pub(crate) fn wall_mm(s: &str) -> Result<f64, String> {
     within(s, ranges::WALL_MM)
 }
 
+/// A kerf width in [`ranges::KERF_WIDTH_MM`].
+pub(crate) fn kerf_width_mm(s: &str) -> Result<f64, String> {
+    within(s, ranges::KERF_WIDTH_MM)
+}
+
 /// `A,B`: two lengths of a lead in mm, each in [`ranges::LEAD_MM`], named `names`.
 fn lead_pair(text: &str, names: [&str; 2]) -> Result<(f64, f64), String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();

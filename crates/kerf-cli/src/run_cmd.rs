@@ -49,6 +49,7 @@ fn job_options(args: &RunArgs) -> JobOptions {
                 }),
         )
         .with_wall_axis_max_mm(args.max_wall)
+        .with_kerf_width_mm(args.kerf_width)
 }
 
 /// Runs `kerf run`.

@@ -59,8 +59,8 @@ pub use fork_head::{ForkHead, ForkTilt};
 pub use head_table::HeadTable;
 pub use kinematics::{Kinematics, Parameter};
 pub use machine::{
-    process_line_defect, Machine, Process, Range, MACHINE_FORMAT, MAX_PIERCE_DWELL_S,
-    MAX_PIERCE_STANDOFF_MM, MAX_PROCESS_LINES, MAX_PROCESS_LINE_CHARS,
+    process_line_defect, Machine, Process, Range, MACHINE_FORMAT, MAX_KERF_WIDTH_MM,
+    MAX_PIERCE_DWELL_S, MAX_PIERCE_STANDOFF_MM, MAX_PROCESS_LINES, MAX_PROCESS_LINE_CHARS,
 };
 pub use nonlinear::{interpolate, linearization_error, slerp, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};

@@ -107,7 +107,14 @@ pub struct Process {
     /// `[0, MAX_PIERCE_STANDOFF_MM]`; the head then descends along the tool axis to the cutting
     /// height with the beam on.
     pub pierce_standoff: Option<f64>,
+    /// The beam's kerf width, mm, in `(0, MAX_KERF_WIDTH_MM]`: with it `kerf run` offsets each
+    /// path by half of it toward the scrap side (a run's own width wins).
+    pub kerf_width_mm: Option<f64>,
 }
+
+/// The widest kerf a machine file may give, mm: a plasma kerf is a few millimetres; beyond
+/// this the number is a mistake, not a kerf.
+pub const MAX_KERF_WIDTH_MM: f64 = 20.0;
 
 /// The longest program line of a process code (`beam_on`, `beam_off`), characters: the
 /// longest line LinuxCNC reads (255). A code is written as given into every cut of every
@@ -222,8 +229,13 @@ fn system_variable_ok(var: &str) -> bool {
 
 impl Process {
     /// The keys of the `process` object.
-    pub const KEYS: [&'static str; 4] =
-        ["beam_on", "beam_off", "pierce_dwell_s", "pierce_standoff"];
+    pub const KEYS: [&'static str; 5] = [
+        "beam_on",
+        "beam_off",
+        "pierce_dwell_s",
+        "pierce_standoff",
+        "kerf_width_mm",
+    ];
 
     /// Checks every present value.
     ///
@@ -274,6 +286,14 @@ impl Process {
                 if let Some(why) = process_line_defect(line) {
                     return Err(KinematicsError::doc(path, why));
                 }
+            }
+        }
+        if let Some(w) = self.kerf_width_mm {
+            if !(w > 0.0 && w <= MAX_KERF_WIDTH_MM) {
+                return Err(KinematicsError::doc(
+                    "process.kerf_width_mm",
+                    format!("must lie in (0, {MAX_KERF_WIDTH_MM}] (got {w})"),
+                ));
             }
         }
         for (key, v, max) in [
@@ -360,6 +380,7 @@ impl Process {
             beam_off: lines("beam_off")?,
             pierce_dwell_s: number("pierce_dwell_s")?,
             pierce_standoff: number("pierce_standoff")?,
+            kerf_width_mm: number("kerf_width_mm")?,
         };
         p.validate()?;
         Ok(p)
@@ -650,6 +671,7 @@ impl Machine {
         for (key, v) in [
             ("pierce_dwell_s", p.pierce_dwell_s),
             ("pierce_standoff", p.pierce_standoff),
+            ("kerf_width_mm", p.kerf_width_mm),
         ] {
             if let Some(v) = v {
                 process.push(format!("\"{key}\": {}", json(v)));

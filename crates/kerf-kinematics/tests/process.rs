@@ -18,7 +18,7 @@ fn absent_process_is_empty_and_a_full_one_reads_back() {
     let m = Machine::from_str(&machine("")).expect("no process");
     assert!(m.process.is_empty());
     let m = Machine::from_str(&machine(
-        r#", "process": { "beam_on": ["M64 P0", "G4 P0.01"], "beam_off": ["M65 P0"], "pierce_dwell_s": 0.2, "pierce_standoff": 1.5 }"#,
+        r#", "process": { "beam_on": ["M64 P0", "G4 P0.01"], "beam_off": ["M65 P0"], "pierce_dwell_s": 0.2, "pierce_standoff": 1.5, "kerf_width_mm": 0.15 }"#,
     ))
     .expect("full process");
     assert_eq!(
@@ -28,6 +28,7 @@ fn absent_process_is_empty_and_a_full_one_reads_back() {
             beam_off: Some(vec!["M65 P0".into()]),
             pierce_dwell_s: Some(0.2),
             pierce_standoff: Some(1.5),
+            kerf_width_mm: Some(0.15),
         }
     );
     let back = Machine::from_str(&m.to_json()).expect("to_json reads back");
@@ -36,6 +37,20 @@ fn absent_process_is_empty_and_a_full_one_reads_back() {
         Machine::from_str(&machine(r#", "process": { "pierce_dwell_s": 0 }"#)).expect("one key");
     assert_eq!(partial.process.pierce_dwell_s, Some(0.0));
     assert_eq!(partial.process.beam_on, None, "absent key stays absent");
+    for (w, want) in [
+        ("0", "process.kerf_width_mm: must lie in (0, 20] (got 0)"),
+        ("25", "process.kerf_width_mm: must lie in (0, 20] (got 25)"),
+        (
+            "\"0.2\"",
+            "process.kerf_width_mm: expected a number, found a string",
+        ),
+    ] {
+        let e = Machine::from_str(&machine(&format!(
+            r#", "process": {{ "kerf_width_mm": {w} }}"#
+        )))
+        .expect_err("kerf width out of range");
+        assert!(e.to_string().contains(want), "{e}");
+    }
 }
 
 #[test]
@@ -77,7 +92,7 @@ fn bad_process_values_are_named_errors() {
         (r#"{"beam_off": [5]}"#, "process.beam_off[0]: expected a string, found a number"),
         (r#"{"beam_on": ["M64 P0\nG0 X1400"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '\\n')"),
         (r#"{"beam_on": ["M3 (on)"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '(')"),
-        (r#"{"beam_on": ["M3"], "dwell": 1}"#, "process.dwell: unknown key (known: beam_on, beam_off, pierce_dwell_s, pierce_standoff)"),
+        (r#"{"beam_on": ["M3"], "dwell": 1}"#, "process.dwell: unknown key (known: beam_on, beam_off, pierce_dwell_s, pierce_standoff, kerf_width_mm)"),
         (r#"["M3"]"#, "process: expected an object, found an array"),
         // The review's machine files: no motion, program end, o-word or tape mark can ride
         // in on a process line, and no absurd pierce.

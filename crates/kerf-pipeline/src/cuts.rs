@@ -11,7 +11,12 @@
 
 use kerf_format::CurvesFile;
 use kerf_normals::Oriented;
-use kerf_process::{plan_cuts, Contour, CutPlan, LeadOptions, PoseArray};
+use std::sync::Arc;
+
+use kerf_process::{
+    offset, plan_cuts, scrap_sides, Contour, CutPlan, LeadOptions, OffsetInput, OffsetOptions,
+    OffsetPath, PoseArray,
+};
 use nalgebra::Point3;
 use serde_json::{json, Value};
 
@@ -97,8 +102,35 @@ pub(crate) fn walls_json(file: &CurvesFile, walls: &[Option<kerf_process::Wall>]
         .collect::<Vec<_>>())
 }
 
+/// With a kerf, the share of the chord tolerance the contour's own chords get; the offset's
+/// term (`r (1 - cos alpha)`, at most a few per cent of the tolerance on radii above a
+/// millimetre) takes the rest, so that the offset needs no more points than the contour.
+pub(crate) const KERF_CONTOUR_SHARE: f64 = 0.9;
+
+/// Kerf compensation of a run: the width and where it came from.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Kerf {
+    /// The kerf width, mm.
+    pub(crate) width_mm: f64,
+    /// Where the width came from, in words.
+    pub(crate) source: &'static str,
+    /// The chord tolerance the offset paths keep, mm.
+    pub(crate) tolerance_mm: f64,
+}
+
+/// What kerf compensation did to one contour.
+pub(crate) struct Compensated {
+    pub(crate) curve: usize,
+    /// The offset path, or why the contour was cut as it is (an open contour whose scrap side
+    /// is not known).
+    pub(crate) outcome: std::result::Result<Arc<OffsetPath>, String>,
+}
+
 /// A contour on a thin wall ([`kerf_process::wall_axis`]) is planned with the tool axes along
-/// the wall and the scrap where the wall's normal points (`walls`, one entry per curve).
+/// the wall and the scrap where the wall's normal points (`walls`, one entry per curve). With
+/// a kerf width, every contour whose scrap side is known is offset by half of it toward the
+/// scrap first ([`kerf_process::offset`]), and the cuts are planned on the offset paths.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn plan(
     file: &CurvesFile,
     oriented: &[Oriented],
@@ -106,8 +138,9 @@ pub(crate) fn plan(
     placed: &Placed,
     starts: &[Option<f64>],
     options: &LeadOptions,
+    kerf: Option<&Kerf>,
     source: Option<&std::path::Path>,
-) -> Result<(Vec<CutPath>, SetupPlans), Error> {
+) -> Result<(Vec<CutPath>, SetupPlans, Vec<Compensated>), Error> {
     let poses: Vec<Vec<PoseArray>> = oriented
         .iter()
         .enumerate()
@@ -116,48 +149,136 @@ pub(crate) fn plan(
             _ => o.poses(),
         })
         .collect();
+    let process_error = |e| Error::Process {
+        file: source.map(std::path::Path::to_path_buf),
+        source: e,
+    };
     let mut cuts = Vec::new();
     let mut plans = Vec::new();
+    let mut compensated = Vec::new();
     for setup in &placed.plan.setups {
+        let scrap_of = |i: usize| match walls.get(i) {
+            Some(Some(w)) => Some(w.scrap),
+            _ => file.curves[i].scrap.map(|s| match s {
+                kerf_format::ScrapSide::Left => kerf_process::Side::Left,
+                kerf_format::ScrapSide::Right => kerf_process::Side::Right,
+            }),
+        };
         let contours: Vec<Contour<'_>> = setup
             .paths
             .iter()
             .map(|&i| Contour {
                 id: &file.curves[i].id,
                 poses: &poses[i],
-                scrap: match walls.get(i) {
-                    Some(Some(w)) => Some(w.scrap),
-                    _ => file.curves[i].scrap.map(|s| match s {
-                        kerf_format::ScrapSide::Left => kerf_process::Side::Left,
-                        kerf_format::ScrapSide::Right => kerf_process::Side::Right,
-                    }),
-                },
+                scrap: scrap_of(i),
                 start: starts[i].map(|t| kerf_process::index_of_param(oriented[i].params(), t)),
             })
             .collect();
-        let plan = plan_cuts(&contours, options).map_err(|e| Error::Process {
-            file: source.map(std::path::Path::to_path_buf),
-            source: e,
-        })?;
+        // The offset paths of this set-up, by position in it.
+        let offsets: Vec<Option<Arc<OffsetPath>>> = match kerf {
+            None => vec![None; contours.len()],
+            Some(k) => {
+                let sides = scrap_sides(&contours, options).map_err(process_error)?;
+                let mut out = Vec::with_capacity(contours.len());
+                for (j, &i) in setup.paths.iter().enumerate() {
+                    let Some(side) = sides[j] else {
+                        compensated.push(Compensated {
+                            curve: i,
+                            outcome: Err("an open contour without a `scrap` key: its scrap side is not known, so it is cut on the contour itself".into()),
+                        });
+                        out.push(None);
+                        continue;
+                    };
+                    let input = OffsetInput {
+                        id: &file.curves[i].id,
+                        curve: &file.curves[i].curve,
+                        params: oriented[i].params(),
+                        poses: &poses[i],
+                        surface_normals: None,
+                        scrap: side,
+                        closed: is_closed(&poses[i], options.closed_tolerance_mm),
+                    };
+                    let path = offset(&input, &OffsetOptions::new(k.width_mm, k.tolerance_mm))
+                        .map_err(process_error)?;
+                    let path = Arc::new(path);
+                    compensated.push(Compensated {
+                        curve: i,
+                        outcome: Ok(Arc::clone(&path)),
+                    });
+                    out.push(Some(path));
+                }
+                out
+            }
+        };
+        let offset_poses: Vec<Option<Vec<PoseArray>>> = offsets
+            .iter()
+            .map(|o| o.as_ref().map(|p| p.poses.clone()))
+            .collect();
+        let contours: Vec<Contour<'_>> = contours
+            .iter()
+            .zip(&offsets)
+            .zip(&offset_poses)
+            .zip(&setup.paths)
+            .map(|(((c, off), op), &i)| match (off, op) {
+                (Some(off), Some(op)) => Contour {
+                    id: c.id,
+                    poses: op,
+                    scrap: Some(off.side),
+                    start: starts[i].map(|t| off.index_of_source(t)),
+                },
+                _ => *c,
+            })
+            .collect();
+        let plan = plan_cuts(&contours, options).map_err(process_error)?;
         for &k in &plan.order {
             let i = setup.paths[k];
-            cuts.push(cut_path(file, &oriented[i], &poses[i], i, &plan, k));
+            let cut = match &offsets[k] {
+                None => {
+                    let c = file.curves[i].curve.clone();
+                    let t = oriented[i].params();
+                    let (t0, t1) = (t[0], t[t.len() - 1]);
+                    let point = move |u: f64| c.point(u.clamp(t0, t1));
+                    cut_path(Box::new(point), t, &poses[i], i, &plan, k)
+                }
+                Some(off) => {
+                    let t: Vec<f64> = (0..off.poses.len()).map(|j| j as f64).collect();
+                    let c = file.curves[i].curve.clone();
+                    let path = Arc::clone(off);
+                    let point = move |u: f64| path.point_at(u, &c);
+                    let mut cut = cut_path(Box::new(point), &t, &off.poses, i, &plan, k);
+                    // The axes file names the start by the contour's cutting point.
+                    cut.start_point = kerf_process::index_of_param(
+                        oriented[i].params(),
+                        off.source[cut.start_point],
+                    );
+                    cut
+                }
+            };
+            cuts.push(cut);
         }
         plans.push((setup.paths.clone(), plan));
     }
-    Ok((cuts, plans))
+    Ok((cuts, plans, compensated))
 }
 
+/// True if the contour's last point is within `tol` of its first.
+fn is_closed(poses: &[PoseArray], tol: f64) -> bool {
+    let (a, b) = (poses[0], poses[poses.len() - 1]);
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt() <= tol
+        && poses.len() >= 4
+}
+
+/// One cut from its contour's poses `poses` at parameters `t` (the curve's, or an offset
+/// path's indices), with `contour` the point at a parameter in `[t[0], t[n - 1]]`.
 fn cut_path(
-    file: &CurvesFile,
-    o: &Oriented,
+    contour: PointFn,
+    t: &[f64],
     poses: &[PoseArray],
     curve: usize,
     plan: &CutPlan,
     k: usize,
 ) -> CutPath {
     let lead = &plan.leads[k];
-    let t = o.params();
     let n = t.len();
     let s = lead.start;
     let closed = plan.closed[k];
@@ -195,7 +316,6 @@ fn cut_path(
         .chain(&lead.lead_out)
         .map(pt)
         .collect();
-    let c = file.curves[curve].curve.clone();
     let (t0, t_end) = (t[0], t[n - 1]);
     let in_start = u_s - m as f64 * step;
     let point: PointFn = Box::new(move |u: f64| {
@@ -214,9 +334,9 @@ fn cut_path(
         } else if u > u_e && q > 0 {
             along(&lead_out, (u - u_e) / step)
         } else if u > t_end {
-            c.point((u - period).clamp(t0, t_end))
+            contour((u - period).clamp(t0, t_end))
         } else {
-            c.point(u.clamp(t0, t_end))
+            contour(u.clamp(t0, t_end))
         }
     });
     CutPath {
@@ -227,6 +347,75 @@ fn cut_path(
         counts: [m, cut.len(), q],
         start_point: if closed { s } else { 0 },
     }
+}
+
+/// The program header's line on kerf compensation: the width and where it came from, or that
+/// the path is the contour itself. Only numbers and kerf's own words: no text from a file.
+pub(crate) fn kerf_header(kerf: Option<&Kerf>, compensated: &[Compensated]) -> String {
+    match kerf {
+        None => "kerf compensation: none (no kerf width given); the path is the contour itself, the finished edge lies half a kerf inside it".into(),
+        Some(k) => {
+            let off = compensated.iter().filter(|c| c.outcome.is_ok()).count();
+            let left = compensated.len() - off;
+            format!(
+                "kerf compensation: in the computer, kerf {} mm from {}; {off} paths offset {} mm toward the scrap{}",
+                k.width_mm,
+                k.source,
+                0.5 * k.width_mm,
+                if left > 0 {
+                    format!(", {left} open contours without a scrap side cut on the contour")
+                } else {
+                    String::new()
+                }
+            )
+        }
+    }
+}
+
+/// The `compensation` object of `report.json`.
+pub(crate) fn compensation_json(
+    file: &CurvesFile,
+    kerf: Option<&Kerf>,
+    compensated: &[Compensated],
+) -> Value {
+    let Some(k) = kerf else {
+        return json!({
+            "kerf_width_mm": null,
+            "note": "no kerf width (--kerf-width or the machine's process.kerf_width_mm): the path is the contour itself",
+        });
+    };
+    let paths: Vec<Value> = compensated
+        .iter()
+        .map(|c| {
+            let id = &file.curves[c.curve].id;
+            match &c.outcome {
+                Ok(p) => json!({
+                    "id": id,
+                    "side": p.side.name(),
+                    "offset_mm": p.offset_mm,
+                    "points": p.poses.len(),
+                    "inserted": p.inserted,
+                    "max_chord_error_mm": p.max_chord_error_mm,
+                    "proven": p.proven,
+                    "outside_corners": p.outside_corners,
+                    "inside_corners": p.inside_corners,
+                    "max_corner_material_mm": p.max_corner_material_mm,
+                    "crossing_checked": p.crossing_checked,
+                }),
+                Err(why) => json!({ "id": id, "offset_mm": 0.0, "reason": why }),
+            }
+        })
+        .collect();
+    json!({
+        "kerf_width_mm": k.width_mm,
+        "source": k.source,
+        "mode": "computer",
+        "offset_mm": 0.5 * k.width_mm,
+        "tolerance_mm": k.tolerance_mm,
+        "proven": compensated.iter().all(|c| c.outcome.as_ref().is_ok_and(|p| p.proven)),
+        "paths": paths,
+        "note": "each path moved half the kerf toward its scrap side, at right angles to the path and the tool axis; outside corners swung round on an arc about the corner, inside corners cut back to where the offsets cross (the round beam leaves max_corner_material_mm there); proven: every chord within the tolerance of the exact offset (flat contours at a fixed tool axis), else measured at 15 points per chord (docs/process.md, Kerf compensation)",
+    })
 }
 
 /// `kerf.axes/1` with the lead-in and lead-out of every path kept apart from its cut (the

@@ -124,6 +124,10 @@ pub struct JobOptions {
     /// along the wall, the scrap where the wall's normal points; 0 turns this off, mm.
     /// Default 4.
     pub wall_axis_max_mm: f64,
+    /// The kerf width, mm: each path moves half of it toward the scrap side, so that the cut
+    /// edge lands on the contour ([`kerf_process::offset`]). `None` (the default) takes the
+    /// machine's `process.kerf_width_mm`; with neither, the path is the contour itself.
+    pub kerf_width_mm: Option<f64>,
 }
 
 /// The tilt tolerance of a job unless it sets another (degrees): 0, the exact normal. A
@@ -158,6 +162,7 @@ impl Default for JobOptions {
             traverse: Some(kerf_process::TraverseOptions::default()),
             max_total_points: DEFAULT_MAX_TOTAL_POINTS_RUN,
             wall_axis_max_mm: 4.0,
+            kerf_width_mm: None,
         }
     }
 }
@@ -243,6 +248,13 @@ impl JobOptions {
         self
     }
 
+    /// With this kerf width, mm (`None`: the machine's, if it gives one; see
+    /// [`JobOptions::kerf_width_mm`]).
+    pub fn with_kerf_width_mm(mut self, mm: Option<f64>) -> Self {
+        self.kerf_width_mm = mm;
+        self
+    }
+
     /// With these traverse checks (`None`: unchecked traverses).
     pub fn with_traverse(mut self, traverse: Option<kerf_process::TraverseOptions>) -> Self {
         self.traverse = traverse;
@@ -295,6 +307,9 @@ impl JobOptions {
         BLEND_TOLERANCE_MM.check("blend_tolerance_mm", self.blend_tolerance_mm)?;
         RETRACT_MM.check("retract_mm", self.retract_mm)?;
         WALL_MM.check("wall_axis_max_mm", self.wall_axis_max_mm)?;
+        if let Some(w) = self.kerf_width_mm {
+            crate::ranges::KERF_WIDTH_MM.check("kerf_width_mm", w)?;
+        }
         let l = &self.leads;
         for (name, v) in [
             ("leads.lead_in_mm", l.lead_in_mm),

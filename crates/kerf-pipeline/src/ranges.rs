@@ -17,6 +17,7 @@
 //! | [`CLEARANCE_MM`] | `0 < x <= 1000` mm | the traverses' clearance from the part (the command line's 0 turns the checks off) |
 //! | [`LEAD_MM`] | `0 <= x <= 1000` mm | the lead-in's line and radius, the overcut and the exit |
 //! | [`WALL_MM`] | `0 <= x <= 100` mm | the widest wall cut along itself (the thickest sheet a laser cuts is tens of mm; a metre would take a sheet's face for a wall) |
+//! | [`KERF_WIDTH_MM`] | `0 < x <= 20` mm | the kerf width (a fibre laser's is 0.1-0.3 mm, a plasma's a few mm) |
 //!
 //! Angles keep the ranges of their stage's own options (the normal step below 180 degrees,
 //! the crease angle in `[0, 180]` degrees, the rotary step and the turn > 0) and the command
@@ -185,6 +186,16 @@ pub const WALL_MM: OptionRange = range(
     "a wall through the sheet is as wide as the sheet is thick",
 );
 
+/// The kerf width the path is offset by (half of it toward the scrap), the same range as the
+/// machine file's `process.kerf_width_mm`.
+pub const KERF_WIDTH_MM: OptionRange = range(
+    0.0,
+    false,
+    kerf_kinematics::MAX_KERF_WIDTH_MM,
+    "mm",
+    "a fibre laser's kerf is 0.1-0.3 mm, a plasma's a few mm",
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -211,6 +222,7 @@ mod tests {
             (CLEARANCE_MM, [1e-6, 1000.0], [0.0, 2e4]),
             (LEAD_MM, [0.0, 1000.0], [-1.0, 1001.0]),
             (WALL_MM, [0.0, 100.0], [-1.0, 1000.0]),
+            (KERF_WIDTH_MM, [1e-3, 20.0], [0.0, 20.5]),
             (SEGMENT_LENGTH_MM, [1e-3, 1e4], [0.0, 1e300]),
         ] {
             for v in inside {

@@ -145,21 +145,42 @@ fn run_placed(
     let o = &job.options;
     job.validate()?;
     let dopts = o.discretize;
-    // 1. Cutting points with a certified chord error.
+    // With a kerf width, each path is first offset by half of it toward the scrap.
+    let kerf = match (o.kerf_width_mm, machine.process.kerf_width_mm) {
+        (Some(w), _) => Some(crate::cuts::Kerf {
+            width_mm: w,
+            source: "the run's kerf width (--kerf-width)",
+            tolerance_mm: dopts.tolerance_mm,
+        }),
+        (None, Some(w)) => Some(crate::cuts::Kerf {
+            width_mm: w,
+            source: "the machine file's process.kerf_width_mm",
+            tolerance_mm: dopts.tolerance_mm,
+        }),
+        (None, None) => None,
+    };
+    // 1. Cutting points with a certified chord error. With a kerf, the contour's chords take
+    // 9/10 of the tolerance and the offset's own term the rest (docs/process.md, "Kerf
+    // compensation"): a hole's offset chords then need no more points.
+    let contour_opts = match &kerf {
+        Some(_) => dopts.with_tolerance_mm(dopts.tolerance_mm * crate::cuts::KERF_CONTOUR_SHARE),
+        None => dopts,
+    };
     let mut discs: Vec<Discretization> =
-        discretize_curves_within(file, &dopts, o.max_total_points, path, progress)?;
+        discretize_curves_within(file, &contour_opts, o.max_total_points, path, progress)?;
     // 1b. Where closed cuts start when the file pins it (`start`) or only corners offer it (a
     // polygon: the middle of its longest edge), made a (certified) cutting point.
     let starts: Vec<Option<f64>> = discs
         .iter_mut()
         .zip(&file.curves)
         .map(|(d, r)| {
-            kerf_process::prepare_start(&r.curve, d, r.start, &o.leads, dopts.tolerance_mm)
+            kerf_process::prepare_start(&r.curve, d, r.start, &o.leads, contour_opts.tolerance_mm)
         })
         .collect();
     lap.split(&mut timings, "discretize");
     // 2. Normals (+z for curves that name no surface, unless the options refuse them).
-    let oriented: Vec<Oriented> = orient_curves(file, &discs, &dopts, &o.orient, path, progress)?;
+    let oriented: Vec<Oriented> =
+        orient_curves(file, &discs, &contour_opts, &o.orient, path, progress)?;
     let tp = toolpath_of_poses(file, dopts.tolerance_mm, &oriented);
     lap.split(&mut timings, "normals");
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
@@ -213,8 +234,16 @@ fn run_placed(
     lap.split(&mut timings, "place");
     // 3c. The cuts: start points, lead-ins and lead-outs on the scrap side, holes before their
     // outlines, the shortest traverse; in part coordinates, then placed.
-    let (cuts, cut_plans) =
-        crate::cuts::plan(file, &oriented, &walls, &placed, &starts, &o.leads, path)?;
+    let (cuts, cut_plans, compensated) = crate::cuts::plan(
+        file,
+        &oriented,
+        &walls,
+        &placed,
+        &starts,
+        &o.leads,
+        kerf.as_ref(),
+        path,
+    )?;
     // Memory: what no later stage reads is dropped as soon as it is done with (the poses for
     // the placement here, the placed cut poses after the kinematics, every path's stations
     // once its blocks are fitted), so that the plan of the motion, the largest part of a run,
@@ -288,6 +317,24 @@ fn run_placed(
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
     let mut warnings: Vec<String> = Vec::new();
+    let uncompensated: Vec<&str> = compensated
+        .iter()
+        .filter(|c| c.outcome.is_err())
+        .map(|c| file.curves[c.curve].id.as_str())
+        .collect();
+    if !uncompensated.is_empty() {
+        let shown: Vec<String> = uncompensated
+            .iter()
+            .take(5)
+            .map(|id| format!("{id:?}"))
+            .collect();
+        warnings.push(format!(
+            "{} open contours without a `scrap` key are cut on the contour, not kerf-compensated (their scrap side is not known): {}{} (report: compensation.paths)",
+            uncompensated.len(),
+            shown.join(", "),
+            if uncompensated.len() > 5 { ", ..." } else { "" }
+        ));
+    }
     lap.split(&mut timings, "kinematics");
     for setup in 0..placed.plan.setups.len() {
         let mut fitted = Vec::new();
@@ -446,6 +493,7 @@ fn run_placed(
                 placed.plan.setups[setup].placement
             ),
             "work offset: none; every coordinate is in the machine's workpiece frame with the placement applied: clamp the part there".to_string(),
+            crate::cuts::kerf_header(kerf.as_ref(), &compensated),
         ];
         let mut text = gcode_motion(&model, &motion, &ids, &gopts_k).map_err(interp(path))?;
         text.shrink_to_fit();
@@ -579,6 +627,7 @@ fn run_placed(
             "cuts": motions.iter().map(|motion| motion.blocks().iter().enumerate().filter(|(i, b)| !b.rapid && (*i == 0 || motion.blocks()[i - 1].rapid)).count()).sum::<usize>(),
             "files": program_names(programs.len()),
         },
+        "compensation": crate::cuts::compensation_json(file, kerf.as_ref(), &compensated),
         "discretize": {
             "curves": file.curves.len(),
             "segments": segments,

@@ -11,6 +11,9 @@
 //!   projects each closed contour along its mean normal and tests winding numbers);
 //! - which side of each contour is scrap: the inside of a hole (a closed contour inside an odd
 //!   number of others), the outside of an outline, or the curve's own `scrap` key ([`Side`]);
+//! - with a kerf width, the path of each contour offset by half of it toward the scrap
+//!   ([`offset`]): outside corners on an arc, inside corners cut back, a loop or a feature
+//!   smaller than the kerf refused;
 //! - where each closed cut starts: never at a corner, on the flattest stretch, and among those
 //!   the point nearest to where the head comes from (a curve may pin it);
 //! - the lead-in (a straight line and a tangent quarter arc on the scrap side, in the tangent
@@ -25,6 +28,7 @@
 
 mod geometry;
 mod lead;
+mod offset;
 mod order;
 mod rapid;
 mod side;
@@ -33,6 +37,7 @@ mod traverse;
 mod wall;
 
 pub use lead::{LeadIn, LeadOptions};
+pub use offset::{offset, OffsetInput, OffsetOptions, OffsetPath};
 pub use order::CutPlan;
 pub use rapid::{
     in_the_cuts_way, own_surfaces_over_the_head, plan_rapids, rapid_moves, Gap, RapidMoves,
@@ -132,6 +137,19 @@ pub enum ProcessError {
         /// What is wrong.
         reason: String,
     },
+    /// Kerf compensation cannot offset a contour: it bends toward the scrap tighter than half
+    /// the kerf (a loop smaller than the kerf), an inside corner's sides or two stretches of
+    /// the offset cross (a feature narrower than the kerf), it runs along the tool axis, or the
+    /// point budget is spent. Fix: a narrower kerf, or leave the feature out of the cut.
+    #[error("contour \"{id}\": kerf compensation of a {kerf_width_mm} mm kerf: {reason}")]
+    Compensation {
+        /// The contour's id.
+        id: String,
+        /// The kerf width, mm.
+        kerf_width_mm: f64,
+        /// Where and why, with the sizes.
+        reason: String,
+    },
     /// No traverse route between two cuts keeps the clearance: the retract along the tool
     /// axis, the approach, or every travel route comes too close (details boxed, so that the
     /// error stays small). Fix: a smaller clearance, another placement, or check the tool axes
@@ -173,6 +191,31 @@ pub type Result<T> = std::result::Result<T, ProcessError>;
 /// # Errors
 /// [`ProcessError::BadContour`], [`ProcessError::BadOption`].
 pub fn plan_cuts(contours: &[Contour<'_>], options: &LeadOptions) -> Result<CutPlan> {
+    let (projected, inside, sides) = nesting(contours, options)?;
+    let n = contours.len();
+    let leads: Vec<lead::Leads> = (0..n)
+        .map(|i| lead::Leads::new(&contours[i], projected[i].as_ref(), sides[i], options))
+        .collect();
+    Ok(order::plan(contours, &inside, sides, leads, options))
+}
+
+/// The scrap side of every contour, as [`plan_cuts`] decides it: the curve's own `scrap` key,
+/// else the inside of a hole (a closed contour inside an odd number of others) or the outside
+/// of an outline; `None` for an open contour without a `scrap` key. Kerf compensation
+/// ([`offset`]) moves each path toward this side before the cuts are planned.
+///
+/// # Errors
+/// As [`plan_cuts`].
+pub fn scrap_sides(contours: &[Contour<'_>], options: &LeadOptions) -> Result<Vec<Option<Side>>> {
+    Ok(nesting(contours, options)?.2)
+}
+
+/// The contours checked, projected, nested (which closed contours contain which) and sided.
+#[allow(clippy::type_complexity)]
+fn nesting(
+    contours: &[Contour<'_>],
+    options: &LeadOptions,
+) -> Result<(Vec<Option<Projected>>, Vec<Vec<usize>>, Vec<Option<Side>>)> {
     options.validate()?;
     for c in contours {
         if c.poses.len() < 2 {
@@ -227,8 +270,5 @@ pub fn plan_cuts(contours: &[Contour<'_>], options: &LeadOptions) -> Result<CutP
             })
         })
         .collect();
-    let leads: Vec<lead::Leads> = (0..n)
-        .map(|i| lead::Leads::new(&contours[i], projected[i].as_ref(), sides[i], options))
-        .collect();
-    Ok(order::plan(contours, &inside, sides, leads, options))
+    Ok((projected, inside, sides))
 }

@@ -1,0 +1,421 @@
+//! Kerf compensation against closed-form geometry: the beam's path offset by half the kerf,
+//! checked by exact distance functions (a circle, a rounded square, a square) and, for a
+//! tilted beam, by projecting along the beam and measuring against a dense polygon of the
+//! exact contour. The checks run on the chords the machine runs, sampled densely, not on the
+//! path's own points only.
+
+use kerf_discretize::{discretize, Options};
+use kerf_nurbs::{NurbsCurve, Segment};
+use kerf_process::{offset, OffsetInput, OffsetOptions, OffsetPath, PoseArray, ProcessError, Side};
+use nalgebra::{Point3, Vector2, Vector3};
+
+const TOL: f64 = 0.01;
+
+/// The discretized contour with a fixed tool axis.
+fn contour(curve: &NurbsCurve, axis: Vector3<f64>) -> (Vec<f64>, Vec<PoseArray>) {
+    let d = discretize(curve, &Options::with_tolerance(TOL)).expect("discretize");
+    let a = axis.normalize();
+    let poses = d
+        .points()
+        .iter()
+        .map(|p| [p.x, p.y, p.z, a.x, a.y, a.z])
+        .collect();
+    (d.params().to_vec(), poses)
+}
+
+fn run(
+    curve: &NurbsCurve,
+    axis: Vector3<f64>,
+    normals: Option<&[[f64; 3]]>,
+    scrap: Side,
+    kerf: f64,
+) -> Result<OffsetPath, ProcessError> {
+    let (params, poses) = contour(curve, axis);
+    let owned: Vec<[f64; 3]>;
+    let normals = match normals {
+        Some(m) => {
+            owned = vec![m[0]; poses.len()];
+            Some(owned.as_slice())
+        }
+        None => None,
+    };
+    offset(
+        &OffsetInput {
+            id: "c",
+            curve,
+            params: &params,
+            poses: &poses,
+            surface_normals: normals,
+            scrap,
+            closed: curve.is_closed(),
+        },
+        &OffsetOptions::new(kerf, TOL),
+    )
+}
+
+/// Points along every chord of the path (what the machine runs), 8 per chord.
+fn along_chords(path: &OffsetPath) -> Vec<Point3<f64>> {
+    let p: Vec<Point3<f64>> = path
+        .poses
+        .iter()
+        .map(|q| Point3::new(q[0], q[1], q[2]))
+        .collect();
+    let mut out = Vec::new();
+    for w in p.windows(2) {
+        for k in 0..8 {
+            out.push(w[0] + (w[1] - w[0]) * (k as f64 / 8.0));
+        }
+    }
+    out.push(p[p.len() - 1]);
+    out
+}
+
+fn circle(radius: f64) -> NurbsCurve {
+    NurbsCurve::circle(Point3::origin(), Vector3::z(), radius).expect("circle")
+}
+
+/// A square of half-size `h` with corners rounded to `rho` (exact: lines and rational
+/// quarter circles, degree 2), counter-clockwise seen from +z.
+fn rounded_square(h: f64, rho: f64) -> NurbsCurve {
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    let e = h - rho;
+    let pts = [
+        (h, -e, 1.0),
+        (h, 0.0, 1.0),
+        (h, e, 1.0),
+        (h, h, w),
+        (e, h, 1.0),
+        (0.0, h, 1.0),
+        (-e, h, 1.0),
+        (-h, h, w),
+        (-h, e, 1.0),
+        (-h, 0.0, 1.0),
+        (-h, -e, 1.0),
+        (-h, -h, w),
+        (-e, -h, 1.0),
+        (0.0, -h, 1.0),
+        (e, -h, 1.0),
+        (h, -h, w),
+        (h, -e, 1.0),
+    ];
+    let mut knots = vec![0.0; 3];
+    for k in 1..8 {
+        knots.extend([k as f64, k as f64]);
+    }
+    knots.extend([8.0; 3]);
+    NurbsCurve::new(
+        2,
+        knots,
+        pts.iter().map(|p| Point3::new(p.0, p.1, 0.0)).collect(),
+        Some(pts.iter().map(|p| p.2).collect()),
+    )
+}
+
+/// Signed distance to the rounded square (negative inside).
+fn rounded_sdf(p: &Point3<f64>, h: f64, rho: f64) -> f64 {
+    let q = Vector2::new(p.x.abs(), p.y.abs()) - Vector2::repeat(h - rho);
+    let outside = Vector2::new(q.x.max(0.0), q.y.max(0.0)).norm();
+    outside + q.x.max(q.y).min(0.0) - rho
+}
+
+fn square(h: f64) -> NurbsCurve {
+    NurbsCurve::polyline(&[
+        Point3::new(h, -h, 0.0),
+        Point3::new(h, h, 0.0),
+        Point3::new(-h, h, 0.0),
+        Point3::new(-h, -h, 0.0),
+        Point3::new(h, -h, 0.0),
+    ])
+    .expect("square")
+}
+
+/// Every point along the chords is `target` (signed distance) from the contour, to the
+/// tolerance.
+fn assert_at(path: &OffsetPath, sdf: impl Fn(&Point3<f64>) -> f64, target: f64, what: &str) {
+    let worst = along_chords(path)
+        .iter()
+        .map(|p| (sdf(p) - target).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= TOL + 1e-9,
+        "{what}: a chord point is {worst:.3e} mm off the offset (tolerance {TOL})"
+    );
+}
+
+/// The largest distance from a point of the contour to the path (the cut edge must reach
+/// every point of the contour: this is `r` up to the tolerance where nothing is left).
+fn contour_to_path(curve: &NurbsCurve, path: &OffsetPath) -> (f64, f64) {
+    let segs: Vec<Segment<3>> = path
+        .poses
+        .windows(2)
+        .map(|w| {
+            Segment::between(
+                &Point3::new(w[0][0], w[0][1], w[0][2]),
+                &Point3::new(w[1][0], w[1][1], w[1][2]),
+            )
+        })
+        .collect();
+    let (a, b) = curve.domain();
+    let mut lo = f64::INFINITY;
+    let mut hi = 0.0_f64;
+    for k in 0..2000 {
+        let c = curve.point(a + (b - a) * k as f64 / 2000.0);
+        let d = segs
+            .iter()
+            .map(|s| s.distance_to(&c))
+            .fold(f64::INFINITY, f64::min);
+        lo = lo.min(d);
+        hi = hi.max(d);
+    }
+    (lo, hi)
+}
+
+#[test]
+fn a_hole_shrinks_and_an_outline_grows_by_half_the_kerf_exactly() {
+    let radius = 5.0;
+    let c = circle(radius);
+    for kerf in [0.1, 0.2, 0.3] {
+        let r = kerf / 2.0;
+        // Counter-clockwise from +z: the left is the inside.
+        let hole = run(&c, Vector3::z(), None, Side::Left, kerf).expect("hole");
+        assert!(hole.proven, "a flat contour at a fixed axis is proven");
+        assert!(hole.max_chord_error_mm <= TOL);
+        assert_at(&hole, |p| p.coords.norm() - radius, -r, "hole");
+        let outline = run(&c, Vector3::z(), None, Side::Right, kerf).expect("outline");
+        assert!(outline.proven);
+        assert_at(&outline, |p| p.coords.norm() - radius, r, "outline");
+        // Closed paths close exactly, and the cut edge reaches the whole contour.
+        for p in [&hole, &outline] {
+            assert_eq!(p.poses[0], p.poses[p.poses.len() - 1]);
+            assert_eq!((p.outside_corners, p.inside_corners), (0, 0));
+            let (lo, hi) = contour_to_path(&c, p);
+            assert!(lo >= r - TOL && hi <= r + TOL, "kerf {kerf}: {lo} {hi}");
+        }
+    }
+}
+
+#[test]
+fn a_rounded_square_keeps_its_size_inside_and_out() {
+    let (h, rho) = (10.0, 2.0);
+    let c = rounded_square(h, rho);
+    for kerf in [0.1, 0.2, 0.3] {
+        let r = kerf / 2.0;
+        let hole = run(&c, Vector3::z(), None, Side::Left, kerf).expect("hole");
+        assert!(hole.proven);
+        assert_at(&hole, |p| rounded_sdf(p, h, rho), -r, "rounded hole");
+        let outline = run(&c, Vector3::z(), None, Side::Right, kerf).expect("outline");
+        assert!(outline.proven);
+        assert_at(&outline, |p| rounded_sdf(p, h, rho), r, "rounded outline");
+        for p in [&hole, &outline] {
+            // Lines meet arcs tangentially: no corner.
+            assert_eq!((p.outside_corners, p.inside_corners), (0, 0));
+            let (lo, hi) = contour_to_path(&c, p);
+            assert!(lo >= r - TOL && hi <= r + TOL, "kerf {kerf}: {lo} {hi}");
+        }
+    }
+}
+
+#[test]
+fn sharp_corners_get_arcs_outside_and_cut_backs_inside() {
+    let h = 10.0;
+    let c = square(h);
+    let sdf = |p: &Point3<f64>| {
+        let q = Vector2::new(p.x.abs() - h, p.y.abs() - h);
+        Vector2::new(q.x.max(0.0), q.y.max(0.0)).norm() + q.x.max(q.y).min(0.0)
+    };
+    for kerf in [0.1, 0.2, 0.3] {
+        let r = kerf / 2.0;
+        let outline = run(&c, Vector3::z(), None, Side::Right, kerf).expect("outline");
+        assert_eq!(outline.outside_corners, 4, "the start is a corner too");
+        assert_eq!(outline.inside_corners, 0);
+        assert!(outline.proven);
+        // On the arcs the path is r from the corner: still r from the square.
+        assert_at(&outline, sdf, r, "square outline");
+        let (lo, hi) = contour_to_path(&c, &outline);
+        assert!(lo >= r - TOL && hi <= r + TOL, "{lo} {hi}");
+        assert_eq!(outline.poses[0], outline.poses[outline.poses.len() - 1]);
+
+        let hole = run(&c, Vector3::z(), None, Side::Left, kerf).expect("hole");
+        assert_eq!(hole.inside_corners, 4);
+        assert_eq!(hole.outside_corners, 0);
+        // Cut back at the crossing: exactly r inside both sides, the square of side
+        // 2 (h - r), never closer to the part.
+        assert_at(&hole, sdf, -r, "square hole");
+        assert_eq!(hole.poses.len(), 5, "{:?}", hole.poses);
+        for q in &hole.poses {
+            assert!((q[0].abs() - (h - r)).abs() < 1e-9 && (q[1].abs() - (h - r)).abs() < 1e-9);
+        }
+        // A round beam leaves (sqrt 2 - 1) r in each inside corner.
+        let left = (2f64.sqrt() - 1.0) * r;
+        assert!((hole.max_corner_material_mm - left).abs() < 1e-9);
+        let (_, hi) = contour_to_path(&c, &hole);
+        assert!((hi - r * 2f64.sqrt()).abs() < 1e-9, "{hi}");
+        assert_eq!(hole.poses[0], hole.poses[hole.poses.len() - 1]);
+    }
+}
+
+/// Projects along `a` onto the plane across it.
+fn across(a: &Vector3<f64>, p: &Point3<f64>) -> Vector2<f64> {
+    let helper = if a.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let e1 = helper.cross(a).normalize();
+    let e2 = a.cross(&e1);
+    Vector2::new(p.coords.dot(&e1), p.coords.dot(&e2))
+}
+
+#[test]
+fn a_tilted_beam_touches_the_contour_with_its_edge_at_the_surface() {
+    let radius = 5.0;
+    let c = circle(radius);
+    // The dense contour, 20,000 sides: within 3e-6 mm of the circle.
+    let dense: Vec<Point3<f64>> = (0..20_000)
+        .map(|k| {
+            let t = std::f64::consts::TAU * k as f64 / 20_000.0;
+            Point3::new(radius * t.cos(), radius * t.sin(), 0.0)
+        })
+        .collect();
+    for tilt_deg in [0.0_f64, 10.0, 20.0, 30.0] {
+        let t = tilt_deg.to_radians();
+        let a = Vector3::new(0.0, t.sin(), t.cos());
+        let flat: Vec<Vector2<f64>> = dense.iter().map(|p| across(&a, p)).collect();
+        let poly: Vec<Segment<2>> = (0..flat.len())
+            .map(|k| Segment::new(flat[k], flat[(k + 1) % flat.len()]))
+            .collect();
+        for kerf in [0.1, 0.2, 0.3] {
+            let r = kerf / 2.0;
+            for side in [Side::Left, Side::Right] {
+                let path = run(&c, a, Some(&[[0.0, 0.0, 1.0]]), side, kerf).expect("tilted");
+                assert!(path.proven, "a fixed tilted axis on a plane is proven");
+                for q in &path.poses {
+                    assert!(q[2].abs() < 1e-9, "the tip is on the sheet: {q:?}");
+                }
+                // Seen along the beam, the beam's centre is r from the contour.
+                let worst = along_chords(&path)
+                    .iter()
+                    .map(|p| {
+                        let d = poly
+                            .iter()
+                            .map(|s| s.distance(&across(&a, p)))
+                            .fold(f64::INFINITY, f64::min);
+                        (d - r).abs()
+                    })
+                    .fold(0.0, f64::max);
+                assert!(
+                    worst <= TOL + 1e-5,
+                    "tilt {tilt_deg}, kerf {kerf}, {side:?}: {worst:.3e}"
+                );
+            }
+        }
+    }
+}
+
+fn compensation_reason(e: ProcessError) -> String {
+    match e {
+        ProcessError::Compensation { reason, .. } => reason,
+        other => panic!("expected a compensation refusal, got {other}"),
+    }
+}
+
+#[test]
+fn a_hole_smaller_than_the_kerf_is_refused_with_its_size() {
+    let e = run(&circle(0.05), Vector3::z(), None, Side::Left, 0.2).expect_err("refused");
+    let reason = compensation_reason(e);
+    assert!(reason.contains("radius of 0.0500 mm"), "{reason}");
+    assert!(reason.contains("0.1000 mm"), "{reason}");
+    // The same circle as an outline is fine: the kerf goes outside.
+    let ok = run(&circle(0.05), Vector3::z(), None, Side::Right, 0.2).expect("outline");
+    assert!(ok.proven);
+}
+
+#[test]
+fn a_notch_narrower_than_the_kerf_is_refused() {
+    // An outline with a notch 0.15 mm wide and 5 mm deep in its top edge.
+    let pts = [
+        (0.0, 0.0),
+        (20.0, 0.0),
+        (20.0, 10.0),
+        (10.075, 10.0),
+        (10.075, 5.0),
+        (9.925, 5.0),
+        (9.925, 10.0),
+        (0.0, 10.0),
+        (0.0, 0.0),
+    ];
+    let c = NurbsCurve::polyline(
+        &pts.iter()
+            .map(|p| Point3::new(p.0, p.1, 0.0))
+            .collect::<Vec<_>>(),
+    )
+    .expect("outline");
+    let e = run(&c, Vector3::z(), None, Side::Right, 0.2).expect_err("refused");
+    let reason = compensation_reason(e);
+    assert!(reason.contains("narrower than the kerf"), "{reason}");
+    // A 0.25 mm notch takes a 0.2 mm kerf.
+    let wide = [
+        (0.0, 0.0),
+        (20.0, 0.0),
+        (20.0, 10.0),
+        (10.125, 10.0),
+        (10.125, 5.0),
+        (9.875, 5.0),
+        (9.875, 10.0),
+        (0.0, 10.0),
+        (0.0, 0.0),
+    ];
+    let c = NurbsCurve::polyline(
+        &wide
+            .iter()
+            .map(|p| Point3::new(p.0, p.1, 0.0))
+            .collect::<Vec<_>>(),
+    )
+    .expect("outline");
+    let path = run(&c, Vector3::z(), None, Side::Right, 0.2).expect("a wider notch");
+    assert_eq!(path.inside_corners, 2);
+}
+
+#[test]
+fn the_point_budget_stops_the_offset() {
+    let (params, poses) = contour(&circle(5.0), Vector3::z());
+    let input = OffsetInput {
+        id: "c",
+        curve: &circle(5.0),
+        params: &params,
+        poses: &poses,
+        surface_normals: None,
+        scrap: Side::Left,
+        closed: true,
+    };
+    let e = offset(&input, &OffsetOptions::new(0.2, TOL).with_max_points(10)).expect_err("budget");
+    assert!(compensation_reason(e).contains("point budget"));
+    let bad = offset(&input, &OffsetOptions::new(0.0, TOL)).expect_err("no kerf");
+    assert!(matches!(
+        bad,
+        ProcessError::BadOption {
+            name: "kerf_width_mm",
+            ..
+        }
+    ));
+}
+
+#[test]
+fn point_at_runs_on_the_exact_offset_between_points() {
+    let radius = 5.0;
+    let c = circle(radius);
+    let path = run(&c, Vector3::z(), None, Side::Left, 0.2).expect("hole");
+    let n = path.poses.len();
+    for k in 0..(n - 1) * 7 {
+        let u = k as f64 / 7.0;
+        let p = path.point_at(u, &c);
+        assert!(
+            (p.coords.norm() - (radius - 0.1)).abs() < 1e-9,
+            "u {u}: {p}"
+        );
+    }
+    for (k, q) in path.poses.iter().enumerate() {
+        let p = path.point_at(k as f64, &c);
+        assert!((p - Point3::new(q[0], q[1], q[2])).norm() < 1e-12);
+    }
+}

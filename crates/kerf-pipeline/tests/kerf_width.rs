@@ -103,14 +103,12 @@ fn check(name: &str, place: PlaceMode, slack: f64) -> Vec<(String, &'static str)
     let (file, out) = run(name, Some(0.2), place);
     let mut sides = Vec::new();
     let report = &out.report["compensation"];
-    assert_eq!(report["kerf_width_mm"], 0.2);
+    assert_eq!(report["kerf_width_mm"], 0.2, "{name}: the width used");
     for path in report["paths"].as_array().expect("paths") {
         let id = path["id"].as_str().expect("id");
         if path.get("side").is_none() {
-            assert!(path["reason"]
-                .as_str()
-                .expect("reason")
-                .contains("open contour"));
+            let why = path["reason"].as_str().expect("reason");
+            assert!(why.contains("open contour"), "{name} {id}: {why}");
             continue;
         }
         let contour = dense(&file, id);

@@ -7,7 +7,8 @@
    the `linuxcnc` program (and the `generic` one on the first such machine) through LinuxCNC's standalone interpreter
    `rs274` with an INI made from that machine; any message on its error stream (errors and
    warnings alike) fails the check.
-2. The simulator runs (`SIMS` below: a flat part and a tilted-head part): a headless LinuxCNC
+2. The simulator runs (`SIMS` below: a flat part and a tilted-head part, and `simulate_kerf`: the
+   flat part with LinuxCNC's own kerf compensation against kerf's): a headless LinuxCNC
    (configuration from `make_config.py`, DISPLAY = `display.py`, run by an unprivileged user)
    executes the program while `halsampler` records the joints and the beam output every servo
    cycle; `lcnc_measure` (Rust, kerf's forward kinematics) measures the samples; the asserts are
@@ -117,10 +118,13 @@ def first_cuts(text, cuts, beam_on="M64 P0", beam_off="M65 P0"):
 
 
 def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), traj=(), edit=None,
-             cuts=None):
+             cuts=None, measure_env=None, compare=False):
     """One simulator run; `extra` are more `kerf run` arguments, `traj` more [TRAJ] lines of
     the INI, `edit` a function applied to the program text (for the experiments), `cuts` the
-    number of cuts to run (a long real part cut short; all when None)."""
+    number of cuts to run (a long real part cut short; all when None). With `compare` the
+    program leaves the kerf to the controller: its tip runs half a kerf off its own poses and
+    the curve by design, so those asserts give way to `kerf_compare` (`simulate_kerf`), and the
+    beam's framing is checked by its count only; `measure_env` goes to `lcnc_measure`."""
     if cuts is not None:
         edit = lambda text, e=edit: first_cuts(e(text) if e else text, cuts)
     fixture_tag = fixture.replace("/", "-") + tag
@@ -163,7 +167,8 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
     res = json.loads(res_path.read_text())
     shutil.copy(work / "samples.txt", outdir / f"sim-{fixture_tag}-samples.txt")
     m = run([str(measure), str(ROOT / "fixtures" / "machines" / f"{machine}.json"), str(kout),
-             str(work / "samples.txt"), "0.001", *([str(cuts)] if cuts is not None else [])])
+             str(work / "samples.txt"), "0.001", *([str(cuts)] if cuts is not None else [])],
+            env={**os.environ, **(measure_env or {})})
     if m.returncode != 0:
         fail(f"sim {fixture}: lcnc_measure: {m.stderr.strip()}")
         return None
@@ -176,8 +181,11 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
         fail(f"{name}: LinuxCNC errors {res['errors']}, end {res['code']}")
     if fig["sample_gaps"]:
         fail(f"{name}: {fig['sample_gaps']} gaps in the samples (sampler overrun)")
-    if not fig["framing_ok"] or fig["beam_intervals"] != fig["cuts"]:
+    if (not fig["framing_ok"] and not compare) or fig["beam_intervals"] != fig["cuts"]:
         fail(f"{name}: beam on {fig['beam_intervals']} times for {fig['cuts']} cuts, framing ok {fig['framing_ok']}")
+    if compare:
+        shutil.rmtree(work, ignore_errors=True)
+        return fig
     if not fig["max_deviation_beam_on_mm"] <= fig["tolerance_budget_mm"]:
         fail(f"{name}: tip deviation {fig['max_deviation_beam_on_mm']} mm > budget {fig['tolerance_budget_mm']} mm")
     # End to end: the tip against the designed NURBS curve itself (closest point), wherever the
@@ -213,6 +221,38 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
           f"time {fig['linuxcnc_time_s']:.3f} s / kerf {fig['kerf_predicted_s']:.3f} s = {fig['time_ratio']:.3f}, "
           f"tip speed max {fig['max_tip_speed_beam_on_mm_per_min']:.0f} mm/min, wall {wall:.1f} s", flush=True)
     shutil.rmtree(work, ignore_errors=True)
+    return fig
+
+
+# The controller's kerf compensation (issue 27): the flat part with a 0.2 mm kerf, once offset
+# by kerf (`--kerf-width`) and once left to LinuxCNC's G41.1/G42.1 (`--kerf-in-control`), both
+# with a 0.5 um blending tolerance; where LinuxCNC's executed tip runs on the compensated
+# contour it must lie within KERF_AGREEMENT_MM of kerf's own offset path.
+KERF_AGREEMENT_MM = 0.002
+
+
+def simulate_kerf(kerf, measure, outdir):
+    args = ("--kerf-width", "0.2", "--blend-tolerance", "0.0005", "--tolerance", "0.001")
+    ref = outdir / "kerf-in-computer"
+    r = kerf_run(kerf, "sheet_metal_holes", "gantry_ac", "linuxcnc", ref, args)
+    if r.returncode != 0:
+        fail(f"kerf in the computer: kerf run: {r.stderr.strip()}")
+        return None
+    fig = simulate(kerf, measure, "sheet_metal_holes", "gantry_ac", True, outdir,
+                   tag="-kerf-in-control", extra=(*args, "--kerf-in-control"),
+                   measure_env={"KERF_COMPARE_DIR": str(ref), "KERF_COMPARE_OFFSET_MM": "0.1"},
+                   compare=True)
+    if not fig:
+        return None
+    c = fig.get("kerf_compare") or {}
+    name = "sim sheet_metal_holes with G41.1/G42.1"
+    if c.get("samples_on_the_offset", 0) < 0.6 * max(c.get("beam_on_samples", 0), 1):
+        fail(f"{name}: only {c.get('samples_on_the_offset')} of {c.get('beam_on_samples')} beam-on samples run half a kerf from the contour: the controller did not compensate")
+    elif not c["max_distance_to_computer_offset_mm"] <= KERF_AGREEMENT_MM:
+        fail(f"{name}: LinuxCNC's tip {c['max_distance_to_computer_offset_mm']:.5f} mm from kerf's offset > {KERF_AGREEMENT_MM}")
+    print(f"{name}: {c.get('samples_on_the_offset')}/{c.get('beam_on_samples')} beam-on samples on the offset, "
+          f"at most {c.get('max_distance_to_computer_offset_mm', float('nan')):.5f} mm from kerf's own offset path "
+          f"(limit {KERF_AGREEMENT_MM}), time {fig['linuxcnc_time_s']:.3f} s", flush=True)
     return fig
 
 
@@ -283,6 +323,10 @@ def main():
     if "--no-sim" not in args:
         for f, m, flat, extra, cuts in sims:
             fig = simulate(kerf, measure, f, m, flat, outdir, extra=extra, cuts=cuts)
+            if fig:
+                figs.append(fig)
+        if "--sim" not in args or "kerf" in args[args.index("--sim") + 1:]:
+            fig = simulate_kerf(kerf, measure, outdir)
             if fig:
                 figs.append(fig)
     summary = {"linuxcnc": run(["dpkg-query", "-W", "-f", "${Version}", "linuxcnc-uspace"]).stdout,

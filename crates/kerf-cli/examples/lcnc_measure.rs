@@ -19,6 +19,12 @@
 //! `kerf.curves/1` file the report names as its input; global closest point in part
 //! coordinates), wherever the curve is nearer than the leads and the pierce descent: the last
 //! is the end-to-end figure the tolerance budget is a claim about.
+//!
+//! With `KERF_COMPARE_DIR` (the output of the same job compensated in the computer,
+//! `--kerf-width`) and `KERF_COMPARE_OFFSET_MM` (half the kerf), a program that leaves the
+//! kerf to the controller (`--kerf-in-control`) is measured against kerf's own offset: the
+//! beam-on samples at the offset distance from the designed curve, against the other run's
+//! cut of the same contour (`kerf_compare`).
 
 use std::path::Path;
 
@@ -371,6 +377,62 @@ fn main() {
         }));
     }
 
+    // The controller's kerf compensation against kerf's own (`KERF_COMPARE_DIR`: the output of
+    // the same run compensated in the computer, `KERF_COMPARE_OFFSET_MM` half the kerf): every
+    // beam-on sample within 0.02 mm of the offset distance from the designed curve (the
+    // compensated contour, not the leads: nearer the curve than the leads by 5 um) against that
+    // run's cut of the same contour.
+    let compare = std::env::var("KERF_COMPARE_DIR").ok().map(|other| {
+        let r: f64 = std::env::var("KERF_COMPARE_OFFSET_MM")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| fail("KERF_COMPARE_OFFSET_MM: half the kerf, mm".into()));
+        let text = std::fs::read_to_string(Path::new(&other).join("axes.json"))
+            .unwrap_or_else(|e| fail(format!("{other}/axes.json: {e}")));
+        let theirs = AxesFile::from_str(&text).unwrap_or_else(|e| fail(e.to_string()));
+        let (mut on, mut measured, mut worst) = (0usize, 0usize, 0.0_f64);
+        let mut worst_at = (String::new(), Point3::origin(), 0.0);
+        for (k, iv) in intervals.iter().enumerate().take(cuts.len()) {
+            let id = &axes.paths[k].id;
+            let Some(path) = theirs.paths.iter().find(|p| &p.id == id) else {
+                fail(format!("{other}: no path {id:?}"))
+            };
+            let poly: Vec<Point3<f64>> = path
+                .poses
+                .iter()
+                .map(|p| Point3::new(p[0], p[1], p[2]))
+                .collect();
+            let design = &designs[k];
+            let Some(c) = &design.curve else { continue };
+            for (p, _) in tips.iter().take(iv.1 + 1).skip(iv.0) {
+                on += 1;
+                let local = Point3::from(design.rot.inverse() * (p - Point3::from(design.shift)));
+                let dc = c.closest_point(&local).distance;
+                // Clearly nearer the contour than its (uncompensated) leads: the lead-in and
+                // the overcut run half a kerf off the leads, and join the contour tangentially.
+                let d_lead = design
+                    .leads
+                    .iter()
+                    .map(|l| poly_dist(p, l))
+                    .fold(f64::INFINITY, f64::min);
+                if (dc - r).abs() <= 0.02 && dc <= d_lead - 0.005 {
+                    measured += 1;
+                    let d = poly_dist(p, &poly);
+                    if d > worst {
+                        worst = d;
+                        worst_at = (id.clone(), *p, dc);
+                    }
+                }
+            }
+        }
+        json!({
+            "beam_on_samples": on,
+            "samples_on_the_offset": measured,
+            "max_distance_to_computer_offset_mm": worst,
+            "worst": { "id": worst_at.0, "at": [worst_at.1.x, worst_at.1.y, worst_at.1.z], "distance_from_curve_mm": worst_at.2 },
+        })
+    });
+
     // Limits, velocities and accelerations (second differences of the commanded positions),
     // separately while the beam is off (rapids) and on (cuts).
     let names = machine.axis_names();
@@ -455,6 +517,7 @@ fn main() {
         "kerf_motion_duration_s": duration,
         "time_ratio": t_lcnc / predicted,
         "per_cut": per_cut,
+        "kerf_compare": compare,
     });
     println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
 }

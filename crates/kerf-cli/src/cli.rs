@@ -509,6 +509,14 @@ pub(crate) struct RunArgs {
     #[arg(long, value_name = "MM", value_parser = crate::guard::kerf_width_mm)]
     pub(crate) kerf_width: Option<f64>,
 
+    /// With a kerf width (this run's or the machine file's), leave the kerf compensation to
+    /// the controller: the program holds the contours
+    /// themselves with LinuxCNC's G41.1/G42.1 D<kerf> from each lead-in on and G40 after the
+    /// beam is off (`--dialect linuxcnc` only; every compensated cut must stand the beam
+    /// vertical with the rotary axes still, else the run is refused with the reason).
+    #[arg(long)]
+    pub(crate) kerf_in_control: bool,
+
     /// Lead-in of every cut: the straight part from the pierce point, then the radius of the
     /// quarter arc that joins the contour tangentially on the scrap side, mm, each 0 to 1000
     /// (`0,0` pierces on the contour). Shrunk where the scrap is smaller (small holes).

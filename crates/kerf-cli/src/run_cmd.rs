@@ -50,6 +50,7 @@ fn job_options(args: &RunArgs) -> JobOptions {
         )
         .with_wall_axis_max_mm(args.max_wall)
         .with_kerf_width_mm(args.kerf_width)
+        .with_kerf_in_control(args.kerf_in_control)
 }
 
 /// Runs `kerf run`.

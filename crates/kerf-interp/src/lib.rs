@@ -79,7 +79,7 @@ pub const DEFAULT_BLEND_TOLERANCE: f64 = 0.005;
 
 pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_csv_to, write_gcode, ChordTerm,
-    Dialect, GcodeOptions, ProcessCodes,
+    CutterCompensation, Dialect, GcodeOptions, ProcessCodes,
 };
 pub use plan::{
     link_paths, link_paths_through, link_paths_with_retract, plan, plan_owned, Cycles, Motion,

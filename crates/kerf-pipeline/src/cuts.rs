@@ -116,14 +116,30 @@ pub(crate) struct Kerf {
     pub(crate) source: &'static str,
     /// The chord tolerance the offset paths keep, mm.
     pub(crate) tolerance_mm: f64,
+    /// True when the controller compensates (`G41.1`/`G42.1`): the paths stay on the contour.
+    pub(crate) in_control: bool,
 }
 
 /// What kerf compensation did to one contour.
 pub(crate) struct Compensated {
     pub(crate) curve: usize,
-    /// The offset path, or why the contour was cut as it is (an open contour whose scrap side
-    /// is not known).
-    pub(crate) outcome: std::result::Result<Arc<OffsetPath>, String>,
+    pub(crate) outcome: Outcome,
+}
+
+/// How one contour is compensated.
+pub(crate) enum Outcome {
+    /// Offset in the computer.
+    Offset(Arc<OffsetPath>),
+    /// By the controller, toward this side.
+    InControl(kerf_process::Side),
+    /// Not at all, and why (an open contour whose scrap side is not known).
+    Uncompensated(String),
+}
+
+impl Outcome {
+    pub(crate) fn is_compensated(&self) -> bool {
+        !matches!(self, Outcome::Uncompensated(_))
+    }
 }
 
 /// A contour on a thin wall ([`kerf_process::wall_axis`]) is planned with the tool axes along
@@ -184,11 +200,19 @@ pub(crate) fn plan(
                     let Some(side) = sides[j] else {
                         compensated.push(Compensated {
                             curve: i,
-                            outcome: Err("an open contour without a `scrap` key: its scrap side is not known, so it is cut on the contour itself".into()),
+                            outcome: Outcome::Uncompensated("an open contour without a `scrap` key: its scrap side is not known, so it is cut on the contour itself".into()),
                         });
                         out.push(None);
                         continue;
                     };
+                    if k.in_control {
+                        compensated.push(Compensated {
+                            curve: i,
+                            outcome: Outcome::InControl(side),
+                        });
+                        out.push(None);
+                        continue;
+                    }
                     let input = OffsetInput {
                         id: &file.curves[i].id,
                         curve: &file.curves[i].curve,
@@ -203,7 +227,7 @@ pub(crate) fn plan(
                     let path = Arc::new(path);
                     compensated.push(Compensated {
                         curve: i,
-                        outcome: Ok(Arc::clone(&path)),
+                        outcome: Outcome::Offset(Arc::clone(&path)),
                     });
                     out.push(Some(path));
                 }
@@ -352,23 +376,32 @@ fn cut_path(
 /// The program header's line on kerf compensation: the width and where it came from, or that
 /// the path is the contour itself. Only numbers and kerf's own words: no text from a file.
 pub(crate) fn kerf_header(kerf: Option<&Kerf>, compensated: &[Compensated]) -> String {
-    match kerf {
-        None => "kerf compensation: none (no kerf width given); the path is the contour itself, the finished edge lies half a kerf inside it".into(),
-        Some(k) => {
-            let off = compensated.iter().filter(|c| c.outcome.is_ok()).count();
-            let left = compensated.len() - off;
-            format!(
-                "kerf compensation: in the computer, kerf {} mm from {}; {off} paths offset {} mm toward the scrap{}",
-                k.width_mm,
-                k.source,
-                0.5 * k.width_mm,
-                if left > 0 {
-                    format!(", {left} open contours without a scrap side cut on the contour")
-                } else {
-                    String::new()
-                }
-            )
-        }
+    let Some(k) = kerf else {
+        return "kerf compensation: none, no kerf width given: the path is the contour itself"
+            .into();
+    };
+    let done = compensated
+        .iter()
+        .filter(|c| c.outcome.is_compensated())
+        .count();
+    let left = compensated.len() - done;
+    let rest = if left > 0 {
+        format!(", {left} open paths not")
+    } else {
+        String::new()
+    };
+    if k.in_control {
+        format!(
+            "kerf compensation in the controller: G41.1/G42.1 D{} from {} on {done} paths{rest}",
+            k.width_mm, k.source
+        )
+    } else {
+        format!(
+            "kerf compensation in the computer: kerf {} mm from {}, {done} paths offset {} mm{rest}",
+            k.width_mm,
+            k.source,
+            0.5 * k.width_mm
+        )
     }
 }
 
@@ -389,7 +422,13 @@ pub(crate) fn compensation_json(
         .map(|c| {
             let id = &file.curves[c.curve].id;
             match &c.outcome {
-                Ok(p) => json!({
+                Outcome::InControl(side) => json!({
+                    "id": id,
+                    "side": side.name(),
+                    "offset_mm": 0.5 * k.width_mm,
+                    "in_control": true,
+                }),
+                Outcome::Offset(p) => json!({
                     "id": id,
                     "side": p.side.name(),
                     "offset_mm": p.offset_mm,
@@ -402,20 +441,97 @@ pub(crate) fn compensation_json(
                     "max_corner_material_mm": p.max_corner_material_mm,
                     "crossing_checked": p.crossing_checked,
                 }),
-                Err(why) => json!({ "id": id, "offset_mm": 0.0, "reason": why }),
+                Outcome::Uncompensated(why) => json!({ "id": id, "offset_mm": 0.0, "reason": why }),
             }
         })
         .collect();
     json!({
         "kerf_width_mm": k.width_mm,
         "source": k.source,
-        "mode": "computer",
+        "mode": if k.in_control { "controller" } else { "computer" },
         "offset_mm": 0.5 * k.width_mm,
         "tolerance_mm": k.tolerance_mm,
-        "proven": compensated.iter().all(|c| c.outcome.as_ref().is_ok_and(|p| p.proven)),
+        "proven": compensated.iter().all(|c| matches!(&c.outcome, Outcome::Offset(p) if p.proven)),
         "paths": paths,
-        "note": "each path moved half the kerf toward its scrap side, at right angles to the path and the tool axis; outside corners swung round on an arc about the corner, inside corners cut back to where the offsets cross (the round beam leaves max_corner_material_mm there); proven: every chord within the tolerance of the exact offset (flat contours at a fixed tool axis), else measured at 15 points per chord (docs/process.md, Kerf compensation)",
+        "note": "in the computer, each path moved half the kerf toward its scrap side, at right angles to the path and the tool axis; outside corners swung round on an arc about the corner, inside corners cut back to where the offsets cross (the round beam leaves max_corner_material_mm there); proven: every chord within the tolerance of the exact offset (flat contours at a fixed tool axis), else measured at 15 points per chord; in the controller, the program holds the contours with G41.1/G42.1 D<kerf> from the lead-in on and G40 after the beam is off (docs/process.md, Kerf compensation)",
     })
+}
+
+/// The controller's compensation of every cut (`cuts[k]`, solved as `solved[k]`): the side
+/// for those the controller compensates, checked to stand the beam vertical (tool axis `+z`)
+/// with the tilt axis at 0 and C still along the whole cut, lead-in and lead-out included
+/// (LinuxCNC's `G41.1` offsets X and Y only), with a lead-in whose first move is longer than
+/// half the kerf (the controller's entry move); `None` for the others.
+///
+/// # Errors
+/// [`kerf_process::ProcessError::Compensation`] for a cut the controller cannot compensate,
+/// with the ranges of its axes.
+pub(crate) fn controller_compensation(
+    file: &CurvesFile,
+    kerf: Option<&Kerf>,
+    compensated: &[Compensated],
+    cuts: &[CutPath],
+    solved: &[kerf_kinematics::SolvedPath],
+) -> Result<Vec<Option<kerf_interp::CutterCompensation>>, kerf_process::ProcessError> {
+    let Some(k) = kerf.filter(|k| k.in_control) else {
+        return Ok(vec![None; cuts.len()]);
+    };
+    let side_of = |curve: usize| {
+        compensated.iter().find_map(|c| match c.outcome {
+            Outcome::InControl(side) if c.curve == curve => Some(side),
+            _ => None,
+        })
+    };
+    cuts.iter()
+        .zip(solved)
+        .map(|(cut, s)| {
+            let Some(side) = side_of(cut.curve) else {
+                return Ok(None);
+            };
+            let range = |f: &dyn Fn(&kerf_kinematics::Axes) -> f64| {
+                s.axes.iter().map(f).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                })
+            };
+            let tilt = range(&|a| a.tilt);
+            let c = range(&|a| a.c);
+            let vertical = s.poses.iter().all(|p| p.axis.z >= 1.0 - 1e-12);
+            if !(vertical && tilt.0.abs() <= 1e-9 && tilt.1.abs() <= 1e-9 && c.1 - c.0 <= 1e-9) {
+                return Err(kerf_process::ProcessError::Compensation {
+                    id: file.curves[cut.curve].id.clone(),
+                    kerf_width_mm: k.width_mm,
+                    reason: format!(
+                        "the controller's compensation (G41.1/G42.1) offsets X and Y only: it needs the beam vertical and the rotary axes still along the whole cut, here the tilt axis runs over [{:.6}, {:.6}] deg and C over [{:.6}, {:.6}] deg; compensate in the computer instead",
+                        tilt.0, tilt.1, c.0, c.1
+                    ),
+                });
+            }
+            // The controller engages on the lead-in's first move (LinuxCNC's entry move), which
+            // must be a straight line longer than the compensation's radius.
+            let [m, _, _] = cut.counts;
+            let entry = if m > 0 {
+                let (a, b) = (cut.poses[0], cut.poses[1]);
+                ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt()
+            } else {
+                0.0
+            };
+            if entry <= 0.5 * k.width_mm {
+                return Err(kerf_process::ProcessError::Compensation {
+                    id: file.curves[cut.curve].id.clone(),
+                    kerf_width_mm: k.width_mm,
+                    reason: format!(
+                        "the controller engages its compensation on the lead-in's first move, which must be a line longer than half the kerf ({} mm); here it is {entry:.4} mm{}: give a longer lead-in or compensate in the computer",
+                        0.5 * k.width_mm,
+                        if m == 0 { " (no lead-in)" } else { "" }
+                    ),
+                });
+            }
+            Ok(Some(kerf_interp::CutterCompensation {
+                left: side == kerf_process::Side::Left,
+                kerf_width_mm: k.width_mm,
+            }))
+        })
+        .collect()
 }
 
 /// `kerf.axes/1` with the lead-in and lead-out of every path kept apart from its cut (the

@@ -128,6 +128,11 @@ pub struct JobOptions {
     /// edge lands on the contour ([`kerf_process::offset`]). `None` (the default) takes the
     /// machine's `process.kerf_width_mm`; with neither, the path is the contour itself.
     pub kerf_width_mm: Option<f64>,
+    /// With a kerf width, leave the compensation to the controller: the program holds the
+    /// contours with LinuxCNC's `G41.1`/`G42.1 D` (linuxcnc dialect only; every compensated cut
+    /// must stand the beam vertical with the rotary axes still). Default false: compensate in
+    /// the computer.
+    pub kerf_in_control: bool,
 }
 
 /// The tilt tolerance of a job unless it sets another (degrees): 0, the exact normal. A
@@ -163,6 +168,7 @@ impl Default for JobOptions {
             max_total_points: DEFAULT_MAX_TOTAL_POINTS_RUN,
             wall_axis_max_mm: 4.0,
             kerf_width_mm: None,
+            kerf_in_control: false,
         }
     }
 }
@@ -252,6 +258,13 @@ impl JobOptions {
     /// [`JobOptions::kerf_width_mm`]).
     pub fn with_kerf_width_mm(mut self, mm: Option<f64>) -> Self {
         self.kerf_width_mm = mm;
+        self
+    }
+
+    /// With the controller's kerf compensation instead of the computer's (see
+    /// [`JobOptions::kerf_in_control`]).
+    pub fn with_kerf_in_control(mut self, in_control: bool) -> Self {
+        self.kerf_in_control = in_control;
         self
     }
 

@@ -149,19 +149,33 @@ fn run_placed(
     let kerf = match (o.kerf_width_mm, machine.process.kerf_width_mm) {
         (Some(w), _) => Some(crate::cuts::Kerf {
             width_mm: w,
-            source: "the run's kerf width (--kerf-width)",
+            source: "--kerf-width",
             tolerance_mm: dopts.tolerance_mm,
+            in_control: o.kerf_in_control,
         }),
         (None, Some(w)) => Some(crate::cuts::Kerf {
             width_mm: w,
-            source: "the machine file's process.kerf_width_mm",
+            source: "machine file process.kerf_width_mm",
             tolerance_mm: dopts.tolerance_mm,
+            in_control: o.kerf_in_control,
         }),
         (None, None) => None,
     };
     // 1. Cutting points with a certified chord error. With a kerf, the contour's chords take
     // 9/10 of the tolerance and the offset's own term the rest (docs/process.md, "Kerf
     // compensation"): a hole's offset chords then need no more points.
+    if kerf.as_ref().is_some_and(|k| k.in_control) && o.dialect != kerf_interp::Dialect::Linuxcnc {
+        return Err(crate::Error::BadOption {
+            name: "kerf_in_control",
+            value: 1.0,
+            requirement: format!(
+                "the controller's kerf compensation is written for the linuxcnc dialect only (G41.1/G42.1), not {}; compensate in the computer instead",
+                o.dialect.name()
+            ),
+        });
+    }
+    // In the controller too: it offsets the same cutting points, so that its path and kerf's
+    // own offset agree (tests/linuxcnc), and the chord polygon's offset keeps the same margin.
     let contour_opts = match &kerf {
         Some(_) => dopts.with_tolerance_mm(dopts.tolerance_mm * crate::cuts::KERF_CONTOUR_SHARE),
         None => dopts,
@@ -281,6 +295,14 @@ fn run_placed(
     let solved = solve_paths(machine, &inputs, &popts).map_err(kin(path))?;
     drop(inputs);
     drop(cut_poses);
+    // The controller's compensation: G41.1/G42.1 per path, where the beam stands vertical
+    // and still along the whole cut (the compensation offsets X and Y only).
+    let in_control =
+        crate::cuts::controller_compensation(file, kerf.as_ref(), &compensated, &cuts, &solved)
+            .map_err(|e| crate::Error::Process {
+                file: path.map(std::path::Path::to_path_buf),
+                source: e,
+            })?;
     let mut axes = AxesFile::new(machine, &solved);
     crate::cuts::split_axes(&mut axes, &cuts, &solved);
     // 4. Interpolation and G-code, one program per set-up.
@@ -319,7 +341,7 @@ fn run_placed(
     let mut warnings: Vec<String> = Vec::new();
     let uncompensated: Vec<&str> = compensated
         .iter()
-        .filter(|c| c.outcome.is_err())
+        .filter(|c| !c.outcome.is_compensated())
         .map(|c| file.curves[c.curve].id.as_str())
         .collect();
     if !uncompensated.is_empty() {
@@ -338,6 +360,7 @@ fn run_placed(
     lap.split(&mut timings, "kinematics");
     for setup in 0..placed.plan.setups.len() {
         let mut fitted = Vec::new();
+        let mut comps: Vec<Option<kerf_interp::CutterCompensation>> = Vec::new();
         let mut ids: Vec<String> = Vec::new();
         let in_setup: Vec<usize> = (0..solved.len())
             .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
@@ -478,12 +501,13 @@ fn run_placed(
                     .map_err(interp(path))?,
             );
             ids.push(s.id.clone());
+            comps.push(in_control[k]);
         }
         let blocks = kerf_interp::link_paths_through(&model, fitted, &traverses, fit.retract_mm);
         drop(traverses);
         let motion = kerf_interp::plan_owned(&model, blocks, &plan).map_err(interp(path))?;
         lap.split(&mut timings, "plan");
-        let mut gopts_k = gopts.clone();
+        let mut gopts_k = gopts.clone().with_cutter_compensation(comps);
         gopts_k.header = vec![
             format!(
                 "set-up {} of {}: {} contours; placement (part to workpiece): {}",

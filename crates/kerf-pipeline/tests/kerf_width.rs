@@ -180,10 +180,19 @@ fn sheet_metal_holes_shrink_by_half_the_kerf_and_the_outline_grows() {
     }
     assert!(plain.report["compensation"]["kerf_width_mm"].is_null());
     let header = &out.programs[0].text;
-    assert!(header.contains("kerf compensation: in the computer, kerf 0.2 mm"));
-    assert!(plain.programs[0]
-        .text
-        .contains("the path is the contour itself"));
+    assert!(
+        header.contains(
+            "kerf compensation in the computer: kerf 0.2 mm from --kerf-width, 8 paths offset 0.1 mm"
+        ),
+        "{}",
+        &header[..600]
+    );
+    assert!(
+        plain.programs[0].text.contains(
+            "kerf compensation: none, no kerf width given: the path is the contour itself"
+        ),
+        "no kerf"
+    );
 }
 
 #[test]
@@ -251,4 +260,102 @@ fn the_machine_files_kerf_width_is_used_and_the_runs_wins() {
         .validate()
         .expect_err("negative kerf");
     assert!(e.to_string().contains("kerf_width_mm"), "{e}");
+}
+
+fn in_control(
+    name: &str,
+    dialect: kerf_interp::Dialect,
+) -> Result<(CurvesFile, Output), kerf_pipeline::Error> {
+    let curves = kerf_format::curves::load(fixture(name)).expect("curves");
+    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    let out = Job::new(curves.clone(), machine)
+        .with_options(
+            JobOptions::default()
+                .with_dialect(dialect)
+                .with_kerf_width_mm(Some(0.2))
+                .with_kerf_in_control(true),
+        )
+        .run()?;
+    Ok((curves, out))
+}
+
+#[test]
+fn the_controller_compensates_the_contours_themselves_with_g41_and_g42() {
+    let (file, out) =
+        in_control("sheet_metal_holes.json", kerf_interp::Dialect::Linuxcnc).expect("run");
+    let c = &out.report["compensation"];
+    assert_eq!(c["mode"], "controller", "{c}");
+    // The sides the computer's offset takes (checked by the geometry above).
+    let (_, computer) = run("sheet_metal_holes.json", Some(0.2), PlaceMode::AsModelled);
+    let sides = |o: &Output| -> Vec<(String, String)> {
+        o.report["compensation"]["paths"]
+            .as_array()
+            .expect("paths")
+            .iter()
+            .map(|p| (p["id"].to_string(), p["side"].to_string()))
+            .collect()
+    };
+    assert_eq!(sides(&out), sides(&computer), "the same sides");
+    // The paths are the contours: the holes' cut poses on their circles.
+    for curve in file.curves.iter().filter(|c| c.id.starts_with("hole-d")) {
+        let cps = curve.curve.control_points();
+        let centre = cps[..cps.len() - 1]
+            .iter()
+            .fold(Vector3::zeros(), |s, p| s + p.coords)
+            / (cps.len() - 1) as f64;
+        let radius = (cps[0].coords - centre).norm();
+        for p in cut_points(&out, &file, &curve.id) {
+            assert!(
+                ((p.coords - centre).norm() - radius).abs() <= TOL,
+                "{}",
+                curve.id
+            );
+        }
+    }
+    // Every cut: beam on, the descent, G41.1 (scrap on the left) or G42.1 before the lead-in,
+    // G40 before the beam goes off; holes (left of their counter-clockwise contour) G41.1.
+    let text = &out.programs[0].text;
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    let on: Vec<usize> = (0..lines.len()).filter(|&i| lines[i] == "M64 P0").collect();
+    assert_eq!(on.len(), 8, "eight cuts");
+    let left = lines.iter().filter(|l| l.starts_with("G41.1 D0.2")).count();
+    let right = lines.iter().filter(|l| l.starts_with("G42.1 D0.2")).count();
+    let want_left = sides(&out).iter().filter(|s| s.1 == "\"left\"").count();
+    assert_eq!(
+        (left, right),
+        (want_left, 8 - want_left),
+        "one compensation per cut"
+    );
+    for &i in &on {
+        let comp = (i..lines.len())
+            .find(|&j| lines[j].starts_with("G41.1") || lines[j].starts_with("G42.1"))
+            .expect("compensation on");
+        let off = (i..lines.len())
+            .find(|&j| lines[j] == "M65 P0")
+            .expect("beam off");
+        assert!(comp < off, "on within the cut");
+        assert_eq!(lines[off - 1], "G40", "off before the beam");
+        // Between the beam and the compensation: the pierce dwell, the blend mode and the
+        // descent only.
+        assert!(comp - i <= 4, "{:?}", &lines[i..=comp]);
+    }
+    assert!(
+        text.contains(
+            "kerf compensation in the controller: G41.1/G42.1 D0.2 from --kerf-width on 8 paths"
+        ),
+        "header"
+    );
+}
+
+#[test]
+fn the_controller_compensation_is_refused_where_it_cannot_hold() {
+    let Err(e) = in_control("sheet_metal_holes.json", kerf_interp::Dialect::Generic) else {
+        panic!("generic has no compensation")
+    };
+    assert!(e.to_string().contains("linuxcnc dialect only"), "{e}");
+    // The door trim's beam leans and turns: G41.1 offsets X and Y only.
+    let Err(e) = in_control("door_trim.json", kerf_interp::Dialect::Linuxcnc) else {
+        panic!("a turning beam")
+    };
+    assert!(e.to_string().contains("needs the beam vertical"), "{e}");
 }

@@ -419,3 +419,168 @@ fn point_at_runs_on_the_exact_offset_between_points() {
         assert!((p - Point3::new(q[0], q[1], q[2])).norm() < 1e-12);
     }
 }
+
+/// A surface's unit normal at a point, in closed form.
+type NormalFn = Box<dyn Fn(&Point3<f64>) -> Vector3<f64>>;
+
+/// A closed contour on a curved surface with its analytic unit normal.
+struct OnSurface {
+    name: &'static str,
+    curve: NurbsCurve,
+    normal: NormalFn,
+}
+
+/// The largest `|d - r|` over points along every chord of the path, `d` the distance from the
+/// beam's line there (the tip with the axis interpolated along the chord) to the contour: the
+/// beam's edge on the contour. The distance is minimized over the exact contour, a scan of
+/// 2,000 points refined by golden sections.
+fn beam_to_contour(path: &OffsetPath, curve: &NurbsCurve, r: f64) -> f64 {
+    let (a, b) = curve.domain();
+    let scan: Vec<(f64, Point3<f64>)> = (0..2000)
+        .map(|k| {
+            let t = a + (b - a) * k as f64 / 2000.0;
+            (t, curve.point(t))
+        })
+        .collect();
+    let line_dist = |p: &Point3<f64>, axis: &Vector3<f64>, c: &Point3<f64>| {
+        let v = c - p;
+        (v - axis * v.dot(axis)).norm()
+    };
+    let mut worst = 0.0_f64;
+    for w in path.poses.windows(2) {
+        let (p0, p1) = (
+            Point3::new(w[0][0], w[0][1], w[0][2]),
+            Point3::new(w[1][0], w[1][1], w[1][2]),
+        );
+        let (a0, a1) = (
+            Vector3::new(w[0][3], w[0][4], w[0][5]),
+            Vector3::new(w[1][3], w[1][4], w[1][5]),
+        );
+        for k in 0..8 {
+            let f = k as f64 / 8.0;
+            let p = p0 + (p1 - p0) * f;
+            let axis = (a0 * (1.0 - f) + a1 * f).normalize();
+            let (mut best, mut bt) = (f64::INFINITY, a);
+            for (t, c) in &scan {
+                let d = line_dist(&p, &axis, c);
+                if d < best {
+                    best = d;
+                    bt = *t;
+                }
+            }
+            let step = (b - a) / 2000.0;
+            let (mut lo, mut hi) = (bt - 2.0 * step, bt + 2.0 * step);
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            let at = |t: f64| {
+                let t = if t < a {
+                    t + (b - a)
+                } else if t > b {
+                    t - (b - a)
+                } else {
+                    t
+                };
+                line_dist(&p, &axis, &curve.point(t))
+            };
+            for _ in 0..80 {
+                let (m1, m2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+                if at(m1) < at(m2) {
+                    hi = m2;
+                } else {
+                    lo = m1;
+                }
+            }
+            worst = worst.max((at(0.5 * (lo + hi)).min(best) - r).abs());
+        }
+    }
+    worst
+}
+
+fn curved_cases() -> Vec<OnSurface> {
+    let saddle = kerf_format::curves::load(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/tube_saddle.json"),
+    )
+    .expect("tube_saddle");
+    let hole = saddle
+        .curves
+        .iter()
+        .find(|c| c.id == "main-tube-hole")
+        .expect("main-tube-hole")
+        .curve
+        .clone();
+    vec![
+        // A latitude circle at z = 30 on a sphere of radius 50 about the origin.
+        OnSurface {
+            name: "sphere",
+            curve: NurbsCurve::circle(Point3::new(0.0, 0.0, 30.0), Vector3::z(), 40.0)
+                .expect("latitude"),
+            normal: Box::new(|p| p.coords.normalize()),
+        },
+        // A circle of radius 20 at z = 10 on the cone z = 30 - rho (45 degrees).
+        OnSurface {
+            name: "cone",
+            curve: NurbsCurve::circle(Point3::new(0.0, 0.0, 10.0), Vector3::z(), 20.0)
+                .expect("cone circle"),
+            normal: Box::new(|p| {
+                let rho = (p.x * p.x + p.y * p.y).sqrt();
+                Vector3::new(p.x / rho, p.y / rho, 1.0).normalize()
+            }),
+        },
+        // The saddle where a tube of radius 30 along z meets the main tube of radius 60 along
+        // x (axis at y = 0, z = 60): the fixture's curve, the main tube's exact normal.
+        OnSurface {
+            name: "saddle",
+            curve: hole,
+            normal: Box::new(|p| Vector3::new(0.0, p.y, p.z - 60.0).normalize()),
+        },
+    ]
+}
+
+#[test]
+fn on_curved_surfaces_and_tilted_beams_the_beams_edge_runs_on_the_contour() {
+    for case in curved_cases() {
+        let d = discretize(&case.curve, &Options::with_tolerance(0.9 * TOL)).expect("discretize");
+        let normals: Vec<Vector3<f64>> = d.points().iter().map(|p| (case.normal)(p)).collect();
+        for tilt_deg in [0.0_f64, 10.0, 20.0, 30.0] {
+            let beta = tilt_deg.to_radians();
+            // The beam leans sideways: the normal turned about the contour's tangent.
+            let poses: Vec<PoseArray> = d
+                .points()
+                .iter()
+                .zip(d.params())
+                .zip(&normals)
+                .map(|((p, &t), n)| {
+                    let tangent = case.curve.tangent(t).expect("tangent");
+                    let a = n * beta.cos() + tangent.cross(n) * beta.sin();
+                    [p.x, p.y, p.z, a.x, a.y, a.z]
+                })
+                .collect();
+            let m: Vec<[f64; 3]> = normals.iter().map(|n| [n.x, n.y, n.z]).collect();
+            for kerf in [0.1, 0.2, 0.3] {
+                for side in [Side::Left, Side::Right] {
+                    let path = offset(
+                        &OffsetInput {
+                            id: case.name,
+                            curve: &case.curve,
+                            params: d.params(),
+                            poses: &poses,
+                            surface_normals: Some(&m),
+                            scrap: side,
+                            closed: true,
+                        },
+                        &OffsetOptions::new(kerf, TOL),
+                    )
+                    .expect("offset");
+                    assert!(!path.proven, "{}: a curved surface is measured", case.name);
+                    assert!(path.max_chord_error_mm <= TOL);
+                    let worst = beam_to_contour(&path, &case.curve, kerf / 2.0);
+                    assert!(
+                        worst <= TOL,
+                        "{} tilt {tilt_deg} kerf {kerf} {side:?}: the beam's edge {worst:.3e} mm off the contour",
+                        case.name
+                    );
+                    assert_eq!(path.poses[0], path.poses[path.poses.len() - 1], "closed");
+                }
+            }
+        }
+    }
+}

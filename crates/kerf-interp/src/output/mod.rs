@@ -99,9 +99,32 @@ pub struct GcodeOptions {
     /// More header comment lines, written after the source (each through the same comment
     /// sanitizer), e.g. the placement of the part and its set-up (default none).
     pub header: Vec<String>,
+    /// The controller's own cutter (kerf) compensation per path (indexed like the blocks'
+    /// `path`): `Some` writes LinuxCNC's `G41.1 D` / `G42.1 D` after the pierce descent, before
+    /// the lead-in, and `G40` at the cut's end, before the beam goes off (LinuxCNC sets no output
+    /// while it compensates); the paths are then the contours themselves.
+    /// Only the LinuxCNC dialect writes it ([`gcode_timed`] refuses it elsewhere). Default none.
+    pub cutter_compensation: Vec<Option<CutterCompensation>>,
+}
+
+/// The controller's cutter compensation of one path: the side the beam moves to, seen along
+/// the path from above (the tool axis toward the viewer), and the kerf width.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CutterCompensation {
+    /// True for the left of the path (`G41.1`), false for the right (`G42.1`).
+    pub left: bool,
+    /// The kerf width, mm: the compensation's diameter `D`.
+    pub kerf_width_mm: f64,
 }
 
 impl GcodeOptions {
+    /// Sets [`cutter_compensation`](Self::cutter_compensation): the controller's kerf
+    /// compensation per path.
+    pub fn with_cutter_compensation(mut self, paths: Vec<Option<CutterCompensation>>) -> Self {
+        self.cutter_compensation = paths;
+        self
+    }
+
     /// Sets [`dialect`](Self::dialect): the G-code dialect.
     pub fn with_dialect(mut self, dialect: Dialect) -> Self {
         self.dialect = dialect;
@@ -202,6 +225,7 @@ impl GcodeOptions {
             source: None,
             decimals: 6,
             header: Vec::new(),
+            cutter_compensation: Vec::new(),
         }
     }
 
@@ -364,6 +388,13 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     positive("chord_tolerance_mm", opts.chord_tolerance_mm)?;
     positive("blend_tolerance_mm", opts.blend_tolerance_mm)?;
     refuse_unchecked_blocks(blocks, opts.dialect)?;
+    if opts.dialect != Dialect::Linuxcnc && opts.cutter_compensation.iter().any(Option::is_some) {
+        return Err(InterpError::BadParameter {
+            name: "cutter_compensation",
+            value: 1.0,
+            reason: "the controller's kerf compensation is written for the linuxcnc dialect only (G41.1/G42.1); compensate in the computer for the others",
+        });
+    }
     let process = ProcessCodes::resolve(opts.dialect, &opts.process)?;
     refuse_pierces_out_of_range(model, blocks, &process)?;
     let mut w = Writer {
@@ -375,6 +406,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         s: String::new(),
         last: None,
         in_cut: false,
+        compensating: false,
         last_f: None,
     };
     w.header(blocks);
@@ -410,6 +442,9 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         }
         if !w.in_cut {
             w.start_cut(b);
+            if let Some(Some(c)) = opts.cutter_compensation.get(b.path) {
+                w.compensation_on(c);
+            }
         }
         let t = block_times
             .get(bi)

@@ -18,6 +18,8 @@ pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
     /// decisions on the values the controller reads.
     pub(super) last: Option<[f64; 5]>,
     pub(super) in_cut: bool,
+    /// True while the controller's cutter compensation is on (`G41.1`/`G42.1` written).
+    pub(super) compensating: bool,
     /// The last `F` written (Sinumerik, modal).
     pub(super) last_f: Option<String>,
 }
@@ -264,7 +266,21 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         }
     }
 
+    /// The controller's kerf compensation from the next move (the lead-in's first, the entry
+    /// move), until [`Writer::end_cut`].
+    pub(super) fn compensation_on(&mut self, c: &super::CutterCompensation) {
+        let g = if c.left { "G41.1" } else { "G42.1" };
+        let l = format!("{g} D{}", feed_number(c.kerf_width_mm));
+        self.line(&l);
+        self.compensating = true;
+    }
+
     pub(super) fn end_cut(&mut self) {
+        // Off before the beam: LinuxCNC sets no output while the compensation is on.
+        if self.compensating {
+            self.line("G40");
+            self.compensating = false;
+        }
         for l in self.process.beam_off.clone() {
             self.line(&l);
         }

@@ -40,6 +40,9 @@ pub struct RawPathRecord {
     pub claimed_chord_error: Option<f64>,
     /// The optional `point_count` the file claims (kerf's writer adds it), if present.
     pub point_count: Option<usize>,
+    /// The optional `kerf_offset`: the path offset by half the kerf (`kerf run` with a kerf
+    /// width), measured against the exact offset by [`crate::check()`].
+    pub kerf_offset: Option<kerf_format::KerfOffset>,
 }
 
 #[derive(Deserialize)]
@@ -59,6 +62,8 @@ struct RawPath {
     max_chord_error: Option<f64>,
     #[serde(default)]
     point_count: Option<usize>,
+    #[serde(default)]
+    kerf_offset: Option<kerf_format::KerfOffset>,
 }
 
 impl RawToolpath {
@@ -119,6 +124,7 @@ impl RawToolpath {
                     points: p.points,
                     claimed_chord_error: p.max_chord_error,
                     point_count: p.point_count,
+                    kerf_offset: p.kerf_offset,
                 })
                 .collect(),
         })
@@ -142,6 +148,7 @@ impl From<&ToolpathFile> for RawToolpath {
                     },
                     claimed_chord_error: Some(p.max_chord_error),
                     point_count: None,
+                    kerf_offset: p.kerf_offset.clone(),
                 })
                 .collect(),
         }

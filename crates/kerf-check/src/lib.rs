@@ -10,7 +10,9 @@
 //! of the domain to the other, every point on the curve at its param (to `1e-9` of the curve
 //! size, plus two ulps of the point's coordinates), every C0 corner a cutting point, unit
 //! normals, every segment's chord error at most the tolerance and a `max_chord_error` claim that
-//! does not understate the measurement. Distances are measured about the curve's local origin
+//! does not understate the measurement; a path's optional `kerf_offset` (the path offset by
+//! half the kerf) is measured against the exact offset of the curve and for the gouge
+//! ([`OffsetReport`]). Distances are measured about the curve's local origin
 //! ([`kerf_nurbs::LocalCurve`], an exact translation), so a curve 1e6 mm from the origin is
 //! measured with the rounding of its own size.
 //!
@@ -47,8 +49,8 @@ mod input;
 mod measure;
 
 pub use check::{
-    check, CheckOptions, Defect, PathReport, Report, Violation, WorstSegment, MAX_SAMPLES,
-    ROUNDING_ALLOWANCE,
+    check, CheckOptions, Defect, OffsetReport, PathReport, Report, Violation, WorstSegment,
+    MAX_SAMPLES, ROUNDING_ALLOWANCE,
 };
 pub use error::{CheckError, Result};
 pub use input::{RawPathRecord, RawToolpath};

@@ -145,14 +145,26 @@ fn print_text(out: &mut impl Write, args: &CheckArgs, report: &Report) -> io::Re
             "  {:<w$}  {:>7}  {:>8}  {:>15}  {:<ww$}  {claim}",
             p.id, p.points, p.segments, error, worst
         )?;
+        if let Some(o) = &p.kerf_offset {
+            writeln!(
+                out,
+                "  {:<w$}  kerf_offset {} mm: {} points, {} chords within {:.4e} mm of the exact offset, {} cut back at inside corners, at least {:.4} mm from the curve",
+                "", o.offset_mm, o.points, o.segments, o.max_chord_error, o.cut_backs, o.min_distance_from_curve
+            )?;
+        }
     }
     if report.passed() {
         writeln!(
             out,
             "passed: every segment's chord error <= {} mm (largest measured {:.4e} mm), every \
-             point on its curve at its param, every C0 corner a cutting point, every claim holds",
+             point on its curve at its param, every C0 corner a cutting point, every claim holds{}",
             report.tolerance,
-            report.measured_chord_error()
+            report.measured_chord_error(),
+            if report.paths.iter().any(|p| p.kerf_offset.is_some()) {
+                "; every kerf offset within the tolerance of the exact offset, never nearer the curve than the offset less the tolerance"
+            } else {
+                ""
+            }
         )?;
         return Ok(());
     }

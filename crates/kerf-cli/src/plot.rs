@@ -152,6 +152,7 @@ fn drawable(loose: &kerf_check::RawToolpath) -> Option<ToolpathFile> {
                 params: p.params.clone(),
                 points,
                 max_chord_error: p.claimed_chord_error.unwrap_or(0.0),
+                kerf_offset: None,
             })
         })
         .collect::<Option<Vec<_>>>()?;

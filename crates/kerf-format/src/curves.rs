@@ -258,7 +258,8 @@ pub struct CurveRecord {
 
 /// The side of a curve that is waste, seen along the curve's direction with the normal toward
 /// the viewer: `Left` is the side of `normal x tangent` (the `scrap` key of `kerf.curves/1`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum ScrapSide {
     /// `"left"`: the side of `normal x tangent`.
     Left,

@@ -35,7 +35,7 @@ pub use curves::{
     UnknownKey,
 };
 pub use error::{FormatError, MeshDefect, Result, StlProblem};
-pub use toolpath::{ToolpathFile, ToolpathPoints, ToolpathRecord};
+pub use toolpath::{KerfOffset, ToolpathFile, ToolpathPoints, ToolpathRecord};
 
 /// The `format` string of curve files.
 pub const CURVES_FORMAT: &str = "kerf.curves/1";

@@ -21,6 +21,7 @@
 //!         params: vec![0.0, 1.0],
 //!         points: ToolpathPoints::Positions(vec![[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]]),
 //!         max_chord_error: 0.0,
+//!         kerf_offset: None,
 //!     }],
 //! };
 //! let text = toolpath::to_string(&file)?;
@@ -67,6 +68,83 @@ pub struct ToolpathRecord {
     /// The largest distance, over every segment, from the curve to the chord; <= the file's
     /// tolerance.
     pub max_chord_error: f64,
+    /// The path offset by half the kerf toward the scrap (`kerf run` with a kerf width, in the
+    /// computer): the optional key `kerf_offset`, which `kerf check` measures against the exact
+    /// offset of the curve. `None`: the path is the contour itself.
+    pub kerf_offset: Option<KerfOffset>,
+}
+
+/// The optional `kerf_offset` of a path: the beam's path offset by `offset_mm` toward `side`,
+/// at right angles to the path and the tool axis (`docs/process.md`, "Kerf compensation").
+#[derive(Debug, Clone, PartialEq, serde::Serialize, Deserialize)]
+pub struct KerfOffset {
+    /// Half the kerf, mm (> 0).
+    pub offset_mm: f64,
+    /// The side the path moved to, seen along the curve with the tool axis toward the viewer.
+    pub side: crate::ScrapSide,
+    /// The curve parameter each point comes from: non-decreasing (the points of an arc about
+    /// a corner share the corner's).
+    pub params: Vec<f64>,
+    /// The offset points with their unit tool axes, `[x, y, z, i, j, k]`, in the curve's
+    /// coordinates.
+    pub points: Vec<[f64; 6]>,
+    /// The largest distance from a chord to the exact offset the writer found, mm: proven
+    /// where `proven`, else measured.
+    pub max_chord_error: f64,
+    /// True if every chord's distance is proven.
+    pub proven: bool,
+}
+
+impl KerfOffset {
+    /// The shape rules: as many params as points, at least two, every number finite, the
+    /// params non-decreasing, the offset > 0. `index` names the path in the messages.
+    ///
+    /// # Errors
+    /// [`FormatError::PathCount`], [`FormatError::BadNumber`], [`FormatError::ParamsNotIncreasing`].
+    pub fn validate(&self, index: usize) -> Result<()> {
+        let (n, m) = (self.points.len(), self.params.len());
+        if n != m || n < 2 {
+            return Err(FormatError::PathCount {
+                index,
+                problem: format!(
+                    "kerf_offset: {n} points and {m} params (one param per point, at least 2)"
+                ),
+            });
+        }
+        if !(self.offset_mm > 0.0 && self.offset_mm.is_finite()) {
+            return Err(FormatError::BadNumber {
+                path: format!("paths[{index}].kerf_offset.offset_mm"),
+                requirement: "finite and > 0",
+                value: self.offset_mm,
+            });
+        }
+        for (i, p) in self.points.iter().enumerate() {
+            if let Some(&v) = p.iter().find(|v| !v.is_finite()) {
+                return Err(FormatError::BadNumber {
+                    path: format!("paths[{index}].kerf_offset.points[{i}]"),
+                    requirement: "finite",
+                    value: v,
+                });
+            }
+        }
+        for (i, &t) in self.params.iter().enumerate() {
+            if !t.is_finite() {
+                return Err(FormatError::BadNumber {
+                    path: format!("paths[{index}].kerf_offset.params[{i}]"),
+                    requirement: "finite",
+                    value: t,
+                });
+            }
+            if i > 0 && t < self.params[i - 1] {
+                return Err(FormatError::ParamsNotIncreasing {
+                    path: format!("paths[{index}].kerf_offset.params[{i}]"),
+                    value: t,
+                    previous: self.params[i - 1],
+                });
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The points of a toolpath: all positions, or all positions with unit normals.
@@ -155,6 +233,9 @@ impl ToolpathFile {
 
 fn validate_path(index: usize, path: &ToolpathRecord, tolerance: f64) -> Result<()> {
     let (params, e) = (&path.params, path.max_chord_error);
+    if let Some(o) = &path.kerf_offset {
+        o.validate(index)?;
+    }
     match &path.points {
         ToolpathPoints::Positions(p) => validate_rows(index, params, p, e, tolerance),
         ToolpathPoints::Poses(p) => validate_rows(index, params, p, e, tolerance),
@@ -325,11 +406,14 @@ fn write_document(file: &ToolpathFile, writer: impl Write) -> Result<()> {
 /// Every path of `file`, in order.
 fn write_paths<W: Write>(file: &ToolpathFile, w: &mut ToolpathWriter<W>) -> Result<()> {
     for path in &file.paths {
+        let o = path.kerf_offset.as_ref();
         match &path.points {
             ToolpathPoints::Positions(p) => {
-                w.path(&path.id, &path.params, p, path.max_chord_error)?
+                w.path_with_offset(&path.id, &path.params, p, path.max_chord_error, o)?
             }
-            ToolpathPoints::Poses(p) => w.path(&path.id, &path.params, p, path.max_chord_error)?,
+            ToolpathPoints::Poses(p) => {
+                w.path_with_offset(&path.id, &path.params, p, path.max_chord_error, o)?
+            }
         }
     }
     Ok(())
@@ -506,11 +590,29 @@ impl<W: Write> ToolpathWriter<W> {
         points: &[R],
         max_chord_error: f64,
     ) -> Result<()> {
+        self.path_with_offset(id, params, points, max_chord_error, None)
+    }
+
+    /// [`ToolpathWriter::path`] with the path's optional `kerf_offset` ([`KerfOffset`]).
+    ///
+    /// # Errors
+    /// As [`ToolpathWriter::path`], and the offset's defects ([`KerfOffset::validate`]).
+    pub fn path_with_offset<R: PointRow>(
+        &mut self,
+        id: &str,
+        params: &[f64],
+        points: &[R],
+        max_chord_error: f64,
+        offset: Option<&KerfOffset>,
+    ) -> Result<()> {
         let index = self.paths;
         self.ids.insert("paths", index, id)?;
         validate_rows(index, params, points, max_chord_error, self.tolerance)?;
+        if let Some(o) = offset {
+            o.validate(index)?;
+        }
         self.paths += 1;
-        self.write_path(id, params, points, max_chord_error)
+        self.write_path(id, params, points, max_chord_error, offset)
             .map_err(write_error)
     }
 
@@ -520,6 +622,7 @@ impl<W: Write> ToolpathWriter<W> {
         params: &[f64],
         points: &[R],
         max_chord_error: f64,
+        offset: Option<&KerfOffset>,
     ) -> io::Result<()> {
         let (s, fmt) = (&mut self.sink, &mut self.fmt);
         let head = format!(
@@ -566,7 +669,16 @@ impl<W: Write> ToolpathWriter<W> {
             }
         }
         s.line()?;
-        s.push(b"      ]\n    }");
+        match offset {
+            None => s.push(b"      ]\n    }"),
+            Some(o) => {
+                s.push(b"      ],\n      \"kerf_offset\": ");
+                let text = serde_json::to_string(o).map_err(io::Error::from)?;
+                s.bytes(text.as_bytes())?;
+                s.line()?;
+                s.push(b"\n    }");
+            }
+        }
         Ok(())
     }
 
@@ -609,6 +721,8 @@ struct RawToolPath {
     max_chord_error: f64,
     #[serde(default)]
     point_count: Option<usize>,
+    #[serde(default)]
+    kerf_offset: Option<KerfOffset>,
 }
 
 /// Reads and checks a `kerf.toolpath/1` file.
@@ -659,6 +773,7 @@ fn from_slice(bytes: &[u8]) -> Result<ToolpathFile> {
             id: p.id,
             params: p.params,
             max_chord_error: p.max_chord_error,
+            kerf_offset: p.kerf_offset,
         });
     }
     let file = ToolpathFile {
@@ -735,12 +850,14 @@ mod tests {
                             .collect(),
                     ),
                     max_chord_error: 0.00097,
+                    kerf_offset: None,
                 },
                 ToolpathRecord {
                     id: "line".into(),
                     params: vec![-1.0, 2.5],
                     points: ToolpathPoints::Positions(vec![[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]),
                     max_chord_error: 0.0,
+                    kerf_offset: None,
                 },
             ],
         }
@@ -1021,6 +1138,7 @@ mod tests {
                     .collect(),
             ),
             max_chord_error: 0.000_999_999_999_999_9,
+            kerf_offset: None,
         });
         let dest = dir.path().join("one-by-one.json");
         write_with(&dest, big.units, big.tolerance, |w| {

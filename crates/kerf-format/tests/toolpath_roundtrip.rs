@@ -47,6 +47,7 @@ fn path(index: usize, normals: bool) -> impl Strategy<Value = ToolpathRecord> {
                 params,
                 points,
                 max_chord_error: err,
+                kerf_offset: None,
             })
         })
 }

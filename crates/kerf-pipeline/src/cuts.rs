@@ -373,6 +373,21 @@ fn cut_path(
     }
 }
 
+/// The toolpath's `kerf_offset` record of an offset path.
+pub(crate) fn kerf_offset_record(p: &OffsetPath) -> kerf_format::KerfOffset {
+    kerf_format::KerfOffset {
+        offset_mm: p.offset_mm,
+        side: match p.side {
+            kerf_process::Side::Left => kerf_format::ScrapSide::Left,
+            kerf_process::Side::Right => kerf_format::ScrapSide::Right,
+        },
+        params: p.source.clone(),
+        points: p.poses.clone(),
+        max_chord_error: p.max_chord_error_mm,
+        proven: p.proven,
+    }
+}
+
 /// The program header's line on kerf compensation: the width and where it came from, or that
 /// the path is the contour itself. Only numbers and kerf's own words: no text from a file.
 pub(crate) fn kerf_header(kerf: Option<&Kerf>, compensated: &[Compensated]) -> String {

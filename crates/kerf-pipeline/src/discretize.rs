@@ -209,6 +209,7 @@ fn toolpath<'a>(
                 params: params.to_vec(),
                 points,
                 max_chord_error,
+                kerf_offset: None,
             })
             .collect(),
     }

@@ -195,7 +195,7 @@ fn run_placed(
     // 2. Normals (+z for curves that name no surface, unless the options refuse them).
     let oriented: Vec<Oriented> =
         orient_curves(file, &discs, &contour_opts, &o.orient, path, progress)?;
-    let tp = toolpath_of_poses(file, dopts.tolerance_mm, &oriented);
+    let mut tp = toolpath_of_poses(file, dopts.tolerance_mm, &oriented);
     lap.split(&mut timings, "normals");
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
     let popts = o.path;
@@ -339,6 +339,12 @@ fn run_placed(
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
     let mut warnings: Vec<String> = Vec::new();
+    // The offset paths go into the toolpath (`kerf_offset`), where `kerf check` measures them.
+    for c in &compensated {
+        if let crate::cuts::Outcome::Offset(p) = &c.outcome {
+            tp.paths[c.curve].kerf_offset = Some(crate::cuts::kerf_offset_record(p));
+        }
+    }
     let uncompensated: Vec<&str> = compensated
         .iter()
         .filter(|c| !c.outcome.is_compensated())

@@ -359,3 +359,61 @@ fn the_controller_compensation_is_refused_where_it_cannot_hold() {
     };
     assert!(e.to_string().contains("needs the beam vertical"), "{e}");
 }
+
+#[test]
+fn kerf_check_measures_the_offset_and_catches_a_wrong_one() {
+    use kerf_check::{check, CheckOptions, Defect, RawToolpath};
+    for name in ["sheet_metal_holes.json", "door_trim.json"] {
+        let (file, out) = run(name, Some(0.2), PlaceMode::AsModelled);
+        let raw = RawToolpath::from(&out.toolpath);
+        let report = check(&file.curves, &raw, &CheckOptions::default());
+        assert!(report.passed(), "{name}: {:?}", report.violations);
+        for p in &report.paths {
+            let o = p.kerf_offset.expect("every closed contour offset");
+            assert!(o.max_chord_error <= TOL, "{name} {}: {o:?}", p.id);
+            assert!(
+                o.min_distance_from_curve >= 0.1 - TOL,
+                "{name} {}: {o:?}",
+                p.id
+            );
+            assert_eq!(o.segments + o.cut_backs + 1, o.points, "{name} {}", p.id);
+        }
+        // Written and read back: the key survives the file.
+        let text = kerf_format::toolpath::to_string(&out.toolpath).expect("write");
+        let back = kerf_format::toolpath::from_str(&text).expect("read");
+        assert_eq!(back, out.toolpath, "{name}: the toolpath round-trips");
+        // The wrong side: every chord far from the exact offset.
+        let mut wrong = raw.clone();
+        let o = wrong.paths[0].kerf_offset.as_mut().expect("offset");
+        o.side = match o.side {
+            kerf_format::ScrapSide::Left => kerf_format::ScrapSide::Right,
+            kerf_format::ScrapSide::Right => kerf_format::ScrapSide::Left,
+        };
+        let report = check(&file.curves, &wrong, &CheckOptions::default());
+        assert!(
+            report
+                .violations
+                .iter()
+                .any(|v| matches!(v.defect, Defect::OffsetChordError { .. })),
+            "{name}: the wrong side"
+        );
+        // One point pushed 0.05 mm toward the part: a gouge.
+        let mut gouged = raw.clone();
+        let o = gouged.paths[0].kerf_offset.as_mut().expect("offset");
+        let c = file.curves[0].curve.point(o.params[3]);
+        let p = &mut o.points[3];
+        let toward = (c - Point3::new(p[0], p[1], p[2])).normalize() * 0.05;
+        p[0] += toward.x;
+        p[1] += toward.y;
+        p[2] += toward.z;
+        let report = check(&file.curves, &gouged, &CheckOptions::default());
+        assert!(
+            report
+                .violations
+                .iter()
+                .any(|v| matches!(v.defect, Defect::OffsetGouge { .. })),
+            "{name}: {:?}",
+            report.violations
+        );
+    }
+}

@@ -343,6 +343,7 @@ mod tests {
                         params,
                         points: ToolpathPoints::Positions(points),
                         max_chord_error: 0.0,
+                        kerf_offset: None,
                     }
                 })
                 .collect(),

@@ -12,11 +12,12 @@ use nalgebra::Point3;
 use crate::input::{RawPathRecord, RawToolpath};
 use crate::measure::segment_chord_error;
 
+mod offset;
 mod report;
 #[cfg(test)]
 mod tests;
 
-pub use report::{Defect, PathReport, Report, Violation, WorstSegment};
+pub use report::{Defect, OffsetReport, PathReport, Report, Violation, WorstSegment};
 
 /// Floating-point allowance of the chord-error comparisons, relative to the curve size: a
 /// measured error may exceed the tolerance (or a claim) by this much before it counts, so that
@@ -200,6 +201,7 @@ fn check_path(
         c0_breaks: curve.map_or(0, |c| c.c0_breaks().len()),
         max_point_distance: 0.0,
         measured: false,
+        kerf_offset: None,
     };
     if n != m {
         found.push(Defect::CountMismatch {
@@ -277,6 +279,9 @@ fn check_path(
     let Some(curve) = curve else {
         return report;
     };
+    if let Some(o) = &path.kerf_offset {
+        report.kerf_offset = Some(offset::check_offset(index, curve, o, tolerance, found));
+    }
     let k = n.min(m);
     let (a, b) = curve.domain();
     let ptol = opts.param_tolerance * (b - a);

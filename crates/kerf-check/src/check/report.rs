@@ -79,6 +79,30 @@ pub struct PathReport {
     pub max_point_distance: f64,
     /// False if the path could not be measured (no curve with its id, or unusable points).
     pub measured: bool,
+    /// What the check of the path's `kerf_offset` found, if it has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kerf_offset: Option<OffsetReport>,
+}
+
+/// The check of a path's `kerf_offset` ([`crate::check()`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OffsetReport {
+    /// Half the kerf the file states, mm.
+    pub offset_mm: f64,
+    /// The number of offset points.
+    pub points: usize,
+    /// Chords measured against the exact offset (the curve's offset, or the arc about a
+    /// corner).
+    pub segments: usize,
+    /// Chords that cross an inside corner where the path was cut back: measured for the gouge
+    /// only (the exact offset there runs into the part).
+    pub cut_backs: usize,
+    /// The largest measured distance from the exact offset to its chord, mm.
+    pub max_chord_error: f64,
+    /// The smallest distance from the path (its points and 8 points along each chord) to the
+    /// curve, mm: at least the offset less the tolerance where the beam's edge stays out of
+    /// the part.
+    pub min_distance_from_curve: f64,
 }
 
 /// The segment with the largest chord error of a path.
@@ -292,6 +316,37 @@ pub enum Defect {
         /// The tolerance, in mm.
         tolerance: f64,
     },
+    /// The `kerf_offset` breaks a rule of its shape ([`kerf_format::KerfOffset::validate`]).
+    OffsetShape {
+        /// What is wrong.
+        reason: String,
+    },
+    /// A chord of the `kerf_offset` lies farther than the tolerance from the exact offset.
+    OffsetChordError {
+        /// The chord's index in the offset.
+        segment: usize,
+        /// The measured distance, mm.
+        error: f64,
+        /// The tolerance, mm.
+        tolerance: f64,
+    },
+    /// The `kerf_offset` comes closer to the curve than the offset less the tolerance: the
+    /// beam's edge would cut into the part there.
+    OffsetGouge {
+        /// Where, mm.
+        at: [f64; 3],
+        /// Its distance from the curve, mm.
+        distance: f64,
+        /// The least distance allowed (offset less tolerance), mm.
+        least: f64,
+    },
+    /// The `kerf_offset`'s `max_chord_error` is below a measured chord's.
+    OffsetClaimUnderstated {
+        /// The claimed value, mm.
+        claimed: f64,
+        /// The measured maximum, mm.
+        measured: f64,
+    },
 }
 
 impl fmt::Display for Defect {
@@ -410,6 +465,28 @@ impl fmt::Display for Defect {
             Defect::ClaimAboveTolerance { claimed, tolerance } => write!(
                 f,
                 "max_chord_error: {claimed:.6e} mm is above the tolerance {tolerance} mm"
+            ),
+            Defect::OffsetShape { reason } => write!(f, "kerf_offset: {reason}"),
+            Defect::OffsetChordError {
+                segment,
+                error,
+                tolerance,
+            } => write!(
+                f,
+                "kerf_offset: chord {segment} is {error:.6e} mm from the exact offset > tolerance {tolerance} mm"
+            ),
+            Defect::OffsetGouge {
+                at,
+                distance,
+                least,
+            } => write!(
+                f,
+                "kerf_offset: at ({:.4}, {:.4}, {:.4}) the path is {distance:.6} mm from the curve, less than {least:.6} mm: the beam's edge cuts into the part",
+                at[0], at[1], at[2]
+            ),
+            Defect::OffsetClaimUnderstated { claimed, measured } => write!(
+                f,
+                "kerf_offset.max_chord_error: claims {claimed:.6e} mm but a chord measures {measured:.6e} mm"
             ),
         }
     }

@@ -23,6 +23,7 @@ fn toolpath(file: &CurvesFile, tol: f64) -> RawToolpath {
                     points: d.points().iter().map(|p| vec![p.x, p.y, p.z]).collect(),
                     claimed_chord_error: Some(d.max_chord_error()),
                     point_count: None,
+                    kerf_offset: None,
                 }
             })
             .collect(),
@@ -458,6 +459,7 @@ fn parabola(offset: [f64; 3]) -> (CurveRecord, RawPathRecord) {
             .collect(),
         claimed_chord_error: None,
         point_count: None,
+        kerf_offset: None,
     };
     let curve = CurveRecord {
         id: "parabola".into(),

@@ -228,7 +228,7 @@ impl Builder<'_, '_> {
                     pos,
                     axis,
                     m: next.m,
-                    source: next.source,
+                    source: last.source,
                     c,
                     tangent,
                     d,

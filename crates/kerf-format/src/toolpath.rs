@@ -126,6 +126,14 @@ impl KerfOffset {
                     value: v,
                 });
             }
+            let norm = (p[3] * p[3] + p[4] * p[4] + p[5] * p[5]).sqrt();
+            if (norm - 1.0).abs() > UNIT_NORMAL_TOLERANCE {
+                return Err(FormatError::BadNumber {
+                    path: format!("paths[{index}].kerf_offset.points[{i}]"),
+                    requirement: "a unit tool axis (i, j, k)",
+                    value: norm,
+                });
+            }
         }
         for (i, &t) in self.params.iter().enumerate() {
             if !t.is_finite() {

@@ -200,7 +200,7 @@ pub(crate) fn plan(
                     let Some(side) = sides[j] else {
                         compensated.push(Compensated {
                             curve: i,
-                            outcome: Outcome::Uncompensated("an open contour without a `scrap` key: its scrap side is not known, so it is cut on the contour itself".into()),
+                            outcome: Outcome::Uncompensated("its scrap side is not known (an open contour, or a loop round a tube, without a `scrap` key), so it is cut on the contour itself".into()),
                         });
                         out.push(None);
                         continue;
@@ -466,7 +466,7 @@ pub(crate) fn compensation_json(
         "mode": if k.in_control { "controller" } else { "computer" },
         "offset_mm": 0.5 * k.width_mm,
         "tolerance_mm": k.tolerance_mm,
-        "proven": compensated.iter().all(|c| matches!(&c.outcome, Outcome::Offset(p) if p.proven)),
+        "proven": !compensated.is_empty() && compensated.iter().all(|c| matches!(&c.outcome, Outcome::Offset(p) if p.proven)),
         "paths": paths,
         "note": "in the computer, each path moved half the kerf toward its scrap side, at right angles to the path and the tool axis; outside corners swung round on an arc about the corner, inside corners cut back to where the offsets cross (the round beam leaves max_corner_material_mm there); proven: every chord within the tolerance of the exact offset (flat contours at a fixed tool axis), else measured at 15 points per chord; in the controller, the program holds the contours with G41.1/G42.1 D<kerf> from the lead-in on and G40 after the beam is off (docs/process.md, Kerf compensation)",
     })

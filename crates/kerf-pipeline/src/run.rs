@@ -357,7 +357,7 @@ fn run_placed(
             .map(|id| format!("{id:?}"))
             .collect();
         warnings.push(format!(
-            "{} open contours without a `scrap` key are cut on the contour, not kerf-compensated (their scrap side is not known): {}{} (report: compensation.paths)",
+            "{} contours without a `scrap` key whose scrap side is not known (open, or a loop round a tube) are cut on the contour, not kerf-compensated: {}{} (report: compensation.paths)",
             uncompensated.len(),
             shown.join(", "),
             if uncompensated.len() > 5 { ", ..." } else { "" }

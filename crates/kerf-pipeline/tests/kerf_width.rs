@@ -108,7 +108,10 @@ fn check(name: &str, place: PlaceMode, slack: f64) -> Vec<(String, &'static str)
         let id = path["id"].as_str().expect("id");
         if path.get("side").is_none() {
             let why = path["reason"].as_str().expect("reason");
-            assert!(why.contains("open contour"), "{name} {id}: {why}");
+            assert!(
+                why.contains("scrap side is not known"),
+                "{name} {id}: {why}"
+            );
             continue;
         }
         let contour = dense(&file, id);
@@ -208,8 +211,12 @@ fn door_trim_and_tube_saddle_are_compensated_on_their_curved_surfaces() {
             ("trim-outline".to_string(), "outline"),
         ]
     );
+    // The hole in the main tube is compensated (a closed contour inside no other is taken
+    // for an outline, as the lead-ins take it: the file has no `scrap` key); the branch tube's
+    // end runs round the tube, where the winding tells no side: cut on the contour, with the
+    // reason.
     let saddle = check("tube_saddle.json", PlaceMode::AsModelled, TOL + 2e-3);
-    assert_eq!(saddle.len(), 2);
+    assert_eq!(saddle, [("main-tube-hole".to_string(), "outline")]);
 }
 
 #[test]

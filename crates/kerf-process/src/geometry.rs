@@ -87,6 +87,11 @@ impl Projected {
         })
     }
 
+    /// The unit normal of the plane the contour is projected onto.
+    pub(crate) fn normal(&self) -> Vector3<f64> {
+        self.e1.cross(&self.e2)
+    }
+
     /// The point in the contour's plane.
     pub(crate) fn project(&self, p: &Point3<f64>) -> Vector2<f64> {
         let d = p - self.origin;

@@ -201,13 +201,33 @@ pub fn plan_cuts(contours: &[Contour<'_>], options: &LeadOptions) -> Result<CutP
 
 /// The scrap side of every contour, as [`plan_cuts`] decides it: the curve's own `scrap` key,
 /// else the inside of a hole (a closed contour inside an odd number of others) or the outside
-/// of an outline; `None` for an open contour without a `scrap` key. Kerf compensation
+/// of an outline; `None` for an open contour, or a loop whose tool axes come within 60 degrees
+/// of the plane it is projected onto (round a tube), without a `scrap` key. Kerf compensation
 /// ([`offset`]) moves each path toward this side before the cuts are planned.
 ///
 /// # Errors
 /// As [`plan_cuts`].
 pub fn scrap_sides(contours: &[Contour<'_>], options: &LeadOptions) -> Result<Vec<Option<Side>>> {
-    Ok(nesting(contours, options)?.2)
+    let (projected, _, sides) = nesting(contours, options)?;
+    // The inside and outside are told in the plane the contour is projected onto; where a tool
+    // axis lies within 60 degrees of that plane (a loop round a tube), the kerf moves along the
+    // tube, to a side the winding does not tell.
+    Ok(sides
+        .into_iter()
+        .zip(projected)
+        .zip(contours)
+        .map(|((side, p), c)| match (c.scrap, p) {
+            (None, Some(p))
+                if p.wraps
+                    || c.poses
+                        .iter()
+                        .any(|q| geometry::normal(q).normalize().dot(&p.normal()).abs() < 0.5) =>
+            {
+                None
+            }
+            _ => side,
+        })
+        .collect())
 }
 
 /// The contours checked, projected, nested (which closed contours contain which) and sided.

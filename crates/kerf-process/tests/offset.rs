@@ -584,3 +584,64 @@ fn on_curved_surfaces_and_tilted_beams_the_beams_edge_runs_on_the_contour() {
         }
     }
 }
+
+#[test]
+fn a_repeated_cutting_point_a_zero_axis_and_an_open_closure_are_handled() {
+    // A square hole whose polygon repeats a vertex: a zero-length chord, skipped.
+    let h = 10.0;
+    let c = NurbsCurve::try_new(
+        1,
+        vec![0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 5.0],
+        vec![
+            Point3::new(h, -h, 0.0),
+            Point3::new(h, h, 0.0),
+            Point3::new(h, h, 0.0),
+            Point3::new(-h, h, 0.0),
+            Point3::new(-h, -h, 0.0),
+            Point3::new(h, -h, 0.0),
+        ],
+        None,
+    )
+    .expect("a polygon with a repeated vertex");
+    let path = run(&c, Vector3::z(), None, Side::Left, 0.2).expect("offset");
+    assert_eq!(path.inserted, 0, "no point inserted on straight chords");
+    assert_eq!(path.inside_corners, 4);
+    // The closing corner cut back: the first point's source lies on the first edge, before the
+    // second point's, and the sources never decrease.
+    assert!(path.source[0] < path.source[1], "{:?}", path.source);
+    assert!(
+        path.source.windows(2).all(|w| w[0] <= w[1]),
+        "{:?}",
+        path.source
+    );
+    let curve = circle(5.0);
+    let (params, mut poses) = contour(&curve, Vector3::z());
+    poses[3][3..].copy_from_slice(&[0.0, 0.0, 0.0]);
+    let zero = OffsetInput {
+        id: "c",
+        curve: &curve,
+        params: &params,
+        poses: &poses,
+        surface_normals: None,
+        scrap: Side::Left,
+        closed: true,
+    };
+    let e = offset(&zero, &OffsetOptions::new(0.2, TOL)).expect_err("zero axis");
+    assert!(
+        e.to_string()
+            .contains("cutting point 3: the tool axis is not a unit vector"),
+        "{e}"
+    );
+    let (_, poses) = contour(&curve, Vector3::z());
+    let open = OffsetInput {
+        id: "c",
+        curve: &curve,
+        params: &params[..params.len() - 1],
+        poses: &poses[..poses.len() - 1],
+        surface_normals: None,
+        scrap: Side::Left,
+        closed: true,
+    };
+    let e = offset(&open, &OffsetOptions::new(0.2, TOL)).expect_err("not closed");
+    assert!(e.to_string().contains("not its first"), "{e}");
+}

@@ -99,7 +99,7 @@ pub(super) fn check_offset(
             for k in 1..SAMPLES {
                 let th = angle * k as f64 / SAMPLES as f64;
                 let u = u0 * th.cos() + turn.cross(&u0) * th.sin();
-                error = error.max(distance_to_segment(&(c + u * r), &p0, &p1));
+                error = nan_max(error, distance_to_segment(&(c + u * r), &p0, &p1));
             }
         } else {
             for k in 1..SAMPLES {
@@ -110,12 +110,12 @@ pub(super) fn check_offset(
                 let Some(d) = ax.cross(&d1).try_normalize(1e-300) else {
                     continue;
                 };
-                error = error.max(distance_to_segment(&(c + d * (sign * r)), &p0, &p1));
+                error = nan_max(error, distance_to_segment(&(c + d * (sign * r)), &p0, &p1));
             }
         }
         report.segments += 1;
-        report.max_chord_error = report.max_chord_error.max(error);
-        if error > tol + allowance {
+        report.max_chord_error = nan_max(report.max_chord_error, error);
+        if error.is_nan() || error > tol + allowance {
             found.push(Defect::OffsetChordError {
                 segment: j,
                 error,
@@ -131,11 +131,20 @@ pub(super) fn check_offset(
             least: r - tol,
         });
     }
-    if o.max_chord_error < report.max_chord_error - allowance {
+    if report.max_chord_error.is_nan() || o.max_chord_error < report.max_chord_error - allowance {
         found.push(Defect::OffsetClaimUnderstated {
             claimed: o.max_chord_error,
             measured: report.max_chord_error,
         });
     }
     report
+}
+
+/// The larger of two distances, NaN if either is: a NaN never passes for a small error.
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
 }

@@ -11,8 +11,9 @@ use crate::{ProcessError, Result};
 /// How many chords on each side of an inside corner the cut-back searches for the crossing.
 const TRIM_WINDOW: usize = 256;
 
-/// Tangents closer than this (radians) join smoothly.
-const SMOOTH_RAD: f64 = 1e-6;
+/// Tangents closer than this (radians) join smoothly; each chord keeps `r SMOOTH_RAD` of the
+/// tolerance for the gap such a join leaves.
+pub(super) const SMOOTH_RAD: f64 = 1e-6;
 
 struct Builder<'c, 'a> {
     ctx: &'c Context<'a>,
@@ -63,6 +64,7 @@ pub(super) fn assemble(ctx: &Context<'_>, segs: Vec<Seg>, inserted: usize) -> Re
     }
     if ctx.input.closed {
         b.close()?;
+        b.budget()?;
     }
     if b.nodes.len() < 2 {
         return Err(ctx.refuse(
@@ -327,7 +329,7 @@ impl Builder<'_, '_> {
         let last = *self.nodes.last().expect("nodes");
         match self.junction(&last, &first) {
             Join::Smooth(gap) => {
-                self.bound = self.bound.max(gap);
+                self.bound += gap;
                 let n = self.nodes.len();
                 self.nodes[n - 1] = Node {
                     source: last.source,
@@ -354,12 +356,15 @@ impl Builder<'_, '_> {
                 let Some((bd, fd, lambda, mu)) = search(&frame, back, fwd) else {
                     return Err(self.no_meeting(&first));
                 };
+                // Where the crossing lies on the front piece, in the contour's parameter.
+                let front_source = self.nodes[fd].source
+                    + (self.nodes[fd + 1].source - self.nodes[fd].source) * mu;
                 let x = self.end_at_crossing(&frame, np - 1 - bd, lambda, &first);
                 // The start: drop what comes before the crossing on piece fd.
                 let front = self.pieces.drain(..=fd).next_back().expect("piece fd");
                 self.nodes.drain(..=fd);
                 let start = Node {
-                    source: self.nodes[0].source.min(x.source),
+                    source: front_source,
                     ..x
                 };
                 let cut = self.start_piece(front, mu, &start);

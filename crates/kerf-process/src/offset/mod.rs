@@ -305,13 +305,38 @@ pub fn offset(input: &OffsetInput<'_>, options: &OffsetOptions) -> Result<Offset
     if input.poses.iter().flatten().any(|v| !v.is_finite()) {
         return Err(bad("a cutting point holds a non-finite value".into()));
     }
+    let unit = |v: [f64; 3]| {
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        (n - 1.0).abs() <= 1e-6
+    };
+    if let Some(i) = input.poses.iter().position(|p| !unit([p[3], p[4], p[5]])) {
+        return Err(bad(format!(
+            "cutting point {i}: the tool axis is not a unit vector"
+        )));
+    }
+    if let Some(i) = input
+        .surface_normals
+        .and_then(|m| m.iter().position(|v| !unit(*v)))
+    {
+        return Err(bad(format!("surface normal {i} is not a unit vector")));
+    }
+    if input.closed {
+        let (a, b) = (position(&input.poses[0]), position(&input.poses[n - 1]));
+        // As `LeadOptions::closed_tolerance_mm` has it by default.
+        if (a - b).norm() > 1e-6 {
+            return Err(bad(
+                "closed, but its last cutting point is not its first".into()
+            ));
+        }
+    }
     let ctx = Context::new(input, options);
     let mut segs: Vec<Seg> = Vec::with_capacity(n);
     let mut inserted = 0usize;
     for i in 0..n - 1 {
         let before = segs.len();
         ctx.segment(i, &mut segs, options.max_points)?;
-        inserted += segs.len() - before - 1;
+        // Chords of zero length (a repeated cutting point) add none.
+        inserted += (segs.len() - before).saturating_sub(1);
     }
     if segs.is_empty() {
         return Err(ctx.refuse("every chord of the contour has zero length".into()));
@@ -449,7 +474,10 @@ impl<'a> Context<'a> {
             };
             let verdict = self.certify(&start, &end, &piece)?;
             let ok = match verdict {
-                Verdict::Proven(b) | Verdict::Measured(b) => b <= self.tol,
+                // Room for a smooth join's gap (tangents within SMOOTH_RAD: r SMOOTH_RAD).
+                Verdict::Proven(b) | Verdict::Measured(b) => {
+                    b <= self.tol - corner::SMOOTH_RAD * self.r
+                }
                 Verdict::Split => false,
             };
             if ok || depth >= 40 {
@@ -546,7 +574,12 @@ impl<'a> Context<'a> {
             // The chord ends' own rounding (a few ulps of the coordinates).
             let ends =
                 8.0 * f64::EPSILON * (start.pos.coords.amax() + end.pos.coords.amax() + self.r);
-            let b = (e + term) / flat.cos + ends;
+            // The translation and subdivision of the pieces round at the coordinates' size,
+            // and the contour may leave the plane by the 1e-9 the flat test allows.
+            let size = self.input.curve.size();
+            let coords = flat.origin.coords.amax() + start.c.coords.amax() + end.c.coords.amax();
+            let rounding = 64.0 * f64::EPSILON * (coords + size) + 2e-9 * size.max(1.0);
+            let b = (e + term) / flat.cos + ends + rounding;
             return Ok(if b <= self.tol {
                 Verdict::Proven(b)
             } else {

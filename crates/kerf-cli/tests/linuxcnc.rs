@@ -28,8 +28,17 @@ fn have_rs274() -> bool {
     found
 }
 
+/// One rs274 at a time: the two tests of this file ran it side by side, and a CI run twice saw
+/// one come back with nothing at all on its streams (not even `executing`) where it parses the
+/// same program alone without fault.
+static RS274: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// Runs rs274 on `program` with a trivkins INI for `coords`; returns (error stream, canon).
+/// The error stream holds the exit status too when rs274 did not exit 0.
 fn rs274(dir: &Path, coords: &str, program: &Path) -> (String, String) {
+    let _one = RS274
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     std::fs::write(
         dir.join("t.ini"),
         format!(
@@ -46,8 +55,11 @@ fn rs274(dir: &Path, coords: &str, program: &Path) -> (String, String) {
         .stdin(std::process::Stdio::null())
         .output()
         .expect("run rs274");
-    let err =
+    let mut err =
         String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() {
+        err.push_str(&format!("\nrs274 exit status: {}", out.status));
+    }
     let canon = std::fs::read_to_string(dir.join("canon.txt")).unwrap_or_default();
     (err, canon)
 }

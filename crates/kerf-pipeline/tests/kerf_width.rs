@@ -423,3 +423,68 @@ fn kerf_check_measures_the_offset_and_catches_a_wrong_one() {
         );
     }
 }
+
+/// A square hole of half-size `h` about `(0, 0, 0)` with corners rounded to `rho` (lines and
+/// rational quarter circles, degree 2), clockwise seen from +z: no outline around it, so the
+/// file says its inside is scrap (`scrap: right` of a clockwise contour).
+fn rounded_hole(h: f64, rho: f64) -> kerf_nurbs::NurbsCurve {
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    let e = h - rho;
+    let ccw = [
+        (h, -e, 1.0),
+        (h, 0.0, 1.0),
+        (h, e, 1.0),
+        (h, h, w),
+        (e, h, 1.0),
+        (0.0, h, 1.0),
+        (-e, h, 1.0),
+        (-h, h, w),
+        (-h, e, 1.0),
+        (-h, 0.0, 1.0),
+        (-h, -e, 1.0),
+        (-h, -h, w),
+        (-e, -h, 1.0),
+        (0.0, -h, 1.0),
+        (e, -h, 1.0),
+        (h, -h, w),
+        (h, -e, 1.0),
+    ];
+    let pts: Vec<_> = ccw.iter().rev().collect();
+    let mut knots = vec![0.0; 3];
+    for k in 1..8 {
+        knots.extend([k as f64, k as f64]);
+    }
+    knots.extend([8.0; 3]);
+    kerf_nurbs::NurbsCurve::new(
+        2,
+        knots,
+        pts.iter().map(|p| Point3::new(p.0, p.1, 0.0)).collect(),
+        Some(pts.iter().map(|p| p.2).collect()),
+    )
+}
+
+#[test]
+fn a_hole_with_roundings_tighter_than_the_kerf_is_cut_back_and_checked() {
+    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    let mut curves = Job::on_machine(machine.clone())
+        .with_curve("slot", rounded_hole(10.0, 0.05), None)
+        .curves()
+        .clone();
+    curves.curves[0].scrap = Some(kerf_format::ScrapSide::Right);
+    let out = Job::new(curves.clone(), machine)
+        .with_options(JobOptions::default().with_kerf_width_mm(Some(0.2)))
+        .run()
+        .expect("run");
+    let p = &out.report["compensation"]["paths"][0];
+    assert_eq!(p["inside_corners"], 4, "{p}");
+    assert_eq!(p["side"], "right", "{p}");
+    let raw = kerf_check::RawToolpath::from(&out.toolpath);
+    let report = kerf_check::check(&curves.curves, &raw, &kerf_check::CheckOptions::default());
+    assert!(report.passed(), "{:?}", report.violations);
+    let o = report.paths[0].kerf_offset.expect("offset");
+    // Three chords straddle a rounding; the fourth cut-back is where the path closes, split
+    // between its first and last chords.
+    assert_eq!(o.cut_backs, 3, "{o:?}");
+    assert_eq!(o.segments + o.cut_backs + 1, o.points, "{o:?}");
+    assert!(o.min_distance_from_curve >= 0.1 - TOL, "{o:?}");
+}

@@ -645,3 +645,40 @@ fn a_repeated_cutting_point_a_zero_axis_and_an_open_closure_are_handled() {
     let e = offset(&open, &OffsetOptions::new(0.2, TOL)).expect_err("not closed");
     assert!(e.to_string().contains("not its first"), "{e}");
 }
+
+#[test]
+fn roundings_tighter_than_half_the_kerf_are_cut_back_like_corners() {
+    // Corners rounded to 0.05 mm, a 0.2 mm kerf: inside the hole the beam cannot follow the
+    // roundings; the straight sides' offsets are cut back to their crossing, as at a sharp
+    // corner, and every chord point stays r from the contour.
+    let (h, rho) = (10.0, 0.05);
+    let c = rounded_square(h, rho);
+    let r = 0.1;
+    let hole = run(&c, Vector3::z(), None, Side::Left, 2.0 * r).expect("hole");
+    assert_eq!(hole.inside_corners, 4, "one cut-back per rounding");
+    assert!(
+        hole.proven,
+        "the chords kept are proven, the cut-backs lie on them"
+    );
+    assert_at(
+        &hole,
+        |p| rounded_sdf(p, h, rho),
+        -r,
+        "hole with tight roundings",
+    );
+    assert!(
+        hole.source.windows(2).all(|w| w[0] <= w[1]),
+        "{:?}",
+        hole.source
+    );
+    assert_eq!(hole.poses[0], hole.poses[hole.poses.len() - 1]);
+    // Round the outside the roundings turn away from the scrap: offset as they are.
+    let outline = run(&c, Vector3::z(), None, Side::Right, 2.0 * r).expect("outline");
+    assert_eq!((outline.outside_corners, outline.inside_corners), (0, 0));
+    assert_at(
+        &outline,
+        |p| rounded_sdf(p, h, rho),
+        r,
+        "outline with tight roundings",
+    );
+}

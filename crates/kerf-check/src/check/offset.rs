@@ -7,8 +7,9 @@
 //! from the contour at right angles to the path and the beam (`docs/process.md`, "Kerf
 //! compensation"). Between two points of the same parameter it is the arc of radius `r` about
 //! the corner `C(t)` in the plane across the axis. A chord whose parameters straddle a C0
-//! corner was cut back at an inside corner: there the exact offsets of the two sides run into
-//! the part, so the chord is checked for the gouge only.
+//! corner, or over which the exact offset runs backwards (a rounding tighter than the offset),
+//! was cut back: there the exact offsets run into the part, so the chord is checked for the
+//! gouge only.
 
 use kerf_format::{KerfOffset, ScrapSide};
 use kerf_nurbs::{distance_to_segment, NurbsCurve};
@@ -102,6 +103,7 @@ pub(super) fn check_offset(
                 error = nan_max(error, distance_to_segment(&(c + u * r), &p0, &p1));
             }
         } else {
+            let mut samples = Vec::with_capacity(SAMPLES);
             for k in 1..SAMPLES {
                 let f = k as f64 / SAMPLES as f64;
                 let t = t0 + (t1 - t0) * f;
@@ -110,7 +112,19 @@ pub(super) fn check_offset(
                 let Some(d) = ax.cross(&d1).try_normalize(1e-300) else {
                     continue;
                 };
-                error = nan_max(error, distance_to_segment(&(c + d * (sign * r)), &p0, &p1));
+                samples.push((c + d * (sign * r), d1));
+            }
+            // Where the exact offset runs backwards against the curve, the curve bends toward
+            // the scrap tighter than the offset: the path was cut back across it.
+            if samples
+                .windows(2)
+                .any(|w| (w[1].0 - w[0].0).dot(&w[0].1) < 0.0)
+            {
+                report.cut_backs += 1;
+                continue;
+            }
+            for (q, _) in &samples {
+                error = nan_max(error, distance_to_segment(q, &p0, &p1));
             }
         }
         report.segments += 1;

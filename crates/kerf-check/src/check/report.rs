@@ -94,8 +94,8 @@ pub struct OffsetReport {
     /// Chords measured against the exact offset (the curve's offset, or the arc about a
     /// corner).
     pub segments: usize,
-    /// Chords that cross an inside corner where the path was cut back: measured for the gouge
-    /// only (the exact offset there runs into the part).
+    /// Chords that cross an inside corner or a rounding tighter than the offset, where the path
+    /// was cut back: measured for the gouge only (the exact offset there runs into the part).
     pub cut_backs: usize,
     /// The largest measured distance from the exact offset to its chord, mm.
     pub max_chord_error: f64,

@@ -28,7 +28,12 @@ struct Builder<'c, 'a> {
 }
 
 /// Joins the chords into the offset path.
-pub(super) fn assemble(ctx: &Context<'_>, segs: Vec<Seg>, inserted: usize) -> Result<OffsetPath> {
+pub(super) fn assemble(
+    ctx: &Context<'_>,
+    segs: Vec<Seg>,
+    inserted: usize,
+    closing_tight: bool,
+) -> Result<OffsetPath> {
     let mut b = Builder {
         ctx,
         nodes: vec![segs[0].start],
@@ -45,7 +50,12 @@ pub(super) fn assemble(ctx: &Context<'_>, segs: Vec<Seg>, inserted: usize) -> Re
     while i < segs.len() {
         let last = *b.nodes.last().expect("one node at least");
         let next = segs[i].start;
-        match b.junction(&last, &next) {
+        let join = if segs[i].after_tight {
+            Join::Inside
+        } else {
+            b.junction(&last, &next)
+        };
+        match join {
             Join::Smooth(gap) => {
                 b.bound = b.bound.max(segs[i].bound + gap);
                 b.push(&segs[i], None, None);
@@ -63,7 +73,7 @@ pub(super) fn assemble(ctx: &Context<'_>, segs: Vec<Seg>, inserted: usize) -> Re
         b.budget()?;
     }
     if ctx.input.closed {
-        b.close()?;
+        b.close(closing_tight)?;
         b.budget()?;
     }
     if b.nodes.len() < 2 {
@@ -323,11 +333,17 @@ impl Builder<'_, '_> {
         ))
     }
 
-    /// Joins a closed path's end to its start.
-    fn close(&mut self) -> Result<()> {
+    /// Joins a closed path's end to its start (as an inside corner where a tight stretch was
+    /// left out between them).
+    fn close(&mut self, tight: bool) -> Result<()> {
         let first = self.nodes[0];
         let last = *self.nodes.last().expect("nodes");
-        match self.junction(&last, &first) {
+        let join = if tight {
+            Join::Inside
+        } else {
+            self.junction(&last, &first)
+        };
+        match join {
             Join::Smooth(gap) => {
                 self.bound += gap;
                 let n = self.nodes.len();

@@ -267,6 +267,9 @@ struct Seg {
     piece: CurvePiece,
     bound: f64,
     proven: bool,
+    /// A stretch tighter than half the kerf was left out just before this chord: it joins the
+    /// path as an inside corner does.
+    after_tight: bool,
 }
 
 /// Offsets one contour by half the kerf toward its scrap side.
@@ -332,16 +335,30 @@ pub fn offset(input: &OffsetInput<'_>, options: &OffsetOptions) -> Result<Offset
     let ctx = Context::new(input, options);
     let mut segs: Vec<Seg> = Vec::with_capacity(n);
     let mut inserted = 0usize;
+    let mut tight = Tight::default();
     for i in 0..n - 1 {
         let before = segs.len();
-        ctx.segment(i, &mut segs, options.max_points)?;
-        // Chords of zero length (a repeated cutting point) add none.
+        ctx.segment(i, &mut segs, &mut tight, options.max_points)?;
+        // Chords of zero length (a repeated cutting point) or left out add none.
         inserted += (segs.len() - before).saturating_sub(1);
     }
     if segs.is_empty() {
-        return Err(ctx.refuse("every chord of the contour has zero length".into()));
+        return Err(match tight.tightest {
+            Some((radius, t)) => ctx.small_radius(t, radius),
+            None => ctx.refuse("every chord of the contour has zero length".into()),
+        });
     }
-    corner::assemble(&ctx, segs, inserted)
+    // A stretch left out at the end (or the start) of a closed contour joins its ends.
+    let closing_tight = input.closed && (tight.pending || segs[0].after_tight);
+    corner::assemble(&ctx, segs, inserted, closing_tight).map_err(|e| match (e, tight.tightest) {
+        // Nothing left once cut back: the contour is a loop smaller than the kerf.
+        (ProcessError::Compensation { reason, .. }, Some((radius, t)))
+            if reason.contains("leave nothing") =>
+        {
+            ctx.small_radius(t, radius)
+        }
+        (e, _) => e,
+    })
 }
 
 /// The geometry shared by a contour's segments.
@@ -436,7 +453,13 @@ impl<'a> Context<'a> {
 
     /// Offsets the chords of contour segment `i`, bisected until each is within the
     /// tolerance, onto `out`.
-    fn segment(&self, i: usize, out: &mut Vec<Seg>, max_points: usize) -> Result<()> {
+    fn segment(
+        &self,
+        i: usize,
+        out: &mut Vec<Seg>,
+        tight: &mut Tight,
+        max_points: usize,
+    ) -> Result<()> {
         let input = self.input;
         let curve = input.curve;
         let (t0, t1) = (input.params[i], input.params[i + 1]);
@@ -473,18 +496,27 @@ impl<'a> Context<'a> {
                 e1: Vector3::zeros(),
             };
             let verdict = self.certify(&start, &end, &piece)?;
+            if let Verdict::Tight(radius, at) = verdict {
+                tight.pending = true;
+                if tight.tightest.is_none_or(|(r, _)| radius < r) {
+                    tight.tightest = Some((radius, at));
+                }
+                continue;
+            }
             let ok = match verdict {
                 // Room for a smooth join's gap (tangents within SMOOTH_RAD: r SMOOTH_RAD).
                 Verdict::Proven(b) | Verdict::Measured(b) => {
                     b <= self.tol - corner::SMOOTH_RAD * self.r
                 }
-                Verdict::Split => false,
+                Verdict::Split | Verdict::Tight(..) => false,
             };
             if ok || depth >= 40 {
                 let (bound, proven) = match verdict {
                     Verdict::Proven(b) => (b, true),
                     Verdict::Measured(b) => (b, false),
-                    Verdict::Split => (self.measure(&start, &end, &piece), false),
+                    Verdict::Split | Verdict::Tight(..) => {
+                        (self.measure(&start, &end, &piece), false)
+                    }
                 };
                 if bound > self.tol {
                     return Err(self.refuse(format!(
@@ -498,6 +530,7 @@ impl<'a> Context<'a> {
                     piece,
                     bound,
                     proven,
+                    after_tight: std::mem::take(&mut tight.pending),
                 });
                 if out.len() > max_points {
                     return Err(self.refuse(format!(
@@ -537,7 +570,7 @@ impl<'a> Context<'a> {
             let tm = 0.5 * (piece.t0 + piece.t1);
             if let Some(radius) = self.radius_toward_scrap(tm, &start.axis) {
                 if radius < self.r {
-                    return Err(self.small_radius(tm, radius));
+                    return Ok(Verdict::Tight(radius, tm));
                 }
             }
             return Ok(Verdict::Split);
@@ -560,7 +593,7 @@ impl<'a> Context<'a> {
                 let tm = 0.5 * (piece.t0 + piece.t1);
                 if let Some(radius) = self.radius_toward_scrap(tm, &start.axis) {
                     if radius < self.r {
-                        return Err(self.small_radius(tm, radius));
+                        return Ok(Verdict::Tight(radius, tm));
                     }
                 }
                 return Ok(Verdict::Split);
@@ -615,7 +648,14 @@ impl<'a> Context<'a> {
                 )
                 .map_or(f64::INFINITY, |q| seg.distance_to(&q.0))
             })
-            .fold(0.0, f64::max)
+            // A NaN distance stays NaN, and fails every comparison with the tolerance.
+            .fold(0.0, |m: f64, d| {
+                if d.is_nan() || m.is_nan() {
+                    f64::NAN
+                } else {
+                    m.max(d)
+                }
+            })
     }
 
     /// The radius of curvature at `t` of the contour seen along `axis`, where it turns toward
@@ -631,7 +671,7 @@ impl<'a> Context<'a> {
     fn small_radius(&self, t: f64, radius: f64) -> ProcessError {
         let c = self.input.curve.point(t);
         self.refuse(format!(
-            "at ({:.3}, {:.3}, {:.3}) the contour bends toward the scrap with a radius of {radius:.4} mm, smaller than half the kerf ({:.4} mm): a loop or a rounding smaller than the kerf cannot be cut to size",
+            "at ({:.3}, {:.3}, {:.3}) the contour bends toward the scrap with a radius of {radius:.4} mm, smaller than half the kerf ({:.4} mm), and nothing of it is left once cut back: a loop smaller than the kerf cannot be cut to size",
             c.x, c.y, c.z, self.r
         ))
     }
@@ -641,6 +681,19 @@ enum Verdict {
     Proven(f64),
     Measured(f64),
     Split,
+    /// The contour bends toward the scrap tighter than half the kerf here (radius, where):
+    /// the offset runs backwards, and the chord is left out: the offsets on either side are
+    /// cut back to their crossing, as at an inside corner.
+    Tight(f64, f64),
+}
+
+/// The stretches left out for bending toward the scrap tighter than half the kerf.
+#[derive(Debug, Default)]
+struct Tight {
+    /// A stretch was left out since the last chord kept.
+    pending: bool,
+    /// The tightest radius met and where (its parameter).
+    tightest: Option<(f64, f64)>,
 }
 
 /// The flat case, when it holds: every tool axis the same (to 1e-9), every surface normal the

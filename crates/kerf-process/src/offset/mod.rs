@@ -16,7 +16,8 @@
 //! radius `r` about it (the cut edge keeps the sharp corner); turning toward the scrap (an
 //! inside corner), both offset polylines are cut back to where they cross, so that no stretch
 //! runs into the part (the beam, being round, leaves a radius `r` of material in the corner,
-//! reported).
+//! reported). A rounding tighter than `r` toward the scrap, where the offset would run
+//! backwards, is left out and cut back the same way; a loop with nothing left is refused.
 //!
 //! The certificate: on a flat contour at a fixed tool axis every chord of the offset is proven
 //! within the tolerance of the exact offset curve (the contour's own proven chord error plus
@@ -213,7 +214,7 @@ enum Piece {
     Curve(CurvePiece),
     /// An arc about a corner.
     Arc(ArcPiece),
-    /// A straight line (never made by the offset itself; kept for completeness of cut-backs).
+    /// A straight line: what is left of a corner arc cut back at an inside corner.
     Line,
 }
 

@@ -175,10 +175,7 @@ pub(crate) fn plan(
     for setup in &placed.plan.setups {
         let scrap_of = |i: usize| match walls.get(i) {
             Some(Some(w)) => Some(w.scrap),
-            _ => file.curves[i].scrap.map(|s| match s {
-                kerf_format::ScrapSide::Left => kerf_process::Side::Left,
-                kerf_format::ScrapSide::Right => kerf_process::Side::Right,
-            }),
+            _ => file.curves[i].scrap.map(kerf_process::Side::from),
         };
         let contours: Vec<Contour<'_>> = setup
             .paths
@@ -377,10 +374,7 @@ fn cut_path(
 pub(crate) fn kerf_offset_record(p: &OffsetPath) -> kerf_format::KerfOffset {
     kerf_format::KerfOffset {
         offset_mm: p.offset_mm,
-        side: match p.side {
-            kerf_process::Side::Left => kerf_format::ScrapSide::Left,
-            kerf_process::Side::Right => kerf_format::ScrapSide::Right,
-        },
+        side: p.side.into(),
         params: p.source.clone(),
         points: p.poses.clone(),
         max_chord_error: p.max_chord_error_mm,

@@ -146,21 +146,21 @@ fn run_placed(
     job.validate()?;
     let dopts = o.discretize;
     // With a kerf width, each path is first offset by half of it toward the scrap.
-    let kerf = match (o.kerf_width_mm, machine.process.kerf_width_mm) {
-        (Some(w), _) => Some(crate::cuts::Kerf {
-            width_mm: w,
-            source: "--kerf-width",
+    let kerf = o
+        .kerf_width_mm
+        .map(|w| (w, "--kerf-width"))
+        .or_else(|| {
+            machine
+                .process
+                .kerf_width_mm
+                .map(|w| (w, "machine file process.kerf_width_mm"))
+        })
+        .map(|(width_mm, source)| crate::cuts::Kerf {
+            width_mm,
+            source,
             tolerance_mm: dopts.tolerance_mm,
             in_control: o.kerf_in_control,
-        }),
-        (None, Some(w)) => Some(crate::cuts::Kerf {
-            width_mm: w,
-            source: "machine file process.kerf_width_mm",
-            tolerance_mm: dopts.tolerance_mm,
-            in_control: o.kerf_in_control,
-        }),
-        (None, None) => None,
-    };
+        });
     // 1. Cutting points with a certified chord error. With a kerf, the contour's chords take
     // 9/10 of the tolerance and the offset's own term the rest (docs/process.md, "Kerf
     // compensation"): a hole's offset chords then need no more points.

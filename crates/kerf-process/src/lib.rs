@@ -92,6 +92,26 @@ impl Side {
     }
 }
 
+/// The file's `scrap` key as a side.
+impl From<kerf_format::ScrapSide> for Side {
+    fn from(s: kerf_format::ScrapSide) -> Self {
+        match s {
+            kerf_format::ScrapSide::Left => Side::Left,
+            kerf_format::ScrapSide::Right => Side::Right,
+        }
+    }
+}
+
+/// A side as the files write it (`scrap`, a toolpath's `kerf_offset.side`).
+impl From<Side> for kerf_format::ScrapSide {
+    fn from(s: Side) -> Self {
+        match s {
+            Side::Left => kerf_format::ScrapSide::Left,
+            Side::Right => kerf_format::ScrapSide::Right,
+        }
+    }
+}
+
 /// One cut contour: its cutting points in order, and what the file says of it.
 #[derive(Debug, Clone, Copy)]
 pub struct Contour<'a> {

@@ -64,16 +64,21 @@ def run(cmd, **kw):
     return subprocess.run(cmd, capture_output=True, text=True, **kw)
 
 
+def machine_file(machine):
+    """A shipped machine by name, or a machine file's path as given."""
+    return machine if isinstance(machine, Path) else ROOT / "fixtures" / "machines" / f"{machine}.json"
+
+
 def kerf_run(kerf, fixture, machine, dialect, out, extra=()):
     r = run([str(kerf), "run", str(ROOT / "fixtures" / f"{fixture}.json"), "-m",
-             str(ROOT / "fixtures" / "machines" / f"{machine}.json"), "--dialect", dialect,
+             str(machine_file(machine)), "--dialect", dialect,
              "-o", str(out), "-q", *extra])
     return r
 
 
 def config(machine, out, display="true"):
     r = run([sys.executable, str(HERE / "make_config.py"),
-             str(ROOT / "fixtures" / "machines" / f"{machine}.json"), str(out), "--display", display])
+             str(machine_file(machine)), str(out), "--display", display])
     if r.returncode != 0:
         raise SystemExit(f"make_config {machine}: {r.stderr}")
 
@@ -118,13 +123,15 @@ def first_cuts(text, cuts, beam_on="M64 P0", beam_off="M65 P0"):
 
 
 def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), traj=(), edit=None,
-             cuts=None, measure_env=None, compare=False):
+             cuts=None, measure_env=None, compare=False, synchronized=False):
     """One simulator run; `extra` are more `kerf run` arguments, `traj` more [TRAJ] lines of
     the INI, `edit` a function applied to the program text (for the experiments), `cuts` the
     number of cuts to run (a long real part cut short; all when None). With `compare` the
     program leaves the kerf to the controller: its tip runs half a kerf off its own poses and
     the curve by design, so those asserts give way to `kerf_compare` (`simulate_kerf`), and the
-    beam's framing is checked by its count only; `measure_env` goes to `lcnc_measure`."""
+    beam's framing is checked by its count only; `measure_env` goes to `lcnc_measure`. With
+    `synchronized` the machine's beam codes are M62/M63 (they act when the next move starts,
+    so the pierce dwell runs dark): the framing is checked by the count only."""
     if cuts is not None:
         edit = lambda text, e=edit: first_cuts(e(text) if e else text, cuts)
     fixture_tag = fixture.replace("/", "-") + tag
@@ -166,14 +173,14 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
         return None
     res = json.loads(res_path.read_text())
     shutil.copy(work / "samples.txt", outdir / f"sim-{fixture_tag}-samples.txt")
-    m = run([str(measure), str(ROOT / "fixtures" / "machines" / f"{machine}.json"), str(kout),
+    m = run([str(measure), str(machine_file(machine)), str(kout),
              str(work / "samples.txt"), "0.001", *([str(cuts)] if cuts is not None else [])],
             env={**os.environ, **(measure_env or {})})
     if m.returncode != 0:
         fail(f"sim {fixture}: lcnc_measure: {m.stderr.strip()}")
         return None
     fig = json.loads(m.stdout)
-    fig.update({"fixture": fixture, "machine": machine, "linuxcnc_errors": res["errors"],
+    fig.update({"fixture": fixture, "machine": str(machine), "linuxcnc_errors": res["errors"],
                 "linuxcnc_end": res["code"], "wall_s": wall})
     fig["variant"] = tag
     name = f"sim {fixture_tag} on {machine}"
@@ -181,9 +188,14 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
         fail(f"{name}: LinuxCNC errors {res['errors']}, end {res['code']}")
     if fig["sample_gaps"]:
         fail(f"{name}: {fig['sample_gaps']} gaps in the samples (sampler overrun)")
-    if (not fig["framing_ok"] and not compare) or fig["beam_intervals"] != fig["cuts"]:
+    if (not fig["framing_ok"] and not compare and not synchronized) or fig["beam_intervals"] != fig["cuts"]:
         fail(f"{name}: beam on {fig['beam_intervals']} times for {fig['cuts']} cuts, framing ok {fig['framing_ok']}")
-    if compare:
+    # A laser left on after the program is a safety defect, whatever codes switch it.
+    if fig["beam_on_at_end"]:
+        fail(f"{name}: the beam is still on after the program ended")
+    if compare or synchronized:
+        if synchronized:
+            print(f"{name}: beam {fig['beam_intervals']}/{fig['cuts']} cuts, on at the end: {fig['beam_on_at_end']}", flush=True)
         shutil.rmtree(work, ignore_errors=True)
         return fig
     if not fig["max_deviation_beam_on_mm"] <= fig["tolerance_budget_mm"]:
@@ -256,6 +268,18 @@ def simulate_kerf(kerf, measure, outdir):
     return fig
 
 
+def simulate_synchronized(kerf, measure, outdir):
+    """The flat part on a gantry whose `process` names the beam codes synchronized with motion
+    (`M62 P0` / `M63 P0`, what a LinuxCNC laser configuration uses): the beam must be off when
+    the program has ended (issue 29: a last `M63` with no move after it never fired)."""
+    machine = json.loads((ROOT / "fixtures" / "machines" / "gantry_ac.json").read_text())
+    machine.setdefault("process", {}).update({"beam_on": ["M62 P0"], "beam_off": ["M63 P0"]})
+    path = outdir / "gantry_ac-m62.json"
+    path.write_text(json.dumps(machine))
+    return simulate(kerf, measure, "sheet_metal_holes", path, True, outdir, tag="-m62",
+                    synchronized=True)
+
+
 def main():
     args = sys.argv[1:]
     # Absolute: rs274 and the simulator run in the configuration directory.
@@ -323,6 +347,10 @@ def main():
     if "--no-sim" not in args:
         for f, m, flat, extra, cuts in sims:
             fig = simulate(kerf, measure, f, m, flat, outdir, extra=extra, cuts=cuts)
+            if fig:
+                figs.append(fig)
+        if "--sim" not in args or "synchronized" in args[args.index("--sim") + 1:]:
+            fig = simulate_synchronized(kerf, measure, outdir)
             if fig:
                 figs.append(fig)
         if "--sim" not in args or "kerf" in args[args.index("--sim") + 1:]:

@@ -500,6 +500,8 @@ fn main() {
         "period_s": period,
         "cuts": cuts.len(),
         "beam_intervals": intervals.len(),
+        // The beam output in the last sample, recorded 0.3 s after the program ended.
+        "beam_on_at_end": beam.last().copied().unwrap_or(false),
         "framing_ok": framing_ok,
         "tolerance_budget_mm": budget,
         "max_deviation_beam_on_mm": max_dev_union,

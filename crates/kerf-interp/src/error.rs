@@ -100,6 +100,27 @@ pub enum InterpError {
         /// Upper limit.
         max: f64,
     },
+    /// The retract after the program's last cut (along the tool axis, the larger of
+    /// `pierce_standoff` and [`crate::EXIT_RETRACT_MIN_MM`]) puts an axis outside its range.
+    /// The program ends with that move so that a beam-off synchronized with motion (LinuxCNC
+    /// `M63`) takes effect. Fix: place the part farther from that limit.
+    #[error(
+        "path {path}: the retract of {retract_mm} mm along the tool axis after the last cut puts {axis} at {value}, outside its range [{min}, {max}]"
+    )]
+    RetractOutOfRange {
+        /// Index of the path whose cut it ends.
+        path: usize,
+        /// The retract, mm.
+        retract_mm: f64,
+        /// Axis name.
+        axis: String,
+        /// The axis value at the retract's end.
+        value: f64,
+        /// Lower limit.
+        min: f64,
+        /// Upper limit.
+        max: f64,
+    },
     /// The feed plan did not bring every axis within its velocity, acceleration and jerk
     /// limits within [`crate::PlanOptions::max_refinements`] rounds of slowing the offending
     /// windows (each round slows harder, so a motion that slowing can bring within the limits

@@ -77,6 +77,10 @@ pub use output::{comment_text, write_atomic, MAX_COMMENT};
 /// Sinumerik's `CTOL` plus the tip error of `OTOL`.
 pub const DEFAULT_BLEND_TOLERANCE: f64 = 0.005;
 
+/// The shortest retract (mm, along the tool axis) that ends a program whose last block is a
+/// cut: a real move after the last beam-off, which a beam-off synchronized with motion needs.
+pub const EXIT_RETRACT_MIN_MM: f64 = 1.0;
+
 pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_csv_to, write_gcode, ChordTerm,
     CutterCompensation, Dialect, GcodeOptions, ProcessCodes,

@@ -439,6 +439,7 @@ fn bad_process_codes_are_named_errors() {
         pierce_dwell_s: Some(0.5),
         pierce_standoff: Some(0.0),
         kerf_width_mm: None,
+        standoff_mm: None,
     });
     let text = gcode_motion(&m, &motion, &[], &opts).expect("gcode");
     assert_eq!(

@@ -8,7 +8,7 @@ use std::collections::HashMap;
 use common::{circle, freeform, stations};
 use kerf_interp::{
     csv_string, fit_blocks, gcode, plan, write_csv, write_gcode, AxisModel, Dialect, FitOptions,
-    GcodeOptions, Geometry, PaperAcHead, PlanOptions,
+    GcodeOptions, Geometry, PaperAcHead, PlanOptions, EXIT_RETRACT_MIN_MM,
 };
 use nalgebra::Vector3;
 
@@ -124,12 +124,31 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
         text.contains("tolerance budget mm: chord unknown"),
         "header states the budget, and no chord term it was not told"
     );
-    let moves: Vec<HashMap<String, f64>> = text
+    let mut moves: Vec<HashMap<String, f64>> = text
         .lines()
         .map(words)
         .filter(|(h, _)| h == "G0" || h == "G1")
         .map(|(_, w)| w)
         .collect();
+    // The program ends with a move after the last beam-off: the retract along the tool axis,
+    // at least 1 mm, so that a beam-off synchronized with motion takes effect.
+    let exit = moves.pop().expect("moves");
+    let last = blocks.last().expect("blocks");
+    let u = m.tool_axis(last.end_axes[3], last.end_axes[4]);
+    let up = last.end_tip()
+        + u * EXIT_RETRACT_MIN_MM.max(Dialect::Generic.default_process().pierce_standoff);
+    let lin = m.linear_axes(&up, last.end_axes[3], last.end_axes[4]);
+    for (k, v) in ["X", "Y", "Z"].iter().zip(lin) {
+        assert!(
+            (exit[*k] - v).abs() <= 5e-7,
+            "exit retract {k}: {} vs {v}",
+            exit[*k]
+        );
+    }
+    assert!(
+        text.rfind("G0 X").expect("G0") > text.rfind("M5").expect("beam off"),
+        "the retract follows the last beam-off"
+    );
     let q = |w: &HashMap<String, f64>| -> [f64; 5] { ["X", "Y", "Z", "A", "C"].map(|k| w[k]) };
     // G0 to the pierce point, then the descent to the start.
     assert_eq!(
@@ -203,8 +222,20 @@ fn sinumerik_gcode_parses_back_to_tips_orientations_and_arcs() {
         .collect();
     assert_eq!(
         moves.len(),
-        blocks.len() + 2,
-        "a move to the pierce point, the descent and one line per block"
+        blocks.len() + 3,
+        "a move to the pierce point, the descent, one line per block and the exit retract"
+    );
+    let (head, exit) = moves.last().expect("moves");
+    let last = blocks.last().expect("blocks");
+    assert_eq!(head, "G0", "the program ends with a retract");
+    assert!(
+        (exit["Z"]
+            - last.end_tip().z
+            - last.end_tool_axis.z
+                * EXIT_RETRACT_MIN_MM.max(Dialect::Generic.default_process().pierce_standoff))
+        .abs()
+            <= 5e-7,
+        "the retract runs along the tool axis"
     );
     for (b, (head, w)) in blocks.iter().zip(&moves[2..]) {
         let tip = b.end_tip();

@@ -43,7 +43,8 @@ impl Dialect {
     /// LinuxCNC's `M64`/`M65` switch the output when every motion queued before them has
     /// finished (they break blending): the dwell after `M64` runs with the beam on and the
     /// beam goes off where the cut ends. (`M62`/`M63` would act at the start of the *next*
-    /// motion: the dwell would run with the beam off, and a last `M63` would never fire.)
+    /// motion: the dwell would run with the beam off. Every program ends with a retract
+    /// after its last beam-off, so that a last `M63` fires too.)
     pub fn default_process(self) -> ProcessCodes {
         let (on, off) = match self {
             Dialect::Linuxcnc => ("M64 P0", "M65 P0"),

@@ -342,28 +342,39 @@ fn refuse_pierces_out_of_range<M: AxisModel + ?Sized>(
     blocks: &[Block],
     process: &ProcessCodes,
 ) -> Result<()> {
-    let names = model.axis_names();
     for (k, b) in blocks.iter().enumerate() {
         let starts_cut = !b.rapid && (k == 0 || blocks[k - 1].rapid);
         if !starts_cut {
             continue;
         }
         let (_, q, _) = writer::pierce_point(model, process, b);
-        for (axis, &range) in model.limits().range.iter().enumerate() {
-            let Some([min, max]) = range else { continue };
-            if !(q[axis] >= min && q[axis] <= max) {
-                return Err(InterpError::PierceOutOfRange {
-                    path: b.path,
-                    standoff_mm: process.pierce_standoff,
-                    axis: names[axis].to_string(),
-                    value: q[axis],
-                    min,
-                    max,
-                });
-            }
+        if let Some((axis, value, [min, max])) = out_of_range(model, &q) {
+            return Err(InterpError::PierceOutOfRange {
+                path: b.path,
+                standoff_mm: process.pierce_standoff,
+                axis,
+                value,
+                min,
+                max,
+            });
         }
     }
     Ok(())
+}
+
+/// The first axis of `q` outside its range: its name, value and range.
+fn out_of_range<M: AxisModel + ?Sized>(model: &M, q: &[f64; 5]) -> Option<(String, f64, [f64; 2])> {
+    let names = model.axis_names();
+    model
+        .limits()
+        .range
+        .iter()
+        .enumerate()
+        .find_map(|(axis, range)| {
+            let [min, max] = (*range)?;
+            (!(q[axis] >= min && q[axis] <= max))
+                .then(|| (names[axis].to_string(), q[axis], [min, max]))
+        })
 }
 
 /// The G-code program of `blocks`, cutting block `b` taking `block_times[b]` seconds (a
@@ -455,6 +466,23 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     }
     if w.in_cut {
         w.end_cut();
+    }
+    // A program whose last block is a cut ends with a move: a beam-off synchronized with
+    // motion (LinuxCNC `M63`) takes effect only when the next move starts, and after `M2`
+    // none would, leaving the beam on.
+    if let Some(b) = blocks.last().filter(|b| !b.rapid) {
+        let (p, q, u, h) = writer::exit_point(model, &w.process, b);
+        if let Some((axis, value, [min, max])) = out_of_range(model, &q) {
+            return Err(InterpError::RetractOutOfRange {
+                path: b.path,
+                retract_mm: h,
+                axis,
+                value,
+                min,
+                max,
+            });
+        }
+        w.rapid(p, q, u);
     }
     match opts.dialect {
         Dialect::Linuxcnc => w.line("M2"),

@@ -386,6 +386,22 @@ fn feed_number(f: f64) -> String {
     format!("{f:.decimals$}")
 }
 
+/// The end of the retract after the program's last cut, `b` (along the tool axis at its
+/// end, the larger of `pierce_standoff` and [`crate::EXIT_RETRACT_MIN_MM`]): the point, the
+/// machine axes there (the end's rotary axes), the tool axis and the retract (mm).
+pub(super) fn exit_point<M: AxisModel + ?Sized>(
+    model: &M,
+    process: &ProcessCodes,
+    b: &Block,
+) -> (nalgebra::Point3<f64>, [f64; 5], nalgebra::Vector3<f64>, f64) {
+    let (tilt, c) = (b.end_axes[3], b.end_axes[4]);
+    let u = model.tool_axis(tilt, c);
+    let h = process.pierce_standoff.max(crate::EXIT_RETRACT_MIN_MM);
+    let p = b.end_tip() + u * h;
+    let lin = model.linear_axes(&p, tilt, c);
+    (p, [lin[0], lin[1], lin[2], tilt, c], u, h)
+}
+
 /// The pierce point of the cut starting with `b` (`pierce_standoff` above its start along the
 /// tool axis), the machine axes there (the start's rotary axes) and the tool axis.
 pub(super) fn pierce_point<M: AxisModel + ?Sized>(

@@ -517,6 +517,19 @@ pub(crate) struct RunArgs {
     #[arg(long)]
     pub(crate) kerf_in_control: bool,
 
+    /// Check the head against the part along every cut (contour, lead-in, lead-out): the
+    /// machine file's `head` (else a 3 mm nozzle cone 25 mm long on a 90 mm body) standing at
+    /// its `process.standoff_mm` must keep this distance, mm, from the part's surfaces, proven
+    /// over the poses and the motion between them; a cut that comes closer is refused naming
+    /// the stretch and the surface. The report's `head` gives the figures per path.
+    #[arg(long, value_name = "MM", value_parser = crate::guard::clearance_mm)]
+    pub(crate) cut_clearance: Option<f64>,
+
+    /// With --cut-clearance: report cuts where the head comes closer as warnings instead of
+    /// refusing the run.
+    #[arg(long, requires = "cut_clearance")]
+    pub(crate) accept_head_collisions: bool,
+
     /// Lead-in of every cut: the straight part from the pierce point, then the radius of the
     /// quarter arc that joins the contour tangentially on the scrap side, mm, each 0 to 1000
     /// (`0,0` pierces on the contour). Shrunk where the scrap is smaller (small holes).

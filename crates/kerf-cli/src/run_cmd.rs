@@ -51,6 +51,8 @@ fn job_options(args: &RunArgs) -> JobOptions {
         .with_wall_axis_max_mm(args.max_wall)
         .with_kerf_width_mm(args.kerf_width)
         .with_kerf_in_control(args.kerf_in_control)
+        .with_cut_clearance_mm(args.cut_clearance)
+        .with_accept_head_collisions(args.accept_head_collisions)
 }
 
 /// Runs `kerf run`.

@@ -37,6 +37,7 @@ mod axes_file;
 mod choice;
 mod error;
 mod fork_head;
+mod head;
 mod head_table;
 mod json;
 mod kinematics;
@@ -56,11 +57,13 @@ pub use axes_file::{AxesFile, AxesMove, AxesPath, AXES_FORMAT};
 pub use choice::{nearest_solution, nearest_turn, turns_near};
 pub use error::{BoxedKinematicsError, IoError, KinematicsError, Result};
 pub use fork_head::{ForkHead, ForkTilt};
+pub use head::{Head, HeadSolid, MAX_HEAD_SIZE_MM, MAX_HEAD_SOLIDS};
 pub use head_table::HeadTable;
 pub use kinematics::{Kinematics, Parameter};
 pub use machine::{
-    process_line_defect, Machine, Process, Range, MACHINE_FORMAT, MAX_KERF_WIDTH_MM,
-    MAX_PIERCE_DWELL_S, MAX_PIERCE_STANDOFF_MM, MAX_PROCESS_LINES, MAX_PROCESS_LINE_CHARS,
+    process_line_defect, Machine, Process, Range, DEFAULT_STANDOFF_MM, MACHINE_FORMAT,
+    MAX_KERF_WIDTH_MM, MAX_PIERCE_DWELL_S, MAX_PIERCE_STANDOFF_MM, MAX_PROCESS_LINES,
+    MAX_PROCESS_LINE_CHARS,
 };
 pub use nonlinear::{interpolate, linearization_error, slerp, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
@@ -72,4 +75,6 @@ pub use placement::{
 pub use pose::{Axes, Axis, Pose};
 pub use registry::kinematics_types;
 pub use table_table::TableTable;
-pub use tilt::{tilt_within_cone, TiltChoice, TiltReport, TILT_WORKING_FRACTION};
+pub use tilt::{
+    tilt_within_cone, tilt_within_cones, Cone, TiltChoice, TiltReport, TILT_WORKING_FRACTION,
+};

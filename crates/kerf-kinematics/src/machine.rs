@@ -34,6 +34,7 @@ use std::sync::Arc;
 use serde_json::{Map, Value};
 
 use crate::error::{json_type_name, KinematicsError, Result};
+use crate::head::Head;
 use crate::kinematics::Kinematics;
 use crate::pose::{Axes, Axis};
 use crate::registry;
@@ -81,6 +82,9 @@ pub struct Machine {
     /// The laser process codes of the optional `process` object; every field `None` when the
     /// file has none (the G-code writer then uses its dialect's defaults).
     pub process: Process,
+    /// The cutting head of the optional `head` object (`None` without one: checks then use
+    /// [`Head::laser_default`]).
+    pub head: Option<Head>,
     /// The file's unknown top-level keys that look like misspellings of the format's
     /// (`max_jerks: unknown key, did you mean "max_jerk"?`): the machine was read without
     /// them, so a misspelt optional limit is absent. Empty for a machine built in code.
@@ -110,7 +114,15 @@ pub struct Process {
     /// The beam's kerf width, mm, in `(0, MAX_KERF_WIDTH_MM]`: with it `kerf run` offsets each
     /// path by half of it toward the scrap side (a run's own width wins).
     pub kerf_width_mm: Option<f64>,
+    /// The nozzle tip's height above the surface while cutting, mm, in
+    /// `[0, MAX_PIERCE_STANDOFF_MM]` (default [`DEFAULT_STANDOFF_MM`]): where the head model
+    /// stands on each cutting pose when cuts are checked against the part.
+    pub standoff_mm: Option<f64>,
 }
+
+/// The nozzle's standoff above the surface while cutting when a machine file gives none, mm
+/// (fiber-laser cutting runs at 0.5-1.5 mm).
+pub const DEFAULT_STANDOFF_MM: f64 = 1.0;
 
 /// The widest kerf a machine file may give, mm: a plasma kerf is a few millimetres; beyond
 /// this the number is a mistake, not a kerf.
@@ -229,12 +241,13 @@ fn system_variable_ok(var: &str) -> bool {
 
 impl Process {
     /// The keys of the `process` object.
-    pub const KEYS: [&'static str; 5] = [
+    pub const KEYS: [&'static str; 6] = [
         "beam_on",
         "beam_off",
         "pierce_dwell_s",
         "pierce_standoff",
         "kerf_width_mm",
+        "standoff_mm",
     ];
 
     /// Checks every present value.
@@ -303,6 +316,7 @@ impl Process {
                 self.pierce_standoff,
                 MAX_PIERCE_STANDOFF_MM,
             ),
+            ("standoff_mm", self.standoff_mm, MAX_PIERCE_STANDOFF_MM),
         ] {
             if let Some(v) = v {
                 if !(v.is_finite() && (0.0..=max).contains(&v)) {
@@ -381,6 +395,7 @@ impl Process {
             pierce_dwell_s: number("pierce_dwell_s")?,
             pierce_standoff: number("pierce_standoff")?,
             kerf_width_mm: number("kerf_width_mm")?,
+            standoff_mm: number("standoff_mm")?,
         };
         p.validate()?;
         Ok(p)
@@ -412,6 +427,7 @@ impl Machine {
             max_velocity,
             max_acceleration,
             process: Process::default(),
+            head: None,
             max_jerk: None,
             warnings: Vec::new(),
         };
@@ -479,6 +495,9 @@ impl Machine {
                     ));
                 }
             }
+        }
+        if let Some(h) = &self.head {
+            h.validate()?;
         }
         self.process.validate()
     }
@@ -551,6 +570,7 @@ impl Machine {
         "max_acceleration",
         "max_jerk",
         "process",
+        "head",
     ];
 
     /// Reads a machine from a parsed JSON document. Unknown top-level keys are allowed
@@ -629,6 +649,9 @@ impl Machine {
         if let Some(p) = top.get("process") {
             machine.process = Process::from_value(p)?;
         }
+        if let Some(h) = top.get("head") {
+            machine.head = Some(Head::from_value(h)?);
+        }
         kerf_io::near_misses_in(top, Self::KEYS, "", &mut machine.warnings);
         Ok(machine)
     }
@@ -672,6 +695,7 @@ impl Machine {
             ("pierce_dwell_s", p.pierce_dwell_s),
             ("pierce_standoff", p.pierce_standoff),
             ("kerf_width_mm", p.kerf_width_mm),
+            ("standoff_mm", p.standoff_mm),
         ] {
             if let Some(v) = v {
                 process.push(format!("\"{key}\": {}", json(v)));
@@ -682,8 +706,11 @@ impl Machine {
         } else {
             format!(",\n  \"process\": {{ {} }}", process.join(", "))
         };
+        let head = self.head.as_ref().map_or(String::new(), |h| {
+            format!(",\n  \"head\": {}", h.to_value())
+        });
         format!(
-            "{{\n  \"format\": \"{MACHINE_FORMAT}\",\n  \"name\": {},\n  \"kinematics\": {{ {} }},\n  \"limits\": {limits},\n  \"max_velocity\": {},\n  \"max_acceleration\": {}{jerk}{process}\n}}\n",
+            "{{\n  \"format\": \"{MACHINE_FORMAT}\",\n  \"name\": {},\n  \"kinematics\": {{ {} }},\n  \"limits\": {limits},\n  \"max_velocity\": {},\n  \"max_acceleration\": {}{jerk}{process}{head}\n}}\n",
             json(self.name.as_str()),
             kin.join(", "),
             numbers(&self.max_velocity),

@@ -91,6 +91,32 @@ pub struct TiltReport {
 /// finite, or no poses) returns the poses' own axes. The axes must be unit vectors (as
 /// [`crate::solve_path`] makes them).
 pub fn tilt_within_cone(poses: &[Pose], tolerance_deg: f64) -> TiltChoice {
+    let cones: Vec<Cone> = poses
+        .iter()
+        .map(|p| Cone {
+            axis: p.axis,
+            half_angle_deg: tolerance_deg,
+        })
+        .collect();
+    tilt_within_cones(poses, &cones, tolerance_deg)
+}
+
+/// A cone of tool axes: its unit centre axis and its half-angle (degrees).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cone {
+    /// The centre (unit).
+    pub axis: Vector3<f64>,
+    /// The half-angle, degrees.
+    pub half_angle_deg: f64,
+}
+
+/// [`tilt_within_cone`] with a cone of its own for each pose: the chosen axis of pose `i` lies
+/// within `cones[i]` (a cone of half-angle <= 0 holds its centre alone), the rotary axes
+/// moving least. The poses' own axes (their normals) are what the report measures against;
+/// `tolerance_deg` is the tolerance it states. So a caller narrows a pose's choice, e.g. to
+/// the axes that keep the head clear of a wall, inside the normal's tolerance cone. `cones`
+/// must hold one cone per pose (else the poses' own axes are returned).
+pub fn tilt_within_cones(poses: &[Pose], cones: &[Cone], tolerance_deg: f64) -> TiltChoice {
     let normals: Vec<Vector3<f64>> = poses.iter().map(|p| p.axis).collect();
     let exact = Coords::of(&normals);
     let travel = exact.travel_deg();
@@ -104,32 +130,47 @@ pub fn tilt_within_cone(poses: &[Pose], tolerance_deg: f64) -> TiltChoice {
         strings_over_budget: 0,
     };
     let mut axes = normals.clone();
-    if !(tolerance_deg.is_finite() && tolerance_deg > 0.0) || poses.is_empty() {
+    if poses.is_empty() || cones.len() != poses.len() {
         return TiltChoice { axes, report };
     }
-    let theta = tolerance_deg.to_radians().min(FRAC_PI_2);
-    let working = theta * TILT_WORKING_FRACTION;
+    let centres: Vec<Vector3<f64>> = cones.iter().map(|c| c.axis.normalize()).collect();
+    let thetas: Vec<f64> = cones
+        .iter()
+        .map(|c| {
+            if c.half_angle_deg.is_finite() && c.half_angle_deg > 0.0 {
+                c.half_angle_deg.to_radians().min(FRAC_PI_2)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    if thetas.iter().all(|&t| t == 0.0) && centres == normals {
+        return TiltChoice { axes, report };
+    }
+    let centre_coords = Coords::of(&centres);
     let s = path_length(poses);
     let mut strings = Strings::default();
 
     // 1. The azimuth: intervals of C seen from the pole.
     let (c_lo, c_hi): (Vec<f64>, Vec<f64>) = (0..poses.len())
         .map(|i| {
-            let phi = exact.pole_angle[i];
+            let working = thetas[i] * TILT_WORKING_FRACTION;
+            let phi = centre_coords.pole_angle[i];
             let half = if phi <= working {
                 FRAC_PI_2 // the pole is in the cone: every line through it (C modulo 180)
             } else {
                 (working.sin() / phi.sin()).clamp(0.0, 1.0).asin()
             };
-            (exact.c[i] - half, exact.c[i] + half)
+            (centre_coords.c[i] - half, centre_coords.c[i] + half)
         })
         .unzip();
-    let c = strings.solve(&s, &c_lo, &c_hi, &exact.c);
+    let c = strings.solve(&s, &c_lo, &c_hi, &centre_coords.c);
 
     // 2. The tilt along each chosen azimuth.
     let (t_lo, t_hi): (Vec<f64>, Vec<f64>) = (0..poses.len())
         .map(|i| {
-            let n = normals[i];
+            let working = thetas[i] * TILT_WORKING_FRACTION;
+            let n = centres[i];
             let (sin_c, cos_c) = c[i].sin_cos();
             let a = n.z;
             let b = n.x * cos_c + n.y * sin_c;
@@ -146,19 +187,21 @@ pub fn tilt_within_cone(poses: &[Pose], tolerance_deg: f64) -> TiltChoice {
     let t_mid: Vec<f64> = t_lo.iter().zip(&t_hi).map(|(l, h)| 0.5 * (l + h)).collect();
     let t = strings.solve(&s, &t_lo, &t_hi, &t_mid);
 
-    // 3. The axes, each measured against its normal; one outside the cone (only rounding
-    // could put it there) takes the normal.
+    // 3. The axes, each measured against its cone; one outside it (only rounding could put it
+    // there) takes the cone's centre. The report measures against the normals.
     for i in 0..poses.len() {
         let (sin_t, cos_t) = t[i].sin_cos();
         let (sin_c, cos_c) = c[i].sin_cos();
         let u = Vector3::new(sin_t * cos_c, sin_t * sin_c, cos_t);
-        let dev = angle(&u, &normals[i]);
-        if dev <= theta {
-            axes[i] = u;
-            if dev > report.max_deviation_deg.to_radians() {
-                report.max_deviation_deg = dev.to_degrees();
-                report.max_deviation_at = i;
-            }
+        axes[i] = if angle(&u, &centres[i]) <= thetas[i] {
+            u
+        } else {
+            centres[i]
+        };
+        let dev = angle(&axes[i], &normals[i]);
+        if dev > report.max_deviation_deg.to_radians() {
+            report.max_deviation_deg = dev.to_degrees();
+            report.max_deviation_at = i;
         }
     }
     report.rotary_travel_deg = Coords::of(&axes).travel_deg();

@@ -18,7 +18,7 @@ fn absent_process_is_empty_and_a_full_one_reads_back() {
     let m = Machine::from_str(&machine("")).expect("no process");
     assert!(m.process.is_empty());
     let m = Machine::from_str(&machine(
-        r#", "process": { "beam_on": ["M64 P0", "G4 P0.01"], "beam_off": ["M65 P0"], "pierce_dwell_s": 0.2, "pierce_standoff": 1.5, "kerf_width_mm": 0.15 }"#,
+        r#", "process": { "beam_on": ["M64 P0", "G4 P0.01"], "beam_off": ["M65 P0"], "pierce_dwell_s": 0.2, "pierce_standoff": 1.5, "kerf_width_mm": 0.15, "standoff_mm": 0.8 }"#,
     ))
     .expect("full process");
     assert_eq!(
@@ -29,6 +29,7 @@ fn absent_process_is_empty_and_a_full_one_reads_back() {
             pierce_dwell_s: Some(0.2),
             pierce_standoff: Some(1.5),
             kerf_width_mm: Some(0.15),
+            standoff_mm: Some(0.8),
         }
     );
     let back = Machine::from_str(&m.to_json()).expect("to_json reads back");
@@ -92,7 +93,7 @@ fn bad_process_values_are_named_errors() {
         (r#"{"beam_off": [5]}"#, "process.beam_off[0]: expected a string, found a number"),
         (r#"{"beam_on": ["M64 P0\nG0 X1400"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '\\n')"),
         (r#"{"beam_on": ["M3 (on)"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '(')"),
-        (r#"{"beam_on": ["M3"], "dwell": 1}"#, "process.dwell: unknown key (known: beam_on, beam_off, pierce_dwell_s, pierce_standoff, kerf_width_mm)"),
+        (r#"{"beam_on": ["M3"], "dwell": 1}"#, "process.dwell: unknown key (known: beam_on, beam_off, pierce_dwell_s, pierce_standoff, kerf_width_mm, standoff_mm)"),
         (r#"["M3"]"#, "process: expected an object, found an array"),
         // The review's machine files: no motion, program end, o-word or tape mark can ride
         // in on a process line, and no absurd pierce.
@@ -168,4 +169,64 @@ fn process_codes_have_a_length_limit() {
         "process.beam_off: 65 lines, at most 64",
         "built in code"
     );
+}
+
+/// The optional `head`: solids from the nozzle tip up, read strictly, written back.
+#[test]
+fn a_head_reads_back_and_bad_heads_are_refused_by_path() {
+    let m = Machine::from_str(&machine(
+        r#", "head": { "solids": [ { "type": "cone", "length": 20, "tip_diameter": 2, "cone_angle_deg": 30 }, { "type": "cylinder", "length": 100, "diameter": 80 } ] }"#,
+    ))
+    .expect("head");
+    let h = m.head.as_ref().expect("a head");
+    // A 30-degree cone widens by 2 tan(15 deg) per mm of length.
+    let top = 2.0 + 2.0 * 20.0 * 15f64.to_radians().tan();
+    assert!((h.solids[0].top_diameter_mm - top).abs() < 1e-12, "{h:?}");
+    assert_eq!(h.length_mm(), 120.0);
+    assert_eq!(h.max_radius_mm(), 40.0);
+    assert_eq!(
+        h.radius_at(20.0),
+        Some(40.0),
+        "the larger radius where solids meet"
+    );
+    let back = Machine::from_str(&m.to_json()).expect("to_json reads back");
+    assert_eq!(back.head, m.head, "to_json keeps the head");
+    for (head, want) in [
+        (r#"[]"#, "head: expected an object, found an array"),
+        (r#"{"solids": []}"#, "head.solids: must list at least one solid"),
+        (r#"{"solid": []}"#, "head.solid: unknown key (known: solids)"),
+        (
+            r#"{"solids": [{"type": "cone", "length": 20, "tip_diameter": 2, "top_diameter": 9, "cone_angle_deg": 30}]}"#,
+            "head.solids[0]: a cone takes top_diameter or cone_angle_deg, not both",
+        ),
+        (
+            r#"{"solids": [{"type": "cylinder", "length": 20, "diameter": 9, "tip_diameter": 2}]}"#,
+            "head.solids[0].tip_diameter: not a key of a cylinder",
+        ),
+        (
+            r#"{"solids": [{"type": "cylinder", "length": -1, "diameter": 9}]}"#,
+            "head.solids[0]: length must lie in (0, 5000] mm (got -1)",
+        ),
+        (
+            r#"{"solids": [{"type": "cylinder", "length": 10}]}"#,
+            "head.solids[0].diameter: missing",
+        ),
+        (
+            r#"{"solids": [{"type": "sphere", "length": 10}]}"#,
+            "head.solids[0].type: unknown type \"sphere\" (known: cone, cylinder)",
+        ),
+        (
+            r#"{"solids": [{"type": "cylinder", "length": 10, "diameter": 5, "colour": 1}]}"#,
+            "head.solids[0].colour: unknown key (known: type, length, diameter, tip_diameter, top_diameter, cone_angle_deg)",
+        ),
+    ] {
+        let e = Machine::from_str(&machine(&format!(r#", "head": {head}"#))).expect_err(want);
+        assert_eq!(e.to_string(), want);
+    }
+    let many = format!(
+        r#", "head": {{"solids": [{}]}}"#,
+        vec![r#"{"type": "cylinder", "length": 1, "diameter": 5}"#; 17].join(", ")
+    );
+    let e = Machine::from_str(&machine(&many)).expect_err("17 solids");
+    assert_eq!(e.to_string(), "head.solids: 17 solids, at most 16");
 }

@@ -133,6 +133,14 @@ pub struct JobOptions {
     /// must stand the beam vertical with the rotary axes still). Default false: compensate in
     /// the computer.
     pub kerf_in_control: bool,
+    /// The distance the head (the machine file's `head`, else
+    /// [`kerf_kinematics::Head::laser_default`]) must keep from the part's surfaces along
+    /// every cut (contour, lead-in, lead-out), mm ([`kerf_process::check_cut`]). `None` (the
+    /// default for now): cuts are not checked against the head.
+    pub cut_clearance_mm: Option<f64>,
+    /// With [`JobOptions::cut_clearance_mm`], cuts where the head comes closer are warnings
+    /// instead of a refused run. Default false.
+    pub accept_head_collisions: bool,
 }
 
 /// The tilt tolerance of a job unless it sets another (degrees): 0, the exact normal. A
@@ -169,6 +177,8 @@ impl Default for JobOptions {
             wall_axis_max_mm: 4.0,
             kerf_width_mm: None,
             kerf_in_control: false,
+            cut_clearance_mm: None,
+            accept_head_collisions: false,
         }
     }
 }
@@ -268,6 +278,20 @@ impl JobOptions {
         self
     }
 
+    /// With the head checked along every cut at this clearance, mm (`None`: not checked; see
+    /// [`JobOptions::cut_clearance_mm`]).
+    pub fn with_cut_clearance_mm(mut self, mm: Option<f64>) -> Self {
+        self.cut_clearance_mm = mm;
+        self
+    }
+
+    /// With head collisions along the cuts reported as warnings instead of refused (see
+    /// [`JobOptions::accept_head_collisions`]).
+    pub fn with_accept_head_collisions(mut self, accept: bool) -> Self {
+        self.accept_head_collisions = accept;
+        self
+    }
+
     /// With these traverse checks (`None`: unchecked traverses).
     pub fn with_traverse(mut self, traverse: Option<kerf_process::TraverseOptions>) -> Self {
         self.traverse = traverse;
@@ -322,6 +346,9 @@ impl JobOptions {
         WALL_MM.check("wall_axis_max_mm", self.wall_axis_max_mm)?;
         if let Some(w) = self.kerf_width_mm {
             crate::ranges::KERF_WIDTH_MM.check("kerf_width_mm", w)?;
+        }
+        if let Some(c) = self.cut_clearance_mm {
+            CLEARANCE_MM.check("cut_clearance_mm", c)?;
         }
         let l = &self.leads;
         for (name, v) in [

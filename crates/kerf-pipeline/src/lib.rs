@@ -38,6 +38,7 @@ mod certify;
 mod cuts;
 mod discretize;
 mod error;
+mod head;
 mod job;
 mod motion;
 mod output;

@@ -122,6 +122,13 @@ fn linear_overshoot(e: &crate::Error) -> Option<f64> {
             min,
             max,
             ..
+        }
+        | kerf_interp::InterpError::RetractOutOfRange {
+            axis,
+            value,
+            min,
+            max,
+            ..
         } => (axis, *value, *min, *max),
         _ => return None,
     };
@@ -292,7 +299,66 @@ fn run_placed(
         })
         .collect();
     lap.split(&mut timings, "cuts");
-    let solved = solve_paths(machine, &inputs, &popts).map_err(kin(path))?;
+    let mut solved = solve_paths(machine, &inputs, &popts).map_err(kin(path))?;
+    lap.split(&mut timings, "kinematics");
+    // 3d. The head against every surface of the file along every cut, set-up by set-up; the
+    // tool axis tilted within the tilt tolerance where it comes too close.
+    let mut head_report: Vec<serde_json::Value> = Vec::new();
+    let mut head_tip_zone: Option<f64> = None;
+    let mut head_warnings: Vec<String> = Vec::new();
+    if let Some(clearance) = o.cut_clearance_mm {
+        let head = machine
+            .head
+            .clone()
+            .unwrap_or_else(kerf_kinematics::Head::laser_default);
+        let hopts = kerf_process::HeadCheckOptions::default()
+            .with_clearance_mm(clearance)
+            .with_standoff_mm(
+                machine
+                    .process
+                    .standoff_mm
+                    .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
+            )
+            .with_max_tilt_deg(popts.tilt_tolerance_deg.max(HEAD_CHECK_MIN_TILT_DEG))
+            .with_path_deviation_mm(popts.linearization_tolerance_mm.min(1.0));
+        for setup in 0..placed.plan.setups.len() {
+            let ks: Vec<usize> = (0..solved.len())
+                .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
+                .collect();
+            let Some(&first) = ks.first() else { continue };
+            let placement = placed.placement_of(cuts[first].curve);
+            // Each cut against the part it lies on: the surfaces its curve names and every
+            // surface joined to those (a wall beside a hole), not another part the file holds.
+            let all =
+                kerf_process::Obstacles::from_all_surfaces(file, |p| placement.apply_point(p))
+                    .map_err(|source| crate::Error::Process {
+                        file: path.map(Path::to_path_buf),
+                        source,
+                    })?;
+            let parts = all.parts(PART_JOIN_TOLERANCE_MM);
+            let r = crate::head::check_and_clear(
+                machine,
+                |k| all.of_parts(&parts, &file.curves[cuts[k].curve].surfaces),
+                &head,
+                &hopts,
+                &popts,
+                &inputs,
+                &ks,
+                &mut solved,
+                o.accept_head_collisions,
+            );
+            head_report.extend(r.report);
+            head_warnings.extend(r.warnings);
+            head_tip_zone = r.tip_zone_mm.or(head_tip_zone);
+            if let Some(source) = r.refusal {
+                return Err(crate::Error::Process {
+                    file: path.map(Path::to_path_buf),
+                    source,
+                });
+            }
+        }
+        lap.split(&mut timings, "head");
+    }
     drop(inputs);
     drop(cut_poses);
     // The controller's compensation: G41.1/G42.1 per path, where the beam stands vertical
@@ -338,7 +404,7 @@ fn run_placed(
     // The traverses for the plot, part coordinates, and a cut's last pose.
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
-    let mut warnings: Vec<String> = Vec::new();
+    let mut warnings: Vec<String> = head_warnings;
     // The offset paths go into the toolpath (`kerf_offset`), where `kerf check` measures them.
     for c in &compensated {
         if let crate::cuts::Outcome::Offset(p) = &c.outcome {
@@ -373,16 +439,26 @@ fn run_placed(
             .collect();
         // Traverses that clear the part's surfaces, placed with this set-up.
         let mut traverses = Vec::new();
-        if let (Some(topts), Some(&first)) = (&topts, in_setup.first()) {
+        // The surfaces the set-up's curves name, placed with it, for the traverses.
+        let obstacles = match in_setup.first() {
+            Some(&first) if topts.is_some() => {
+                let placement = placed.placement_of(cuts[first].curve);
+                Some(
+                    kerf_process::Obstacles::from_file(
+                        file,
+                        &placed.plan.setups[setup].paths,
+                        |p| placement.apply_point(p),
+                    )
+                    .map_err(|source| crate::Error::Process {
+                        file: path.map(Path::to_path_buf),
+                        source,
+                    })?,
+                )
+            }
+            _ => None,
+        };
+        if let (Some(topts), Some(obs), Some(&first)) = (&topts, &obstacles, in_setup.first()) {
             let placement = placed.placement_of(cuts[first].curve);
-            let obs =
-                kerf_process::Obstacles::from_file(file, &placed.plan.setups[setup].paths, |p| {
-                    placement.apply_point(p)
-                })
-                .map_err(|source| crate::Error::Process {
-                    file: path.map(Path::to_path_buf),
-                    source,
-                })?;
             let gaps: Vec<kerf_process::Gap> = in_setup
                 .windows(2)
                 .map(|w| {
@@ -408,7 +484,7 @@ fn run_placed(
                 })
                 .collect();
             let rapids =
-                kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, &obs, &gaps, topts);
+                kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, obs, &gaps, topts);
             for ((w, planned), gap) in in_setup.windows(2).zip(&rapids).zip(&gaps) {
                 let (t, r, absent) = match planned {
                     Ok(p) => p,
@@ -418,7 +494,7 @@ fn run_placed(
                         warnings.push(format!("{e}; this traverse is NOT checked"));
                         // The surfaces the routes were checked without (the last attempt
                         // leaves out all those in the cuts' way).
-                        let left_out = kerf_process::in_the_cuts_way(&obs, gap, topts);
+                        let left_out = kerf_process::in_the_cuts_way(obs, gap, topts);
                         blocked_report.push(json!({
                             "after": solved[w[0]].id,
                             "before": solved[w[1]].id,
@@ -459,7 +535,7 @@ fn run_placed(
                 );
                 // Surfaces left out that a neighbouring cut names itself: its own surface
                 // curls over its head line (the cut meets it, whatever the traverse does).
-                let over = kerf_process::own_surfaces_over_the_head(&obs, gap, topts);
+                let over = kerf_process::own_surfaces_over_the_head(obs, gap, topts);
                 let own: Vec<&String> = absent.iter().filter(|id| over.contains(id)).collect();
                 if !own.is_empty() {
                     own_report.push(json!({
@@ -658,6 +734,7 @@ fn run_placed(
             "files": program_names(programs.len()),
         },
         "compensation": crate::cuts::compensation_json(file, kerf.as_ref(), &compensated),
+        "head": crate::head::head_json(o.cut_clearance_mm, machine, head_tip_zone, head_report),
         "discretize": {
             "curves": file.curves.len(),
             "segments": segments,
@@ -739,6 +816,14 @@ fn run_placed(
 /// angle between a tool axis and its surface normal with the path and the place, and the
 /// rotary travel `sum |d tilt| + |d C|` (degrees) of the exact normals and of the chosen axes,
 /// in all and per path. `null` without a tolerance.
+/// How near a surface's boundary must come to another for the two to be one part, mm (CAD
+/// edges meet within hundredths of a millimetre).
+const PART_JOIN_TOLERANCE_MM: f64 = 0.05;
+
+/// The least tilt the head check's tip zone allows for, degrees: a lead-in's or a blended
+/// pose's axis may stand a little off the surface normal even without a tilt tolerance.
+const HEAD_CHECK_MIN_TILT_DEG: f64 = 10.0;
+
 fn tilt_report(solved: &[kerf_kinematics::SolvedPath], tolerance_deg: f64) -> serde_json::Value {
     if tolerance_deg <= 0.0 {
         return serde_json::Value::Null;

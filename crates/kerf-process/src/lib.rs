@@ -27,6 +27,7 @@
 //! The derivations and the checks are in `docs/process.md`.
 
 mod geometry;
+mod head;
 mod lead;
 mod offset;
 mod order;
@@ -36,6 +37,10 @@ mod start;
 mod traverse;
 mod wall;
 
+pub use head::{
+    check_cut, tip_zone_mm, CloseStretch, CutClearance, HeadCheckOptions, CLOSE_CELL_MM,
+    SAMPLE_STEP_MM, STRETCH_SLACK_MM,
+};
 pub use lead::{LeadIn, LeadOptions};
 pub use offset::{offset, OffsetInput, OffsetOptions, OffsetPath};
 pub use order::CutPlan;
@@ -168,6 +173,16 @@ pub enum ProcessError {
         /// The kerf width, mm.
         kerf_width_mm: f64,
         /// Where and why, with the sizes.
+        reason: String,
+    },
+    /// The head comes closer to the part than the cutting clearance along a cut
+    /// ([`check_cut`]). Fix: a tilt tolerance or another placement, a smaller clearance, or
+    /// accept it as a warning where the head model is known to be pessimistic.
+    #[error("path \"{id}\": the head comes too close to the part: {reason}")]
+    HeadTooClose {
+        /// The path's id.
+        id: String,
+        /// The stretch, the distance, the surface.
         reason: String,
     },
     /// No traverse route between two cuts keeps the clearance: the retract along the tool

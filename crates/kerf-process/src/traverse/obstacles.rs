@@ -17,6 +17,34 @@ enum Obstacle {
     Mesh(Box<TriMesh>),
 }
 
+/// Points on the boundary of a surface ([`Obstacles::joined_to`]).
+fn boundary_points(shape: &Obstacle) -> Vec<Point3<f64>> {
+    match shape {
+        Obstacle::Nurbs(t) => {
+            let s = t.surface();
+            let ((u0, u1), (v0, v1)) = (s.domain_u(), s.domain_v());
+            let k = 32;
+            (0..=k)
+                .flat_map(|j| {
+                    let f = j as f64 / k as f64;
+                    let (u, v) = (u0 + (u1 - u0) * f, v0 + (v1 - v0) * f);
+                    [
+                        s.point(u, v0),
+                        s.point(u, v1),
+                        s.point(u0, v),
+                        s.point(u1, v),
+                    ]
+                })
+                .collect()
+        }
+        Obstacle::Mesh(m) => {
+            let v = m.vertices();
+            let step = v.len().div_ceil(512).max(1);
+            v.iter().step_by(step).copied().collect()
+        }
+    }
+}
+
 /// One surface with its bounding box and its name.
 #[derive(Debug)]
 struct Item {
@@ -117,6 +145,58 @@ impl Obstacles {
             generation: next_generation(),
             tree: Default::default(),
         }
+    }
+
+    /// The parts of the surfaces: for each surface (in the order added) the index of its part,
+    /// surfaces being of one part where joined directly or through others. Two surfaces are
+    /// joined where a point of one's boundary (for a NURBS surface, its four boundary curves
+    /// at 33 points each; for a mesh, its vertices, at most 512 of them) lies within
+    /// `tolerance_mm` of the other: the floor a cut lies on and the wall beside it, not
+    /// another part that a file holds in the same place.
+    pub fn parts(&self, tolerance_mm: f64) -> Vec<usize> {
+        let n = self.items.len();
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn root(parent: &mut [usize], mut i: usize) -> usize {
+            while parent[i] != i {
+                parent[i] = parent[parent[i]];
+                i = parent[i];
+            }
+            i
+        }
+        for (i, item) in self.items.iter().enumerate() {
+            for b in boundary_points(&item.shape) {
+                for (j, other) in self.items.iter().enumerate() {
+                    if j == i || box_distance(&b, &other.lo, &other.hi) > tolerance_mm {
+                        continue;
+                    }
+                    let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
+                    if ri != rj && shape_distance(&other.shape, &b) <= tolerance_mm {
+                        parent[ri] = rj;
+                    }
+                }
+            }
+        }
+        (0..n).map(|k| root(&mut parent, k)).collect()
+    }
+
+    /// The surfaces whose part (`parts`, from [`Obstacles::parts`]) holds one of the surfaces
+    /// named in `seeds` (shared, not copied).
+    pub fn of_parts(&self, parts: &[usize], seeds: &[String]) -> Obstacles {
+        let keep: Vec<usize> = self
+            .items
+            .iter()
+            .zip(parts)
+            .filter(|(i, _)| seeds.contains(&i.id))
+            .map(|(_, &p)| p)
+            .collect();
+        let out: Vec<String> = self
+            .items
+            .iter()
+            .zip(parts)
+            .filter(|(_, p)| !keep.contains(p))
+            .map(|(i, _)| i.id.clone())
+            .collect();
+        self.without(&out)
     }
 
     /// The names of the surfaces that come within `distance_mm` of the segment `a b` (sampled
@@ -265,23 +345,47 @@ impl Obstacles {
                     continue;
                 }
                 seen.push(id);
-                let Some(s) = file.surface(id) else { continue };
-                match &s.geometry {
-                    kerf_format::SurfaceGeometry::Nurbs(n) => {
-                        obs.add_nurbs_mapped_named(n, &map, id)?
-                    }
-                    kerf_format::SurfaceGeometry::Mesh {
-                        vertices,
-                        triangles,
-                    } => obs.add_mesh_named(
-                        vertices.iter().map(&map).collect(),
-                        triangles.clone(),
-                        id.clone(),
-                    )?,
+                if let Some(s) = file.surface(id) {
+                    obs.add_surface(s, &map)?;
                 }
             }
         }
         Ok(obs)
+    }
+
+    /// Every surface of `file`, whether a curve names it or not (a wall beside a hole, a
+    /// flange over a trim line), moved by `map`, named by their ids.
+    ///
+    /// # Errors
+    /// As [`Obstacles::from_file`].
+    pub fn from_all_surfaces(
+        file: &kerf_format::CurvesFile,
+        map: impl Fn(&Point3<f64>) -> Point3<f64>,
+    ) -> Result<Self> {
+        let mut obs = Self::new();
+        for s in &file.surfaces {
+            obs.add_surface(s, &map)?;
+        }
+        Ok(obs)
+    }
+
+    fn add_surface(
+        &mut self,
+        s: &kerf_format::SurfaceRecord,
+        map: &impl Fn(&Point3<f64>) -> Point3<f64>,
+    ) -> Result<()> {
+        let id = &s.id;
+        match &s.geometry {
+            kerf_format::SurfaceGeometry::Nurbs(n) => self.add_nurbs_mapped_named(n, map, id),
+            kerf_format::SurfaceGeometry::Mesh {
+                vertices,
+                triangles,
+            } => self.add_mesh_named(
+                vertices.iter().map(map).collect(),
+                triangles.clone(),
+                id.clone(),
+            ),
+        }
     }
 
     /// The largest coordinate along `up` of the boxes of the surfaces that come within

@@ -107,6 +107,11 @@ const NEAREST_STRIPS: usize = 64;
 const CELLS_PER_SPAN: usize = 6;
 
 impl Tessellated {
+    /// The surface itself.
+    pub(super) fn surface(&self) -> &NurbsSurface {
+        &self.surface
+    }
+
     pub(super) fn new(surface: NurbsSurface) -> Self {
         // The grid's values and its cells, each cell inside one knot span.
         let grid = |spans: Vec<(usize, f64, f64)>| {

@@ -1,0 +1,343 @@
+//! The head along the cuts: every cut of a set-up checked against every surface of the file
+//! ([`kerf_process::check_cut`]); where the head comes too close, the tool axis is tilted
+//! within the tilt tolerance, away from the surface in the way, and the path solved again
+//! (`docs/process.md`, "The head along the cuts").
+
+use kerf_kinematics::{
+    solve_path, tilt_within_cones, Cone, Head, Machine, PathInput, PathOptions, Pose, SolvedPath,
+};
+use kerf_process::{check_cut, CutClearance, HeadCheckOptions, Obstacles};
+use nalgebra::{Point3, Vector3};
+use serde_json::{json, Value};
+
+/// Rounds of tilting and checking again a path may take.
+const MAX_ROUNDS: usize = 4;
+
+/// Steps of the tilt search within the tolerance (the smallest clearing tilt is taken).
+const TILT_STEPS: usize = 8;
+
+/// The largest tilt the refusal's "would clear" search tries, degrees.
+const MAX_NEEDED_TILT_DEG: f64 = 60.0;
+
+/// What the check and the avoidance did to the cuts of one set-up.
+#[derive(Debug, Default)]
+pub(crate) struct HeadOutcome {
+    /// One report entry per path.
+    pub report: Vec<Value>,
+    /// Collisions accepted as warnings.
+    pub warnings: Vec<String>,
+    /// The tip zone the check left out, mm.
+    pub tip_zone_mm: Option<f64>,
+    /// A refusal (the first path that could not be cleared), unless accepted.
+    pub refusal: Option<kerf_process::ProcessError>,
+}
+
+/// The tool axis tilted by `alpha` (radians) from `n` toward the unit `d` (at right angles to
+/// `n`).
+fn tilted(n: &Vector3<f64>, d: &Vector3<f64>, alpha: f64) -> Vector3<f64> {
+    (n * alpha.cos() + d * alpha.sin()).normalize()
+}
+
+/// The direction at right angles to `n` pointing away from `w` seen from `p` (any
+/// perpendicular where `w` lies on the axis line).
+fn away(n: &Vector3<f64>, p: &Point3<f64>, w: &Point3<f64>) -> Vector3<f64> {
+    let v = w - p;
+    let d = -(v - n * n.dot(&v));
+    if d.norm() > 1e-9 {
+        d.normalize()
+    } else {
+        n.cross(&Vector3::x())
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| n.cross(&Vector3::y()).normalize())
+    }
+}
+
+/// True if the head standing at `(p, axis)` keeps the clearance (a single placement).
+fn clears(
+    obs: &Obstacles,
+    head: &Head,
+    opts: &HeadCheckOptions,
+    p: Point3<f64>,
+    axis: Vector3<f64>,
+) -> bool {
+    let c = check_cut(obs, head, &[Pose { position: p, axis }], opts);
+    c.proven && c.close.is_empty()
+}
+
+/// The input pose indices a range of solved poses covers (inserted poses belong to the
+/// stretch between their neighbours).
+fn input_range(s: &SolvedPath, [a, b]: [usize; 2]) -> [usize; 2] {
+    let lo = (0..=a.min(s.source.len() - 1))
+        .rev()
+        .find_map(|j| s.source[j])
+        .unwrap_or(0);
+    let hi = (b.min(s.source.len() - 1)..s.source.len())
+        .find_map(|j| s.source[j])
+        .unwrap_or(lo);
+    [lo, hi.max(lo)]
+}
+
+/// Checks the cuts `ks` of one set-up (their solved paths in `solved`, the poses with their
+/// normals in `inputs`, cut `k` against `obstacles(k)`) and tilts the tool axis within the tilt tolerance where the head comes
+/// too close; a path that cannot be cleared is a refusal (or a warning when `accept`).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_and_clear(
+    machine: &Machine,
+    obstacles: impl Fn(usize) -> Obstacles,
+    head: &Head,
+    hopts: &HeadCheckOptions,
+    popts: &PathOptions,
+    inputs: &[PathInput<'_>],
+    ks: &[usize],
+    solved: &mut [SolvedPath],
+    accept: bool,
+) -> HeadOutcome {
+    let mut out = HeadOutcome::default();
+    let theta =
+        popts.tilt_tolerance_deg.max(0.0).to_radians() * kerf_kinematics::TILT_WORKING_FRACTION;
+    let fixed = (*popts).with_tilt_tolerance_deg(0.0);
+    for &k in ks {
+        let own = obstacles(k);
+        let obs = &own;
+        let mut c = check_cut(obs, head, &solved[k].poses, hopts);
+        out.tip_zone_mm = Some(c.tip_zone_mm);
+        let normals = inputs[k].poses;
+        // Required tilt and its direction per input pose.
+        let mut need: Vec<Option<(f64, Vector3<f64>)>> = vec![None; normals.len()];
+        let mut rounds = 0;
+        let mut unclearable: Vec<String> = Vec::new();
+        while !c.close.is_empty() && theta > 0.0 && rounds < MAX_ROUNDS && unclearable.is_empty() {
+            rounds += 1;
+            for st in &c.close {
+                let [lo, hi] = input_range(&solved[k], st.poses);
+                for i in lo..=hi {
+                    let p = normals[i].position;
+                    let n = normals[i].axis;
+                    let d = away(&n, &p, &st.point);
+                    let start = need[i].map_or(0, |(a, _)| {
+                        ((a / theta) * TILT_STEPS as f64).round() as usize
+                    });
+                    let found = (start + 1..=TILT_STEPS)
+                        .map(|j| theta * j as f64 / TILT_STEPS as f64)
+                        .find(|&a| clears(obs, head, hopts, p, tilted(&n, &d, a)));
+                    match found {
+                        Some(a) => need[i] = Some((a, d)),
+                        None => {
+                            unclearable.push(needed_tilt(
+                                obs,
+                                head,
+                                hopts,
+                                &normals[i],
+                                i,
+                                st,
+                                popts.tilt_tolerance_deg,
+                            ));
+                            break;
+                        }
+                    }
+                }
+                if !unclearable.is_empty() {
+                    break;
+                }
+            }
+            if !unclearable.is_empty() {
+                break;
+            }
+            // The cones: a tilted pose holds its clearing axis, the others their tolerance.
+            let cones: Vec<Cone> = normals
+                .iter()
+                .zip(&need)
+                .map(|(pose, req)| match req {
+                    Some((a, d)) => Cone {
+                        axis: tilted(&pose.axis, d, *a),
+                        half_angle_deg: 0.0,
+                    },
+                    None => Cone {
+                        axis: pose.axis,
+                        half_angle_deg: popts.tilt_tolerance_deg,
+                    },
+                })
+                .collect();
+            let choice = tilt_within_cones(normals, &cones, popts.tilt_tolerance_deg);
+            let poses: Vec<Pose> = normals
+                .iter()
+                .zip(&choice.axes)
+                .map(|(p, a)| Pose {
+                    position: p.position,
+                    axis: *a,
+                })
+                .collect();
+            let input = PathInput {
+                id: inputs[k].id,
+                poses: &poses,
+                curve: inputs[k].curve,
+            };
+            match solve_path(machine, &input, &fixed) {
+                Ok(mut s) => {
+                    s.tilt = Some(choice.report);
+                    solved[k] = s;
+                }
+                Err(e) => {
+                    unclearable.push(format!("the tilted path cannot be solved: {e}"));
+                    break;
+                }
+            }
+            c = check_cut(obs, head, &solved[k].poses, hopts);
+        }
+        let tilted_poses = need.iter().filter(|n| n.is_some()).count();
+        let max_tilt_deg = need
+            .iter()
+            .flatten()
+            .map(|(a, _)| a.to_degrees())
+            .fold(0.0, f64::max);
+        let entry = report_entry(&solved[k], &c, rounds, tilted_poses, max_tilt_deg);
+        if c.close.is_empty() && c.proven {
+            out.report.push(entry);
+            continue;
+        }
+        let mut reasons = describe(&solved[k], &c, hopts.clearance_mm);
+        if theta == 0.0 {
+            // What tilt would clear the worst stretch at its middle cutting point.
+            if let Some(st) = c
+                .close
+                .iter()
+                .min_by(|a, b| a.distance_mm.total_cmp(&b.distance_mm))
+            {
+                let [lo, hi] = input_range(&solved[k], st.poses);
+                let i = (lo + hi) / 2;
+                reasons.push(needed_tilt(obs, head, hopts, &normals[i], i, st, 0.0));
+            }
+        }
+        reasons.extend(unclearable);
+        let e = kerf_process::ProcessError::HeadTooClose {
+            id: solved[k].id.clone(),
+            reason: reasons.join("; "),
+        };
+        out.report.push(entry);
+        if accept {
+            out.warnings
+                .push(format!("{e} (accepted: --accept-head-collisions)"));
+        } else if out.refusal.is_none() {
+            out.refusal = Some(e);
+        }
+    }
+    out
+}
+
+/// The tilt away from the surface in the way that would clear cutting point `i` (`pose`, its
+/// normal), in words, for a refusal.
+fn needed_tilt(
+    obs: &Obstacles,
+    head: &Head,
+    hopts: &HeadCheckOptions,
+    pose: &Pose,
+    i: usize,
+    st: &kerf_process::CloseStretch,
+    tolerance_deg: f64,
+) -> String {
+    let d = away(&pose.axis, &pose.position, &st.point);
+    let surface = st.surface.as_deref().unwrap_or("?");
+    let more = (1..)
+        .map(|j| j as f64 * 2.5)
+        .take_while(|a| *a <= MAX_NEEDED_TILT_DEG)
+        .find(|a| {
+            clears(
+                obs,
+                head,
+                hopts,
+                pose.position,
+                tilted(&pose.axis, &d, a.to_radians()),
+            )
+        });
+    match more {
+        Some(a) => format!(
+            "at cutting point {i} a tilt of {a:.1} deg away from surface {surface} would clear it (tilt tolerance {tolerance_deg} deg; --tilt-tolerance DEG allows it)"
+        ),
+        None => format!(
+            "at cutting point {i} no tilt up to {MAX_NEEDED_TILT_DEG} deg away from surface {surface} clears it"
+        ),
+    }
+}
+
+/// The close stretches of a path in words.
+fn describe(s: &SolvedPath, c: &CutClearance, clearance: f64) -> Vec<String> {
+    let length = |a: usize, b: usize| -> f64 {
+        s.poses[a..=b]
+            .windows(2)
+            .map(|w| (w[1].position - w[0].position).norm())
+            .sum::<f64>()
+            + 0.0
+    };
+    let mut reasons: Vec<String> = c
+        .close
+        .iter()
+        .map(|st| {
+            format!(
+                "poses {}..{} ({:.1} mm from the cut's start, {:.1} mm long): a head point {:.1} mm above the nozzle tip within {:.3} mm of surface {} (clearance {clearance} mm)",
+                st.poses[0],
+                st.poses[1],
+                length(0, st.poses[0]),
+                st.length_mm,
+                st.at_height_mm,
+                st.distance_mm,
+                st.surface.as_deref().unwrap_or("?"),
+            )
+        })
+        .collect();
+    if !c.proven {
+        reasons.push(format!(
+            "the check's work budget ran out after {} distance queries: not proven clear",
+            c.queries
+        ));
+    }
+    reasons
+}
+
+/// One path's entry of the report's `head.paths`.
+fn report_entry(
+    s: &SolvedPath,
+    c: &CutClearance,
+    rounds: usize,
+    tilted_poses: usize,
+    max_tilt_deg: f64,
+) -> Value {
+    json!({
+        "path": s.id,
+        "min_distance_mm": if c.min_distance_mm.is_finite() { json!(c.min_distance_mm) } else { Value::Null },
+        "at_pose": c.at_pose,
+        "close": c.close.iter().map(|st| json!({
+            "poses": st.poses,
+            "length_mm": st.length_mm,
+            "distance_mm": st.distance_mm,
+            "at_height_mm": st.at_height_mm,
+            "surface": st.surface,
+        })).collect::<Vec<_>>(),
+        "proven": c.proven,
+        "tilted": { "rounds": rounds, "cutting_points": tilted_poses, "max_tilt_deg": max_tilt_deg },
+        "samples": c.samples,
+        "queries": c.queries,
+    })
+}
+
+/// The report's `head` object: the check's settings and its figures per path.
+pub(crate) fn head_json(
+    clearance: Option<f64>,
+    machine: &Machine,
+    tip_zone: Option<f64>,
+    paths: Vec<Value>,
+) -> Value {
+    let Some(clearance) = clearance else {
+        return json!({ "checked": false, "note": "cuts not checked against the head (--cut-clearance MM checks them)" });
+    };
+    let head = machine.head.clone().unwrap_or_else(Head::laser_default);
+    json!({
+        "checked": true,
+        "clearance_mm": clearance,
+        "head": head.to_value(),
+        "head_source": if machine.head.is_some() { "machine file" } else { "default laser head" },
+        "standoff_mm": machine.process.standoff_mm.unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
+        "tip_zone_mm": tip_zone,
+        "paths": paths,
+        "note": "min_distance_mm: a proven lower bound of the distance from the head above the tip zone (the nozzle's lowest tip_zone_mm, meant to be near the cut) to every surface of the file over the cut's poses and the motion between them; close: stretches where a head point was found within the clearance; tilted: cutting points whose tool axis was tilted (within the tilt tolerance, away from the surface in the way) to clear it",
+    })
+}

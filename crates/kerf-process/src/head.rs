@@ -1,0 +1,581 @@
+//! The head against the part while it cuts: the smallest distance between the machine file's
+//! head model, standing on every pose of a cut, and the part's surfaces, with a proven lower
+//! bound that holds between the poses too.
+//!
+//! **The head at a pose** `(p, a)` (tip on the surface, unit tool axis toward the head): the
+//! solids of revolution of [`kerf_kinematics::Head`] about the line `p + a t`, the nozzle tip
+//! at `t = standoff`. A head point is `p + a (standoff + h) + rho (cos phi e1 + sin phi e2)`
+//! with `h` its height above the nozzle tip and `rho <= r(h)` the head's radius there.
+//!
+//! **The tip zone.** The nozzle's lowest part is meant to be near the surface it cuts. The
+//! check leaves out the head below `tip_zone_mm` (above the nozzle tip): the lowest height
+//! from which, on a plane through the cutting point tilted by up to `max_tilt_deg` against the
+//! tool axis, every head point keeps the clearance plus [`STRETCH_SLACK_MM`]. A step of the
+//! part lower than the tip zone within the nozzle's radius is not seen (it is inside the
+//! nozzle's footprint on the surface, where the beam cuts).
+//!
+//! **The distance, proven.** The head above the tip zone is covered by cells in cylindrical
+//! coordinates `[h0, h1] x [rho0, rho1] x [phi0, phi1]`; a cell lies in the ball about its
+//! centre `c` of radius `R = sqrt((dh/2)^2 + (drho/2 + rho1 dphi/2)^2)`, and the distance
+//! from the part to any point of the cell is at least `d(c) - R` (the distance to a set is
+//! 1-Lipschitz), with `d(c)` the exact point-to-surface distance of
+//! [`Obstacles::distance_below`]. A cell whose bound clears is done; one that does not is
+//! split along its longest extent; a cell centre inside the head closer than the clearance is a
+//! witness that the head comes too close there.
+//!
+//! **Between poses.** From pose `P = (p, a)` to `Q = (q, b)`, every head point moves by at
+//! most `D = |p - q| + sqrt(H^2 + r_max^2) angle(a, b)` (`H` the head's top above the tip,
+//! `r_max` its largest radius): the head at `Q` lies within `D` of the head at `P`. The poses
+//! are subdivided (tip linear, axis along the great circle) until consecutive samples are
+//! within [`SAMPLE_STEP_MM`]; a stretch of samples is checked at its middle sample with the
+//! clearance plus the largest `D` from it (plus the machine's tolerance budget for its path's
+//! deviation from the chords), and split in two where that does not clear, down to single
+//! samples. `docs/process.md` ("The head") has the derivation.
+
+use kerf_kinematics::{Head, Pose};
+use nalgebra::{Point3, Unit, UnitQuaternion, Vector3};
+
+use crate::traverse::Obstacles;
+
+/// The largest displacement of any head point between two consecutive samples, mm.
+pub const SAMPLE_STEP_MM: f64 = 0.5;
+
+/// Samples between the probes that extend a close stretch from a witness: two witnesses this
+/// close make the samples between them close (at most 4 mm of head motion apart).
+const RUN_STRIDE: usize = 8;
+
+/// The slack the tip zone keeps on a plane for a stretch of samples checked at once, mm.
+pub const STRETCH_SLACK_MM: f64 = 1.0;
+
+/// The smallest cell radius, mm: a cell this small that neither clears nor witnesses a
+/// violation counts as a violation (its bound is what is reported).
+const MIN_CELL_MM: f64 = 0.02;
+
+/// The resolution of the check at a single sample, mm: a cell this small that neither clears
+/// the requirement nor has its centre (a head point) closer than the clearance keeps its
+/// bound `d - R`, so a sample may pass with a proven distance down to the clearance less this
+/// (and the slack of its motion); [`CutClearance::min_distance_mm`] says what was proven.
+pub const CLOSE_CELL_MM: f64 = 0.25;
+
+/// Options of [`check_cut`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct HeadCheckOptions {
+    /// The distance the head must keep from the part while it cuts, mm.
+    pub clearance_mm: f64,
+    /// The nozzle tip's height above the cutting point along the tool axis, mm.
+    pub standoff_mm: f64,
+    /// The largest angle between the tool axis and the surface normal the tip zone allows
+    /// for, degrees.
+    pub max_tilt_deg: f64,
+    /// The deviation of the machine's tip path from the chords between poses, mm (the
+    /// tolerance budget's non-linearity term).
+    pub path_deviation_mm: f64,
+    /// The most exact distance queries one cut may make: past it the rest of the cut is not
+    /// proven clear ([`CutClearance::proven`] false).
+    pub max_queries: usize,
+}
+
+impl Default for HeadCheckOptions {
+    fn default() -> Self {
+        Self {
+            clearance_mm: 1.0,
+            standoff_mm: kerf_kinematics::DEFAULT_STANDOFF_MM,
+            max_tilt_deg: 10.0,
+            path_deviation_mm: 0.0,
+            max_queries: 2_000_000,
+        }
+    }
+}
+
+impl HeadCheckOptions {
+    /// Sets [`clearance_mm`](Self::clearance_mm).
+    pub fn with_clearance_mm(mut self, clearance_mm: f64) -> Self {
+        self.clearance_mm = clearance_mm;
+        self
+    }
+    /// Sets [`standoff_mm`](Self::standoff_mm).
+    pub fn with_standoff_mm(mut self, standoff_mm: f64) -> Self {
+        self.standoff_mm = standoff_mm;
+        self
+    }
+    /// Sets [`max_tilt_deg`](Self::max_tilt_deg).
+    pub fn with_max_tilt_deg(mut self, max_tilt_deg: f64) -> Self {
+        self.max_tilt_deg = max_tilt_deg;
+        self
+    }
+    /// Sets [`path_deviation_mm`](Self::path_deviation_mm).
+    pub fn with_path_deviation_mm(mut self, path_deviation_mm: f64) -> Self {
+        self.path_deviation_mm = path_deviation_mm;
+        self
+    }
+    /// Sets [`max_queries`](Self::max_queries).
+    pub fn with_max_queries(mut self, max_queries: usize) -> Self {
+        self.max_queries = max_queries;
+        self
+    }
+}
+
+/// A run of poses where the head comes closer to the part than the clearance: samples
+/// witnessed close, and the samples between two such witnesses at most 8 samples (4 mm of head
+/// motion) apart.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CloseStretch {
+    /// The first and last pose index of the stretch (the samples between them included).
+    pub poses: [usize; 2],
+    /// Its length along the tip's path, mm.
+    pub length_mm: f64,
+    /// The smallest distance witnessed in it, mm: a point of the head (above the tip zone)
+    /// this close to the part at one of its samples (an upper bound of the smallest distance
+    /// there; negative: inside the part).
+    pub distance_mm: f64,
+    /// The height above the nozzle tip of the head point nearest the part, mm.
+    pub at_height_mm: f64,
+    /// The surface nearest that point.
+    pub surface: Option<String>,
+    /// That point of the head (workpiece frame): the avoidance tilts away from it.
+    pub point: Point3<f64>,
+}
+
+/// The head against the part along one cut ([`check_cut`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CutClearance {
+    /// A proven lower bound of the distance between the head (above the tip zone) and the
+    /// part over the cut, poses and the motion between them, outside the close stretches, mm
+    /// (infinite without surfaces). Where no stretch is close it is at least the clearance
+    /// less [`CLOSE_CELL_MM`] and half a sample step.
+    pub min_distance_mm: f64,
+    /// The pose nearest which that bound was found.
+    pub at_pose: usize,
+    /// The stretches closer than the clearance, in order.
+    pub close: Vec<CloseStretch>,
+    /// The height of the tip zone the check leaves out, mm above the nozzle tip.
+    pub tip_zone_mm: f64,
+    /// Samples checked (poses and the points between them).
+    pub samples: usize,
+    /// Exact distance queries made.
+    pub queries: usize,
+    /// False when the query budget ran out before every sample was shown clear or close.
+    pub proven: bool,
+}
+
+/// The height above the nozzle tip from which the head keeps `clearance + STRETCH_SLACK_MM`
+/// from a plane through the cutting point tilted by up to `max_tilt_deg` from the tool axis.
+pub fn tip_zone_mm(head: &Head, opts: &HeadCheckOptions) -> f64 {
+    let (s, c) = opts.max_tilt_deg.to_radians().sin_cos();
+    let need = opts.clearance_mm + STRETCH_SLACK_MM;
+    let len = head.length_mm();
+    let steps = 4096usize;
+    let mut zone = 0.0;
+    for k in (0..=steps).rev() {
+        let h = len * k as f64 / steps as f64;
+        let r = head.radius_at(h).unwrap_or(0.0);
+        if (opts.standoff_mm + h) * c - r * s < need {
+            zone = (len * (k + 1) as f64 / steps as f64).min(len);
+            break;
+        }
+    }
+    zone
+}
+
+/// One sample: the tip, the unit axis, and the pose before it (or at it).
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    tip: Point3<f64>,
+    axis: Vector3<f64>,
+    pose: usize,
+    /// True at a pose itself, false between `pose` and the next.
+    exact: bool,
+    /// Path length from the cut's start, mm.
+    s: f64,
+}
+
+/// A cell of the head in cylindrical coordinates about the tool axis.
+#[derive(Debug, Clone, Copy)]
+struct Cell {
+    h: [f64; 2],
+    rho: [f64; 2],
+    phi: [f64; 2],
+}
+
+impl Cell {
+    fn radius(&self) -> f64 {
+        let dh = (self.h[1] - self.h[0]) / 2.0;
+        let planar =
+            (self.rho[1] - self.rho[0]) / 2.0 + self.rho[1] * (self.phi[1] - self.phi[0]) / 2.0;
+        (dh * dh + planar * planar).sqrt()
+    }
+
+    fn split(&self) -> [Cell; 2] {
+        let dh = self.h[1] - self.h[0];
+        let dr = self.rho[1] - self.rho[0];
+        let arc = self.rho[1] * (self.phi[1] - self.phi[0]);
+        let mut a = *self;
+        let mut b = *self;
+        if dh >= dr && dh >= arc {
+            let m = (self.h[0] + self.h[1]) / 2.0;
+            a.h[1] = m;
+            b.h[0] = m;
+        } else if dr >= arc {
+            let m = (self.rho[0] + self.rho[1]) / 2.0;
+            a.rho[1] = m;
+            b.rho[0] = m;
+        } else {
+            let m = (self.phi[0] + self.phi[1]) / 2.0;
+            a.phi[1] = m;
+            b.phi[0] = m;
+        }
+        [a, b]
+    }
+}
+
+/// What one head placement showed.
+#[derive(Debug, Clone, Copy)]
+enum Verdict {
+    /// Every cell clears the requirement; the least `d - R` found.
+    Clear(f64),
+    /// Not shown clear: for a stretch, the bound of the first cell that did not clear; for a
+    /// single sample, the distance of a head point (a cell centre) closer than the clearance;
+    /// with the height of that cell and its centre.
+    Close {
+        bound: f64,
+        height: f64,
+        point: Point3<f64>,
+    },
+    /// The query budget ran out.
+    Spent,
+}
+
+/// The head's cells above the tip zone, before any split: one per solid, four quadrants.
+fn initial_cells(head: &Head, zone: f64) -> Vec<Cell> {
+    let mut cells = Vec::new();
+    let mut base = 0.0;
+    for s in &head.solids {
+        let top = base + s.length_mm;
+        let h0 = base.max(zone);
+        if h0 < top {
+            let r = head.max_radius_over(h0, top).max(1e-9);
+            for q in 0..4 {
+                let phi0 = q as f64 * std::f64::consts::FRAC_PI_2;
+                cells.push(Cell {
+                    h: [h0, top],
+                    rho: [0.0, r],
+                    phi: [phi0, phi0 + std::f64::consts::FRAC_PI_2],
+                });
+            }
+        }
+        base = top;
+    }
+    cells
+}
+
+/// The head at `(tip, axis)` against `obstacles`, each cell required to clear `need` mm.
+/// With `first_only` the first cell whose centre does not clear ends the search (a stretch is
+/// then split); without it, cells are refined down to [`CLOSE_CELL_MM`], and a cell centre
+/// inside the head closer than `clearance` is a witness that the head comes that close.
+#[allow(clippy::too_many_arguments)]
+fn place_head(
+    obstacles: &Obstacles,
+    head: &Head,
+    cells0: &[Cell],
+    standoff: f64,
+    tip: &Point3<f64>,
+    axis: &Vector3<f64>,
+    need: f64,
+    clearance: f64,
+    first_only: bool,
+    queries: &mut usize,
+    max_queries: usize,
+) -> Verdict {
+    let e1 = axis
+        .cross(
+            &(if axis.x.abs() < 0.6 {
+                Vector3::x()
+            } else {
+                Vector3::y()
+            }),
+        )
+        .normalize();
+    let e2 = axis.cross(&e1);
+    let point = |h: f64, rho: f64, phi: f64| {
+        tip + axis * (standoff + h) + e1 * (rho * phi.cos()) + e2 * (rho * phi.sin())
+    };
+    let mut stack: Vec<Cell> = cells0.to_vec();
+    let mut least = f64::INFINITY;
+    let mut close: Option<(f64, f64, Point3<f64>)> = None;
+    while let Some(cell) = stack.pop() {
+        // A cell wholly outside the head (beyond the largest radius over its heights).
+        if cell.rho[0] > head.max_radius_over(cell.h[0], cell.h[1]) {
+            continue;
+        }
+        let r = cell.radius();
+        let hm = (cell.h[0] + cell.h[1]) / 2.0;
+        let c = point(
+            hm,
+            (cell.rho[0] + cell.rho[1]) / 2.0,
+            (cell.phi[0] + cell.phi[1]) / 2.0,
+        );
+        if *queries >= max_queries {
+            return Verdict::Spent;
+        }
+        *queries += 1;
+        let d = obstacles.distance_below(&c, r + need);
+        if d >= r + need {
+            least = least.min(d - r);
+            continue;
+        }
+        if first_only && (d < need || r <= CLOSE_CELL_MM) {
+            // The stretch does not clear at its middle: it is split.
+            close = Some((d - r, hm, c));
+            break;
+        }
+        if r <= CLOSE_CELL_MM || r <= MIN_CELL_MM {
+            // A witness: the cell's centre inside the head (within the smaller radius at the
+            // cell's ends: the solids are frustums) closer to the part than the clearance.
+            let rho = (cell.rho[0] + cell.rho[1]) / 2.0;
+            let inside = rho
+                <= head
+                    .radius_at(cell.h[0])
+                    .unwrap_or(0.0)
+                    .min(head.radius_at(cell.h[1]).unwrap_or(0.0));
+            if inside && d < clearance {
+                close = Some((d, hm, c));
+                break;
+            }
+            if rho - (cell.rho[1] - cell.rho[0]) / 2.0 > head.radius_at(hm).unwrap_or(0.0)
+                && r > MIN_CELL_MM
+            {
+                // Mostly outside the head: refine to find where the head's edge lies.
+            } else {
+                // Within the resolution: its bound stands (it may be below the requirement
+                // by at most the cell's radius).
+                least = least.min(d - r);
+                continue;
+            }
+        }
+        let [a, b] = cell.split();
+        stack.push(a);
+        stack.push(b);
+    }
+    match close {
+        Some((bound, height, point)) => Verdict::Close {
+            bound,
+            height,
+            point,
+        },
+        None => Verdict::Clear(least),
+    }
+}
+
+/// The samples of a cut: its poses, and between two poses as many points as keep every head
+/// point within [`SAMPLE_STEP_MM`] of the last sample.
+fn samples(poses: &[Pose], reach: f64) -> Vec<Sample> {
+    let mut out = Vec::with_capacity(poses.len());
+    let mut s = 0.0;
+    for (k, p) in poses.iter().enumerate() {
+        if k > 0 {
+            let q = &poses[k - 1];
+            let step = (p.position - q.position).norm();
+            let angle = q.axis.angle(&p.axis);
+            let d = step + reach * angle;
+            let n = ((d / SAMPLE_STEP_MM).ceil() as usize).clamp(1, 1 << 16);
+            let rot = UnitQuaternion::rotation_between(&q.axis, &p.axis)
+                .unwrap_or_else(UnitQuaternion::identity);
+            for j in 1..n {
+                let t = j as f64 / n as f64;
+                let axis = (UnitQuaternion::identity().nlerp(&rot, t) * q.axis).normalize();
+                out.push(Sample {
+                    tip: q.position + (p.position - q.position) * t,
+                    axis,
+                    pose: k - 1,
+                    exact: false,
+                    s: s + step * t,
+                });
+            }
+            s += step;
+        }
+        out.push(Sample {
+            tip: p.position,
+            axis: Unit::new_normalize(p.axis).into_inner(),
+            pose: k,
+            exact: true,
+            s,
+        });
+    }
+    out
+}
+
+/// The head standing on every pose of one cut (`poses`: tip on the surface, unit tool axis
+/// toward the head, workpiece frame) and moving between them, against `obstacles`: the
+/// smallest distance proven and the stretches closer than the clearance.
+pub fn check_cut(
+    obstacles: &Obstacles,
+    head: &Head,
+    poses: &[Pose],
+    opts: &HeadCheckOptions,
+) -> CutClearance {
+    let zone = tip_zone_mm(head, opts);
+    let reach = (opts.standoff_mm + head.length_mm()).hypot(head.max_radius_mm());
+    let samples = samples(poses, reach);
+    let cells0 = initial_cells(head, zone);
+    let mut out = CutClearance {
+        min_distance_mm: f64::INFINITY,
+        at_pose: 0,
+        close: Vec::new(),
+        tip_zone_mm: zone,
+        samples: samples.len(),
+        queries: 0,
+        proven: true,
+    };
+    if samples.is_empty() || obstacles.is_empty() || cells0.is_empty() {
+        return out;
+    }
+    let disp = |a: &Sample, b: &Sample| (a.tip - b.tip).norm() + reach * a.axis.angle(&b.axis);
+    // Close samples with their bound, height and point.
+    // Close samples: the witnessed distance, the height and the head point.
+    let mut close_at: Vec<Option<(f64, f64, Point3<f64>)>> = vec![None; samples.len()];
+    let mut todo = vec![(0usize, samples.len() - 1)];
+    while let Some((mut i, mut j)) = todo.pop() {
+        // Samples already shown close (from a witness nearby) are not checked again.
+        while i <= j && close_at[i].is_some() {
+            i += 1;
+        }
+        while j > i && close_at[j].is_some() {
+            j -= 1;
+        }
+        if i > j || close_at[j].is_some() {
+            continue;
+        }
+        let m = (i + j) / 2;
+        if close_at[m].is_some() {
+            todo.push((m + 1, j));
+            todo.push((i, m - 1));
+            continue;
+        }
+        let spread = (i..=j)
+            .map(|k| disp(&samples[k], &samples[m]))
+            .fold(0.0, f64::max);
+        // A single sample stands for the motion to its neighbours' midpoints.
+        let spread = if i == j {
+            [m.checked_sub(1), (m + 1 < samples.len()).then_some(m + 1)]
+                .into_iter()
+                .flatten()
+                .map(|n| disp(&samples[n], &samples[m]) / 2.0)
+                .fold(0.0, f64::max)
+        } else {
+            spread
+        };
+        let slack = spread + opts.path_deviation_mm;
+        let verdict = place_head(
+            obstacles,
+            head,
+            &cells0,
+            opts.standoff_mm,
+            &samples[m].tip,
+            &samples[m].axis,
+            opts.clearance_mm + slack,
+            opts.clearance_mm,
+            i != j,
+            &mut out.queries,
+            opts.max_queries,
+        );
+        match verdict {
+            Verdict::Clear(least) => {
+                let bound = least - slack;
+                if bound < out.min_distance_mm {
+                    out.min_distance_mm = bound;
+                    out.at_pose = samples[m].pose;
+                }
+            }
+            Verdict::Spent => {
+                out.proven = false;
+                break;
+            }
+            Verdict::Close {
+                bound,
+                height,
+                point,
+            } if i == j => {
+                // The witness holds for the samples whose head lies within the clearance's
+                // margin of this one: every head point moves by at most `disp`.
+                close_at[m] = Some((bound, height, point));
+                // Then probes every RUN_STRIDE samples on either side: two witnesses that
+                // close make the samples between them part of one close stretch.
+                for dir in [1isize, -1] {
+                    let mut at = m;
+                    loop {
+                        let k = at as isize + dir * RUN_STRIDE as isize;
+                        if k < 0 || k as usize >= samples.len() || close_at[k as usize].is_some() {
+                            break;
+                        }
+                        let k = k as usize;
+                        let probe = place_head(
+                            obstacles,
+                            head,
+                            &cells0,
+                            opts.standoff_mm,
+                            &samples[k].tip,
+                            &samples[k].axis,
+                            opts.clearance_mm + opts.path_deviation_mm,
+                            opts.clearance_mm,
+                            false,
+                            &mut out.queries,
+                            opts.max_queries,
+                        );
+                        let Verdict::Close {
+                            bound,
+                            height,
+                            point,
+                        } = probe
+                        else {
+                            break;
+                        };
+                        let (lo, hi) = (at.min(k), at.max(k));
+                        for c in &mut close_at[lo..=hi] {
+                            if c.is_none() {
+                                *c = Some((bound, height, point));
+                            }
+                        }
+                        at = k;
+                    }
+                }
+            }
+            Verdict::Close { .. } => {
+                // The halves, the first checked first (the stack pops the last pushed).
+                todo.push((m + 1, j));
+                todo.push((i, m));
+            }
+        }
+    }
+    let mut marks: Vec<(usize, f64, f64, Point3<f64>)> = close_at
+        .iter()
+        .enumerate()
+        .filter_map(|(k, c)| c.map(|(b, h, p)| (k, b, h, p)))
+        .collect();
+    marks.sort_by_key(|m| m.0);
+    // Runs of consecutive close samples.
+    let mut k = 0;
+    while k < marks.len() {
+        let mut e = k;
+        while e + 1 < marks.len() && marks[e + 1].0 == marks[e].0 + 1 {
+            e += 1;
+        }
+        let run = &marks[k..=e];
+        let worst = run
+            .iter()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .copied()
+            .unwrap_or(run[0]);
+        let (a, b) = (&samples[run[0].0], &samples[run[run.len() - 1].0]);
+        out.close.push(CloseStretch {
+            poses: [a.pose, if b.exact { b.pose } else { b.pose + 1 }],
+            length_mm: b.s - a.s,
+            distance_mm: worst.1,
+            at_height_mm: worst.2,
+            surface: obstacles.nearest(&worst.3).map(|(id, _)| id),
+            point: worst.3,
+        });
+        k = e + 1;
+    }
+    out
+}

@@ -1,0 +1,153 @@
+//! The head against the part while it cuts (`kerf_process::check_cut`), against exact
+//! distances: a hole in a floor near the foot of a vertical wall, whose distance to the
+//! head's body is `x_wall - (r cos theta + 45)` at the hole's point of angle `theta`.
+
+use kerf_kinematics::{Head, Pose};
+use kerf_nurbs::NurbsSurface;
+use kerf_process::{check_cut, HeadCheckOptions, Obstacles};
+use nalgebra::{Point3, Vector3};
+
+const HOLE_R: f64 = 5.0;
+/// The default head's body: 45 mm radius from 26 mm above the cutting point (1 mm standoff
+/// plus the 25 mm nozzle cone).
+const BODY_R: f64 = 45.0;
+
+fn floor() -> NurbsSurface {
+    NurbsSurface::plane(
+        Point3::new(-300.0, -300.0, 0.0),
+        Vector3::x(),
+        Vector3::y(),
+        600.0,
+        600.0,
+    )
+    .expect("floor")
+}
+
+/// A wall at `x`, 60 mm high, 600 mm long.
+fn wall(x: f64) -> NurbsSurface {
+    NurbsSurface::plane(
+        Point3::new(x, -300.0, 0.0),
+        Vector3::y(),
+        Vector3::z(),
+        600.0,
+        60.0,
+    )
+    .expect("wall")
+}
+
+/// A hole of radius 5 about the origin, the beam vertical (axis tilted by `tilt_deg` about y).
+fn hole(n: usize, tilt_deg: f64) -> Vec<Pose> {
+    let a = tilt_deg.to_radians();
+    (0..=n)
+        .map(|k| {
+            let t = std::f64::consts::TAU * k as f64 / n as f64;
+            Pose {
+                position: Point3::new(HOLE_R * t.cos(), HOLE_R * t.sin(), 0.0),
+                axis: Vector3::new(a.sin(), 0.0, a.cos()),
+            }
+        })
+        .collect()
+}
+
+/// The exact distance from the vertical head's body to the wall at `x` at angle `t`.
+fn exact(x: f64, t: f64) -> f64 {
+    x - (HOLE_R * t.cos() + BODY_R)
+}
+
+#[test]
+fn a_flat_floor_alone_keeps_the_clearance_at_any_tilt_within_the_tip_zone() {
+    let mut obs = Obstacles::new();
+    obs.add_nurbs(floor());
+    let head = Head::laser_default();
+    for tilt in [0.0, 5.0, 10.0] {
+        let r = check_cut(&obs, &head, &hole(32, tilt), &HeadCheckOptions::default());
+        assert!(r.proven, "tilt {tilt}: proven");
+        assert!(r.close.is_empty(), "tilt {tilt}: {:?}", r.close);
+        let floor_mm = 1.0 - kerf_process::CLOSE_CELL_MM - kerf_process::SAMPLE_STEP_MM / 2.0;
+        assert!(
+            r.min_distance_mm >= floor_mm,
+            "tilt {tilt}: bound {} below the clearance less the resolution",
+            r.min_distance_mm
+        );
+        // The nozzle's lowest 1.4 mm or so is the tip zone at 10 degrees (docs/process.md).
+        assert!(
+            r.tip_zone_mm > 0.0 && r.tip_zone_mm < 3.0,
+            "tip zone {}",
+            r.tip_zone_mm
+        );
+    }
+}
+
+#[test]
+fn a_wall_beside_the_hole_is_found_where_the_body_comes_within_the_clearance() {
+    let head = Head::laser_default();
+    let opts = HeadCheckOptions::default();
+    let n = 72;
+    let poses = hole(n, 0.0);
+    for x in [53.0, 51.3, 50.5, 49.0] {
+        let mut obs = Obstacles::new();
+        obs.add_nurbs(floor());
+        obs.add_nurbs(wall(x));
+        let r = check_cut(&obs, &head, &poses, &opts);
+        assert!(r.proven, "x {x}: proven");
+        let truth = (0..=n)
+            .map(|k| exact(x, std::f64::consts::TAU * k as f64 / n as f64))
+            .fold(f64::INFINITY, f64::min);
+        // The bound is a lower bound of the exact distance, over poses and the motion.
+        if r.close.is_empty() {
+            assert!(
+                r.min_distance_mm <= truth + 1e-9,
+                "x {x}: bound {} above the exact {truth}",
+                r.min_distance_mm
+            );
+        }
+        let inside = |k: usize| r.close.iter().any(|c| c.poses[0] <= k && k <= c.poses[1]);
+        for k in 0..=n {
+            let d = exact(x, std::f64::consts::TAU * k as f64 / n as f64);
+            // Reported where a head point (a cell centre, within the resolution of the
+            // nearest) is witnessed closer than the clearance.
+            if d < opts.clearance_mm - kerf_process::CLOSE_CELL_MM {
+                assert!(inside(k), "x {x}: pose {k} at {d} mm not reported");
+            }
+            // Not reported where the head clears by more than a sample step's slack.
+            if d > opts.clearance_mm {
+                assert!(!inside(k), "x {x}: pose {k} at {d} mm reported close");
+            }
+        }
+        if truth >= opts.clearance_mm {
+            assert!(r.close.is_empty(), "x {x}: {:?}", r.close);
+        } else {
+            let c = &r.close[0];
+            assert_eq!(c.surface.as_deref(), Some("#1"), "x {x}: the wall is named");
+            assert!(
+                c.at_height_mm >= 25.0,
+                "x {x}: the body ({} mm up) meets the wall",
+                c.at_height_mm
+            );
+            // A head point witnessed within the clearance, no closer than the exact minimum.
+            assert!(
+                c.distance_mm < opts.clearance_mm && c.distance_mm >= truth - 1e-9,
+                "x {x}: {c:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_slot_narrower_than_the_nozzle_is_close_everywhere_and_the_work_is_bounded() {
+    let head = Head::laser_default();
+    let mut obs = Obstacles::new();
+    obs.add_nurbs(floor());
+    obs.add_nurbs(wall(8.0));
+    obs.add_nurbs(wall(-8.0));
+    let poses = hole(24, 0.0);
+    let r = check_cut(&obs, &head, &poses, &HeadCheckOptions::default());
+    assert_eq!(r.close.len(), 1, "{:?}", r.close);
+    assert_eq!(r.close[0].poses, [0, 24], "the whole hole");
+    assert!(r.close[0].distance_mm < 1.0, "{:?}", r.close[0]);
+    // The query budget bounds the work, whatever the geometry.
+    let tight = HeadCheckOptions::default().with_max_queries(50);
+    let r = check_cut(&obs, &head, &poses, &tight);
+    assert!(!r.proven, "the budget ran out");
+    assert!(r.queries <= 50, "{} queries", r.queries);
+}

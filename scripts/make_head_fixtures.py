@@ -1,8 +1,20 @@
 #!/usr/bin/python3
-"""fixtures/head_wall.json: a drawn box's floor with a vertical wall, two holes of radius 5 in
-the floor, one 47 mm from the wall's foot (its nearest point 42 mm from the wall: the default
-head's 45 mm body comes within 52 - 50 = 2 mm of the wall) and one far from it. Exact NURBS:
-planes of degree 1, circles as rational quadratics (weights 1/sqrt 2 at the corners)."""
+"""The head-check fixtures (docs/process.md, "The head along the cuts"), exact NURBS: planes of
+degree 1, circles and the bend as rational quadratics (weights 1/sqrt 2 at the corners).
+
+- fixtures/head_wall.json: a drawn box's floor with a vertical wall, two holes of radius 5 in
+  the floor, one 47 mm from the wall's foot (its nearest point 42 mm from the wall: the default
+  head's 45 mm body comes within 52 - 50 = 2 mm of the wall) and one far from it.
+- fixtures/head_channel.json: a trim line along the floor of a U-channel 100 mm wide with walls
+  40 mm high, 6 mm off the channel's middle: the 45 mm body passes 44 - 45 = -1 mm from the
+  nearer wall (it cuts into it) with the beam upright; tilted away by 5 degrees or so it clears.
+- fixtures/head_bend.json: a trim line along a 90-degree bend of inner radius 20 (15 degrees up
+  it) between a floor and a vertical flange whose top is 33 mm above the floor: the beam along
+  the bend's normal leans 15 degrees away from the flange, and the flange's top edge lies 27.4
+  mm along the axis from the cutting point, above the body's bottom face (26 mm) and 22.7 mm
+  from the axis (inside its 45 mm radius); leaning 7.5-10 degrees more brings the edge below
+  the bottom face by the clearance (24.2 mm along at 22.5 degrees), while the other side of the
+  body's bottom rim stays 5 mm above the floor."""
 import json
 import math
 from pathlib import Path
@@ -30,7 +42,17 @@ def plane(id_, origin, u, v):
     }
 
 
-doc = {
+def write(name, doc):
+    out = Path(__file__).resolve().parents[1] / "fixtures" / name
+    out.write_text(json.dumps(doc, indent=1) + "\n")
+    print(out)
+
+
+def line(a, b):
+    return {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [a, b]}
+
+
+write("head_wall.json", {
     "format": "kerf.curves/1",
     "units": "mm",
     "curves": [
@@ -41,7 +63,41 @@ doc = {
         plane("floor", [-200.0, -200.0, 0.0], [252.0, 0.0, 0.0], [0.0, 400.0, 0.0]),
         plane("wall", [52.0, -200.0, 0.0], [0.0, 400.0, 0.0], [0.0, 0.0, 60.0]),
     ],
+})
+
+write("head_channel.json", {
+    "format": "kerf.curves/1",
+    "units": "mm",
+    "curves": [
+        {"id": "channel-trim", **line([6.0, -100.0, 0.0], [6.0, 100.0, 0.0]), "surface": "channel-floor"},
+    ],
+    "surfaces": [
+        plane("channel-floor", [-50.0, -200.0, 0.0], [100.0, 0.0, 0.0], [0.0, 400.0, 0.0]),
+        plane("channel-left", [-50.0, -200.0, 0.0], [0.0, 0.0, 40.0], [0.0, 400.0, 0.0]),
+        plane("channel-right", [50.0, -200.0, 0.0], [0.0, 400.0, 0.0], [0.0, 0.0, 40.0]),
+    ],
+})
+
+R = 20.0
+H = 13.0
+T = math.radians(15.0)
+bend = {
+    "type": "nurbs", "id": "bend", "degree_u": 2, "degree_v": 1,
+    "knots_u": [0, 0, 0, 1, 1, 1], "knots_v": [0, 0, 1, 1],
+    "control_points": [[[0.0, -200.0, 0.0], [0.0, 200.0, 0.0]],
+                       [[R, -200.0, 0.0], [R, 200.0, 0.0]],
+                       [[R, -200.0, R], [R, 200.0, R]]],
+    "weights": [[1, 1], [W, W], [1, 1]],
 }
-out = Path(__file__).resolve().parents[1] / "fixtures" / "head_wall.json"
-out.write_text(json.dumps(doc, indent=1) + "\n")
-print(out)
+write("head_bend.json", {
+    "format": "kerf.curves/1",
+    "units": "mm",
+    "curves": [
+        {"id": "bend-trim", **line([R * math.sin(T), -60.0, R - R * math.cos(T)], [R * math.sin(T), 60.0, R - R * math.cos(T)]), "surface": "bend"},
+    ],
+    "surfaces": [
+        plane("bend-floor", [-150.0, -200.0, 0.0], [150.0, 0.0, 0.0], [0.0, 400.0, 0.0]),
+        bend,
+        plane("bend-flange", [R, -200.0, R], [0.0, 0.0, H], [0.0, 400.0, 0.0]),
+    ],
+})

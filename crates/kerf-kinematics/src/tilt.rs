@@ -91,14 +91,30 @@ pub struct TiltReport {
 /// finite, or no poses) returns the poses' own axes. The axes must be unit vectors (as
 /// [`crate::solve_path`] makes them).
 pub fn tilt_within_cone(poses: &[Pose], tolerance_deg: f64) -> TiltChoice {
-    let cones: Vec<Cone> = poses
-        .iter()
-        .map(|p| Cone {
-            axis: p.axis,
-            half_angle_deg: tolerance_deg,
-        })
-        .collect();
-    tilt_within_cones(poses, &cones, tolerance_deg)
+    let normals: Vec<Vector3<f64>> = poses.iter().map(|p| p.axis).collect();
+    if !(tolerance_deg.is_finite() && tolerance_deg > 0.0) || poses.is_empty() {
+        return unchanged(poses, tolerance_deg);
+    }
+    let theta = tolerance_deg.to_radians().min(FRAC_PI_2);
+    choose(poses, &normals, &vec![theta; poses.len()], tolerance_deg)
+}
+
+/// The poses' own axes, with the report of a choice that changed nothing.
+fn unchanged(poses: &[Pose], tolerance_deg: f64) -> TiltChoice {
+    let axes: Vec<Vector3<f64>> = poses.iter().map(|p| p.axis).collect();
+    let travel = Coords::of(&axes).travel_deg();
+    TiltChoice {
+        axes,
+        report: TiltReport {
+            tolerance_deg: tolerance_deg.max(0.0),
+            max_deviation_deg: 0.0,
+            max_deviation_at: 0,
+            rotary_travel_exact_deg: travel,
+            rotary_travel_deg: travel,
+            work: 0,
+            strings_over_budget: 0,
+        },
+    }
 }
 
 /// A cone of tool axes: its unit centre axis and its half-angle (degrees).
@@ -117,21 +133,8 @@ pub struct Cone {
 /// the axes that keep the head clear of a wall, inside the normal's tolerance cone. `cones`
 /// must hold one cone per pose (else the poses' own axes are returned).
 pub fn tilt_within_cones(poses: &[Pose], cones: &[Cone], tolerance_deg: f64) -> TiltChoice {
-    let normals: Vec<Vector3<f64>> = poses.iter().map(|p| p.axis).collect();
-    let exact = Coords::of(&normals);
-    let travel = exact.travel_deg();
-    let mut report = TiltReport {
-        tolerance_deg: tolerance_deg.max(0.0),
-        max_deviation_deg: 0.0,
-        max_deviation_at: 0,
-        rotary_travel_exact_deg: travel,
-        rotary_travel_deg: travel,
-        work: 0,
-        strings_over_budget: 0,
-    };
-    let mut axes = normals.clone();
     if poses.is_empty() || cones.len() != poses.len() {
-        return TiltChoice { axes, report };
+        return unchanged(poses, tolerance_deg);
     }
     let centres: Vec<Vector3<f64>> = cones.iter().map(|c| c.axis.normalize()).collect();
     let thetas: Vec<f64> = cones
@@ -144,10 +147,23 @@ pub fn tilt_within_cones(poses: &[Pose], cones: &[Cone], tolerance_deg: f64) -> 
             }
         })
         .collect();
-    if thetas.iter().all(|&t| t == 0.0) && centres == normals {
-        return TiltChoice { axes, report };
-    }
-    let centre_coords = Coords::of(&centres);
+    choose(poses, &centres, &thetas, tolerance_deg)
+}
+
+/// The taut strings through the cones `(centres[i], thetas[i])` (unit centres, radians), the
+/// report measured against the poses' own axes.
+fn choose(
+    poses: &[Pose],
+    centres: &[Vector3<f64>],
+    thetas: &[f64],
+    tolerance_deg: f64,
+) -> TiltChoice {
+    let TiltChoice {
+        mut axes,
+        mut report,
+    } = unchanged(poses, tolerance_deg);
+    let normals = axes.clone();
+    let centre_coords = Coords::of(centres);
     let s = path_length(poses);
     let mut strings = Strings::default();
 

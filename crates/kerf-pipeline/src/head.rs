@@ -1,4 +1,4 @@
-//! The head along the cuts: every cut of a set-up checked against every surface of the file
+//! The head along the cuts: every cut of a set-up checked against the part it lies on
 //! ([`kerf_process::check_cut`]); where the head comes too close, the tool axis is tilted
 //! within the tilt tolerance, away from the surface in the way, and the path solved again
 //! (`docs/process.md`, "The head along the cuts").
@@ -52,16 +52,70 @@ fn away(n: &Vector3<f64>, p: &Point3<f64>, w: &Point3<f64>) -> Vector3<f64> {
     }
 }
 
-/// True if the head standing at `(p, axis)` keeps the clearance (a single placement).
+/// The margin a tilt must clear beyond the clearance, mm: room for the taut strings between
+/// the tilted cutting points and for the check of the tilted path, which proves a distance
+/// near its requirement only with fine cells.
+const TILT_MARGIN_MM: f64 = 0.5;
+
+/// The most distance queries one placement of the head may take while searching a tilt.
+const PLACEMENT_QUERIES: usize = 100_000;
+
+/// The direction at right angles to `n` in which the head point `w` moves away from the part
+/// fastest: the gradient of the distance to the part at `w` (central differences over
+/// 0.01 mm), less its part along `n`; `None` where that is too small to tell.
+fn escape(obs: &Obstacles, n: &Vector3<f64>, w: &Point3<f64>) -> Option<Vector3<f64>> {
+    let e = 0.01;
+    let g = Vector3::from_fn(|i, _| {
+        let mut dv = Vector3::zeros();
+        dv[i] = e;
+        (obs.distance(&(w + dv)) - obs.distance(&(w - dv))) / (2.0 * e)
+    });
+    let t = g - n * n.dot(&g);
+    (t.iter().all(|v| v.is_finite()) && t.norm() > 0.1).then(|| t.normalize())
+}
+
+/// The head standing once at `(p, axis)` with `opts`, its queries (at most
+/// [`PLACEMENT_QUERIES`]) taken from `budget`.
+fn place_once(
+    obs: &Obstacles,
+    head: &Head,
+    opts: &HeadCheckOptions,
+    p: Point3<f64>,
+    axis: Vector3<f64>,
+    budget: &mut usize,
+) -> CutClearance {
+    let opts = opts.with_max_queries(PLACEMENT_QUERIES.min(*budget));
+    let c = check_cut(obs, head, &[Pose { position: p, axis }], &opts);
+    *budget = budget.saturating_sub(c.queries);
+    c
+}
+
+/// True if the head standing at `(p, axis)` keeps the clearance plus [`TILT_MARGIN_MM`] (a
+/// single placement; none of the budget left: false).
 fn clears(
     obs: &Obstacles,
     head: &Head,
     opts: &HeadCheckOptions,
     p: Point3<f64>,
     axis: Vector3<f64>,
+    budget: &mut usize,
 ) -> bool {
-    let c = check_cut(obs, head, &[Pose { position: p, axis }], opts);
+    let opts = opts.with_clearance_mm(opts.clearance_mm + TILT_MARGIN_MM);
+    let c = place_once(obs, head, &opts, p, axis, budget);
     c.proven && c.close.is_empty()
+}
+
+/// A head point that a placement at `(p, axis)` witnesses within the clearance, if any.
+fn witness(
+    obs: &Obstacles,
+    head: &Head,
+    opts: &HeadCheckOptions,
+    p: Point3<f64>,
+    axis: Vector3<f64>,
+    budget: &mut usize,
+) -> Option<Point3<f64>> {
+    let c = place_once(obs, head, opts, p, axis, budget);
+    c.close.first().map(|st| st.point)
 }
 
 /// The input pose indices a range of solved poses covers (inserted poses belong to the
@@ -97,13 +151,22 @@ pub(crate) fn check_and_clear(
         popts.tilt_tolerance_deg.max(0.0).to_radians() * kerf_kinematics::TILT_WORKING_FRACTION;
     let fixed = (*popts).with_tilt_tolerance_deg(0.0);
     for &k in ks {
+        // After a refusal the run stops: the other cuts are not checked.
+        if out.refusal.is_some() {
+            break;
+        }
         let own = obstacles(k);
         let obs = &own;
+        // One work budget for the cut: the checks and the tilt search.
+        let mut budget = hopts.max_queries;
         let mut c = check_cut(obs, head, &solved[k].poses, hopts);
+        budget = budget.saturating_sub(c.queries);
         out.tip_zone_mm = Some(c.tip_zone_mm);
         let normals = inputs[k].poses;
         // Required tilt and its direction per input pose.
         let mut need: Vec<Option<(f64, Vector3<f64>)>> = vec![None; normals.len()];
+        // The tilts of the last path solved (what the report states).
+        let mut applied: Vec<Option<(f64, Vector3<f64>)>> = need.clone();
         let mut rounds = 0;
         let mut unclearable: Vec<String> = Vec::new();
         while !c.close.is_empty() && theta > 0.0 && rounds < MAX_ROUNDS && unclearable.is_empty() {
@@ -113,13 +176,16 @@ pub(crate) fn check_and_clear(
                 for i in lo..=hi {
                     let p = normals[i].position;
                     let n = normals[i].axis;
-                    let d = away(&n, &p, &st.point);
+                    // Away from what this cutting point's own head meets (upright on its
+                    // normal), else from the stretch's witness.
+                    let w = witness(obs, head, hopts, p, n, &mut budget).unwrap_or(st.point);
+                    let d = escape(obs, &n, &w).unwrap_or_else(|| away(&n, &p, &w));
                     let start = need[i].map_or(0, |(a, _)| {
                         ((a / theta) * TILT_STEPS as f64).round() as usize
                     });
                     let found = (start + 1..=TILT_STEPS)
                         .map(|j| theta * j as f64 / TILT_STEPS as f64)
-                        .find(|&a| clears(obs, head, hopts, p, tilted(&n, &d, a)));
+                        .find(|&a| clears(obs, head, hopts, p, tilted(&n, &d, a), &mut budget));
                     match found {
                         Some(a) => need[i] = Some((a, d)),
                         None => {
@@ -131,6 +197,7 @@ pub(crate) fn check_and_clear(
                                 i,
                                 st,
                                 popts.tilt_tolerance_deg,
+                                &mut budget,
                             ));
                             break;
                         }
@@ -176,16 +243,19 @@ pub(crate) fn check_and_clear(
                 Ok(mut s) => {
                     s.tilt = Some(choice.report);
                     solved[k] = s;
+                    applied = need.clone();
                 }
                 Err(e) => {
                     unclearable.push(format!("the tilted path cannot be solved: {e}"));
                     break;
                 }
             }
-            c = check_cut(obs, head, &solved[k].poses, hopts);
+            let left = hopts.with_max_queries(budget);
+            c = check_cut(obs, head, &solved[k].poses, &left);
+            budget = budget.saturating_sub(c.queries);
         }
-        let tilted_poses = need.iter().filter(|n| n.is_some()).count();
-        let max_tilt_deg = need
+        let tilted_poses = applied.iter().filter(|n| n.is_some()).count();
+        let max_tilt_deg = applied
             .iter()
             .flatten()
             .map(|(a, _)| a.to_degrees())
@@ -205,7 +275,16 @@ pub(crate) fn check_and_clear(
             {
                 let [lo, hi] = input_range(&solved[k], st.poses);
                 let i = (lo + hi) / 2;
-                reasons.push(needed_tilt(obs, head, hopts, &normals[i], i, st, 0.0));
+                reasons.push(needed_tilt(
+                    obs,
+                    head,
+                    hopts,
+                    &normals[i],
+                    i,
+                    st,
+                    0.0,
+                    &mut budget,
+                ));
             }
         }
         reasons.extend(unclearable);
@@ -226,6 +305,7 @@ pub(crate) fn check_and_clear(
 
 /// The tilt away from the surface in the way that would clear cutting point `i` (`pose`, its
 /// normal), in words, for a refusal.
+#[allow(clippy::too_many_arguments)]
 fn needed_tilt(
     obs: &Obstacles,
     head: &Head,
@@ -234,8 +314,10 @@ fn needed_tilt(
     i: usize,
     st: &kerf_process::CloseStretch,
     tolerance_deg: f64,
+    budget: &mut usize,
 ) -> String {
-    let d = away(&pose.axis, &pose.position, &st.point);
+    let d = escape(obs, &pose.axis, &st.point)
+        .unwrap_or_else(|| away(&pose.axis, &pose.position, &st.point));
     let surface = st.surface.as_deref().unwrap_or("?");
     let more = (1..)
         .map(|j| j as f64 * 2.5)
@@ -247,11 +329,18 @@ fn needed_tilt(
                 hopts,
                 pose.position,
                 tilted(&pose.axis, &d, a.to_radians()),
+                budget,
             )
         });
+    let usable = kerf_kinematics::MAX_TILT_TOLERANCE_DEG * kerf_kinematics::TILT_WORKING_FRACTION;
     match more {
+        Some(a) if a > usable => format!(
+            "at cutting point {i} a tilt of {a:.1} deg away from surface {surface} would clear it, beyond the largest tilt tolerance ({} deg): another placement or a smaller head",
+            kerf_kinematics::MAX_TILT_TOLERANCE_DEG
+        ),
         Some(a) => format!(
-            "at cutting point {i} a tilt of {a:.1} deg away from surface {surface} would clear it (tilt tolerance {tolerance_deg} deg; --tilt-tolerance DEG allows it)"
+            "at cutting point {i} a tilt of {a:.1} deg away from surface {surface} would clear it (tilt tolerance {tolerance_deg} deg; --tilt-tolerance {} allows it)",
+            (a / kerf_kinematics::TILT_WORKING_FRACTION).ceil()
         ),
         None => format!(
             "at cutting point {i} no tilt up to {MAX_NEEDED_TILT_DEG} deg away from surface {surface} clears it"
@@ -286,8 +375,8 @@ fn describe(s: &SolvedPath, c: &CutClearance, clearance: f64) -> Vec<String> {
         .collect();
     if !c.proven {
         reasons.push(format!(
-            "the check's work budget ran out after {} distance queries: not proven clear",
-            c.queries
+            "not proven clear: {}",
+            c.unproven.as_deref().unwrap_or("the check did not finish")
         ));
     }
     reasons
@@ -338,6 +427,6 @@ pub(crate) fn head_json(
         "standoff_mm": machine.process.standoff_mm.unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
         "tip_zone_mm": tip_zone,
         "paths": paths,
-        "note": "min_distance_mm: a proven lower bound of the distance from the head above the tip zone (the nozzle's lowest tip_zone_mm, meant to be near the cut) to every surface of the file over the cut's poses and the motion between them; close: stretches where a head point was found within the clearance; tilted: cutting points whose tool axis was tilted (within the tilt tolerance, away from the surface in the way) to clear it",
+        "note": "min_distance_mm: a proven lower bound of the distance from the head above the tip zone (the nozzle's lowest tip_zone_mm, meant to be near the cut) to the part the cut lies on (the surfaces its curve names and those joined to them; every surface of the file for a curve that names none) over the cut's poses and the motion between them; close: stretches where a head point was found within the clearance; tilted: cutting points whose tool axis was tilted (within the tilt tolerance, away from the surface in the way) to clear it",
     })
 }

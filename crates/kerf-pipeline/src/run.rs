@@ -320,7 +320,9 @@ fn run_placed(
                     .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
             )
             .with_max_tilt_deg(popts.tilt_tolerance_deg.max(HEAD_CHECK_MIN_TILT_DEG))
-            .with_path_deviation_mm(popts.linearization_tolerance_mm.min(1.0));
+            // The controller's tip leaves the chords by the non-linearity error and its
+            // blending (an infinite tolerance leaves the check unproven).
+            .with_path_deviation_mm(popts.linearization_tolerance_mm + o.blend_tolerance_mm);
         for setup in 0..placed.plan.setups.len() {
             let ks: Vec<usize> = (0..solved.len())
                 .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
@@ -812,10 +814,6 @@ fn run_placed(
     })
 }
 
-/// What the tilt tolerance did (`kinematics.tilt` of the report): the tolerance, the largest
-/// angle between a tool axis and its surface normal with the path and the place, and the
-/// rotary travel `sum |d tilt| + |d C|` (degrees) of the exact normals and of the chosen axes,
-/// in all and per path. `null` without a tolerance.
 /// How near a surface's boundary must come to another for the two to be one part, mm (CAD
 /// edges meet within hundredths of a millimetre).
 const PART_JOIN_TOLERANCE_MM: f64 = 0.05;
@@ -824,6 +822,10 @@ const PART_JOIN_TOLERANCE_MM: f64 = 0.05;
 /// pose's axis may stand a little off the surface normal even without a tilt tolerance.
 const HEAD_CHECK_MIN_TILT_DEG: f64 = 10.0;
 
+/// What the tilt tolerance did (`kinematics.tilt` of the report): the tolerance, the largest
+/// angle between a tool axis and its surface normal with the path and the place, and the
+/// rotary travel `sum |d tilt| + |d C|` (degrees) of the exact normals and of the chosen axes,
+/// in all and per path. `null` without a tolerance.
 fn tilt_report(solved: &[kerf_kinematics::SolvedPath], tolerance_deg: f64) -> serde_json::Value {
     if tolerance_deg <= 0.0 {
         return serde_json::Value::Null;

@@ -32,7 +32,7 @@ fn the_head_clears_the_wall_at_one_millimetre() {
         // Proven at least the clearance less the check's resolution, and never above the
         // exact 2 mm the body passes from the wall.
         assert!(
-            d >= 1.0 - kerf_process::CLOSE_CELL_MM - kerf_process::SAMPLE_STEP_MM / 2.0,
+            d >= 1.0 - kerf_process::RESOLUTION_MM - kerf_process::SAMPLE_STEP_MM / 2.0,
             "{p}"
         );
         if p["path"] == "hole-near-wall" {
@@ -76,39 +76,83 @@ fn the_wall_is_named_when_the_clearance_is_three_millimetres() {
     assert!(far["close"].as_array().expect("close").is_empty(), "{far}");
 }
 
-/// The smallest distance from the default head (above `zone` mm over the nozzle tip, 1 mm
-/// standoff), standing at each pose, to the floor and the wall of `head_wall.json`, by dense
-/// sampling of the head's surface against the exact rectangles: independent of the check's
-/// cells and closest points.
-fn sampled_distance(poses: &[(Point3<f64>, Vector3<f64>)], zone: f64) -> f64 {
-    let head = kerf_kinematics::Head::laser_default();
-    // The rectangles: origin, two edges.
-    let rects = [
-        (
-            Point3::new(-200.0, -200.0, 0.0),
-            Vector3::new(252.0, 0.0, 0.0),
-            Vector3::new(0.0, 400.0, 0.0),
-        ),
-        (
-            Point3::new(52.0, -200.0, 0.0),
-            Vector3::new(0.0, 400.0, 0.0),
-            Vector3::new(0.0, 0.0, 60.0),
-        ),
-    ];
-    let to_rect = |q: &Point3<f64>| -> f64 {
-        rects
-            .iter()
-            .map(|(o, u, v)| {
+/// An exact surface of the fixtures: a rectangle (origin, two edges) or the quarter cylinder
+/// of `head_bend.json` (axis along y through x = 0, z = 20, radius 20, from the floor to the
+/// flange, y in [-200, 200]).
+enum Exact {
+    Rect(Point3<f64>, Vector3<f64>, Vector3<f64>),
+    Bend,
+}
+
+impl Exact {
+    fn distance(&self, q: &Point3<f64>) -> f64 {
+        match self {
+            Exact::Rect(o, u, v) => {
                 let w = q - o;
                 let a = (w.dot(u) / u.norm_squared()).clamp(0.0, 1.0);
                 let b = (w.dot(v) / v.norm_squared()).clamp(0.0, 1.0);
                 (q - (o + u * a + v * b)).norm()
-            })
-            .fold(f64::INFINITY, f64::min)
-    };
+            }
+            Exact::Bend => {
+                let r = 20.0;
+                // The angle from the bottom (0) to the flange (90 degrees), clamped to the arc.
+                let (x, z) = (q.x, q.z - r);
+                let t = x.atan2(-z).clamp(0.0, std::f64::consts::FRAC_PI_2);
+                let y = q.y.clamp(-200.0, 200.0);
+                let on = Point3::new(r * t.sin(), y, r - r * t.cos());
+                (q - on).norm()
+            }
+        }
+    }
+}
+
+/// The exact surfaces of a head fixture.
+fn exact_surfaces(name: &str) -> Vec<Exact> {
+    let p = Point3::new;
+    let v = Vector3::new;
+    match name {
+        "head_wall.json" => vec![
+            Exact::Rect(
+                p(-200.0, -200.0, 0.0),
+                v(252.0, 0.0, 0.0),
+                v(0.0, 400.0, 0.0),
+            ),
+            Exact::Rect(p(52.0, -200.0, 0.0), v(0.0, 400.0, 0.0), v(0.0, 0.0, 60.0)),
+        ],
+        "head_channel.json" => vec![
+            Exact::Rect(
+                p(-50.0, -200.0, 0.0),
+                v(100.0, 0.0, 0.0),
+                v(0.0, 400.0, 0.0),
+            ),
+            Exact::Rect(p(-50.0, -200.0, 0.0), v(0.0, 0.0, 40.0), v(0.0, 400.0, 0.0)),
+            Exact::Rect(p(50.0, -200.0, 0.0), v(0.0, 400.0, 0.0), v(0.0, 0.0, 40.0)),
+        ],
+        "head_bend.json" => vec![
+            Exact::Rect(
+                p(-150.0, -200.0, 0.0),
+                v(150.0, 0.0, 0.0),
+                v(0.0, 400.0, 0.0),
+            ),
+            Exact::Bend,
+            Exact::Rect(p(20.0, -200.0, 20.0), v(0.0, 0.0, 13.0), v(0.0, 400.0, 0.0)),
+        ],
+        other => panic!("no exact surfaces for {other}"),
+    }
+}
+
+/// The smallest distance from the default head (above `zone` mm over the nozzle tip, 1 mm
+/// standoff), standing at each pose, to `surfaces`, by dense sampling of the head's surface
+/// (every 0.5 mm along the axis, every degree around it) against the exact surfaces:
+/// independent of the check's cells and closest points.
+fn sampled_distance(poses: &[(Point3<f64>, Vector3<f64>)], zone: f64, surfaces: &[Exact]) -> f64 {
+    let head = kerf_kinematics::Head::laser_default();
     let mut best = f64::INFINITY;
     for (p, a) in poses {
-        let e1 = a.cross(&Vector3::y()).normalize();
+        let e1 = a
+            .cross(&Vector3::y())
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| a.cross(&Vector3::x()).normalize());
         let e2 = a.cross(&e1);
         let steps = (head.length_mm() / 0.5) as usize;
         for j in 0..=steps {
@@ -117,56 +161,34 @@ fn sampled_distance(poses: &[(Point3<f64>, Vector3<f64>)], zone: f64) -> f64 {
             for m in 0..360 {
                 let phi = (m as f64).to_radians();
                 let q = p + a * (1.0 + h) + (e1 * phi.cos() + e2 * phi.sin()) * r;
-                best = best.min(to_rect(&q));
+                for s in surfaces {
+                    best = best.min(s.distance(&q));
+                }
             }
         }
     }
     best
 }
 
-#[test]
-fn a_tilt_within_the_tolerance_clears_the_wall_and_dense_sampling_agrees() {
-    let curves = kerf_format::curves::load(fixture("head_wall.json")).expect("curves");
-    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
-    let out = Job::new(curves.clone(), machine)
-        .with_options(
-            JobOptions::default()
-                .with_cut_clearance_mm(Some(3.0))
-                .with_path(kerf_kinematics::PathOptions::default().with_tilt_tolerance_deg(10.0)),
-        )
-        .run()
-        .expect("tilted to clear");
-    let head = &out.report["head"];
-    let zone = head["tip_zone_mm"].as_f64().expect("zone");
-    let near = head["paths"]
-        .as_array()
-        .expect("paths")
-        .iter()
-        .find(|p| p["path"] == "hole-near-wall")
-        .expect("near")
-        .clone();
-    let tilt = near["tilted"]["max_tilt_deg"].as_f64().expect("tilt");
-    assert!(tilt > 0.5 && tilt <= 10.0, "{near}");
-    // Every written pose of the cut, its lead-in and lead-out, in part coordinates, against
-    // the exact floor and wall: the clearance less the check's resolution.
+/// Every written pose of `id` (the cut, its lead-in and lead-out), in part coordinates.
+fn written_poses(
+    curves: &kerf_format::CurvesFile,
+    out: &kerf_pipeline::Output,
+    id: &str,
+) -> Vec<(Point3<f64>, Vector3<f64>)> {
     let i = curves
         .curves
         .iter()
-        .position(|c| c.id == "hole-near-wall")
+        .position(|c| c.id == id)
         .expect("curve");
     let pl = out.placement.placement_of(i);
     let (r, t) = (pl.rotation(), pl.translation_mm);
-    let path = out
-        .axes
-        .paths
-        .iter()
-        .find(|p| p.id == "hole-near-wall")
-        .expect("path");
+    let path = out.axes.paths.iter().find(|p| p.id == id).expect("path");
     let mut poses: Vec<[f64; 6]> = path.poses.clone();
     for m in [&path.lead_in, &path.lead_out].into_iter().flatten() {
         poses.extend(m.poses.iter().copied());
     }
-    let poses: Vec<(Point3<f64>, Vector3<f64>)> = poses
+    poses
         .iter()
         .map(|q| {
             (
@@ -174,17 +196,81 @@ fn a_tilt_within_the_tolerance_clears_the_wall_and_dense_sampling_agrees() {
                 r.inverse() * Vector3::new(q[3], q[4], q[5]),
             )
         })
-        .collect();
-    let d = sampled_distance(&poses, zone);
+        .collect()
+}
+
+/// A head fixture run with a tilt tolerance: every path clears by tilting (reported), and
+/// dense sampling of the head at every written pose agrees; upright on the curve's own
+/// normals (`normal` at each written point), the same sampling finds it closer than the
+/// clearance: the tilt, not the sampling, made the difference.
+fn tilted_fixture(
+    name: &str,
+    id: &str,
+    clearance: f64,
+    normal: impl Fn(&Point3<f64>) -> Vector3<f64>,
+) -> f64 {
+    let curves = kerf_format::curves::load(fixture(name)).expect("curves");
+    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    let run = |tilt: f64| {
+        Job::new(curves.clone(), machine.clone())
+            .with_options(
+                JobOptions::default()
+                    .with_cut_clearance_mm(Some(clearance))
+                    .with_path(
+                        kerf_kinematics::PathOptions::default().with_tilt_tolerance_deg(tilt),
+                    ),
+            )
+            .run()
+    };
+    let e = run(0.0).expect_err("upright: refused").to_string();
+    assert!(e.contains(id) && e.contains("would clear it"), "{e}");
+    let out = run(10.0).expect("tilted to clear");
+    let head = &out.report["head"];
+    let zone = head["tip_zone_mm"].as_f64().expect("zone");
+    let entry = head["paths"]
+        .as_array()
+        .expect("paths")
+        .iter()
+        .find(|p| p["path"] == id)
+        .expect("path")
+        .clone();
+    let tilt = entry["tilted"]["max_tilt_deg"].as_f64().expect("tilt");
+    assert!(tilt > 0.5 && tilt <= 10.0, "{entry}");
+    let surfaces = exact_surfaces(name);
+    let poses = written_poses(&curves, &out, id);
+    let d = sampled_distance(&poses, zone, &surfaces);
     assert!(
-        d >= 3.0 - kerf_process::CLOSE_CELL_MM - kerf_process::SAMPLE_STEP_MM / 2.0,
-        "dense sampling: the head within {d} mm of the part"
+        d >= clearance - kerf_process::RESOLUTION_MM - kerf_process::SAMPLE_STEP_MM / 2.0,
+        "{name}: dense sampling finds the head within {d} mm of the part"
     );
-    // Without the tilt the same sampling finds the wall closer than the clearance: the
-    // tilt, not the sampling, made the difference.
     let upright: Vec<(Point3<f64>, Vector3<f64>)> =
-        poses.iter().map(|(p, _)| (*p, Vector3::z())).collect();
-    assert!(sampled_distance(&upright, zone) < 2.5);
+        poses.iter().map(|(p, _)| (*p, normal(p))).collect();
+    let u = sampled_distance(&upright, zone, &surfaces);
+    assert!(u < clearance, "{name}: upright the head keeps {u} mm");
+    tilt
+}
+
+#[test]
+fn a_tilt_within_the_tolerance_clears_the_wall_and_dense_sampling_agrees() {
+    let tilt = tilted_fixture("head_wall.json", "hole-near-wall", 3.0, |_| Vector3::z());
+    assert!(tilt < 5.0, "{tilt}");
+}
+
+#[test]
+fn a_trim_line_in_a_u_channel_is_tilted_away_from_the_nearer_wall() {
+    tilted_fixture("head_channel.json", "channel-trim", 1.0, |_| Vector3::z());
+}
+
+#[test]
+fn a_trim_line_on_a_bend_leans_away_from_the_flange() {
+    // On the bend the normal points to its axis (x = 0, z = 20); on the floor it is +z.
+    tilted_fixture("head_bend.json", "bend-trim", 1.0, |p| {
+        if p.x > 1e-6 {
+            Vector3::new(-p.x, 0.0, 20.0 - p.z).normalize()
+        } else {
+            Vector3::z()
+        }
+    });
 }
 
 #[test]

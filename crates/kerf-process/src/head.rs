@@ -47,15 +47,14 @@ const RUN_STRIDE: usize = 8;
 /// The slack the tip zone keeps on a plane for a stretch of samples checked at once, mm.
 pub const STRETCH_SLACK_MM: f64 = 1.0;
 
-/// The smallest cell radius, mm: a cell this small that neither clears nor witnesses a
-/// violation counts as a violation (its bound is what is reported).
-const MIN_CELL_MM: f64 = 0.02;
+/// The radius of the smallest cells at a single sample, mm: a cell this small that neither
+/// clears the requirement nor witnesses a head point closer than the clearance keeps its bound.
+const CLOSE_CELL_MM: f64 = 0.25;
 
-/// The resolution of the check at a single sample, mm: a cell this small that neither clears
-/// the requirement nor has its centre (a head point) closer than the clearance keeps its
-/// bound `d - R`, so a sample may pass with a proven distance down to the clearance less this
-/// (and the slack of its motion); [`CutClearance::min_distance_mm`] says what was proven.
-pub const CLOSE_CELL_MM: f64 = 0.25;
+/// The resolution of the check, mm: a sample with no witness is proven at least the clearance
+/// less this (and the slack of its motion) from the part, and a head point closer than the
+/// clearance less this is witnessed ([`CutClearance::min_distance_mm`] says what was proven).
+pub const RESOLUTION_MM: f64 = 2.0 * CLOSE_CELL_MM;
 
 /// Options of [`check_cut`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -143,7 +142,8 @@ pub struct CutClearance {
     /// A proven lower bound of the distance between the head (above the tip zone) and the
     /// part over the cut, poses and the motion between them, outside the close stretches, mm
     /// (infinite without surfaces). Where no stretch is close it is at least the clearance
-    /// less [`CLOSE_CELL_MM`] and half a sample step.
+    /// less [`RESOLUTION_MM`] and the slack of the motion (half a sample step and the path
+    /// deviation).
     pub min_distance_mm: f64,
     /// The pose nearest which that bound was found.
     pub at_pose: usize,
@@ -155,8 +155,57 @@ pub struct CutClearance {
     pub samples: usize,
     /// Exact distance queries made.
     pub queries: usize,
-    /// False when the query budget ran out before every sample was shown clear or close.
+    /// False when the check could not be made or finished: see
+    /// [`unproven`](Self::unproven).
     pub proven: bool,
+    /// Why the cut is not proven: the query budget ran out, a pose or an option is not
+    /// usable, or the tip zone reaches past the nozzle (a clearance too large for the head).
+    pub unproven: Option<String>,
+}
+
+/// Marks `out` unproven: the query budget ran out.
+fn spent(out: &mut CutClearance, max_queries: usize) {
+    out.proven = false;
+    out.unproven = Some(format!(
+        "the work budget of {max_queries} distance queries ran out"
+    ));
+}
+
+/// Why a check cannot be made with these inputs, if it cannot.
+fn unusable(head: &Head, poses: &[Pose], opts: &HeadCheckOptions, zone: f64) -> Option<String> {
+    let o = opts;
+    let usable = o.clearance_mm.is_finite()
+        && o.clearance_mm > 0.0
+        && o.standoff_mm.is_finite()
+        && o.standoff_mm >= 0.0
+        && o.max_tilt_deg.is_finite()
+        && (0.0..=80.0).contains(&o.max_tilt_deg)
+        && o.path_deviation_mm.is_finite()
+        && o.path_deviation_mm >= 0.0;
+    if !usable {
+        return Some(format!(
+            "the options are not usable (clearance {} mm, standoff {} mm, tilt {} deg, path deviation {} mm)",
+            o.clearance_mm, o.standoff_mm, o.max_tilt_deg, o.path_deviation_mm
+        ));
+    }
+    if head.validate().is_err() {
+        return Some("the head model is not valid".into());
+    }
+    if let Some(k) = poses.iter().position(|p| {
+        !(p.position.coords.iter().all(|v| v.is_finite()) && (p.axis.norm() - 1.0).abs() <= 1e-6)
+    }) {
+        return Some(format!(
+            "pose {k} is not finite or its axis not of unit length"
+        ));
+    }
+    let nozzle = head.solids[0].length_mm;
+    if zone >= nozzle {
+        return Some(format!(
+            "the tip zone ({zone:.1} mm above the nozzle tip, where the head keeps the clearance plus {STRETCH_SLACK_MM} mm from a plane tilted by {} deg) reaches past the nozzle ({nozzle} mm): the clearance is too large for this head",
+            o.max_tilt_deg
+        ));
+    }
+    None
 }
 
 /// The height above the nozzle tip from which the head keeps `clearance + STRETCH_SLACK_MM`
@@ -190,15 +239,27 @@ struct Sample {
     s: f64,
 }
 
-/// A cell of the head in cylindrical coordinates about the tool axis.
+/// A cell of the head in cylindrical coordinates about the tool axis, inside one solid.
 #[derive(Debug, Clone, Copy)]
 struct Cell {
     h: [f64; 2],
     rho: [f64; 2],
     phi: [f64; 2],
+    /// Its solid: the height of its lower end above the tip, its length and its radii at its
+    /// two ends.
+    solid: [f64; 4],
 }
 
 impl Cell {
+    /// The solid's radius at height `h` above the nozzle tip (a frustum: linear).
+    fn solid_radius(&self, h: f64) -> f64 {
+        let [base, len, r0, r1] = self.solid;
+        r0 + (r1 - r0) * ((h - base) / len).clamp(0.0, 1.0)
+    }
+}
+
+impl Cell {
+    /// The radius of the ball about the centre that holds the cell.
     fn radius(&self) -> f64 {
         let dh = (self.h[1] - self.h[0]) / 2.0;
         let planar =
@@ -254,14 +315,24 @@ fn initial_cells(head: &Head, zone: f64) -> Vec<Cell> {
         let top = base + s.length_mm;
         let h0 = base.max(zone);
         if h0 < top {
-            let r = head.max_radius_over(h0, top).max(1e-9);
+            let solid = [
+                base,
+                s.length_mm,
+                s.bottom_diameter_mm / 2.0,
+                s.top_diameter_mm / 2.0,
+            ];
+            let mut cell = Cell {
+                h: [h0, top],
+                rho: [0.0, 0.0],
+                phi: [0.0, 0.0],
+                solid,
+            };
+            let r = cell.solid_radius(h0).max(cell.solid_radius(top)).max(1e-9);
+            cell.rho = [0.0, r];
             for q in 0..4 {
                 let phi0 = q as f64 * std::f64::consts::FRAC_PI_2;
-                cells.push(Cell {
-                    h: [h0, top],
-                    rho: [0.0, r],
-                    phi: [phi0, phi0 + std::f64::consts::FRAC_PI_2],
-                });
+                cell.phi = [phi0, phi0 + std::f64::consts::FRAC_PI_2];
+                cells.push(cell);
             }
         }
         base = top;
@@ -276,7 +347,6 @@ fn initial_cells(head: &Head, zone: f64) -> Vec<Cell> {
 #[allow(clippy::too_many_arguments)]
 fn place_head(
     obstacles: &Obstacles,
-    head: &Head,
     cells0: &[Cell],
     standoff: f64,
     tip: &Point3<f64>,
@@ -304,8 +374,9 @@ fn place_head(
     let mut least = f64::INFINITY;
     let mut close: Option<(f64, f64, Point3<f64>)> = None;
     while let Some(cell) = stack.pop() {
-        // A cell wholly outside the head (beyond the largest radius over its heights).
-        if cell.rho[0] > head.max_radius_over(cell.h[0], cell.h[1]) {
+        // A cell wholly outside its solid (beyond its largest radius over the cell's heights).
+        let (r_lo, r_hi) = (cell.solid_radius(cell.h[0]), cell.solid_radius(cell.h[1]));
+        if cell.rho[0] > r_lo.max(r_hi) {
             continue;
         }
         let r = cell.radius();
@@ -329,29 +400,32 @@ fn place_head(
             close = Some((d - r, hm, c));
             break;
         }
-        if r <= CLOSE_CELL_MM || r <= MIN_CELL_MM {
-            // A witness: the cell's centre inside the head (within the smaller radius at the
-            // cell's ends: the solids are frustums) closer to the part than the clearance.
+        if r <= CLOSE_CELL_MM {
+            // A witness: a head point (the centre, or where it lies outside its solid, the
+            // centre pulled in to the solid's surface at its height) closer to the part than
+            // the clearance.
             let rho = (cell.rho[0] + cell.rho[1]) / 2.0;
-            let inside = rho
-                <= head
-                    .radius_at(cell.h[0])
-                    .unwrap_or(0.0)
-                    .min(head.radius_at(cell.h[1]).unwrap_or(0.0));
-            if inside && d < clearance {
-                close = Some((d, hm, c));
+            let edge = cell.solid_radius(hm);
+            let phi = (cell.phi[0] + cell.phi[1]) / 2.0;
+            let (dw, w) = if rho <= edge {
+                (d, c)
+            } else {
+                let w = point(hm, edge, phi);
+                if *queries >= max_queries {
+                    return Verdict::Spent;
+                }
+                *queries += 1;
+                (obstacles.distance_below(&w, clearance), w)
+            };
+            if dw < clearance {
+                close = Some((dw, hm, w));
                 break;
             }
-            if rho - (cell.rho[1] - cell.rho[0]) / 2.0 > head.radius_at(hm).unwrap_or(0.0)
-                && r > MIN_CELL_MM
-            {
-                // Mostly outside the head: refine to find where the head's edge lies.
-            } else {
-                // Within the resolution: its bound stands (it may be below the requirement
-                // by at most the cell's radius).
-                least = least.min(d - r);
-                continue;
-            }
+            // Within the resolution: every point of the cell is within `r` of the centre and
+            // `2 r` of `w`, so at least `max(d - r, dw - 2 r)` from the part; with no witness
+            // `dw >= clearance`, so the bound is at least the clearance less `2 r`.
+            least = least.min((d - r).max(dw - 2.0 * r));
+            continue;
         }
         let [a, b] = cell.split();
         stack.push(a);
@@ -415,23 +489,39 @@ pub fn check_cut(
     opts: &HeadCheckOptions,
 ) -> CutClearance {
     let zone = tip_zone_mm(head, opts);
-    let reach = (opts.standoff_mm + head.length_mm()).hypot(head.max_radius_mm());
-    let samples = samples(poses, reach);
-    let cells0 = initial_cells(head, zone);
     let mut out = CutClearance {
         min_distance_mm: f64::INFINITY,
         at_pose: 0,
         close: Vec::new(),
         tip_zone_mm: zone,
-        samples: samples.len(),
+        samples: 0,
         queries: 0,
         proven: true,
+        unproven: None,
     };
-    if samples.is_empty() || obstacles.is_empty() || cells0.is_empty() {
+    if let Some(why) = unusable(head, poses, opts, zone) {
+        out.proven = false;
+        out.unproven = Some(why);
+        return out;
+    }
+    let reach = (opts.standoff_mm + head.length_mm()).hypot(head.max_radius_mm());
+    let samples = samples(poses, reach);
+    out.samples = samples.len();
+    let cells0 = initial_cells(head, zone);
+    if samples.is_empty() || obstacles.is_empty() {
         return out;
     }
     let disp = |a: &Sample, b: &Sample| (a.tip - b.tip).norm() + reach * a.axis.angle(&b.axis);
-    // Close samples with their bound, height and point.
+    // Half the larger step from each sample to its neighbours: the motion it stands for.
+    let half_step: Vec<f64> = (0..samples.len())
+        .map(|k| {
+            [k.checked_sub(1), (k + 1 < samples.len()).then_some(k + 1)]
+                .into_iter()
+                .flatten()
+                .map(|n| disp(&samples[n], &samples[k]) / 2.0)
+                .fold(0.0, f64::max)
+        })
+        .collect();
     // Close samples: the witnessed distance, the height and the head point.
     let mut close_at: Vec<Option<(f64, f64, Point3<f64>)>> = vec![None; samples.len()];
     let mut todo = vec![(0usize, samples.len() - 1)];
@@ -452,23 +542,13 @@ pub fn check_cut(
             todo.push((i, m - 1));
             continue;
         }
+        // Each sample stands for the motion halfway to its neighbours.
         let spread = (i..=j)
-            .map(|k| disp(&samples[k], &samples[m]))
+            .map(|k| disp(&samples[k], &samples[m]) + half_step[k])
             .fold(0.0, f64::max);
-        // A single sample stands for the motion to its neighbours' midpoints.
-        let spread = if i == j {
-            [m.checked_sub(1), (m + 1 < samples.len()).then_some(m + 1)]
-                .into_iter()
-                .flatten()
-                .map(|n| disp(&samples[n], &samples[m]) / 2.0)
-                .fold(0.0, f64::max)
-        } else {
-            spread
-        };
         let slack = spread + opts.path_deviation_mm;
         let verdict = place_head(
             obstacles,
-            head,
             &cells0,
             opts.standoff_mm,
             &samples[m].tip,
@@ -488,7 +568,7 @@ pub fn check_cut(
                 }
             }
             Verdict::Spent => {
-                out.proven = false;
+                spent(&mut out, opts.max_queries);
                 break;
             }
             Verdict::Close {
@@ -496,8 +576,6 @@ pub fn check_cut(
                 height,
                 point,
             } if i == j => {
-                // The witness holds for the samples whose head lies within the clearance's
-                // margin of this one: every head point moves by at most `disp`.
                 close_at[m] = Some((bound, height, point));
                 // Then probes every RUN_STRIDE samples on either side: two witnesses that
                 // close make the samples between them part of one close stretch.
@@ -511,24 +589,27 @@ pub fn check_cut(
                         let k = k as usize;
                         let probe = place_head(
                             obstacles,
-                            head,
                             &cells0,
                             opts.standoff_mm,
                             &samples[k].tip,
                             &samples[k].axis,
-                            opts.clearance_mm + opts.path_deviation_mm,
+                            opts.clearance_mm + opts.path_deviation_mm + half_step[k],
                             opts.clearance_mm,
                             false,
                             &mut out.queries,
                             opts.max_queries,
                         );
-                        let Verdict::Close {
-                            bound,
-                            height,
-                            point,
-                        } = probe
-                        else {
-                            break;
+                        let (bound, height, point) = match probe {
+                            Verdict::Close {
+                                bound,
+                                height,
+                                point,
+                            } => (bound, height, point),
+                            Verdict::Clear(_) => break,
+                            Verdict::Spent => {
+                                spent(&mut out, opts.max_queries);
+                                break;
+                            }
                         };
                         let (lo, hi) = (at.min(k), at.max(k));
                         for c in &mut close_at[lo..=hi] {

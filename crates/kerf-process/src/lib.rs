@@ -38,7 +38,7 @@ mod traverse;
 mod wall;
 
 pub use head::{
-    check_cut, tip_zone_mm, CloseStretch, CutClearance, HeadCheckOptions, CLOSE_CELL_MM,
+    check_cut, tip_zone_mm, CloseStretch, CutClearance, HeadCheckOptions, RESOLUTION_MM,
     SAMPLE_STEP_MM, STRETCH_SLACK_MM,
 };
 pub use lead::{LeadIn, LeadOptions};

@@ -63,7 +63,7 @@ fn a_flat_floor_alone_keeps_the_clearance_at_any_tilt_within_the_tip_zone() {
         let r = check_cut(&obs, &head, &hole(32, tilt), &HeadCheckOptions::default());
         assert!(r.proven, "tilt {tilt}: proven");
         assert!(r.close.is_empty(), "tilt {tilt}: {:?}", r.close);
-        let floor_mm = 1.0 - kerf_process::CLOSE_CELL_MM - kerf_process::SAMPLE_STEP_MM / 2.0;
+        let floor_mm = 1.0 - kerf_process::RESOLUTION_MM - kerf_process::SAMPLE_STEP_MM / 2.0;
         assert!(
             r.min_distance_mm >= floor_mm,
             "tilt {tilt}: bound {} below the clearance less the resolution",
@@ -106,7 +106,7 @@ fn a_wall_beside_the_hole_is_found_where_the_body_comes_within_the_clearance() {
             let d = exact(x, std::f64::consts::TAU * k as f64 / n as f64);
             // Reported where a head point (a cell centre, within the resolution of the
             // nearest) is witnessed closer than the clearance.
-            if d < opts.clearance_mm - kerf_process::CLOSE_CELL_MM {
+            if d < opts.clearance_mm - kerf_process::RESOLUTION_MM {
                 assert!(inside(k), "x {x}: pose {k} at {d} mm not reported");
             }
             // Not reported where the head clears by more than a sample step's slack.
@@ -150,4 +150,62 @@ fn a_slot_narrower_than_the_nozzle_is_close_everywhere_and_the_work_is_bounded()
     let r = check_cut(&obs, &head, &poses, &tight);
     assert!(!r.proven, "the budget ran out");
     assert!(r.queries <= 50, "{} queries", r.queries);
+}
+
+/// A low wall beside the nozzle cone (10 mm high, 3.6 mm from the axis): the cone's radius at
+/// the wall's top (9 mm above the nozzle tip) is 1.5 + 5.5 x 9 / 25 = 3.48 mm, so the wall's
+/// edge passes 0.12 mm from it, within the clearance less the resolution: a witness on the
+/// nozzle, not the body.
+#[test]
+fn a_low_wall_beside_the_nozzle_cone_is_witnessed_on_the_cone() {
+    let head = Head::laser_default();
+    let mut obs = Obstacles::new();
+    obs.add_nurbs(floor());
+    obs.add_nurbs(
+        NurbsSurface::plane(
+            Point3::new(3.6, -100.0, 0.0),
+            Vector3::y(),
+            Vector3::z(),
+            200.0,
+            10.0,
+        )
+        .expect("low wall"),
+    );
+    let pose = [Pose {
+        position: Point3::origin(),
+        axis: Vector3::z(),
+    }];
+    let r = check_cut(&obs, &head, &pose, &HeadCheckOptions::default());
+    assert_eq!(r.close.len(), 1, "{r:?}");
+    let c = &r.close[0];
+    assert!(c.at_height_mm < 25.0, "on the nozzle cone: {c:?}");
+    assert!(c.distance_mm < 1.0 && c.distance_mm >= 0.11, "{c:?}");
+}
+
+#[test]
+fn unusable_inputs_are_not_proven_clear() {
+    let head = Head::laser_default();
+    let mut obs = Obstacles::new();
+    obs.add_nurbs(floor());
+    let poses = hole(8, 0.0);
+    // A clearance whose tip zone swallows the nozzle: the check would see nothing of it.
+    let r = check_cut(
+        &obs,
+        &head,
+        &poses,
+        &HeadCheckOptions::default().with_clearance_mm(30.0),
+    );
+    assert!(!r.proven, "{r:?}");
+    assert!(
+        r.unproven
+            .as_deref()
+            .is_some_and(|w| w.contains("too large for this head")),
+        "{r:?}"
+    );
+    // A pose that is not finite, an infinite path deviation.
+    let mut bad = poses.clone();
+    bad[3].position.x = f64::NAN;
+    assert!(!check_cut(&obs, &head, &bad, &HeadCheckOptions::default()).proven);
+    let inf = HeadCheckOptions::default().with_path_deviation_mm(f64::INFINITY);
+    assert!(!check_cut(&obs, &head, &poses, &inf).proven);
 }

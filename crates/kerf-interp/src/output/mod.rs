@@ -387,7 +387,9 @@ fn out_of_range<M: AxisModel + ?Sized>(model: &M, q: &[f64; 5]) -> Option<(Strin
 /// and > 0; [`InterpError::Process`] for unusable process codes;
 /// [`InterpError::UncheckedBlock`] for an arc or a merged line in a program for a dialect that
 /// gives the raw machine axes ([`Dialect::raw_axes`]); [`InterpError::PierceOutOfRange`] for a
-/// pierce point (the standoff above a cut's start) outside an axis range.
+/// pierce point (the standoff above a cut's start) outside an axis range;
+/// [`InterpError::RetractOutOfRange`] for the retract that ends a program whose last block is
+/// a cut (so that a beam-off synchronized with motion fires) outside an axis range.
 pub fn gcode_timed<M: AxisModel + ?Sized>(
     model: &M,
     blocks: &[Block],

@@ -17,7 +17,11 @@ enum Obstacle {
     Mesh(Box<TriMesh>),
 }
 
-/// Points on the boundary of a surface ([`Obstacles::joined_to`]).
+/// The most vertices of one mesh tested for joins ([`Obstacles::parts`]).
+const MESH_JOIN_VERTICES: usize = 20_000;
+
+/// Points on the boundary of a surface ([`Obstacles::parts`]): a NURBS surface's four
+/// boundary curves, a mesh's vertices.
 fn boundary_points(shape: &Obstacle) -> Vec<Point3<f64>> {
     match shape {
         Obstacle::Nurbs(t) => {
@@ -39,7 +43,9 @@ fn boundary_points(shape: &Obstacle) -> Vec<Point3<f64>> {
         }
         Obstacle::Mesh(m) => {
             let v = m.vertices();
-            let step = v.len().div_ceil(512).max(1);
+            // Every vertex of a mesh of up to 20,000 (a shared edge's vertices lie on the
+            // other surface); every k-th of a larger one.
+            let step = v.len().div_ceil(MESH_JOIN_VERTICES).max(1);
             v.iter().step_by(step).copied().collect()
         }
     }
@@ -150,7 +156,7 @@ impl Obstacles {
     /// The parts of the surfaces: for each surface (in the order added) the index of its part,
     /// surfaces being of one part where joined directly or through others. Two surfaces are
     /// joined where a point of one's boundary (for a NURBS surface, its four boundary curves
-    /// at 33 points each; for a mesh, its vertices, at most 512 of them) lies within
+    /// at 33 points each; for a mesh, its vertices, at most 20,000 of them) lies within
     /// `tolerance_mm` of the other: the floor a cut lies on and the wall beside it, not
     /// another part that a file holds in the same place.
     pub fn parts(&self, tolerance_mm: f64) -> Vec<usize> {
@@ -180,8 +186,12 @@ impl Obstacles {
     }
 
     /// The surfaces whose part (`parts`, from [`Obstacles::parts`]) holds one of the surfaces
-    /// named in `seeds` (shared, not copied).
+    /// named in `seeds` (shared, not copied); every surface when `seeds` names none of them
+    /// (a curve that names no surface is checked against the whole file).
     pub fn of_parts(&self, parts: &[usize], seeds: &[String]) -> Obstacles {
+        if !self.items.iter().any(|i| seeds.contains(&i.id)) {
+            return self.without(&[]);
+        }
         let keep: Vec<usize> = self
             .items
             .iter()

@@ -65,7 +65,7 @@ pub(crate) enum Command {
     #[command(
         after_help = "Examples:\n  kerf run fixtures/dome.json --machine fixtures/machines/ac_head.json --tolerance 0.01 --out out\n  kerf run part.json -m machine.json -t 0.005 --feed 4000 --dialect sinumerik --out part-out"
     )]
-    Run(RunArgs),
+    Run(Box<RunArgs>),
 
     /// Interpolate a program: per-cycle machine axis set-points (paper 000's time-division
     /// lines and 3-point space arcs, with a look-ahead feed plan within every axis limit).
@@ -428,9 +428,26 @@ pub(crate) struct RunArgs {
     #[arg(short, long, default_value = "kerf-out", value_name = "DIR")]
     pub(crate) out: PathBuf,
 
-    /// Programmed cutting feed, mm/min.
-    #[arg(short, long, default_value_t = 6000.0, value_name = "MM_PER_MIN", value_parser = crate::guard::feed_mm_per_min)]
-    pub(crate) feed: f64,
+    /// Programmed cutting feed, mm/min: this, else the technology entry's (--technology),
+    /// else 6000.
+    #[arg(short, long, value_name = "MM_PER_MIN", value_parser = crate::guard::feed_mm_per_min)]
+    pub(crate) feed: Option<f64>,
+
+    /// A technology table (`kerf.technology/1`): the entry of --material (and --thickness)
+    /// sets the feed (unless --feed), the pierce time and height, the standoff and the kerf
+    /// width (unless --kerf-width); the program header and the report name it.
+    #[arg(long, value_name = "FILE", requires = "material")]
+    pub(crate) technology: Option<PathBuf>,
+
+    /// The material of the technology entry (compared without case); an unknown one is
+    /// refused with the known ones listed.
+    #[arg(long, value_name = "NAME", requires = "technology")]
+    pub(crate) material: Option<String>,
+
+    /// The sheet thickness of the technology entry, mm (needed where the material has several
+    /// entries).
+    #[arg(long, value_name = "MM", requires = "technology", value_parser = crate::guard::positive_mm)]
+    pub(crate) thickness: Option<f64>,
 
     /// Interpolation cycle, seconds (from 1e-5 to 0.1: 10 microseconds to 100 milliseconds).
     #[arg(short, long, default_value_t = 0.001, value_name = "S", value_parser = crate::guard::cycle_s)]

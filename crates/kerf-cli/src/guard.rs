@@ -124,6 +124,19 @@ pub(crate) fn wall_mm(s: &str) -> Result<f64, String> {
     within(s, ranges::WALL_MM)
 }
 
+/// A sheet thickness in mm: finite, above 0 and at most 100 (the technology entries' range).
+pub(crate) fn positive_mm(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("expected a number of mm, got {s:?}"))?;
+    if v.is_finite() && v > 0.0 && v <= 100.0 {
+        Ok(v)
+    } else {
+        Err(format!("must lie in (0, 100] mm (got {s})"))
+    }
+}
+
 /// A kerf width in [`ranges::KERF_WIDTH_MM`].
 pub(crate) fn kerf_width_mm(s: &str) -> Result<f64, String> {
     within(s, ranges::KERF_WIDTH_MM)

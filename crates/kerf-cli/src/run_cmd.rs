@@ -11,6 +11,9 @@ use crate::cli::RunArgs;
 use crate::error::CliError;
 use crate::input::{load_curves, ProgressBar};
 
+/// The feed of a run that names none and no technology, mm/min.
+const DEFAULT_FEED_MM_PER_MIN: f64 = 6000.0;
+
 /// The job options the arguments ask for.
 fn job_options(args: &RunArgs) -> JobOptions {
     let mut discretize = kerf_discretize::Options::with_tolerance(args.tolerance);
@@ -36,7 +39,7 @@ fn job_options(args: &RunArgs) -> JobOptions {
         .with_path(path)
         .with_place(args.place.unwrap_or_default())
         .with_leads(args.lead_options())
-        .with_feed_mm_per_min(args.feed)
+        .with_feed_mm_per_min(args.feed.unwrap_or(DEFAULT_FEED_MM_PER_MIN))
         .with_cycle_s(args.cycle)
         .with_dialect(args.dialect.into())
         .with_blend_tolerance_mm(args.blend_tolerance)
@@ -87,7 +90,21 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
         Job::new(file, machine).with_source(path)
     };
     lap.stop(&mut read, "read");
-    let job = job.with_options(job_options(args));
+    let mut job = job.with_options(job_options(args));
+    if let (Some(file), Some(material)) = (&args.technology, &args.material) {
+        let table = kerf_kinematics::Technology::read(file)?;
+        let entry = table.entry(material, args.thickness).map_err(|error| {
+            kerf_kinematics::KinematicsError::File {
+                file: file.display().to_string(),
+                error: Box::new(error),
+            }
+        })?;
+        job = job.with_technology(entry.clone());
+        if let Some(feed) = args.feed {
+            job = job.with_feed_mm_per_min(feed);
+        }
+    }
+    let feed = job.options().feed_mm_per_min;
     let bar = ProgressBar::new(job.curves().curves.len());
     let out = job.run_with_progress(&|p| bar.update(p));
     bar.finish();
@@ -127,7 +144,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
             int(&r["interpolation"]["lines"]),
             int(&r["interpolation"]["arcs"]),
             num(&r["interpolation"]["duration_s"]),
-            args.feed,
+            feed,
             args.out.display(),
             start.elapsed().as_secs_f64(),
             out.timings.cpu_s(),

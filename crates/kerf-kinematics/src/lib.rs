@@ -50,6 +50,7 @@ mod pose;
 mod registry;
 mod rotation;
 mod table_table;
+mod technology;
 mod tilt;
 
 pub use ac_head::AcHead;
@@ -75,6 +76,9 @@ pub use placement::{
 pub use pose::{Axes, Axis, Pose};
 pub use registry::kinematics_types;
 pub use table_table::TableTable;
+pub use technology::{
+    Pierce, SmallHole, Technology, TechnologyEntry, MAX_TECHNOLOGY_ENTRIES, TECHNOLOGY_FORMAT,
+};
 pub use tilt::{
     tilt_within_cone, tilt_within_cones, Cone, TiltChoice, TiltReport, TILT_WORKING_FRACTION,
 };

@@ -141,6 +141,9 @@ pub struct JobOptions {
     /// With [`JobOptions::cut_clearance_mm`], cuts where the head comes closer are warnings
     /// instead of a refused run. Default false.
     pub accept_head_collisions: bool,
+    /// The technology entry the run cuts with ([`Job::with_technology`]), for the report and
+    /// the program header. `None` by default.
+    pub technology: Option<kerf_kinematics::TechnologyEntry>,
 }
 
 /// The tilt tolerance of a job unless it sets another (degrees): 0, the exact normal. A
@@ -179,6 +182,7 @@ impl Default for JobOptions {
             kerf_in_control: false,
             cut_clearance_mm: None,
             accept_head_collisions: false,
+            technology: None,
         }
     }
 }
@@ -562,6 +566,36 @@ impl Job {
     /// With these options.
     pub fn with_options(mut self, options: JobOptions) -> Self {
         self.options = options;
+        self
+    }
+
+    /// Cuts with a technology entry (`kerf.technology/1`): its feed becomes the job's feed, and
+    /// its pierce (time, height), standoff and kerf width replace the machine file's
+    /// `process` values where the entry gives them (a run's own `--kerf-width` still wins:
+    /// [`JobOptions::kerf_width_mm`]). Call it after [`Job::with_options`], then set a feed
+    /// the user gave explicitly. The entry is named in the report and the program header. Its
+    /// power is stated there, not yet commanded.
+    pub fn with_technology(mut self, entry: kerf_kinematics::TechnologyEntry) -> Self {
+        self.options.feed_mm_per_min = entry.feed_mm_per_min;
+        let p = &mut self.machine.process;
+        if let Some(pierce) = &entry.pierce {
+            p.pierce_dwell_s = Some(pierce.time_s);
+            p.pierce_standoff = Some(pierce.height_mm);
+        }
+        if let Some(s) = entry.standoff_mm {
+            p.standoff_mm = Some(s);
+        }
+        if let Some(k) = entry.kerf_width_mm {
+            p.kerf_width_mm = Some(k);
+        }
+        self.options.technology = Some(entry);
+        self
+    }
+
+    /// With this feed, mm/min (after [`Job::with_technology`], a feed the user gave wins over
+    /// the entry's).
+    pub fn with_feed_mm_per_min(mut self, feed_mm_per_min: f64) -> Self {
+        self.options.feed_mm_per_min = feed_mm_per_min;
         self
     }
 

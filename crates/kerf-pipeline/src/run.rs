@@ -157,6 +157,12 @@ fn run_placed(
         .kerf_width_mm
         .map(|w| (w, "--kerf-width"))
         .or_else(|| {
+            o.technology
+                .as_ref()
+                .and_then(|t| t.kerf_width_mm)
+                .map(|w| (w, "technology entry"))
+        })
+        .or_else(|| {
             machine
                 .process
                 .kerf_width_mm
@@ -602,6 +608,7 @@ fn run_placed(
             ),
             "work offset: none; every coordinate is in the machine's workpiece frame with the placement applied: clamp the part there".to_string(),
             crate::cuts::kerf_header(kerf.as_ref(), &compensated),
+            technology_header(o.technology.as_ref()),
         ];
         let mut text = gcode_motion(&model, &motion, &ids, &gopts_k).map_err(interp(path))?;
         text.shrink_to_fit();
@@ -736,6 +743,7 @@ fn run_placed(
             "files": program_names(programs.len()),
         },
         "compensation": crate::cuts::compensation_json(file, kerf.as_ref(), &compensated),
+        "technology": technology_json(o.technology.as_ref()),
         "head": crate::head::head_json(o.cut_clearance_mm, machine, head_tip_zone, head_report),
         "discretize": {
             "curves": file.curves.len(),
@@ -811,6 +819,48 @@ fn run_placed(
         timings,
         model,
         cycle_s: o.cycle_s,
+    })
+}
+
+/// The program header's line on the technology entry (its text goes through the comment
+/// sanitizer like every header line).
+fn technology_header(t: Option<&kerf_kinematics::TechnologyEntry>) -> String {
+    let Some(t) = t else {
+        return "technology: none (feed from --feed, process codes from the machine file)".into();
+    };
+    let pierce = t.pierce.map_or(String::new(), |p| {
+        format!(
+            ", pierce {} s at {} mm and {} %",
+            p.time_s, p.height_mm, p.power_percent
+        )
+    });
+    format!(
+        "technology: {}: feed {} mm/min, power {} % (stated, not commanded){pierce}",
+        t.label(),
+        t.feed_mm_per_min,
+        t.power_percent
+    )
+}
+
+/// The report's `technology` object: the entry used, or null.
+fn technology_json(t: Option<&kerf_kinematics::TechnologyEntry>) -> serde_json::Value {
+    let Some(t) = t else {
+        return serde_json::Value::Null;
+    };
+    json!({
+        "entry": t.label(),
+        "material": t.material,
+        "thickness_mm": t.thickness_mm,
+        "gas": t.gas,
+        "gas_pressure_bar": t.gas_pressure_bar,
+        "feed_mm_per_min": t.feed_mm_per_min,
+        "power_percent": t.power_percent,
+        "focus_mm": t.focus_mm,
+        "standoff_mm": t.standoff_mm,
+        "kerf_width_mm": t.kerf_width_mm,
+        "pierce": t.pierce.map(|p| json!({ "time_s": p.time_s, "power_percent": p.power_percent, "height_mm": p.height_mm })),
+        "small_hole": t.small_hole.map(|h| json!({ "max_diameter_mm": h.max_diameter_mm, "feed_factor": h.feed_factor, "power_factor": h.power_factor })),
+        "note": "the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; power, gas, focus and the small-hole rule are stated, not yet commanded",
     })
 }
 

@@ -1,0 +1,159 @@
+//! `kerf run --technology FILE --material NAME [--thickness MM]`: the entry sets the feed, the
+//! pierce, the standoff and the kerf width, and is named in the program and the report; bad
+//! tables and unknown materials are refused by file and JSON path with nothing written.
+
+mod common;
+use common::{fixture, kerf};
+
+fn run(extra: &[&str], out: &std::path::Path) -> std::process::Output {
+    kerf()
+        .args(["run"])
+        .arg(fixture("sheet_metal_holes.json"))
+        .arg("-m")
+        .arg(fixture("machines/gantry_ac.json"))
+        .arg("-o")
+        .arg(out)
+        .arg("-q")
+        .args(extra)
+        .output()
+        .expect("kerf runs")
+}
+
+#[test]
+fn the_entry_sets_feed_pierce_and_kerf_and_is_named() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let table = fixture("technology/fiber_3kw_example.json");
+    let table = table.to_str().expect("path");
+    let out = dir.path().join("out");
+    let r = run(
+        &[
+            "--technology",
+            table,
+            "--material",
+            "Mild Steel",
+            "--thickness",
+            "2",
+        ],
+        &out,
+    );
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let program = std::fs::read_to_string(out.join("program.nc")).expect("program");
+    assert!(
+        program.contains("; technology: mild steel 2 mm O2: feed 4500 mm/min"),
+        "{}",
+        &program[..600.min(program.len())]
+    );
+    // The entry's pierce time is the dwell; its kerf is offset; its feed is planned.
+    assert!(program.contains("G4 P0.2\n"), "pierce dwell 0.2 s");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("report"))
+            .expect("json");
+    assert_eq!(report["technology"]["entry"], "mild steel 2 mm O2");
+    assert_eq!(report["compensation"]["kerf_width_mm"], 0.15);
+    assert_eq!(report["compensation"]["source"], "technology entry");
+    assert_eq!(report["interpolation"]["feed_mm_per_min"], 4500.0);
+    // --feed wins over the entry's.
+    let out2 = dir.path().join("out2");
+    let r = run(
+        &[
+            "--technology",
+            table,
+            "--material",
+            "mild steel",
+            "--thickness",
+            "2",
+            "--feed",
+            "3000",
+        ],
+        &out2,
+    );
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let program = std::fs::read_to_string(out2.join("program.nc")).expect("program");
+    assert!(
+        program.contains("feed 4500 mm/min"),
+        "the entry is still named"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out2.join("report.json")).expect("report"))
+            .expect("json");
+    assert_eq!(report["interpolation"]["feed_mm_per_min"], 3000.0);
+}
+
+#[test]
+fn unknown_materials_and_bad_tables_are_refused_by_name_with_nothing_written() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let table = fixture("technology/fiber_3kw_example.json");
+    let table = table.to_str().expect("path");
+    let out = dir.path().join("out");
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["--technology".into(), table.into(), "--material".into(), "copper".into()],
+            "technology: no entry for material \"copper\" (known: mild steel 1 mm, mild steel 2 mm",
+        ),
+        (
+            vec!["--technology".into(), table.into(), "--material".into(), "stainless".into()],
+            "material \"stainless\" has several entries: give the thickness",
+        ),
+        (
+            vec![
+                "--technology".into(),
+                table.into(),
+                "--material".into(),
+                "aluminium".into(),
+                "--thickness".into(),
+                "4".into(),
+            ],
+            "no entry for material \"aluminium\" at 4 mm (known: aluminium 1 mm, aluminium 2 mm, aluminium 3 mm)",
+        ),
+    ];
+    let bad = dir.path().join("bad.json");
+    let tables = [
+        (
+            r#"{"format": "kerf.technology/1", "entries": [{"material": "x", "thickness_mm": 1, "feed_mm_per_min": 1000, "power_percent": 120}]}"#,
+            "entries[0].power_percent: must lie in (0, 100] (got 120)",
+        ),
+        (
+            r#"{"format": "kerf.technology/1", "entries": [{"material": "x", "thickness_mm": 1, "feed_mm_per_min": 1000, "power_percent": 50, "speed": 3}]}"#,
+            "entries[0]",
+        ),
+        (
+            r#"{"format": "kerf.technology/1", "entries": [{"material": "x", "thickness_mm": 1, "feed_mm_per_min": 1000, "power_percent": 50, "pierce": {"time_s": -1, "power_percent": 50, "height_mm": 2}}]}"#,
+            "entries[0].pierce.time_s: must lie in [0, 60] (got -1)",
+        ),
+        (
+            r#"{"format": "kerf.technology/1", "entries": [{"material": "x", "thickness_mm": 1, "feed_mm_per_min": 1000, "power_percent": 50}, {"material": "X", "thickness_mm": 1, "feed_mm_per_min": 900, "power_percent": 50}]}"#,
+            "entries[1]: X 1 mm is also entries[0]",
+        ),
+        (
+            r#"{"format": "kerf.technology/1", "entries": []}"#,
+            "entries: 0 entries, expected 1 to 4096",
+        ),
+        (r#"{"format": "kerf.machine/1"}"#, "format: unknown format"),
+    ];
+    for (args, want) in &cases {
+        let r = run(&args.iter().map(String::as_str).collect::<Vec<_>>(), &out);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success() && err.contains(want), "{args:?}: {err}");
+        assert!(
+            err.contains("fiber_3kw_example.json"),
+            "names the file: {err}"
+        );
+        assert!(!out.exists(), "nothing written");
+    }
+    for (text, want) in tables {
+        std::fs::write(&bad, text).expect("write");
+        let r = run(
+            &[
+                "--technology",
+                bad.to_str().expect("path"),
+                "--material",
+                "x",
+            ],
+            &out,
+        );
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success() && err.contains(want), "{text}: {err}");
+        assert!(err.contains("bad.json"), "names the file: {err}");
+        assert!(!out.exists(), "nothing written");
+    }
+}

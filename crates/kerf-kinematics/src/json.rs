@@ -38,3 +38,34 @@ pub(crate) fn read(path: &Path) -> Result<Vec<u8>> {
 pub(crate) fn check_text(path: &str, text: &str) -> Result<()> {
     kerf_io::check_text(text).map_err(|defect| KinematicsError::doc(path, defect.to_string()))
 }
+
+/// The top-level object of a document that must be of `format` (`{"format": FORMAT, ...}`).
+///
+/// # Errors
+/// [`KinematicsError::Document`] at `top level` for another JSON value, at `format` for
+/// another or a missing format.
+pub(crate) fn top_object<'a>(
+    value: &'a Value,
+    format: &str,
+) -> Result<&'a serde_json::Map<String, Value>> {
+    let Value::Object(top) = value else {
+        return Err(KinematicsError::doc(
+            "top level",
+            format!(
+                "expected an object {{\"format\": \"{format}\", ...}}, found {}",
+                crate::error::json_type_name(value)
+            ),
+        ));
+    };
+    match top.get("format") {
+        Some(Value::String(s)) if s == format => Ok(top),
+        Some(other) => Err(KinematicsError::doc(
+            "format",
+            format!("unknown format {other} (this reader reads \"{format}\")"),
+        )),
+        None => Err(KinematicsError::doc(
+            "format",
+            format!("missing (expected \"{format}\")"),
+        )),
+    }
+}

@@ -580,30 +580,7 @@ impl Machine {
     /// # Errors
     /// [`KinematicsError::Document`] naming the JSON path of the first defect.
     pub fn from_value(value: &Value) -> Result<Self> {
-        let Value::Object(top) = value else {
-            return Err(KinematicsError::doc(
-                "top level",
-                format!(
-                    "expected an object {{\"format\": \"{MACHINE_FORMAT}\", ...}}, found {}",
-                    json_type_name(value)
-                ),
-            ));
-        };
-        match top.get("format") {
-            Some(Value::String(s)) if s == MACHINE_FORMAT => {}
-            Some(other) => {
-                return Err(KinematicsError::doc(
-                    "format",
-                    format!("unknown format {other} (this reader reads \"{MACHINE_FORMAT}\")"),
-                ))
-            }
-            None => {
-                return Err(KinematicsError::doc(
-                    "format",
-                    format!("missing (expected \"{MACHINE_FORMAT}\")"),
-                ))
-            }
-        }
+        let top = crate::json::top_object(value, MACHINE_FORMAT)?;
         let name = match top.get("name") {
             Some(Value::String(s)) => s.clone(),
             Some(other) => {

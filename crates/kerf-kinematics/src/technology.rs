@@ -222,30 +222,7 @@ impl Technology {
     /// JSON path of the first defect.
     pub fn from_slice(bytes: &[u8]) -> Result<Self> {
         let value = crate::json::parse(bytes)?;
-        let Value::Object(top) = &value else {
-            return Err(KinematicsError::doc(
-                "top level",
-                format!(
-                    "expected an object {{\"format\": \"{TECHNOLOGY_FORMAT}\", ...}}, found {}",
-                    json_type_name(&value)
-                ),
-            ));
-        };
-        match top.get("format") {
-            Some(Value::String(s)) if s == TECHNOLOGY_FORMAT => {}
-            Some(other) => {
-                return Err(KinematicsError::doc(
-                    "format",
-                    format!("unknown format {other} (this reader reads \"{TECHNOLOGY_FORMAT}\")"),
-                ))
-            }
-            None => {
-                return Err(KinematicsError::doc(
-                    "format",
-                    format!("missing (expected \"{TECHNOLOGY_FORMAT}\")"),
-                ))
-            }
-        }
+        let top = crate::json::top_object(&value, TECHNOLOGY_FORMAT)?;
         if let Some(extra) = top
             .keys()
             .find(|k| !["format", "entries"].contains(&k.as_str()))

@@ -522,6 +522,21 @@ pub fn check_cut(
                 .fold(0.0, f64::max)
         })
         .collect();
+    // The head at sample `k`, required to clear the clearance plus `slack`.
+    let place = |k: usize, slack: f64, first_only: bool, queries: &mut usize| {
+        place_head(
+            obstacles,
+            &cells0,
+            opts.standoff_mm,
+            &samples[k].tip,
+            &samples[k].axis,
+            opts.clearance_mm + slack,
+            opts.clearance_mm,
+            first_only,
+            queries,
+            opts.max_queries,
+        )
+    };
     // Close samples: the witnessed distance, the height and the head point.
     let mut close_at: Vec<Option<(f64, f64, Point3<f64>)>> = vec![None; samples.len()];
     let mut todo = vec![(0usize, samples.len() - 1)];
@@ -547,18 +562,7 @@ pub fn check_cut(
             .map(|k| disp(&samples[k], &samples[m]) + half_step[k])
             .fold(0.0, f64::max);
         let slack = spread + opts.path_deviation_mm;
-        let verdict = place_head(
-            obstacles,
-            &cells0,
-            opts.standoff_mm,
-            &samples[m].tip,
-            &samples[m].axis,
-            opts.clearance_mm + slack,
-            opts.clearance_mm,
-            i != j,
-            &mut out.queries,
-            opts.max_queries,
-        );
+        let verdict = place(m, slack, i != j, &mut out.queries);
         match verdict {
             Verdict::Clear(least) => {
                 let bound = least - slack;
@@ -587,17 +591,11 @@ pub fn check_cut(
                             break;
                         }
                         let k = k as usize;
-                        let probe = place_head(
-                            obstacles,
-                            &cells0,
-                            opts.standoff_mm,
-                            &samples[k].tip,
-                            &samples[k].axis,
-                            opts.clearance_mm + opts.path_deviation_mm + half_step[k],
-                            opts.clearance_mm,
+                        let probe = place(
+                            k,
+                            opts.path_deviation_mm + half_step[k],
                             false,
                             &mut out.queries,
-                            opts.max_queries,
                         );
                         let (bound, height, point) = match probe {
                             Verdict::Close {

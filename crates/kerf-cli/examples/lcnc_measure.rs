@@ -135,13 +135,15 @@ fn main() {
         std::fs::read_to_string(&args[2]).unwrap_or_else(|e| fail(format!("{}: {e}", args[2])));
     let mut q: Vec<[f64; 5]> = Vec::new();
     let mut beam: Vec<bool> = Vec::new();
+    // The laser power output (HAL's speed-following power, percent), when sampled.
+    let mut power: Vec<f64> = Vec::new();
     let mut gaps = 0usize;
     let mut last_n: Option<i64> = None;
     for (i, line) in text.lines().enumerate() {
         let v: Vec<&str> = line.split_whitespace().collect();
-        if v.len() != 7 {
+        if v.len() != 7 && v.len() != 8 {
             fail(format!(
-                "{}:{}: expected 7 columns, found {}",
+                "{}:{}: expected 7 or 8 columns, found {}",
                 args[2],
                 i + 1,
                 v.len()
@@ -162,6 +164,12 @@ fn main() {
         }
         q.push(a);
         beam.push(v[6] != "0");
+        if let Some(p) = v.get(7) {
+            power.push(
+                p.parse()
+                    .unwrap_or_else(|_| fail(format!("line {}: power", i + 1))),
+            );
+        }
     }
     let tips: Vec<(Point3<f64>, Vector3<f64>)> = q
         .iter()
@@ -468,6 +476,7 @@ fn main() {
         .filter(|&i| beam[i] && beam[i - 1])
         .map(|i| (tips[i].0 - tips[i - 1].0).norm() / period * 60.0)
         .fold(0.0, f64::max);
+    let power_fig = measure_power(&report, &axes, &intervals, &tips, &beam, &power, period);
     let by_axis = |r: &[f64; 5]| -> Value {
         let m: serde_json::Map<String, Value> = names
             .iter()
@@ -520,6 +529,110 @@ fn main() {
         "time_ratio": t_lcnc / predicted,
         "per_cut": per_cut,
         "kerf_compare": compare,
+        "power": power_fig,
     });
     println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
+}
+
+/// The laser power against the tip's speed while the beam cuts (issue 29): with a technology
+/// in the report and the power sampled, every beam-on sample whose power lies strictly between
+/// the floor and 100 % is compared with the rule `power = factor P_cut v / v_ref`, `v` the tip
+/// speed from the same two samples the controller's `ddt` differentiated. Samples within
+/// `POWER_SETTLE` cycles of a beam switch are left out (the beam's own edge); the samples of
+/// the pierce (beam on, head still) give the range of the pierce power. `null` without a
+/// technology or a power column.
+fn measure_power(
+    report: &Value,
+    axes: &AxesFile,
+    intervals: &[(usize, usize)],
+    tips: &[(Point3<f64>, Vector3<f64>)],
+    beam: &[bool],
+    power: &[f64],
+    period: f64,
+) -> Value {
+    const POWER_SETTLE: usize = 2;
+    let t = &report["technology"];
+    let (Some(p_cut), Some(v_ref), Some(floor)) = (
+        t["power_percent"].as_f64(),
+        t["feed_mm_per_min"].as_f64(),
+        t["power_min_percent"].as_f64(),
+    ) else {
+        return Value::Null;
+    };
+    if power.len() != beam.len() {
+        return Value::Null;
+    }
+    let small: Vec<&str> = t["small_holes"]
+        .as_array()
+        .map_or(Vec::new(), |a| a.iter().filter_map(Value::as_str).collect());
+    let factor = t["small_hole"]["power_factor"].as_f64().unwrap_or(1.0);
+    let feed_factor = t["small_hole"]["feed_factor"].as_f64().unwrap_or(1.0);
+    let mut checked = 0usize;
+    let mut at_floor = 0usize;
+    let mut worst = 0.0f64;
+    let mut worst_at = Value::Null;
+    let mut per_cut = Vec::new();
+    let mut pierce = (f64::INFINITY, f64::NEG_INFINITY);
+    for (k, &(on, off)) in intervals.iter().enumerate() {
+        let Some(path) = axes.paths.get(k) else { break };
+        let f = if small.contains(&path.id.as_str()) {
+            factor
+        } else {
+            1.0
+        };
+        let slope = f * p_cut / v_ref;
+        let mut cut_worst = 0.0f64;
+        let mut speeds = Vec::new();
+        // The pierce: from the beam's switch until the head first moves, at the pierce power.
+        let mut moving = false;
+        for i in on + POWER_SETTLE..off.saturating_sub(POWER_SETTLE) {
+            if !(beam[i] && beam[i - 1]) {
+                continue;
+            }
+            let v = (tips[i].0 - tips[i - 1].0).norm() / period * 60.0;
+            if !moving && v == 0.0 {
+                pierce.0 = pierce.0.min(power[i]);
+                pierce.1 = pierce.1.max(power[i]);
+                continue;
+            }
+            moving = true;
+            let p = power[i];
+            if p <= floor * 1.001 + 1e-9 {
+                at_floor += 1;
+                continue;
+            }
+            if p >= 99.999 {
+                continue;
+            }
+            checked += 1;
+            speeds.push(v);
+            let err = (p / (slope * v) - 1.0).abs();
+            cut_worst = cut_worst.max(err);
+            if err > worst {
+                worst = err;
+                worst_at = json!({ "id": path.id, "sample": i, "power_percent": p, "tip_speed_mm_per_min": v });
+            }
+        }
+        let peak = speeds.iter().copied().fold(0.0, f64::max);
+        per_cut.push(json!({
+            "id": path.id,
+            "small_hole": f != 1.0,
+            "max_ratio_error": cut_worst,
+            "peak_tip_speed_mm_per_min": peak,
+        }));
+    }
+    json!({
+        "cut_percent": p_cut,
+        "reference_feed_mm_per_min": v_ref,
+        "floor_percent": floor,
+        "small_hole_power_factor": factor,
+        "small_hole_feed_factor": feed_factor,
+        "samples_checked": checked,
+        "samples_at_floor": at_floor,
+        "pierce_power_percent": [pierce.0, pierce.1],
+        "pierce_expected_percent": t["pierce"]["power_percent"].as_f64().unwrap_or(p_cut),
+        "max_ratio_error": worst,
+        "worst": worst_at,
+        "per_cut": per_cut,
+    })
 }

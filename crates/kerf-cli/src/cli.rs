@@ -434,8 +434,9 @@ pub(crate) struct RunArgs {
     pub(crate) feed: Option<f64>,
 
     /// A technology table (`kerf.technology/1`): the entry of --material (and --thickness)
-    /// sets the feed (unless --feed), the pierce time and height, the standoff and the kerf
-    /// width (unless --kerf-width); the program header and the report name it.
+    /// sets the feed (unless --feed), the pierce time, height and power, the standoff and the
+    /// kerf width (unless --kerf-width); its power follows the tip's speed, its small-hole rule
+    /// slows small holes; the program header and the report name it.
     #[arg(long, value_name = "FILE", requires = "material")]
     pub(crate) technology: Option<PathBuf>,
 

@@ -231,3 +231,18 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
     }
     Ok(value)
 }
+
+/// Every factor of `factors` (per path) within (0, 1].
+pub(crate) fn unit_factors(name: &'static str, factors: &[f64]) -> Result<()> {
+    match factors
+        .iter()
+        .find(|f| !(f.is_finite() && **f > 0.0 && **f <= 1.0))
+    {
+        Some(f) => Err(InterpError::BadParameter {
+            name,
+            value: *f,
+            reason: "each path's factor must lie in (0, 1]",
+        }),
+        None => Ok(()),
+    }
+}

@@ -83,7 +83,7 @@ pub const EXIT_RETRACT_MIN_MM: f64 = 1.0;
 
 pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, write_csv, write_csv_to, write_gcode, ChordTerm,
-    CutterCompensation, Dialect, GcodeOptions, ProcessCodes,
+    CutterCompensation, Dialect, GcodeOptions, LaserPower, ProcessCodes,
 };
 pub use plan::{
     link_paths, link_paths_through, link_paths_with_retract, plan, plan_owned, Cycles, Motion,

@@ -115,6 +115,10 @@ pub struct PlanOptions {
     /// (a curvature jump is an acceleration jump, which they allow) or with
     /// [`PlanOptions::block_ends_on_cycles`] (whose block ends are exact).
     pub blend_tolerance_mm: f64,
+    /// The share of the programmed feed each path cuts at (indexed like the blocks' `path`;
+    /// a small hole's feed factor from the technology's small-hole rule), each in (0, 1]; 1
+    /// where missing. Default none.
+    pub feed_factors: Vec<f64>,
     /// Test hook: the share of the velocity, acceleration and jerk limits the grid plans with
     /// (default 1). Above 1 the first plan breaks the limits on purpose, so that the tests can
     /// watch the verification repair it; the verification always checks the true limits.
@@ -126,6 +130,12 @@ impl PlanOptions {
     /// Sets [`feed_mm_per_min`](Self::feed_mm_per_min): programmed cutting feed, mm/min (the tip's speed along the path).
     pub fn with_feed_mm_per_min(mut self, feed_mm_per_min: f64) -> Self {
         self.feed_mm_per_min = feed_mm_per_min;
+        self
+    }
+
+    /// Sets [`feed_factors`](Self::feed_factors): each path's share of the programmed feed.
+    pub fn with_feed_factors(mut self, feed_factors: Vec<f64>) -> Self {
+        self.feed_factors = feed_factors;
         self
     }
 
@@ -193,6 +203,7 @@ impl PlanOptions {
             grid_step_mm: 0.5,
             max_grid_points: 5_000_000,
             blend_tolerance_mm: crate::DEFAULT_BLEND_TOLERANCE,
+            feed_factors: Vec::new(),
             planned_limit_scale: 1.0,
         }
     }
@@ -203,6 +214,7 @@ impl PlanOptions {
         positive("chord_tolerance_mm", self.chord_tolerance_mm)?;
         positive("grid_step_mm", self.grid_step_mm)?;
         positive("planned_limit_scale", self.planned_limit_scale)?;
+        crate::error::unit_factors("feed_factors", &self.feed_factors)?;
         if !(self.blend_tolerance_mm >= 0.0 && self.blend_tolerance_mm.is_finite()) {
             return Err(InterpError::BadParameter {
                 name: "blend_tolerance_mm",
@@ -304,6 +316,12 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
         });
     }
     let mut runs = runs(&blocks, &path);
+    for run in &mut runs {
+        run.feed_factor = blocks[run.first..=run.last]
+            .iter()
+            .filter_map(|b| opts.feed_factors.get(b.path).copied())
+            .fold(1.0, f64::min);
+    }
     let total_len: f64 = runs.iter().map(Run::len).sum();
     // The work budget: a coarser grid for very long programs.
     let step = opts
@@ -348,7 +366,13 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
         let (s, g) = run_grid(model, run, step, opts);
         grid_points += s.len();
         let tm = time_run(s, &g, acc, limits.max_jerk, tau);
-        run_feeds(run, &g, &tm, feed, &mut block_feeds[run.first..=run.last]);
+        run_feeds(
+            run,
+            &g,
+            &tm,
+            feed * run.feed_factor,
+            &mut block_feeds[run.first..=run.last],
+        );
         timed.push(tm);
     }
     // By run, sorted by grid point: the cap on `x` the refinements set there (infinite: none)
@@ -516,7 +540,7 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
                     run,
                     &g,
                     &timed[r],
-                    feed,
+                    feed * run.feed_factor,
                     &mut block_feeds[run.first..=run.last],
                 );
             }

@@ -288,6 +288,9 @@ pub(crate) struct Run {
     pub(crate) cutting: bool,
     /// The tip moves (false for pure rotations: no feed or chord cap).
     pub(crate) moves_tip: bool,
+    /// The share of the programmed feed this run cuts at (a small hole's feed factor, the
+    /// least of its paths' [`crate::PlanOptions::feed_factors`]; 1 otherwise).
+    pub(crate) feed_factor: f64,
     /// The tip nodes' parameters (the planner's grid is refined from them).
     pub(crate) nodes: Vec<f64>,
     tip: Spline<3>,
@@ -823,6 +826,7 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         last,
         cutting: !run[0].rapid,
         moves_tip,
+        feed_factor: 1.0,
         nodes: ts,
         tip,
         rot: Spline::clamped(rs, ry, r0, r1),

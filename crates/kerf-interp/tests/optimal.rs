@@ -476,3 +476,36 @@ fn the_set_points_stay_within_the_proven_spline_bound_of_the_blocks() {
         assert!(from_curve <= 0.01 + bound, "{name}: {from_curve}");
     }
 }
+
+/// A path's feed factor (a small hole of a technology) is the programmed feed of that path:
+/// the set-points never pass `factor x feed`, reach it on most of the length, and the share
+/// at feed is measured against it. A factor outside (0, 1] is refused by name.
+#[test]
+fn a_feed_factor_plans_the_path_at_its_share_of_the_feed() {
+    let m = gantry();
+    let c = circle(35.0, 0.0, 0.0, 0.0);
+    let st = stations(&m, &c, 0.01, vertical);
+    let curve = |t: f64| c.point(t);
+    let blocks =
+        fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::with_tolerance(0.01)).expect("fit");
+    let feed = 20000.0;
+    let opts = PlanOptions::new(feed, 0.001).with_feed_factors(vec![0.5]);
+    let motion = plan(&m, &blocks, &opts).expect("plan");
+    let rows = motion.setpoints(&m);
+    let top = rows
+        .windows(2)
+        .map(|w| ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt() / 0.001 * 60.0)
+        .fold(0.0, f64::max);
+    assert!(top <= 0.5 * feed * 1.001, "{top} mm/min");
+    let share = share_at_feed(&rows, 0.5 * feed, 0.001);
+    assert!(share >= 0.9, "{share}");
+    let stats = &motion.path_stats()[0];
+    assert!((stats.length_at_feed / stats.cutting_length - share).abs() < 0.01);
+    for (b, f) in motion.block_feeds().iter().enumerate() {
+        assert_eq!(*f, 0.5 * feed, "block {b}");
+    }
+    for bad in [0.0, 1.5, f64::NAN] {
+        let e = plan(&m, &blocks, &opts.clone().with_feed_factors(vec![bad])).unwrap_err();
+        assert!(e.to_string().contains("feed_factors"), "{e}");
+    }
+}

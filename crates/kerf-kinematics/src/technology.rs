@@ -30,6 +30,10 @@ pub const TECHNOLOGY_FORMAT: &str = "kerf.technology/1";
 /// The most entries a technology table may hold.
 pub const MAX_TECHNOLOGY_ENTRIES: usize = 4096;
 
+/// The share of an entry's cutting power that is its least power when the entry names none
+/// (`power_min_percent`): 0.2, a common floor of laser controls' speed-following power.
+pub const DEFAULT_POWER_MIN_SHARE: f64 = 0.2;
+
 /// The pierce of an entry: how long and with what power the beam stands at the pierce point,
 /// and how high above the surface.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
@@ -71,8 +75,14 @@ pub struct TechnologyEntry {
     pub gas_pressure_bar: Option<f64>,
     /// The cutting feed, mm/min.
     pub feed_mm_per_min: f64,
-    /// The cutting power, percent of the source's.
+    /// The cutting power at the entry's feed, percent of the source's; where the head runs
+    /// slower the power follows the speed down to [`power_min_percent`](Self::power_min_percent).
     pub power_percent: f64,
+    /// The least power while cutting, percent (the floor of the power that follows the
+    /// speed, where the head slows at corners and stops at a pierce). Default:
+    /// [`DEFAULT_POWER_MIN_SHARE`] of [`power_percent`](Self::power_percent).
+    #[serde(default)]
+    pub power_min_percent: Option<f64>,
     /// The focus position relative to the surface, mm (positive above).
     #[serde(default)]
     pub focus_mm: Option<f64>,
@@ -91,6 +101,13 @@ pub struct TechnologyEntry {
 }
 
 impl TechnologyEntry {
+    /// The least power while cutting, percent: `power_min_percent` or
+    /// [`DEFAULT_POWER_MIN_SHARE`] of the cutting power.
+    pub fn power_min(&self) -> f64 {
+        self.power_min_percent
+            .unwrap_or(DEFAULT_POWER_MIN_SHARE * self.power_percent)
+    }
+
     /// `mild steel 1.5 mm O2`: the entry's name for headers and messages.
     pub fn label(&self) -> String {
         let gas = self
@@ -136,6 +153,9 @@ impl TechnologyEntry {
         within("thickness_mm", self.thickness_mm, 0.0, true, 100.0)?;
         within("feed_mm_per_min", self.feed_mm_per_min, 0.0, true, 1e6)?;
         within("power_percent", self.power_percent, 0.0, true, 100.0)?;
+        if let Some(v) = self.power_min_percent {
+            within("power_min_percent", v, 0.0, false, self.power_percent)?;
+        }
         if let Some(v) = self.gas_pressure_bar {
             within("gas_pressure_bar", v, 0.0, false, 100.0)?;
         }

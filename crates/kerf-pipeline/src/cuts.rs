@@ -688,3 +688,45 @@ pub(crate) fn traverse_report(
         "searched_note": "searched: the gaps where no route shape (straight, lifted, over the safe plane) cleared and a search around the part found a path, the head turned to one tool axis for the travel; lifted counts every route that is not straight",
     })
 }
+
+/// Per cut (indexed like `cuts`): true for a small hole of a technology's small-hole rule: a
+/// closed contour the plans call a hole whose diameter (the largest distance between two of
+/// its cutting points) is at most `max_diameter_mm`. A contour of more than
+/// [`SMALL_HOLE_SAMPLES`] points is measured on every k-th point, which can only make a hole
+/// look smaller by the gap between sampled points: a few hundredths of a millimetre on the
+/// holes the rule is for.
+pub(crate) fn small_holes(cuts: &[CutPath], plans: &SetupPlans, max_diameter_mm: f64) -> Vec<bool> {
+    let hole_curves: std::collections::HashSet<usize> = plans
+        .iter()
+        .flat_map(|(paths, plan)| {
+            paths
+                .iter()
+                .enumerate()
+                .filter(|&(k, _)| plan.closed[k] && plan.is_hole(k))
+                .map(|(_, &i)| i)
+        })
+        .collect();
+    cuts.iter()
+        .map(|c| {
+            if !hole_curves.contains(&c.curve) {
+                return false;
+            }
+            let contour = &c.poses[c.counts[0]..c.counts[0] + c.counts[1]];
+            let stride = contour.len().div_ceil(SMALL_HOLE_SAMPLES).max(1);
+            let pts: Vec<&PoseArray> = contour.iter().step_by(stride).collect();
+            let mut d2 = 0.0f64;
+            for (a, p) in pts.iter().enumerate() {
+                for q in &pts[a + 1..] {
+                    d2 = d2
+                        .max((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2));
+                }
+            }
+            // A hole of exactly the rule's diameter is one (its points lie on the circle, a
+            // rounding either way).
+            d2.sqrt() <= max_diameter_mm + 1e-6
+        })
+        .collect()
+}
+
+/// The most cutting points [`small_holes`] compares pairwise per contour.
+const SMALL_HOLE_SAMPLES: usize = 512;

@@ -573,8 +573,9 @@ impl Job {
     /// its pierce (time, height), standoff and kerf width replace the machine file's
     /// `process` values where the entry gives them (a run's own `--kerf-width` still wins:
     /// [`JobOptions::kerf_width_mm`]). Call it after [`Job::with_options`], then set a feed
-    /// the user gave explicitly. The entry is named in the report and the program header. Its
-    /// power is stated there, not yet commanded.
+    /// the user gave explicitly. The entry is named in the report and the program header; its
+    /// power is commanded following the tip's speed and its small-hole rule slows the holes
+    /// it names (docs/process.md "Technology").
     pub fn with_technology(mut self, entry: kerf_kinematics::TechnologyEntry) -> Self {
         self.options.feed_mm_per_min = entry.feed_mm_per_min;
         let p = &mut self.machine.process;

@@ -400,7 +400,22 @@ fn run_placed(
     // where the normals or the start point inserted points).
     .with_chord_term(ChordTerm::Certified(dopts.tolerance_mm))
     .with_chord_tolerance_mm(plan.chord_tolerance_mm)
-    .with_linearization_tolerance_mm(Some(popts.linearization_tolerance_mm));
+    .with_linearization_tolerance_mm(Some(popts.linearization_tolerance_mm))
+    .with_power(o.technology.as_ref().map(laser_power));
+    // The technology's small-hole rule: which cuts run at its feed and power factors.
+    let small = o.technology.as_ref().and_then(|t| t.small_hole).map(|h| {
+        (
+            h,
+            crate::cuts::small_holes(&cuts, &cut_plans, h.max_diameter_mm),
+        )
+    });
+    let small_ids: Vec<&str> = small.as_ref().map_or(Vec::new(), |(_, holes)| {
+        cuts.iter()
+            .zip(holes)
+            .filter(|(_, &h)| h)
+            .map(|(c, _)| file.curves[c.curve].id.as_str())
+            .collect()
+    });
     let mut motions = Vec::new();
     let mut programs = Vec::new();
     let mut setup_ids: Vec<Vec<String>> = Vec::new();
@@ -441,6 +456,8 @@ fn run_placed(
     for setup in 0..placed.plan.setups.len() {
         let mut fitted = Vec::new();
         let mut comps: Vec<Option<kerf_interp::CutterCompensation>> = Vec::new();
+        let mut feed_factors: Vec<f64> = Vec::new();
+        let mut power_factors: Vec<f64> = Vec::new();
         let mut ids: Vec<String> = Vec::new();
         let in_setup: Vec<usize> = (0..solved.len())
             .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
@@ -592,12 +609,22 @@ fn run_placed(
             );
             ids.push(s.id.clone());
             comps.push(in_control[k]);
+            let (feed_factor, power_factor) = match &small {
+                Some((h, holes)) if holes[k] => (h.feed_factor, h.power_factor),
+                _ => (1.0, 1.0),
+            };
+            feed_factors.push(feed_factor);
+            power_factors.push(power_factor);
         }
         let blocks = kerf_interp::link_paths_through(&model, fitted, &traverses, fit.retract_mm);
         drop(traverses);
-        let motion = kerf_interp::plan_owned(&model, blocks, &plan).map_err(interp(path))?;
+        let plan_k = plan.clone().with_feed_factors(feed_factors);
+        let motion = kerf_interp::plan_owned(&model, blocks, &plan_k).map_err(interp(path))?;
         lap.split(&mut timings, "plan");
-        let mut gopts_k = gopts.clone().with_cutter_compensation(comps);
+        let mut gopts_k = gopts
+            .clone()
+            .with_cutter_compensation(comps)
+            .with_power_factors(power_factors);
         gopts_k.header = vec![
             format!(
                 "set-up {} of {}: {} contours; placement (part to workpiece): {}",
@@ -608,8 +635,10 @@ fn run_placed(
             ),
             "work offset: none; every coordinate is in the machine's workpiece frame with the placement applied: clamp the part there".to_string(),
             crate::cuts::kerf_header(kerf.as_ref(), &compensated),
-            technology_header(o.technology.as_ref()),
         ];
+        gopts_k
+            .header
+            .extend(technology_header(o.technology.as_ref()));
         let mut text = gcode_motion(&model, &motion, &ids, &gopts_k).map_err(interp(path))?;
         text.shrink_to_fit();
         programs.push(text);
@@ -743,7 +772,7 @@ fn run_placed(
             "files": program_names(programs.len()),
         },
         "compensation": crate::cuts::compensation_json(file, kerf.as_ref(), &compensated),
-        "technology": technology_json(o.technology.as_ref()),
+        "technology": technology_json(o.technology.as_ref(), &small_ids),
         "head": crate::head::head_json(o.cut_clearance_mm, machine, head_tip_zone, head_report),
         "discretize": {
             "curves": file.curves.len(),
@@ -822,28 +851,52 @@ fn run_placed(
     })
 }
 
-/// The program header's line on the technology entry (its text goes through the comment
+/// The power of a technology entry: its cutting power at its feed, following the tip's
+/// speed down to its floor, and its pierce power (the cutting power without a pierce).
+fn laser_power(t: &kerf_kinematics::TechnologyEntry) -> kerf_interp::LaserPower {
+    kerf_interp::LaserPower::new(t.power_percent, t.feed_mm_per_min)
+        .with_min_percent(t.power_min())
+        .with_pierce_percent(t.pierce.map_or(t.power_percent, |p| p.power_percent))
+}
+
+/// The program header's lines on the technology entry (their text goes through the comment
 /// sanitizer like every header line).
-fn technology_header(t: Option<&kerf_kinematics::TechnologyEntry>) -> String {
+fn technology_header(t: Option<&kerf_kinematics::TechnologyEntry>) -> Vec<String> {
     let Some(t) = t else {
-        return "technology: none (feed from --feed, process codes from the machine file)".into();
+        return vec![
+            "technology: none (feed from --feed, process codes from the machine file)".into(),
+        ];
     };
     let pierce = t.pierce.map_or(String::new(), |p| {
         format!(
-            ", pierce {} s at {} mm and {} %",
+            ": pierce {} s at {} mm and {} %",
             p.time_s, p.height_mm, p.power_percent
         )
     });
-    format!(
-        "technology: {}: feed {} mm/min, power {} % (stated, not commanded){pierce}",
-        t.label(),
-        t.feed_mm_per_min,
-        t.power_percent
-    )
+    let small = t.small_hole.map_or(String::new(), |h| {
+        format!(
+            "; holes up to {} mm at {} x feed and {} x power",
+            h.max_diameter_mm, h.feed_factor, h.power_factor
+        )
+    });
+    vec![
+        format!(
+            "technology: {}: feed {} mm/min, power {} % at that feed, following the tip speed down to {} %",
+            t.label(),
+            t.feed_mm_per_min,
+            t.power_percent,
+            t.power_min(),
+        ),
+        format!("technology: {}{pierce}{small}", t.label()),
+    ]
 }
 
-/// The report's `technology` object: the entry used, or null.
-fn technology_json(t: Option<&kerf_kinematics::TechnologyEntry>) -> serde_json::Value {
+/// The report's `technology` object: the entry used and the ids of the cuts its small-hole
+/// rule slowed, or null.
+fn technology_json(
+    t: Option<&kerf_kinematics::TechnologyEntry>,
+    small_holes: &[&str],
+) -> serde_json::Value {
     let Some(t) = t else {
         return serde_json::Value::Null;
     };
@@ -860,7 +913,9 @@ fn technology_json(t: Option<&kerf_kinematics::TechnologyEntry>) -> serde_json::
         "kerf_width_mm": t.kerf_width_mm,
         "pierce": t.pierce.map(|p| json!({ "time_s": p.time_s, "power_percent": p.power_percent, "height_mm": p.height_mm })),
         "small_hole": t.small_hole.map(|h| json!({ "max_diameter_mm": h.max_diameter_mm, "feed_factor": h.feed_factor, "power_factor": h.power_factor })),
-        "note": "the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; power, gas, focus and the small-hole rule are stated, not yet commanded",
+        "power_min_percent": t.power_min(),
+        "small_holes": small_holes,
+        "note": "the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; its power is commanded following the tip speed (its power at its feed, down to power_min_percent), its pierce power at the pierce; holes within the small-hole rule run at its feed and power factors; gas and focus are stated, not commanded",
     })
 }
 

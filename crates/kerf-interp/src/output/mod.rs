@@ -35,10 +35,12 @@ use crate::DEFAULT_BLEND_TOLERANCE;
 
 mod csv;
 mod dialect;
+mod power;
 mod writer;
 
 pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};
 pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
+pub use power::LaserPower;
 use writer::Writer;
 
 /// Where the tolerance budget's `chord` term (the cutting points' chord error against the
@@ -105,6 +107,13 @@ pub struct GcodeOptions {
     /// while it compensates); the paths are then the contours themselves.
     /// Only the LinuxCNC dialect writes it ([`gcode_timed`] refuses it elsewhere). Default none.
     pub cutter_compensation: Vec<Option<CutterCompensation>>,
+    /// Laser power that follows the tip's speed ([`LaserPower`]; its module docs give each
+    /// dialect's words). `None` (the default): the program switches the beam and commands
+    /// no power.
+    pub power: Option<LaserPower>,
+    /// The power factor per path (indexed like the blocks' `path`; a small hole's factor from
+    /// the technology's small-hole rule), 1 where missing. Default none.
+    pub power_factors: Vec<f64>,
 }
 
 /// The controller's cutter compensation of one path: the side the beam moves to, seen along
@@ -122,6 +131,18 @@ impl GcodeOptions {
     /// compensation per path.
     pub fn with_cutter_compensation(mut self, paths: Vec<Option<CutterCompensation>>) -> Self {
         self.cutter_compensation = paths;
+        self
+    }
+
+    /// Sets [`power`](Self::power): laser power that follows the tip's speed.
+    pub fn with_power(mut self, power: Option<LaserPower>) -> Self {
+        self.power = power;
+        self
+    }
+
+    /// Sets [`power_factors`](Self::power_factors): each path's power factor.
+    pub fn with_power_factors(mut self, factors: Vec<f64>) -> Self {
+        self.power_factors = factors;
         self
     }
 
@@ -226,6 +247,8 @@ impl GcodeOptions {
             decimals: 6,
             header: Vec::new(),
             cutter_compensation: Vec::new(),
+            power: None,
+            power_factors: Vec::new(),
         }
     }
 
@@ -409,6 +432,10 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         });
     }
     let process = ProcessCodes::resolve(opts.dialect, &opts.process)?;
+    if let Some(power) = &opts.power {
+        power.validate()?;
+    }
+    crate::error::unit_factors("power_factors", &opts.power_factors)?;
     refuse_pierces_out_of_range(model, blocks, &process)?;
     let mut w = Writer {
         model,
@@ -421,6 +448,10 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         in_cut: false,
         compensating: false,
         last_f: None,
+        last_power: None,
+        factor: 1.0,
+        coeffs: [0.0; 6],
+        held: None,
     };
     w.header(blocks);
     let mut last_path = usize::MAX;
@@ -454,6 +485,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
             continue;
         }
         if !w.in_cut {
+            w.factor = opts.power_factors.get(b.path).copied().unwrap_or(1.0);
             w.start_cut(b);
             if let Some(Some(c)) = opts.cutter_compensation.get(b.path) {
                 w.compensation_on(c);
@@ -486,6 +518,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         }
         w.rapid(p, q, u);
     }
+    w.power_off();
     match opts.dialect {
         Dialect::Linuxcnc => w.line("M2"),
         Dialect::Generic => w.line("M30"),
@@ -494,7 +527,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
             w.line("M30");
         }
     }
-    Ok(w.s)
+    Ok(w.finish())
 }
 
 /// Writes [`gcode`] to `path` atomically.

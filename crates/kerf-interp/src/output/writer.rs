@@ -4,7 +4,12 @@ use crate::block::{Block, Geometry};
 use crate::chord::max_step;
 use crate::model::AxisModel;
 
+use super::power::power_number;
 use super::{comment_text, ChordTerm, Dialect, GcodeOptions, ProcessCodes};
+
+/// The relative change of a commanded power (or LinuxCNC's power scale) below which the
+/// writer does not write it again: 0.5 %, a tenth of what the power check allows.
+const POWER_STEP: f64 = 0.005;
 
 /// The state of one program being written.
 pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
@@ -22,12 +27,43 @@ pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
     pub(super) compensating: bool,
     /// The last `F` written (Sinumerik, modal).
     pub(super) last_f: Option<String>,
+    /// The last power value written in this cut (LinuxCNC's scale `E0`, the generic `S`).
+    pub(super) last_power: Option<f64>,
+    /// The power factor of the path being cut (a small hole's; 1 otherwise).
+    pub(super) factor: f64,
+    /// LinuxCNC's rotary coefficients last written (`E2`..`E7`, mm per degree).
+    pub(super) coeffs: [f64; 6],
+    /// A LinuxCNC cutting line whose rotary axes stand still, held back (with its newline) so
+    /// that the coefficients of a rotating block after it can be written before it: the
+    /// controller's blend starts turning the rotary axes before the next block's synchronized
+    /// outputs fire, and while the held block runs the coefficients do not count.
+    pub(super) held: Option<String>,
 }
 
 impl<M: AxisModel + ?Sized> Writer<'_, M> {
     pub(super) fn line(&mut self, l: &str) {
+        if let Some(h) = self.held.take() {
+            self.s.push_str(&h);
+        }
         self.s.push_str(l.trim_end());
         self.s.push('\n');
+    }
+
+    /// Holds `l` back (see [`Writer::held`]), writing the line held before.
+    fn hold(&mut self, mut l: String) {
+        if let Some(h) = self.held.take() {
+            self.s.push_str(&h);
+        }
+        l.push('\n');
+        self.held = Some(l);
+    }
+
+    /// The program text, every held line written.
+    pub(super) fn finish(mut self) -> String {
+        if let Some(h) = self.held.take() {
+            self.s.push_str(&h);
+        }
+        self.s
     }
 
     pub(super) fn comment(&mut self, text: &str) {
@@ -180,6 +216,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
             p.pierce_standoff, p.pierce_dwell_s, o.feed_mm_per_min
         );
         self.comment(&pm);
+        self.power_header();
         match o.dialect {
             Dialect::Linuxcnc => {
                 self.line("G17 G21 G40 G49 G54 G80 G90 G94");
@@ -203,6 +240,9 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 self.line("ORIWKS");
                 self.line("ORIVECT");
                 self.line("G60");
+                if self.opts.power.is_some() {
+                    self.line("ID=1 WHENEVER TRUE DO SYNFCT(1,$A_OUTA[1],$AC_VACTW)");
+                }
             }
         }
         // The beam is off before the first move, whatever state the controller was left in.
@@ -232,6 +272,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         let start = b.start_tip();
         let h = self.process.pierce_standoff;
         self.rapid(pierce, qp, u);
+        self.pierce_power();
         for l in self.process.beam_on.clone() {
             self.line(&l);
         }
@@ -252,6 +293,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
             Dialect::Generic => {}
         }
         self.in_cut = true;
+        self.cut_power();
         if h > 0.0 {
             let t = self.process.descent_s(self.opts.feed_mm_per_min);
             match self.opts.dialect {
@@ -261,7 +303,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     self.line(&l);
                     self.last_f = Some(f);
                 }
-                _ => self.raw_move(b.start_axes, t),
+                _ => self.raw_move(b.start_axes, t, h),
             }
         }
     }
@@ -292,29 +334,188 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         self.in_cut = false;
     }
 
-    /// One `G1` of a raw-axis dialect to `q`, taking `t` seconds; nothing if the printed axes
-    /// do not change.
-    pub(super) fn raw_move(&mut self, q: [f64; 5], t: f64) {
+    /// One `G1` of a raw-axis dialect to `q`, taking `t` seconds while the tip moves
+    /// `tip_mm`; nothing if the printed axes do not change. With [`GcodeOptions::power`] the
+    /// block's power goes with it (LinuxCNC's scale line before it, the generic `S` on it).
+    pub(super) fn raw_move(&mut self, q: [f64; 5], t: f64, tip_mm: f64) {
         let qp = self.printed(&q);
         let prev = self.last.unwrap_or(qp);
         if prev == qp {
             return;
         }
+        let lin =
+            ((qp[0] - prev[0]).powi(2) + (qp[1] - prev[1]).powi(2) + (qp[2] - prev[2]).powi(2))
+                .sqrt();
         let f = match self.opts.dialect {
             Dialect::Linuxcnc => 60.0 / t,
             _ => {
-                let lin = ((qp[0] - prev[0]).powi(2)
-                    + (qp[1] - prev[1]).powi(2)
-                    + (qp[2] - prev[2]).powi(2))
-                .sqrt();
                 let rot = ((qp[3] - prev[3]).powi(2) + (qp[4] - prev[4]).powi(2)).sqrt();
                 let len = if lin > 0.0 { lin } else { rot };
                 len / t * 60.0
             }
         };
-        let l = format!("G1 {} F{}", self.axis_words(&q), feed_number(f));
+        let mut s_word = String::new();
+        if let (Some(power), true) = (self.opts.power, self.in_cut) {
+            match self.opts.dialect {
+                // The controller computes the tip's speed from the joints' (module docs of
+                // `power`): the rotary coefficients go with the block where stale ones would
+                // misjudge its tip travel by more than POWER_STEP.
+                Dialect::Linuxcnc if !self.compensating => {
+                    let pieces = super::power::pieces(self.model, &prev, &qp);
+                    let mut f0 = 0.0;
+                    for (i, &(f1, coeffs)) in pieces.iter().enumerate() {
+                        let a: [f64; 5] = std::array::from_fn(|k| prev[k] + f0 * (qp[k] - prev[k]));
+                        let b: [f64; 5] = if i + 1 == pieces.len() {
+                            qp
+                        } else {
+                            self.printed(&std::array::from_fn(|k| prev[k] + f1 * (qp[k] - prev[k])))
+                        };
+                        self.write_coefficients(&a, &b, coeffs);
+                        let last = i + 1 == pieces.len();
+                        let (end, dt) = if last {
+                            (q, t * (1.0 - f0))
+                        } else {
+                            (b, t * (f1 - f0))
+                        };
+                        let l = format!("G1 {} F{}", self.axis_words(&end), feed_number(60.0 / dt));
+                        if qp[3] == prev[3] && qp[4] == prev[4] {
+                            self.hold(l);
+                        } else {
+                            self.line(&l);
+                        }
+                        if last {
+                            self.last = Some(qp);
+                            return;
+                        }
+                        f0 = f1;
+                    }
+                }
+                Dialect::Generic => {
+                    let p = power.at_speed(tip_mm / t * 60.0, self.factor);
+                    if self.power_changed(p) {
+                        s_word = format!(" S{}", power_number(p));
+                    }
+                }
+                _ => {}
+            }
+        }
+        let l = format!("G1 {} F{}{s_word}", self.axis_words(&q), feed_number(f));
         self.line(&l);
         self.last = Some(qp);
+    }
+
+    /// LinuxCNC's rotary coefficients `coeffs` for the piece from `a` to `b`, written where
+    /// the last ones written would misjudge its tip travel by more than [`POWER_STEP`].
+    fn write_coefficients(&mut self, a: &[f64; 5], b: &[f64; 5], coeffs: [f64; 6]) {
+        let d: [f64; 5] = std::array::from_fn(|k| b[k] - a[k]);
+        let (new, old) = (
+            super::power::tip_travel(&d, &coeffs),
+            super::power::tip_travel(&d, &self.coeffs),
+        );
+        if (new - old).abs() > POWER_STEP * new.max(1e-9) {
+            // Before a held line (a block whose rotary axes stand still), so that they are
+            // set when the controller's blend into this block starts turning them.
+            for (j, v) in coeffs.iter().enumerate() {
+                self.s
+                    .push_str(&format!("M67 E{} Q{}\n", j + 2, coeff_number(*v)));
+            }
+            self.coeffs = coeffs;
+        }
+    }
+
+    /// True (and `v` remembered) when `v` differs from the last power value written in this
+    /// cut by more than [`POWER_STEP`] of it.
+    fn power_changed(&mut self, v: f64) -> bool {
+        let changed = self
+            .last_power
+            .is_none_or(|last| (v - last).abs() > POWER_STEP * last.abs().max(1e-9));
+        if changed {
+            self.last_power = Some(v);
+        }
+        changed
+    }
+
+    /// The header's lines on the power: the rule and how the dialect commands it.
+    fn power_header(&mut self) {
+        let Some(p) = self.opts.power else {
+            self.comment(
+                "power: not commanded (no technology): the beam is switched on and off only",
+            );
+            return;
+        };
+        self.comment(&format!(
+            "power: {} % at {} mm/min of the tool tip, following the tip speed, floor {} %, pierce {} %",
+            p.cut_percent, p.reference_feed_mm_per_min, p.min_percent, p.pierce_percent
+        ));
+        match self.opts.dialect {
+            Dialect::Linuxcnc => {
+                self.comment("power: HAL power = clamp[E0 x tip speed in mm/s, E1, 100], E0 = % per mm/s, E1 = floor [M68 E1 = pierce power]");
+                self.comment("power: HAL tip speed = |d[X,Y,Z]/dt + [E2,E3,E4] d[tilt]/dt + [E5,E6,E7] dC/dt|, rotary rates in deg/s");
+                self.comment("power: E2..E7 mm/deg, set with M67 [synchronized with the next block] where the rotary axes move");
+            }
+            Dialect::Generic => self.comment("power: S = % per block from kerf's planned tip speed"),
+            Dialect::Sinumerik => self.comment("power: FCTDEF[1, floor, 100, 0, % per mm/min] on $AC_VACTW by synchronized action ID=1"),
+        }
+    }
+
+    /// The pierce power, before the beam comes on at the pierce point.
+    fn pierce_power(&mut self) {
+        let Some(p) = self.opts.power else {
+            return;
+        };
+        let pierce = power_number(p.pierce_percent.min(100.0));
+        match self.opts.dialect {
+            Dialect::Linuxcnc => {
+                self.line("M68 E0 Q0");
+                self.line(&format!("M68 E1 Q{pierce}"));
+                if self.coeffs != [0.0; 6] {
+                    for j in 2..8 {
+                        self.line(&format!("M68 E{j} Q0"));
+                    }
+                    self.coeffs = [0.0; 6];
+                }
+            }
+            Dialect::Generic => self.line(&format!("S{pierce}")),
+            Dialect::Sinumerik => self.line(&format!("FCTDEF(1,{pierce},{pierce},{pierce},0)")),
+        }
+        self.last_power = None;
+    }
+
+    /// The cut's power rule, after the pierce dwell and before the descent: the floor (and on
+    /// Sinumerik the slope); the speed-following values come with the blocks.
+    fn cut_power(&mut self) {
+        let Some(p) = self.opts.power else {
+            return;
+        };
+        let floor = power_number(p.min_percent.min(p.cut_percent * self.factor));
+        match self.opts.dialect {
+            Dialect::Linuxcnc => {
+                let k = power_number(p.per_mm_s(self.factor));
+                self.line(&format!("M67 E1 Q{floor}"));
+                self.line(&format!("M67 E0 Q{k}"));
+            }
+            Dialect::Generic => {}
+            Dialect::Sinumerik => {
+                let k = power_number(p.per_mm_s(self.factor) / 60.0);
+                self.line(&format!("FCTDEF(1,{floor},100,0,{k})"));
+            }
+        }
+    }
+
+    /// The power outputs back to zero at the program's end.
+    pub(super) fn power_off(&mut self) {
+        if self.opts.power.is_none() {
+            return;
+        }
+        match self.opts.dialect {
+            Dialect::Linuxcnc => {
+                for j in 0..8 {
+                    self.line(&format!("M68 E{j} Q0"));
+                }
+            }
+            Dialect::Generic => self.line("S0"),
+            Dialect::Sinumerik => self.line("CANCEL(1)"),
+        }
     }
 
     /// The cutting block `b`, taking `t` seconds.
@@ -341,7 +542,13 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     } else {
                         1.0
                     };
-                    self.raw_move(q, t * share);
+                    // A turn's parameter is degrees; its tip stands still.
+                    let tip = if matches!(b.geometry, Geometry::Turn { .. }) {
+                        0.0
+                    } else {
+                        s - s0
+                    };
+                    self.raw_move(q, t * share, tip);
                     s0 = s;
                 }
             }
@@ -374,6 +581,16 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 self.line(&l);
             }
         }
+    }
+}
+
+/// A rotary coefficient as written (mm per degree): nine decimals, enough that the rounding
+/// moves a tip speed by less than 1e-6 of a 100 deg/s rotation's.
+fn coeff_number(v: f64) -> String {
+    let t = format!("{v:.9}");
+    match t.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|c| c == b'0' || c == b'.') => rest.to_string(),
+        _ => t,
     }
 }
 

@@ -59,7 +59,7 @@ pub(super) fn assemble(
         }
         feeds[run.first..=run.last].copy_from_slice(&block_feeds[run.first..=run.last]);
         if run.cutting && run.moves_tip {
-            modal_feeds(&mut feeds[run.first..=run.last], feed);
+            modal_feeds(&mut feeds[run.first..=run.last], feed * run.feed_factor);
         }
         // Statistics of the path this run belongs to.
         let path = blocks[run.first].path;
@@ -85,7 +85,7 @@ pub(super) fn assemble(
                 let s = tm.s_at(t);
                 let (t1, _) = run.tip_derivatives(s);
                 let v = tm.speed_at(t) * t1.norm();
-                if v >= feed * 0.999 {
+                if v >= feed * run.feed_factor * 0.999 {
                     st.time_at_feed += dt;
                     st.length_at_feed += v * dt;
                 }

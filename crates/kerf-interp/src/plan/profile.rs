@@ -238,7 +238,7 @@ pub(super) fn run_grid<M: AxisModel + ?Sized>(
     let mut tip_speed = Vec::with_capacity(n);
     let mut cap = Vec::with_capacity(n);
     let mut static_mv = Vec::with_capacity(n);
-    let feed = opts.feed_mm_per_min / 60.0;
+    let feed = opts.feed_mm_per_min / 60.0 * run.feed_factor;
     for (&si, &(a, b, c)) in s.iter().zip(&fine_d) {
         let (t1, t2) = run.tip_derivatives(si);
         let speed = t1.norm();

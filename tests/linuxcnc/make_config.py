@@ -10,8 +10,9 @@ positions looped back as feedback, the laser power that follows the tip's speed 
 "Power that follows the speed": the tip speed v = |XYZ' + (E2, E3, E4) tilt' + (E5, E6, E7) C'|
 from `ddt` of the five joints' commanded positions, `mult2`, `sum2` and `hypot`, and
 power = clamp(E0 v, E1, 100) with `mult2` and `limit1`, E<n> being motion.analog-out-<n>),
-and a HAL `sampler` recording the five joint positions, motion.digital-out-00 (the beam) and
-the power every servo cycle. Only numbers from the machine file reach the
+the beam: motion.digital-out-00 delayed by two servo periods (`timedelay`, `BEAM_DELAY_S`: the
+joints' lag behind the trajectory in LinuxCNC's cubic interpolator), and a HAL `sampler`
+recording the five joint positions, the beam and the power every servo cycle. Only numbers from the machine file reach the
 INI; the machine's name is not written (it is free text).
 """
 import json
@@ -20,6 +21,11 @@ import sys
 from pathlib import Path
 
 SERVO_NS = 1_000_000
+# LinuxCNC switches motion.digital-out-NN (M62-M65) on the trajectory's time, and its cubic
+# interpolator runs the joints two servo periods behind the trajectory: the laser's enable is
+# the output delayed by that much (timedelay), so that the beam switches where the axes are.
+# Measured without it: micro-joint switches 2.0-3.0 servo cycles ahead of their places.
+BEAM_DELAY_S = 2 * SERVO_NS * 1e-9
 # Unlimited (continuous) rotary axes get a travel LinuxCNC accepts but no program reaches.
 UNLIMITED = 1.0e6
 
@@ -119,6 +125,7 @@ def main():
         "loadrt sum2 count=6",
         "loadrt hypot count=1",
         "loadrt limit1 count=1",
+        "loadrt timedelay count=1",
         "addf motion-command-handler servo-thread",
         "addf motion-controller servo-thread",
         *[f"addf ddt.{j} servo-thread" for j in range(5)],
@@ -127,6 +134,7 @@ def main():
         "addf hypot.0 servo-thread",
         "addf mult2.6 servo-thread",
         "addf limit1.0 servo-thread",
+        "addf timedelay.0 servo-thread",
         "addf sampler.0 servo-thread",
     ]
     for j in range(5):
@@ -150,7 +158,10 @@ def main():
         "net power-floor motion.analog-out-01 => limit1.0.min",
         "setp limit1.0.max 100",
         "net power limit1.0.out => sampler.0.pin.6",
-        "net beam motion.digital-out-00 => sampler.0.pin.5",
+        "net beam-cmd motion.digital-out-00 => timedelay.0.in",
+        f"setp timedelay.0.on-delay {BEAM_DELAY_S}",
+        f"setp timedelay.0.off-delay {BEAM_DELAY_S}",
+        "net beam timedelay.0.out => sampler.0.pin.5",
         "net estop-loop iocontrol.0.user-enable-out iocontrol.0.emc-enable-in",
         "net tool-prep-loop iocontrol.0.tool-prepare iocontrol.0.tool-prepared",
         "net tool-change-loop iocontrol.0.tool-change iocontrol.0.tool-changed",

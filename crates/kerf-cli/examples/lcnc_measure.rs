@@ -191,6 +191,10 @@ fn main() {
             }
         }
     }
+    // Micro-joints: each cut's beam is off over its joints, so a cut with n joints is n + 1
+    // intervals; each switch is measured against the joint's planned end, then the cut's
+    // intervals are merged into one for the framing below.
+    let (intervals, joints_fig) = group_joints(intervals, &report, &axes, &tips);
     // The toolpath is in part coordinates; the axes, the program and so the samples in the
     // workpiece frame of the path's set-up: `p' = R p + t` with `R = Rz Ry Rx` of the report's
     // `rotation_deg` (x, y, z) and `t` its `translation_mm` (none without a placement).
@@ -361,7 +365,10 @@ fn main() {
             && before < 1e-2
             && off_at < 1e-2
             && after < 1e-2
-            && dwell_on >= dwell - 2.0 * period;
+            // Two cycles of sampling and two of the HAL's beam delay (tests/linuxcnc's
+            // make_config.py: the enable follows the joints, two servo periods behind the
+            // trajectory that switches the output).
+            && dwell_on >= dwell - 4.0 * period;
         framing_ok &= ok;
         max_dev_points = max_dev_points.max(dev_points);
         if let Some(d) = dev_curve {
@@ -530,6 +537,7 @@ fn main() {
         "per_cut": per_cut,
         "kerf_compare": compare,
         "power": power_fig,
+        "micro_joints": joints_fig,
     });
     println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
 }
@@ -635,4 +643,81 @@ fn measure_power(
         "worst": worst_at,
         "per_cut": per_cut,
     })
+}
+
+/// A planned micro-joint: its start and end tip points and its length, mm.
+type PlannedJoint = (Point3<f64>, Point3<f64>, f64);
+
+/// Merges each cut's beam intervals over its micro-joints (the report's `micro_joints`) into
+/// one, and measures every joint: where the beam went off and on again against the joint's
+/// planned start and end (the distance from the planned point to the tip's move over the
+/// servo cycle in which the output switched), and the tip's travel with the beam off. When
+/// the intervals do not number the cuts plus their joints, they are returned unmerged (the
+/// framing check then fails on the count).
+fn group_joints(
+    intervals: Vec<(usize, usize)>,
+    report: &Value,
+    axes: &AxesFile,
+    tips: &[(Point3<f64>, Vector3<f64>)],
+) -> (Vec<(usize, usize)>, Value) {
+    let Some(paths) = report["micro_joints"]["paths"].as_array() else {
+        return (intervals, Value::Null);
+    };
+    let point = |v: &Value| {
+        let x = |k: usize| v.get(k).and_then(Value::as_f64).unwrap_or(f64::NAN);
+        Point3::new(x(0), x(1), x(2))
+    };
+    let per_path: Vec<Vec<PlannedJoint>> = axes
+        .paths
+        .iter()
+        .map(|a| {
+            paths
+                .iter()
+                .find(|p| p["id"].as_str() == Some(a.id.as_str()))
+                .and_then(|p| p["joints"].as_array())
+                .map_or(Vec::new(), |j| {
+                    j.iter()
+                        .map(|j| {
+                            let len = j["end_mm"].as_f64().unwrap_or(f64::NAN)
+                                - j["start_mm"].as_f64().unwrap_or(f64::NAN);
+                            (point(&j["start"]), point(&j["end"]), len)
+                        })
+                        .collect()
+                })
+        })
+        .collect();
+    let expected: usize = per_path.iter().map(|j| j.len() + 1).sum();
+    let planned: usize = per_path.iter().map(Vec::len).sum();
+    if intervals.len() != expected {
+        return (intervals, json!({ "planned": planned, "grouped": false }));
+    }
+    // Distance from `p` to the tip's move over the cycle ending at sample `i`.
+    let at_switch = |p: &Point3<f64>, i: usize| seg_dist(p, &tips[i - 1].0, &tips[i].0);
+    let mut merged = Vec::new();
+    let mut worst_switch = 0.0f64;
+    let mut worst_length = 0.0f64;
+    let mut k = 0;
+    for joints in &per_path {
+        let group = &intervals[k..k + joints.len() + 1];
+        for (j, (start, end, len)) in joints.iter().enumerate() {
+            let off = group[j].1 + 1; // the first sample with the beam off
+            let on = group[j + 1].0; // the first sample with the beam on again
+            worst_switch = worst_switch
+                .max(at_switch(start, off))
+                .max(at_switch(end, on));
+            let dark: f64 = (off..on).map(|i| (tips[i].0 - tips[i - 1].0).norm()).sum();
+            worst_length = worst_length.max((dark - len).abs());
+        }
+        merged.push((group[0].0, group[group.len() - 1].1));
+        k += joints.len() + 1;
+    }
+    (
+        merged,
+        json!({
+            "planned": planned,
+            "grouped": true,
+            "max_switch_distance_mm": worst_switch,
+            "max_dark_length_error_mm": worst_length,
+        }),
+    )
 }

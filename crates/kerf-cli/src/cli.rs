@@ -548,6 +548,14 @@ pub(crate) struct RunArgs {
     #[arg(long, requires = "cut_clearance")]
     pub(crate) accept_head_collisions: bool,
 
+    /// Micro-joints: leave LENGTH mm of each part's outline (and of each cut-out at least
+    /// SPACING mm round) uncut every SPACING mm of path, away from corners and the lead-in; the
+    /// beam is switched there with codes synchronized with motion (linuxcnc: M63/M62 on the
+    /// output the machine's beam codes name; generic: the machine's codes). LENGTH in (0, 10],
+    /// SPACING in [1, 1e5], LENGTH < SPACING.
+    #[arg(long, value_name = "LENGTH,SPACING", value_parser = crate::guard::micro_joints)]
+    pub(crate) micro_joints: Option<(f64, f64)>,
+
     /// Lead-in of every cut: the straight part from the pierce point, then the radius of the
     /// quarter arc that joins the contour tangentially on the scrap side, mm, each 0 to 1000
     /// (`0,0` pierces on the contour). Shrunk where the scrap is smaller (small holes).

@@ -165,6 +165,25 @@ pub(crate) fn lead_out(text: &str) -> Result<(f64, f64), String> {
     lead_pair(text, ["OVERCUT", "EXIT"])
 }
 
+/// `--micro-joints LENGTH,SPACING` ([`ranges::MICRO_JOINT_MM`],
+/// [`ranges::MICRO_JOINT_SPACING_MM`], the length below the spacing).
+pub(crate) fn micro_joints(text: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [a, b] = parts.as_slice() else {
+        return Err(format!(
+            "expected two values LENGTH,SPACING in mm, got {text:?}"
+        ));
+    };
+    let length = within(a, ranges::MICRO_JOINT_MM).map_err(|e| format!("LENGTH: {e}"))?;
+    let spacing = within(b, ranges::MICRO_JOINT_SPACING_MM).map_err(|e| format!("SPACING: {e}"))?;
+    if length >= spacing {
+        return Err(format!(
+            "LENGTH ({length} mm) must be less than SPACING ({spacing} mm)"
+        ));
+    }
+    Ok((length, spacing))
+}
+
 /// A fraction strictly between 0 and 1.
 pub(crate) fn fraction(s: &str) -> Result<f64, String> {
     within(s, FRACTION)

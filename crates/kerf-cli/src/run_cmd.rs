@@ -56,6 +56,7 @@ fn job_options(args: &RunArgs) -> JobOptions {
         .with_kerf_in_control(args.kerf_in_control)
         .with_cut_clearance_mm(args.cut_clearance)
         .with_accept_head_collisions(args.accept_head_collisions)
+        .with_micro_joints(args.micro_joints)
 }
 
 /// Runs `kerf run`.

@@ -44,8 +44,15 @@ fn process_codes_reach_the_program() {
         } else {
             "G4 P0.5"
         };
+        // LinuxCNC lights the pierce with the immediate form of a synchronized code (M62
+        // would wait for the next move: the dwell would run dark).
+        let on = if dialect == "linuxcnc" {
+            "M64 P1"
+        } else {
+            "M62 P1"
+        };
         assert_eq!(
-            text.matches(&format!("\nM62 P1\nG4 P0.05\n{dwell}\n"))
+            text.matches(&format!("\n{on}\nG4 P0.05\n{dwell}\n"))
                 .count(),
             2,
             "{dialect}: beam on as given, then the dwell, for both dome circles"

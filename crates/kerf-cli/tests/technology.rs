@@ -3,21 +3,8 @@
 //! tables and unknown materials are refused by file and JSON path with nothing written.
 
 mod common;
-use common::{fixture, kerf};
-
-fn run(extra: &[&str], out: &std::path::Path) -> std::process::Output {
-    kerf()
-        .args(["run"])
-        .arg(fixture("sheet_metal_holes.json"))
-        .arg("-m")
-        .arg(fixture("machines/gantry_ac.json"))
-        .arg("-o")
-        .arg(out)
-        .arg("-q")
-        .args(extra)
-        .output()
-        .expect("kerf runs")
-}
+use common::fixture;
+use common::run_flat as run;
 
 #[test]
 fn the_entry_sets_feed_pierce_and_kerf_and_is_named() {

@@ -442,13 +442,14 @@ fn bad_process_codes_are_named_errors() {
         standoff_mm: None,
     });
     let text = gcode_motion(&m, &motion, &[], &opts).expect("gcode");
+    // The synchronized M62 lights the pierce as the immediate M64 (else the dwell runs dark).
     assert_eq!(
-        text.matches("\nM62 P2\nM3 S900\nG4 P0.5\n").count(),
+        text.matches("\nM64 P2\nM3 S900\nG4 P0.5\n").count(),
         2,
         "beam on, dwell per cut"
     );
     assert!(
-        !text.contains("M64") && !text.contains("M65"),
+        !text.contains("M64 P0") && !text.contains("M65"),
         "no default codes"
     );
 }

@@ -730,3 +730,121 @@ pub(crate) fn small_holes(cuts: &[CutPath], plans: &SetupPlans, max_diameter_mm:
 
 /// The most cutting points [`small_holes`] compares pairwise per contour.
 const SMALL_HOLE_SAMPLES: usize = 512;
+
+/// The micro-joints of every cut (indexed like `cuts`): `[start, end]`, mm along the cut's
+/// poses from its first (the lead-in's start), and one warning per joint there was no room
+/// for. Closed contours only: each part's outline gets `max(1, round(P / spacing))` joints,
+/// `P` its length, and each cut-out `floor(P / spacing)` (none on one shorter than the
+/// spacing: its slug may fall). Joint `k` is centred at `(k + 1/2) P / n` from the contour's
+/// start, or as near as its share of the contour allows (0.25 mm steps) so that no corner (a
+/// turn of more than [`JOINT_CORNER_DEG`]) lies within 1 mm of it and it keeps its length
+/// plus 1 mm from the contour's start and end (the lead-in joins there, the overcut runs
+/// past it).
+pub(crate) fn micro_joints(
+    file: &CurvesFile,
+    cuts: &[CutPath],
+    plans: &SetupPlans,
+    length_mm: f64,
+    spacing_mm: f64,
+) -> (Vec<Vec<[f64; 2]>>, Vec<String>) {
+    let mut kind: std::collections::HashMap<usize, bool> = std::collections::HashMap::new();
+    for (paths, plan) in plans {
+        for (k, &i) in paths.iter().enumerate() {
+            if plan.closed[k] {
+                kind.insert(i, plan.is_hole(k));
+            }
+        }
+    }
+    let mut warnings = Vec::new();
+    let joints = cuts
+        .iter()
+        .map(|c| {
+            let Some(&hole) = kind.get(&c.curve) else {
+                return Vec::new();
+            };
+            let p = &c.poses;
+            let mut cum = vec![0.0];
+            for w in p.windows(2) {
+                let d = ((w[1][0] - w[0][0]).powi(2)
+                    + (w[1][1] - w[0][1]).powi(2)
+                    + (w[1][2] - w[0][2]).powi(2))
+                .sqrt();
+                cum.push(cum[cum.len() - 1] + d);
+            }
+            let (first, last) = (c.counts[0], c.counts[0] + c.counts[1] - 1);
+            let (s_in, s_out) = (cum[first], cum[last]);
+            let perimeter = s_out - s_in;
+            let n = if hole {
+                (perimeter / spacing_mm).floor() as usize
+            } else {
+                ((perimeter / spacing_mm).round() as usize).max(1)
+            };
+            if n == 0 {
+                return Vec::new();
+            }
+            // Corners of the contour, as distances along the cut.
+            let dir = |a: &PoseArray, b: &PoseArray| {
+                nalgebra::Vector3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2])
+            };
+            let corners: Vec<f64> = (first + 1..last)
+                .filter(|&i| {
+                    let (u, v) = (dir(&p[i - 1], &p[i]), dir(&p[i], &p[i + 1]));
+                    u.norm() > 0.0
+                        && v.norm() > 0.0
+                        && u.angle(&v) > JOINT_CORNER_DEG.to_radians()
+                })
+                .map(|i| cum[i])
+                .collect();
+            let fits = |centre: f64| {
+                let (a, b) = (centre - 0.5 * length_mm, centre + 0.5 * length_mm);
+                let lo = corners.partition_point(|&s| s < a - 1.0);
+                a >= s_in + length_mm + 1.0
+                    && b <= s_out - length_mm - 1.0
+                    && corners.get(lo).is_none_or(|&s| s > b + 1.0)
+            };
+            let share = perimeter / n as f64;
+            let steps = (0.5 * share / 0.25).floor() as usize;
+            let mut out = Vec::new();
+            for k in 0..n {
+                let target = s_in + (k as f64 + 0.5) * share;
+                let found = (0..=steps)
+                    .flat_map(|i| [target + 0.25 * i as f64, target - 0.25 * i as f64])
+                    .find(|&centre| fits(centre));
+                match found {
+                    Some(centre) => {
+                        out.push([centre - 0.5 * length_mm, centre + 0.5 * length_mm])
+                    }
+                    None => warnings.push(format!(
+                        "{}: no room for micro-joint {} of {} away from the corners and the lead-in (left out)",
+                        file.curves[c.curve].id,
+                        k + 1,
+                        n
+                    )),
+                }
+            }
+            out
+        })
+        .collect();
+    (joints, warnings)
+}
+
+/// A turn of the contour above this is a corner no micro-joint may lie within 1 mm of,
+/// degrees (the start point's corner rule).
+pub(crate) const JOINT_CORNER_DEG: f64 = 20.0;
+
+/// The point at `s` mm along the poses `p` (the first pose's, linearly between poses).
+pub(crate) fn point_along(p: &[[f64; 3]], s: f64) -> [f64; 3] {
+    let mut left = s;
+    for w in p.windows(2) {
+        let d = ((w[1][0] - w[0][0]).powi(2)
+            + (w[1][1] - w[0][1]).powi(2)
+            + (w[1][2] - w[0][2]).powi(2))
+        .sqrt();
+        if left <= d && d > 0.0 {
+            let f = left / d;
+            return std::array::from_fn(|k| w[0][k] + f * (w[1][k] - w[0][k]));
+        }
+        left -= d;
+    }
+    p.last().copied().unwrap_or([0.0; 3])
+}

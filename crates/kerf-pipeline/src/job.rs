@@ -141,6 +141,11 @@ pub struct JobOptions {
     /// With [`JobOptions::cut_clearance_mm`], cuts where the head comes closer are warnings
     /// instead of a refused run. Default false.
     pub accept_head_collisions: bool,
+    /// Micro-joints: `Some((length_mm, spacing_mm))` leaves `length_mm` of each part's outline
+    /// (and of each cut-out wider than `spacing_mm`) uncut every `spacing_mm` of path, away
+    /// from corners and the lead-in, with the beam switched by codes synchronized with motion
+    /// (docs/process.md "Micro-joints"). Default `None`.
+    pub micro_joints: Option<(f64, f64)>,
     /// The technology entry the run cuts with ([`Job::with_technology`]), for the report and
     /// the program header. `None` by default.
     pub technology: Option<kerf_kinematics::TechnologyEntry>,
@@ -182,6 +187,7 @@ impl Default for JobOptions {
             kerf_in_control: false,
             cut_clearance_mm: None,
             accept_head_collisions: false,
+            micro_joints: None,
             technology: None,
         }
     }
@@ -289,6 +295,12 @@ impl JobOptions {
         self
     }
 
+    /// With micro-joints of `length_mm` every `spacing_mm` (see [`JobOptions::micro_joints`]).
+    pub fn with_micro_joints(mut self, joints: Option<(f64, f64)>) -> Self {
+        self.micro_joints = joints;
+        self
+    }
+
     /// With head collisions along the cuts reported as warnings instead of refused (see
     /// [`JobOptions::accept_head_collisions`]).
     pub fn with_accept_head_collisions(mut self, accept: bool) -> Self {
@@ -353,6 +365,17 @@ impl JobOptions {
         }
         if let Some(c) = self.cut_clearance_mm {
             CLEARANCE_MM.check("cut_clearance_mm", c)?;
+        }
+        if let Some((length, spacing)) = self.micro_joints {
+            crate::ranges::MICRO_JOINT_MM.check("micro_joints.length_mm", length)?;
+            crate::ranges::MICRO_JOINT_SPACING_MM.check("micro_joints.spacing_mm", spacing)?;
+            if length >= spacing {
+                return Err(Error::BadOption {
+                    name: "micro_joints.length_mm",
+                    value: length,
+                    requirement: format!("must be less than the spacing ({spacing} mm)"),
+                });
+            }
         }
         let l = &self.leads;
         for (name, v) in [

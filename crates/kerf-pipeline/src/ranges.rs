@@ -17,6 +17,8 @@
 //! | [`CLEARANCE_MM`] | `0 < x <= 1000` mm | the traverses' clearance from the part (the command line's 0 turns the checks off) |
 //! | [`LEAD_MM`] | `0 <= x <= 1000` mm | the lead-in's line and radius, the overcut and the exit |
 //! | [`WALL_MM`] | `0 <= x <= 100` mm | the widest wall cut along itself (the thickest sheet a laser cuts is tens of mm; a metre would take a sheet's face for a wall) |
+//! | [`MICRO_JOINT_MM`] | `0 < x <= 10` mm | a micro-joint's length |
+//! | [`MICRO_JOINT_SPACING_MM`] | `1 <= x <= 1e5` mm | the path between micro-joints (more than their length) |
 //! | [`KERF_WIDTH_MM`] | `0 < x <= 20` mm | the kerf width (a fibre laser's is 0.1-0.3 mm, a plasma's a few mm) |
 //!
 //! Angles keep the ranges of their stage's own options (the normal step below 180 degrees,
@@ -176,6 +178,18 @@ pub const CLEARANCE_MM: OptionRange = range(0.0, false, 1000.0, "mm", "");
 
 /// The lengths of the leads: the lead-in's line and arc radius, the overcut, the exit.
 pub const LEAD_MM: OptionRange = range(0.0, true, 1000.0, "mm", "");
+
+/// A micro-joint's length: the beam off over at most 10 mm of the path.
+pub const MICRO_JOINT_MM: OptionRange = range(
+    0.0,
+    false,
+    10.0,
+    "mm",
+    "a micro-joint holds a part by a few tenths of a millimetre of uncut sheet",
+);
+
+/// The path between micro-joints.
+pub const MICRO_JOINT_SPACING_MM: OptionRange = range(1.0, true, 1e5, "mm", "");
 
 /// The widest wall cut along itself (0: off).
 pub const WALL_MM: OptionRange = range(

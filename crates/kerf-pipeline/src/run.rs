@@ -305,6 +305,34 @@ fn run_placed(
         })
         .collect();
     lap.split(&mut timings, "cuts");
+    // Micro-joints: where the beam leaves each part's outline (and big cut-outs) uncut.
+    let (joints, joint_warnings) = match o.micro_joints {
+        Some((length, spacing)) => {
+            crate::cuts::micro_joints(file, &cuts, &cut_plans, length, spacing)
+        }
+        None => (vec![Vec::new(); cuts.len()], Vec::new()),
+    };
+    let joints_report: Vec<serde_json::Value> = cuts
+        .iter()
+        .zip(&joints)
+        .enumerate()
+        .filter(|(_, (_, j))| !j.is_empty())
+        .map(|(k, (c, j))| {
+            let placed: Vec<[f64; 3]> = cut_poses[k]
+                .iter()
+                .map(|p| [p.position.x, p.position.y, p.position.z])
+                .collect();
+            json!({
+                "id": file.curves[c.curve].id,
+                "joints": j.iter().map(|&[a, b]| json!({
+                    "start_mm": a,
+                    "end_mm": b,
+                    "start": crate::cuts::point_along(&placed, a),
+                    "end": crate::cuts::point_along(&placed, b),
+                })).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
     let mut solved = solve_paths(machine, &inputs, &popts).map_err(kin(path))?;
     lap.split(&mut timings, "kinematics");
     // 3d. The head against every surface of the file along every cut, set-up by set-up; the
@@ -428,6 +456,7 @@ fn run_placed(
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
     let mut warnings: Vec<String> = head_warnings;
+    warnings.extend(joint_warnings.iter().cloned());
     // The offset paths go into the toolpath (`kerf_offset`), where `kerf check` measures them.
     for c in &compensated {
         if let crate::cuts::Outcome::Offset(p) = &c.outcome {
@@ -458,6 +487,7 @@ fn run_placed(
         let mut comps: Vec<Option<kerf_interp::CutterCompensation>> = Vec::new();
         let mut feed_factors: Vec<f64> = Vec::new();
         let mut power_factors: Vec<f64> = Vec::new();
+        let mut path_joints: Vec<Vec<[f64; 2]>> = Vec::new();
         let mut ids: Vec<String> = Vec::new();
         let in_setup: Vec<usize> = (0..solved.len())
             .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
@@ -615,6 +645,7 @@ fn run_placed(
             };
             feed_factors.push(feed_factor);
             power_factors.push(power_factor);
+            path_joints.push(joints[k].clone());
         }
         let blocks = kerf_interp::link_paths_through(&model, fitted, &traverses, fit.retract_mm);
         drop(traverses);
@@ -624,7 +655,8 @@ fn run_placed(
         let mut gopts_k = gopts
             .clone()
             .with_cutter_compensation(comps)
-            .with_power_factors(power_factors);
+            .with_power_factors(power_factors)
+            .with_micro_joints(path_joints);
         gopts_k.header = vec![
             format!(
                 "set-up {} of {}: {} contours; placement (part to workpiece): {}",
@@ -773,6 +805,12 @@ fn run_placed(
         },
         "compensation": crate::cuts::compensation_json(file, kerf.as_ref(), &compensated),
         "technology": technology_json(o.technology.as_ref(), &small_ids),
+        "micro_joints": o.micro_joints.map(|(length, spacing)| json!({
+            "length_mm": length,
+            "spacing_mm": spacing,
+            "paths": joints_report,
+            "left_out": joint_warnings,
+        })),
         "head": crate::head::head_json(o.cut_clearance_mm, machine, head_tip_zone, head_report),
         "discretize": {
             "curves": file.curves.len(),

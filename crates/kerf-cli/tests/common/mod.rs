@@ -69,3 +69,19 @@ pub(crate) fn run_auto_with(curves: &str, machine: &str, more: &[&str]) -> tempf
     );
     dir
 }
+
+/// `kerf run sheet_metal_holes.json -m gantry_ac.json -o OUT -q EXTRA...` (not placed): the
+/// flat part's run, its outcome.
+pub(crate) fn run_flat(extra: &[&str], out: &Path) -> std::process::Output {
+    kerf()
+        .args(["run"])
+        .arg(fixture("sheet_metal_holes.json"))
+        .arg("-m")
+        .arg(fixture("machines/gantry_ac.json"))
+        .arg("-o")
+        .arg(out)
+        .arg("-q")
+        .args(extra)
+        .output()
+        .expect("kerf runs")
+}

@@ -42,9 +42,11 @@ impl Dialect {
     ///
     /// LinuxCNC's `M64`/`M65` switch the output when every motion queued before them has
     /// finished (they break blending): the dwell after `M64` runs with the beam on and the
-    /// beam goes off where the cut ends. (`M62`/`M63` would act at the start of the *next*
-    /// motion: the dwell would run with the beam off. Every program ends with a retract
-    /// after its last beam-off, so that a last `M63` fires too.)
+    /// beam goes off where the cut ends. (`M62`/`M63` act at the start of the *next* motion:
+    /// a machine that names `M62 P<n>` gets its pierce lit with the immediate `M64 P<n>`, so
+    /// that the dwell runs with the beam on, and every program ends with a retract after its
+    /// last beam-off, so that a last `M63` fires too. Micro-joints always switch with the
+    /// synchronized `M63`/`M62`.)
     pub fn default_process(self) -> ProcessCodes {
         let (on, off) = match self {
             Dialect::Linuxcnc => ("M64 P0", "M65 P0"),

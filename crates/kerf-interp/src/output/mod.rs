@@ -114,6 +114,13 @@ pub struct GcodeOptions {
     /// The power factor per path (indexed like the blocks' `path`; a small hole's factor from
     /// the technology's small-hole rule), 1 where missing. Default none.
     pub power_factors: Vec<f64>,
+    /// Micro-joints per path (indexed like the blocks' `path`): `[start, end]` in mm of tip
+    /// travel from the path's first cutting block, increasing and disjoint. The beam goes off
+    /// over each with codes synchronized with motion (LinuxCNC `M63`/`M62` on the output the
+    /// machine's beam codes name; the generic dialect writes the machine's own beam codes
+    /// between the blocks); each block that a joint's end falls in is split there. The
+    /// Sinumerik dialect refuses them. Default none.
+    pub micro_joints: Vec<Vec<[f64; 2]>>,
 }
 
 /// The controller's cutter compensation of one path: the side the beam moves to, seen along
@@ -137,6 +144,12 @@ impl GcodeOptions {
     /// Sets [`power`](Self::power): laser power that follows the tip's speed.
     pub fn with_power(mut self, power: Option<LaserPower>) -> Self {
         self.power = power;
+        self
+    }
+
+    /// Sets [`micro_joints`](Self::micro_joints): each path's micro-joints.
+    pub fn with_micro_joints(mut self, joints: Vec<Vec<[f64; 2]>>) -> Self {
+        self.micro_joints = joints;
         self
     }
 
@@ -249,6 +262,7 @@ impl GcodeOptions {
             cutter_compensation: Vec::new(),
             power: None,
             power_factors: Vec::new(),
+            micro_joints: Vec::new(),
         }
     }
 
@@ -436,6 +450,11 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         power.validate()?;
     }
     crate::error::unit_factors("power_factors", &opts.power_factors)?;
+    let joint_codes = if opts.micro_joints.iter().any(|j| !j.is_empty()) {
+        Some(writer::joint_codes(opts, &process)?)
+    } else {
+        None
+    };
     refuse_pierces_out_of_range(model, blocks, &process)?;
     let mut w = Writer {
         model,
@@ -452,6 +471,9 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         factor: 1.0,
         coeffs: [0.0; 6],
         held: None,
+        joint_codes,
+        joints: Vec::new(),
+        path_s: 0.0,
     };
     w.header(blocks);
     let mut last_path = usize::MAX;
@@ -486,6 +508,8 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         }
         if !w.in_cut {
             w.factor = opts.power_factors.get(b.path).copied().unwrap_or(1.0);
+            w.joints = opts.micro_joints.get(b.path).cloned().unwrap_or_default();
+            w.path_s = 0.0;
             w.start_cut(b);
             if let Some(Some(c)) = opts.cutter_compensation.get(b.path) {
                 w.compensation_on(c);

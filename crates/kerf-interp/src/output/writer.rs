@@ -38,6 +38,13 @@ pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
     /// controller's blend starts turning the rotary axes before the next block's synchronized
     /// outputs fire, and while the held block runs the coefficients do not count.
     pub(super) held: Option<String>,
+    /// The lines that switch the beam off and on again over a micro-joint (synchronized with
+    /// motion), when the program has micro-joints.
+    pub(super) joint_codes: Option<(Vec<String>, Vec<String>)>,
+    /// The micro-joints of the path being cut (mm of tip travel from its first block).
+    pub(super) joints: Vec<[f64; 2]>,
+    /// The tip travel of the path being cut so far, mm.
+    pub(super) path_s: f64,
 }
 
 impl<M: AxisModel + ?Sized> Writer<'_, M> {
@@ -274,6 +281,12 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         self.rapid(pierce, qp, u);
         self.pierce_power();
         for l in self.process.beam_on.clone() {
+            // The pierce is lit at once: a synchronized `M62` would wait for the next move and
+            // the dwell would run dark.
+            let l = match (self.opts.dialect, digital_output(&l)) {
+                (Dialect::Linuxcnc, Some((62, p))) => format!("M64 P{p}"),
+                _ => l,
+            };
             self.line(&l);
         }
         let dwell = self.process.pierce_dwell_s;
@@ -305,6 +318,17 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 }
                 _ => self.raw_move(b.start_axes, t, h),
             }
+        }
+    }
+
+    /// The beam off (`on` false) or on again at a micro-joint's end, synchronized with the
+    /// next move.
+    fn joint_switch(&mut self, on: bool) {
+        let Some((off_lines, on_lines)) = self.joint_codes.clone() else {
+            return;
+        };
+        for l in if on { on_lines } else { off_lines } {
+            self.line(&l);
         }
     }
 
@@ -535,6 +559,27 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     }
                 }
                 ends.push((b.length(), b.end_axes));
+                // A turn's parameter is degrees; its tip stands still.
+                let turn = matches!(b.geometry, Geometry::Turn { .. });
+                // Micro-joint ends inside the block: split there, the beam switched after.
+                let mut switches: Vec<(f64, bool)> = Vec::new();
+                if !turn && b.length() > 0.0 {
+                    for j in &self.joints {
+                        for (edge, on) in [(j[0], false), (j[1], true)] {
+                            let s = edge - self.path_s;
+                            if s > 0.0 && s <= b.length() {
+                                switches.push((s, on));
+                            }
+                        }
+                    }
+                }
+                for &(s, _) in &switches {
+                    if s < b.length() {
+                        ends.push((s, b.axes_at(self.model, s)));
+                    }
+                }
+                ends.sort_by(|a, b| a.0.total_cmp(&b.0));
+                ends.dedup_by(|a, b| a.0 == b.0);
                 let mut s0 = 0.0;
                 for (s, q) in ends {
                     let share = if b.length() > 0.0 {
@@ -542,14 +587,14 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     } else {
                         1.0
                     };
-                    // A turn's parameter is degrees; its tip stands still.
-                    let tip = if matches!(b.geometry, Geometry::Turn { .. }) {
-                        0.0
-                    } else {
-                        s - s0
-                    };
-                    self.raw_move(q, t * share, tip);
+                    self.raw_move(q, t * share, if turn { 0.0 } else { s - s0 });
+                    for &(_, on) in switches.iter().filter(|w| w.0 == s) {
+                        self.joint_switch(on);
+                    }
                     s0 = s;
+                }
+                if !turn {
+                    self.path_s += b.length();
                 }
             }
             Dialect::Sinumerik => {
@@ -579,6 +624,53 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     }
                 }
                 self.line(&l);
+            }
+        }
+    }
+}
+
+/// `M<m> P<n>` (LinuxCNC's digital outputs, `m` in 62..=65): `(m, n)`.
+fn digital_output(line: &str) -> Option<(u32, u32)> {
+    let mut words = line.split_whitespace();
+    let m = words.next()?.strip_prefix('M')?.parse().ok()?;
+    let p = words.next()?.strip_prefix('P')?.parse().ok()?;
+    (words.next().is_none() && (62..=65).contains(&m)).then_some((m, p))
+}
+
+/// The lines that switch the beam off and on over a micro-joint: on LinuxCNC the synchronized
+/// `M63`/`M62` on the outputs the machine's beam codes switch (`M62`-`M65 P<n>` only); in the
+/// generic dialect the machine's beam codes themselves.
+///
+/// # Errors
+/// [`InterpError::BadParameter`] for the Sinumerik dialect, the controller's kerf
+/// compensation, or LinuxCNC beam codes that are not `M62`-`M65 P<n>`.
+pub(super) fn joint_codes(
+    opts: &GcodeOptions,
+    process: &ProcessCodes,
+) -> crate::error::Result<(Vec<String>, Vec<String>)> {
+    let refuse = |reason: &'static str| {
+        Err(crate::error::InterpError::BadParameter {
+            name: "micro_joints",
+            value: 1.0,
+            reason,
+        })
+    };
+    if opts.cutter_compensation.iter().any(Option::is_some) {
+        return refuse("micro-joints are not written while the controller compensates the kerf (LinuxCNC sets no output then); compensate in the computer");
+    }
+    match opts.dialect {
+        Dialect::Sinumerik => refuse("micro-joints are written for the linuxcnc and generic dialects (the Sinumerik dialect's arcs and merged lines are not split)"),
+        Dialect::Generic => Ok((process.beam_off.clone(), process.beam_on.clone())),
+        Dialect::Linuxcnc => {
+            let map = |lines: &[String], m: u32| -> Option<Vec<String>> {
+                lines
+                    .iter()
+                    .map(|l| digital_output(l).map(|(_, p)| format!("M{m} P{p}")))
+                    .collect()
+            };
+            match (map(&process.beam_off, 63), map(&process.beam_on, 62)) {
+                (Some(off), Some(on)) if !off.is_empty() && !on.is_empty() => Ok((off, on)),
+                _ => refuse("micro-joints on LinuxCNC need beam codes of the form M62-M65 P<n> (switched with motion as M63/M62 at the joints)"),
             }
         }
     }

@@ -259,6 +259,16 @@ def simulate(kerf, measure, fixture, machine, flat, outdir, tag="", extra=(), tr
         else:
             print(f"{name}: power follows the tip speed within {pw['max_ratio_error']:.4f} over {pw['samples_checked']} samples "
                   f"({pw['samples_at_floor']} at the floor)", flush=True)
+        # Small holes run at their factor: the executed tip reaches the hole's share of the feed
+        # and never passes it (the power's own factor is in the ratio above).
+        if pw:
+            cap = pw["reference_feed_mm_per_min"] * pw["small_hole_feed_factor"]
+            for c in (c for c in pw["per_cut"] if c["small_hole"]):
+                if not 0.9 * cap <= c["peak_tip_speed_mm_per_min"] <= 1.01 * cap:
+                    fail(f"{name}: small hole {c['id']} peaks at {c['peak_tip_speed_mm_per_min']:.0f} mm/min, its feed {cap:.0f}")
+            holes = [c["id"] for c in pw["per_cut"] if c["small_hole"]]
+            if holes:
+                print(f"{name}: small holes {', '.join(holes)} at their feed {cap:.0f} mm/min", flush=True)
     if "--micro-joints" in extra_in:
         mj = fig.get("micro_joints") or {}
         if not mj.get("grouped") or not mj.get("planned"):

@@ -575,6 +575,9 @@ fn measure_power(
         .map_or(Vec::new(), |a| a.iter().filter_map(Value::as_str).collect());
     let factor = t["small_hole"]["power_factor"].as_f64().unwrap_or(1.0);
     let feed_factor = t["small_hole"]["feed_factor"].as_f64().unwrap_or(1.0);
+    let descent = report["program"]["pierce_standoff_mm"]
+        .as_f64()
+        .unwrap_or(0.0);
     let mut checked = 0usize;
     let mut at_floor = 0usize;
     let mut worst = 0.0f64;
@@ -591,8 +594,10 @@ fn measure_power(
         let slope = f * p_cut / v_ref;
         let mut cut_worst = 0.0f64;
         let mut speeds = Vec::new();
-        // The pierce: from the beam's switch until the head first moves, at the pierce power.
+        // The pierce: from the beam's switch until the head first moves, at the pierce power;
+        // then the descent (the pierce standoff, at the programmed feed), left out of the peak.
         let mut moving = false;
+        let mut travel = 0.0;
         for i in on + POWER_SETTLE..off.saturating_sub(POWER_SETTLE) {
             if !(beam[i] && beam[i - 1]) {
                 continue;
@@ -604,6 +609,8 @@ fn measure_power(
                 continue;
             }
             moving = true;
+            travel += v * period / 60.0;
+            let descending = travel <= descent + 1e-3;
             let p = power[i];
             if p <= floor * 1.001 + 1e-9 {
                 at_floor += 1;
@@ -613,7 +620,9 @@ fn measure_power(
                 continue;
             }
             checked += 1;
-            speeds.push(v);
+            if !descending {
+                speeds.push(v);
+            }
             let err = (p / (slope * v) - 1.0).abs();
             cut_worst = cut_worst.max(err);
             if err > worst {
@@ -626,7 +635,7 @@ fn measure_power(
             "id": path.id,
             "small_hole": f != 1.0,
             "max_ratio_error": cut_worst,
-            "peak_tip_speed_mm_per_min": peak,
+            "peak_tip_speed_mm_per_min": peak, // after the descent
         }));
     }
     json!({

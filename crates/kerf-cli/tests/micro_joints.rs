@@ -44,16 +44,18 @@ struct Dark {
 }
 
 /// The flat part in `dialect` with joints of 0.5 mm every 40 mm: its program and report.
-fn with_joints(dialect: &str) -> (String, serde_json::Value) {
+fn with_joints(dialect: &str) -> (String, serde_json::Value, String) {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("out");
     let r = run(&["--dialect", dialect, "--micro-joints", "0.5,40"], &out);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let program = std::fs::read_to_string(out.join("program.nc")).expect("program");
-    (program, common::read_json(&out.join("report.json")))
+    let plot = std::fs::read_to_string(out.join("plot.svg")).expect("plot");
+    (program, common::read_json(&out.join("report.json")), plot)
 }
 
-/// How many joints the report plans.
+/// How many joints the report plans (and the picture marks: one bar a joint in each of its
+/// four views).
 fn joints_in(report: &serde_json::Value) -> usize {
     report["micro_joints"]["paths"]
         .as_array()
@@ -65,7 +67,7 @@ fn joints_in(report: &serde_json::Value) -> usize {
 
 #[test]
 fn the_joints_are_dark_where_the_report_plans_them_and_nowhere_else() {
-    let (program, report) = with_joints("linuxcnc");
+    let (program, report, plot) = with_joints("linuxcnc");
     let m = kerf_kinematics::Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
     // Replay: the beam state each move runs with, the moves of each cut after its descent.
     let (mut id, mut beam, mut pending) = (String::new(), false, None::<bool>);
@@ -174,6 +176,11 @@ fn the_joints_are_dark_where_the_report_plans_them_and_nowhere_else() {
     let hole_70 = std::f64::consts::PI * 70.0;
     assert_eq!(count("hole-d70"), (hole_70 / 40.0).floor() as usize);
     assert!(count("outline") >= 1);
+    // The picture marks them: one bar a joint in each of the four views.
+    assert_eq!(
+        plot.matches("class=\"micro-joint\"").count(),
+        4 * planned.len()
+    );
     // The beam is on everywhere else on the cuts.
     let lit = cut_moves.iter().filter(|m| m.3).count();
     assert!(lit > 600, "{lit} lit moves");
@@ -221,7 +228,7 @@ fn micro_joints_that_cannot_be_written_are_refused() {
 
 #[test]
 fn the_generic_dialect_switches_with_the_machines_codes_between_blocks() {
-    let (program, report) = with_joints("generic");
+    let (program, report, _) = with_joints("generic");
     let joints = joints_in(&report);
     let cuts = report["program"]["cuts"].as_u64().expect("cuts") as usize;
     // One beam-on per cut and one per joint; one beam-off per joint, per cut and the preamble's.
@@ -269,4 +276,34 @@ fn a_real_part_runs_with_technology_and_micro_joints() {
     );
     assert_eq!(scaled, cuts, "every cut's power commanded");
     assert!(cuts > 0);
+}
+
+/// A technology entry's `micro_joints` are the run's unless `--micro-joints` names others.
+#[test]
+fn a_technology_entry_sets_the_default_joints() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let table = dir.path().join("table.json");
+    std::fs::write(
+        &table,
+        r#"{"format": "kerf.technology/1", "entries": [{"material": "steel", "thickness_mm": 2, "feed_mm_per_min": 4000, "power_percent": 80, "micro_joints": {"length_mm": 0.3, "spacing_mm": 60}}]}"#,
+    )
+    .expect("write");
+    let table = table.to_str().expect("path");
+    for (extra, want) in [
+        (&[][..], (0.3, 60.0)),
+        (&["--micro-joints", "0.5,40"][..], (0.5, 40.0)),
+    ] {
+        let out = dir.path().join(format!("out{}", extra.len()));
+        let mut args = vec!["--technology", table, "--material", "steel"];
+        args.extend_from_slice(extra);
+        let r = run(&args, &out);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let report = common::read_json(&out.join("report.json"));
+        let mj = &report["micro_joints"];
+        assert_eq!(
+            (mj["length_mm"].as_f64(), mj["spacing_mm"].as_f64()),
+            (Some(want.0), Some(want.1))
+        );
+        assert!(joints_in(&report) > 0);
+    }
 }

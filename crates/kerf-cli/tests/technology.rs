@@ -116,6 +116,10 @@ fn unknown_materials_and_bad_tables_are_refused_by_name_with_nothing_written() {
             "entries[0].power_min_percent: must lie in [0, 50] (got 60)",
         ),
         (
+            r#"{"format": "kerf.technology/1", "entries": [{"material": "x", "thickness_mm": 1, "feed_mm_per_min": 1000, "power_percent": 50, "micro_joints": {"length_mm": 5, "spacing_mm": 4}}]}"#,
+            "entries[0].micro_joints.length_mm: must be less than the spacing (4 mm, got 5)",
+        ),
+        (
             r#"{"format": "kerf.technology/1", "entries": []}"#,
             "entries: 0 entries, expected 1 to 4096",
         ),

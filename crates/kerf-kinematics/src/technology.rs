@@ -59,6 +59,16 @@ pub struct SmallHole {
     pub power_factor: f64,
 }
 
+/// The micro-joints of an entry: the run's default for `--micro-joints`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MicroJoints {
+    /// The length left uncut, mm, in (0, 10].
+    pub length_mm: f64,
+    /// The path between joints, mm, in [1, 1e5] and longer than the joint.
+    pub spacing_mm: f64,
+}
+
 /// One entry of a technology table: the cutting parameters of one material and thickness.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -98,6 +108,9 @@ pub struct TechnologyEntry {
     /// The small-hole rule.
     #[serde(default)]
     pub small_hole: Option<SmallHole>,
+    /// Micro-joints the run leaves unless it names its own.
+    #[serde(default)]
+    pub micro_joints: Option<MicroJoints>,
 }
 
 impl TechnologyEntry {
@@ -184,6 +197,19 @@ impl TechnologyEntry {
                 false,
                 crate::MAX_PIERCE_STANDOFF_MM,
             )?;
+        }
+        if let Some(j) = &self.micro_joints {
+            within("micro_joints.length_mm", j.length_mm, 0.0, true, 10.0)?;
+            within("micro_joints.spacing_mm", j.spacing_mm, 1.0, false, 1e5)?;
+            if j.length_mm >= j.spacing_mm {
+                return bad(
+                    "micro_joints.length_mm",
+                    format!(
+                        "must be less than the spacing ({} mm, got {})",
+                        j.spacing_mm, j.length_mm
+                    ),
+                );
+            }
         }
         if let Some(h) = &self.small_hole {
             within(

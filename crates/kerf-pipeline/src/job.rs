@@ -596,7 +596,8 @@ impl Job {
     /// its pierce (time, height), standoff and kerf width replace the machine file's
     /// `process` values where the entry gives them (a run's own `--kerf-width` still wins:
     /// [`JobOptions::kerf_width_mm`]). Call it after [`Job::with_options`], then set a feed
-    /// the user gave explicitly. The entry is named in the report and the program header; its
+    /// the user gave explicitly. Its micro-joints apply where the options name none. The entry
+    /// is named in the report and the program header; its
     /// power is commanded following the tip's speed and its small-hole rule slows the holes
     /// it names (docs/process.md "Technology").
     pub fn with_technology(mut self, entry: kerf_kinematics::TechnologyEntry) -> Self {
@@ -611,6 +612,9 @@ impl Job {
         }
         if let Some(k) = entry.kerf_width_mm {
             p.kerf_width_mm = Some(k);
+        }
+        if let (None, Some(j)) = (self.options.micro_joints, entry.micro_joints) {
+            self.options.micro_joints = Some((j.length_mm, j.spacing_mm));
         }
         self.options.technology = Some(entry);
         self

@@ -719,6 +719,13 @@ fn run_placed(
                     } else {
                         Vec::new()
                     },
+                    micro_joints: {
+                        let part: Vec<[f64; 3]> =
+                            c.poses.iter().map(|q| [q[0], q[1], q[2]]).collect();
+                        let at =
+                            |s: f64| nalgebra::Point3::from(crate::cuts::point_along(&part, s));
+                        joints[k].iter().map(|&[a, b]| [at(a), at(b)]).collect()
+                    },
                 }
             })
             .collect(),

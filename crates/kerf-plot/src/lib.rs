@@ -21,9 +21,10 @@
 //! `view-iso`, `legend-error`, `chart-chord-error`, `chart-axes`; every cutting point is one
 //! `<circle class="pt">` per view. With a [`ProcessPicture`], every view also holds a group
 //! `class="process"`: each traverse a dashed `<polyline class="traverse">`, each lead-in a
-//! `<polyline class="lead-in">`, each lead-out a `<polyline class="lead-out">`, each pierce a
-//! `<circle class="pierce" data-order="k">` and beside it `<text class="order">k</text>`, `k`
-//! from 1 in cutting order.
+//! `<polyline class="lead-in">`, each lead-out a `<polyline class="lead-out">`, each
+//! micro-joint a `<polyline class="micro-joint">` (a bar wider than the path, from where the beam
+//! goes off to where it comes on), each pierce a `<circle class="pierce" data-order="k">` and
+//! beside it `<text class="order">k</text>`, `k` from 1 in cutting order.
 //!
 //! The picture's size is bounded whatever the input: beyond [`MAX_DRAWN_SEGMENTS`] segments,
 //! [`MAX_DRAWN_PATHS`] paths or [`MAX_DRAWN_CURVE_SAMPLES`] curve samples or axis positions,
@@ -635,12 +636,17 @@ mod tests {
                     pierce: p0,
                     lead_in: vec![p0, Point3::new(0.0, -10.0, 0.0)],
                     lead_out: vec![Point3::new(40.0, -10.0, 0.0), Point3::new(42.0, -8.0, 0.0)],
+                    micro_joints: vec![[
+                        Point3::new(20.0, -10.0, 0.0),
+                        Point3::new(20.5, -10.0, 0.0),
+                    ]],
                 },
                 CutPicture {
                     id: "arc".into(),
                     pierce: p1,
                     lead_in: vec![p1, Point3::new(30.0, 0.0, 0.0)],
                     lead_out: Vec::new(),
+                    micro_joints: Vec::new(),
                 },
             ],
             traverses: vec![vec![Point3::new(42.0, -8.0, 0.0), p1]],
@@ -655,6 +661,11 @@ mod tests {
         );
         assert_eq!(top.matches("class=\"traverse\"").count(), 1);
         assert_eq!(top.matches("class=\"lead-in\"").count(), 2);
+        assert_eq!(
+            top.matches("class=\"micro-joint\"").count(),
+            1,
+            "one bar a joint"
+        );
         assert_eq!(
             top.matches("class=\"lead-out\"").count(),
             1,

@@ -50,6 +50,8 @@ pub struct CutPicture {
     pub lead_in: Vec<Point3<f64>>,
     /// The lead-out from the contour's last cutting point (empty: none).
     pub lead_out: Vec<Point3<f64>>,
+    /// The micro-joints on the contour: where the beam goes off and on again (empty: none).
+    pub micro_joints: Vec<[Point3<f64>; 2]>,
 }
 
 /// One cut contour: its curve, cutting points, normals and per-segment chord errors.

@@ -520,6 +520,10 @@ fn draw_process(doc: &mut Doc, process: &crate::ProcessPicture, view: View, fit:
         if c.lead_out.len() >= 2 {
             doc.polyline(&line(&c.lead_out), "class=\"lead-out\"");
         }
+        // A joint is a fraction of a millimetre: drawn as a bar across the path's line width.
+        for j in &c.micro_joints {
+            doc.polyline(&line(j), "class=\"micro-joint\"");
+        }
     }
     for (k, c) in process.cuts.iter().enumerate() {
         let (x, y) = fit.px(view.project(&c.pierce));
@@ -552,5 +556,6 @@ pub(crate) const STYLE: &str = concat!(
     ".lead-in{stroke:#e07b00;stroke-width:1.8}",
     ".lead-out{stroke:#8e44ad;stroke-width:1.4;stroke-dasharray:2 2}",
     ".pierce{fill:#d62728;stroke:#fff;stroke-width:0.8}",
+    ".micro-joint{stroke:#0a8f3c;stroke-width:6;stroke-linecap:round}",
     ".order{font-size:10px;font-weight:bold;fill:#d62728;stroke:#fff;stroke-width:2.5px;paint-order:stroke}",
 );

@@ -49,6 +49,17 @@ impl Basis {
         }
     }
 
+    /// The point at parameter `t`.
+    pub(crate) fn point_at(&self, t: f64) -> Point3<f64> {
+        match self {
+            Basis::Line { origin, step } => origin + step * t,
+            Basis::Conic { frame, rx, ry } => {
+                frame.origin + frame.x * (rx * t.cos()) + frame.y * (ry * t.sin())
+            }
+            Basis::Nurbs(c) => c.point(t),
+        }
+    }
+
     /// The piece from parameter `t1` to `t2` as a NURBS curve, running from `t1` to `t2`
     /// (so `t1 > t2` gives the reversed piece). For conics `t2` may exceed `t1` by up to 2 pi
     /// or fall short of it by as much; the caller chooses the turn.
@@ -423,19 +434,38 @@ fn trim_param(
     } else {
         1.0
     };
-    match (param, point) {
-        (Some(t), Some(p)) if prefer_point => {
-            let _ = t;
-            Ok(b.param_of(&p))
+    // A trim given as a point must lie on its curve: its projection is where the piece ends,
+    // and a point far off (a circle's centre, another curve's end) would cut a silently wrong
+    // piece.
+    let on_curve = |p: Point3<f64>| -> Result<f64> {
+        let t = b.param_of(&p);
+        let off = (b.point_at(t) - p).norm();
+        if off.is_finite() && off <= TRIM_POINT_TOLERANCE_MM {
+            Ok(t)
+        } else {
+            Err(err(
+                inst,
+                format!(
+                    "{what}: the trim point ({:.6}, {:.6}, {:.6}) lies {off:.6} mm off its curve (at most {TRIM_POINT_TOLERANCE_MM} mm)",
+                    p.x, p.y, p.z
+                ),
+            ))
         }
+    };
+    match (param, point) {
+        (Some(_), Some(p)) if prefer_point => on_curve(p),
         (Some(t), _) => Ok(t * angle),
-        (None, Some(p)) => Ok(b.param_of(&p)),
+        (None, Some(p)) => on_curve(p),
         (None, None) => Err(err(
             inst,
             format!("{what} has neither a parameter nor a point"),
         )),
     }
 }
+
+/// How far a trim given as a point may lie from its curve, mm: above the edge tolerances CAD
+/// files carry (0.01-0.07 mm), far below a point that belongs elsewhere.
+pub(crate) const TRIM_POINT_TOLERANCE_MM: f64 = 0.1;
 
 /// Any bounded curve entity as one NURBS curve per segment (a composite gives its segments,
 /// senses applied; others one). Full conics give the closed curve starting at angle 0.

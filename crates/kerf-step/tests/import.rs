@@ -882,3 +882,34 @@ fn a_byte_order_mark_is_skipped_by_both_entry_points() {
         "the same document from text"
     );
 }
+
+#[test]
+fn a_trim_point_off_its_curve_is_refused_by_name() {
+    // A circle of radius 2 trimmed by points (master representation .CARTESIAN.): on the
+    // circle the piece is the quarter; at its centre, or 500 mm away, the trim would cut a
+    // piece from nowhere (the adversarial round's E1/E3), so the file is refused naming the
+    // trimmed curve and the distance.
+    let base = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(0.,0.,1.));\n#3=DIRECTION('',(1.,0.,0.));\n\
+        #4=AXIS2_PLACEMENT_3D('',#1,#2,#3);\n#5=CIRCLE('',#4,2.);\n#8=CARTESIAN_POINT('',(2.,0.,0.));\n";
+    let file = |p2: &str| {
+        step(&format!(
+            "{base}#9=CARTESIAN_POINT('',({p2}));\n\
+             #6=TRIMMED_CURVE('arc',#5,(#8),(#9),.T.,.CARTESIAN.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n"
+        ))
+    };
+    let im = import(&file("0.,2.,0."), &ImportOptions::default()).expect("on the circle");
+    let c = curve(&im.file.curves[0]);
+    let (_, b) = c.domain();
+    assert!((c.point(b) - Point3::new(0.0, 2.0, 0.0)).norm() < 1e-9);
+    // 0.05 mm off (a CAD edge tolerance): accepted, projected.
+    import(&file("0.,2.05,0."), &ImportOptions::default()).expect("within the tolerance");
+    for (p, off) in [("0.,0.,0.", "2.000000"), ("0.,502.,0.", "500.000000")] {
+        let e = import(&file(p), &ImportOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("#6") && e.contains(&format!("lies {off} mm off its curve")),
+            "{p}: {e}"
+        );
+    }
+}

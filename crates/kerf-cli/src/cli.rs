@@ -440,14 +440,15 @@ pub(crate) struct RunArgs {
     #[arg(long, value_name = "FILE", requires = "material")]
     pub(crate) technology: Option<PathBuf>,
 
-    /// The material of the technology entry (compared without case); an unknown one is
-    /// refused with the known ones listed.
-    #[arg(long, value_name = "NAME", requires = "technology")]
+    /// The material of the technology entry (compared without case), from --technology or
+    /// else the machine file's `process.technology` table; an unknown one is refused with the
+    /// known ones listed.
+    #[arg(long, value_name = "NAME")]
     pub(crate) material: Option<String>,
 
     /// The sheet thickness of the technology entry, mm (needed where the material has several
     /// entries).
-    #[arg(long, value_name = "MM", requires = "technology", value_parser = crate::guard::positive_mm)]
+    #[arg(long, value_name = "MM", requires = "material", value_parser = crate::guard::positive_mm)]
     pub(crate) thickness: Option<f64>,
 
     /// Interpolation cycle, seconds (from 1e-5 to 0.1: 10 microseconds to 100 milliseconds).

@@ -92,7 +92,22 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     };
     lap.stop(&mut read, "read");
     let mut job = job.with_options(job_options(args));
-    if let (Some(file), Some(material)) = (&args.technology, &args.material) {
+    // The table: --technology, else the machine file's `process.technology` (relative to the
+    // machine file).
+    let table_file = args.technology.clone().or_else(|| {
+        job.machine().process.technology.as_ref().map(|t| {
+            args.machine
+                .parent()
+                .unwrap_or_else(|| std::path::Path::new("."))
+                .join(t)
+        })
+    });
+    if let (Some(_), None) = (&args.material, &table_file) {
+        return Err(CliError::Usage(
+            "--material needs a technology table: --technology FILE, or the machine file's process.technology".into(),
+        ));
+    }
+    if let (Some(file), Some(material)) = (&table_file, &args.material) {
         let table = kerf_kinematics::Technology::read(file)?;
         let entry = table.entry(material, args.thickness).map_err(|error| {
             kerf_kinematics::KinematicsError::File {

@@ -152,3 +152,66 @@ fn unknown_materials_and_bad_tables_are_refused_by_name_with_nothing_written() {
         assert!(!out.exists(), "nothing written");
     }
 }
+
+/// The machine file's `process.technology` (relative to the machine file) is the table
+/// `--material` picks from when no `--technology` is given; `--material` with no table at all
+/// is a usage error.
+#[test]
+fn the_machine_files_table_is_used_when_no_technology_is_given() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    std::fs::copy(
+        fixture("technology/fiber_3kw_example.json"),
+        dir.path().join("table.json"),
+    )
+    .expect("copy");
+    let mut machine: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(fixture("machines/gantry_ac.json")).expect("read"),
+    )
+    .expect("json");
+    machine["process"]["technology"] = "table.json".into();
+    let machine_path = dir.path().join("machine.json");
+    std::fs::write(&machine_path, machine.to_string()).expect("write");
+    let out = dir.path().join("out");
+    let r = common::kerf()
+        .args(["run"])
+        .arg(fixture("sheet_metal_holes.json"))
+        .arg("-m")
+        .arg(&machine_path)
+        .args(["--material", "stainless", "--thickness", "3", "-q", "-o"])
+        .arg(&out)
+        .output()
+        .expect("kerf runs");
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let report = common::read_json(&out.join("report.json"));
+    assert_eq!(report["technology"]["entry"], "stainless 3 mm N2");
+    assert_eq!(report["interpolation"]["feed_mm_per_min"], 4000.0);
+    // No table anywhere: --material is a usage error, nothing written.
+    let out2 = dir.path().join("out2");
+    let r = run(&["--material", "stainless"], &out2);
+    assert_eq!(
+        r.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    assert!(String::from_utf8_lossy(&r.stderr).contains("--material needs a technology table"));
+    assert!(!out2.exists());
+    // A table key that is not a file name is refused by its JSON path.
+    machine["process"]["technology"] = 3.into();
+    std::fs::write(&machine_path, machine.to_string()).expect("write");
+    let r = common::kerf()
+        .args(["run"])
+        .arg(fixture("sheet_metal_holes.json"))
+        .arg("-m")
+        .arg(&machine_path)
+        .args(["-q", "-o"])
+        .arg(dir.path().join("out3"))
+        .output()
+        .expect("kerf runs");
+    assert_eq!(r.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&r.stderr).contains("process.technology: expected a file name"),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+}

@@ -440,6 +440,7 @@ fn bad_process_codes_are_named_errors() {
         pierce_standoff: Some(0.0),
         kerf_width_mm: None,
         standoff_mm: None,
+        technology: None,
     });
     let text = gcode_motion(&m, &motion, &[], &opts).expect("gcode");
     // The synchronized M62 lights the pierce as the immediate M64 (else the dwell runs dark).

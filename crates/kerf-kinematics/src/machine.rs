@@ -118,6 +118,11 @@ pub struct Process {
     /// `[0, MAX_PIERCE_STANDOFF_MM]` (default [`DEFAULT_STANDOFF_MM`]): where the head model
     /// stands on each cutting pose when cuts are checked against the part.
     pub standoff_mm: Option<f64>,
+    /// A `kerf.technology/1` table for this machine, as a path relative to the machine
+    /// file's directory (one printable line of at most [`MAX_PROCESS_LINE_CHARS`]
+    /// characters): the table `kerf run --material NAME` picks from when no `--technology` is
+    /// given.
+    pub technology: Option<String>,
 }
 
 /// The nozzle's standoff above the surface while cutting when a machine file gives none, mm
@@ -241,13 +246,14 @@ fn system_variable_ok(var: &str) -> bool {
 
 impl Process {
     /// The keys of the `process` object.
-    pub const KEYS: [&'static str; 6] = [
+    pub const KEYS: [&'static str; 7] = [
         "beam_on",
         "beam_off",
         "pierce_dwell_s",
         "pierce_standoff",
         "kerf_width_mm",
         "standoff_mm",
+        "technology",
     ];
 
     /// Checks every present value.
@@ -257,6 +263,18 @@ impl Process {
     /// `process.pierce_dwell_s: must be finite and >= 0 (got -1)` or
     /// `process.beam_on[0]: must not be empty`.
     pub fn validate(&self) -> Result<()> {
+        if let Some(t) = &self.technology {
+            let chars = t.chars().count();
+            if t.trim().is_empty()
+                || chars > MAX_PROCESS_LINE_CHARS
+                || kerf_io::check_text(t).is_err()
+            {
+                return Err(KinematicsError::doc(
+                    "process.technology",
+                    format!("must be one printable line of 1 to {MAX_PROCESS_LINE_CHARS} characters naming a file"),
+                ));
+            }
+        }
         for (key, lines) in [("beam_on", &self.beam_on), ("beam_off", &self.beam_off)] {
             let Some(lines) = lines else { continue };
             if lines.is_empty() {
@@ -396,6 +414,16 @@ impl Process {
             pierce_standoff: number("pierce_standoff")?,
             kerf_width_mm: number("kerf_width_mm")?,
             standoff_mm: number("standoff_mm")?,
+            technology: match map.get("technology") {
+                None => None,
+                Some(Value::String(t)) => Some(t.clone()),
+                Some(other) => {
+                    return Err(KinematicsError::doc(
+                        "process.technology",
+                        format!("expected a file name, found {}", json_type_name(other)),
+                    ))
+                }
+            },
         };
         p.validate()?;
         Ok(p)
@@ -677,6 +705,9 @@ impl Machine {
             if let Some(v) = v {
                 process.push(format!("\"{key}\": {}", json(v)));
             }
+        }
+        if let Some(t) = &p.technology {
+            process.push(format!("\"technology\": {}", json(t)));
         }
         let process = if process.is_empty() {
             String::new()

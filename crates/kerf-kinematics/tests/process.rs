@@ -18,7 +18,7 @@ fn absent_process_is_empty_and_a_full_one_reads_back() {
     let m = Machine::from_str(&machine("")).expect("no process");
     assert!(m.process.is_empty());
     let m = Machine::from_str(&machine(
-        r#", "process": { "beam_on": ["M64 P0", "G4 P0.01"], "beam_off": ["M65 P0"], "pierce_dwell_s": 0.2, "pierce_standoff": 1.5, "kerf_width_mm": 0.15, "standoff_mm": 0.8 }"#,
+        r#", "process": { "beam_on": ["M64 P0", "G4 P0.01"], "beam_off": ["M65 P0"], "pierce_dwell_s": 0.2, "pierce_standoff": 1.5, "kerf_width_mm": 0.15, "standoff_mm": 0.8, "technology": "tables/fiber.json" }"#,
     ))
     .expect("full process");
     assert_eq!(
@@ -30,6 +30,7 @@ fn absent_process_is_empty_and_a_full_one_reads_back() {
             pierce_standoff: Some(1.5),
             kerf_width_mm: Some(0.15),
             standoff_mm: Some(0.8),
+            technology: Some("tables/fiber.json".into()),
         }
     );
     let back = Machine::from_str(&m.to_json()).expect("to_json reads back");
@@ -93,7 +94,7 @@ fn bad_process_values_are_named_errors() {
         (r#"{"beam_off": [5]}"#, "process.beam_off[0]: expected a string, found a number"),
         (r#"{"beam_on": ["M64 P0\nG0 X1400"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '\\n')"),
         (r#"{"beam_on": ["M3 (on)"]}"#, "process.beam_on[0]: must be one printable ASCII program line without comments (found '(')"),
-        (r#"{"beam_on": ["M3"], "dwell": 1}"#, "process.dwell: unknown key (known: beam_on, beam_off, pierce_dwell_s, pierce_standoff, kerf_width_mm, standoff_mm)"),
+        (r#"{"beam_on": ["M3"], "dwell": 1}"#, "process.dwell: unknown key (known: beam_on, beam_off, pierce_dwell_s, pierce_standoff, kerf_width_mm, standoff_mm, technology)"),
         (r#"["M3"]"#, "process: expected an object, found an array"),
         // The review's machine files: no motion, program end, o-word or tape mark can ride
         // in on a process line, and no absurd pierce.

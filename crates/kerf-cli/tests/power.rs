@@ -305,3 +305,121 @@ fn linuxcnc_cuts_set_pierce_floor_and_scale_with_the_small_hole_factor() {
         "outputs back to zero at the end"
     );
 }
+
+/// A technology's corner rule (`corner`: turns above 45 degrees, 2 mm each side, half the
+/// feed): in the set-points, the tip within 1.5 mm of path of a sharp vertex of the program's
+/// cuts never passes half the feed, while without the rule it passes faster there (the
+/// gantry brakes within 0.8 mm). The vertices come from the program's own blocks.
+#[test]
+fn the_corner_rule_slows_the_cut_near_sharp_vertices() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let table = dir.path().join("table.json");
+    let entry = |corner: &str| {
+        format!(
+            r#"{{"format": "kerf.technology/1", "entries": [{{"material": "steel", "thickness_mm": 2, "feed_mm_per_min": 6000, "power_percent": 80{corner}}}]}}"#
+        )
+    };
+    let near_corners = |corner: &str, tag: &str| -> (f64, usize) {
+        std::fs::write(&table, entry(corner)).expect("write");
+        let out = dir.path().join(tag);
+        let r = kerf()
+            .args(["run"])
+            .arg(fixture("sheet_metal_holes.json"))
+            .arg("-m")
+            .arg(fixture("machines/gantry_ac.json"))
+            .args(["--dialect", "generic", "--technology"])
+            .arg(&table)
+            .args(["--material", "steel", "-q", "-o"])
+            .arg(&out)
+            .output()
+            .expect("kerf runs");
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        // Sharp vertices of the cuts (machine X Y Z: the head stands upright, so they are
+        // the tip's, shifted).
+        let program = std::fs::read_to_string(out.join("program.nc")).expect("program");
+        let mut vertices: Vec<[f64; 3]> = Vec::new();
+        let (mut prev, mut dir_prev): (Option<[f64; 3]>, Option<[f64; 3]>) = (None, None);
+        for l in program.lines() {
+            let w: Vec<f64> = ['X', 'Y', 'Z'].iter().filter_map(|&n| word(l, n)).collect();
+            if w.len() != 3 {
+                continue;
+            }
+            let p = [w[0], w[1], w[2]];
+            if l.starts_with("G0") {
+                (prev, dir_prev) = (Some(p), None);
+                continue;
+            }
+            if let Some(a) = prev {
+                let d = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+                let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                if n > 0.0 && d[2] == 0.0 {
+                    if let Some(e) = dir_prev {
+                        let m = (e[0] * e[0] + e[1] * e[1]).sqrt();
+                        if (d[0] * e[0] + d[1] * e[1]) / (n * m) < 45f64.to_radians().cos() {
+                            vertices.push(a);
+                        }
+                    }
+                    dir_prev = Some(d);
+                } else if d[2] != 0.0 {
+                    dir_prev = None;
+                }
+            }
+            prev = Some(p);
+        }
+        assert!(vertices.len() >= 10, "{} sharp vertices", vertices.len());
+        let csv = std::fs::read_to_string(out.join("setpoints.csv")).expect("csv");
+        let rows: Vec<[f64; 3]> = csv
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let v: Vec<f64> = l.split(',').map(|x| x.parse().expect("number")).collect();
+                [v[1], v[2], v[3]]
+            })
+            .collect();
+        // Along the path: each vertex at the set-point nearest it (the path passes through it;
+        // elsewhere the same contour may pass within a millimetre, e.g. an overcut's exit
+        // beside the contour's start), then every cutting sample within 1.5 mm of path.
+        let mut along = vec![0.0];
+        for w in rows.windows(2) {
+            let d = ((w[1][0] - w[0][0]).powi(2)
+                + (w[1][1] - w[0][1]).powi(2)
+                + (w[1][2] - w[0][2]).powi(2))
+            .sqrt();
+            along.push(along[along.len() - 1] + d);
+        }
+        let mut top = 0.0f64;
+        let mut samples = 0;
+        for v in &vertices {
+            let i = (0..rows.len())
+                .min_by(|&a, &b| {
+                    let d = |k: usize| (0..3).map(|j| (rows[k][j] - v[j]).powi(2)).sum::<f64>();
+                    d(a).total_cmp(&d(b))
+                })
+                .expect("rows");
+            for j in 1..rows.len() {
+                if (along[j] - along[i]).abs() <= 1.5 && rows[j][2] == rows[j - 1][2] {
+                    let d = ((rows[j][0] - rows[j - 1][0]).powi(2)
+                        + (rows[j][1] - rows[j - 1][1]).powi(2))
+                    .sqrt();
+                    top = top.max(d / 0.001 * 60.0);
+                    samples += 1;
+                }
+            }
+        }
+        (top, samples)
+    };
+    let (with_rule, n) = near_corners(
+        r#", "corner": {"min_turn_deg": 45, "length_mm": 2, "feed_factor": 0.5}"#,
+        "rule",
+    );
+    assert!(n > 100, "{n} samples near corners");
+    assert!(
+        with_rule <= 0.5 * 6000.0 * 1.02,
+        "{with_rule} mm/min near a corner"
+    );
+    let (without, _) = near_corners("", "free");
+    assert!(
+        without > 0.6 * 6000.0,
+        "{without} mm/min near a corner without the rule"
+    );
+}

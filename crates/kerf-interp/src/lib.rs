@@ -86,8 +86,8 @@ pub use output::{
     CutterCompensation, Dialect, GcodeOptions, LaserPower, ProcessCodes,
 };
 pub use plan::{
-    link_paths, link_paths_through, link_paths_with_retract, plan, plan_owned, Cycles, Motion,
-    PathStats, PlanOptions, PlanWork,
+    link_paths, link_paths_through, link_paths_with_retract, plan, plan_owned, CornerSlowdown,
+    Cycles, Motion, PathStats, PlanOptions, PlanWork,
 };
 pub use plan::{ACCELERATION_MARGIN, JERK_CROSS_SHARE, JERK_FILTER_WIDTH, JERK_STATIC_SHARE};
 #[cfg(feature = "research")]

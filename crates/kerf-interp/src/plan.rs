@@ -77,6 +77,77 @@ pub(crate) const ROTATION_DOMINANCE: f64 = 5.0;
 /// most `0.98^60 * 0.9^420`, about `1e-20`.
 pub(crate) const REPAIR_ESCALATION: f64 = 0.9;
 
+/// The corner rule of a technology: within `length_mm` of the path parameter on either side of
+/// a point where the tip's direction turns by more than `min_turn_deg`, a cut runs at no more
+/// than `feed_factor` of its feed (the power, following the speed, comes down with it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CornerSlowdown {
+    /// The least turn of the tip's direction that makes a corner, degrees, in (0, 180).
+    pub min_turn_deg: f64,
+    /// How far on each side of the corner the slowdown reaches, mm of the path parameter
+    /// (the tip's travel where it dominates), > 0.
+    pub length_mm: f64,
+    /// The share of the feed there, in (0, 1].
+    pub feed_factor: f64,
+}
+
+/// The path parameters along `run` of the points where the tip turns by more than
+/// `min_turn_deg` between two cutting blocks of its path (turns in place between them skipped),
+/// including those in the path's neighbouring runs up to `reach` mm of tip travel beyond the
+/// run's ends (runs end where the motion has a corner of its own; a corner just past one still
+/// slows the run's end), there at parameters below 0 or past the run's length. Each block's
+/// direction near its ends comes from [`Block::pose_at`] 0.01 mm (or its length) in.
+fn corners(blocks: &[Block], run: &Run, min_turn_deg: f64, reach: f64) -> Vec<f64> {
+    let cos_max = min_turn_deg.to_radians().cos();
+    let path = blocks[run.first].path;
+    let same = |k: usize| blocks.get(k).is_some_and(|b| !b.rapid && b.path == path);
+    // The blocks within `reach` of tip travel before and after the run, with the parameter of
+    // each block's start.
+    let mut lo = run.first;
+    let mut before = 0.0;
+    while lo > 0 && same(lo - 1) && before <= reach {
+        lo -= 1;
+        before += blocks[lo].length();
+    }
+    let mut hi = run.last;
+    let mut after = 0.0;
+    while same(hi + 1) && after <= reach {
+        hi += 1;
+        after += blocks[hi].length();
+    }
+    let mut param = -before;
+    let mut out = Vec::new();
+    let mut last_dir: Option<nalgebra::Vector3<f64>> = None;
+    for (k, b) in blocks.iter().enumerate().take(hi + 1).skip(lo) {
+        let start = if (run.first..=run.last).contains(&k) {
+            run.starts[k - run.first]
+        } else if k > run.last {
+            run.len() + (param - run.len()).max(0.0)
+        } else {
+            param
+        };
+        param = if (run.first..=run.last).contains(&k) {
+            run.starts[k + 1 - run.first]
+        } else {
+            start + b.length()
+        };
+        if matches!(b.geometry, Geometry::Turn { .. }) || b.length() <= 0.0 {
+            continue;
+        }
+        let h = b.length().min(0.01);
+        let start_dir = b.pose_at(h).0 - b.start_tip();
+        if let Some(d) = last_dir {
+            let (n1, n2) = (d.norm(), start_dir.norm());
+            if n1 > 0.0 && n2 > 0.0 && d.dot(&start_dir) / (n1 * n2) < cos_max {
+                out.push(start);
+            }
+        }
+        last_dir = Some(b.end_tip() - b.pose_at(b.length() - h).0);
+    }
+    out.dedup();
+    out
+}
+
 /// Options of [`plan`].
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -119,6 +190,8 @@ pub struct PlanOptions {
     /// a small hole's feed factor from the technology's small-hole rule), each in (0, 1]; 1
     /// where missing. Default none.
     pub feed_factors: Vec<f64>,
+    /// Slow the tip at sharp corners of the cuts (a technology's corner rule). Default `None`.
+    pub corner_slowdown: Option<CornerSlowdown>,
     /// Test hook: the share of the velocity, acceleration and jerk limits the grid plans with
     /// (default 1). Above 1 the first plan breaks the limits on purpose, so that the tests can
     /// watch the verification repair it; the verification always checks the true limits.
@@ -130,6 +203,12 @@ impl PlanOptions {
     /// Sets [`feed_mm_per_min`](Self::feed_mm_per_min): programmed cutting feed, mm/min (the tip's speed along the path).
     pub fn with_feed_mm_per_min(mut self, feed_mm_per_min: f64) -> Self {
         self.feed_mm_per_min = feed_mm_per_min;
+        self
+    }
+
+    /// Sets [`corner_slowdown`](Self::corner_slowdown): the corner rule.
+    pub fn with_corner_slowdown(mut self, rule: Option<CornerSlowdown>) -> Self {
+        self.corner_slowdown = rule;
         self
     }
 
@@ -204,6 +283,7 @@ impl PlanOptions {
             max_grid_points: 5_000_000,
             blend_tolerance_mm: crate::DEFAULT_BLEND_TOLERANCE,
             feed_factors: Vec::new(),
+            corner_slowdown: None,
             planned_limit_scale: 1.0,
         }
     }
@@ -215,6 +295,17 @@ impl PlanOptions {
         positive("grid_step_mm", self.grid_step_mm)?;
         positive("planned_limit_scale", self.planned_limit_scale)?;
         crate::error::unit_factors("feed_factors", &self.feed_factors)?;
+        if let Some(c) = &self.corner_slowdown {
+            crate::error::unit_factors("corner_slowdown.feed_factor", &[c.feed_factor])?;
+            if !(c.min_turn_deg.is_finite() && c.min_turn_deg > 0.0 && c.min_turn_deg < 180.0) {
+                return Err(InterpError::BadParameter {
+                    name: "corner_slowdown.min_turn_deg",
+                    value: c.min_turn_deg,
+                    reason: "must lie in (0, 180) degrees",
+                });
+            }
+            positive("corner_slowdown.length_mm", c.length_mm)?;
+        }
         if !(self.blend_tolerance_mm >= 0.0 && self.blend_tolerance_mm.is_finite()) {
             return Err(InterpError::BadParameter {
                 name: "blend_tolerance_mm",
@@ -321,6 +412,13 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
             .iter()
             .filter_map(|b| opts.feed_factors.get(b.path).copied())
             .fold(1.0, f64::min);
+        if let (Some(rule), true) = (&opts.corner_slowdown, run.cutting) {
+            run.corners = (
+                corners(&blocks, run, rule.min_turn_deg, rule.length_mm),
+                rule.length_mm,
+                rule.feed_factor,
+            );
+        }
     }
     let total_len: f64 = runs.iter().map(Run::len).sum();
     // The work budget: a coarser grid for very long programs.

@@ -291,6 +291,9 @@ pub(crate) struct Run {
     /// The share of the programmed feed this run cuts at (a small hole's feed factor, the
     /// least of its paths' [`crate::PlanOptions::feed_factors`]; 1 otherwise).
     pub(crate) feed_factor: f64,
+    /// Where the tip turns sharply along the run (path parameters, sorted) and how far on
+    /// each side the corner rule slows it, with its factor: `(corners, half-width, factor)`.
+    pub(crate) corners: (Vec<f64>, f64, f64),
     /// The tip nodes' parameters (the planner's grid is refined from them).
     pub(crate) nodes: Vec<f64>,
     tip: Spline<3>,
@@ -303,6 +306,17 @@ pub(crate) struct Run {
 }
 
 impl Run {
+    /// The share of the feed at parameter `s`: the corner rule's factor within its half-width
+    /// of a corner, 1 elsewhere (the run's own [`Run::feed_factor`] comes on top).
+    pub(crate) fn corner_factor(&self, s: f64) -> f64 {
+        let (corners, half, factor) = &self.corners;
+        let i = corners.partition_point(|&c| c < s - half);
+        match corners.get(i) {
+            Some(&c) if c <= s + half => *factor,
+            _ => 1.0,
+        }
+    }
+
     /// Length of the run's path parameter (mm, degrees for a turn).
     pub(crate) fn len(&self) -> f64 {
         self.starts[self.starts.len() - 1]
@@ -827,6 +841,7 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         cutting: !run[0].rapid,
         moves_tip,
         feed_factor: 1.0,
+        corners: (Vec::new(), 0.0, 1.0),
         nodes: ts,
         tip,
         rot: Spline::clamped(rs, ry, r0, r1),

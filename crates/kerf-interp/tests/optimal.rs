@@ -509,3 +509,82 @@ fn a_feed_factor_plans_the_path_at_its_share_of_the_feed() {
         assert!(e.to_string().contains("feed_factors"), "{e}");
     }
 }
+
+/// The corner rule: a square (side 40 mm, started mid-edge) at 6000 mm/min on the gantry;
+/// within 2 mm of the path on each side of a corner the tip runs at no more than half the
+/// feed, mid-edge at the feed. Without the rule the tip passes 1.5 mm from a corner at more
+/// than 0.6 x the feed (the gantry brakes in 0.83 mm), so the rule is what slows it.
+#[test]
+fn the_corner_rule_slows_the_tip_near_sharp_corners_only() {
+    let m = gantry();
+    let pts: Vec<Point3<f64>> = [
+        (20., 0.),
+        (40., 0.),
+        (40., 40.),
+        (0., 40.),
+        (0., 0.),
+        (20., 0.),
+    ]
+    .iter()
+    .map(|&(x, y)| Point3::new(x, y, 0.0))
+    .collect();
+    let square =
+        kerf_nurbs::NurbsCurve::new(1, vec![0., 0., 0.2, 0.4, 0.6, 0.8, 1., 1.], pts, None);
+    let st = stations(&m, &square, 0.01, vertical);
+    let blocks = one_line_per_pose(&m, &st);
+    let feed = 6000.0;
+    let speeds_at = |rule: Option<kerf_interp::CornerSlowdown>| -> Vec<(f64, f64)> {
+        let opts = PlanOptions::new(feed, 0.001).with_corner_slowdown(rule);
+        let rows = plan(&m, &blocks, &opts).expect("plan").setpoints(&m);
+        let mut s = 0.0;
+        rows.windows(2)
+            .map(|w| {
+                let step = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
+                s += step;
+                (s, step / 0.001 * 60.0)
+            })
+            .collect()
+    };
+    let corner_gap = |s: f64| {
+        [20.0, 60.0, 100.0, 140.0]
+            .iter()
+            .map(|c| (s - c).abs())
+            .fold(f64::INFINITY, f64::min)
+    };
+    let rule = kerf_interp::CornerSlowdown {
+        min_turn_deg: 45.0,
+        length_mm: 2.0,
+        feed_factor: 0.5,
+    };
+    let slowed = speeds_at(Some(rule));
+    for &(s, v) in &slowed {
+        if corner_gap(s) <= 1.5 {
+            assert!(
+                v <= 0.5 * feed * 1.02,
+                "{v} mm/min at {s} mm, {} mm from a corner",
+                corner_gap(s)
+            );
+        }
+    }
+    assert!(
+        slowed
+            .iter()
+            .any(|&(s, v)| corner_gap(s) > 15.0 && v >= 0.99 * feed),
+        "mid-edge at the feed"
+    );
+    let free = speeds_at(None);
+    assert!(
+        free.iter()
+            .any(|&(s, v)| (corner_gap(s) - 1.5).abs() < 0.1 && v > 0.6 * feed),
+        "without the rule the tip passes near the corners faster"
+    );
+    let bad =
+        PlanOptions::new(feed, 0.001).with_corner_slowdown(Some(kerf_interp::CornerSlowdown {
+            min_turn_deg: 0.0,
+            ..rule
+        }));
+    assert!(
+        plan(&m, &blocks, &bad).is_err(),
+        "a turn of 0 degrees is no corner rule"
+    );
+}

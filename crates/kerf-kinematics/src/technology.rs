@@ -59,6 +59,19 @@ pub struct SmallHole {
     pub power_factor: f64,
 }
 
+/// The corner rule of an entry: near sharp corners the cut runs slower (the power, following
+/// the speed, comes down with it).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Corner {
+    /// The least turn of the path that makes a corner, degrees, in (0, 180).
+    pub min_turn_deg: f64,
+    /// How far on each side of the corner the cut runs slower, mm, in (0, 100].
+    pub length_mm: f64,
+    /// The share of the feed there, in (0, 1].
+    pub feed_factor: f64,
+}
+
 /// The micro-joints of an entry: the run's default for `--micro-joints`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -111,6 +124,9 @@ pub struct TechnologyEntry {
     /// Micro-joints the run leaves unless it names its own.
     #[serde(default)]
     pub micro_joints: Option<MicroJoints>,
+    /// The corner rule.
+    #[serde(default)]
+    pub corner: Option<Corner>,
 }
 
 impl TechnologyEntry {
@@ -197,6 +213,16 @@ impl TechnologyEntry {
                 false,
                 crate::MAX_PIERCE_STANDOFF_MM,
             )?;
+        }
+        if let Some(c) = &self.corner {
+            if !(c.min_turn_deg.is_finite() && c.min_turn_deg > 0.0 && c.min_turn_deg < 180.0) {
+                return bad(
+                    "corner.min_turn_deg",
+                    format!("must lie in (0, 180) (got {})", c.min_turn_deg),
+                );
+            }
+            within("corner.length_mm", c.length_mm, 0.0, true, 100.0)?;
+            within("corner.feed_factor", c.feed_factor, 0.0, true, 1.0)?;
         }
         if let Some(j) = &self.micro_joints {
             within("micro_joints.length_mm", j.length_mm, 0.0, true, 10.0)?;

@@ -649,7 +649,16 @@ fn run_placed(
         }
         let blocks = kerf_interp::link_paths_through(&model, fitted, &traverses, fit.retract_mm);
         drop(traverses);
-        let plan_k = plan.clone().with_feed_factors(feed_factors);
+        let plan_k = plan
+            .clone()
+            .with_feed_factors(feed_factors)
+            .with_corner_slowdown(o.technology.as_ref().and_then(|t| t.corner).map(|c| {
+                kerf_interp::CornerSlowdown {
+                    min_turn_deg: c.min_turn_deg,
+                    length_mm: c.length_mm,
+                    feed_factor: c.feed_factor,
+                }
+            }));
         let motion = kerf_interp::plan_owned(&model, blocks, &plan_k).map_err(interp(path))?;
         lap.split(&mut timings, "plan");
         let mut gopts_k = gopts
@@ -958,9 +967,10 @@ fn technology_json(
         "kerf_width_mm": t.kerf_width_mm,
         "pierce": t.pierce.map(|p| json!({ "time_s": p.time_s, "power_percent": p.power_percent, "height_mm": p.height_mm })),
         "small_hole": t.small_hole.map(|h| json!({ "max_diameter_mm": h.max_diameter_mm, "feed_factor": h.feed_factor, "power_factor": h.power_factor })),
+        "corner": t.corner.map(|c| json!({ "min_turn_deg": c.min_turn_deg, "length_mm": c.length_mm, "feed_factor": c.feed_factor })),
         "power_min_percent": t.power_min(),
         "small_holes": small_holes,
-        "note": "the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; its power is commanded following the tip speed (its power at its feed, down to power_min_percent), its pierce power at the pierce; holes within the small-hole rule run at its feed and power factors; gas and focus are stated, not commanded",
+        "note": "the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; its power is commanded following the tip speed (its power at its feed, down to power_min_percent), its pierce power at the pierce; holes within the small-hole rule run at its feed and power factors, corners within its corner rule at its feed factor; gas and focus are stated, not commanded",
     })
 }
 

@@ -256,7 +256,7 @@ pub(super) fn run_grid<M: AxisModel + ?Sized>(
         }
         if run.moves_tip && speed > 0.0 {
             if run.cutting {
-                x = x.min((feed / speed).powi(2));
+                x = x.min((feed * run.corner_factor(si) / speed).powi(2));
             }
             let kappa = t1.cross(&t2).norm() / speed.powi(3);
             if kappa > 1e-12 {

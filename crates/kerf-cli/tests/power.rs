@@ -286,8 +286,7 @@ fn linuxcnc_cuts_set_pierce_floor_and_scale_with_the_small_hole_factor() {
         let rest = &program[at..];
         let cut = &rest[..rest.find("M65 P0").expect("beam off")];
         let expect = format!(
-            "M68 E0 Q0\nM68 E1 Q60\nM64 P0\nG4 P0.4\nG64 P0.005 Q0\nM67 E1 Q20\nM67 E0 Q{}\n",
-            format!("{scale:.4}").trim_end_matches('0')
+            "M68 E0 Q0\nM68 E1 Q60\nM64 P0\nG4 P0.4\nG64 P0.005 Q0\nM67 E1 Q20\nM67 E0 Q{scale:.5}\n"
         );
         assert!(
             cut.contains(&expect),
@@ -422,4 +421,38 @@ fn the_corner_rule_slows_the_cut_near_sharp_vertices() {
         without > 0.6 * 6000.0,
         "{without} mm/min near a corner without the rule"
     );
+}
+
+/// The Sinumerik dialect writes Siemens' laser-power pattern (not executed here: no Sinumerik
+/// oracle): one synchronized action on the path velocity, per cut the pierce power as a flat
+/// polynomial and then the cut's slope `P_cut / v_cut` per mm/min with the floor, and the
+/// action cancelled at the end.
+#[test]
+fn sinumerik_writes_the_synchronized_power_action() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let program = flat_part("sinumerik", &dir.path().join("out"));
+    assert_eq!(
+        program
+            .matches("\nID=1 WHENEVER TRUE DO SYNFCT(1,$A_OUTA[1],$AC_VACTW)\n")
+            .count(),
+        1
+    );
+    let cuts = program.matches("\nM3\n").count();
+    assert_eq!(cuts, 8);
+    assert_eq!(
+        program.matches("\nFCTDEF(1,60,60,60,0)\nM3\n").count(),
+        cuts,
+        "pierce power"
+    );
+    // 100 % at 3500 mm/min: 0.0285714 % per mm/min (six significant digits); the holes at
+    // 0.7 of it.
+    assert_eq!(
+        program.matches("\nFCTDEF(1,20,100,0,0.0285714)\n").count(),
+        4
+    );
+    assert_eq!(
+        program.matches("\nFCTDEF(1,20,100,0,0.0200000)\n").count(),
+        4
+    );
+    assert!(program.contains("CANCEL(1)\nTRAFOOF\nM30"));
 }

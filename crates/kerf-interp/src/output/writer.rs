@@ -514,13 +514,13 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         let floor = power_number(p.min_percent.min(p.cut_percent * self.factor));
         match self.opts.dialect {
             Dialect::Linuxcnc => {
-                let k = power_number(p.per_mm_s(self.factor));
+                let k = feed_number(p.per_mm_s(self.factor));
                 self.line(&format!("M67 E1 Q{floor}"));
                 self.line(&format!("M67 E0 Q{k}"));
             }
             Dialect::Generic => {}
             Dialect::Sinumerik => {
-                let k = power_number(p.per_mm_s(self.factor) / 60.0);
+                let k = feed_number(p.per_mm_s(self.factor) / 60.0);
                 self.line(&format!("FCTDEF(1,{floor},100,0,{k})"));
             }
         }

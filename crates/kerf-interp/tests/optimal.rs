@@ -149,14 +149,18 @@ fn share_at_feed(rows: &[[f64; 5]], feed: f64, t: f64) -> f64 {
     at_feed / total
 }
 
+/// The 70 mm hole (upright tool) fitted as blocks on `m` at 0.01 mm.
+fn hole_70_blocks(m: &PaperAcHead) -> Vec<kerf_interp::Block> {
+    let c = circle(35.0, 0.0, 0.0, 0.0);
+    let st = stations(m, &c, 0.01, vertical);
+    let curve = |t: f64| c.point(t);
+    fit_blocks(m, &st, Some(&curve), 0, &FitOptions::with_tolerance(0.01)).expect("fit")
+}
+
 #[test]
 fn the_70_mm_hole_runs_at_the_programmed_feed_with_one_modal_f_word() {
     let m = gantry();
-    let c = circle(35.0, 0.0, 0.0, 0.0);
-    let st = stations(&m, &c, 0.01, vertical);
-    let curve = |t: f64| c.point(t);
-    let blocks =
-        fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::with_tolerance(0.01)).expect("fit");
+    let blocks = hole_70_blocks(&m);
     let feed = 20000.0;
     let motion = plan(&m, &blocks, &PlanOptions::new(feed, 0.001)).expect("plan");
     for (b, f) in motion.block_feeds().iter().enumerate() {
@@ -483,11 +487,7 @@ fn the_set_points_stay_within_the_proven_spline_bound_of_the_blocks() {
 #[test]
 fn a_feed_factor_plans_the_path_at_its_share_of_the_feed() {
     let m = gantry();
-    let c = circle(35.0, 0.0, 0.0, 0.0);
-    let st = stations(&m, &c, 0.01, vertical);
-    let curve = |t: f64| c.point(t);
-    let blocks =
-        fit_blocks(&m, &st, Some(&curve), 0, &FitOptions::with_tolerance(0.01)).expect("fit");
+    let blocks = hole_70_blocks(&m);
     let feed = 20000.0;
     let opts = PlanOptions::new(feed, 0.001).with_feed_factors(vec![0.5]);
     let motion = plan(&m, &blocks, &opts).expect("plan");

@@ -294,12 +294,7 @@ impl AxesFile {
     /// [`KinematicsError::Io`] if the file cannot be read, else the errors of
     /// [`AxesFile::from_slice`] wrapped in [`KinematicsError::File`] naming the file.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
-        let path = path.as_ref();
-        let bytes = crate::json::read(path)?;
-        Self::from_slice(&bytes).map_err(|error| KinematicsError::File {
-            file: path.display().to_string(),
-            error: Box::new(error),
-        })
+        crate::json::read_with(path.as_ref(), Self::from_slice)
     }
 
     /// Reads `kerf.axes/1` JSON text.

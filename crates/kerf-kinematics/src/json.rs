@@ -25,12 +25,18 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Value> {
     })
 }
 
-/// Reads the file at `path` (at most [`kerf_io::MAX_INPUT_BYTES`]).
-pub(crate) fn read(path: &Path) -> Result<Vec<u8>> {
-    kerf_io::read_file(path).map_err(|e| KinematicsError::Io {
+/// Reads the document at `path` (at most [`kerf_io::MAX_INPUT_BYTES`]) with `parse`: an
+/// unreadable file is [`KinematicsError::Io`], a parse error comes back wrapped in
+/// [`KinematicsError::File`] so that its message names the file.
+pub(crate) fn read_with<T>(path: &Path, parse: impl FnOnce(&[u8]) -> Result<T>) -> Result<T> {
+    let bytes = kerf_io::read_file(path).map_err(|e| KinematicsError::Io {
         file: path.display().to_string(),
         action: "read",
         source: e.into(),
+    })?;
+    parse(&bytes).map_err(|error| KinematicsError::File {
+        file: path.display().to_string(),
+        error: Box::new(error),
     })
 }
 

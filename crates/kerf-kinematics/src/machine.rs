@@ -562,12 +562,7 @@ impl Machine {
     /// [`Machine::from_str`] wrapped in [`KinematicsError::File`], so that the message names
     /// the file: `machine.json: limits.A: min 10 > max -10`.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
-        let path = path.as_ref();
-        let bytes = crate::json::read(path)?;
-        Self::from_slice(&bytes).map_err(|error| KinematicsError::File {
-            file: path.display().to_string(),
-            error: Box::new(error),
-        })
+        crate::json::read_with(path.as_ref(), Self::from_slice)
     }
 
     /// Reads a machine from `kerf.machine/1` JSON text.

@@ -267,12 +267,7 @@ impl Technology {
     /// [`Technology::from_slice`] wrapped in [`KinematicsError::File`] (the message names the
     /// file).
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
-        let path = path.as_ref();
-        let bytes = crate::json::read(path)?;
-        Self::from_slice(&bytes).map_err(|error| KinematicsError::File {
-            file: path.display().to_string(),
-            error: Box::new(error),
-        })
+        crate::json::read_with(path.as_ref(), Self::from_slice)
     }
 
     /// Reads a table from its JSON text.

@@ -696,19 +696,10 @@ pub(crate) fn traverse_report(
 /// look smaller by the gap between sampled points: a few hundredths of a millimetre on the
 /// holes the rule is for.
 pub(crate) fn small_holes(cuts: &[CutPath], plans: &SetupPlans, max_diameter_mm: f64) -> Vec<bool> {
-    let hole_curves: std::collections::HashSet<usize> = plans
-        .iter()
-        .flat_map(|(paths, plan)| {
-            paths
-                .iter()
-                .enumerate()
-                .filter(|&(k, _)| plan.closed[k] && plan.is_hole(k))
-                .map(|(_, &i)| i)
-        })
-        .collect();
+    let closed = closed_contours(plans);
     cuts.iter()
         .map(|c| {
-            if !hole_curves.contains(&c.curve) {
+            if closed.get(&c.curve) != Some(&true) {
                 return false;
             }
             let contour = &c.poses[c.counts[0]..c.counts[0] + c.counts[1]];
@@ -724,6 +715,20 @@ pub(crate) fn small_holes(cuts: &[CutPath], plans: &SetupPlans, max_diameter_mm:
             // A hole of exactly the rule's diameter is one (its points lie on the circle, a
             // rounding either way).
             d2.sqrt() <= max_diameter_mm + 1e-6
+        })
+        .collect()
+}
+
+/// The closed contours of the plans (curve index in the file) and whether each is a hole.
+fn closed_contours(plans: &SetupPlans) -> std::collections::HashMap<usize, bool> {
+    plans
+        .iter()
+        .flat_map(|(paths, plan)| {
+            paths
+                .iter()
+                .enumerate()
+                .filter(|&(k, _)| plan.closed[k])
+                .map(move |(k, &i)| (i, plan.is_hole(k)))
         })
         .collect()
 }
@@ -747,14 +752,7 @@ pub(crate) fn micro_joints(
     length_mm: f64,
     spacing_mm: f64,
 ) -> (Vec<Vec<[f64; 2]>>, Vec<String>) {
-    let mut kind: std::collections::HashMap<usize, bool> = std::collections::HashMap::new();
-    for (paths, plan) in plans {
-        for (k, &i) in paths.iter().enumerate() {
-            if plan.closed[k] {
-                kind.insert(i, plan.is_hole(k));
-            }
-        }
-    }
+    let kind = closed_contours(plans);
     let mut warnings = Vec::new();
     let joints = cuts
         .iter()

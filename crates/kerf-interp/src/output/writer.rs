@@ -49,27 +49,28 @@ pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
 
 impl<M: AxisModel + ?Sized> Writer<'_, M> {
     pub(super) fn line(&mut self, l: &str) {
-        if let Some(h) = self.held.take() {
-            self.s.push_str(&h);
-        }
+        self.release_held();
         self.s.push_str(l.trim_end());
         self.s.push('\n');
     }
 
-    /// Holds `l` back (see [`Writer::held`]), writing the line held before.
-    fn hold(&mut self, mut l: String) {
+    /// Writes the line held back, if any (see [`Writer::held`]).
+    fn release_held(&mut self) {
         if let Some(h) = self.held.take() {
             self.s.push_str(&h);
         }
+    }
+
+    /// Holds `l` back (see [`Writer::held`]), writing the line held before.
+    fn hold(&mut self, mut l: String) {
+        self.release_held();
         l.push('\n');
         self.held = Some(l);
     }
 
     /// The program text, every held line written.
     pub(super) fn finish(mut self) -> String {
-        if let Some(h) = self.held.take() {
-            self.s.push_str(&h);
-        }
+        self.release_held();
         self.s
     }
 

@@ -440,13 +440,13 @@ fn trim_param(
     let on_curve = |p: Point3<f64>| -> Result<f64> {
         let t = b.param_of(&p);
         let off = (b.point_at(t) - p).norm();
-        if off.is_finite() && off <= TRIM_POINT_TOLERANCE_MM {
+        if off.is_finite() && off <= ON_GEOMETRY_TOLERANCE_MM {
             Ok(t)
         } else {
             Err(err(
                 inst,
                 format!(
-                    "{what}: the trim point ({:.6}, {:.6}, {:.6}) lies {off:.6} mm off its curve (at most {TRIM_POINT_TOLERANCE_MM} mm)",
+                    "{what}: the trim point ({:.6}, {:.6}, {:.6}) lies {off:.6} mm off its curve (at most {ON_GEOMETRY_TOLERANCE_MM} mm)",
                     p.x, p.y, p.z
                 ),
             ))
@@ -463,9 +463,10 @@ fn trim_param(
     }
 }
 
-/// How far a trim given as a point may lie from its curve, mm: above the edge tolerances CAD
-/// files carry (0.01-0.07 mm), far below a point that belongs elsewhere.
-pub(crate) const TRIM_POINT_TOLERANCE_MM: f64 = 0.1;
+/// How far a point the file puts on a curve or a surface (a trim point on its curve, an edge
+/// on its face) may lie from it, mm: above the edge tolerances CAD files carry (0.01-0.07 mm),
+/// far below a point that belongs elsewhere.
+pub(crate) const ON_GEOMETRY_TOLERANCE_MM: f64 = 0.1;
 
 /// Any bounded curve entity as one NURBS curve per segment (a composite gives its segments,
 /// senses applied; others one). Full conics give the closed curve starting at angle 0.

@@ -7,7 +7,7 @@ use std::f64::consts::TAU;
 use kerf_nurbs::{NurbsCurve, NurbsSurface};
 use nalgebra::{Point3, Vector3};
 
-use crate::curves::{basis, oriented_piece, Basis};
+use crate::curves::{basis, oriented_piece, Basis, ON_GEOMETRY_TOLERANCE_MM};
 use crate::error::{Result, StepError};
 use crate::model::{boolean, err, name_of, refs, Charge, Model};
 use crate::parser::{Instance, Value};
@@ -202,6 +202,7 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         }
     }
     let mut surface = g.to_nurbs(inst, u, v)?;
+    edges_on_surface(m, inst, &surface, g.kind(), &loops, &edge_ids)?;
     if same_sense == flip {
         surface = reverse_u(&surface);
     }
@@ -213,6 +214,52 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         loops,
         edge_ids,
     })
+}
+
+/// Samples of each edge use checked against its face's surface.
+pub(crate) const EDGE_CHECK_SAMPLES: usize = 5;
+
+/// Every edge of a face lies on the face's surface, within [`ON_GEOMETRY_TOLERANCE_MM`]:
+/// [`EDGE_CHECK_SAMPLES`] points inside each edge use (the ends are vertices the neighbouring
+/// edges share) projected onto the surface.
+///
+/// A file whose edge runs off its face (an inconsistent wall, a face given the wrong plane)
+/// would otherwise get the face's parameter range from points that are not on it and its
+/// normal, which decides the scrap side of a cut, from the wrong place. The face is refused
+/// naming the edge and the distance (the caller skips it and says why).
+fn edges_on_surface(
+    m: &Model<'_>,
+    inst: &Instance,
+    surface: &NurbsSurface,
+    kind: &str,
+    loops: &[Vec<NurbsCurve>],
+    edge_ids: &[Vec<u64>],
+) -> Result<()> {
+    let uses: usize = loops.iter().map(Vec::len).sum();
+    m.charge(inst, Charge::FaceTests, uses * EDGE_CHECK_SAMPLES)?;
+    for (l, ids) in loops.iter().zip(edge_ids) {
+        for (e, id) in l.iter().zip(ids) {
+            let (a, b) = e.domain();
+            let mut warm = None;
+            for k in 0..EDGE_CHECK_SAMPLES {
+                let t = a + (b - a) * (k as f64 + 0.5) / EDGE_CHECK_SAMPLES as f64;
+                let q = e.point(t);
+                let pr = surface.closest_point(&q, warm);
+                warm = Some((pr.u, pr.v));
+                // NaN fails the comparison and is refused too.
+                if !(pr.distance <= ON_GEOMETRY_TOLERANCE_MM) {
+                    return Err(err(
+                        inst,
+                        format!(
+                            "edge #{id} lies {:.6} mm off the face's {kind} at ({:.6}, {:.6}, {:.6}) (at most {ON_GEOMETRY_TOLERANCE_MM} mm): the edge does not bound this face",
+                            pr.distance, q.x, q.y, q.z
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The same surface with u reversed: `Su x Sv` flips.

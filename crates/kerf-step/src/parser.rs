@@ -22,7 +22,7 @@ pub(crate) enum Value {
     Int(i64),
     /// A real.
     Real(f64),
-    /// A string, with `''` and the `\X2\...\X0\` escapes decoded.
+    /// A string, with `''` and the Part 21 escapes decoded (`decode_string`).
     Str(String),
     /// An enumeration value without its dots (`.T.` is `Enum("T")`).
     Enum(String),
@@ -628,29 +628,76 @@ impl Parser<'_> {
     }
 }
 
-/// Decodes the Part 21 string escapes; anything malformed is kept as written.
+/// Decodes the Part 21 string escapes (ISO 10303-21, 6.4.3); anything malformed is kept as
+/// written.
+///
+/// - `\\` is a backslash (`''`, a quote, is undone by the tokenizer);
+/// - `\X\hh` is the ISO 8859-1 character `hh`;
+/// - `\X2\hhhh...\X0\` is UTF-16 (UCS-2 in the standard), `\X4\hhhhhhhh...\X0\` UCS-4;
+/// - `\S\c` is the character `c` + 128 of the current code page, which `\PA\` to `\PI\`
+///   select (ISO 8859-1 to -9; `\PA\` at the start of every string). Page A is decoded
+///   exactly (the Latin-1 upper half is U+0080-U+00FF); an upper-half character of another
+///   page becomes U+FFFD: kerf reads strings for names in its reports only, and says so
+///   rather than guess a letter.
 fn decode_string(s: &str) -> String {
     if !s.contains('\\') {
         return s.to_owned();
     }
+    let hex_units = |hex: &str, width: usize| -> Option<Vec<u32>> {
+        if hex.len() % width != 0 {
+            return None;
+        }
+        (0..hex.len() / width)
+            .map(|j| u32::from_str_radix(hex.get(width * j..width * (j + 1))?, 16).ok())
+            .collect()
+    };
     let mut out = String::new();
     let mut rest = s;
+    let mut latin1 = true;
     while let Some(k) = rest.find('\\') {
         out.push_str(&rest[..k]);
         rest = &rest[k..];
         if let Some(body) = rest.strip_prefix("\\X2\\") {
             if let Some(end) = body.find("\\X0\\") {
-                let hex = &body[..end];
-                let units: Vec<u16> = (0..hex.len() / 4)
-                    .filter_map(|j| u16::from_str_radix(hex.get(4 * j..4 * j + 4)?, 16).ok())
-                    .collect();
-                out.push_str(&String::from_utf16_lossy(&units));
-                rest = &body[end + 4..];
-                continue;
+                if let Some(units) = hex_units(&body[..end], 4) {
+                    let units: Vec<u16> = units.into_iter().map(|u| u as u16).collect();
+                    out.push_str(&String::from_utf16_lossy(&units));
+                    rest = &body[end + 4..];
+                    continue;
+                }
+            }
+        } else if let Some(body) = rest.strip_prefix("\\X4\\") {
+            if let Some(end) = body.find("\\X0\\") {
+                if let Some(units) = hex_units(&body[..end], 8) {
+                    out.extend(
+                        units
+                            .into_iter()
+                            .map(|u| char::from_u32(u).unwrap_or(char::REPLACEMENT_CHARACTER)),
+                    );
+                    rest = &body[end + 4..];
+                    continue;
+                }
             }
         } else if let Some(body) = rest.strip_prefix("\\X\\") {
             if let Some(c) = body.get(..2).and_then(|h| u8::from_str_radix(h, 16).ok()) {
                 out.push(char::from(c));
+                rest = &body[2..];
+                continue;
+            }
+        } else if let Some(body) = rest.strip_prefix("\\S\\") {
+            if let Some(c) = body.chars().next().filter(|c| (' '..='~').contains(c)) {
+                out.push(if latin1 {
+                    char::from(c as u8 + 0x80)
+                } else {
+                    char::REPLACEMENT_CHARACTER
+                });
+                rest = &body[1..];
+                continue;
+            }
+        } else if let Some(body) = rest.strip_prefix("\\P") {
+            let page = body.as_bytes();
+            if page.len() >= 2 && (b'A'..=b'I').contains(&page[0]) && page[1] == b'\\' {
+                latin1 = page[0] == b'A';
                 rest = &body[2..];
                 continue;
             }
@@ -773,5 +820,21 @@ mod tests {
             "back\\slash",
             "double backslash"
         );
+        // \S\ adds 128 in the current page: 'M\S\|ller' is Müller in ISO 8859-1 (| is 0x7C,
+        // 0xFC is u-umlaut); the page is A until \P?\ changes it.
+        assert_eq!(decode_string("M\\S\\|ller"), "M\u{fc}ller", "S, page A");
+        assert_eq!(decode_string("\\PA\\M\\S\\|ller"), "M\u{fc}ller", "PA");
+        assert_eq!(
+            decode_string("\\PB\\\\S\\9"),
+            "\u{fffd}",
+            "another page: not guessed"
+        );
+        assert_eq!(decode_string("\\X4\\0001F600\\X0\\!"), "\u{1f600}!", "X4");
+        assert_eq!(
+            decode_string("\\X2\\00E900\\X0\\"),
+            "\\X2\\00E900\\X0\\",
+            "an odd X2 run is kept as written"
+        );
+        assert_eq!(decode_string("a\\S\\"), "a\\S\\", "S at the end, kept");
     }
 }

@@ -745,7 +745,8 @@ fn face_association_works_on_the_faces_a_contour_passes_within_a_budget() {
         im.file.curves[0].surface,
         Some(SurfaceRef::One("face #1730".into()))
     );
-    let boundary = 200 * 4 * 181; // EDGE_SAMPLES per edge use
+    // EDGE_SAMPLES (181) for the range and EDGE_CHECK_SAMPLES (5) on the surface, per edge use.
+    let boundary = 200 * 4 * (181 + 5);
     let projected = im.report.work.face_tests as usize - boundary;
     assert!(projected > 0 && projected <= 201, "{projected} projections");
     // A thousand faces over one plane and a thousand circles on it: each surface is projected
@@ -771,7 +772,7 @@ fn face_association_works_on_the_faces_a_contour_passes_within_a_budget() {
         .curves
         .iter()
         .all(|c| c.surface == Some(SurfaceRef::One("face #1030".into()))));
-    let projected = im.report.work.face_tests as usize - 1000 * 4 * 181;
+    let projected = im.report.work.face_tests as usize - 1000 * 4 * (181 + 5);
     assert!(projected <= 1000 * 201, "{projected} projections");
     // Eleven different faces over one another and a polyline of 62,500 spans (a million
     // samples) on them: 11 M projections, over the budget of 10 M: refused before any is made,
@@ -912,4 +913,46 @@ fn a_trim_point_off_its_curve_is_refused_by_name() {
             "{p}: {e}"
         );
     }
+}
+
+#[test]
+fn an_edge_off_its_face_gets_the_face_refused_by_name() {
+    // The plate's front wall (#298, the plane y = 0 through #277, normal -y) moved to y = 5
+    // while its edges stay at y = 0: its edges do not bound it. It was read, its parameter
+    // range taken from points off it; now the face is skipped naming an edge of it and the
+    // distance (5 mm, the move), and the sheet is not recognised with the wall missing. A move
+    // of 0.05 mm (a CAD edge tolerance) is accepted, and the plate is the plate.
+    let text = std::fs::read_to_string(fixture("sheet/plate.step")).expect("fixture");
+    let wall = "#277 = CARTESIAN_POINT('',(0.0,0.0,0.0));";
+    assert!(text.contains(wall), "the fixture's front wall origin");
+    let moved = |y: &str| text.replace(wall, &format!("#277 = CARTESIAN_POINT('',(0.0,{y},0.0));"));
+    let opts = ImportOptions::default().with_edges(None);
+    let im = import(&moved("5.0"), &opts).expect("the other faces are read");
+    let why = im
+        .report
+        .skipped
+        .iter()
+        .find(|s| s.starts_with("face #298 ADVANCED_FACE"))
+        .unwrap_or_else(|| panic!("the wall skipped: {:?}", im.report.skipped));
+    // #192 is the plate's bottom front edge, y = 0, z = 0: 5 mm from the moved plane.
+    assert!(
+        why.contains("edge #192 lies 5.000000 mm off the face's plane at (")
+            && why.contains(
+                ", 0.000000, 0.000000) (at most 0.1 mm): the edge does not bound this face"
+            ),
+        "{why}"
+    );
+    assert!(
+        im.report
+            .sheet
+            .as_ref()
+            .and_then(|s| s.not_a_sheet.as_ref())
+            .is_some(),
+        "no sheet without its wall: {:?}",
+        im.report.sheet
+    );
+    let im = import(&moved("0.05"), &opts).expect("within the tolerance");
+    let sheet = im.report.sheet.expect("ran");
+    assert_eq!(sheet.not_a_sheet, None, "0.05 mm off is a CAD tolerance");
+    assert_eq!(im.file.curves.len(), 2, "the outline and the hole");
 }

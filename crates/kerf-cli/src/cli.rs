@@ -393,6 +393,9 @@ pub(crate) enum DialectArg {
     Sinumerik,
     /// LinuxCNC (trivkins): machine axes, G93 inverse-time feed, G64 P blending on cuts.
     Linuxcnc,
+    /// LinuxCNC with its tool-tip kinematics (xyzac-trt-kins; table-table machines with
+    /// conventional false): tip X Y Z in the workpiece frame and A C, G94 tip feed.
+    LinuxcncTcp,
 }
 
 impl From<DialectArg> for kerf_interp::Dialect {
@@ -401,6 +404,7 @@ impl From<DialectArg> for kerf_interp::Dialect {
             DialectArg::Generic => Self::Generic,
             DialectArg::Sinumerik => Self::Sinumerik,
             DialectArg::Linuxcnc => Self::Linuxcnc,
+            DialectArg::LinuxcncTcp => Self::LinuxcncTcp,
         }
     }
 }

@@ -194,48 +194,12 @@ fn linuxcnc_coefficients_give_the_tip_speed(curves: &str, machine: &str, extra: 
         if program.contains(" B") { 'B' } else { 'A' },
         'C',
     ];
-    let mut e = [0.0f64; 8];
-    let mut prev: Option<[f64; 5]> = None;
-    let (mut checked, mut rotating, mut worst) = (0, 0, 0.0f64);
-    let mut in_cut = false;
-    for l in program.lines() {
-        if let Some(rest) = l.strip_prefix("M67 E").or_else(|| l.strip_prefix("M68 E")) {
-            let (n, v) = rest.split_once(" Q").expect("M67 E<n> Q<v>");
-            e[n.parse::<usize>().expect("n")] = v.parse().expect("value");
-            continue;
-        }
-        match l {
-            "M64 P0" => in_cut = true,
-            "M65 P0" => in_cut = false,
-            _ => {}
-        }
-        let Some(q) = axes(l, names) else { continue };
-        if let (Some(p), true, true) = (prev, in_cut, l.starts_with("G1")) {
-            let d: [f64; 5] = std::array::from_fn(|k| q[k] - p[k]);
-            // What HAL computes per unit of joint motion: |XYZ' + E2..4 t' + E5..7 C'|.
-            let hal = (0..3)
-                .map(|j| (d[j] + e[2 + j] * d[3] + e[5 + j] * d[4]).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            for end in [p, q] {
-                let exact = tip_rate(&m, &end, &d);
-                if exact < 1e-3 * d.iter().map(|v| v.abs()).sum::<f64>() {
-                    continue; // a turn in place: the tip stands (at the floor either way)
-                }
-                let err = (hal - exact).abs() / exact;
-                worst = worst.max(err);
-                assert!(
-                    err <= 0.031,
-                    "{curves} on {machine}: HAL's tip speed {hal} vs {exact} ({err}) at {l}"
-                );
-                checked += 1;
-            }
-            if d[3] != 0.0 || d[4] != 0.0 {
-                rotating += 1;
-            }
-        }
-        prev = Some(q);
-    }
+    let (checked, rotating, worst) = common::replay_power_coefficients(
+        &program,
+        |l| axes(l, names),
+        |end, d| tip_rate(&m, end, d),
+        0.031,
+    );
     assert!(
         rotating > 50,
         "{rotating} rotating blocks: the fixture must turn the head"

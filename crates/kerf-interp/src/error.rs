@@ -184,7 +184,7 @@ pub enum InterpError {
     /// `merge_lines` off for such dialects (`kerf_pipeline::fit_options` does), or use a
     /// dialect with tool-tip control (Sinumerik TRAORI).
     #[error(
-        "{dialect} programs give raw machine axes, but block {block} is {what}: fit the motion with arcs and merged lines off for this dialect"
+        "{dialect} programs join neighbouring poses only, but block {block} is {what}: fit the motion with arcs and merged lines off for this dialect"
     )]
     UncheckedBlock {
         /// The dialect's name.
@@ -193,6 +193,17 @@ pub enum InterpError {
         block: usize,
         /// `an arc` or `a line merged over N poses`.
         what: String,
+    },
+    /// The dialect programs the tool tip for a controller that runs its own kinematics, and
+    /// that controller has none that computes this machine as kerf does (or the model is not
+    /// a `kerf.machine/1` machine). Fix: the reason names the mismatch; use a joint-space
+    /// dialect for such a machine.
+    #[error("dialect {dialect}: {reason}")]
+    DialectMachine {
+        /// The dialect's name.
+        dialect: &'static str,
+        /// What does not match.
+        reason: String,
     },
 }
 

@@ -126,6 +126,18 @@ impl AxisModel for MachineModel {
             .forward(&Axes::new(0.0, 0.0, 0.0, tilt, c))
             .axis
     }
+
+    /// kerf-kinematics' forward kinematics.
+    fn tip(&self, q: &[f64; 5]) -> Point3<f64> {
+        self.machine
+            .kinematics
+            .forward(&Axes::from_array(*q))
+            .position
+    }
+
+    fn machine(&self) -> Option<&Machine> {
+        Some(&self.machine)
+    }
 }
 
 /// Stations from a path solved by kerf-kinematics (its continuity, ranges, pole handling and

@@ -121,6 +121,32 @@ pub trait AxisModel {
 
     /// The tool axis (unit, workpiece frame) when the rotary axes stand at `tilt` and `c`.
     fn tool_axis(&self, tilt: f64, c: f64) -> Vector3<f64>;
+
+    /// Forward kinematics: the tip (workpiece frame) when the axes stand at `q`.
+    ///
+    /// The default inverts [`AxisModel::linear_axes`]: for fixed rotary axes every rigid
+    /// five-axis machine places its linear axes as `XYZ = M tip + o` with `M` a rotation, so
+    /// `o` is the image of the origin, `M`'s columns the images of the unit vectors less `o`,
+    /// and `tip = M^T (XYZ - o)` (four calls). A model with its own forward kinematics should
+    /// say so.
+    fn tip(&self, q: &[f64; 5]) -> Point3<f64> {
+        let (tilt, c) = (q[3], q[4]);
+        let at = |p: Point3<f64>| Vector3::from(self.linear_axes(&p, tilt, c));
+        let o = at(Point3::origin());
+        let m = nalgebra::Matrix3::from_columns(&[
+            at(Point3::new(1.0, 0.0, 0.0)) - o,
+            at(Point3::new(0.0, 1.0, 0.0)) - o,
+            at(Point3::new(0.0, 0.0, 1.0)) - o,
+        ]);
+        Point3::from(m.transpose() * (Vector3::new(q[0], q[1], q[2]) - o))
+    }
+
+    /// The `kerf.machine/1` machine behind the model, if there is one: dialects for a
+    /// controller that runs its own kinematics ([`crate::Dialect::LinuxcncTcp`]) need its type
+    /// and parameters to name the controller's kinematics module. `None` by default.
+    fn machine(&self) -> Option<&kerf_kinematics::Machine> {
+        None
+    }
 }
 
 /// Paper 000's laser head (`kerf.machine/1` type `ac-head`): `u = Rz(C) Rx(A) ez`,

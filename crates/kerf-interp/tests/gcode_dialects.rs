@@ -258,6 +258,8 @@ fn headers_state_units_feed_budget_machine_and_process() {
             Dialect::Linuxcnc => "feed: G93 inverse time",
             Dialect::Generic => "NOT of the tool tip",
             Dialect::Sinumerik => "F in mm/min of the tool tip [TRAORI]",
+            // linuxcnc-tcp needs a kerf.machine/1 machine: crates/kerf-cli/tests/linuxcnc_tcp.rs.
+            other => unreachable!("{other:?} is not in DIALECTS"),
         };
         assert!(
             head.contains(feed),
@@ -285,6 +287,7 @@ fn headers_state_units_feed_budget_machine_and_process() {
                 }
             }
             Dialect::Generic => assert!(text.contains("G90 G94")),
+            other => unreachable!("{other:?} is not in DIALECTS"),
         }
     }
 }
@@ -339,6 +342,7 @@ fn feed_words_reproduce_the_planned_block_times() {
                     }
                     // Lines only here (the tip's chord); arcs are checked by length below.
                     Dialect::Sinumerik => 0.0,
+                    other => unreachable!("{other:?} is not in DIALECTS"),
                 };
             }
             prev = Some(q);

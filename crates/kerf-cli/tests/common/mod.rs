@@ -85,3 +85,59 @@ pub(crate) fn run_flat(extra: &[&str], out: &Path) -> std::process::Output {
         .output()
         .expect("kerf runs")
 }
+
+/// LinuxCNC's power coefficients replayed as the HAL of docs/process.md computes the tip
+/// speed (`|XYZ' + E2..4 tilt' + E5..7 C'|` per unit of joint motion), against `tip_rate(end,
+/// d)` (the true tip speed per unit of joint motion at `end` along `d`) at both ends of every
+/// cutting move of `program` (beam codes `M64 P0` / `M65 P0`): each within `tolerance`.
+/// `joints` turns a move line into the machine's joints (`None`: not a move). Returns the ends
+/// checked, the moves that turn a rotary axis, and the worst relative error.
+pub(crate) fn replay_power_coefficients(
+    program: &str,
+    joints: impl Fn(&str) -> Option<[f64; 5]>,
+    tip_rate: impl Fn(&[f64; 5], &[f64; 5]) -> f64,
+    tolerance: f64,
+) -> (usize, usize, f64) {
+    let mut e = [0.0f64; 8];
+    let mut prev: Option<[f64; 5]> = None;
+    let (mut checked, mut rotating, mut worst) = (0, 0, 0.0f64);
+    let mut in_cut = false;
+    for l in program.lines() {
+        if let Some(rest) = l.strip_prefix("M67 E").or_else(|| l.strip_prefix("M68 E")) {
+            let (n, v) = rest.split_once(" Q").expect("M67 E<n> Q<v>");
+            e[n.parse::<usize>().expect("n")] = v.parse().expect("value");
+            continue;
+        }
+        match l {
+            "M64 P0" => in_cut = true,
+            "M65 P0" => in_cut = false,
+            _ => {}
+        }
+        let Some(q) = joints(l) else { continue };
+        if let (Some(p), true, true) = (prev, in_cut, l.starts_with("G1")) {
+            let d: [f64; 5] = std::array::from_fn(|k| q[k] - p[k]);
+            let hal = (0..3)
+                .map(|j| (d[j] + e[2 + j] * d[3] + e[5 + j] * d[4]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            for end in [p, q] {
+                let exact = tip_rate(&end, &d);
+                if exact < 1e-3 * d.iter().map(|v| v.abs()).sum::<f64>() {
+                    continue; // a turn in place: the tip stands (at the floor either way)
+                }
+                let err = (hal - exact).abs() / exact;
+                worst = worst.max(err);
+                assert!(
+                    err <= tolerance,
+                    "HAL's tip speed {hal} vs {exact} ({err}) at {l}"
+                );
+                checked += 1;
+            }
+            if d[3] != 0.0 || d[4] != 0.0 {
+                rotating += 1;
+            }
+        }
+        prev = Some(q);
+    }
+    (checked, rotating, worst)
+}

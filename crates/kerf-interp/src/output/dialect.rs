@@ -4,6 +4,7 @@ use crate::error::{InterpError, Result};
 
 /// G-code dialect.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Dialect {
     /// `G1 X Y Z A C F` with machine axis values, `G94` feed of the machine axes
     /// (RS274/NGC rule), `;` comments, `M30`.
@@ -14,6 +15,11 @@ pub enum Dialect {
     /// LinuxCNC (trivkins, the machine's axis letters): inverse-time feed `G93`, `G64 P` on
     /// cuts and `G61` on rapids, `( ... )` comments, `M2`.
     Linuxcnc,
+    /// LinuxCNC with its own tool-tip kinematics (`xyzac-trt-kins` for a `table-table`
+    /// machine, see [`linuxcnc_kinematics`](crate::linuxcnc_kinematics)): `X Y Z` the tool
+    /// tip in the workpiece frame and the rotary axes, `G94` with `F` the tip's feed in
+    /// mm/min, `G64 P` on cuts and `G61` on rapids, `( ... )` comments, `M2`.
+    LinuxcncTcp,
 }
 
 impl Dialect {
@@ -23,11 +29,27 @@ impl Dialect {
             Dialect::Generic => "generic",
             Dialect::Sinumerik => "sinumerik",
             Dialect::Linuxcnc => "linuxcnc",
+            Dialect::LinuxcncTcp => "linuxcnc-tcp",
         }
     }
 
-    /// True for the dialects that program the raw machine axes (a controller that interpolates
-    /// the axes linearly between blocks: no arcs may be fitted for them).
+    /// True for LinuxCNC's dialects (joint space and tool tip): `( ... )` comments, the
+    /// `M62`-`M65` outputs, `G64 P`/`G61`, `M67`/`M68` power, `M2`.
+    pub fn linuxcnc(self) -> bool {
+        matches!(self, Dialect::Linuxcnc | Dialect::LinuxcncTcp)
+    }
+
+    /// True for the dialects whose `X Y Z` are the tool tip in the workpiece frame (the
+    /// controller runs the kinematics).
+    pub fn tool_tip(self) -> bool {
+        matches!(self, Dialect::Sinumerik | Dialect::LinuxcncTcp)
+    }
+
+    /// True for the dialects whose blocks join neighbouring poses only: no arcs, no lines
+    /// merged over several poses. The raw-axis dialects (the controller interpolates the axes
+    /// linearly, so only the poses' checked non-linearity holds) and `linuxcnc-tcp` (LinuxCNC
+    /// interpolates its rotary axes linearly in each block, so a merged line would carry the
+    /// tool axis off the poses between its ends; it writes no 3D arcs).
     pub fn raw_axes(self) -> bool {
         !matches!(self, Dialect::Sinumerik)
     }
@@ -36,7 +58,7 @@ impl Dialect {
     ///
     /// | dialect | beam on | beam off | dwell | standoff |
     /// |---|---|---|---|---|
-    /// | linuxcnc | `M64 P0` | `M65 P0` | 0.2 s | 1.5 mm |
+    /// | linuxcnc, linuxcnc-tcp | `M64 P0` | `M65 P0` | 0.2 s | 1.5 mm |
     /// | generic | `M3` | `M5` | 0.2 s | 1.5 mm |
     /// | sinumerik | `M3` | `M5` | 0.2 s | 1.5 mm |
     ///
@@ -49,7 +71,7 @@ impl Dialect {
     /// synchronized `M63`/`M62`.)
     pub fn default_process(self) -> ProcessCodes {
         let (on, off) = match self {
-            Dialect::Linuxcnc => ("M64 P0", "M65 P0"),
+            Dialect::Linuxcnc | Dialect::LinuxcncTcp => ("M64 P0", "M65 P0"),
             Dialect::Generic | Dialect::Sinumerik => ("M3", "M5"),
         };
         ProcessCodes {
@@ -66,7 +88,7 @@ impl Dialect {
     pub(super) fn comment(self, text: &str) -> String {
         let text = escape(text, usize::MAX);
         match self {
-            Dialect::Linuxcnc => format!("({text})"),
+            Dialect::Linuxcnc | Dialect::LinuxcncTcp => format!("({text})"),
             Dialect::Generic | Dialect::Sinumerik => format!("; {text}"),
         }
     }

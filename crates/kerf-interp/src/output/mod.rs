@@ -7,6 +7,12 @@
 //!   block's planned time in seconds), `G64 P<q> Q0` with `q` the budget's controller-blending
 //!   term on cuts, exact path (`G61`) on rapids, the safe preamble `G17 G21 G40 G49 G54 G80 G90`,
 //!   `( ... )` comments, `M2` at the end.
+//! - **LinuxCNC tool tip** ([`Dialect::LinuxcncTcp`]): for a configuration whose kinematics
+//!   module computes the machine ([`linuxcnc_kinematics`], named in the header with its HAL
+//!   parameters): `X Y Z` the tool tip in the workpiece frame with the rotary axes, `G94` with
+//!   `F` the tip's mean planned speed of the block in mm/min (deg/min of the rotary motion on a
+//!   block where the tip stands), `G64 P<q> Q0` on cuts, `G61` on rapids, each rapid split so
+//!   that its tip follows kerf's joint-space traverse within [`RAPID_TCP_TOLERANCE_MM`].
 //! - **Generic** ([`Dialect::Generic`]): raw machine axes, `G94` feed in the RS274/NGC sense:
 //!   `F` is mm/min of the combined X Y Z machine-axis motion (deg/min of the combined rotary
 //!   motion on blocks without X Y Z motion), chosen so that each block takes its planned time.
@@ -35,11 +41,15 @@ use crate::DEFAULT_BLEND_TOLERANCE;
 
 mod csv;
 mod dialect;
+mod linuxcnc_tcp;
 mod power;
 mod writer;
 
 pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};
 pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
+pub use linuxcnc_tcp::{
+    linuxcnc_kinematics, LinuxcncKinematics, RAPID_TCP_MAX_PIECES, RAPID_TCP_TOLERANCE_MM,
+};
 pub use power::LaserPower;
 use writer::Writer;
 
@@ -426,7 +436,9 @@ fn out_of_range<M: AxisModel + ?Sized>(model: &M, q: &[f64; 5]) -> Option<(Strin
 /// gives the raw machine axes ([`Dialect::raw_axes`]); [`InterpError::PierceOutOfRange`] for a
 /// pierce point (the standoff above a cut's start) outside an axis range;
 /// [`InterpError::RetractOutOfRange`] for the retract that ends a program whose last block is
-/// a cut (so that a beam-off synchronized with motion fires) outside an axis range.
+/// a cut (so that a beam-off synchronized with motion fires) outside an axis range;
+/// [`InterpError::DialectMachine`] for [`Dialect::LinuxcncTcp`] on a machine no LinuxCNC
+/// kinematics module computes ([`linuxcnc_kinematics`]).
 pub fn gcode_timed<M: AxisModel + ?Sized>(
     model: &M,
     blocks: &[Block],
@@ -438,6 +450,15 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     positive("chord_tolerance_mm", opts.chord_tolerance_mm)?;
     positive("blend_tolerance_mm", opts.blend_tolerance_mm)?;
     refuse_unchecked_blocks(blocks, opts.dialect)?;
+    let tcp = match opts.dialect {
+        Dialect::LinuxcncTcp => Some(
+            linuxcnc_kinematics(model.machine().ok_or_else(|| InterpError::DialectMachine {
+                dialect: "linuxcnc-tcp",
+                reason: "the program needs a kerf.machine/1 machine to name LinuxCNC's kinematics module".to_string(),
+            })?)?,
+        ),
+        _ => None,
+    };
     if opts.dialect != Dialect::Linuxcnc && opts.cutter_compensation.iter().any(Option::is_some) {
         return Err(InterpError::BadParameter {
             name: "cutter_compensation",
@@ -474,6 +495,8 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         joint_codes,
         joints: Vec::new(),
         path_s: 0.0,
+        tcp,
+        last_axes: None,
     };
     w.header(blocks);
     let mut last_path = usize::MAX;
@@ -544,7 +567,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     }
     w.power_off();
     match opts.dialect {
-        Dialect::Linuxcnc => w.line("M2"),
+        Dialect::Linuxcnc | Dialect::LinuxcncTcp => w.line("M2"),
         Dialect::Generic => w.line("M30"),
         Dialect::Sinumerik => {
             w.line("TRAFOOF");

@@ -19,8 +19,9 @@ pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
     pub(super) names: [&'a str; 5],
     pub(super) d: usize,
     pub(super) s: String,
-    /// The axis words last written (raw-axis dialects), as printed, for feed and zero-move
-    /// decisions on the values the controller reads.
+    /// The numbers last written as the controller reads them, for feed and zero-move
+    /// decisions: the axis words (raw-axis dialects), or the tip's `X Y Z` and the rotary axes
+    /// (`linuxcnc-tcp`).
     pub(super) last: Option<[f64; 5]>,
     pub(super) in_cut: bool,
     /// True while the controller's cutter compensation is on (`G41.1`/`G42.1` written).
@@ -45,6 +46,11 @@ pub(super) struct Writer<'a, M: AxisModel + ?Sized> {
     pub(super) joints: Vec<[f64; 2]>,
     /// The tip travel of the path being cut so far, mm.
     pub(super) path_s: f64,
+    /// LinuxCNC's kinematics module for the machine ([`Dialect::LinuxcncTcp`] only).
+    pub(super) tcp: Option<super::LinuxcncKinematics>,
+    /// The machine axes where the last move ended (`linuxcnc-tcp`: the start of the next
+    /// rapid's joint-space path).
+    pub(super) last_axes: Option<[f64; 5]>,
 }
 
 impl<M: AxisModel + ?Sized> Writer<'_, M> {
@@ -150,6 +156,17 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 ),
                 "arcs written as G1 chords",
             ),
+            Dialect::LinuxcncTcp => (
+                format!(
+                    "kerf LinuxCNC tool-tip program: X Y Z the tool tip in the workpiece frame, {} {} the rotary axes",
+                    n[3], n[4]
+                ),
+                format!(
+                    "feed: G94, F in mm/min of the tool tip [the kinematics' world X Y Z], the block's mean planned speed;\nfeed: on blocks where the tip stands F is deg/min of the rotary motion;\nfeed: rapids G0 in exact path G61, split so that the tip follows kerf's joint-space traverse within {} mm",
+                    super::RAPID_TCP_TOLERANCE_MM
+                ),
+                "arcs written as G1 chords",
+            ),
             Dialect::Sinumerik => (
                 "kerf Sinumerik-style program: TRAORI, tool tip X Y Z and orientation vector A3 B3 C3 in workpiece coordinates".to_string(),
                 "feed: G94, F in mm/min of the tool tip (TRAORI), the block's mean planned speed".to_string(),
@@ -159,6 +176,15 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         self.comment(&title);
         let machine = format!("machine: {}", comment_text(self.model.name()));
         self.comment(&machine);
+        if let Some(k) = self.tcp.clone() {
+            self.comment(&format!(
+                "kinematics: LinuxCNC [KINS] KINEMATICS = {}, [TRAJ] COORDINATES = {}, its tool-tip kinematics active [switchkins type 0]",
+                k.module, k.coordinates
+            ));
+            for l in k.setp_lines() {
+                self.comment(&format!("kinematics: {l}"));
+            }
+        }
         if let Some(src) = &o.source {
             self.comment(&format!("source: {}", comment_text(src)));
         }
@@ -231,6 +257,10 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 self.line("G93");
                 self.line("G61");
             }
+            Dialect::LinuxcncTcp => {
+                self.line("G17 G21 G40 G49 G54 G80 G90 G94");
+                self.line("G61");
+            }
             Dialect::Generic => self.line("G17 G21 G40 G90 G94"),
             Dialect::Sinumerik => {
                 self.line("G17 G71 G90 G94 G40");
@@ -268,10 +298,93 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
     ) {
         let l = match self.opts.dialect {
             Dialect::Sinumerik => format!("G0 {}", self.tip_words(&p, &u)),
+            Dialect::LinuxcncTcp => {
+                // LinuxCNC moves the tip straight between G0 ends: pieces along the
+                // joint-space traverse kerf checked, the last ending exactly at `p`.
+                let pieces = match self.last_axes {
+                    Some(from) => super::linuxcnc_tcp::rapid_pieces(self.model, &from, &q),
+                    None => vec![q],
+                };
+                let n = pieces.len();
+                for (i, a) in pieces.into_iter().enumerate() {
+                    let tip = if i + 1 == n { p } else { self.model.tip(&a) };
+                    let l = format!("G0 {}", self.tcp_words(&tip, a[3], a[4]));
+                    self.line(&l);
+                }
+                self.last = Some(self.printed(&[p.x, p.y, p.z, q[3], q[4]]));
+                self.last_axes = Some(q);
+                return;
+            }
             _ => format!("G0 {}", self.axis_words(&q)),
         };
         self.line(&l);
         self.last = Some(self.printed(&q));
+        self.last_axes = Some(q);
+    }
+
+    /// The words of a `linuxcnc-tcp` position: the tip `X Y Z` and the rotary axes.
+    fn tcp_words(&self, tip: &nalgebra::Point3<f64>, tilt: f64, c: f64) -> String {
+        let n = &self.names;
+        format!(
+            "X{} Y{} Z{} {}{} {}{}",
+            self.num(tip.x),
+            self.num(tip.y),
+            self.num(tip.z),
+            n[3],
+            self.num(tilt),
+            n[4],
+            self.num(c)
+        )
+    }
+
+    /// One `linuxcnc-tcp` `G1` to the tip `tip` with the axes `q`, taking `t` seconds: `F` the
+    /// tip's speed in mm/min (deg/min of the rotary motion where the printed tip stands, the
+    /// RS274/NGC rule); nothing if the printed words do not change.
+    fn tcp_move(&mut self, tip: nalgebra::Point3<f64>, q: [f64; 5], t: f64) {
+        let now = self.printed(&[tip.x, tip.y, tip.z, q[3], q[4]]);
+        let prev = self.last.unwrap_or(now);
+        let from = self.last_axes.replace(q);
+        if prev == now {
+            return;
+        }
+        let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
+        let lin = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let len = if lin > 0.0 {
+            lin
+        } else {
+            (d[3] * d[3] + d[4] * d[4]).sqrt()
+        };
+        // The feed is the same on every piece: the pieces split the move evenly in time.
+        let f = feed_number(len / t * 60.0);
+        match (self.opts.power.is_some() && self.in_cut, from) {
+            // The controller computes the tip's speed from its joints as for the joint-space
+            // dialect (module docs of `power`): the same coefficients, the move in pieces of
+            // its own tip line.
+            (true, Some(from)) => {
+                let words = |w: &Self, f: f64| -> String {
+                    let p: [f64; 5] = std::array::from_fn(|k| prev[k] + f * d[k]);
+                    w.tcp_words(&nalgebra::Point3::new(p[0], p[1], p[2]), p[3], p[4])
+                };
+                self.powered_pieces(
+                    &self.printed(&from),
+                    &self.printed(&q),
+                    |w, fr, _| {
+                        let end = if fr == 1.0 {
+                            w.tcp_words(&tip, q[3], q[4])
+                        } else {
+                            words(w, fr)
+                        };
+                        format!("G1 {end} F{f}")
+                    },
+                    t,
+                );
+            }
+            _ => {
+                let l = format!("G1 {} F{f}", self.tcp_words(&tip, q[3], q[4]));
+                self.line(&l);
+            }
+        }
+        self.last = Some(now);
     }
 
     /// Rapid to the pierce point of the cut starting with `b`, beam on, dwell, descent.
@@ -284,8 +397,8 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         for l in self.process.beam_on.clone() {
             // The pierce is lit at once: a synchronized `M62` would wait for the next move and
             // the dwell would run dark.
-            let l = match (self.opts.dialect, digital_output(&l)) {
-                (Dialect::Linuxcnc, Some((62, p))) => format!("M64 P{p}"),
+            let l = match digital_output(&l) {
+                Some((62, p)) if self.opts.dialect.linuxcnc() => format!("M64 P{p}"),
                 _ => l,
             };
             self.line(&l);
@@ -299,7 +412,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
             self.line(&l);
         }
         match self.opts.dialect {
-            Dialect::Linuxcnc => {
+            Dialect::Linuxcnc | Dialect::LinuxcncTcp => {
                 let l = format!("G64 P{} Q0", self.opts.blend_tolerance_mm);
                 self.line(&l);
             }
@@ -317,6 +430,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     self.line(&l);
                     self.last_f = Some(f);
                 }
+                Dialect::LinuxcncTcp => self.tcp_move(start, b.start_axes, t),
                 _ => self.raw_move(b.start_axes, t, h),
             }
         }
@@ -352,7 +466,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
             self.line(&l);
         }
         match self.opts.dialect {
-            Dialect::Linuxcnc => self.line("G61"),
+            Dialect::Linuxcnc | Dialect::LinuxcncTcp => self.line("G61"),
             Dialect::Sinumerik => self.line("G60"),
             Dialect::Generic => {}
         }
@@ -386,34 +500,22 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                 // `power`): the rotary coefficients go with the block where stale ones would
                 // misjudge its tip travel by more than POWER_STEP.
                 Dialect::Linuxcnc if !self.compensating => {
-                    let pieces = super::power::pieces(self.model, &prev, &qp);
-                    let mut f0 = 0.0;
-                    for (i, &(f1, coeffs)) in pieces.iter().enumerate() {
-                        let a: [f64; 5] = std::array::from_fn(|k| prev[k] + f0 * (qp[k] - prev[k]));
-                        let b: [f64; 5] = if i + 1 == pieces.len() {
-                            qp
-                        } else {
-                            self.printed(&std::array::from_fn(|k| prev[k] + f1 * (qp[k] - prev[k])))
-                        };
-                        self.write_coefficients(&a, &b, coeffs);
-                        let last = i + 1 == pieces.len();
-                        let (end, dt) = if last {
-                            (q, t * (1.0 - f0))
-                        } else {
-                            (b, t * (f1 - f0))
-                        };
-                        let l = format!("G1 {} F{}", self.axis_words(&end), feed_number(60.0 / dt));
-                        if qp[3] == prev[3] && qp[4] == prev[4] {
-                            self.hold(l);
-                        } else {
-                            self.line(&l);
-                        }
-                        if last {
-                            self.last = Some(qp);
-                            return;
-                        }
-                        f0 = f1;
-                    }
+                    self.powered_pieces(
+                        &prev,
+                        &qp,
+                        |w, f, dt| {
+                            let end = if f == 1.0 {
+                                q
+                            } else {
+                                w.printed(&std::array::from_fn(|k| prev[k] + f * (qp[k] - prev[k])))
+                            };
+                            format!("G1 {} F{}", w.axis_words(&end), feed_number(60.0 / dt))
+                        },
+                        t,
+                    );
+                    self.last = Some(qp);
+                    self.last_axes = Some(q);
+                    return;
                 }
                 Dialect::Generic => {
                     let p = power.at_speed(tip_mm / t * 60.0, self.factor);
@@ -427,6 +529,37 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         let l = format!("G1 {} F{}{s_word}", self.axis_words(&q), feed_number(f));
         self.line(&l);
         self.last = Some(qp);
+        self.last_axes = Some(q);
+    }
+
+    /// A powered LinuxCNC move from the axes `a` to `b` (as printed) taking `t` seconds, as
+    /// [`super::power::pieces`] splits it (up to [`super::power::MAX_POWER_PIECES`] pieces of
+    /// the same motion): before each piece its rotary coefficients where they changed, then the
+    /// line `line(writer, f, dt)` that moves to fraction `f` of the move (1 for the last piece)
+    /// in `dt` seconds; a move whose rotary axes stand still is held back (see
+    /// [`Writer::held`]).
+    fn powered_pieces(
+        &mut self,
+        a: &[f64; 5],
+        b: &[f64; 5],
+        line: impl Fn(&Self, f64, f64) -> String,
+        t: f64,
+    ) {
+        let pieces = super::power::pieces(self.model, a, b);
+        let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| a[k] + f * (b[k] - a[k])) };
+        let mut f0 = 0.0;
+        for (i, &(f1, coeffs)) in pieces.iter().enumerate() {
+            let f1 = if i + 1 == pieces.len() { 1.0 } else { f1 };
+            let (qa, qb) = (at(f0), if f1 == 1.0 { *b } else { self.printed(&at(f1)) });
+            self.write_coefficients(&qa, &qb, coeffs);
+            let l = line(self, f1, t * (f1 - f0));
+            if a[3] == b[3] && a[4] == b[4] {
+                self.hold(l);
+            } else {
+                self.line(&l);
+            }
+            f0 = f1;
+        }
     }
 
     /// LinuxCNC's rotary coefficients `coeffs` for the piece from `a` to `b`, written where
@@ -473,7 +606,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
             p.cut_percent, p.reference_feed_mm_per_min, p.min_percent, p.pierce_percent
         ));
         match self.opts.dialect {
-            Dialect::Linuxcnc => {
+            Dialect::Linuxcnc | Dialect::LinuxcncTcp => {
                 self.comment("power: HAL power = clamp[E0 x tip speed in mm/s, E1, 100], E0 = % per mm/s, E1 = floor [M68 E1 = pierce power]");
                 self.comment("power: HAL tip speed = |d[X,Y,Z]/dt + [E2,E3,E4] d[tilt]/dt + [E5,E6,E7] dC/dt|, rotary rates in deg/s");
                 self.comment("power: E2..E7 mm/deg, set with M67 [synchronized with the next block] where the rotary axes move");
@@ -490,7 +623,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         };
         let pierce = power_number(p.pierce_percent.min(100.0));
         match self.opts.dialect {
-            Dialect::Linuxcnc => {
+            Dialect::Linuxcnc | Dialect::LinuxcncTcp => {
                 self.line("M68 E0 Q0");
                 self.line(&format!("M68 E1 Q{pierce}"));
                 if self.coeffs != [0.0; 6] {
@@ -514,7 +647,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
         };
         let floor = power_number(p.min_percent.min(p.cut_percent * self.factor));
         match self.opts.dialect {
-            Dialect::Linuxcnc => {
+            Dialect::Linuxcnc | Dialect::LinuxcncTcp => {
                 let k = feed_number(p.per_mm_s(self.factor));
                 self.line(&format!("M67 E1 Q{floor}"));
                 self.line(&format!("M67 E0 Q{k}"));
@@ -533,7 +666,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
             return;
         }
         match self.opts.dialect {
-            Dialect::Linuxcnc => {
+            Dialect::Linuxcnc | Dialect::LinuxcncTcp => {
                 for j in 0..8 {
                     self.line(&format!("M68 E{j} Q0"));
                 }
@@ -546,7 +679,7 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
     /// The cutting block `b`, taking `t` seconds.
     pub(super) fn cut(&mut self, b: &Block, t: f64) {
         match self.opts.dialect {
-            Dialect::Generic | Dialect::Linuxcnc => {
+            Dialect::Generic | Dialect::Linuxcnc | Dialect::LinuxcncTcp => {
                 // Arcs become chords within the chord tolerance (eq 18), the block's time
                 // shared in proportion to the path parameter.
                 let mut ends = Vec::new();
@@ -588,7 +721,11 @@ impl<M: AxisModel + ?Sized> Writer<'_, M> {
                     } else {
                         1.0
                     };
-                    self.raw_move(q, t * share, if turn { 0.0 } else { s - s0 });
+                    if self.opts.dialect == Dialect::LinuxcncTcp {
+                        self.tcp_move(b.pose_at(s).0, q, t * share);
+                    } else {
+                        self.raw_move(q, t * share, if turn { 0.0 } else { s - s0 });
+                    }
                     for &(_, on) in switches.iter().filter(|w| w.0 == s) {
                         self.joint_switch(on);
                     }
@@ -662,7 +799,7 @@ pub(super) fn joint_codes(
     match opts.dialect {
         Dialect::Sinumerik => refuse("micro-joints are written for the linuxcnc and generic dialects (the Sinumerik dialect's arcs and merged lines are not split)"),
         Dialect::Generic => Ok((process.beam_off.clone(), process.beam_on.clone())),
-        Dialect::Linuxcnc => {
+        Dialect::Linuxcnc | Dialect::LinuxcncTcp => {
             let map = |lines: &[String], m: u32| -> Option<Vec<String>> {
                 lines
                     .iter()

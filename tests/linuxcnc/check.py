@@ -31,10 +31,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
-MACHINES = ["ac_head", "gantry_ac", "fork_head", "table_table", "head_table", "xyzac_trt"]
+MACHINES = ["ac_head", "gantry_ac", "fork_head", "table_table", "head_table", "xyzac_trt",
+            "bc_head_5axiskins"]
 # Issue 30: the machines whose tool-tip programs (`linuxcnc-tcp`) LinuxCNC runs with its own
 # kinematics module (docs/linuxcnc.md, "Tool-tip programs").
-TCP_MACHINES = ["xyzac_trt"]
+TCP_MACHINES = ["xyzac_trt", "bc_head_5axiskins"]
 # (fixture, machine, flat, more `kerf run` arguments, cuts to run or None for all): the flat
 # part must run within 10 % of kerf's predicted time. The real propeller (placed by `--place
 # auto`, blade edges at up to 112 degrees of tilt) runs its first cuts only: all 47 take LinuxCNC
@@ -355,11 +356,29 @@ def simulate_kerf(kerf, measure, outdir):
 TCP_SIMS = [
     ("dome", "xyzac_trt", TECH_TILTED),
     ("trim_panel", "xyzac_trt", ("--place", "auto", "--tilt-tolerance", "1")),
+    ("tube_saddle", "bc_head_5axiskins", TECH_TILTED),
 ]
-# The negative control: kerf's machine file with the A axis this much (mm) farther above the C
-# table than the controller's; kerf's tip from LinuxCNC's joints then leaves the path by
-# 2 sin(A/2) of it (A 26-53 degrees on the dome: 0.045-0.089 mm, above its 0.021 mm budget).
+# The negative controls: kerf's machine file with a pivot offset this much (mm) off the
+# controller's. The table: the A axis farther above the C table; kerf's tip from LinuxCNC's
+# joints then leaves the path by 2 sin(A/2) of it (A 26-53 degrees on the dome: 0.045-0.089 mm,
+# above its 0.021 mm budget). The head: a longer pivot (L and d together), off by up to
+# 2 sin(B/2) of it (B to 90 degrees on the saddle: 0.14 mm).
 WRONG_PIVOT_MM = 0.1
+
+
+def longer_table_pivot(kin):
+    kin["z_offset"] += WRONG_PIVOT_MM
+
+
+def longer_head_pivot(kin):
+    kin["L"] += WRONG_PIVOT_MM
+    kin["d"][2] += WRONG_PIVOT_MM
+
+
+NEGATIVE_CONTROLS = [
+    ("dome", "xyzac_trt", TECH_TILTED, longer_table_pivot, "z_offset"),
+    ("tube_saddle", "bc_head_5axiskins", TECH_TILTED, longer_head_pivot, "pivot L"),
+]
 
 
 def simulate_tcp(kerf, measure, outdir):
@@ -373,26 +392,26 @@ def simulate_tcp(kerf, measure, outdir):
             print(f"sim {fixture} on {machine}: LinuxCNC's time / kerf's plan {tcp['time_ratio']:.3f} "
                   f"as a tool-tip program, {joint['time_ratio']:.3f} in joint space", flush=True)
         figs += [f for f in (joint, tcp) if f]
-    fixture, machine, extra = TCP_SIMS[0]
-    m = json.loads(machine_file(machine).read_text())
-    m["kinematics"]["z_offset"] += WRONG_PIVOT_MM
-    wrong = outdir / f"{machine}-z-offset-{WRONG_PIVOT_MM}-off.json"
-    wrong.write_text(json.dumps(m))
-    collecting = []
-    try:
-        fig = simulate(kerf, measure, fixture, machine, False, outdir, tag="-tcp-wrong-pivot",
-                       extra=extra, dialect="linuxcnc-tcp", kerf_machine=wrong)
-    finally:
-        caught, collecting = collecting, None
-    name = f"negative control: {fixture} with kerf's z_offset {WRONG_PIVOT_MM} mm off the controller's"
-    if not any("tip deviation" in c or "from the designed curve" in c for c in caught):
-        fail(f"{name}: the tool-tip check did not notice ({caught})")
-    else:
-        tip = next(c for c in caught if "tip deviation" in c or "from the designed curve" in c)
-        print(f"{name}: the check fails as it must ({len(caught)} assertion(s): {tip})", flush=True)
-    if fig:
-        fig["expected_failures"] = caught
-        figs.append(fig)
+    for fixture, machine, extra, edit, what in NEGATIVE_CONTROLS:
+        m = json.loads(machine_file(machine).read_text())
+        edit(m["kinematics"])
+        wrong = outdir / f"{machine}-pivot-{WRONG_PIVOT_MM}-off.json"
+        wrong.write_text(json.dumps(m))
+        collecting = []
+        try:
+            fig = simulate(kerf, measure, fixture, machine, False, outdir, tag="-tcp-wrong-pivot",
+                           extra=extra, dialect="linuxcnc-tcp", kerf_machine=wrong)
+        finally:
+            caught, collecting = collecting, None
+        name = f"negative control: {fixture} on {machine} with kerf's {what} {WRONG_PIVOT_MM} mm off the controller's"
+        tip = [c for c in caught if "tip deviation" in c or "from the designed curve" in c]
+        if not tip:
+            fail(f"{name}: the tool-tip check did not notice ({caught})")
+        else:
+            print(f"{name}: the check fails as it must ({len(caught)} assertion(s): {tip[0]})", flush=True)
+        if fig:
+            fig["expected_failures"] = caught
+            figs.append(fig)
     return figs
 
 

@@ -393,8 +393,9 @@ pub(crate) enum DialectArg {
     Sinumerik,
     /// LinuxCNC (trivkins): machine axes, G93 inverse-time feed, G64 P blending on cuts.
     Linuxcnc,
-    /// LinuxCNC with its tool-tip kinematics (xyzac-trt-kins; table-table machines with
-    /// conventional false): tip X Y Z in the workpiece frame and A C, G94 tip feed.
+    /// LinuxCNC with its own tool-tip kinematics (xyzac-trt-kins for a table-table with
+    /// conventional false, 5axiskins for a B fork head with tilt_sign -1): tip X Y Z in the
+    /// workpiece frame and the rotary axes, G94 tip feed.
     LinuxcncTcp,
 }
 

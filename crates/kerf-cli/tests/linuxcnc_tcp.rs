@@ -58,6 +58,72 @@ fn lcnc_inverse(w: &[f64; 5]) -> [f64; 5] {
     ]
 }
 
+/// `fixtures/machines/bc_head_5axiskins.json`'s `5axiskins.pivot-length`.
+const PIVOT: f64 = 210.0;
+
+/// 5axiskins' forward kinematics (`src/emc/kinematics/5axiskins.c`, the W joint at 0):
+/// `world = J + (0, 0, L) + s2r(L, C, 180 - B)`, `s2r(r, t, p) = r (sin p cos t, sin p sin t,
+/// cos p)`.
+fn five_forward(j: &[f64; 5]) -> [f64; 3] {
+    let (t, p) = (j[4].to_radians(), (180.0 - j[3]).to_radians());
+    [
+        j[0] + PIVOT * p.sin() * t.cos(),
+        j[1] + PIVOT * p.sin() * t.sin(),
+        j[2] + PIVOT + PIVOT * p.cos(),
+    ]
+}
+
+/// 5axiskins' inverse kinematics: `J = world - (0, 0, L) - s2r(L, C, 180 - B)`.
+fn five_inverse(w: &[f64; 5]) -> [f64; 5] {
+    let (t, p) = (w[4].to_radians(), (180.0 - w[3]).to_radians());
+    [
+        w[0] - PIVOT * p.sin() * t.cos(),
+        w[1] - PIVOT * p.sin() * t.sin(),
+        w[2] - PIVOT - PIVOT * p.cos(),
+        w[3],
+        w[4],
+    ]
+}
+
+/// A LinuxCNC tool-tip module with the shipped machine that matches it and the fixture its
+/// program is tested on.
+struct Module {
+    machine: &'static str,
+    fixture: &'static str,
+    tilt: char,
+    forward: fn(&[f64; 5]) -> [f64; 3],
+    inverse: fn(&[f64; 5]) -> [f64; 5],
+    header: &'static [&'static str],
+}
+
+const TRT: Module = Module {
+    machine: "machines/xyzac_trt.json",
+    fixture: "dome.json",
+    tilt: 'A',
+    forward: lcnc_forward,
+    inverse: lcnc_inverse,
+    header: &[
+        "(kinematics: LinuxCNC [KINS] KINEMATICS = xyzac-trt-kins, [TRAJ] COORDINATES = XYZAC",
+        "(kinematics: setp xyzac-trt-kins.x-rot-point 3)",
+        "(kinematics: setp xyzac-trt-kins.y-rot-point -2)",
+        "(kinematics: setp xyzac-trt-kins.y-offset 5)",
+        "(kinematics: setp xyzac-trt-kins.z-offset 80)",
+        "(kinematics: setp xyzac-trt-kins.tool-offset 0)",
+    ],
+};
+
+const FIVE_AXIS: Module = Module {
+    machine: "machines/bc_head_5axiskins.json",
+    fixture: "tube_saddle.json",
+    tilt: 'B',
+    forward: five_forward,
+    inverse: five_inverse,
+    header: &[
+        "(kinematics: LinuxCNC [KINS] KINEMATICS = 5axiskins, [TRAJ] COORDINATES = XYZBCW",
+        "(kinematics: setp 5axiskins.pivot-length 210)",
+    ],
+};
+
 fn machine() -> Machine {
     Machine::read(fixture("machines/xyzac_trt.json")).expect("machine")
 }
@@ -97,6 +163,41 @@ fn kerfs_table_table_with_conventional_false_is_linuxcncs_xyzac_trt() {
     assert!(worst < 1e-9, "kerf vs LinuxCNC forward: {worst} mm");
 }
 
+#[test]
+fn kerfs_fork_head_with_tilt_sign_minus_one_is_linuxcncs_5axiskins() {
+    let m = Machine::read(fixture(FIVE_AXIS.machine)).expect("machine");
+    for i in 0..9 {
+        for k in 0..9 {
+            let j = [
+                -700.0 + 173.0 * i as f64,
+                310.0 - 61.0 * k as f64,
+                -40.0 + 23.0 * (i + k) as f64,
+                -120.0 + 29.0 * i as f64,
+                -400.0 + 97.0 * k as f64,
+            ];
+            let pose = m.kinematics.forward(&Axes::from_array(j));
+            let w = five_forward(&j);
+            assert!(
+                (pose.position - Point3::from(w)).norm() < 1e-9,
+                "{j:?}: kerf {} vs 5axiskins {w:?}",
+                pose.position
+            );
+            // The tool axis runs from the tip to LinuxCNC's pivot, J + (0, 0, L).
+            let pivot = Point3::new(j[0], j[1], j[2] + PIVOT);
+            let u = (pivot - Point3::from(w)) / PIVOT;
+            assert!(
+                (pose.axis - u).norm() < 1e-12,
+                "{j:?}: axis {} vs {u}",
+                pose.axis
+            );
+            let back = five_inverse(&[w[0], w[1], w[2], j[3], j[4]]);
+            for n in 0..5 {
+                assert!((back[n] - j[n]).abs() < 1e-9, "{j:?}: inverse {back:?}");
+            }
+        }
+    }
+}
+
 /// The number after `letter` in a block (`X-1.5` -> -1.5).
 fn word(line: &str, letter: char) -> Option<f64> {
     line.split_whitespace()
@@ -104,14 +205,23 @@ fn word(line: &str, letter: char) -> Option<f64> {
         .map(|w| w[1..].parse().expect("number"))
 }
 
-fn words5(line: &str) -> [f64; 5] {
-    ['X', 'Y', 'Z', 'A', 'C'].map(|l| word(line, l).unwrap_or_else(|| panic!("{l} in {line}")))
+fn words5(line: &str, tilt: char) -> [f64; 5] {
+    ['X', 'Y', 'Z', tilt, 'C'].map(|l| word(line, l).unwrap_or_else(|| panic!("{l} in {line}")))
 }
 
 fn run(dialect: &str, machine: &str, out: &std::path::Path) -> std::process::Output {
+    run_fixture("dome.json", dialect, machine, out)
+}
+
+fn run_fixture(
+    curves: &str,
+    dialect: &str,
+    machine: &str,
+    out: &std::path::Path,
+) -> std::process::Output {
     kerf()
         .args(["run"])
-        .arg(fixture("dome.json"))
+        .arg(fixture(curves))
         .arg("-m")
         .arg(fixture(machine))
         .args(["--dialect", dialect, "-q", "-o"])
@@ -120,27 +230,26 @@ fn run(dialect: &str, machine: &str, out: &std::path::Path) -> std::process::Out
         .expect("kerf runs")
 }
 
-fn program(dialect: &str) -> String {
+fn program(m: &Module, dialect: &str) -> String {
     let dir = tempfile::tempdir().expect("tmp");
-    let r = run(dialect, "machines/xyzac_trt.json", dir.path());
+    let r = run_fixture(m.fixture, dialect, m.machine, dir.path());
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     std::fs::read_to_string(dir.path().join("program.nc")).expect("program")
 }
 
 #[test]
 fn a_tool_tip_program_through_linuxcncs_inverse_is_kerfs_joint_program() {
-    let tcp = program("linuxcnc-tcp");
-    let joint = program("linuxcnc");
+    for m in [TRT, FIVE_AXIS] {
+        tool_tip_program_is_the_joint_program(&m);
+    }
+}
+
+fn tool_tip_program_is_the_joint_program(m: &Module) {
+    let tcp = program(m, "linuxcnc-tcp");
+    let joint = program(m, "linuxcnc");
     // The header names the module and its pins with the machine file's numbers.
-    for l in [
-        "(kinematics: LinuxCNC [KINS] KINEMATICS = xyzac-trt-kins, [TRAJ] COORDINATES = XYZAC",
-        "(kinematics: setp xyzac-trt-kins.x-rot-point 3)",
-        "(kinematics: setp xyzac-trt-kins.y-rot-point -2)",
-        "(kinematics: setp xyzac-trt-kins.y-offset 5)",
-        "(kinematics: setp xyzac-trt-kins.z-offset 80)",
-        "(kinematics: setp xyzac-trt-kins.tool-offset 0)",
-    ] {
-        assert!(tcp.contains(l), "header line {l}");
+    for l in m.header {
+        assert!(tcp.contains(l), "{}: header line {l}", m.machine);
     }
     assert!(
         tcp.contains("\nG94\n") || tcp.contains("G90 G94\n"),
@@ -180,9 +289,9 @@ fn a_tool_tip_program_through_linuxcncs_inverse_is_kerfs_joint_program() {
             prev = None;
             continue;
         }
-        let w = words5(lt);
-        let q = words5(lj);
-        let from_lcnc = lcnc_inverse(&w);
+        let w = words5(lt, m.tilt);
+        let q = words5(lj, m.tilt);
+        let from_lcnc = (m.inverse)(&w);
         for n in 0..5 {
             worst = worst.max((from_lcnc[n] - q[n]).abs());
         }
@@ -211,12 +320,18 @@ fn a_tool_tip_program_through_linuxcncs_inverse_is_kerfs_joint_program() {
 
 #[test]
 fn tool_tip_rapids_follow_kerfs_joint_space_traverses() {
-    let tcp = program("linuxcnc-tcp");
-    let joint = program("linuxcnc");
+    for m in [TRT, FIVE_AXIS] {
+        tool_tip_rapids_follow_the_traverses(&m);
+    }
+}
+
+fn tool_tip_rapids_follow_the_traverses(m: &Module) {
+    let tcp = program(m, "linuxcnc-tcp");
+    let joint = program(m, "linuxcnc");
     let rapids = |p: &str| -> Vec<[f64; 5]> {
         p.lines()
             .filter(|l| l.starts_with("G0 "))
-            .map(words5)
+            .map(|l| words5(l, m.tilt))
             .collect()
     };
     let (t, j) = (rapids(&tcp), rapids(&joint));
@@ -230,7 +345,7 @@ fn tool_tip_rapids_follow_kerfs_joint_space_traverses() {
     for q in &j {
         assert!(
             t.iter().any(|w| {
-                let back = lcnc_inverse(w);
+                let back = (m.inverse)(w);
                 (0..5).all(|n| (back[n] - q[n]).abs() < 2e-5)
             }),
             "joint-space G0 target {q:?} missing"
@@ -246,10 +361,10 @@ fn tool_tip_rapids_follow_kerfs_joint_space_traverses() {
             continue;
         }
         pieces += 1;
-        let (a, b) = (words5(w[0]), words5(w[1]));
-        let (ja, jb) = (lcnc_inverse(&a), lcnc_inverse(&b));
+        let (a, b) = (words5(w[0], m.tilt), words5(w[1], m.tilt));
+        let (ja, jb) = ((m.inverse)(&a), (m.inverse)(&b));
         let jm: [f64; 5] = std::array::from_fn(|n| 0.5 * (ja[n] + jb[n]));
-        let on_traverse = lcnc_forward(&jm);
+        let on_traverse = (m.forward)(&jm);
         let chord_mid = [0, 1, 2].map(|n| 0.5 * (a[n] + b[n]));
         let d = (0..3)
             .map(|n| (on_traverse[n] - chord_mid[n]).powi(2))
@@ -275,6 +390,10 @@ fn machines_linuxcnc_has_no_tool_tip_kinematics_for_are_refused_by_name() {
             "machines/table_table.json",
             "dialect linuxcnc-tcp: kinematics.conventional is true",
         ),
+        (
+            "machines/fork_head.json",
+            "dialect linuxcnc-tcp: fork-head for LinuxCNC's 5axiskins: kinematics.tilt_sign is +1",
+        ),
     ] {
         let dir = tempfile::tempdir().expect("tmp");
         let out = dir.path().join("out");
@@ -294,6 +413,35 @@ fn machines_linuxcnc_has_no_tool_tip_kinematics_for_are_refused_by_name() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("kinematics.tool_offset is 10"), "{e}");
+    // A fork head turning B the 5axiskins way whose pivot is not straight above the joints'
+    // point, or whose nozzle sits beside the axis, is not 5axiskins either.
+    let mut m = machine();
+    for (d, lateral, says) in [
+        (
+            [0.0, 35.0, -120.0],
+            [0.0, 0.0],
+            "kinematics.d is [0.0, 35.0, -120.0]",
+        ),
+        (
+            [0.0, 0.0, 210.0],
+            [2.0, 0.0],
+            "kinematics.tool_lateral is [2.0, 0.0]",
+        ),
+    ] {
+        let head = kerf_kinematics::ForkHead::try_new(
+            kerf_kinematics::ForkTilt::B,
+            210.0,
+            Vector3::from(d),
+            lateral,
+        )
+        .and_then(|h| h.with_tilt_sign(-1.0))
+        .expect("fork head");
+        m.kinematics = std::sync::Arc::new(head);
+        let e = kerf_interp::linuxcnc_kinematics(&m)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(says), "{e}");
+    }
     let k = kerf_interp::linuxcnc_kinematics(&machine()).expect("xyzac-trt");
     assert_eq!(k.module, "xyzac-trt-kins");
     assert_eq!(
@@ -354,7 +502,7 @@ fn tool_tip_power_coefficients_give_the_tip_speed_from_linuxcncs_joints() {
     let program = std::fs::read_to_string(dir.path().join("program.nc")).expect("program");
     let (checked, rotating, _) = common::replay_power_coefficients(
         &program,
-        |l| (l.starts_with("G0 ") || l.starts_with("G1 ")).then(|| lcnc_inverse(&words5(l))),
+        |l| (l.starts_with("G0 ") || l.starts_with("G1 ")).then(|| lcnc_inverse(&words5(l, 'A'))),
         |end, d| {
             let h = 1e-4;
             let at =

@@ -1,9 +1,10 @@
 //! `fork-head`: the double swing head of paper 002 (C primary, A or B tilting).
 //!
-//! `u = Rz(C) R_tilt(t) ez`, `P = XYZ + Rz(C) (d + R_tilt(t) (tx, ty, -L))`: the machine's
+//! `u = Rz(C) R_tilt(s t) ez`, `P = XYZ + Rz(C) (d + R_tilt(s t) (tx, ty, -L))`: the machine's
 //! X, Y, Z is the C axis' reference point; `d` goes from it (in the C-rotated frame) to the
 //! tilt axis, and the tool tip sits `L` below the tilt axis, shifted sideways by
-//! `tool_lateral = (tx, ty)`.
+//! `tool_lateral = (tx, ty)`; `s` is the optional `tilt_sign` (+1 by default, -1 for a tilt
+//! that turns the other way, as LinuxCNC's `5axiskins` B).
 //!
 //! Inverse: the tilt and C from the tool axis (as for every type), then
 //! `XYZ = P - Rz(C) (d + R_tilt(t) (tx, ty, -L))`.
@@ -35,12 +36,10 @@ pub(crate) const TYPE: KinematicsType = KinematicsType {
         let l = p.number("L")?;
         let d = p.numbers::<3>("d")?;
         let lateral = p.numbers::<2>("tool_lateral")?;
-        Ok(Arc::new(ForkHead::try_new(
-            tilt,
-            l,
-            Vector3::from(d),
-            lateral,
-        )?))
+        let tilt_sign = p.optional_number("tilt_sign")?.unwrap_or(1.0);
+        Ok(Arc::new(
+            ForkHead::try_new(tilt, l, Vector3::from(d), lateral)?.with_tilt_sign(tilt_sign)?,
+        ))
     },
 };
 
@@ -97,7 +96,24 @@ impl ForkHead {
         })
     }
 
-    /// `Rz(C) (d + R_tilt(t) (tx, ty, -L))`: from X, Y, Z to the tip.
+    /// The same head with its tilt turning the other way for `sign` -1 (`tilt_sign`: `u =
+    /// Rz(C) R_tilt(-t) ez`); +1 is the default.
+    ///
+    /// # Errors
+    /// [`crate::KinematicsError::Document`] naming `kinematics.tilt_sign` unless `sign` is +1
+    /// or -1.
+    pub fn with_tilt_sign(mut self, sign: f64) -> Result<Self> {
+        crate::params::sign("tilt_sign", sign)?;
+        self.orientation.tilt_sign = sign;
+        Ok(self)
+    }
+
+    /// The tilt's direction sign (`tilt_sign`, +1 or -1).
+    pub fn tilt_sign(&self) -> f64 {
+        self.orientation.tilt_sign
+    }
+
+    /// `Rz(C) (d + R_tilt(s t) (tx, ty, -L))`: from X, Y, Z to the tip.
     #[inline]
     fn offset(&self, s: &Angles) -> Vector3<f64> {
         let tool = Vector3::new(self.tool_lateral[0], self.tool_lateral[1], -self.l);
@@ -150,11 +166,16 @@ impl Kinematics for ForkHead {
     }
 
     fn parameters(&self) -> Vec<(&'static str, Parameter)> {
-        vec![
+        let mut params = vec![
             ("tilt", self.tilt_name().into()),
             ("L", self.l.into()),
             ("d", vec![self.d.x, self.d.y, self.d.z].into()),
             ("tool_lateral", self.tool_lateral.to_vec().into()),
-        ]
+        ];
+        // Optional: written only where it is not the default, so files without it round-trip.
+        if self.tilt_sign() != 1.0 {
+            params.push(("tilt_sign", self.tilt_sign().into()));
+        }
+        params
     }
 }

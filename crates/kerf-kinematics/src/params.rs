@@ -58,6 +58,16 @@ impl<'a> Params<'a> {
         })
     }
 
+    /// An optional number: `None` when the key is absent.
+    pub(crate) fn optional_number(&mut self, key: &'static str) -> Result<Option<f64>> {
+        if self.map.contains_key(key) {
+            self.number(key).map(Some)
+        } else {
+            self.used.push(key);
+            Ok(None)
+        }
+    }
+
     /// A required array of `N` numbers.
     pub(crate) fn numbers<const N: usize>(&mut self, key: &'static str) -> Result<[f64; N]> {
         let value = self.get(key)?;

@@ -35,6 +35,8 @@ fn every_fixture_reads_and_writes_back() {
         ("fork_head.json", "fork-head", "B"),
         ("table_table.json", "table-table", "A"),
         ("head_table.json", "head-table", "B"),
+        ("xyzac_trt.json", "table-table", "A"),
+        ("bc_head_5axiskins.json", "fork-head", "B"),
     ] {
         let m = fixture(file);
         assert_eq!(m.kinematics.type_name(), kind, "{file}");
@@ -163,6 +165,15 @@ fn kinematics_errors() {
         "limits.A: not an axis of this machine (its axes are X, Y, Z, B, C)"
     );
 
+    // The optional tilt_sign: +1 or -1, written back only where it is -1.
+    assert_eq!(
+        fork(&|d| d["kinematics"]["tilt_sign"] = json!(0)),
+        "kinematics.tilt_sign: must be +1 or -1 (got 0)"
+    );
+    assert!(!fixture("fork_head.json").to_json().contains("tilt_sign"));
+    assert!(fixture("bc_head_5axiskins.json")
+        .to_json()
+        .contains("\"tilt_sign\": -1"));
     let head_table = error_after(|d| {
         d["kinematics"] = json!({ "type": "head-table", "L": 180, "c_point": [0, 0, 0], "b_sign": 2, "c_sign": 1 });
     });

@@ -16,7 +16,8 @@ pub enum Dialect {
     /// cuts and `G61` on rapids, `( ... )` comments, `M2`.
     Linuxcnc,
     /// LinuxCNC with its own tool-tip kinematics (`xyzac-trt-kins` for a `table-table`
-    /// machine, see [`linuxcnc_kinematics`](crate::linuxcnc_kinematics)): `X Y Z` the tool
+    /// machine, `5axiskins` for a B fork head, see
+    /// [`linuxcnc_kinematics`](crate::linuxcnc_kinematics)): `X Y Z` the tool
     /// tip in the workpiece frame and the rotary axes, `G94` with `F` the tip's feed in
     /// mm/min, `G64 P` on cuts and `G61` on rapids, `( ... )` comments, `M2`.
     LinuxcncTcp,

@@ -12,8 +12,20 @@
 //! which is kerf's `table-table` (`P = q_c + Rz(sC)^T [(q_a - q_c) + Rx(sA)^T (T - q_a)]`) with
 //! `s = +1` (`conventional: false`), `q_c = r`, `q_a - q_c = d` and `tool_offset` 0 (kerf's tip
 //! is `tool_offset` below the joints without adding it back; LinuxCNC folds the tool length into
-//! `d` and applies its length offset itself). Those are the machines this dialect writes for;
-//! any other is refused by name ([`linuxcnc_kinematics`]).
+//! `d` and applies its length offset itself).
+//!
+//! Its `5axiskins` (a B/C head, `src/emc/kinematics/5axiskins.c`) computes, with `L` its
+//! `pivot-length` pin and the W joint at 0,
+//!
+//! ```text
+//! world = J + (0, 0, L) + L (sin B cos C, sin B sin C, -cos B)
+//! ```
+//!
+//! which is kerf's `fork-head` (`P = XYZ + Rz(C) (d + Ry(s B) (tx, ty, -L))`) with tilt B,
+//! `tilt_sign` -1, `d = (0, 0, L)` and no lateral offset: `Rz(C) ((0, 0, L) + Ry(-B) (0, 0,
+//! -L)) = (0, 0, L) + L (sin B cos C, sin B sin C, -cos B)`, and the tool axis `Rz(C) Ry(-B) ez`
+//! is the direction from LinuxCNC's tip to its pivot. Those are the machines this dialect
+//! writes for; any other is refused by name ([`linuxcnc_kinematics`]).
 
 use kerf_kinematics::{Machine, Parameter};
 
@@ -57,10 +69,11 @@ impl LinuxcncKinematics {
 
 /// The LinuxCNC kinematics module that computes `machine` exactly, for a tool-tip program.
 ///
-/// Supported: `table-table` with `conventional: false` and `tool_offset` 0 (LinuxCNC 2.9's
-/// `xyzac-trt-kins`, module docs). A head machine or a table-table with other sign conventions
-/// has no module in LinuxCNC 2.9 that computes it as kerf does, so a tool-tip program would
-/// put the tip elsewhere: refused.
+/// Supported (module docs): `table-table` with `conventional: false` and `tool_offset` 0
+/// (LinuxCNC 2.9's `xyzac-trt-kins`), and `fork-head` with tilt B, `tilt_sign` -1, `d = (0, 0,
+/// L)` and no lateral offset (`5axiskins`, coordinates `XYZBCW`, the W joint left at 0). Other
+/// machines have no module in LinuxCNC 2.9 that computes them as kerf does, so a tool-tip
+/// program would put the tip elsewhere: refused.
 ///
 /// # Errors
 /// [`InterpError::DialectMachine`] naming what does not match.
@@ -72,18 +85,45 @@ pub fn linuxcnc_kinematics(machine: &Machine) -> Result<LinuxcncKinematics> {
         })
     };
     let k = &machine.kinematics;
-    if k.type_name() != "table-table" {
-        return refuse(format!(
-            "the machine's kinematics are {}; LinuxCNC's tool-tip kinematics that kerf writes for are xyzac-trt-kins, a table-table machine (use the linuxcnc dialect, joint space, for the others)",
-            k.type_name()
-        ));
-    }
     let params = k.parameters();
     let get = |name: &str| params.iter().find(|(n, _)| *n == name).map(|(_, v)| v);
     let number = |name: &str| match get(name) {
         Some(Parameter::Number(v)) => Some(*v),
         _ => None,
     };
+    let numbers = |name: &str| match get(name) {
+        Some(Parameter::Numbers(v)) => v.clone(),
+        _ => Vec::new(),
+    };
+    match k.type_name() {
+        "table-table" => {}
+        "fork-head" => {
+            let l = number("L").unwrap_or(f64::NAN);
+            let d = numbers("d");
+            let lateral = numbers("tool_lateral");
+            let why = if k.tilt_name() != "B" {
+                "the tilt is A (5axiskins tilts B)".to_string()
+            } else if number("tilt_sign") != Some(-1.0) {
+                "kinematics.tilt_sign is +1: 5axiskins turns B the other way (tilt_sign -1 computes it)".to_string()
+            } else if d != [0.0, 0.0, l] {
+                format!("kinematics.d is {d:?}: 5axiskins puts its pivot L = {l} mm above the joints' point, d = [0, 0, {l}]")
+            } else if lateral.iter().any(|v| *v != 0.0) {
+                format!("kinematics.tool_lateral is {lateral:?}: 5axiskins has the tip on the tool axis, [0, 0]")
+            } else {
+                return Ok(LinuxcncKinematics {
+                    module: "5axiskins",
+                    coordinates: "XYZBCW",
+                    pins: vec![("pivot-length", l)],
+                });
+            };
+            return refuse(format!("fork-head for LinuxCNC's 5axiskins: {why}"));
+        }
+        other => {
+            return refuse(format!(
+                "the machine's kinematics are {other}; LinuxCNC's tool-tip kinematics that kerf writes for are xyzac-trt-kins (a table-table) and 5axiskins (a B/C fork head); use the linuxcnc dialect, joint space, for the others"
+            ))
+        }
+    }
     if let Some(Parameter::Flag(true)) = get("conventional") {
         return refuse(
             "kinematics.conventional is true: LinuxCNC 2.9's xyzac-trt-kins turns A and C the other way (conventional: false computes it)".to_string(),

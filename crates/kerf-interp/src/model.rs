@@ -149,6 +149,47 @@ pub trait AxisModel {
     }
 }
 
+/// A reference to a model is the model (so that `&dyn AxisModel`, passed as `&&dyn
+/// AxisModel`, goes wherever a sized model does).
+impl<T: AxisModel + ?Sized> AxisModel for &T {
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+
+    fn axis_names(&self) -> [&str; 5] {
+        (**self).axis_names()
+    }
+
+    fn limits(&self) -> &AxisLimits {
+        (**self).limits()
+    }
+
+    fn inverse(
+        &self,
+        tip: &Point3<f64>,
+        axis: &Vector3<f64>,
+        previous: Option<&[f64; 5]>,
+    ) -> Result<[f64; 5]> {
+        (**self).inverse(tip, axis, previous)
+    }
+
+    fn linear_axes(&self, tip: &Point3<f64>, tilt: f64, c: f64) -> [f64; 3] {
+        (**self).linear_axes(tip, tilt, c)
+    }
+
+    fn tool_axis(&self, tilt: f64, c: f64) -> Vector3<f64> {
+        (**self).tool_axis(tilt, c)
+    }
+
+    fn tip(&self, q: &[f64; 5]) -> Point3<f64> {
+        (**self).tip(q)
+    }
+
+    fn machine(&self) -> Option<&kerf_kinematics::Machine> {
+        (**self).machine()
+    }
+}
+
 /// Paper 000's laser head (`kerf.machine/1` type `ac-head`): `u = Rz(C) Rx(A) ez`,
 /// `XYZ = P + r_a u - r_c (cos C, sin C, 0)` (paper 000 eq 16).
 ///

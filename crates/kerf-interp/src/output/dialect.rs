@@ -1,5 +1,7 @@
 //! The G-code dialects, the laser process codes and the escaping of comment text.
 
+use super::dialects;
+use super::rules::Rules;
 use crate::error::{InterpError, Result};
 
 /// G-code dialect.
@@ -24,26 +26,26 @@ pub enum Dialect {
 }
 
 impl Dialect {
-    /// The dialect's name as the CLI spells it.
-    pub fn name(self) -> &'static str {
+    /// The dialect's rules: the one place a dialect is registered (its file under
+    /// `output/dialects/`).
+    pub(super) fn rules(self) -> &'static dyn Rules {
         match self {
-            Dialect::Generic => "generic",
-            Dialect::Sinumerik => "sinumerik",
-            Dialect::Linuxcnc => "linuxcnc",
-            Dialect::LinuxcncTcp => "linuxcnc-tcp",
+            Dialect::Generic => &dialects::Generic,
+            Dialect::Sinumerik => &dialects::Sinumerik,
+            Dialect::Linuxcnc => &dialects::Linuxcnc,
+            Dialect::LinuxcncTcp => &dialects::LinuxcncTcp,
         }
     }
 
-    /// True for LinuxCNC's dialects (joint space and tool tip): `( ... )` comments, the
-    /// `M62`-`M65` outputs, `G64 P`/`G61`, `M67`/`M68` power, `M2`.
-    pub fn linuxcnc(self) -> bool {
-        matches!(self, Dialect::Linuxcnc | Dialect::LinuxcncTcp)
+    /// The dialect's name as the CLI spells it.
+    pub fn name(self) -> &'static str {
+        self.rules().name()
     }
 
     /// True for the dialects whose `X Y Z` are the tool tip in the workpiece frame (the
     /// controller runs the kinematics).
     pub fn tool_tip(self) -> bool {
-        matches!(self, Dialect::Sinumerik | Dialect::LinuxcncTcp)
+        self.rules().tool_tip()
     }
 
     /// True for the dialects whose blocks join neighbouring poses only: no arcs, no lines
@@ -52,7 +54,7 @@ impl Dialect {
     /// interpolates its rotary axes linearly in each block, so a merged line would carry the
     /// tool axis off the poses between its ends; it writes no 3D arcs).
     pub fn raw_axes(self) -> bool {
-        !matches!(self, Dialect::Sinumerik)
+        self.rules().joins_poses_only()
     }
 
     /// The process codes used when the machine file's `process` object lacks a key:
@@ -71,27 +73,14 @@ impl Dialect {
     /// last beam-off, so that a last `M63` fires too. Micro-joints always switch with the
     /// synchronized `M63`/`M62`.)
     pub fn default_process(self) -> ProcessCodes {
-        let (on, off) = match self {
-            Dialect::Linuxcnc | Dialect::LinuxcncTcp => ("M64 P0", "M65 P0"),
-            Dialect::Generic | Dialect::Sinumerik => ("M3", "M5"),
-        };
-        ProcessCodes {
-            beam_on: vec![on.to_string()],
-            beam_off: vec![off.to_string()],
-            pierce_dwell_s: 0.2,
-            pierce_standoff: 1.5,
-        }
+        super::rules::default_process(self.rules())
     }
 
     /// One whole-line comment in the dialect's syntax, its text escaped as by
     /// [`comment_text`] but not cut (text from the input must already have been through
     /// [`comment_text`], which cuts it).
     pub(super) fn comment(self, text: &str) -> String {
-        let text = escape(text, usize::MAX);
-        match self {
-            Dialect::Linuxcnc | Dialect::LinuxcncTcp => format!("({text})"),
-            Dialect::Generic | Dialect::Sinumerik => format!("; {text}"),
-        }
+        self.rules().comment(&escape(text, usize::MAX))
     }
 }
 

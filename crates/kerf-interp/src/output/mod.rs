@@ -1,4 +1,5 @@
-//! Outputs: the set-points CSV of `formats.md` and G-code in three dialects, written atomically.
+//! Outputs: the set-points CSV of `formats.md` and G-code in four dialects (one file each under
+//! `dialects/`, their decisions the `Rules` trait of `rules.rs`), written atomically.
 //!
 //! - **CSV**: header `t,X,Y,Z,<tilt>,C`, one row per cycle, `t` in seconds, axes in mm and
 //!   degrees; values are written in Rust's shortest round-trip form, so they read back exactly.
@@ -41,13 +42,14 @@ use crate::DEFAULT_BLEND_TOLERANCE;
 
 mod csv;
 mod dialect;
-mod linuxcnc_tcp;
+mod dialects;
 mod power;
+mod rules;
 mod writer;
 
 pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};
 pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
-pub use linuxcnc_tcp::{
+pub use dialects::{
     linuxcnc_kinematics, LinuxcncKinematics, RAPID_TCP_MAX_PIECES, RAPID_TCP_TOLERANCE_MM,
 };
 pub use power::LaserPower;
@@ -315,7 +317,7 @@ impl GcodeOptions {
 ///
 /// # Errors
 /// As [`gcode_timed`].
-pub fn gcode<M: AxisModel + ?Sized>(
+pub fn gcode<M: AxisModel>(
     model: &M,
     blocks: &[Block],
     path_ids: &[String],
@@ -342,7 +344,7 @@ pub fn gcode<M: AxisModel + ?Sized>(
 ///
 /// # Errors
 /// As [`gcode_timed`].
-pub fn gcode_motion<M: AxisModel + ?Sized>(
+pub fn gcode_motion<M: AxisModel>(
     model: &M,
     motion: &crate::Motion,
     path_ids: &[String],
@@ -439,7 +441,7 @@ fn out_of_range<M: AxisModel + ?Sized>(model: &M, q: &[f64; 5]) -> Option<(Strin
 /// a cut (so that a beam-off synchronized with motion fires) outside an axis range;
 /// [`InterpError::DialectMachine`] for [`Dialect::LinuxcncTcp`] on a machine no LinuxCNC
 /// kinematics module computes ([`linuxcnc_kinematics`]).
-pub fn gcode_timed<M: AxisModel + ?Sized>(
+pub fn gcode_timed<M: AxisModel>(
     model: &M,
     blocks: &[Block],
     path_ids: &[String],
@@ -450,16 +452,11 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     positive("chord_tolerance_mm", opts.chord_tolerance_mm)?;
     positive("blend_tolerance_mm", opts.blend_tolerance_mm)?;
     refuse_unchecked_blocks(blocks, opts.dialect)?;
-    let tcp = match opts.dialect {
-        Dialect::LinuxcncTcp => Some(
-            linuxcnc_kinematics(model.machine().ok_or_else(|| InterpError::DialectMachine {
-                dialect: "linuxcnc-tcp",
-                reason: "the program needs a kerf.machine/1 machine to name LinuxCNC's kinematics module".to_string(),
-            })?)?,
-        ),
-        _ => None,
-    };
-    if opts.dialect != Dialect::Linuxcnc && opts.cutter_compensation.iter().any(Option::is_some) {
+    let rules = opts.dialect.rules();
+    let model: &dyn AxisModel = model;
+    let machine_lines = rules.machine_lines(model)?;
+    let compensating = opts.cutter_compensation.iter().any(Option::is_some);
+    if compensating && !rules.controller_compensation() {
         return Err(InterpError::BadParameter {
             name: "cutter_compensation",
             value: 1.0,
@@ -472,32 +469,20 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
     }
     crate::error::unit_factors("power_factors", &opts.power_factors)?;
     let joint_codes = if opts.micro_joints.iter().any(|j| !j.is_empty()) {
-        Some(writer::joint_codes(opts, &process)?)
+        let refuse = |reason: &'static str| InterpError::BadParameter {
+            name: "micro_joints",
+            value: 1.0,
+            reason,
+        };
+        if compensating {
+            return Err(refuse("micro-joints are not written while the controller compensates the kerf (LinuxCNC sets no output then); compensate in the computer"));
+        }
+        Some(rules.joint_codes(&process).map_err(refuse)?)
     } else {
         None
     };
     refuse_pierces_out_of_range(model, blocks, &process)?;
-    let mut w = Writer {
-        model,
-        opts,
-        process,
-        names: model.axis_names(),
-        d: opts.decimals.min(12),
-        s: String::new(),
-        last: None,
-        in_cut: false,
-        compensating: false,
-        last_f: None,
-        last_power: None,
-        factor: 1.0,
-        coeffs: [0.0; 6],
-        held: None,
-        joint_codes,
-        joints: Vec::new(),
-        path_s: 0.0,
-        tcp,
-        last_axes: None,
-    };
+    let mut w = Writer::new(model, opts, process, joint_codes, machine_lines);
     w.header(blocks);
     let mut last_path = usize::MAX;
     for (bi, b) in blocks.iter().enumerate() {
@@ -565,15 +550,10 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
         }
         w.rapid(p, q, u);
     }
-    w.power_off();
-    match opts.dialect {
-        Dialect::Linuxcnc | Dialect::LinuxcncTcp => w.line("M2"),
-        Dialect::Generic => w.line("M30"),
-        Dialect::Sinumerik => {
-            w.line("TRAFOOF");
-            w.line("M30");
-        }
+    if opts.power.is_some() {
+        rules.power_off(&mut w);
     }
+    rules.footer(&mut w);
     Ok(w.finish())
 }
 
@@ -581,7 +561,7 @@ pub fn gcode_timed<M: AxisModel + ?Sized>(
 ///
 /// # Errors
 /// As [`gcode`], plus [`InterpError::Io`].
-pub fn write_gcode<M: AxisModel + ?Sized>(
+pub fn write_gcode<M: AxisModel>(
     path: impl AsRef<Path>,
     model: &M,
     blocks: &[Block],

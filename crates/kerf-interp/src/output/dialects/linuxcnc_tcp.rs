@@ -1,6 +1,10 @@
-//! LinuxCNC with its own tool-tip kinematics ([`Dialect::LinuxcncTcp`](super::Dialect)): which
-//! kinematics module computes a kerf machine, with which HAL parameters, and the split of
-//! rapids so that the tip-space `G0` follows kerf's joint-space traverse.
+//! `linuxcnc-tcp`: LinuxCNC with its own tool-tip kinematics: the tip `X Y Z` in the
+//! workpiece frame and the rotary axes, `G94` with `F` the tip's mean planned speed of the
+//! block (deg/min of the rotary motion where the tip stands), `G64 P<q> Q0` on cuts and `G61`
+//! on rapids, each rapid split so that its tip follows kerf's joint-space traverse within
+//! [`RAPID_TCP_TOLERANCE_MM`]; comments, beam, power, micro-joints and footer as `linuxcnc`
+//! (no controller kerf compensation). Below: which kinematics module computes a kerf machine,
+//! with which HAL parameters.
 //!
 //! LinuxCNC 2.9's `xyzac-trt-kins` (`src/emc/kinematics/trtfuncs.c`) computes, with
 //! `r` its `{x,y,z}-rot-point`, `d = (0, y-offset, z-offset + tool-offset)` and the joints `J`,
@@ -28,7 +32,13 @@
 //! writes for; any other is refused by name ([`linuxcnc_kinematics`]).
 
 use kerf_kinematics::{Machine, Parameter};
+use nalgebra::{Point3, Vector3};
 
+use super::super::rules::Rules;
+use super::super::writer::{feed_number, Writer};
+use super::super::{LaserPower, ProcessCodes};
+use super::Linuxcnc;
+use crate::block::Block;
 use crate::error::{InterpError, Result};
 use crate::model::AxisModel;
 
@@ -162,11 +172,7 @@ pub fn linuxcnc_kinematics(machine: &Machine) -> Result<LinuxcncKinematics> {
 /// `2^k` equal pieces in joint space, the fewest (at most [`RAPID_TCP_MAX_PIECES`]) whose tip
 /// chords lie within [`RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's
 /// middle.
-pub(super) fn rapid_pieces<M: AxisModel + ?Sized>(
-    model: &M,
-    from: &[f64; 5],
-    to: &[f64; 5],
-) -> Vec<[f64; 5]> {
+fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> Vec<[f64; 5]> {
     let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| from[k] + f * (to[k] - from[k])) };
     let mut n = 1;
     loop {
@@ -184,4 +190,200 @@ pub(super) fn rapid_pieces<M: AxisModel + ?Sized>(
     (1..=n)
         .map(|i| if i == n { *to } else { at(i as f64 / n as f64) })
         .collect()
+}
+
+/// LinuxCNC with its own tool-tip kinematics.
+pub(in crate::output) struct LinuxcncTcp;
+
+impl Rules for LinuxcncTcp {
+    fn name(&self) -> &'static str {
+        "linuxcnc-tcp"
+    }
+
+    fn tool_tip(&self) -> bool {
+        true
+    }
+
+    fn beam_codes(&self) -> (&'static str, &'static str) {
+        Linuxcnc.beam_codes()
+    }
+
+    fn comment(&self, text: &str) -> String {
+        Linuxcnc.comment(text)
+    }
+
+    fn machine_lines(&self, model: &dyn AxisModel) -> Result<Vec<String>> {
+        let machine = model.machine().ok_or_else(|| InterpError::DialectMachine {
+            dialect: "linuxcnc-tcp",
+            reason:
+                "the program needs a kerf.machine/1 machine to name LinuxCNC's kinematics module"
+                    .to_string(),
+        })?;
+        let k = linuxcnc_kinematics(machine)?;
+        let mut lines = vec![format!(
+            "kinematics: LinuxCNC [KINS] KINEMATICS = {}, [TRAJ] COORDINATES = {}, its tool-tip kinematics active [switchkins type 0]",
+            k.module, k.coordinates
+        )];
+        lines.extend(
+            k.setp_lines()
+                .into_iter()
+                .map(|l| format!("kinematics: {l}")),
+        );
+        Ok(lines)
+    }
+
+    fn describe(&self, n: [&str; 5]) -> (String, String, &'static str) {
+        (
+            format!(
+                "kerf LinuxCNC tool-tip program: X Y Z the tool tip in the workpiece frame, {} {} the rotary axes",
+                n[3], n[4]
+            ),
+            format!(
+                "feed: G94, F in mm/min of the tool tip [the kinematics' world X Y Z], the block's mean planned speed;\nfeed: on blocks where the tip stands F is deg/min of the rotary motion;\nfeed: rapids G0 in exact path G61, split so that the tip follows kerf's joint-space traverse within {RAPID_TCP_TOLERANCE_MM} mm"
+            ),
+            "arcs written as G1 chords",
+        )
+    }
+
+    fn preamble(&self, w: &mut Writer<'_>) {
+        w.line("G17 G21 G40 G49 G54 G80 G90 G94");
+        w.line("G61");
+    }
+
+    fn power_header(&self, w: &mut Writer<'_>) {
+        Linuxcnc.power_header(w);
+    }
+
+    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
+        // LinuxCNC moves the tip straight between G0 ends: pieces along the joint-space
+        // traverse kerf checked, the last ending exactly at `p`.
+        let pieces = match w.last_axes {
+            Some(from) => rapid_pieces(w.model, &from, &q),
+            None => vec![q],
+        };
+        let n = pieces.len();
+        for (i, a) in pieces.into_iter().enumerate() {
+            let tip = if i + 1 == n { p } else { w.model.tip(&a) };
+            let l = format!("G0 {}", tcp_words(w, &tip, a[3], a[4]));
+            w.line(&l);
+        }
+        w.last = Some(w.printed(&[p.x, p.y, p.z, q[3], q[4]]));
+        w.last_axes = Some(q);
+    }
+
+    fn pierce_beam_on(&self, line: String) -> String {
+        Linuxcnc.pierce_beam_on(line)
+    }
+
+    fn blend_on(&self, w: &mut Writer<'_>) {
+        Linuxcnc.blend_on(w);
+    }
+
+    fn descent(
+        &self,
+        w: &mut Writer<'_>,
+        b: &Block,
+        start: Point3<f64>,
+        _u: Vector3<f64>,
+        t: f64,
+        _h: f64,
+    ) {
+        tcp_move(w, start, b.start_axes, t);
+    }
+
+    fn blend_off(&self, w: &mut Writer<'_>) {
+        Linuxcnc.blend_off(w);
+    }
+
+    fn cut(&self, w: &mut Writer<'_>, b: &Block, t: f64) {
+        w.block_pieces(b, t, |w, s, q, dt, _| tcp_move(w, b.pose_at(s).0, q, dt));
+    }
+
+    fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower) {
+        Linuxcnc.pierce_power(w, power);
+    }
+
+    fn cut_power(&self, w: &mut Writer<'_>, power: &LaserPower) {
+        Linuxcnc.cut_power(w, power);
+    }
+
+    fn power_off(&self, w: &mut Writer<'_>) {
+        Linuxcnc.power_off(w);
+    }
+
+    fn joint_codes(
+        &self,
+        process: &ProcessCodes,
+    ) -> std::result::Result<(Vec<String>, Vec<String>), &'static str> {
+        Linuxcnc.joint_codes(process)
+    }
+
+    fn footer(&self, w: &mut Writer<'_>) {
+        Linuxcnc.footer(w);
+    }
+}
+
+/// The words of a position: the tip `X Y Z` and the rotary axes.
+fn tcp_words(w: &Writer<'_>, tip: &Point3<f64>, tilt: f64, c: f64) -> String {
+    let n = &w.names;
+    format!(
+        "X{} Y{} Z{} {}{} {}{}",
+        w.num(tip.x),
+        w.num(tip.y),
+        w.num(tip.z),
+        n[3],
+        w.num(tilt),
+        n[4],
+        w.num(c)
+    )
+}
+
+/// One `G1` to the tip `tip` with the axes `q`, taking `t` seconds: `F` the tip's speed in
+/// mm/min (deg/min of the rotary motion where the printed tip stands, the RS274/NGC rule);
+/// nothing if the printed words do not change. With power the controller computes the tip's
+/// speed from its joints as for the joint-space dialect: the same coefficients, the move in
+/// pieces of its own tip line.
+fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64) {
+    let now = w.printed(&[tip.x, tip.y, tip.z, q[3], q[4]]);
+    let prev = w.last.unwrap_or(now);
+    let from = w.last_axes.replace(q);
+    if prev == now {
+        return;
+    }
+    let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
+    let lin = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let len = if lin > 0.0 {
+        lin
+    } else {
+        (d[3] * d[3] + d[4] * d[4]).sqrt()
+    };
+    // The feed is the same on every piece: the pieces split the move evenly in time.
+    let f = feed_number(len / t * 60.0);
+    match (w.opts.power.is_some() && w.in_cut, from) {
+        (true, Some(from)) => {
+            let words = |w: &Writer<'_>, fr: f64| -> String {
+                let p: [f64; 5] = std::array::from_fn(|k| prev[k] + fr * d[k]);
+                tcp_words(w, &Point3::new(p[0], p[1], p[2]), p[3], p[4])
+            };
+            let (a, b) = (w.printed(&from), w.printed(&q));
+            w.powered_pieces(
+                &a,
+                &b,
+                |w, fr, _| {
+                    let end = if fr == 1.0 {
+                        tcp_words(w, &tip, q[3], q[4])
+                    } else {
+                        words(w, fr)
+                    };
+                    format!("G1 {end} F{f}")
+                },
+                t,
+            );
+        }
+        _ => {
+            let l = format!("G1 {} F{f}", tcp_words(w, &tip, q[3], q[4]));
+            w.line(&l);
+        }
+    }
+    w.last = Some(now);
 }

@@ -1,0 +1,16 @@
+//! One file per G-code dialect, each implementing [`Rules`](super::rules::Rules); adding a
+//! controller is a new file here, its variant in [`Dialect`](super::Dialect) and one line in
+//! [`Dialect::rules`](super::Dialect::rules).
+
+mod generic;
+mod linuxcnc;
+mod linuxcnc_tcp;
+mod sinumerik;
+
+pub(super) use generic::Generic;
+pub(super) use linuxcnc::Linuxcnc;
+pub(super) use linuxcnc_tcp::LinuxcncTcp;
+pub use linuxcnc_tcp::{
+    linuxcnc_kinematics, LinuxcncKinematics, RAPID_TCP_MAX_PIECES, RAPID_TCP_TOLERANCE_MM,
+};
+pub(super) use sinumerik::Sinumerik;

@@ -1,0 +1,174 @@
+//! `sinumerik`: Sinumerik-style `TRAORI`: the tool tip `X Y Z` and the orientation vector
+//! `A3= B3= C3=` in workpiece coordinates (`ORIWKS`, `ORIVECT`), arcs as `CIP` through the
+//! intermediate point, `G54`, `SOFT`, `G642` with `CTOL`/`OTOL` from the blending term, `F`
+//! the tip's mean planned speed of the block (modal), `;` comments, `TRAFOOF` and `M30`. Power
+//! by the synchronized action `SYNFCT` on `$AC_VACTW` with `FCTDEF` per cut (written to
+//! Siemens' documented pattern, not executed here). No micro-joints: its arcs and merged lines
+//! are not split.
+
+use nalgebra::{Point3, Vector3};
+
+use super::super::rules::Rules;
+use super::super::writer::{feed_number, Writer};
+use super::super::{LaserPower, ProcessCodes};
+use crate::block::{Block, Geometry};
+
+/// The Sinumerik-style dialect.
+pub(in crate::output) struct Sinumerik;
+
+impl Rules for Sinumerik {
+    fn name(&self) -> &'static str {
+        "sinumerik"
+    }
+
+    fn joins_poses_only(&self) -> bool {
+        false
+    }
+
+    fn tool_tip(&self) -> bool {
+        true
+    }
+
+    fn describe(&self, _n: [&str; 5]) -> (String, String, &'static str) {
+        (
+            "kerf Sinumerik-style program: TRAORI, tool tip X Y Z and orientation vector A3 B3 C3 in workpiece coordinates".to_string(),
+            "feed: G94, F in mm/min of the tool tip (TRAORI), the block's mean planned speed".to_string(),
+            "arcs as CIP through the intermediate point",
+        )
+    }
+
+    fn units_word(&self) -> &'static str {
+        "G71"
+    }
+
+    fn preamble(&self, w: &mut Writer<'_>) {
+        let o = w.opts;
+        w.line("G17 G71 G90 G94 G40");
+        w.line("G54");
+        w.line("SOFT");
+        let ctol = o.blend_tolerance_mm / 2.0;
+        match o.pivot_length_mm.filter(|l| l.is_finite() && *l > 0.0) {
+            Some(l) => {
+                let otol = (ctol / l).to_degrees();
+                w.line(&format!("CTOL={ctol} OTOL={otol:.6}"));
+            }
+            None => w.line(&format!("CTOL={}", o.blend_tolerance_mm)),
+        }
+        w.line("TRAORI");
+        w.line("ORIWKS");
+        w.line("ORIVECT");
+        w.line("G60");
+        if o.power.is_some() {
+            w.line("ID=1 WHENEVER TRUE DO SYNFCT(1,$A_OUTA[1],$AC_VACTW)");
+        }
+    }
+
+    fn power_header(&self, w: &mut Writer<'_>) {
+        w.comment(
+            "power: FCTDEF[1, floor, 100, 0, % per mm/min] on $AC_VACTW by synchronized action ID=1",
+        );
+    }
+
+    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], u: Vector3<f64>) {
+        let l = format!("G0 {}", tip_words(w, &p, &u));
+        w.line(&l);
+        w.last = Some(w.printed(&q));
+        w.last_axes = Some(q);
+    }
+
+    fn dwell(&self, s: f64) -> String {
+        format!("G4 F{s}")
+    }
+
+    fn blend_on(&self, w: &mut Writer<'_>) {
+        w.line("G642");
+    }
+
+    fn descent(
+        &self,
+        w: &mut Writer<'_>,
+        _b: &Block,
+        start: Point3<f64>,
+        u: Vector3<f64>,
+        _t: f64,
+        _h: f64,
+    ) {
+        let f = format!("{:.1}", w.opts.feed_mm_per_min);
+        let l = format!("G1 {} F{f}", tip_words(w, &start, &u));
+        w.line(&l);
+        w.last_f = Some(f);
+    }
+
+    fn blend_off(&self, w: &mut Writer<'_>) {
+        w.line("G60");
+    }
+
+    fn cut(&self, w: &mut Writer<'_>, b: &Block, t: f64) {
+        let p = b.end_tip();
+        let u = b.end_tool_axis;
+        let mut l = match &b.geometry {
+            Geometry::Arc(a) => format!(
+                "CIP X{} Y{} Z{} I1={} J1={} K1={} A3={} B3={} C3={}",
+                w.num(p.x),
+                w.num(p.y),
+                w.num(p.z),
+                w.num(a.mid.x),
+                w.num(a.mid.y),
+                w.num(a.mid.z),
+                w.num(u.x),
+                w.num(u.y),
+                w.num(u.z)
+            ),
+            _ => format!("G1 {}", tip_words(w, &p, &u)),
+        };
+        if !matches!(b.geometry, Geometry::Turn { .. }) {
+            let f = format!("{:.1}", b.length() / t * 60.0);
+            if w.last_f.as_deref() != Some(f.as_str()) {
+                l.push_str(" F");
+                l.push_str(&f);
+                w.last_f = Some(f);
+            }
+        }
+        w.line(&l);
+    }
+
+    fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower) {
+        let pierce = Writer::pierce_number(power);
+        w.line(&format!("FCTDEF(1,{pierce},{pierce},{pierce},0)"));
+    }
+
+    fn cut_power(&self, w: &mut Writer<'_>, power: &LaserPower) {
+        let floor = w.floor_number(power);
+        let k = feed_number(power.per_mm_s(w.factor) / 60.0);
+        w.line(&format!("FCTDEF(1,{floor},100,0,{k})"));
+    }
+
+    fn power_off(&self, w: &mut Writer<'_>) {
+        w.line("CANCEL(1)");
+    }
+
+    fn joint_codes(
+        &self,
+        _process: &ProcessCodes,
+    ) -> std::result::Result<(Vec<String>, Vec<String>), &'static str> {
+        Err("micro-joints are written for the linuxcnc and generic dialects (the Sinumerik dialect's arcs and merged lines are not split)")
+    }
+
+    fn footer(&self, w: &mut Writer<'_>) {
+        w.line("TRAFOOF");
+        w.line("M30");
+    }
+}
+
+/// `X Y Z A3= B3= C3=`: the tip and the orientation vector.
+fn tip_words(w: &Writer<'_>, p: &Point3<f64>, u: &Vector3<f64>) -> String {
+    format!(
+        "X{} Y{} Z{} A3={} B3={} C3={}",
+        w.num(p.x),
+        w.num(p.y),
+        w.num(p.z),
+        w.num(u.x),
+        w.num(u.y),
+        w.num(u.z)
+    )
+}

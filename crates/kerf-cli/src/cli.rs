@@ -397,6 +397,11 @@ pub(crate) enum DialectArg {
     /// conventional false, 5axiskins for a B fork head with tilt_sign -1): tip X Y Z in the
     /// workpiece frame and the rotary axes, G94 tip feed.
     LinuxcncTcp,
+    /// Fanuc tool center point control G43.4: tip X Y Z in G54 with the rotary axes, G05.1 Q1
+    /// look-ahead, G94 tip feed.
+    Fanuc,
+    /// Fanuc G43.5: tip X Y Z with the tool direction I J K (head machines only).
+    FanucIjk,
 }
 
 impl From<DialectArg> for kerf_interp::Dialect {
@@ -406,6 +411,8 @@ impl From<DialectArg> for kerf_interp::Dialect {
             DialectArg::Sinumerik => Self::Sinumerik,
             DialectArg::Linuxcnc => Self::Linuxcnc,
             DialectArg::LinuxcncTcp => Self::LinuxcncTcp,
+            DialectArg::Fanuc => Self::Fanuc,
+            DialectArg::FanucIjk => Self::FanucIjk,
         }
     }
 }

@@ -238,6 +238,9 @@ pub fn plan_program(
 ) -> Result<Program> {
     options.validate()?;
     let model = MachineModel::new(machine.clone()).map_err(interp(source))?;
+    if let Some(d) = options.dialect {
+        d.check_machine(&model).map_err(interp(source))?;
+    }
     let mut linearization = None;
     let mut traverses: Vec<Vec<kerf_interp::Station>> = Vec::new();
     let (ids, paths, file_tol, chord_term) = match input {

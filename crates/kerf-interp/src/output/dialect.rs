@@ -23,6 +23,14 @@ pub enum Dialect {
     /// tip in the workpiece frame and the rotary axes, `G94` with `F` the tip's feed in
     /// mm/min, `G64 P` on cuts and `G61` on rapids, `( ... )` comments, `M2`.
     LinuxcncTcp,
+    /// Fanuc tool center point control `G43.4` (type 1): `X Y Z` the tool tip in the workpiece
+    /// frame `G54` with the rotary axes, `G05.1 Q1` look-ahead, `G94` tip feed, `G49` at the
+    /// end, `( ... )` comments, `%`, `O1000`, `M30`.
+    Fanuc,
+    /// Fanuc `G43.5` (type 2): the tool tip with the tool direction `I J K`, for head machines
+    /// only (a table machine raises alarm PS5421: refused by name); otherwise as
+    /// [`Dialect::Fanuc`].
+    FanucIjk,
 }
 
 impl Dialect {
@@ -34,7 +42,20 @@ impl Dialect {
             Dialect::Sinumerik => &dialects::Sinumerik,
             Dialect::Linuxcnc => &dialects::Linuxcnc,
             Dialect::LinuxcncTcp => &dialects::LinuxcncTcp,
+            Dialect::Fanuc => &dialects::Fanuc { ijk: false },
+            Dialect::FanucIjk => &dialects::Fanuc { ijk: true },
         }
+    }
+
+    /// Whether the dialect can program `model`'s machine: a tool-tip dialect for a controller
+    /// that runs its own kinematics needs one it knows (`linuxcnc-tcp`, see
+    /// [`linuxcnc_kinematics`](crate::linuxcnc_kinematics)), `fanuc-ijk` a head machine. The
+    /// G-code writer checks it too; a pipeline checks it first, before any work.
+    ///
+    /// # Errors
+    /// [`InterpError::DialectMachine`] naming the mismatch.
+    pub fn check_machine<M: crate::AxisModel>(self, model: &M) -> Result<()> {
+        self.rules().machine_lines(model).map(|_| ())
     }
 
     /// The dialect's name as the CLI spells it.

@@ -50,6 +50,12 @@ pub(super) trait Rules: Sync {
         Ok(Vec::new())
     }
 
+    /// The lines before the header comments (a tape start, a program number); none by
+    /// default.
+    fn opening(&self) -> &'static [&'static str] {
+        &[]
+    }
+
     /// The header's title, its feed semantics (lines separated by `\n`) and how arcs are
     /// written, for the axis names `names`.
     fn describe(&self, names: [&str; 5]) -> (String, String, &'static str);

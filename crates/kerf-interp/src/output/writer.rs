@@ -165,6 +165,9 @@ impl<'a> Writer<'a> {
         let o = self.opts;
         let counts = crate::fit::BlockCounts::of(blocks);
         let (title, feed, arcs_as) = self.rules.describe(self.names);
+        for l in self.rules.opening() {
+            self.line(l);
+        }
         self.comment(&title);
         let machine = format!("machine: {}", comment_text(self.model.name()));
         self.comment(&machine);

@@ -172,7 +172,7 @@ pub fn linuxcnc_kinematics(machine: &Machine) -> Result<LinuxcncKinematics> {
 /// `2^k` equal pieces in joint space, the fewest (at most [`RAPID_TCP_MAX_PIECES`]) whose tip
 /// chords lie within [`RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's
 /// middle.
-fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> Vec<[f64; 5]> {
+pub(super) fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> Vec<[f64; 5]> {
     let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| from[k] + f * (to[k] - from[k])) };
     let mut n = 1;
     loop {
@@ -324,7 +324,7 @@ impl Rules for LinuxcncTcp {
 }
 
 /// The words of a position: the tip `X Y Z` and the rotary axes.
-fn tcp_words(w: &Writer<'_>, tip: &Point3<f64>, tilt: f64, c: f64) -> String {
+pub(super) fn tcp_words(w: &Writer<'_>, tip: &Point3<f64>, tilt: f64, c: f64) -> String {
     let n = &w.names;
     format!(
         "X{} Y{} Z{} {}{} {}{}",

@@ -2,11 +2,13 @@
 //! controller is a new file here, its variant in [`Dialect`](super::Dialect) and one line in
 //! [`Dialect::rules`](super::Dialect::rules).
 
+mod fanuc;
 mod generic;
 mod linuxcnc;
 mod linuxcnc_tcp;
 mod sinumerik;
 
+pub(super) use fanuc::Fanuc;
 pub(super) use generic::Generic;
 pub(super) use linuxcnc::Linuxcnc;
 pub(super) use linuxcnc_tcp::LinuxcncTcp;

@@ -454,6 +454,49 @@ impl<'a> Writer<'a> {
         changed
     }
 
+    /// The planned power at `tip_mm` of tip travel in `t` seconds as an ` S` word, where it
+    /// changed by more than [`POWER_STEP`] (the dialects that command power by `S`); empty
+    /// outside a cut or without power.
+    pub(super) fn s_word(&mut self, tip_mm: f64, t: f64) -> String {
+        match (self.opts.power, self.in_cut) {
+            (Some(power), true) => {
+                let p = power.at_speed(tip_mm / t * 60.0, self.factor);
+                if self.power_changed(p) {
+                    format!(" S{}", power_number(p))
+                } else {
+                    String::new()
+                }
+            }
+            _ => String::new(),
+        }
+    }
+
+    /// A rapid of a tool-tip dialect to the tip `p` with the axes `q`: LinuxCNC and Fanuc
+    /// move the tip straight between `G0` ends (or the axes linearly, by a machine
+    /// parameter), so the rapid is split along kerf's checked joint-space traverse from the
+    /// last axes ([`rapid_pieces`]), each piece `<g0> <words(tip, axes)>`,
+    /// the last ending exactly at `p`.
+    pub(super) fn tip_rapid(
+        &mut self,
+        g0: &str,
+        p: nalgebra::Point3<f64>,
+        q: [f64; 5],
+        words: impl Fn(&Self, &nalgebra::Point3<f64>, &[f64; 5]) -> String,
+    ) {
+        let pieces = match self.last_axes {
+            Some(from) => rapid_pieces(self.model, &from, &q),
+            None => vec![q],
+        };
+        let n = pieces.len();
+        for (i, a) in pieces.into_iter().enumerate() {
+            let tip = if i + 1 == n { p } else { self.model.tip(&a) };
+            let l = format!("{g0} {}", words(self, &tip, &a));
+            self.line(&l);
+        }
+        self.last = Some(self.printed(&[p.x, p.y, p.z, q[3], q[4]]));
+        self.last_axes = Some(q);
+    }
+
     /// The pierce power's number (percent, at most 100).
     pub(super) fn pierce_number(power: &super::LaserPower) -> String {
         power_number(power.pierce_percent.min(100.0))
@@ -471,6 +514,44 @@ pub(super) fn digital_output(line: &str) -> Option<(u32, u32)> {
     let m = words.next()?.strip_prefix('M')?.parse().ok()?;
     let p = words.next()?.strip_prefix('P')?.parse().ok()?;
     (words.next().is_none() && (62..=65).contains(&m)).then_some((m, p))
+}
+
+/// The ends of the `G0` pieces of a rapid from the axes `from` to `to` (the last is `to`):
+/// `2^k` equal pieces in joint space, the fewest (at most [`super::RAPID_TCP_MAX_PIECES`]) whose tip
+/// chords lie within [`super::RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's
+/// middle.
+fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> Vec<[f64; 5]> {
+    let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| from[k] + f * (to[k] - from[k])) };
+    let mut n = 1;
+    loop {
+        let within = (0..n).all(|i| {
+            let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+            let (ta, tb) = (model.tip(&at(a)), model.tip(&at(b)));
+            let mid = model.tip(&at((a + b) / 2.0));
+            (nalgebra::center(&ta, &tb) - mid).norm() <= super::RAPID_TCP_TOLERANCE_MM
+        });
+        if within || n >= super::RAPID_TCP_MAX_PIECES {
+            break;
+        }
+        n *= 2;
+    }
+    (1..=n)
+        .map(|i| if i == n { *to } else { at(i as f64 / n as f64) })
+        .collect()
+}
+
+/// The feed of a move from `prev` to `now` (printed `X Y Z` and rotary axes) taking `t`
+/// seconds by the RS274/NGC rule: mm/min of the `X Y Z` motion, or deg/min of the rotary
+/// motion where `X Y Z` stand.
+pub(super) fn rs274_feed(prev: &[f64; 5], now: &[f64; 5], t: f64) -> f64 {
+    let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
+    let lin = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let len = if lin > 0.0 {
+        lin
+    } else {
+        (d[3] * d[3] + d[4] * d[4]).sqrt()
+    };
+    len / t * 60.0
 }
 
 /// A rotary coefficient as written (mm per degree): nine decimals, enough that the rounding

@@ -15,11 +15,10 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::super::power::power_number;
 use super::super::rules::Rules;
-use super::super::writer::{feed_number, Writer};
+use super::super::writer::{feed_number, rs274_feed, Writer};
 use super::super::{LaserPower, ProcessCodes};
-use super::linuxcnc_tcp::{rapid_pieces, tcp_words};
+use super::linuxcnc_tcp::tcp_words;
 use crate::block::Block;
 use crate::error::{InterpError, Result};
 use crate::model::AxisModel;
@@ -98,18 +97,7 @@ impl Rules for Fanuc {
     }
 
     fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
-        let pieces = match w.last_axes {
-            Some(from) => rapid_pieces(w.model, &from, &q),
-            None => vec![q],
-        };
-        let n = pieces.len();
-        for (i, a) in pieces.into_iter().enumerate() {
-            let tip = if i + 1 == n { p } else { w.model.tip(&a) };
-            let l = format!("G00 {}", self.words(w, &tip, &a));
-            w.line(&l);
-        }
-        w.last = Some(w.printed(&[p.x, p.y, p.z, q[3], q[4]]));
-        w.last_axes = Some(q);
+        w.tip_rapid("G00", p, q, |w, tip, a| self.words(w, tip, a));
     }
 
     fn dwell(&self, s: f64) -> String {
@@ -191,24 +179,12 @@ impl Fanuc {
         if prev == now {
             return;
         }
-        let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
-        let lin = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        let len = if lin > 0.0 {
-            lin
-        } else {
-            (d[3] * d[3] + d[4] * d[4]).sqrt()
-        };
-        let mut s_word = String::new();
-        if let (Some(power), true) = (w.opts.power, w.in_cut) {
-            let p = power.at_speed(tip_mm / t * 60.0, w.factor);
-            if w.power_changed(p) {
-                s_word = format!(" S{}", power_number(p));
-            }
-        }
+        let f = rs274_feed(&prev, &now, t);
+        let s_word = w.s_word(tip_mm, t);
         let l = format!(
             "G01 {} F{}{s_word}",
             self.words(w, &tip, &q),
-            feed_number(len / t * 60.0)
+            feed_number(f)
         );
         w.line(&l);
         w.last = Some(now);

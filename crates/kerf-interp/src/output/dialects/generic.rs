@@ -5,9 +5,8 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::super::power::power_number;
 use super::super::rules::Rules;
-use super::super::writer::{feed_number, Writer};
+use super::super::writer::{feed_number, rs274_feed, Writer};
 use super::super::{LaserPower, ProcessCodes};
 use crate::block::Block;
 
@@ -99,18 +98,8 @@ fn axes_move(w: &mut Writer<'_>, q: [f64; 5], t: f64, tip_mm: f64) {
     let Some((qp, prev)) = w.moved(&q) else {
         return;
     };
-    let lin =
-        ((qp[0] - prev[0]).powi(2) + (qp[1] - prev[1]).powi(2) + (qp[2] - prev[2]).powi(2)).sqrt();
-    let rot = ((qp[3] - prev[3]).powi(2) + (qp[4] - prev[4]).powi(2)).sqrt();
-    let len = if lin > 0.0 { lin } else { rot };
-    let f = len / t * 60.0;
-    let mut s_word = String::new();
-    if let (Some(power), true) = (w.opts.power, w.in_cut) {
-        let p = power.at_speed(tip_mm / t * 60.0, w.factor);
-        if w.power_changed(p) {
-            s_word = format!(" S{}", power_number(p));
-        }
-    }
+    let f = rs274_feed(&prev, &qp, t);
+    let s_word = w.s_word(tip_mm, t);
     let l = format!("G1 {} F{}{s_word}", w.axis_words(&q), feed_number(f));
     w.line(&l);
     w.last = Some(qp);

@@ -35,7 +35,7 @@ use kerf_kinematics::{Machine, Parameter};
 use nalgebra::{Point3, Vector3};
 
 use super::super::rules::Rules;
-use super::super::writer::{feed_number, Writer};
+use super::super::writer::{feed_number, rs274_feed, Writer};
 use super::super::{LaserPower, ProcessCodes};
 use super::Linuxcnc;
 use crate::block::Block;
@@ -168,30 +168,6 @@ pub fn linuxcnc_kinematics(machine: &Machine) -> Result<LinuxcncKinematics> {
     })
 }
 
-/// The ends of the `G0` pieces of a rapid from the axes `from` to `to` (the last is `to`):
-/// `2^k` equal pieces in joint space, the fewest (at most [`RAPID_TCP_MAX_PIECES`]) whose tip
-/// chords lie within [`RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's
-/// middle.
-pub(super) fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> Vec<[f64; 5]> {
-    let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| from[k] + f * (to[k] - from[k])) };
-    let mut n = 1;
-    loop {
-        let within = (0..n).all(|i| {
-            let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
-            let (ta, tb) = (model.tip(&at(a)), model.tip(&at(b)));
-            let mid = model.tip(&at((a + b) / 2.0));
-            (nalgebra::center(&ta, &tb) - mid).norm() <= RAPID_TCP_TOLERANCE_MM
-        });
-        if within || n >= RAPID_TCP_MAX_PIECES {
-            break;
-        }
-        n *= 2;
-    }
-    (1..=n)
-        .map(|i| if i == n { *to } else { at(i as f64 / n as f64) })
-        .collect()
-}
-
 /// LinuxCNC with its own tool-tip kinematics.
 pub(in crate::output) struct LinuxcncTcp;
 
@@ -255,20 +231,7 @@ impl Rules for LinuxcncTcp {
     }
 
     fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
-        // LinuxCNC moves the tip straight between G0 ends: pieces along the joint-space
-        // traverse kerf checked, the last ending exactly at `p`.
-        let pieces = match w.last_axes {
-            Some(from) => rapid_pieces(w.model, &from, &q),
-            None => vec![q],
-        };
-        let n = pieces.len();
-        for (i, a) in pieces.into_iter().enumerate() {
-            let tip = if i + 1 == n { p } else { w.model.tip(&a) };
-            let l = format!("G0 {}", tcp_words(w, &tip, a[3], a[4]));
-            w.line(&l);
-        }
-        w.last = Some(w.printed(&[p.x, p.y, p.z, q[3], q[4]]));
-        w.last_axes = Some(q);
+        w.tip_rapid("G0", p, q, |w, tip, a| tcp_words(w, tip, a[3], a[4]));
     }
 
     fn pierce_beam_on(&self, line: String) -> String {
@@ -351,14 +314,8 @@ fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64) {
         return;
     }
     let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
-    let lin = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    let len = if lin > 0.0 {
-        lin
-    } else {
-        (d[3] * d[3] + d[4] * d[4]).sqrt()
-    };
     // The feed is the same on every piece: the pieces split the move evenly in time.
-    let f = feed_number(len / t * 60.0);
+    let f = feed_number(rs274_feed(&prev, &now, t));
     match (w.opts.power.is_some() && w.in_cut, from) {
         (true, Some(from)) => {
             let words = |w: &Writer<'_>, fr: f64| -> String {

@@ -49,11 +49,10 @@ mod writer;
 
 pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};
 pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
-pub use dialects::{
-    linuxcnc_kinematics, LinuxcncKinematics, RAPID_TCP_MAX_PIECES, RAPID_TCP_TOLERANCE_MM,
-};
+pub use dialects::{linuxcnc_kinematics, LinuxcncKinematics};
 pub use power::LaserPower;
 use writer::Writer;
+pub use writer::{RAPID_TCP_MAX_PIECES, RAPID_TCP_TOLERANCE_MM};
 
 /// Where the tolerance budget's `chord` term (the cutting points' chord error against the
 /// designed curve) comes from. A program states it in its header; only a bound kerf proved

@@ -14,6 +14,19 @@ use super::{comment_text, ChordTerm, GcodeOptions, ProcessCodes};
 /// writer does not write it again: 0.5 %, a tenth of what the power check allows.
 pub(super) const POWER_STEP: f64 = 0.005;
 
+/// How far (mm) the tip of a tool-tip dialect's rapid (`linuxcnc-tcp`, `fanuc`) may run from
+/// kerf's joint-space traverse at the middle of each `G0`: LinuxCNC (and Fanuc, by a machine
+/// parameter) moves the tip on a straight line between the `G0` ends (with the rotary axes
+/// linear, as in joint space), so a traverse is split until each
+/// piece's tip chord is this close to the joint-space path at its middle. For fixed rotary axes
+/// the head is rigid with the tip, so the whole head runs within it of the checked traverse
+/// (to second order between the middles).
+pub const RAPID_TCP_TOLERANCE_MM: f64 = 0.1;
+
+/// The most pieces a rapid is split into (a bound that rounding cannot defeat: the split
+/// doubles from one piece and stops here).
+pub const RAPID_TCP_MAX_PIECES: usize = 256;
+
 /// The state of one program being written.
 pub(super) struct Writer<'a> {
     pub(super) model: &'a dyn AxisModel,
@@ -517,8 +530,8 @@ pub(super) fn digital_output(line: &str) -> Option<(u32, u32)> {
 }
 
 /// The ends of the `G0` pieces of a rapid from the axes `from` to `to` (the last is `to`):
-/// `2^k` equal pieces in joint space, the fewest (at most [`super::RAPID_TCP_MAX_PIECES`]) whose tip
-/// chords lie within [`super::RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's
+/// `2^k` equal pieces in joint space, the fewest (at most [`RAPID_TCP_MAX_PIECES`]) whose tip
+/// chords lie within [`RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's
 /// middle.
 fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> Vec<[f64; 5]> {
     let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| from[k] + f * (to[k] - from[k])) };
@@ -528,9 +541,9 @@ fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> Vec<[f
             let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
             let (ta, tb) = (model.tip(&at(a)), model.tip(&at(b)));
             let mid = model.tip(&at((a + b) / 2.0));
-            (nalgebra::center(&ta, &tb) - mid).norm() <= super::RAPID_TCP_TOLERANCE_MM
+            (nalgebra::center(&ta, &tb) - mid).norm() <= RAPID_TCP_TOLERANCE_MM
         });
-        if within || n >= super::RAPID_TCP_MAX_PIECES {
+        if within || n >= RAPID_TCP_MAX_PIECES {
             break;
         }
         n *= 2;

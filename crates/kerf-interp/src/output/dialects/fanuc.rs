@@ -11,7 +11,7 @@
 //! `S` is the common one). Rapids: `G00` under tool center point control moves the tip
 //! straight or the axes linearly by the machine's parameter; either way each rapid is split so
 //! that it follows kerf's checked joint-space traverse (its pieces' ends lie on it, the tip
-//! chords within [`super::RAPID_TCP_TOLERANCE_MM`] of it).
+//! chords within [`crate::RAPID_TCP_TOLERANCE_MM`] of it).
 
 use nalgebra::{Point3, Vector3};
 
@@ -75,7 +75,7 @@ impl Rules for Fanuc {
             format!("kerf Fanuc program: tool center point control, X Y Z the tool tip in the workpiece frame G54, {words}"),
             format!(
                 "feed: G94, F in mm/min of the tool tip, the block's mean planned speed; where the tip stands F is deg/min of the rotary motion;\nfeed: look-ahead G05.1 Q1; its corner rounding is the machine's parameter, not this program's: the budget's controller_blending term assumes it no larger;\nfeed: rapids G00 split so that they follow kerf's joint-space traverse within {} mm",
-                super::RAPID_TCP_TOLERANCE_MM
+                crate::RAPID_TCP_TOLERANCE_MM
             ),
             "arcs written as G01 chords",
         )

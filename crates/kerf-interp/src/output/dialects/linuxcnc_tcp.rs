@@ -2,7 +2,7 @@
 //! workpiece frame and the rotary axes, `G94` with `F` the tip's mean planned speed of the
 //! block (deg/min of the rotary motion where the tip stands), `G64 P<q> Q0` on cuts and `G61`
 //! on rapids, each rapid split so that its tip follows kerf's joint-space traverse within
-//! [`RAPID_TCP_TOLERANCE_MM`]; comments, beam, power, micro-joints and footer as `linuxcnc`
+//! [`RAPID_TCP_TOLERANCE_MM`](crate::RAPID_TCP_TOLERANCE_MM); comments, beam, power, micro-joints and footer as `linuxcnc`
 //! (no controller kerf compensation). Below: which kinematics module computes a kerf machine,
 //! with which HAL parameters.
 //!
@@ -41,18 +41,6 @@ use super::Linuxcnc;
 use crate::block::Block;
 use crate::error::{InterpError, Result};
 use crate::model::AxisModel;
-
-/// How far (mm) the tip of a `linuxcnc-tcp` rapid may run from kerf's joint-space traverse at
-/// the middle of each `G0`: LinuxCNC moves the tip on a straight line between the `G0` ends
-/// (with the rotary axes linear, as in joint space), so a traverse is split until each
-/// piece's tip chord is this close to the joint-space path at its middle. For fixed rotary axes
-/// the head is rigid with the tip, so the whole head runs within it of the checked traverse
-/// (to second order between the middles).
-pub const RAPID_TCP_TOLERANCE_MM: f64 = 0.1;
-
-/// The most pieces a rapid is split into (a bound that rounding cannot defeat: the split
-/// doubles from one piece and stops here).
-pub const RAPID_TCP_MAX_PIECES: usize = 256;
 
 /// A LinuxCNC kinematics module that computes a kerf machine: its name and the HAL pins a
 /// configuration sets (`setp <module>.<pin> <value>`).
@@ -215,7 +203,8 @@ impl Rules for LinuxcncTcp {
                 n[3], n[4]
             ),
             format!(
-                "feed: G94, F in mm/min of the tool tip [the kinematics' world X Y Z], the block's mean planned speed;\nfeed: on blocks where the tip stands F is deg/min of the rotary motion;\nfeed: rapids G0 in exact path G61, split so that the tip follows kerf's joint-space traverse within {RAPID_TCP_TOLERANCE_MM} mm"
+                "feed: G94, F in mm/min of the tool tip [the kinematics' world X Y Z], the block's mean planned speed;\nfeed: on blocks where the tip stands F is deg/min of the rotary motion;\nfeed: rapids G0 in exact path G61, split so that the tip follows kerf's joint-space traverse within {} mm",
+                crate::RAPID_TCP_TOLERANCE_MM
             ),
             "arcs written as G1 chords",
         )

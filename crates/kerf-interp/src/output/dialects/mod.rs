@@ -12,7 +12,5 @@ pub(super) use fanuc::Fanuc;
 pub(super) use generic::Generic;
 pub(super) use linuxcnc::Linuxcnc;
 pub(super) use linuxcnc_tcp::LinuxcncTcp;
-pub use linuxcnc_tcp::{
-    linuxcnc_kinematics, LinuxcncKinematics, RAPID_TCP_MAX_PIECES, RAPID_TCP_TOLERANCE_MM,
-};
+pub use linuxcnc_tcp::{linuxcnc_kinematics, LinuxcncKinematics};
 pub(super) use sinumerik::Sinumerik;

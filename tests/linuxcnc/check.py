@@ -9,8 +9,8 @@
    warnings alike) fails the check.
 2. The simulator runs (`SIMS` below: a flat part and a tilted-head part, and `simulate_kerf`: the
    flat part with LinuxCNC's own kerf compensation against kerf's; `simulate_tcp`: tool-tip
-   programs on LinuxCNC's own `xyzac-trt-kins` beside their joint-space twins, and a negative
-   control that must fail): a headless LinuxCNC
+   programs on LinuxCNC's own `xyzac-trt-kins` and `5axiskins` beside their joint-space twins,
+   and a negative control per module that must fail): a headless LinuxCNC
    (configuration from `make_config.py`, DISPLAY = `display.py`, run by an unprivileged user)
    executes the program while `halsampler` records the joints and the beam output every servo
    cycle; `lcnc_measure` (Rust, kerf's forward kinematics) measures the samples; the asserts are
@@ -348,8 +348,8 @@ def simulate_kerf(kerf, measure, outdir):
     return fig
 
 
-# Issue 30: tool-tip programs executed by LinuxCNC's own tool-tip kinematics (xyzac-trt-kins,
-# an implementation of the machine's inverse kinematics independent of kerf's): the joints it
+# Issue 30: tool-tip programs executed by LinuxCNC's own tool-tip kinematics (xyzac-trt-kins
+# and 5axiskins, implementations of the machines' inverse kinematics independent of kerf's): the joints it
 # computes go through kerf's *forward* kinematics in lcnc_measure and must put the tip on kerf's
 # path within the budget. Each fixture runs twice, as a joint-space program (trivkins) and as
 # a tool-tip program, for LinuxCNC's time against kerf's plan side by side.

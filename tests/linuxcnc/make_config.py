@@ -151,8 +151,8 @@ def main():
             f"MIN_LIMIT = {lo:.6f}",
             f"MAX_LIMIT = {hi:.6f}",
         ]
-        # Under tool-tip kinematics the axes are the tip in the workpiece frame: bounded by
-        # the joints' travel, not by their own (the joints keep theirs).
+        # Under tool-tip kinematics the axes are the tip in the workpiece frame: given a wide
+        # range (WORLD_RANGE), so that the joints' own limits are what binds.
         world = [f"MIN_LIMIT = {-WORLD_RANGE:.6f}", f"MAX_LIMIT = {WORLD_RANGE:.6f}"] if tcp and j < 3 else common[2:]
         ini += [f"[AXIS_{name}]"] + common[:2] + world
         ini += [f"[JOINT_{j}]", f"TYPE = {'LINEAR' if j < 3 else 'ANGULAR'}"] + common + [

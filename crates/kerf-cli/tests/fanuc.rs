@@ -67,16 +67,26 @@ fn check_syntax(p: &str, ijk: bool, tilt: char) {
     );
     assert_eq!(*lines.last().expect("lines"), "%", "tape end");
     let tcp = if ijk { "G43.5 H1" } else { "G43.4 H1" };
-    let at = |l: &str| lines.iter().position(|x| *x == l);
+    let at = |l: &str| {
+        lines
+            .iter()
+            .position(|x| *x == l)
+            .unwrap_or_else(|| panic!("no {l} block"))
+    };
     let (on, off, end) = (at(tcp), at("G49"), at("M30"));
     let is_move = |l: &&str| l.starts_with("G00 ") || l.starts_with("G01 ");
-    let first_move = lines.iter().position(is_move);
-    let last_move = lines.iter().rposition(is_move);
+    let first_move = lines.iter().position(is_move).expect("moves");
+    let last_move = lines.iter().rposition(is_move).expect("moves");
     assert!(
         on < first_move && last_move < off && off < at("G05.1 Q0") && at("G05.1 Q0") < end,
         "TCP on before the first move, G49 and G05.1 Q0 after the last, then M30"
     );
     assert!(at("G05.1 Q1") < on, "look-ahead on before TCP");
+    // `%` ends the record on a Fanuc control: only the first and the last line.
+    assert!(
+        lines[1..lines.len() - 1].iter().all(|l| !l.contains('%')),
+        "a % inside the program"
+    );
     let position: Vec<char> = if ijk {
         vec!['X', 'Y', 'Z', 'I', 'J', 'K']
     } else {
@@ -126,7 +136,11 @@ fn check_syntax(p: &str, ijk: bool, tilt: char) {
                     "{l}: power %"
                 )
             }
-            Some("G04") => assert!(letters == ['G', 'X'] && w[1].1 > 0.0, "{l}: seconds"),
+            // Seconds with a decimal point (without one Fanuc reads milliseconds).
+            Some("G04") => assert!(
+                letters == ['G', 'X'] && w[1].1 > 0.0 && l.contains('.'),
+                "{l}: seconds"
+            ),
             _ => panic!("a block a Fanuc TCP program of kerf does not write: {l}"),
         }
         if ijk && is_move(l) {

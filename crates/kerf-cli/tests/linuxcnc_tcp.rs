@@ -1,10 +1,11 @@
 //! The `linuxcnc-tcp` dialect (issue 30) against LinuxCNC 2.9's own tool-tip kinematics,
-//! `xyzac-trt-kins`, written here from its published formulas
-//! (`src/emc/kinematics/trtfuncs.c`, `xyzacKinematicsForward`/`Inverse`), not from kerf's
-//! code: kerf's table-table with `conventional: false` is that module; a tool-tip program put
-//! through the module's inverse is the joint-space program kerf writes for the same job, line
-//! by line; the feed is the tip's at kerf's planned time; the rapids follow kerf's joint-space
-//! traverses within `RAPID_TCP_TOLERANCE_MM`; other machines are refused by name. The
+//! `xyzac-trt-kins` and `5axiskins`, written here from their published formulas
+//! (`src/emc/kinematics/trtfuncs.c`, `xyzacKinematicsForward`/`Inverse`; `5axiskins.c`), not
+//! from kerf's code: kerf's table-table with `conventional: false` and its B fork head with
+//! `tilt_sign` -1 are those modules; a tool-tip program put through the module's inverse is the
+//! joint-space program kerf writes for the same job, line by line; the feed is the tip's at
+//! kerf's planned time; the rapids follow kerf's joint-space traverses within
+//! `RAPID_TCP_TOLERANCE_MM`; other machines are refused by name. The
 //! controller's execution is checked in tests/linuxcnc/check.py.
 
 mod common;
@@ -351,13 +352,17 @@ fn tool_tip_rapids_follow_the_traverses(m: &Module) {
             "joint-space G0 target {q:?} missing"
         );
     }
-    // Between consecutive G0 ends LinuxCNC moves the tip straight; kerf's traverse is linear in
-    // the joints: their middles within the tolerance.
+    // Between a G0's start (the last move's end) and its end LinuxCNC moves the tip straight;
+    // kerf's traverse is linear in the joints: their middles within the tolerance, for every
+    // G0 piece (the first from where the cut before it ended).
     let mut worst = 0.0f64;
     let mut pieces = 0;
-    let lines: Vec<&str> = tcp.lines().collect();
+    let lines: Vec<&str> = tcp
+        .lines()
+        .filter(|l| l.starts_with("G0 ") || l.starts_with("G1 "))
+        .collect();
     for w in lines.windows(2) {
-        if !(w[0].starts_with("G0 ") && w[1].starts_with("G0 ")) {
+        if !w[1].starts_with("G0 ") {
             continue;
         }
         pieces += 1;

@@ -177,12 +177,14 @@ pub enum InterpError {
     /// the machine file.
     #[error("{0}")]
     Process(String),
-    /// A program for a dialect that gives the raw machine axes (`generic`, `linuxcnc`: the
-    /// controller interpolates every axis linearly between blocks) holds an arc or a line merged
-    /// over several poses: its chords would move the rotary axes in steps the kinematics never
-    /// checked against the linearization tolerance. Fix: fit the blocks with `arcs` and
-    /// `merge_lines` off for such dialects (`kerf_pipeline::fit_options` does), or use a
-    /// dialect with tool-tip control (Sinumerik TRAORI).
+    /// A program for a dialect whose blocks join neighbouring poses only holds an arc or a line
+    /// merged over several poses: the raw-axis dialects (`generic`, `linuxcnc`: the controller
+    /// interpolates every axis linearly, so the chords would move the rotary axes in steps the
+    /// kinematics never checked against the linearization tolerance) and the tool-tip dialects
+    /// that interpolate the rotary axes or the tool direction linearly in each block
+    /// (`linuxcnc-tcp`, `fanuc`, `fanuc-ijk`: the tool axis would leave the poses). Fix: fit
+    /// the blocks with `arcs` and `merge_lines` off for such dialects
+    /// (`kerf_pipeline::fit_options` does), or use Sinumerik TRAORI.
     #[error(
         "{dialect} programs join neighbouring poses only, but block {block} is {what}: fit the motion with arcs and merged lines off for this dialect"
     )]
@@ -193,6 +195,22 @@ pub enum InterpError {
         block: usize,
         /// `an arc` or `a line merged over N poses`.
         what: String,
+    },
+    /// A rapid of a tool-tip dialect turns the rotary axes so far from the tip (many turns of
+    /// C far from its axis) that [`crate::RAPID_TCP_MAX_PIECES`] straight `G0` pieces of the
+    /// tip still leave the joint-space traverse kerf checked by more than
+    /// [`crate::RAPID_TCP_TOLERANCE_MM`]. Fix: place the part nearer the C axis, or use the
+    /// joint-space dialect of the controller.
+    #[error("{dialect}: a rapid needs more than {pieces} G0 pieces to stay within {tolerance_mm} mm of its checked traverse ({deviation_mm:.3} mm with {pieces})")]
+    RapidTooCurved {
+        /// The dialect's name.
+        dialect: &'static str,
+        /// The pieces tried.
+        pieces: usize,
+        /// The largest distance of a piece's middle from the traverse, mm.
+        deviation_mm: f64,
+        /// The tolerance, mm.
+        tolerance_mm: f64,
     },
     /// The dialect programs the tool tip for a controller that runs its own kinematics, and
     /// that controller has none that computes this machine as kerf does (or the model is not

@@ -84,7 +84,8 @@ pub const EXIT_RETRACT_MIN_MM: f64 = 1.0;
 pub use output::{
     csv_string, gcode, gcode_motion, gcode_timed, linuxcnc_kinematics, write_csv, write_csv_to,
     write_gcode, ChordTerm, CutterCompensation, Dialect, GcodeOptions, LaserPower,
-    LinuxcncKinematics, ProcessCodes, RAPID_TCP_MAX_PIECES, RAPID_TCP_TOLERANCE_MM,
+    LinuxcncKinematics, ProcessCodes, RAPID_TCP_MAX_PIECES, RAPID_TCP_MAX_STEP_DEG,
+    RAPID_TCP_TOLERANCE_MM,
 };
 pub use plan::{
     link_paths, link_paths_through, link_paths_with_retract, plan, plan_owned, CornerSlowdown,

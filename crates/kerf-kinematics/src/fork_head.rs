@@ -7,7 +7,7 @@
 //! that turns the other way, as LinuxCNC's `5axiskins` B).
 //!
 //! Inverse: the tilt and C from the tool axis (as for every type), then
-//! `XYZ = P - Rz(C) (d + R_tilt(t) (tx, ty, -L))`.
+//! `XYZ = P - Rz(C) (d + R_tilt(s t) (tx, ty, -L))`.
 
 use std::sync::Arc;
 

@@ -174,13 +174,13 @@ fn run_placed(
             tolerance_mm: dopts.tolerance_mm,
             in_control: o.kerf_in_control,
         });
-    // 1. Cutting points with a certified chord error. With a kerf, the contour's chords take
-    // 9/10 of the tolerance and the offset's own term the rest (docs/process.md, "Kerf
-    // compensation"): a hole's offset chords then need no more points.
     // A dialect that cannot program this machine is refused before any work.
     MachineModel::new(machine.clone())
         .and_then(|m| o.dialect.check_machine(&m))
         .map_err(interp(path))?;
+    // 1. Cutting points with a certified chord error. With a kerf, the contour's chords take
+    // 9/10 of the tolerance and the offset's own term the rest (docs/process.md, "Kerf
+    // compensation"): a hole's offset chords then need no more points.
     if kerf.as_ref().is_some_and(|k| k.in_control) && o.dialect != kerf_interp::Dialect::Linuxcnc {
         return Err(crate::Error::BadOption {
             name: "kerf_in_control",

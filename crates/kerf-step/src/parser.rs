@@ -644,7 +644,7 @@ fn decode_string(s: &str) -> String {
         return s.to_owned();
     }
     let hex_units = |hex: &str, width: usize| -> Option<Vec<u32>> {
-        if hex.len() % width != 0 {
+        if hex.len() % width != 0 || !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
             return None;
         }
         (0..hex.len() / width)
@@ -836,5 +836,10 @@ mod tests {
             "an odd X2 run is kept as written"
         );
         assert_eq!(decode_string("a\\S\\"), "a\\S\\", "S at the end, kept");
+        assert_eq!(
+            decode_string("\\X2\\+0E9\\X0\\"),
+            "\\X2\\+0E9\\X0\\",
+            "a sign is not a hex digit"
+        );
     }
 }

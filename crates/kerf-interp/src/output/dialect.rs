@@ -84,7 +84,7 @@ impl Dialect {
     /// |---|---|---|---|---|
     /// | linuxcnc, linuxcnc-tcp | `M64 P0` | `M65 P0` | 0.2 s | 1.5 mm |
     /// | generic | `M3` | `M5` | 0.2 s | 1.5 mm |
-    /// | sinumerik | `M3` | `M5` | 0.2 s | 1.5 mm |
+    /// | sinumerik, fanuc, fanuc-ijk | `M3` | `M5` | 0.2 s | 1.5 mm |
     ///
     /// LinuxCNC's `M64`/`M65` switch the output when every motion queued before them has
     /// finished (they break blending): the dwell after `M64` runs with the beam on and the

@@ -1,4 +1,4 @@
-//! Outputs: the set-points CSV of `formats.md` and G-code in four dialects (one file each under
+//! Outputs: the set-points CSV of `formats.md` and G-code in six dialects (one file each under
 //! `dialects/`, their decisions the `Rules` trait of `rules.rs`), written atomically.
 //!
 //! - **CSV**: header `t,X,Y,Z,<tilt>,C`, one row per cycle, `t` in seconds, axes in mm and
@@ -14,6 +14,9 @@
 //!   `F` the tip's mean planned speed of the block in mm/min (deg/min of the rotary motion on a
 //!   block where the tip stands), `G64 P<q> Q0` on cuts, `G61` on rapids, each rapid split so
 //!   that its tip follows kerf's joint-space traverse within [`RAPID_TCP_TOLERANCE_MM`].
+//! - **Fanuc** ([`Dialect::Fanuc`], [`Dialect::FanucIjk`]): tool center point control `G43.4`
+//!   (the tip with the rotary axes) or `G43.5` (with `I J K`, head machines only), `G05.1 Q1`,
+//!   `G94` tip feed, `S` power, `%` and `O1000` (`dialects/fanuc.rs`).
 //! - **Generic** ([`Dialect::Generic`]): raw machine axes, `G94` feed in the RS274/NGC sense:
 //!   `F` is mm/min of the combined X Y Z machine-axis motion (deg/min of the combined rotary
 //!   motion on blocks without X Y Z motion), chosen so that each block takes its planned time.
@@ -52,7 +55,7 @@ pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
 pub use dialects::{linuxcnc_kinematics, LinuxcncKinematics};
 pub use power::LaserPower;
 use writer::Writer;
-pub use writer::{RAPID_TCP_MAX_PIECES, RAPID_TCP_TOLERANCE_MM};
+pub use writer::{RAPID_TCP_MAX_PIECES, RAPID_TCP_MAX_STEP_DEG, RAPID_TCP_TOLERANCE_MM};
 
 /// Where the tolerance budget's `chord` term (the cutting points' chord error against the
 /// designed curve) comes from. A program states it in its header; only a bound kerf proved
@@ -548,6 +551,14 @@ pub fn gcode_timed<M: AxisModel>(
             });
         }
         w.rapid(p, q, u);
+    }
+    if let Some(deviation_mm) = w.rapid_too_curved {
+        return Err(InterpError::RapidTooCurved {
+            dialect: rules.name(),
+            pieces: RAPID_TCP_MAX_PIECES,
+            deviation_mm,
+            tolerance_mm: RAPID_TCP_TOLERANCE_MM,
+        });
     }
     if opts.power.is_some() {
         rules.power_off(&mut w);

@@ -20,9 +20,10 @@
 //!   they change where the next block starts) wherever the last ones written would misjudge
 //!   the block's tip travel by more than 0.5 %. They are linear in the joints' speeds, so the
 //!   controller's blends between two blocks are followed too. During the pierce `E1` holds
-//!   the pierce power (`M68`, immediate) and `E0` is 0.
-//! - **Generic**: an `S` word on every cutting block whose power changes, from kerf's planned
-//!   speed of the block (the block's tip length over its planned time).
+//!   the pierce power (`M68`, immediate) and `E0` is 0. **linuxcnc-tcp** writes the same: under
+//!   tool-tip kinematics the joints are still the machine's, and HAL reads the joints.
+//! - **Generic** and **Fanuc**: an `S` word on every cutting block whose power changes, from
+//!   kerf's planned speed of the block (the block's tip length over its planned time).
 //! - **Sinumerik**: Siemens' laser-power pattern, the polynomial `FCTDEF(1, P_min, 100, 0, k)`
 //!   evaluated every interpolation cycle on the path velocity by the synchronized action
 //!   `ID=1 WHENEVER TRUE DO SYNFCT(1, $A_OUTA[1], $AC_VACTW)` (`k` in percent per mm/min of

@@ -24,8 +24,17 @@ pub(super) const POWER_STEP: f64 = 0.005;
 pub const RAPID_TCP_TOLERANCE_MM: f64 = 0.1;
 
 /// The most pieces a rapid is split into (a bound that rounding cannot defeat: the split
-/// doubles from one piece and stops here).
-pub const RAPID_TCP_MAX_PIECES: usize = 256;
+/// doubles from one piece and stops here). A rapid that needs more (many turns of C far from
+/// the axis) is refused ([`crate::InterpError::RapidTooCurved`]), never written farther from
+/// its traverse than the header says.
+pub const RAPID_TCP_MAX_PIECES: usize = 4096;
+
+/// The most a rotary axis turns in one piece of a tool-tip rapid, degrees, before the
+/// middle-distance test: a piece that turns C by whole turns has its middle on its chord (the
+/// tip comes back), so the test alone would pass a two-turn rapid as one straight `G0`; on a
+/// piece of at most 10 degrees the tip's path is near a circular arc whose largest distance
+/// from its chord is at its middle.
+pub const RAPID_TCP_MAX_STEP_DEG: f64 = 10.0;
 
 /// The state of one program being written.
 pub(super) struct Writer<'a> {
@@ -38,14 +47,14 @@ pub(super) struct Writer<'a> {
     pub(super) s: String,
     /// The numbers last written as the controller reads them, for feed and zero-move
     /// decisions: the axis words (raw-axis dialects), or the tip's `X Y Z` and the rotary axes
-    /// (`linuxcnc-tcp`).
+    /// (the tool-tip dialects; Sinumerik keeps the axes).
     pub(super) last: Option<[f64; 5]>,
     pub(super) in_cut: bool,
     /// True while the controller's cutter compensation is on (`G41.1`/`G42.1` written).
     pub(super) compensating: bool,
     /// The last `F` written (Sinumerik, modal).
     pub(super) last_f: Option<String>,
-    /// The last power value written in this cut (LinuxCNC's scale `E0`, the generic `S`).
+    /// The last power value written in this cut (LinuxCNC's scale `E0`, an `S`).
     pub(super) last_power: Option<f64>,
     /// The power factor of the path being cut (a small hole's; 1 otherwise).
     pub(super) factor: f64,
@@ -66,9 +75,12 @@ pub(super) struct Writer<'a> {
     /// The header lines the dialect's [`Rules::machine_lines`] gave (what the controller must
     /// be set up with).
     pub(super) machine_lines: Vec<String>,
-    /// The machine axes where the last move ended (`linuxcnc-tcp`: the start of the next
-    /// rapid's joint-space path).
+    /// The machine axes where the last move ended (the tool-tip dialects: the start of the
+    /// next rapid's joint-space path).
     pub(super) last_axes: Option<[f64; 5]>,
+    /// The largest distance (mm) of a tool-tip rapid's piece from its joint-space traverse,
+    /// where [`RAPID_TCP_MAX_PIECES`] were not enough: the program is refused.
+    pub(super) rapid_too_curved: Option<f64>,
 }
 
 impl<'a> Writer<'a> {
@@ -101,6 +113,7 @@ impl<'a> Writer<'a> {
             path_s: 0.0,
             machine_lines,
             last_axes: None,
+            rapid_too_curved: None,
         }
     }
 
@@ -497,7 +510,16 @@ impl<'a> Writer<'a> {
         words: impl Fn(&Self, &nalgebra::Point3<f64>, &[f64; 5]) -> String,
     ) {
         let pieces = match self.last_axes {
-            Some(from) => rapid_pieces(self.model, &from, &q),
+            Some(from) => {
+                let (pieces, worst) = rapid_pieces(self.model, &from, &q);
+                // False for NaN too (an unusable model): refused.
+                let within = worst <= RAPID_TCP_TOLERANCE_MM;
+                if !within {
+                    let d = if worst.is_nan() { f64::INFINITY } else { worst };
+                    self.rapid_too_curved = Some(self.rapid_too_curved.map_or(d, |w| w.max(d)));
+                }
+                pieces
+            }
             None => vec![q],
         };
         let n = pieces.len();
@@ -530,27 +552,48 @@ pub(super) fn digital_output(line: &str) -> Option<(u32, u32)> {
 }
 
 /// The ends of the `G0` pieces of a rapid from the axes `from` to `to` (the last is `to`):
-/// `2^k` equal pieces in joint space, the fewest (at most [`RAPID_TCP_MAX_PIECES`]) whose tip
-/// chords lie within [`RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's
-/// middle.
-fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> Vec<[f64; 5]> {
+/// `2^k` equal pieces in joint space, the fewest (at most [`RAPID_TCP_MAX_PIECES`]) that turn
+/// no rotary axis by more than [`RAPID_TCP_MAX_STEP_DEG`] and whose tip chords lie within
+/// [`RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's middle; with the
+/// largest middle distance of the pieces returned (above the tolerance, or infinite, only when
+/// [`RAPID_TCP_MAX_PIECES`] were not enough).
+fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> (Vec<[f64; 5]>, f64) {
     let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| from[k] + f * (to[k] - from[k])) };
-    let mut n = 1;
-    loop {
-        let within = (0..n).all(|i| {
-            let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
-            let (ta, tb) = (model.tip(&at(a)), model.tip(&at(b)));
-            let mid = model.tip(&at((a + b) / 2.0));
-            (nalgebra::center(&ta, &tb) - mid).norm() <= RAPID_TCP_TOLERANCE_MM
-        });
-        if within || n >= RAPID_TCP_MAX_PIECES {
-            break;
+    let turn = (to[3] - from[3]).abs().max((to[4] - from[4]).abs());
+    let steps = (turn / RAPID_TCP_MAX_STEP_DEG).ceil();
+    // False for NaN too.
+    let fits = steps <= RAPID_TCP_MAX_PIECES as f64;
+    if !fits {
+        return (vec![*to], f64::INFINITY);
+    }
+    let mut n = (steps as usize).max(1).next_power_of_two();
+    let worst = loop {
+        let worst = (0..n)
+            .map(|i| {
+                let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+                let (ta, tb) = (model.tip(&at(a)), model.tip(&at(b)));
+                let mid = model.tip(&at((a + b) / 2.0));
+                (nalgebra::center(&ta, &tb) - mid).norm()
+            })
+            // NaN wins (f64::max would drop it).
+            .fold(0.0, |a: f64, b| {
+                if a.is_nan() || b.is_nan() {
+                    f64::NAN
+                } else {
+                    a.max(b)
+                }
+            });
+        // NaN (an unusable model) stops the split too; the caller refuses it.
+        let over = worst > RAPID_TCP_TOLERANCE_MM;
+        if !over || n >= RAPID_TCP_MAX_PIECES {
+            break worst;
         }
         n *= 2;
-    }
-    (1..=n)
+    };
+    let pieces = (1..=n)
         .map(|i| if i == n { *to } else { at(i as f64 / n as f64) })
-        .collect()
+        .collect();
+    (pieces, worst)
 }
 
 /// The feed of a move from `prev` to `now` (printed `X Y Z` and rotary axes) taking `t`
@@ -620,4 +663,64 @@ pub(super) fn pierce_point<M: AxisModel + ?Sized>(
         b.start_axes
     };
     (pierce, q, u)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn trunnion() -> crate::MachineModel {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/machines/xyzac_trt.json"
+        );
+        crate::MachineModel::new(kerf_kinematics::Machine::read(path).expect("machine"))
+            .expect("model")
+    }
+
+    #[test]
+    fn rapids_are_split_until_their_tip_follows_the_traverse_or_refused() {
+        let m = trunnion();
+        // A straight move of the linear axes alone: one piece, on the traverse.
+        let (p, worst) = rapid_pieces(&m, &[0.0; 5], &[100.0, 50.0, 20.0, 0.0, 0.0]);
+        assert_eq!(p.len(), 1);
+        assert!(worst < 1e-9, "{worst}");
+        // Half a turn of C with the tip 200 mm from the C axis: the tip's circle, split into
+        // pieces of at most 10 degrees and then until every piece's middle is within the
+        // tolerance, by the fewest halvings.
+        let from = [200.0, 0.0, 0.0, 0.0, 0.0];
+        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 180.0]);
+        assert!(worst <= RAPID_TCP_TOLERANCE_MM, "{worst}");
+        // The tip turns about the C axis through rot_point (3, -2) of xyzac_trt.json.
+        let t = m.tip(&from);
+        let r = (t.x - 3.0).hypot(t.y + 2.0);
+        // An arc of `turn` degrees and radius r in n pieces has its chords' middles
+        // r (1 - cos(turn / 2n)) inside it: the fewest n = 2^k with pieces of at most 10
+        // degrees and that at most 0.1 mm.
+        let need = |turn: f64| {
+            (0..20)
+                .map(|k| 1usize << k)
+                .find(|n| {
+                    let piece = turn / *n as f64;
+                    piece <= RAPID_TCP_MAX_STEP_DEG
+                        && r * (1.0 - (piece.to_radians() / 2.0).cos()) <= 0.1
+                })
+                .expect("a count")
+        };
+        assert_eq!(p.len(), need(180.0), "r = {r}");
+        // Two whole turns: the tip comes back to its start at the middle too, yet the rapid
+        // swings it round twice; pieces of 10 degrees see the circle.
+        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 720.0]);
+        assert_eq!(p.len(), need(720.0), "r = {r}");
+        assert!(worst <= RAPID_TCP_TOLERANCE_MM, "{worst}");
+        // A hundred turns at the same distance: 4096 pieces of 8.8 degrees leave 0.59 mm, more
+        // than RAPID_TCP_MAX_PIECES would be needed: the distance left is reported, and the
+        // writer refuses the program.
+        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 36000.0]);
+        assert_eq!(p.len(), RAPID_TCP_MAX_PIECES);
+        assert!(worst > RAPID_TCP_TOLERANCE_MM, "{worst}");
+        // Two thousand turns cannot even be cut into 10-degree pieces: refused at once.
+        let (_, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 720000.0]);
+        assert!(worst.is_infinite());
+    }
 }

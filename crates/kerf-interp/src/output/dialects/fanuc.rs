@@ -9,9 +9,12 @@
 //! the machine's parameter, not the program's: the header says so. Power as `S` per block
 //! from kerf's planned tip speed (a laser's power channel on Fanuc is the machine builder's;
 //! `S` is the common one). Rapids: `G00` under tool center point control moves the tip
-//! straight or the axes linearly by the machine's parameter; either way each rapid is split so
-//! that it follows kerf's checked joint-space traverse (its pieces' ends lie on it, the tip
-//! chords within [`crate::RAPID_TCP_TOLERANCE_MM`] of it).
+//! straight or the axes linearly by the machine's parameter; under `G43.4` either way each
+//! rapid is split so that it follows kerf's checked joint-space traverse (its pieces' ends lie
+//! on it, the tip chords within [`crate::RAPID_TCP_TOLERANCE_MM`] of it). Under `G43.5` the
+//! control chooses the rotary solution of each `I J K` itself: the traverse holds where it
+//! chooses kerf's (the nearest, as kerf does), and where the tip stands the feed kerf writes
+//! is deg/min of kerf's rotary motion, which the program does not name.
 
 use nalgebra::{Point3, Vector3};
 
@@ -42,8 +45,10 @@ impl Rules for Fanuc {
         true
     }
 
+    /// `( ... )`, with `%` written `pct`: a Fanuc control reads `%` as the end of the record
+    /// (the tape end), wherever it stands.
     fn comment(&self, text: &str) -> String {
-        format!("({text})")
+        format!("({})", text.replace('%', "pct"))
     }
 
     fn machine_lines(&self, model: &dyn AxisModel) -> Result<Vec<String>> {
@@ -100,8 +105,10 @@ impl Rules for Fanuc {
         w.tip_rapid("G00", p, q, |w, tip, a| self.words(w, tip, a));
     }
 
+    /// `G04 X` in seconds, always with a decimal point: a Fanuc control reads `X1` without
+    /// one in its least input increment (1 ms), so a 1 s dwell would run 1000 times too short.
     fn dwell(&self, s: f64) -> String {
-        format!("G04 X{s}")
+        format!("G04 X{s:.3}")
     }
 
     fn descent(

@@ -130,7 +130,7 @@ pub fn linuxcnc_kinematics(machine: &Machine) -> Result<LinuxcncKinematics> {
     let tool = number("tool_offset").unwrap_or(f64::NAN);
     if tool != 0.0 {
         return refuse(format!(
-            "kinematics.tool_offset is {tool}: xyzac-trt-kins adds the tool length back at the pivot and LinuxCNC applies its own length offset; give the tool length to the controller (G43) and 0 here"
+            "kinematics.tool_offset is {tool}: xyzac-trt-kins adds the tool length back at the pivot, which kerf's table-table does not; kerf's programs cancel the controller's length offset (G49), so the focus must be the machine's reference: tool_offset 0"
         ));
     }
     let (Some(Parameter::Numbers(rot)), Some(y), Some(z)) =

@@ -63,12 +63,6 @@ impl Dialect {
         self.rules().name()
     }
 
-    /// True for the dialects whose `X Y Z` are the tool tip in the workpiece frame (the
-    /// controller runs the kinematics).
-    pub fn tool_tip(self) -> bool {
-        self.rules().tool_tip()
-    }
-
     /// True for the dialects whose blocks join neighbouring poses only: no arcs, no lines
     /// merged over several poses. The raw-axis dialects (the controller interpolates the axes
     /// linearly, so only the poses' checked non-linearity holds) and `linuxcnc-tcp` (LinuxCNC

@@ -25,12 +25,6 @@ pub(super) trait Rules: Sync {
         true
     }
 
-    /// True where `X Y Z` are the tool tip in the workpiece frame (the controller runs the
-    /// kinematics).
-    fn tool_tip(&self) -> bool {
-        false
-    }
-
     /// The beam codes used where the machine file names none: `(on, off)`.
     fn beam_codes(&self) -> (&'static str, &'static str) {
         ("M3", "M5")
@@ -106,21 +100,31 @@ pub(super) trait Rules: Sync {
     /// The cutting block `b`, taking `t` seconds.
     fn cut(&self, w: &mut Writer<'_>, b: &Block, t: f64);
 
-    /// The pierce power before the beam comes on.
-    fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower);
+    /// The pierce power before the beam comes on: `S<percent>` by default (the cutting moves
+    /// then carry `S` where the planned power changes, [`Writer::s_word`]).
+    fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower) {
+        let l = format!("S{}", Writer::pierce_number(power));
+        w.line(&l);
+    }
 
-    /// The cut's power rule after the dwell, before the descent.
-    fn cut_power(&self, w: &mut Writer<'_>, power: &LaserPower);
+    /// The cut's power rule after the dwell, before the descent: nothing by default (the `S`
+    /// words come with the moves).
+    fn cut_power(&self, _w: &mut Writer<'_>, _power: &LaserPower) {}
 
-    /// The power outputs back to zero at the end.
-    fn power_off(&self, w: &mut Writer<'_>);
+    /// The power back to zero at the end: `S0` by default.
+    fn power_off(&self, w: &mut Writer<'_>) {
+        w.line("S0");
+    }
 
     /// The lines that switch the beam off and on again over a micro-joint (synchronized with
-    /// motion), or why the dialect cannot.
+    /// motion), or why the dialect cannot: the machine's own beam codes between the blocks by
+    /// default.
     fn joint_codes(
         &self,
         process: &ProcessCodes,
-    ) -> std::result::Result<(Vec<String>, Vec<String>), &'static str>;
+    ) -> std::result::Result<(Vec<String>, Vec<String>), &'static str> {
+        Ok((process.beam_off.clone(), process.beam_on.clone()))
+    }
 
     /// True where the controller's kerf compensation can be written (`G41.1`/`G42.1`).
     fn controller_compensation(&self) -> bool {

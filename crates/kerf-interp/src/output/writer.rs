@@ -162,8 +162,9 @@ impl<'a> Writer<'a> {
         q.map(|v| self.num(v).parse().unwrap_or(v))
     }
 
-    /// The move to `q` as printed and the position it starts from (the last printed, or
-    /// `q`'s where nothing was written yet): `None` where the printed axes do not change.
+    /// The move to `q` (axes, or the tip and the rotary axes) as printed and the position it
+    /// starts from (the last printed, or `q`'s where nothing was written yet): `None` where the
+    /// printed words do not change.
     pub(super) fn moved(&self, q: &[f64; 5]) -> Option<([f64; 5], [f64; 5])> {
         let qp = self.printed(q);
         let prev = self.last.unwrap_or(qp);

@@ -20,7 +20,6 @@ use nalgebra::{Point3, Vector3};
 
 use super::super::rules::Rules;
 use super::super::writer::{feed_number, rs274_feed, Writer};
-use super::super::{LaserPower, ProcessCodes};
 use super::linuxcnc_tcp::tcp_words;
 use crate::block::Block;
 use crate::error::{InterpError, Result};
@@ -39,10 +38,6 @@ impl Rules for Fanuc {
         } else {
             "fanuc"
         }
-    }
-
-    fn tool_tip(&self) -> bool {
-        true
     }
 
     /// `( ... )`, with `%` written `pct`: a Fanuc control reads `%` as the end of the record
@@ -129,24 +124,6 @@ impl Rules for Fanuc {
         });
     }
 
-    fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower) {
-        let l = format!("S{}", Writer::pierce_number(power));
-        w.line(&l);
-    }
-
-    fn cut_power(&self, _w: &mut Writer<'_>, _power: &LaserPower) {}
-
-    fn power_off(&self, w: &mut Writer<'_>) {
-        w.line("S0");
-    }
-
-    fn joint_codes(
-        &self,
-        process: &ProcessCodes,
-    ) -> std::result::Result<(Vec<String>, Vec<String>), &'static str> {
-        Ok((process.beam_off.clone(), process.beam_on.clone()))
-    }
-
     fn footer(&self, w: &mut Writer<'_>) {
         w.line("G49");
         w.line("G05.1 Q0");
@@ -180,12 +157,10 @@ impl Fanuc {
     /// the planned power as `S` where it changed; nothing if the printed position does not
     /// change.
     fn cut_move(&self, w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64, tip_mm: f64) {
-        let now = w.printed(&[tip.x, tip.y, tip.z, q[3], q[4]]);
-        let prev = w.last.unwrap_or(now);
         w.last_axes = Some(q);
-        if prev == now {
+        let Some((now, prev)) = w.moved(&[tip.x, tip.y, tip.z, q[3], q[4]]) else {
             return;
-        }
+        };
         let f = rs274_feed(&prev, &now, t);
         let s_word = w.s_word(tip_mm, t);
         let l = format!(

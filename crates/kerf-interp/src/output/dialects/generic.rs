@@ -7,7 +7,6 @@ use nalgebra::{Point3, Vector3};
 
 use super::super::rules::Rules;
 use super::super::writer::{feed_number, rs274_feed, Writer};
-use super::super::{LaserPower, ProcessCodes};
 use crate::block::Block;
 
 /// The generic dialect.
@@ -58,24 +57,6 @@ impl Rules for Generic {
 
     fn cut(&self, w: &mut Writer<'_>, b: &Block, t: f64) {
         w.block_pieces(b, t, |w, _, q, dt, tip_mm| axes_move(w, q, dt, tip_mm));
-    }
-
-    fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower) {
-        let l = format!("S{}", Writer::pierce_number(power));
-        w.line(&l);
-    }
-
-    fn cut_power(&self, _w: &mut Writer<'_>, _power: &LaserPower) {}
-
-    fn power_off(&self, w: &mut Writer<'_>) {
-        w.line("S0");
-    }
-
-    fn joint_codes(
-        &self,
-        process: &ProcessCodes,
-    ) -> std::result::Result<(Vec<String>, Vec<String>), &'static str> {
-        Ok((process.beam_off.clone(), process.beam_on.clone()))
     }
 
     fn footer(&self, w: &mut Writer<'_>) {

@@ -164,10 +164,6 @@ impl Rules for LinuxcncTcp {
         "linuxcnc-tcp"
     }
 
-    fn tool_tip(&self) -> bool {
-        true
-    }
-
     fn beam_codes(&self) -> (&'static str, &'static str) {
         Linuxcnc.beam_codes()
     }
@@ -296,12 +292,10 @@ pub(super) fn tcp_words(w: &Writer<'_>, tip: &Point3<f64>, tilt: f64, c: f64) ->
 /// speed from its joints as for the joint-space dialect: the same coefficients, the move in
 /// pieces of its own tip line.
 fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64) {
-    let now = w.printed(&[tip.x, tip.y, tip.z, q[3], q[4]]);
-    let prev = w.last.unwrap_or(now);
     let from = w.last_axes.replace(q);
-    if prev == now {
+    let Some((now, prev)) = w.moved(&[tip.x, tip.y, tip.z, q[3], q[4]]) else {
         return;
-    }
+    };
     let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
     // The feed is the same on every piece: the pieces split the move evenly in time.
     let f = feed_number(rs274_feed(&prev, &now, t));

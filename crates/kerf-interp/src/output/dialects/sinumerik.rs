@@ -25,10 +25,6 @@ impl Rules for Sinumerik {
         false
     }
 
-    fn tool_tip(&self) -> bool {
-        true
-    }
-
     fn describe(&self, _n: [&str; 5]) -> (String, String, &'static str) {
         (
             "kerf Sinumerik-style program: TRAORI, tool tip X Y Z and orientation vector A3 B3 C3 in workpiece coordinates".to_string(),

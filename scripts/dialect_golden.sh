@@ -10,7 +10,7 @@ K=./target/release/kerf
 TECH="--technology fixtures/technology/fiber_3kw_example.json --material stainless --thickness 2"
 for f in fixtures/*.json; do n=$(basename $f .json)
  for m in fixtures/machines/*.json; do mn=$(basename $m .json)
-  for d in generic sinumerik linuxcnc linuxcnc-tcp fanuc fanuc-ijk; do
+  for d in generic sinumerik linuxcnc linuxcnc-tcp fanuc fanuc-ijk heidenhain heidenhain-axes; do
    for v in plain tech; do
     extra=""; [ $v = tech ] && extra="$TECH"
     o="$OUT"/$n-$mn-$d-$v; $K run $f -m $m --dialect $d -o $o -q $extra >/dev/null 2>$o.err; echo $? > $o.rc

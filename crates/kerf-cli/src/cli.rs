@@ -402,6 +402,11 @@ pub(crate) enum DialectArg {
     Fanuc,
     /// Fanuc G43.5: tip X Y Z with the tool direction I J K (head machines only).
     FanucIjk,
+    /// HEIDENHAIN Klartext under FUNCTION TCPM: numbered LN X Y Z TX TY TZ blocks (tip and
+    /// tool direction), CYCL DEF 32 tolerance; no power that follows the speed.
+    Heidenhain,
+    /// HEIDENHAIN Klartext under FUNCTION TCPM with L X Y Z and the rotary axes.
+    HeidenhainAxes,
 }
 
 impl From<DialectArg> for kerf_interp::Dialect {
@@ -413,6 +418,8 @@ impl From<DialectArg> for kerf_interp::Dialect {
             DialectArg::LinuxcncTcp => Self::LinuxcncTcp,
             DialectArg::Fanuc => Self::Fanuc,
             DialectArg::FanucIjk => Self::FanucIjk,
+            DialectArg::Heidenhain => Self::Heidenhain,
+            DialectArg::HeidenhainAxes => Self::HeidenhainAxes,
         }
     }
 }

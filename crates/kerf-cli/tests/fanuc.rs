@@ -6,32 +6,16 @@
 //! seconds, `%` and an `O` number), not an execution.
 
 mod common;
-use common::{fixture, kerf};
+use common::{cut_lines, fixture, kerf, read_back_against_joints, run_program, ReadBack, TipMove};
 
-use kerf_kinematics::{Axes, Machine};
+use kerf_kinematics::Machine;
 
 fn program(curves: &str, machine: &str, dialect: &str) -> String {
     program_with(curves, machine, dialect, &[])
 }
 
 fn program_with(curves: &str, machine: &str, dialect: &str, extra: &[&str]) -> String {
-    let dir = tempfile::tempdir().expect("tmp");
-    let r = kerf()
-        .args(["run"])
-        .arg(fixture(curves))
-        .arg("-m")
-        .arg(fixture(machine))
-        .args(extra)
-        .args(["--dialect", dialect, "-q", "-o"])
-        .arg(dir.path())
-        .output()
-        .expect("kerf runs");
-    assert!(
-        r.status.success(),
-        "{dialect}: {}",
-        String::from_utf8_lossy(&r.stderr)
-    );
-    std::fs::read_to_string(dir.path().join("program.nc")).expect("program")
+    run_program(&fixture(curves), &fixture(machine), dialect, extra)
 }
 
 /// The words of a block: letter (with a `.`-suffix such as `G43.4` kept whole) and number.
@@ -153,23 +137,6 @@ fn check_syntax(p: &str, ijk: bool, tilt: char) {
     }
 }
 
-/// The cutting lines of a program, each cut after a mark (`None`).
-fn cut_lines(p: &str, on: &str, off: &str) -> Vec<Option<String>> {
-    let mut cut = false;
-    let mut out = Vec::new();
-    for l in p.lines() {
-        if l == on {
-            cut = true;
-            out.push(None);
-        } else if l == off {
-            cut = false;
-        } else if cut && (l.starts_with("G1 ") || l.starts_with("G01 ")) {
-            out.push(Some(l.to_string()));
-        }
-    }
-    out
-}
-
 fn round_trip(curves: &str, machine: &str, ijk: bool) {
     let m = Machine::read(fixture(machine)).expect("machine");
     let tilt = m.axis_names()[3].chars().next().expect("tilt");
@@ -177,78 +144,26 @@ fn round_trip(curves: &str, machine: &str, ijk: bool) {
     let fanuc = program(curves, machine, dialect);
     check_syntax(&fanuc, ijk, tilt);
     let joint = program(curves, machine, "linuxcnc");
-    let (f, j) = (
-        cut_lines(&fanuc, "M3", "M5"),
-        cut_lines(&joint, "M64 P0", "M65 P0"),
-    );
-    assert!(f.len() > 100, "{} cutting lines", f.len());
-    assert_eq!(f.len(), j.len(), "{dialect}: one line per joint-space line");
-    let mut prev: Option<[f64; 3]> = None;
-    let mut worst = (0.0f64, 0.0f64);
-    for (lf, lj) in f.iter().zip(&j) {
-        let (Some(lf), Some(lj)) = (lf, lj) else {
-            assert!(lf.is_none() && lj.is_none(), "the cuts line up");
-            prev = None;
-            continue;
-        };
-        let q = [
-            word(lj, 'X').expect("X"),
-            word(lj, 'Y').expect("Y"),
-            word(lj, 'Z').expect("Z"),
-            word(lj, tilt).expect("tilt"),
-            word(lj, 'C').expect("C"),
-        ];
-        let pose = m.kinematics.forward(&Axes::from_array(q));
-        let tip = [
-            word(lf, 'X').expect("X"),
-            word(lf, 'Y').expect("Y"),
-            word(lf, 'Z').expect("Z"),
-        ];
-        let dp = (0..3)
-            .map(|k| (tip[k] - pose.position[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let axis = if ijk {
-            [
-                word(lf, 'I').expect("I"),
-                word(lf, 'J').expect("J"),
-                word(lf, 'K').expect("K"),
-            ]
-        } else {
-            let (t, c) = (word(lf, tilt).expect("tilt"), word(lf, 'C').expect("C"));
-            assert!(
-                (t - q[3]).abs() < 2e-6 && (c - q[4]).abs() < 2e-6,
-                "{lf} vs {lj}"
-            );
-            let u = m
-                .kinematics
-                .forward(&Axes::from_array([0.0, 0.0, 0.0, t, c]))
-                .axis;
-            [u.x, u.y, u.z]
-        };
-        let da = (0..3)
-            .map(|k| (axis[k] - pose.axis[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        worst = (worst.0.max(dp), worst.1.max(da));
-        // F: the tip's travel over the joint line's planned time (60 / F in G93).
-        if let Some(pt) = prev {
-            let travel = (0..3).map(|k| (tip[k] - pt[k]).powi(2)).sum::<f64>().sqrt();
-            let time_s = 60.0 / word(lj, 'F').expect("F");
-            if travel > 1e-3 {
-                let feed = word(lf, 'F').expect("F");
-                let want = travel / time_s * 60.0;
-                assert!(
-                    (feed - want).abs() <= 2e-5 * feed + 1e-3 * 60.0 / time_s,
-                    "{lf}: F {feed} vs {want}"
-                );
-            }
-        }
-        prev = Some(tip);
-    }
+    let tilt = tilt.to_string();
+    let moves: Vec<Option<TipMove>> = cut_lines(&fanuc, "M3", "M5", |l| l.starts_with("G01 "))
+        .into_iter()
+        .map(|l| {
+            l.map(|l| {
+                TipMove::read(
+                    &l,
+                    ijk.then_some(["I", "J", "K"]),
+                    (!ijk).then_some([&tilt, "C"]),
+                )
+            })
+        })
+        .collect();
     // Six printed decimals of the joints through a ~300 mm lever: a few um.
-    assert!(worst.0 < 2e-5, "{dialect}: tip {} mm off", worst.0);
-    assert!(worst.1 < 1e-5, "{dialect}: direction {} off", worst.1);
+    let within = ReadBack {
+        tip_mm: 2e-5,
+        direction: 1e-5,
+        rotary_deg: 2e-6,
+    };
+    read_back_against_joints(&m, &moves, &joint, &within);
 }
 
 #[test]

@@ -182,7 +182,8 @@ pub enum InterpError {
     /// interpolates every axis linearly, so the chords would move the rotary axes in steps the
     /// kinematics never checked against the linearization tolerance) and the tool-tip dialects
     /// that interpolate the rotary axes or the tool direction linearly in each block
-    /// (`linuxcnc-tcp`, `fanuc`, `fanuc-ijk`: the tool axis would leave the poses). Fix: fit
+    /// (`linuxcnc-tcp`, `fanuc`, `fanuc-ijk`, `heidenhain`, `heidenhain-axes`: the tool axis
+    /// would leave the poses). Fix: fit
     /// the blocks with `arcs` and `merge_lines` off for such dialects
     /// (`kerf_pipeline::fit_options` does), or use Sinumerik TRAORI.
     #[error(

@@ -824,7 +824,7 @@ fn run_placed(
             "files": program_names(programs.len()),
         },
         "compensation": crate::cuts::compensation_json(file, kerf.as_ref(), &compensated),
-        "technology": technology_json(o.technology.as_ref(), &small_ids),
+        "technology": technology_json(o.technology.as_ref(), &small_ids, o.dialect.commands_power()),
         "micro_joints": o.micro_joints.map(|(length, spacing)| json!({
             "length_mm": length,
             "spacing_mm": spacing,
@@ -954,9 +954,15 @@ fn technology_header(t: Option<&kerf_kinematics::TechnologyEntry>) -> Vec<String
 fn technology_json(
     t: Option<&kerf_kinematics::TechnologyEntry>,
     small_holes: &[&str],
+    commands_power: bool,
 ) -> serde_json::Value {
     let Some(t) = t else {
         return serde_json::Value::Null;
+    };
+    let power = if commands_power {
+        "its power is commanded following the tip speed (its power at its feed, down to power_min_percent), its pierce power at the pierce"
+    } else {
+        "its power is not commanded (the dialect has no power word that acts with the motion: the program's header says why)"
     };
     json!({
         "entry": t.label(),
@@ -974,7 +980,7 @@ fn technology_json(
         "corner": t.corner.map(|c| json!({ "min_turn_deg": c.min_turn_deg, "length_mm": c.length_mm, "feed_factor": c.feed_factor })),
         "power_min_percent": t.power_min(),
         "small_holes": small_holes,
-        "note": "the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; its power is commanded following the tip speed (its power at its feed, down to power_min_percent), its pierce power at the pierce; holes within the small-hole rule run at its feed and power factors, corners within its corner rule at its feed factor; gas and focus are stated, not commanded",
+        "note": format!("the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; {power}; holes within the small-hole rule run at its feed and power factors, corners within its corner rule at its feed factor; gas and focus are stated, not commanded"),
     })
 }
 

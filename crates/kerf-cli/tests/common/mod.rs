@@ -141,3 +141,174 @@ pub(crate) fn replay_power_coefficients(
     }
     (checked, rotating, worst)
 }
+
+/// The words of an NC block: each address (its leading letters: `X`, `TX`, `G`) with the
+/// number after it (a sign allowed: `X+1.5`); words without a number (`FMAX`, `LN`) are left
+/// out.
+pub(crate) fn nc_words(line: &str) -> Vec<(String, f64)> {
+    line.split_whitespace()
+        .filter_map(|w| {
+            let split = w.find(|c: char| !c.is_ascii_alphabetic())?;
+            let (address, number) = w.split_at(split);
+            Some((address.to_string(), number.parse().ok()?))
+        })
+        .collect()
+}
+
+/// The number of the word with address `address` in an NC block.
+pub(crate) fn nc_word(line: &str, address: &str) -> Option<f64> {
+    nc_words(line)
+        .into_iter()
+        .find(|(a, _)| a == address)
+        .map(|(_, v)| v)
+}
+
+/// The cutting lines of a program (the lines `is_move` accepts between the beam-on line `on`
+/// and the beam-off line `off`), each cut after a mark (`None`).
+pub(crate) fn cut_lines(
+    p: &str,
+    on: &str,
+    off: &str,
+    is_move: impl Fn(&str) -> bool,
+) -> Vec<Option<String>> {
+    let mut cut = false;
+    let mut out = Vec::new();
+    for l in p.lines() {
+        if l == on {
+            cut = true;
+            out.push(None);
+        } else if l == off {
+            cut = false;
+        } else if cut && is_move(l) {
+            out.push(Some(l.to_string()));
+        }
+    }
+    out
+}
+
+/// A cutting move of a tool-tip program read back: the tip, the tool direction or the rotary
+/// axes, and `F` (mm/min of the tip).
+pub(crate) struct TipMove {
+    pub(crate) tip: [f64; 3],
+    pub(crate) direction: Option<[f64; 3]>,
+    pub(crate) rotary: Option<[f64; 2]>,
+    pub(crate) feed: f64,
+}
+
+impl TipMove {
+    /// The move of the block `l`: `X Y Z`, the direction's three addresses or the rotary
+    /// axes' two (one of them given), `F`.
+    pub(crate) fn read(l: &str, direction: Option<[&str; 3]>, rotary: Option<[&str; 2]>) -> Self {
+        let w = |a: &str| nc_word(l, a).unwrap_or_else(|| panic!("{a} in {l}"));
+        Self {
+            tip: [w("X"), w("Y"), w("Z")],
+            direction: direction.map(|d| d.map(w)),
+            rotary: rotary.map(|r| r.map(w)),
+            feed: w("F"),
+        }
+    }
+}
+
+/// The program `kerf run` writes for `curves` on `machine` in `dialect`, with the `extra`
+/// arguments; the run must succeed.
+pub(crate) fn run_program(curves: &Path, machine: &Path, dialect: &str, extra: &[&str]) -> String {
+    let dir = tempfile::tempdir().expect("tmp");
+    let r = kerf()
+        .args(["run"])
+        .arg(curves)
+        .arg("-m")
+        .arg(machine)
+        .args(extra)
+        .args(["--dialect", dialect, "-q", "-o"])
+        .arg(dir.path())
+        .output()
+        .expect("kerf runs");
+    assert!(
+        r.status.success(),
+        "{dialect}: {}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    std::fs::read_to_string(dir.path().join("program.nc")).expect("program")
+}
+
+/// How closely a tool-tip program must read back as the joint-space program.
+pub(crate) struct ReadBack {
+    /// The tip, mm.
+    pub(crate) tip_mm: f64,
+    /// The tool direction (unit vectors' difference).
+    pub(crate) direction: f64,
+    /// The rotary words against the joints, degrees.
+    pub(crate) rotary_deg: f64,
+}
+
+/// The round trip of a tool-tip dialect (issue 30): its cutting moves (`None` at each cut's
+/// start) against the same job's joint-space LinuxCNC program `joint`, line by line: the tip
+/// and the tool direction against the joint line through kerf's forward kinematics, rotary
+/// words equal to the joints', and `F` the tip's travel over the joint line's planned time
+/// (`60 / F` in `G93`). Returns the largest tip and direction differences.
+pub(crate) fn read_back_against_joints(
+    m: &kerf_kinematics::Machine,
+    moves: &[Option<TipMove>],
+    joint: &str,
+    within: &ReadBack,
+) -> (f64, f64) {
+    use kerf_kinematics::Axes;
+    let names = m.axis_names();
+    let j = cut_lines(joint, "M64 P0", "M65 P0", |l| l.starts_with("G1 "));
+    assert!(moves.len() > 100, "{} cutting lines", moves.len());
+    assert_eq!(moves.len(), j.len(), "one line per joint-space line");
+    let mut prev: Option<[f64; 3]> = None;
+    let mut worst = (0.0f64, 0.0f64);
+    for (mv, lj) in moves.iter().zip(&j) {
+        let (Some(mv), Some(lj)) = (mv, lj) else {
+            assert!(mv.is_none() && lj.is_none(), "the cuts line up");
+            prev = None;
+            continue;
+        };
+        let q: [f64; 5] = std::array::from_fn(|k| nc_word(lj, names[k]).expect("a joint word"));
+        let pose = m.kinematics.forward(&Axes::from_array(q));
+        let dp = (0..3)
+            .map(|k| (mv.tip[k] - pose.position[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let axis = match (mv.direction, mv.rotary) {
+            (Some(d), _) => d,
+            (None, Some([t, c])) => {
+                assert!(
+                    (t - q[3]).abs() < within.rotary_deg && (c - q[4]).abs() < within.rotary_deg,
+                    "{t} {c} vs {lj}"
+                );
+                let u = m
+                    .kinematics
+                    .forward(&Axes::from_array([0.0, 0.0, 0.0, t, c]))
+                    .axis;
+                [u.x, u.y, u.z]
+            }
+            (None, None) => panic!("a move with neither a direction nor rotary axes"),
+        };
+        let da = (0..3)
+            .map(|k| (axis[k] - pose.axis[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        worst = (worst.0.max(dp), worst.1.max(da));
+        if let Some(pt) = prev {
+            let travel = (0..3)
+                .map(|k| (mv.tip[k] - pt[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let time_s = 60.0 / nc_word(lj, "F").expect("F");
+            if travel > 1e-3 {
+                let want = travel / time_s * 60.0;
+                assert!(
+                    (mv.feed - want).abs() <= 2e-5 * mv.feed + 1e-3 * 60.0 / time_s + 1e-3,
+                    "{lj}: F {} vs {want}",
+                    mv.feed
+                );
+            }
+        }
+        prev = Some(mv.tip);
+    }
+    assert!(worst.0 < within.tip_mm, "tip {} mm off", worst.0);
+    assert!(worst.1 < within.direction, "direction {} off", worst.1);
+    worst
+}

@@ -31,6 +31,14 @@ pub enum Dialect {
     /// only (a table machine raises alarm PS5421: refused by name); otherwise as
     /// [`Dialect::Fanuc`].
     FanucIjk,
+    /// HEIDENHAIN Klartext under `FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS`: numbered
+    /// blocks `LN X Y Z TX TY TZ F`, the tool tip with the unit tool direction (the TNC chooses
+    /// the rotary solution), `CYCL DEF 32` tolerance from the budget, `FMAX` rapids, `;`
+    /// comments, `BEGIN PGM`/`END PGM`. No power that follows the speed (the header says so).
+    Heidenhain,
+    /// As [`Dialect::Heidenhain`] with `L X Y Z <tilt> C F`: the tool tip with the rotary axes
+    /// kerf solved.
+    HeidenhainAxes,
 }
 
 impl Dialect {
@@ -44,6 +52,8 @@ impl Dialect {
             Dialect::LinuxcncTcp => &dialects::LinuxcncTcp,
             Dialect::Fanuc => &dialects::Fanuc { ijk: false },
             Dialect::FanucIjk => &dialects::Fanuc { ijk: true },
+            Dialect::Heidenhain => &dialects::Heidenhain { axes: false },
+            Dialect::HeidenhainAxes => &dialects::Heidenhain { axes: true },
         }
     }
 
@@ -56,6 +66,13 @@ impl Dialect {
     /// [`InterpError::DialectMachine`] naming the mismatch.
     pub fn check_machine<M: crate::AxisModel>(self, model: &M) -> Result<()> {
         self.rules().machine_lines(model).map(|_| ())
+    }
+
+    /// True where the dialect commands a [`LaserPower`](crate::LaserPower) that follows the
+    /// speed; false where the program switches the beam only and its header says why
+    /// (`heidenhain`: no power word acts with the motion in Klartext).
+    pub fn commands_power(self) -> bool {
+        self.rules().power_refusal().is_none()
     }
 
     /// The dialect's name as the CLI spells it.
@@ -78,7 +95,7 @@ impl Dialect {
     /// |---|---|---|---|---|
     /// | linuxcnc, linuxcnc-tcp | `M64 P0` | `M65 P0` | 0.2 s | 1.5 mm |
     /// | generic | `M3` | `M5` | 0.2 s | 1.5 mm |
-    /// | sinumerik, fanuc, fanuc-ijk | `M3` | `M5` | 0.2 s | 1.5 mm |
+    /// | sinumerik, fanuc, fanuc-ijk, heidenhain, heidenhain-axes | `M3` | `M5` | 0.2 s | 1.5 mm |
     ///
     /// LinuxCNC's `M64`/`M65` switch the output when every motion queued before them has
     /// finished (they break blending): the dwell after `M64` runs with the beam on and the

@@ -1,4 +1,4 @@
-//! Outputs: the set-points CSV of `formats.md` and G-code in six dialects (one file each under
+//! Outputs: the set-points CSV of `formats.md` and G-code in eight dialects (one file each under
 //! `dialects/`, their decisions the `Rules` trait of `rules.rs`), written atomically.
 //!
 //! - **CSV**: header `t,X,Y,Z,<tilt>,C`, one row per cycle, `t` in seconds, axes in mm and
@@ -17,6 +17,9 @@
 //! - **Fanuc** ([`Dialect::Fanuc`], [`Dialect::FanucIjk`]): tool center point control `G43.4`
 //!   (the tip with the rotary axes) or `G43.5` (with `I J K`, head machines only), `G05.1 Q1`,
 //!   `G94` tip feed, `S` power, `%` and `O1000` (`dialects/fanuc.rs`).
+//! - **HEIDENHAIN** ([`Dialect::Heidenhain`], [`Dialect::HeidenhainAxes`]): Klartext under
+//!   `FUNCTION TCPM`, numbered `LN X Y Z TX TY TZ F` (or `L` with the rotary axes) blocks,
+//!   `CYCL DEF 32` from the blending term, `FMAX` rapids; no power (`dialects/heidenhain.rs`).
 //! - **Generic** ([`Dialect::Generic`]): raw machine axes, `G94` feed in the RS274/NGC sense:
 //!   `F` is mm/min of the combined X Y Z machine-axis motion (deg/min of the combined rotary
 //!   motion on blocks without X Y Z motion), chosen so that each block takes its planned time.
@@ -560,11 +563,11 @@ pub fn gcode_timed<M: AxisModel>(
             tolerance_mm: RAPID_TCP_TOLERANCE_MM,
         });
     }
-    if opts.power.is_some() {
+    if w.power().is_some() {
         rules.power_off(&mut w);
     }
     rules.footer(&mut w);
-    Ok(w.finish())
+    Ok(rules.finish(w.finish()))
 }
 
 /// Writes [`gcode`] to `path` atomically.

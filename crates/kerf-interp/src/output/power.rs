@@ -24,6 +24,9 @@
 //!   tool-tip kinematics the joints are still the machine's, and HAL reads the joints.
 //! - **Generic** and **Fanuc**: an `S` word on every cutting block whose power changes, from
 //!   kerf's planned speed of the block (the block's tip length over its planned time).
+//! - **HEIDENHAIN**: not commanded ([`Dialect::commands_power`](super::Dialect::commands_power)
+//!   is false): `S` is a `TOOL CALL` word and Q parameters are computed ahead of the motion, so
+//!   nothing in Klartext acts with it; the header gives the technology's power and says so.
 //! - **Sinumerik**: Siemens' laser-power pattern, the polynomial `FCTDEF(1, P_min, 100, 0, k)`
 //!   evaluated every interpolation cycle on the path velocity by the synchronized action
 //!   `ID=1 WHENEVER TRUE DO SYNFCT(1, $A_OUTA[1], $AC_VACTW)` (`k` in percent per mm/min of

@@ -54,6 +54,12 @@ pub(super) trait Rules: Sync {
     /// written, for the axis names `names`.
     fn describe(&self, names: [&str; 5]) -> (String, String, &'static str);
 
+    /// The most decimals a coordinate or an angle is written with (the controller's input
+    /// resolution); the options' `decimals` are cut to it.
+    fn max_decimals(&self) -> usize {
+        12
+    }
+
     /// The word of the metric unit in the header (`G21`).
     fn units_word(&self) -> &'static str {
         "G21"
@@ -100,6 +106,12 @@ pub(super) trait Rules: Sync {
     /// The cutting block `b`, taking `t` seconds.
     fn cut(&self, w: &mut Writer<'_>, b: &Block, t: f64);
 
+    /// Why the dialect cannot command a power that follows the speed (the header says it and
+    /// the program switches the beam only), or `None` where it can.
+    fn power_refusal(&self) -> Option<&'static str> {
+        None
+    }
+
     /// The pierce power before the beam comes on: `S<percent>` by default (the cutting moves
     /// then carry `S` where the planned power changes, [`Writer::s_word`]).
     fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower) {
@@ -133,6 +145,12 @@ pub(super) trait Rules: Sync {
 
     /// The program's last lines.
     fn footer(&self, w: &mut Writer<'_>);
+
+    /// The whole program text as written to the file (block numbers where the controller
+    /// wants them); the text itself by default.
+    fn finish(&self, text: String) -> String {
+        text
+    }
 }
 
 /// The default process codes of a dialect's rules.

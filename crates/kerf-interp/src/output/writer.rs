@@ -98,7 +98,7 @@ impl<'a> Writer<'a> {
             opts,
             process,
             names: model.axis_names(),
-            d: opts.decimals.min(12),
+            d: opts.decimals.min(opts.dialect.rules().max_decimals()),
             s: String::new(),
             last: None,
             in_cut: false,
@@ -262,11 +262,15 @@ impl<'a> Writer<'a> {
             p.pierce_standoff, p.pierce_dwell_s, o.feed_mm_per_min
         );
         self.comment(&pm);
-        match self.opts.power {
-            None => self.comment(
+        match (self.opts.power, self.rules.power_refusal()) {
+            (None, _) => self.comment(
                 "power: not commanded (no technology): the beam is switched on and off only",
             ),
-            Some(p) => {
+            (Some(p), Some(why)) => self.comment(&format!(
+                "power: the technology's {} % at {} mm/min is not commanded: {why}",
+                p.cut_percent, p.reference_feed_mm_per_min
+            )),
+            (Some(p), None) => {
                 self.comment(&format!(
                     "power: {} % at {} mm/min of the tool tip, following the tip speed, floor {} %, pierce {} %",
                     p.cut_percent, p.reference_feed_mm_per_min, p.min_percent, p.pierce_percent
@@ -297,7 +301,7 @@ impl<'a> Writer<'a> {
         let start = b.start_tip();
         let h = self.process.pierce_standoff;
         self.rapid(pierce, qp, u);
-        if let Some(p) = self.opts.power {
+        if let Some(p) = self.power() {
             self.rules.pierce_power(self, &p);
             self.last_power = None;
         }
@@ -312,7 +316,7 @@ impl<'a> Writer<'a> {
         }
         self.rules.blend_on(self);
         self.in_cut = true;
-        if let Some(p) = self.opts.power {
+        if let Some(p) = self.power() {
             self.rules.cut_power(self, &p);
         }
         if h > 0.0 {
@@ -485,7 +489,7 @@ impl<'a> Writer<'a> {
     /// changed by more than [`POWER_STEP`] (the dialects that command power by `S`); empty
     /// outside a cut or without power.
     pub(super) fn s_word(&mut self, tip_mm: f64, t: f64) -> String {
-        match (self.opts.power, self.in_cut) {
+        match (self.power(), self.in_cut) {
             (Some(power), true) => {
                 let p = power.at_speed(tip_mm / t * 60.0, self.factor);
                 if self.power_changed(p) {
@@ -531,6 +535,14 @@ impl<'a> Writer<'a> {
         }
         self.last = Some(self.printed(&[p.x, p.y, p.z, q[3], q[4]]));
         self.last_axes = Some(q);
+    }
+
+    /// The power the program commands: the options' where the dialect can command it
+    /// ([`Rules::power_refusal`]).
+    pub(super) fn power(&self) -> Option<super::LaserPower> {
+        self.opts
+            .power
+            .filter(|_| self.rules.power_refusal().is_none())
     }
 
     /// The pierce power's number (percent, at most 100).

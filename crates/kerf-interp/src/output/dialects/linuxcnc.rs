@@ -121,7 +121,7 @@ fn joint_move(w: &mut Writer<'_>, q: [f64; 5], t: f64) {
     let Some((qp, prev)) = w.moved(&q) else {
         return;
     };
-    if w.opts.power.is_some() && w.in_cut && !w.compensating {
+    if w.power().is_some() && w.in_cut && !w.compensating {
         w.powered_pieces(
             &prev,
             &qp,

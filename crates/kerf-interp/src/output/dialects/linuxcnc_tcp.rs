@@ -299,7 +299,7 @@ fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64) {
     let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
     // The feed is the same on every piece: the pieces split the move evenly in time.
     let f = feed_number(rs274_feed(&prev, &now, t));
-    match (w.opts.power.is_some() && w.in_cut, from) {
+    match (w.power().is_some() && w.in_cut, from) {
         (true, Some(from)) => {
             let words = |w: &Writer<'_>, fr: f64| -> String {
                 let p: [f64; 5] = std::array::from_fn(|k| prev[k] + fr * d[k]);

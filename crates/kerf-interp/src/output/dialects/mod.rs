@@ -4,12 +4,14 @@
 
 mod fanuc;
 mod generic;
+mod heidenhain;
 mod linuxcnc;
 mod linuxcnc_tcp;
 mod sinumerik;
 
 pub(super) use fanuc::Fanuc;
 pub(super) use generic::Generic;
+pub(super) use heidenhain::Heidenhain;
 pub(super) use linuxcnc::Linuxcnc;
 pub(super) use linuxcnc_tcp::LinuxcncTcp;
 pub use linuxcnc_tcp::{linuxcnc_kinematics, LinuxcncKinematics};

@@ -54,7 +54,7 @@ impl Rules for Sinumerik {
         w.line("ORIWKS");
         w.line("ORIVECT");
         w.line("G60");
-        if o.power.is_some() {
+        if w.power().is_some() {
             w.line("ID=1 WHENEVER TRUE DO SYNFCT(1,$A_OUTA[1],$AC_VACTW)");
         }
     }

@@ -1,0 +1,273 @@
+//! `heidenhain` and `heidenhain-axes`: HEIDENHAIN Klartext (conversational) for a TNC with
+//! tool center point management. `FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS` for the whole
+//! program: `X Y Z` the tool tip in the active preset (the workpiece frame), `F` the tip's
+//! speed, the rotary axes interpolated linearly in each block (as kerf's poses are joined).
+//! `heidenhain` writes `LN X Y Z TX TY TZ F` (the tip with the unit tool direction; the TNC
+//! chooses the rotary solution of each direction itself, which is kerf's where it takes the
+//! nearest one, as kerf does); `heidenhain-axes` writes `L X Y Z <tilt> C F` with the rotary
+//! axes kerf solved (its limits, its side of a singularity). Every block is numbered, the
+//! program framed by `BEGIN PGM KERF MM` and `END PGM KERF MM`; `;` comments (a `~`, which
+//! would continue a block onto the next line, is escaped); coordinates with their sign and
+//! four decimals (the TNC's input resolution), directions with seven; `FMAX` rapids with
+//! `R0`; the pierce dwell `CYCL DEF 9.0 DWELL TIME` / `CYCL DEF 9.1 DWELL <s>`; the contour
+//! tolerance `CYCL DEF 32` with `T` half the budget's controller-blending term and `TA` the
+//! other half turned into degrees at the pivot length (as Sinumerik's `CTOL`/`OTOL`); the beam
+//! codes as M-function blocks of their own; `FUNCTION RESET TCPM`, `M30` at the end. No
+//! `BLK FORM` and no `TOOL CALL`: the active tool's length must put the tip where kerf's
+//! machine file does (the header says so).
+//!
+//! Power that follows the speed is not written: S is a `TOOL CALL` word only, and Q parameters
+//! are computed ahead of the motion, not with it; the header says the technology's power is
+//! not commanded, and the machine's laser control must follow the path speed itself.
+
+use nalgebra::{Point3, Vector3};
+
+use super::super::rules::Rules;
+use super::super::writer::{rs274_feed, Writer};
+use crate::block::Block;
+use crate::error::Result;
+use crate::model::AxisModel;
+
+/// The program's name in `BEGIN PGM` / `END PGM`.
+const PROGRAM: &str = "KERF";
+
+/// HEIDENHAIN Klartext under `FUNCTION TCPM`: `LN` with the tool direction, or `L` with the
+/// rotary axes.
+pub(in crate::output) struct Heidenhain {
+    /// `L` with the rotary axes (`heidenhain-axes`) instead of `LN` with `TX TY TZ`.
+    pub(in crate::output) axes: bool,
+}
+
+impl Rules for Heidenhain {
+    fn name(&self) -> &'static str {
+        if self.axes {
+            "heidenhain-axes"
+        } else {
+            "heidenhain"
+        }
+    }
+
+    /// `; text`, with `~` escaped: a line that ends in `~` continues its block on the next
+    /// line, which would take the next block into the comment.
+    fn comment(&self, text: &str) -> String {
+        format!("; {}", text.replace('~', "\\u{7e}"))
+    }
+
+    fn max_decimals(&self) -> usize {
+        4
+    }
+
+    fn machine_lines(&self, _model: &dyn AxisModel) -> Result<Vec<String>> {
+        Ok(vec![
+            "tool center point management: FUNCTION TCPM; the TNC's kinematics description must be the machine's, and the active tool's length must put its tip at kerf's tool tip [no TOOL CALL is written]".to_string(),
+        ])
+    }
+
+    fn opening(&self) -> &'static [&'static str] {
+        &["BEGIN PGM KERF MM"]
+    }
+
+    fn describe(&self, n: [&str; 5]) -> (String, String, &'static str) {
+        let words = if self.axes {
+            format!(
+                "L X Y Z {} {}: the tool tip and the rotary axes",
+                n[3], n[4]
+            )
+        } else {
+            "LN X Y Z TX TY TZ: the tool tip and the unit tool direction [the TNC chooses the rotary solution]".to_string()
+        };
+        (
+            format!("kerf HEIDENHAIN Klartext program: {words}, in the active preset"),
+            format!(
+                "feed: FUNCTION TCPM F TCP, F in mm/min of the tool tip, the block's mean planned speed; where the tip stands F is deg/min of the rotary motion;\nfeed: CYCL DEF 32 T and TA from the budget's controller_blending term;\nfeed: rapids FMAX split so that the tip follows kerf's joint-space traverse within {} mm;\nfeed: coordinates to 4 decimals, rotary axes to 4, directions to 7",
+                crate::RAPID_TCP_TOLERANCE_MM
+            ),
+            "arcs written as line chords",
+        )
+    }
+
+    fn units_word(&self) -> &'static str {
+        "MM"
+    }
+
+    fn preamble(&self, w: &mut Writer<'_>) {
+        let o = w.opts;
+        w.line("FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS");
+        w.line("CYCL DEF 32.0 TOLERANCE");
+        let t = o.blend_tolerance_mm / 2.0;
+        w.line(&format!("CYCL DEF 32.1 T{}", tolerance_number(t)));
+        match o.pivot_length_mm.filter(|l| l.is_finite() && *l > 0.0) {
+            Some(l) => {
+                let ta = (t / l).to_degrees();
+                w.line(&format!(
+                    "CYCL DEF 32.2 HSC-MODE:0 TA{}",
+                    tolerance_number(ta)
+                ));
+            }
+            None => w.line("CYCL DEF 32.2 HSC-MODE:0"),
+        }
+        // What the four decimals cost: half a unit of the last decimal on each of X Y Z and
+        // on each rotary axis, through the pivot length (where known).
+        let half = 0.5e-4;
+        let xyz = 3f64.sqrt() * half;
+        let rotary = o
+            .pivot_length_mm
+            .filter(|l| l.is_finite() && *l > 0.0)
+            .map(|l| l * 2f64.sqrt() * half.to_radians());
+        let rounding = match (self.axes, rotary) {
+            (true, Some(r)) => format!("at most {:.6} mm", xyz + r),
+            (true, None) => format!("{xyz:.6} mm plus the rotary axes' 0.00005 deg through the tool's distance from them"),
+            // Seven decimals of a unit direction: 1e-7 of the pivot length, negligible.
+            (false, _) => format!("at most {:.6} mm", xyz + rotary.map_or(0.0, |r| r * 1e-3)),
+        };
+        w.comment(&format!(
+            "rounding: the written coordinates move the tip by {rounding}, not in the budget"
+        ));
+    }
+
+    fn power_header(&self, _w: &mut Writer<'_>) {}
+
+    fn power_refusal(&self) -> Option<&'static str> {
+        Some("a Klartext program has no power word that acts with the motion [S belongs to TOOL CALL, Q parameters are computed ahead of it]: the machine's laser control must follow the path speed itself")
+    }
+
+    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
+        let l = if self.axes { "L" } else { "LN" };
+        w.tip_rapid(l, p, q, |w, tip, a| {
+            format!("{} R0 FMAX", self.words(w, tip, a))
+        });
+    }
+
+    fn dwell(&self, s: f64) -> String {
+        format!(
+            "CYCL DEF 9.0 DWELL TIME\nCYCL DEF 9.1 DWELL {}",
+            dwell_number(s)
+        )
+    }
+
+    fn descent(
+        &self,
+        w: &mut Writer<'_>,
+        b: &Block,
+        start: Point3<f64>,
+        _u: Vector3<f64>,
+        t: f64,
+        _h: f64,
+    ) {
+        self.cut_move(w, start, b.start_axes, t);
+    }
+
+    fn cut(&self, w: &mut Writer<'_>, b: &Block, t: f64) {
+        w.block_pieces(b, t, |w, s, q, dt, _| {
+            self.cut_move(w, b.pose_at(s).0, q, dt);
+        });
+    }
+
+    fn footer(&self, w: &mut Writer<'_>) {
+        w.line("FUNCTION RESET TCPM");
+        w.line("M30");
+        w.line(&format!("END PGM {PROGRAM} MM"));
+    }
+
+    /// Every line numbered from 0, as the TNC numbers its blocks.
+    fn finish(&self, text: String) -> String {
+        let mut out = String::with_capacity(text.len() + text.len() / 4);
+        for (i, l) in text.lines().enumerate() {
+            out.push_str(&format!("{i} {l}\n"));
+        }
+        out
+    }
+}
+
+impl Heidenhain {
+    /// The position words: the tip with the rotary axes (`L`) or with the tool direction
+    /// (`LN`, from the axes through the machine's kinematics).
+    fn words(&self, w: &Writer<'_>, tip: &Point3<f64>, q: &[f64; 5]) -> String {
+        let xyz = format!(
+            "X{} Y{} Z{}",
+            signed(w, tip.x),
+            signed(w, tip.y),
+            signed(w, tip.z)
+        );
+        if self.axes {
+            format!(
+                "{xyz} {}{} {}{}",
+                w.names[3],
+                signed(w, q[3]),
+                w.names[4],
+                signed(w, q[4])
+            )
+        } else {
+            let u = w.model.tool_axis(q[3], q[4]).normalize();
+            format!(
+                "{xyz} TX{} TY{} TZ{}",
+                direction(u.x),
+                direction(u.y),
+                direction(u.z)
+            )
+        }
+    }
+
+    /// One `L`/`LN` to the tip `tip` with the axes `q`, taking `t` seconds: `F` the tip's
+    /// speed (deg/min of the rotary motion where the printed tip stands); nothing if the
+    /// printed position does not change.
+    fn cut_move(&self, w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64) {
+        w.last_axes = Some(q);
+        let Some((now, prev)) = w.moved(&[tip.x, tip.y, tip.z, q[3], q[4]]) else {
+            return;
+        };
+        let f = rs274_feed(&prev, &now, t);
+        let l = format!(
+            "{} {} F{}",
+            if self.axes { "L" } else { "LN" },
+            self.words(w, &tip, &q),
+            feed(f)
+        );
+        w.line(&l);
+        w.last = Some(now);
+    }
+}
+
+/// A coordinate with its sign, as the TNC writes it (`X+12.5`, `X-0.25`; zero is `+0`).
+fn signed(w: &Writer<'_>, v: f64) -> String {
+    let t = w.num(v);
+    if t.starts_with('-') {
+        t
+    } else {
+        format!("+{t}")
+    }
+}
+
+/// A component of a unit direction with its sign and seven decimals (the manuals' `LN`
+/// blocks), never `-0`.
+fn direction(v: f64) -> String {
+    let t = format!("{v:+.7}");
+    if t.bytes().skip(1).all(|c| c == b'0' || c == b'.') {
+        "+0.0000000".to_string()
+    } else {
+        t
+    }
+}
+
+/// A feed in mm/min (deg/min) with three decimals, at least 0.001 (never `F0`, which the
+/// TNC reads as no feed).
+fn feed(f: f64) -> String {
+    format!("{:.3}", f.max(0.001))
+}
+
+/// A tolerance of `CYCL DEF 32` (mm or degrees): four decimals, rounded down so that the
+/// controller keeps within the budget, at least 0.0001; trailing zeros dropped.
+fn tolerance_number(v: f64) -> String {
+    trimmed(((v * 1e4).floor() / 1e4).max(1e-4), 4)
+}
+
+/// A dwell in seconds: three decimals, rounded up (a pierce never shorter than asked).
+fn dwell_number(s: f64) -> String {
+    trimmed((s * 1e3).ceil() / 1e3, 3)
+}
+
+/// `v` with `decimals` decimals, trailing zeros (and a bare point) dropped.
+fn trimmed(v: f64, decimals: usize) -> String {
+    let t = format!("{v:.decimals$}");
+    t.trim_end_matches('0').trim_end_matches('.').to_string()
+}

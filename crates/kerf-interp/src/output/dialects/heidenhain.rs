@@ -271,3 +271,54 @@ fn trimmed(v: f64, decimals: usize) -> String {
     let t = format!("{v:.decimals$}");
     t.trim_end_matches('0').trim_end_matches('.').to_string()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::{Dialect, GcodeOptions};
+    use super::*;
+
+    /// The manuals' example block `L X+31.737 Y+21.954 Z+33.165 B+12.357 C+5.896 F1000`
+    /// (TNC 426/430 and TNC 620 user's manuals, "Block format with rotary axes"), written by
+    /// the dialect for the same tip, axes and feed on a B/C head: the same words, each number
+    /// to the dialect's four decimals (three for `F`).
+    #[test]
+    fn the_manuals_rotary_axis_block() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/machines/bc_head_5axiskins.json"
+        );
+        let model =
+            crate::MachineModel::new(kerf_kinematics::Machine::read(path).expect("machine"))
+                .expect("model");
+        let opts = GcodeOptions::new(Dialect::HeidenhainAxes, 1000.0);
+        let mut w = Writer::new(
+            &model,
+            &opts,
+            Dialect::HeidenhainAxes.default_process(),
+            None,
+            Vec::new(),
+        );
+        let tip = Point3::new(31.737, 21.954, 33.165);
+        let q = [0.0, 0.0, 0.0, 12.357, 5.896];
+        // 1000 mm/min: 10 mm of tip travel in 0.6 s from a tip 10 mm away along X.
+        w.last = Some([21.737, 21.954, 33.165, 12.357, 5.896]);
+        Heidenhain { axes: true }.cut_move(&mut w, tip, q, 0.6);
+        assert_eq!(
+            w.finish(),
+            "L X+31.7370 Y+21.9540 Z+33.1650 B+12.3570 C+5.8960 F1000.000\n"
+        );
+    }
+
+    #[test]
+    fn numbers_as_the_tnc_writes_them() {
+        assert_eq!(direction(-0.8764339), "-0.8764339");
+        assert_eq!(direction(-1e-9), "+0.0000000");
+        assert_eq!(direction(0.25903194), "+0.2590319");
+        assert_eq!(tolerance_number(0.0025), "0.0025");
+        assert_eq!(tolerance_number(0.00079), "0.0007"); // down: within the budget
+        assert_eq!(tolerance_number(1e-7), "0.0001");
+        assert_eq!(dwell_number(0.2), "0.2");
+        assert_eq!(dwell_number(0.2001), "0.201"); // up: never a shorter pierce
+        assert_eq!(feed(0.0), "0.001");
+    }
+}

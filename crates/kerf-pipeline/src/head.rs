@@ -319,18 +319,17 @@ fn needed_tilt(
     let d = escape(obs, &pose.axis, &st.point)
         .unwrap_or_else(|| away(&pose.axis, &pose.position, &st.point));
     let surface = st.surface.as_deref().unwrap_or("?");
+    // A placement left unproven (the work budget spent) is not a tilt that fails to clear.
+    let mut unproven = false;
     let more = (1..)
         .map(|j| j as f64 * 2.5)
         .take_while(|a| *a <= MAX_NEEDED_TILT_DEG)
         .find(|a| {
-            clears(
-                obs,
-                head,
-                hopts,
-                pose.position,
-                tilted(&pose.axis, &d, a.to_radians()),
-                budget,
-            )
+            let margin = hopts.with_clearance_mm(hopts.clearance_mm + TILT_MARGIN_MM);
+            let axis = tilted(&pose.axis, &d, a.to_radians());
+            let c = place_once(obs, head, &margin, pose.position, axis, budget);
+            unproven |= !c.proven;
+            c.proven && c.close.is_empty()
         });
     let usable = kerf_kinematics::MAX_TILT_TOLERANCE_DEG * kerf_kinematics::TILT_WORKING_FRACTION;
     match more {
@@ -341,6 +340,10 @@ fn needed_tilt(
         Some(a) => format!(
             "at cutting point {i} a tilt of {a:.1} deg away from surface {surface} would clear it (tilt tolerance {tolerance_deg} deg; --tilt-tolerance {} allows it)",
             (a / kerf_kinematics::TILT_WORKING_FRACTION).ceil()
+        ),
+        None if unproven => format!(
+            "at cutting point {i} the head check's work budget ({} distance queries) ran out before a tilt away from surface {surface} that clears it was found",
+            hopts.max_queries
         ),
         None => format!(
             "at cutting point {i} no tilt up to {MAX_NEEDED_TILT_DEG} deg away from surface {surface} clears it"
@@ -429,4 +432,39 @@ pub(crate) fn head_json(
         "paths": paths,
         "note": "min_distance_mm: a proven lower bound of the distance from the head above the tip zone (the nozzle's lowest tip_zone_mm, meant to be near the cut) to the part the cut lies on (the surfaces its curve names and those joined to them; every surface of the file for a curve that names none) over the cut's poses and the motion between them; close: stretches where a head point was found within the clearance; tilted: cutting points whose tool axis was tilted (within the tilt tolerance, away from the surface in the way) to clear it",
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refusal whose search for a clearing tilt ran out of work says so, instead of
+    /// claiming that no tilt up to 60 degrees clears the head.
+    #[test]
+    fn a_spent_budget_is_not_reported_as_no_clearing_tilt() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/head_wall.json");
+        let file = kerf_format::curves::load(path).expect("fixture");
+        let obs = Obstacles::from_all_surfaces(&file, |p| *p).expect("obstacles");
+        let head = kerf_kinematics::Head::laser_default();
+        let pose = Pose {
+            position: Point3::origin(),
+            axis: Vector3::z(),
+        };
+        let st = kerf_process::CloseStretch {
+            poses: [0, 0],
+            length_mm: 0.0,
+            distance_mm: 0.5,
+            at_height_mm: 50.0,
+            surface: Some("wall".to_string()),
+            point: Point3::new(40.0, 0.0, 50.0),
+        };
+        let hopts = HeadCheckOptions::default();
+        let mut spent = 0;
+        let s = needed_tilt(&obs, &head, &hopts, &pose, 7, &st, 0.0, &mut spent);
+        assert!(
+            s.contains("at cutting point 7 the head check's work budget")
+                && s.contains("ran out before a tilt away from surface wall"),
+            "{s}"
+        );
+    }
 }

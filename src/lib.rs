@@ -25,7 +25,7 @@
 //! 8. [`pipeline`]: the stages chained ([`Job`]); its items are also here at the top.
 //!
 //! Beside them: [`check`], the independent checker of any toolpath against its curves;
-//! [`plot`], the SVG pictures; [`io`], the one reader and atomic writer; [`nalgebra`], the
+//! [`plot`], the SVG pictures; [`view`], the interactive 3D view (`view.html`); [`io`], the one reader and atomic writer; [`nalgebra`], the
 //! maths types every API takes (so a caller need not match its version by hand).
 
 pub use kerf_check as check;
@@ -40,6 +40,7 @@ pub use kerf_pipeline as pipeline;
 pub use kerf_plot as plot;
 pub use kerf_process as process;
 pub use kerf_step as step;
+pub use kerf_view as view;
 pub use nalgebra;
 
 pub use kerf_pipeline::{

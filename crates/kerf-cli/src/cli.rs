@@ -59,13 +59,21 @@ pub(crate) enum Command {
     /// The whole pipeline: discretize, normals, machine axes, interpolation and G-code, with a
     /// report and a picture, in one output directory.
     ///
-    /// Writes toolpath.json, axes.json, program.nc, setpoints.csv, report.json and plot.svg into
+    /// Writes toolpath.json, axes.json, program.nc, setpoints.csv, report.json, plot.svg and view.html into
     /// --out, all at once after every stage has succeeded (a failed run leaves the directory as
     /// it was). Curves without a surface are cut with a vertical beam.
     #[command(
         after_help = "Examples:\n  kerf run fixtures/dome.json --machine fixtures/machines/ac_head.json --tolerance 0.01 --out out\n  kerf run part.json -m machine.json -t 0.005 --feed 4000 --dialect sinumerik --out part-out"
     )]
     Run(Box<RunArgs>),
+
+    /// Refresh the interactive 3D view (view.html) of a `kerf run` output directory.
+    ///
+    /// Reads the scene the directory's view.html holds and writes the page again with this
+    /// version's viewer and the warnings of the directory's report.json (kerf run writes
+    /// view.html itself: open it in a browser, no network needed).
+    #[command(after_help = "Examples:\n  kerf view out")]
+    View(ViewArgs),
 
     /// Interpolate a program: per-cycle machine axis set-points (paper 000's time-division
     /// lines and 3-point space arcs, with a look-ahead feed plan within every axis limit).
@@ -382,6 +390,14 @@ pub(crate) struct GcodeArgs {
     /// Print no summary.
     #[arg(short, long)]
     pub(crate) quiet: bool,
+}
+
+/// Arguments of `kerf view`.
+#[derive(Debug, Args)]
+pub(crate) struct ViewArgs {
+    /// The output directory of `kerf run`.
+    #[arg(value_name = "DIR")]
+    pub(crate) dir: PathBuf,
 }
 
 /// `--dialect` values.

@@ -19,6 +19,7 @@ mod plot;
 mod post;
 mod run_cmd;
 mod validate;
+mod view;
 
 use std::process::ExitCode;
 
@@ -34,6 +35,7 @@ fn main() -> ExitCode {
         Command::Discretize(args) => discretize_cmd::run(args),
         Command::Post(args) => post::run(args),
         Command::Run(args) => run_cmd::run(args),
+        Command::View(args) => view::run(args),
         Command::Interpolate(args) => motion_cmd::run_interpolate(args),
         Command::Gcode(args) => motion_cmd::run_gcode(args),
         Command::Check(args) => check::run(args),

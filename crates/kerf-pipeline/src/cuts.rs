@@ -574,18 +574,21 @@ pub(crate) fn split_axes(
     }
 }
 
+/// The length of the polyline through the poses' points, mm.
+pub(crate) fn polyline_length(p: &[PoseArray]) -> f64 {
+    p.windows(2)
+        .map(|w| {
+            ((w[1][0] - w[0][0]).powi(2)
+                + (w[1][1] - w[0][1]).powi(2)
+                + (w[1][2] - w[0][2]).powi(2))
+            .sqrt()
+        })
+        .sum()
+}
+
 /// The `process` object of `report.json`: pierces, lengths, order and what each cut got.
 pub(crate) fn report(file: &CurvesFile, cuts: &[CutPath], plans: &SetupPlans) -> Value {
-    let len = |p: &[PoseArray]| -> f64 {
-        p.windows(2)
-            .map(|w| {
-                ((w[1][0] - w[0][0]).powi(2)
-                    + (w[1][1] - w[0][1]).powi(2)
-                    + (w[1][2] - w[0][2]).powi(2))
-                .sqrt()
-            })
-            .sum()
-    };
+    let len = polyline_length;
     let cut_length: f64 = cuts
         .iter()
         .map(|c| len(&c.poses[c.counts[0]..c.counts[0] + c.counts[1]]))

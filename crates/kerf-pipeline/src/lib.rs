@@ -13,10 +13,10 @@
 //! 4. The motion, one program per set-up: fitted blocks, the feed plan, set-points and G-code
 //!    (`kerf-interp`). The fit follows from the dialect ([`fit_options`]): a program that
 //!    gives raw machine axes never gets unchecked arc chords or merged lines.
-//! 5. The report and the picture (`kerf-plot`).
+//! 5. The 3D view's scene (`kerf-view`), the report and the picture (`kerf-plot`).
 //!
 //! [`Job::run`] chains them; [`Output::write_dir`] writes `toolpath.json`, `axes.json`,
-//! `program.nc`, `setpoints.csv`, `report.json` and `plot.svg` into a directory all or
+//! `program.nc`, `setpoints.csv`, `report.json`, `plot.svg` and `view.html` into a directory all or
 //! nothing, and every part can be written to any [`std::io::Write`]. [`plan_program`] is the
 //! motion stage alone, on a `kerf.axes/1` or `kerf.toolpath/1` document ([`MotionInput`]).
 //! The `kerf` command line is argument parsing and printing over this crate.
@@ -47,6 +47,7 @@ mod post;
 pub mod ranges;
 mod run;
 mod timing;
+mod view;
 
 pub use certify::CertifiedToolpath;
 pub use discretize::{

@@ -84,6 +84,9 @@ pub struct Output {
     /// The picture (`plot.svg`): the curves, points and tool axes, chord errors and the axes
     /// against the machine's limits.
     pub plot_svg: String,
+    /// The interactive 3D view's scene (`view.html`, [`Output::write_view`]): the part, the
+    /// cuts, the traverses and the planned motion of every set-up.
+    pub scene: kerf_view::Scene,
     /// What the caller should be told: traverses that could not be checked against the part
     /// (they fall back to the unchecked retract traverse; `traverses.unchecked` in the report).
     pub warnings: Vec<String>,
@@ -113,6 +116,7 @@ impl Output {
         }
         names.push(OUTPUTS[4].to_string());
         names.push(OUTPUTS[5].to_string());
+        names.push(OUTPUTS[6].to_string());
         names
     }
 
@@ -173,6 +177,31 @@ impl Output {
     pub fn write_plot(&self, mut w: impl Write) -> Result<()> {
         w.write_all(self.plot_svg.as_bytes())
             .map_err(|source| Error::Write { path: None, source })
+    }
+
+    /// Writes the interactive 3D view (one self-contained HTML file, [`kerf_view::html`]) to
+    /// `w`, with every warning of the report (`report["warnings"]`) beside it.
+    ///
+    /// # Errors
+    /// [`Error::Write`] if `w` fails.
+    pub fn write_view(&self, mut w: impl Write) -> Result<()> {
+        w.write_all(self.view_html().as_bytes())
+            .map_err(|source| Error::Write { path: None, source })
+    }
+
+    /// The page [`Output::write_view`] writes.
+    pub fn view_html(&self) -> String {
+        let mut scene = self.scene.clone();
+        scene.warnings = self.report["warnings"]
+            .as_array()
+            .map(|ws| {
+                ws.iter()
+                    .filter_map(|w| w.as_str())
+                    .map(kerf_view::Warning::new)
+                    .collect()
+            })
+            .unwrap_or_default();
+        kerf_view::html(&scene)
     }
 
     fn setup(&self, setup: usize) -> Result<&SetupProgram> {
@@ -266,6 +295,11 @@ impl Output {
             name: OUTPUTS[5],
             contents: text(&self.plot_svg),
         });
+        let view = self.view_html();
+        entries.push(DirEntry {
+            name: OUTPUTS[6],
+            contents: Box::new(move |w| w.write_all(view.as_bytes())),
+        });
         kerf_io::write_dir_all_or_nothing(dir, entries).map_err(|e| Error::Write {
             path: Some(e.path),
             source: e.error,
@@ -295,11 +329,12 @@ pub fn csv_names(setups: usize) -> Vec<String> {
 /// The files `kerf run` writes into its output directory for one set-up, all or nothing
 /// (through [`kerf_io::write_dir_all_or_nothing`]); several set-ups number the program and
 /// set-point files ([`program_names`], [`csv_names`]).
-pub const OUTPUTS: [&str; 6] = [
+pub const OUTPUTS: [&str; 7] = [
     "toolpath.json",
     "axes.json",
     "program.nc",
     "setpoints.csv",
     "report.json",
     "plot.svg",
+    "view.html",
 ];

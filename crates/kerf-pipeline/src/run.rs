@@ -693,20 +693,49 @@ fn run_placed(
     }
     let process =
         kerf_interp::ProcessCodes::resolve(dialect, &machine.process).map_err(interp(path))?;
-    // 5. Picture and report.
+    // 5. The 3D view, the picture and the report.
     progress(Progress::new(Stage::Report, 0, 1));
-    let mut scene = kerf_plot::Scene::new(file, &tp, &kerf_plot::SceneOptions::default())?;
-    scene.title = format!(
-        "kerf run \u{2014} {} on {}",
-        path.map_or_else(
-            || "curves".to_string(),
-            |path| path.file_name().map_or_else(
+    let input_name = path.map_or_else(
+        || "curves".to_string(),
+        |path| {
+            path.file_name().map_or_else(
                 || path.display().to_string(),
-                |n| n.to_string_lossy().into_owned()
+                |n| n.to_string_lossy().into_owned(),
             )
-        ),
-        machine.name
+        },
     );
+    let program_files = crate::output::program_names(motions.len());
+    let view_setups: Vec<crate::view::SetupInput<'_>> = motions
+        .iter()
+        .enumerate()
+        .map(|(k, m)| crate::view::SetupInput {
+            placement: placed
+                .plan
+                .setups
+                .get(k)
+                .map_or(kerf_kinematics::Placement::IDENTITY, |s| s.placement),
+            motion: m,
+            ids: &setup_ids[k],
+            program: &program_files[k],
+        })
+        .collect();
+    let view = crate::view::scene(
+        &input_name,
+        file,
+        &cuts,
+        &view_setups,
+        &model,
+        &machine
+            .head
+            .clone()
+            .unwrap_or_else(kerf_kinematics::Head::laser_default),
+        o.feed_mm_per_min,
+        process.pierce_standoff,
+    );
+    drop(view_setups);
+    lap.split(&mut timings, "view");
+    let mut scene = kerf_plot::Scene::new(file, &tp, &kerf_plot::SceneOptions::default())?;
+    scene.title = format!("kerf run \u{2014} {input_name} on {}", machine.name);
     scene.axes = Some(kerf_plot::AxesChart::new(&axes, Some(machine))?);
     // The process over the paths (part coordinates): pierces numbered in cutting order,
     // lead-ins, lead-outs and the traverses, set-up by set-up as the programs run them.
@@ -902,6 +931,7 @@ fn run_placed(
         programs,
         report,
         plot_svg: svg,
+        scene: view,
         warnings,
         timings,
         model,

@@ -57,6 +57,7 @@ fn stages_are_timed_in_order_and_cpu_time_counts_work_not_waiting() {
             "traverses",
             "plan",
             "gcode",
+            "view",
             "report"
         ],
         "stages in order"

@@ -189,6 +189,11 @@ fn check_page(name: &str, dir: &Path, machine: &str) -> f64 {
     let pose = m
         .kinematics
         .forward(&Axes::from_array([q[1], q[2], q[3], q[4], q[5]]));
+    let shown = v["at"]["t"].as_f64().expect("the slider's time");
+    assert!(
+        (shown - t).abs() < 1e-9,
+        "{name}: the slider shows {shown}, not {t}"
+    );
     let at = |key: &str, k: usize| v["at"][key][k].as_f64().expect("a number");
     let tip = (0..3)
         .map(|k| (at("tip", k) - pose.position[k]).powi(2))
@@ -244,11 +249,18 @@ fn real_parts_views_open_and_show_the_part() {
         return;
     }
     let shots = screenshots_dir();
-    let mut parts: Vec<(String, PathBuf, Vec<&str>)> = vec![(
-        "occt_propeller".into(),
-        fixture("realdata/occt_propeller.json"),
-        vec!["--place", "auto"],
-    )];
+    let mut parts: Vec<(String, PathBuf, Vec<&str>)> = vec![
+        (
+            "occt_propeller".into(),
+            fixture("realdata/occt_propeller.json"),
+            vec!["--place", "auto"],
+        ),
+        (
+            "nori_sheetmetal".into(),
+            fixture("realdata/nori_sheetmetal.json"),
+            vec!["--place", "auto"],
+        ),
+    ];
     let step =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step/S06298.stp");
     if step.is_file() {

@@ -305,9 +305,16 @@
   const hash = new URLSearchParams(location.hash.slice(1));
   if (hash.has("t")) {
     const k = Number(hash.get("setup") || 0);
-    if (k !== 0 && data.setups[k]) showSetup(k);
-    const at = setTime(k, Number(hash.get("t")));
+    if (k !== 0 && data.setups[k]) {
+      sel.value = String(k);
+      sel.dispatchEvent(new Event("change"));
+    }
+    // Through the slider, as a user moves it.
+    const slider = el("time");
+    slider.value = hash.get("t");
+    slider.dispatchEvent(new Event("input"));
     render();
+    const at = { tip: state.tip, axis: state.axis, t: time, setup };
     el("kerf-test").textContent = JSON.stringify({ counts, at, errors });
   }
   requestAnimationFrame(loop);

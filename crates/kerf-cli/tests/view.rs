@@ -143,26 +143,48 @@ fn setpoints(path: &Path) -> Vec<[f64; 6]> {
         .collect()
 }
 
-/// The page of `dir` against its report and its set-points, at a third of set-up 1's
-/// samples: returns the head's distance from the set-point's tip.
+/// The page of `dir` against its report and its set-points: set-up 1 at a third of its
+/// samples, and where there are several set-ups the last one too (switched in the page's
+/// set-up list). Returns the largest distance of the head from its set-point's tip.
 fn check_page(name: &str, dir: &Path, machine: &str) -> f64 {
-    let page = dir.join("view.html");
     let report = read_json(&dir.join("report.json"));
+    let setups = report["placement"]["setups"].as_array().map_or(1, Vec::len);
+    let mut worst = check_setup(name, dir, machine, &report, 0, setups);
+    if setups > 1 {
+        worst = worst.max(check_setup(name, dir, machine, &report, setups - 1, setups));
+    }
+    worst
+}
+
+/// Set-up `k` (of `setups`) of the page of `dir` at a third of its samples.
+fn check_setup(
+    name: &str,
+    dir: &Path,
+    machine: &str,
+    report: &Value,
+    k: usize,
+    setups: usize,
+) -> f64 {
+    let page = dir.join("view.html");
     let m = Machine::read(fixture(machine)).expect("machine");
-    let rows = setpoints(&dir.join(
-        match report["placement"]["setups"].as_array().map(Vec::len) {
-            Some(1) => "setpoints.csv".to_string(),
-            _ => "setpoints-1.csv".to_string(),
-        },
-    ));
+    let rows = setpoints(&dir.join(if setups == 1 {
+        "setpoints.csv".to_string()
+    } else {
+        format!("setpoints-{}.csv", k + 1)
+    }));
     // The page's samples: every `stride` cycles (kerf_view::MAX_TIMELINE_SAMPLES at most).
     let stride = rows.len().div_ceil(kerf_view::MAX_TIMELINE_SAMPLES).max(1);
     let cycle = report["interpolation"]["cycle_s"].as_f64().expect("cycle");
-    let k = (rows.len() - 1) / stride / 3;
-    let i = k * stride;
+    let i = (rows.len() - 1) / stride / 3 * stride;
     let t = i as f64 * cycle;
-    let v = browse(&page, &format!("t={t}"));
+    let v = browse(&page, &format!("t={t}&setup={k}"));
+    let name = format!("{name} set-up {}", k + 1);
     assert_eq!(v["errors"], serde_json::json!([]), "{name}: script errors");
+    assert_eq!(
+        v["at"]["setup"].as_u64(),
+        Some(k as u64),
+        "{name}: the set-up shown"
+    );
     let c = &v["counts"];
     let cuts = report["program"]["cuts"].as_u64().expect("cuts");
     assert_eq!(c["paths"].as_u64(), Some(cuts), "{name}: cuts");

@@ -188,7 +188,11 @@ fn check_setup(
     let c = &v["counts"];
     let cuts = report["program"]["cuts"].as_u64().expect("cuts");
     assert_eq!(c["paths"].as_u64(), Some(cuts), "{name}: cuts");
-    assert_eq!(c["pierces"].as_u64(), Some(cuts), "{name}: pierces");
+    // The pierce markers drawn against the process stage's own count.
+    assert_eq!(
+        c["pierces"], report["process"]["pierces"],
+        "{name}: pierces"
+    );
     assert_eq!(
         c["traverses"], report["traverses"]["count"],
         "{name}: traverses"
@@ -335,6 +339,10 @@ fn kerf_view_refreshes_a_page_with_the_reports_warnings() {
         let v = browse(&page, "t=0.5");
         assert_eq!(v["errors"], serde_json::json!([]));
         assert_eq!(v["counts"]["warnings"], 1);
+        assert_eq!(
+            v["counts"]["warning_markers"], 1,
+            "one set-up: its marker drawn"
+        );
     }
     // A directory without a view: refused by name, nothing written.
     let empty = tempfile::tempdir().expect("tmp");

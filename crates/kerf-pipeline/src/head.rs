@@ -319,8 +319,9 @@ fn needed_tilt(
     let d = escape(obs, &pose.axis, &st.point)
         .unwrap_or_else(|| away(&pose.axis, &pose.position, &st.point));
     let surface = st.surface.as_deref().unwrap_or("?");
-    // A placement left unproven (the work budget spent) is not a tilt that fails to clear.
-    let mut unproven = false;
+    // A placement left unproven (the work budget spent, a placement's own cap, an unusable
+    // head zone) is not a tilt that fails to clear: the first reason is quoted.
+    let mut unproven: Option<String> = None;
     let more = (1..)
         .map(|j| j as f64 * 2.5)
         .take_while(|a| *a <= MAX_NEEDED_TILT_DEG)
@@ -328,7 +329,9 @@ fn needed_tilt(
             let margin = hopts.with_clearance_mm(hopts.clearance_mm + TILT_MARGIN_MM);
             let axis = tilted(&pose.axis, &d, a.to_radians());
             let c = place_once(obs, head, &margin, pose.position, axis, budget);
-            unproven |= !c.proven;
+            if !c.proven && unproven.is_none() {
+                unproven = Some(c.unproven.clone().unwrap_or_else(|| "unproven".to_string()));
+            }
             c.proven && c.close.is_empty()
         });
     let usable = kerf_kinematics::MAX_TILT_TOLERANCE_DEG * kerf_kinematics::TILT_WORKING_FRACTION;
@@ -341,8 +344,9 @@ fn needed_tilt(
             "at cutting point {i} a tilt of {a:.1} deg away from surface {surface} would clear it (tilt tolerance {tolerance_deg} deg; --tilt-tolerance {} allows it)",
             (a / kerf_kinematics::TILT_WORKING_FRACTION).ceil()
         ),
-        None if unproven => format!(
-            "at cutting point {i} the head check's work budget ({} distance queries) ran out before a tilt away from surface {surface} that clears it was found",
+        None if unproven.is_some() => format!(
+            "at cutting point {i} no tilt away from surface {surface} was proven to clear it: {} (the head check's budget is {} distance queries)",
+            unproven.unwrap_or_default(),
             hopts.max_queries
         ),
         None => format!(
@@ -462,8 +466,8 @@ mod tests {
         let mut spent = 0;
         let s = needed_tilt(&obs, &head, &hopts, &pose, 7, &st, 0.0, &mut spent);
         assert!(
-            s.contains("at cutting point 7 the head check's work budget")
-                && s.contains("ran out before a tilt away from surface wall"),
+            s.contains("at cutting point 7 no tilt away from surface wall was proven to clear it")
+                && s.contains("distance queries ran out"),
             "{s}"
         );
     }

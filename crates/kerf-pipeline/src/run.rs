@@ -729,6 +729,10 @@ fn run_placed(
             .head
             .clone()
             .unwrap_or_else(kerf_kinematics::Head::laser_default),
+        machine
+            .process
+            .standoff_mm
+            .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
         o.feed_mm_per_min,
         process.pierce_standoff,
     );
@@ -989,10 +993,10 @@ fn technology_json(
     let Some(t) = t else {
         return serde_json::Value::Null;
     };
-    let power = if commands_power {
-        "its power is commanded following the tip speed (its power at its feed, down to power_min_percent), its pierce power at the pierce"
+    let (power, holes) = if commands_power {
+        ("its power is commanded following the tip speed (its power at its feed, down to power_min_percent), its pierce power at the pierce", "feed and power factors")
     } else {
-        "its power is not commanded (the dialect has no power word that acts with the motion: the program's header says why)"
+        ("its power is not commanded (the dialect has no power word that acts with the motion: the program's header says why)", "feed factor")
     };
     json!({
         "entry": t.label(),
@@ -1010,7 +1014,7 @@ fn technology_json(
         "corner": t.corner.map(|c| json!({ "min_turn_deg": c.min_turn_deg, "length_mm": c.length_mm, "feed_factor": c.feed_factor })),
         "power_min_percent": t.power_min(),
         "small_holes": small_holes,
-        "note": format!("the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; {power}; holes within the small-hole rule run at its feed and power factors, corners within its corner rule at its feed factor; gas and focus are stated, not commanded"),
+        "note": format!("the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; {power}; holes within the small-hole rule run at its {holes}, corners within its corner rule at its feed factor; gas and focus are stated, not commanded"),
     })
 }
 

@@ -34,6 +34,7 @@ pub(crate) fn scene(
     setups: &[SetupInput<'_>],
     model: &MachineModel,
     head: &Head,
+    head_standoff_mm: f64,
     feed_mm_per_min: f64,
     pierce_standoff_mm: f64,
 ) -> Scene {
@@ -41,6 +42,7 @@ pub(crate) fn scene(
     s.title = title.to_string();
     s.machine = model.name().to_string();
     s.feed_mm_per_min = feed_mm_per_min;
+    s.head_standoff_mm = head_standoff_mm;
     s.head = head
         .solids
         .iter()

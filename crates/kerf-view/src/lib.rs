@@ -50,13 +50,17 @@ pub struct Scene {
     /// The head's solids from the nozzle tip up: `[length, bottom diameter, top diameter]`
     /// in mm each.
     pub head: Vec<[f64; 3]>,
+    /// How far the nozzle tip stands above the tool tip along the axis, mm (the machine's
+    /// `process.standoff_mm`).
+    pub head_standoff_mm: f64,
     /// The run's warnings, in order.
     pub warnings: Vec<Warning>,
     /// The set-ups, in cutting order.
     pub setups: Vec<Setup>,
 }
 
-/// One warning of the run, with the point it names, if any (workpiece frame of set-up 1).
+/// One warning of the run, with the first point its text names, if any (drawn as a marker
+/// where the scene has one set-up: the text does not say in which set-up's frame it is).
 #[derive(Debug, Clone, Default, Serialize)]
 #[non_exhaustive]
 pub struct Warning {

@@ -46,7 +46,8 @@
     return l;
   }
 
-  // Each cut's points split where its lead-in ends and its lead-out starts (mm along it).
+  // Each cut's points split at the points nearest to where its lead-in ends and its lead-out
+  // starts (mm along it); the point at a split belongs to both pieces, so none goes missing.
   function cutPieces(c) {
     const p = c.points, n = p.length / 3;
     const along = [0];
@@ -54,19 +55,19 @@
       along.push(along[i - 1] + Math.hypot(p[3 * i] - p[3 * i - 3], p[3 * i + 1] - p[3 * i - 2], p[3 * i + 2] - p[3 * i - 1]));
     }
     const total = along[n - 1] || 0;
-    const piece = (a, b) => {
-      const out = [];
-      for (let i = 0; i < n; i++) if (along[i] >= a - 1e-9 && along[i] <= b + 1e-9) out.push(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
-      return out;
+    const nearest = (s) => {
+      let best = 0;
+      for (let i = 1; i < n; i++) if (Math.abs(along[i] - s) < Math.abs(along[best] - s)) best = i;
+      return best;
     };
-    return {
-      leadIn: c.lead_in_mm > 0 ? piece(0, c.lead_in_mm) : [],
-      contour: piece(c.lead_in_mm, total - c.lead_out_mm),
-      leadOut: c.lead_out_mm > 0 ? piece(total - c.lead_out_mm, total) : [],
-    };
+    const a = c.lead_in_mm > 0 ? nearest(c.lead_in_mm) : 0;
+    const b = c.lead_out_mm > 0 ? Math.max(a, nearest(total - c.lead_out_mm)) : n - 1;
+    const piece = (i, j) => (j > i ? p.slice(3 * i, 3 * j + 3) : []);
+    return { leadIn: piece(0, a), contour: piece(a, b), leadOut: piece(b, n - 1) };
   }
 
   const groups = [];
+  const drawn = { pierces: 0, markers: 0 };
   const labels = [];
   const markers = [];
   data.setups.forEach((s, k) => {
@@ -103,6 +104,7 @@
       const dot = new THREE.Mesh(new THREE.SphereGeometry(0.8, 10, 8), new THREE.MeshBasicMaterial({ color: 0xffd040 }));
       dot.position.set(c.pierce[0], c.pierce[1], c.pierce[2]);
       g.add(dot);
+      drawn.pierces += 1;
       labels.push({ setup: k, text: String(i + 1), at: new THREE.Vector3(c.pierce[0], c.pierce[1], c.pierce[2]) });
       for (let j = 0; j < c.points.length; j += 3) box.expandByPoint(new THREE.Vector3(c.points[j], c.points[j + 1], c.points[j + 2]));
     });
@@ -131,19 +133,21 @@
     groups.push(g);
   });
 
-  // Warnings: a marker at each point one names (set-up 1's frame), every one listed.
+  // Warnings: every one listed; a marker at the point one names where there is one set-up
+  // (a warning's text does not say in which set-up's frame its point is).
   const list = el("warnings");
   data.warnings.forEach((w, i) => {
     const li = document.createElement("li");
     li.textContent = w.text.length > 90 ? w.text.slice(0, 90) + "..." : w.text;
     li.onclick = () => showWarning(i);
     list.appendChild(li);
-    if (w.point) {
+    if (w.point && data.setups.length === 1) {
       const m = new THREE.Mesh(new THREE.OctahedronGeometry(2.5), new THREE.MeshBasicMaterial({ color: 0xff3030 }));
       m.position.set(w.point[0], w.point[1], w.point[2]);
       m.userData.warning = i;
       if (groups[0]) groups[0].add(m);
       markers.push(m);
+      drawn.markers += 1;
     }
   });
   function showWarning(i) {
@@ -160,7 +164,8 @@
 
   // The head: its solids along the tool axis from the nozzle tip.
   const head = new THREE.Group();
-  let z = 0;
+  // The nozzle tip stands `head_standoff_mm` above the tool tip, along the axis.
+  let z = data.head_standoff_mm || 0;
   for (const [len, bottom, top] of data.head) {
     const c = new THREE.Mesh(new THREE.CylinderGeometry(top / 2, bottom / 2, len, 32, 1),
       new THREE.MeshStandardMaterial({ color: 0xc8a060, transparent: true, opacity: 0.4, metalness: 0.3, roughness: 0.5, depthWrite: false }));
@@ -226,7 +231,8 @@
   const counts = {
     setups: data.setups.length,
     paths: data.setups.reduce((a, s) => a + s.cuts.length, 0),
-    pierces: data.setups.reduce((a, s) => a + s.cuts.filter((c) => c.pierce).length, 0),
+    pierces: drawn.pierces,
+    warning_markers: drawn.markers,
     traverses: data.setups.reduce((a, s) => a + s.traverses.length, 0),
     warnings: data.warnings.length,
     surfaces: data.setups.reduce((a, s) => a + s.surfaces.length, 0),

@@ -11,7 +11,9 @@
 //! four decimals (the TNC's input resolution), directions with seven; `FMAX` rapids with
 //! `R0`; the pierce dwell `CYCL DEF 9.0 DWELL TIME` / `CYCL DEF 9.1 DWELL <s>`; the contour
 //! tolerance `CYCL DEF 32` with `T` half the budget's controller-blending term and `TA` the
-//! other half turned into degrees at the pivot length (as Sinumerik's `CTOL`/`OTOL`); the beam
+//! other half turned into degrees at the pivot length (as Sinumerik's `CTOL`/`OTOL`), rounded
+//! down to the TNC's four decimals (where that leaves nothing, its least, 0.0001, and the header
+//! says the controller may then blend more than the budget); the beam
 //! codes as M-function blocks of their own; `FUNCTION RESET TCPM`, `M30` at the end. No
 //! `BLK FORM` and no `TOOL CALL`: the active tool's length must put the tip where kerf's
 //! machine file does (the header says so).
@@ -79,8 +81,9 @@ impl Rules for Heidenhain {
         (
             format!("kerf HEIDENHAIN Klartext program: {words}, in the active preset"),
             format!(
-                "feed: FUNCTION TCPM F TCP, F in mm/min of the tool tip, the block's mean planned speed; where the tip stands F is deg/min of the rotary motion;\nfeed: CYCL DEF 32 T and TA from the budget's controller_blending term;\nfeed: rapids FMAX split so that the tip follows kerf's joint-space traverse within {} mm;\nfeed: coordinates to 4 decimals, rotary axes to 4, directions to 7",
-                crate::RAPID_TCP_TOLERANCE_MM
+                "feed: FUNCTION TCPM F TCP, F in mm/min of the tool tip, the block's mean planned speed; where the tip stands F is deg/min of the rotary motion;\nfeed: CYCL DEF 32 T and TA from the budget's controller_blending term;\nfeed: rapids FMAX split so that the tip follows kerf's joint-space traverse within {} mm{};\nfeed: coordinates to 4 decimals, rotary axes to 4, directions to 7",
+                crate::RAPID_TCP_TOLERANCE_MM,
+                if self.axes { "" } else { " where the TNC takes kerf's rotary solution of each direction" }
             ),
             "arcs written as line chords",
         )
@@ -95,33 +98,41 @@ impl Rules for Heidenhain {
         w.line("FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS");
         w.line("CYCL DEF 32.0 TOLERANCE");
         let t = o.blend_tolerance_mm / 2.0;
-        w.line(&format!("CYCL DEF 32.1 T{}", tolerance_number(t)));
+        let (t_word, t_over) = tolerance_word(t);
+        w.line(&format!("CYCL DEF 32.1 T{t_word}"));
+        if t_over {
+            w.comment(&format!(
+                "tolerance: T {t_word} mm is the TNC's least, above the budget's half of the blending term [{t} mm]: the controller may blend more than the budget says"
+            ));
+        }
         match o.pivot_length_mm.filter(|l| l.is_finite() && *l > 0.0) {
             Some(l) => {
                 let ta = (t / l).to_degrees();
-                w.line(&format!(
-                    "CYCL DEF 32.2 HSC-MODE:0 TA{}",
-                    tolerance_number(ta)
-                ));
+                let (ta_word, ta_over) = tolerance_word(ta);
+                w.line(&format!("CYCL DEF 32.2 HSC-MODE:0 TA{ta_word}"));
+                if ta_over {
+                    let at_tip = ta_word.parse::<f64>().unwrap_or(1e-4).to_radians() * l;
+                    w.comment(&format!(
+                        "tolerance: TA {ta_word} deg is the TNC's least: at the pivot length {l} mm it allows {at_tip:.6} mm at the tip, above the budget's half of the blending term [{t} mm]"
+                    ));
+                }
             }
-            None => w.line("CYCL DEF 32.2 HSC-MODE:0"),
+            None => {
+                w.line("CYCL DEF 32.2 HSC-MODE:0");
+                w.comment("tolerance: TA not written [no pivot length known]: the TNC's own rotary tolerance applies, outside the budget");
+            }
         }
-        // What the four decimals cost: half a unit of the last decimal on each of X Y Z and
-        // on each rotary axis, through the pivot length (where known).
-        let half = 0.5e-4;
-        let xyz = 3f64.sqrt() * half;
-        let rotary = o
-            .pivot_length_mm
-            .filter(|l| l.is_finite() && *l > 0.0)
-            .map(|l| l * 2f64.sqrt() * half.to_radians());
-        let rounding = match (self.axes, rotary) {
-            (true, Some(r)) => format!("at most {:.6} mm", xyz + r),
-            (true, None) => format!("{xyz:.6} mm plus the rotary axes' 0.00005 deg through the tool's distance from them"),
-            // Seven decimals of a unit direction: 1e-7 of the pivot length, negligible.
-            (false, _) => format!("at most {:.6} mm", xyz + rotary.map_or(0.0, |r| r * 1e-3)),
+        // What the four decimals cost: half a unit of the last decimal on each of X Y Z. Under
+        // TCPM the rotary words (or the direction) set the tool's orientation about the tip,
+        // so their rounding turns the tool, it does not move the tip.
+        let xyz = 3f64.sqrt() * 0.5e-4;
+        let orientation = if self.axes {
+            "the rotary axes' 0.00005 deg each turn the tool about it"
+        } else {
+            "the directions' seven decimals turn the tool about it by 1e-7 rad"
         };
         w.comment(&format!(
-            "rounding: the written coordinates move the tip by {rounding}, not in the budget"
+            "rounding: X Y Z to four decimals move the tip by at most {xyz:.6} mm, not in the budget; {orientation}"
         ));
     }
 
@@ -255,10 +266,16 @@ fn feed(f: f64) -> String {
     format!("{:.3}", f.max(0.001))
 }
 
-/// A tolerance of `CYCL DEF 32` (mm or degrees): four decimals, rounded down so that the
-/// controller keeps within the budget, at least 0.0001; trailing zeros dropped.
-fn tolerance_number(v: f64) -> String {
-    trimmed(((v * 1e4).floor() / 1e4).max(1e-4), 4)
+/// A tolerance of `CYCL DEF 32` (mm or degrees) as written: four decimals, rounded down so
+/// that the controller keeps within the budget; where that would be 0 the TNC's least,
+/// 0.0001, and `true`: the written tolerance is above `v` (the header says so).
+fn tolerance_word(v: f64) -> (String, bool) {
+    let down = (v * 1e4).floor() / 1e4;
+    if down >= 1e-4 {
+        (trimmed(down, 4), false)
+    } else {
+        ("0.0001".to_string(), true)
+    }
 }
 
 /// A dwell in seconds: three decimals, rounded up (a pierce never shorter than asked).
@@ -314,9 +331,11 @@ mod tests {
         assert_eq!(direction(-0.8764339), "-0.8764339");
         assert_eq!(direction(-1e-9), "+0.0000000");
         assert_eq!(direction(0.25903194), "+0.2590319");
-        assert_eq!(tolerance_number(0.0025), "0.0025");
-        assert_eq!(tolerance_number(0.00079), "0.0007"); // down: within the budget
-        assert_eq!(tolerance_number(1e-7), "0.0001");
+        assert_eq!(tolerance_word(0.0025), ("0.0025".to_string(), false));
+        // Down: within the budget.
+        assert_eq!(tolerance_word(0.00079), ("0.0007".to_string(), false));
+        // Below the TNC's least: its least, flagged as above the budget.
+        assert_eq!(tolerance_word(1e-7), ("0.0001".to_string(), true));
         assert_eq!(dwell_number(0.2), "0.2");
         assert_eq!(dwell_number(0.2001), "0.201"); // up: never a shorter pierce
         assert_eq!(feed(0.0), "0.001");

@@ -172,6 +172,7 @@ fn curve(
         surface: Some(surface.into()),
         start: None,
         scrap: None,
+        on_surface_tolerance_mm: None,
     }
 }
 
@@ -1853,6 +1854,7 @@ fn trim_creases(out: &Path) {
         surface: Some(curves::SurfaceRef::Many(ids)),
         start: None,
         scrap: None,
+        on_surface_tolerance_mm: None,
     };
     let surfaces = faces
         .iter()

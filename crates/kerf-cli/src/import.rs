@@ -144,6 +144,9 @@ pub(crate) fn print_account(path: &Path, r: &kerf_step::Report, file: &CurvesFil
         file.surfaces.len(),
         r.faces_read
     );
+    if let Some(u) = r.uncertainty_mm {
+        eprintln!("  the file's length tolerance: {u} mm (face-loop contours may lie that far from their faces)");
+    }
     if let Some(s) = &r.sheet {
         match &s.not_a_sheet {
             Some(why) => eprintln!("  not one sheet ({why}): every face loop is cut"),

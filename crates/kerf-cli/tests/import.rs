@@ -274,3 +274,76 @@ fn what_the_step_import_assumed_is_in_the_run_report_even_when_quiet() {
         "{warnings:?}"
     );
 }
+
+#[test]
+fn an_edge_within_its_files_tolerance_is_cut_and_named_and_beyond_it_refused() {
+    // The plate's front wall (#298, the plane y = 0 through #277) moved 0.015 mm off its
+    // edges: the wall's own loop (`--faces 298`) lies 0.015 mm from the wall, more than the run's on-surface tolerance (0.01 mm). A file whose uncertainty
+    // is 0.02 mm says its edges are good to that: the loop is cut, and the report names it with
+    // both distances. The same file stating 0.005 mm, or nothing, is refused by the normals
+    // stage naming the distance.
+    let text = std::fs::read_to_string(fixture("step/sheet/plate.step")).expect("fixture");
+    let wall = "#277 = CARTESIAN_POINT('',(0.0,0.0,0.0));";
+    assert!(text.contains(wall), "the fixture's front wall origin");
+    let moved = text.replace(wall, "#277 = CARTESIAN_POINT('',(0.0,0.015,0.0));");
+    let with_uncertainty = |u: &str| {
+        moved.replacen(
+            "DATA;\n",
+            &format!(
+                "DATA;\n#9001 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n#9002 = UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE({u}),#9001,'distance_accuracy_value','');\n"
+            ),
+            1,
+        )
+    };
+    let dir = tempfile::tempdir().expect("tmp");
+    let run_on = |name: &str, step: &str| {
+        let path = dir.path().join(format!("{name}.step"));
+        std::fs::write(&path, step).expect("write");
+        let out = dir.path().join(name);
+        let (code, _, err) = run(kerf()
+            .arg("run")
+            .arg(&path)
+            .args(["--edges", "--faces", "298", "--place", "auto", "-m"])
+            .arg(fixture("machines/gantry_ac.json"))
+            .args(["-q", "-o"])
+            .arg(&out));
+        (code, err, out)
+    };
+    let (code, err, out) = run_on("within", &with_uncertainty("0.02"));
+    assert_eq!(code, 0, "{err}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("report"))
+            .expect("JSON");
+    let warnings: Vec<&str> = report["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .filter_map(|w| w.as_str())
+        .filter(|w| w.contains("beyond the run's on-surface tolerance"))
+        .collect();
+    assert!(!warnings.is_empty(), "{}", report["warnings"]);
+    for w in &warnings {
+        // The wall's loop: 0.015 mm (the move), within the file's 0.02 mm.
+        assert!(
+            w.contains("face #298 loop")
+                && w.contains("up to 0.015000 mm from its surface")
+                && w.contains("on-surface tolerance (0.01 mm) but within the curve's own (0.02 mm"),
+            "{w}"
+        );
+    }
+    for (name, step) in [
+        ("tight", with_uncertainty("0.005")),
+        ("none", moved.clone()),
+    ] {
+        let (code, err, out) = run_on(name, &step);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(
+            err.contains("face #298 loop")
+                && err.contains("1.5")
+                && err.contains("e-2 mm from its surface")
+                && err.contains("0.01 mm"),
+            "{name}: {err}"
+        );
+        assert!(!out.exists(), "{name}: nothing written");
+    }
+}

@@ -94,7 +94,17 @@ pub struct RawCurve {
     /// checked by [`from_raw`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scrap: Option<String>,
+    /// How far the curve's points may lie from its surface, mm (optional
+    /// `on_surface_tolerance_mm` key): the curve's own tolerance where it is looser than a
+    /// run's (a CAD edge on its face within the tolerance its file states). Checked by
+    /// [`from_raw`]: finite, > 0 and at most [`MAX_CURVE_ON_SURFACE_TOLERANCE_MM`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub on_surface_tolerance_mm: Option<f64>,
 }
+
+/// The largest `on_surface_tolerance_mm` a curve may state, mm: farther from its surface a
+/// curve is not on it (its normals would be another place's).
+pub const MAX_CURVE_ON_SURFACE_TOLERANCE_MM: f64 = 0.1;
 
 /// The `surface` key of a curve: one surface id, or a list of them for a curve that runs over
 /// several faces (the normal at each point then comes from the nearest of them).
@@ -254,6 +264,9 @@ pub struct CurveRecord {
     pub start: Option<f64>,
     /// The side that is waste (the `scrap` key); `None` lets kerf decide.
     pub scrap: Option<ScrapSide>,
+    /// The curve's own on-surface tolerance, mm (the `on_surface_tolerance_mm` key): the
+    /// normals stage takes the looser of it and the run's.
+    pub on_surface_tolerance_mm: Option<f64>,
 }
 
 /// The side of a curve that is waste, seen along the curve's direction with the normal toward
@@ -482,6 +495,8 @@ fn raw_in_one_pass(bytes: &[u8]) -> Option<(RawCurvesFile, Vec<UnknownKey>)> {
         start: Option<f64>,
         #[serde(default)]
         scrap: Option<String>,
+        #[serde(default)]
+        on_surface_tolerance_mm: Option<f64>,
     }
     let body: Body = serde_json::from_slice(kerf_io::strip_bom(bytes)).ok()?;
     if body.format != CURVES_FORMAT || Units::from_name(&body.units).is_none() {
@@ -516,6 +531,7 @@ fn raw_in_one_pass(bytes: &[u8]) -> Option<(RawCurvesFile, Vec<UnknownKey>)> {
             surface: c.surface,
             start: c.start,
             scrap: c.scrap,
+            on_surface_tolerance_mm: c.on_surface_tolerance_mm,
         })
         .collect();
     let raw = RawCurvesFile {
@@ -630,6 +646,16 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
             });
         }
         let (start, scrap) = start_and_scrap(index, &curve, c.start, c.scrap.as_deref())?;
+        if let Some(t) = c.on_surface_tolerance_mm {
+            if !(t > 0.0 && t <= MAX_CURVE_ON_SURFACE_TOLERANCE_MM) {
+                return Err(FormatError::Shape {
+                    path: format!("curves[{index}].on_surface_tolerance_mm"),
+                    message: format!(
+                        "must be > 0 and at most {MAX_CURVE_ON_SURFACE_TOLERANCE_MM} mm (got {t})"
+                    ),
+                });
+            }
+        }
         curves.push(CurveRecord {
             id: c.id,
             curve,
@@ -637,6 +663,7 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
             surfaces: named,
             start,
             scrap,
+            on_surface_tolerance_mm: c.on_surface_tolerance_mm,
         });
     }
 

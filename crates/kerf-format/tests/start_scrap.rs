@@ -115,3 +115,30 @@ fn the_keys_survive_a_raw_round_trip() {
         "absent keys are not written: {text}"
     );
 }
+
+#[test]
+fn a_curves_own_on_surface_tolerance_is_read_checked_and_written_back() {
+    let f = read(&doc(r#", "on_surface_tolerance_mm": 0.02"#, "")).expect("valid key");
+    assert_eq!(f.curves[1].on_surface_tolerance_mm, Some(0.02));
+    assert_eq!(f.curves[0].on_surface_tolerance_mm, None, "absent");
+    // Not a near miss: no warning for the key.
+    assert!(f.warnings.is_empty(), "{:?}", f.warnings);
+    for bad in ["0", "-0.01", "0.2", "1"] {
+        let e =
+            read(&doc(&format!(r#", "on_surface_tolerance_mm": {bad}"#), "")).expect_err("refused");
+        assert!(
+            e.contains("curves[1].on_surface_tolerance_mm")
+                && e.contains("must be > 0 and at most 0.1 mm"),
+            "{bad}: {e}"
+        );
+    }
+    // The raw document keeps it: what `kerf import` writes, read back.
+    let raw = curves::raw_from_slice(doc(r#", "on_surface_tolerance_mm": 0.02"#, "").as_bytes())
+        .expect("raw");
+    let text = serde_json::to_string(&raw).expect("JSON");
+    assert!(text.contains(r#""on_surface_tolerance_mm":0.02"#), "{text}");
+    assert_eq!(
+        read(&text).expect("again").curves[1].on_surface_tolerance_mm,
+        Some(0.02)
+    );
+}

@@ -337,6 +337,14 @@ pub fn orient_curves(
                     nearest = Nearest(picked);
                     &nearest
                 };
+                // The curve's own tolerance where it is looser (a CAD edge on its face within
+                // its file's tolerance).
+                let nopts = match rec.on_surface_tolerance_mm {
+                    Some(t) if t > nopts.on_surface_tolerance_mm => {
+                        nopts.with_on_surface_tolerance_mm(t)
+                    }
+                    _ => nopts,
+                };
                 orient(&rec.curve, d, src, opts, &nopts).map_err(|error| Error::Normals {
                     file: file_path(),
                     place: place(i),

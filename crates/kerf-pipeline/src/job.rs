@@ -513,6 +513,7 @@ impl Job {
             surface,
             start: None,
             scrap: None,
+            on_surface_tolerance_mm: None,
         });
         self
     }

@@ -213,6 +213,24 @@ fn run_placed(
     let oriented: Vec<Oriented> =
         orient_curves(file, &discs, &contour_opts, &o.orient, path, progress)?;
     let mut tp = toolpath_of_poses(file, dopts.tolerance_mm, &oriented);
+    // Curves taken within their own tolerance (a CAD edge on its face within its file's),
+    // beyond the run's: each named with both.
+    let run_tolerance = o.orient.normals.on_surface_tolerance_mm;
+    let edge_warnings: Vec<String> = file
+        .curves
+        .iter()
+        .zip(&oriented)
+        .enumerate()
+        .filter(|(_, (_, or))| or.max_surface_distance > run_tolerance)
+        .map(|(i, (c, or))| {
+            format!(
+                "curves[{i}] ({:?}): its points lie up to {:.6} mm from its surface, beyond the run's on-surface tolerance ({run_tolerance} mm) but within the curve's own ({} mm, its file's tolerance): taken, the normals from the nearest surface points",
+                c.id,
+                or.max_surface_distance,
+                c.on_surface_tolerance_mm.unwrap_or(run_tolerance)
+            )
+        })
+        .collect();
     lap.split(&mut timings, "normals");
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
     let popts = o.path;
@@ -459,7 +477,8 @@ fn run_placed(
     // The traverses for the plot, part coordinates, and a cut's last pose.
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
-    let mut warnings: Vec<String> = head_warnings;
+    let mut warnings: Vec<String> = edge_warnings;
+    warnings.extend(head_warnings);
     warnings.extend(joint_warnings.iter().cloned());
     // The offset paths go into the toolpath (`kerf_offset`), where `kerf check` measures them.
     for c in &compensated {

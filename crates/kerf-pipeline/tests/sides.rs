@@ -33,6 +33,7 @@ fn hole(side: ScrapSide) -> CurvesFile {
             surfaces: vec!["wall".into()],
             start: None,
             scrap: Some(side),
+            on_surface_tolerance_mm: None,
         }],
         surfaces: vec![SurfaceRecord {
             id: "wall".into(),
@@ -158,6 +159,7 @@ fn a_contour_under_a_roof_keeps_its_side_when_the_head_cannot_reach_the_other() 
         surfaces: vec![surface.into()],
         start: None,
         scrap: None,
+        on_surface_tolerance_mm: None,
     };
     let surface = |id: &str, s: NurbsSurface| SurfaceRecord {
         id: id.into(),

@@ -177,6 +177,10 @@ pub struct Report {
     pub surfaces: Vec<String>,
     /// What the reader assumed (a file with no unit context is read in mm).
     pub warnings: Vec<String>,
+    /// The file's length uncertainty, mm (its largest `UNCERTAINTY_MEASURE_WITH_UNIT` of a
+    /// length): with `edges`, each face-loop contour carries it (at most
+    /// [`kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM`]) as its `on_surface_tolerance_mm`.
+    pub uncertainty_mm: Option<f64>,
     /// The work done, counted against the reader's budgets.
     pub work: Work,
     /// With `edges` and every face: the sheet the faces form, its features each cut once
@@ -516,6 +520,10 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         .iter()
         .map(|&fi| RawSurface::Nurbs(raw_surface(&face_id(&faces[fi]), &faces[fi].surface)))
         .collect();
+    let edge_tolerance = m
+        .uncertainty_mm
+        .map(|u| u.min(kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM));
+    report.uncertainty_mm = m.uncertainty_mm;
     let mut raw_curves = Vec::with_capacity(contours.len());
     for (id, c, named, scrap) in contours {
         let surface = match named.len() {
@@ -537,6 +545,12 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         ));
         let mut raw = raw_curve(id, &c, surface);
         raw.scrap = scrap.map(str::to_owned);
+        // A face's edge lies on the face within the file's own tolerance (the reader took
+        // it within ON_GEOMETRY_TOLERANCE_MM): the curve says so, and the normals stage takes
+        // the looser of it and the run's on-surface tolerance.
+        if opts.edges && raw.surface.is_some() {
+            raw.on_surface_tolerance_mm = edge_tolerance;
+        }
         raw_curves.push(raw);
     }
     let file = RawCurvesFile {
@@ -714,6 +728,7 @@ fn raw_curve(id: String, c: &NurbsCurve, surface: Option<SurfaceRef>) -> RawCurv
         surface,
         start: None,
         scrap: None,
+        on_surface_tolerance_mm: None,
     }
 }
 

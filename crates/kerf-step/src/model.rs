@@ -112,6 +112,10 @@ pub(crate) struct Model<'a> {
     pub(crate) units: Units,
     /// What was assumed about the units (a file with no unit context).
     pub(crate) warnings: Vec<String>,
+    /// The file's length uncertainty (its `UNCERTAINTY_MEASURE_WITH_UNIT` of a length, the
+    /// largest if it gives several), mm: how far apart two points may be and still be one
+    /// for the system that wrote it.
+    pub(crate) uncertainty_mm: Option<f64>,
     /// The work done so far, per [`Charge`].
     spent: [std::cell::Cell<u64>; 4],
 }
@@ -128,11 +132,13 @@ pub(crate) fn err(inst: &Instance, message: impl Into<String>) -> StepError {
 impl<'a> Model<'a> {
     /// Wraps the table, reading the units.
     pub(crate) fn new(ex: &'a Exchange<'a>) -> Result<Self> {
-        let (units, warnings) = read_units(ex)?;
+        let (units, mut warnings) = read_units(ex)?;
+        let uncertainty_mm = read_uncertainty(ex, &mut warnings)?;
         Ok(Self {
             ex,
             units,
             warnings,
+            uncertainty_mm,
             spent: Default::default(),
         })
     }
@@ -476,6 +482,42 @@ impl Kind {
             Kind::Angle => "PLANE_ANGLE_UNIT",
         }
     }
+}
+
+/// The file's length uncertainty in mm: the largest `UNCERTAINTY_MEASURE_WITH_UNIT` whose
+/// value is a `LENGTH_MEASURE`, in the length unit it references. One whose unit cannot be
+/// read, or whose value is not a finite number > 0, is left out with a warning.
+fn read_uncertainty(ex: &Exchange<'_>, warnings: &mut Vec<String>) -> Result<Option<f64>> {
+    let mut largest: Option<f64> = None;
+    for inst in all(ex, "UNCERTAINTY_MEASURE_WITH_UNIT")? {
+        let p = inst.record("UNCERTAINTY_MEASURE_WITH_UNIT").unwrap_or(&[]);
+        let value = match p.first() {
+            Some(Value::Typed(name, v)) if name == "LENGTH_MEASURE" => match **v {
+                Value::Real(r) => r,
+                Value::Int(i) => i as f64,
+                _ => continue,
+            },
+            _ => continue,
+        };
+        let unit = match p.get(1) {
+            Some(Value::Ref(id)) => ex.get(*id)?,
+            _ => None,
+        };
+        let factor = unit
+            .as_ref()
+            .and_then(|u| unit_factor(ex, u, Kind::Length, 0).ok())
+            .map(|(f, _)| f);
+        match factor {
+            Some(f) if value.is_finite() && value > 0.0 && (value * f).is_finite() => {
+                largest = Some(largest.map_or(value * f, |l: f64| l.max(value * f)));
+            }
+            _ => warnings.push(format!(
+                "#{} UNCERTAINTY_MEASURE_WITH_UNIT: its length ({value}) or its unit cannot be read: the file's edge tolerance is not taken from it",
+                inst.id
+            )),
+        }
+    }
+    Ok(largest)
 }
 
 /// The units of the geometry: from every `GLOBAL_UNIT_ASSIGNED_CONTEXT`, which must agree.

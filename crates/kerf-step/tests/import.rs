@@ -956,3 +956,46 @@ fn an_edge_off_its_face_gets_the_face_refused_by_name() {
     assert_eq!(sheet.not_a_sheet, None, "0.05 mm off is a CAD tolerance");
     assert_eq!(im.file.curves.len(), 2, "the outline and the hole");
 }
+
+#[test]
+fn the_files_length_uncertainty_is_read_in_its_unit_and_given_to_face_loops() {
+    // composite_inch.step states 3.937007874016e-9 inch (1e-7 mm, OCCT's default precision)
+    // in inches; composite_mm.step 1e-7 mm.
+    for name in ["composite_inch.step", "composite_mm.step"] {
+        let im = import_file(fixture(name), &ImportOptions::default()).expect("import");
+        let u = im.report.uncertainty_mm.expect("the file's uncertainty");
+        assert!((u - 1e-7).abs() < 1e-12, "{name}: {u} mm");
+        // Contours from geometric sets do not carry it (they were matched to faces within
+        // the import's own face tolerance).
+        assert!(
+            im.file
+                .curves
+                .iter()
+                .all(|c| c.on_surface_tolerance_mm.is_none()),
+            "{name}"
+        );
+    }
+    // Face loops carry the file's tolerance as their own.
+    let im = import_file(
+        fixture("faces.step"),
+        &ImportOptions::default().with_edges(None),
+    )
+    .expect("import");
+    let u = im.report.uncertainty_mm.expect("faces.step states one");
+    assert!(!im.file.curves.is_empty());
+    for c in &im.file.curves {
+        assert_eq!(c.on_surface_tolerance_mm, Some(u), "{}", c.id);
+    }
+    // A file without one: none.
+    let im = import_file(
+        fixture("sheet/plate.step"),
+        &ImportOptions::default().with_edges(None),
+    )
+    .expect("import");
+    assert_eq!(im.report.uncertainty_mm, None);
+    assert!(im
+        .file
+        .curves
+        .iter()
+        .all(|c| c.on_surface_tolerance_mm.is_none()));
+}

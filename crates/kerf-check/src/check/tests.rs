@@ -468,6 +468,7 @@ fn parabola(offset: [f64; 3]) -> (CurveRecord, RawPathRecord) {
         surfaces: Vec::new(),
         start: None,
         scrap: None,
+        on_surface_tolerance_mm: None,
     };
     (curve, record)
 }

@@ -20,6 +20,7 @@ const CURVE: &[&str] = &[
     "surface",
     "start",
     "scrap",
+    "on_surface_tolerance_mm",
 ];
 /// The keys of a `"type": "nurbs"` surface.
 const NURBS: &[&str] = &[

@@ -195,7 +195,8 @@ pub(crate) struct DiscretizeArgs {
     pub(crate) normals: bool,
 
     /// With --normals: a cutting point farther than this from its surface is an error (mm,
-    /// default 0.01).
+    /// default 0.01), unless its curve states a looser on_surface_tolerance_mm of its own (then
+    /// that one, with a warning naming the curve).
     #[arg(long, value_name = "MM", requires = "normals", value_parser = crate::guard::tolerance_mm)]
     pub(crate) on_surface_tolerance: Option<f64>,
 

@@ -186,6 +186,10 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             Some(path),
             &|_| {},
         )?;
+        let run_tolerance = orient_options(args).normals.on_surface_tolerance_mm;
+        for w in kerf_pipeline::beyond_run_tolerance(&file, &oriented, run_tolerance) {
+            eprintln!("warning: {}: {w}", path.display());
+        }
         let out = toolpath_of_poses(&file, opts.tolerance_mm, &oriented);
         // `-` is standard output; kerf_io also writes devices and FIFOs through.
         toolpath::write(&out, &dest)?;

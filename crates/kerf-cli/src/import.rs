@@ -145,7 +145,10 @@ pub(crate) fn print_account(path: &Path, r: &kerf_step::Report, file: &CurvesFil
         r.faces_read
     );
     if let Some(u) = r.uncertainty_mm {
-        eprintln!("  the file's length tolerance: {u} mm (face-loop contours may lie that far from their faces)");
+        eprintln!(
+            "  the file's length tolerance: {u} mm (face-loop contours may lie up to {} mm from their faces)",
+            u.min(kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM)
+        );
     }
     if let Some(s) = &r.sheet {
         match &s.not_a_sheet {
@@ -233,6 +236,7 @@ pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
             "length_unit": r.units.length_name,
             "mm_per_length_unit": r.units.mm_per_length,
             "rad_per_angle_unit": r.units.rad_per_angle,
+            "uncertainty_mm": r.uncertainty_mm,
             "curves": import.file.curves.len(),
             "surfaces": import.file.surfaces.len(),
             "faces_read": r.faces_read,

@@ -290,7 +290,7 @@ fn an_edge_within_its_files_tolerance_is_cut_and_named_and_beyond_it_refused() {
         moved.replacen(
             "DATA;\n",
             &format!(
-                "DATA;\n#9001 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n#9002 = UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE({u}),#9001,'distance_accuracy_value','');\n"
+                "DATA;\n#9001 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n#9002 = UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE({u}),#9001,'distance_accuracy_value','');\n#9003 = ( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#9002)) REPRESENTATION_CONTEXT('','') );\n"
             ),
             1,
         )
@@ -326,14 +326,17 @@ fn an_edge_within_its_files_tolerance_is_cut_and_named_and_beyond_it_refused() {
         // The wall's loop: 0.015 mm (the move), within the file's 0.02 mm.
         assert!(
             w.contains("face #298 loop")
-                && w.contains("up to 0.015000 mm from its surface")
+                && w.contains("up to 0.015")
+                && w.contains("mm from its surface")
                 && w.contains("on-surface tolerance (0.01 mm) but within the curve's own (0.02 mm"),
             "{w}"
         );
     }
-    for (name, step) in [
-        ("tight", with_uncertainty("0.005")),
-        ("none", moved.clone()),
+    // 0.012 mm: looser than the run's 0.01 mm, yet tighter than the 0.015 mm the edge is off.
+    for (name, step, tolerance) in [
+        ("own", with_uncertainty("0.012"), "0.012 mm"),
+        ("tight", with_uncertainty("0.005"), "0.01 mm"),
+        ("none", moved.clone(), "0.01 mm"),
     ] {
         let (code, err, out) = run_on(name, &step);
         assert_eq!(code, 1, "{name}: {err}");
@@ -341,7 +344,7 @@ fn an_edge_within_its_files_tolerance_is_cut_and_named_and_beyond_it_refused() {
             err.contains("face #298 loop")
                 && err.contains("1.5")
                 && err.contains("e-2 mm from its surface")
-                && err.contains("0.01 mm"),
+                && err.contains(tolerance),
             "{name}: {err}"
         );
         assert!(!out.exists(), "{name}: nothing written");

@@ -121,6 +121,8 @@ fn a_curves_own_on_surface_tolerance_is_read_checked_and_written_back() {
     let f = read(&doc(r#", "on_surface_tolerance_mm": 0.02"#, "")).expect("valid key");
     assert_eq!(f.curves[1].on_surface_tolerance_mm, Some(0.02));
     assert_eq!(f.curves[0].on_surface_tolerance_mm, None, "absent");
+    let f = read(&doc(r#", "on_surface_tolerance_mm": 0.1"#, "")).expect("the largest");
+    assert_eq!(f.curves[1].on_surface_tolerance_mm, Some(0.1));
     // Not a near miss: no warning for the key.
     assert!(f.warnings.is_empty(), "{:?}", f.warnings);
     for bad in ["0", "-0.01", "0.2", "1"] {

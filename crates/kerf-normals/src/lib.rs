@@ -195,6 +195,10 @@ struct Sample {
     hint: Hint,
 }
 
+/// A warm-started projection farther than this from the surface (or than the on-surface
+/// tolerance, if smaller) is redone from scratch, mm: kerf's default on-surface tolerance.
+const RESCUE_ABOVE_MM: f64 = 0.01;
+
 struct Ctx<'a> {
     curve: &'a NurbsCurve,
     /// Built once per curve: re-certifying an inserted segment costs no pass over the curve.
@@ -211,9 +215,12 @@ impl Ctx<'_> {
     fn sample(&mut self, t: f64, p: Point3<f64>, hint: Hint) -> Result<Sample> {
         let mut pr = self.surface.project(&p, hint);
         let degenerate = self.surface.is_degenerate(pr.hint);
+        // Redone globally above the tolerance or 0.01 mm, whichever is smaller: a curve allowed
+        // a looser tolerance of its own (a CAD edge, up to 0.1 mm) still gets its nearest
+        // surface point, not a warm start's local minimum.
+        let rescue = self.nopts.on_surface_tolerance_mm.min(RESCUE_ABOVE_MM);
         if hint != Hint::None
-            && (pr.distance > self.nopts.on_surface_tolerance_mm
-                || (degenerate && pr.distance > 1e-6 * self.nopts.on_surface_tolerance_mm))
+            && (pr.distance > rescue || (degenerate && pr.distance > 1e-6 * rescue))
         {
             // A warm start can settle in a local minimum, or stay on a collapsed edge the
             // point has left: decide globally, keep the closer.

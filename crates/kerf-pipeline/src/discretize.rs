@@ -263,7 +263,10 @@ fn surface_ids(c: &kerf_format::CurveRecord) -> impl Iterator<Item = &String> {
 }
 
 /// Normals for every curve (in parallel, results in input order): `discs[i]` is the
-/// discretization of `file.curves[i]` with `opts`. A curve without a surface is cut with the
+/// discretization of `file.curves[i]` with `opts`. A curve that states its own
+/// `on_surface_tolerance_mm` looser than the options' is checked against its own (a CAD edge on
+/// its face within its file's tolerance); [`beyond_run_tolerance`] names those it took beyond
+/// the options'. A curve without a surface is cut with the
 /// tool axis +z at every point (flat 2D cutting) or refused, as `orient_opts.missing_surface`
 /// says. `source` names the file in errors.
 ///
@@ -354,6 +357,30 @@ pub fn orient_curves(
             let n = done.fetch_add(1, Ordering::Relaxed) + 1;
             progress(Progress::new(Stage::Normals, n, total));
             result
+        })
+        .collect()
+}
+
+/// One line per curve whose points lie farther from its surface than `run_tolerance_mm` (the
+/// run's on-surface tolerance), taken within the curve's own looser `on_surface_tolerance_mm`
+/// ([`orient_curves`]), with both figures: what a caller tells the user.
+pub fn beyond_run_tolerance(
+    file: &CurvesFile,
+    oriented: &[Oriented],
+    run_tolerance_mm: f64,
+) -> Vec<String> {
+    file.curves
+        .iter()
+        .zip(oriented)
+        .enumerate()
+        .filter(|(_, (_, or))| or.max_surface_distance > run_tolerance_mm)
+        .map(|(i, (c, or))| {
+            format!(
+                "curves[{i}] ({:?}): its points lie up to {} mm from its surface, beyond the run's on-surface tolerance ({run_tolerance_mm} mm) but within the curve's own ({} mm): taken",
+                c.id,
+                or.max_surface_distance,
+                c.on_surface_tolerance_mm.unwrap_or(run_tolerance_mm)
+            )
         })
         .collect()
 }

@@ -564,12 +564,22 @@ impl Job {
             }
         }
         for (i, c) in self.curves.curves.iter().enumerate() {
+            let invalid = |message: String| Error::Invalid {
+                file: file(),
+                place: format!("curves[{i}] ({:?})", c.id),
+                message,
+            };
             if kerf_format::curves::is_a_point(&c.curve) {
-                return Err(Error::Invalid {
-                    file: file(),
-                    place: format!("curves[{i}] ({:?})", c.id),
-                    message: kerf_format::curves::POINT_CURVE.to_owned(),
-                });
+                return Err(invalid(kerf_format::curves::POINT_CURVE.to_owned()));
+            }
+            // A curve built in code states its own tolerance as a file must.
+            if let Some(t) = c.on_surface_tolerance_mm {
+                if !(t > 0.0 && t <= kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM) {
+                    return Err(invalid(format!(
+                        "on_surface_tolerance_mm must be > 0 and at most {} mm (got {t})",
+                        kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM
+                    )));
+                }
             }
         }
         for (i, c) in self.curves.curves.iter().enumerate() {

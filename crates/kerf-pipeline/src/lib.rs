@@ -51,8 +51,8 @@ mod view;
 
 pub use certify::CertifiedToolpath;
 pub use discretize::{
-    discretize_curves, discretize_curves_within, orient_curves, toolpath_of_points,
-    toolpath_of_poses, DEFAULT_MAX_TOTAL_POINTS,
+    beyond_run_tolerance, discretize_curves, discretize_curves_within, orient_curves,
+    toolpath_of_points, toolpath_of_poses, DEFAULT_MAX_TOTAL_POINTS,
 };
 pub use error::{Error, Result};
 pub use job::{

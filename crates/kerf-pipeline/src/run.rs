@@ -215,22 +215,11 @@ fn run_placed(
     let mut tp = toolpath_of_poses(file, dopts.tolerance_mm, &oriented);
     // Curves taken within their own tolerance (a CAD edge on its face within its file's),
     // beyond the run's: each named with both.
-    let run_tolerance = o.orient.normals.on_surface_tolerance_mm;
-    let edge_warnings: Vec<String> = file
-        .curves
-        .iter()
-        .zip(&oriented)
-        .enumerate()
-        .filter(|(_, (_, or))| or.max_surface_distance > run_tolerance)
-        .map(|(i, (c, or))| {
-            format!(
-                "curves[{i}] ({:?}): its points lie up to {:.6} mm from its surface, beyond the run's on-surface tolerance ({run_tolerance} mm) but within the curve's own ({} mm, its file's tolerance): taken, the normals from the nearest surface points",
-                c.id,
-                or.max_surface_distance,
-                c.on_surface_tolerance_mm.unwrap_or(run_tolerance)
-            )
-        })
-        .collect();
+    let edge_warnings = crate::discretize::beyond_run_tolerance(
+        file,
+        &oriented,
+        o.orient.normals.on_surface_tolerance_mm,
+    );
     lap.split(&mut timings, "normals");
     // 3. Machine axes, points inserted on the curve against the non-linearity error.
     let popts = o.path;

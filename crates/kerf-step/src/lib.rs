@@ -547,8 +547,9 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         raw.scrap = scrap.map(str::to_owned);
         // A face's edge lies on the face within the file's own tolerance (the reader took
         // it within ON_GEOMETRY_TOLERANCE_MM): the curve says so, and the normals stage takes
-        // the looser of it and the run's on-surface tolerance.
-        if opts.edges && raw.surface.is_some() {
+        // the looser of it and the run's on-surface tolerance. Face edges are the contours of
+        // `edges` and of a sheet recognised without it.
+        if (opts.edges || sheet.as_ref().is_some_and(|s| s.is_ok())) && raw.surface.is_some() {
             raw.on_surface_tolerance_mm = edge_tolerance;
         }
         raw_curves.push(raw);

@@ -485,18 +485,50 @@ impl Kind {
 }
 
 /// The file's length uncertainty in mm: the largest `UNCERTAINTY_MEASURE_WITH_UNIT` whose
-/// value is a `LENGTH_MEASURE`, in the length unit it references. One whose unit cannot be
-/// read, or whose value is not a finite number > 0, is left out with a warning.
+/// value is a `LENGTH_MEASURE` (or `POSITIVE_LENGTH_MEASURE`), in the length unit it
+/// references, among those a `GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT` names (a stray one is not
+/// the file's). The value and unit are read from the instance's `MEASURE_WITH_UNIT` part where
+/// it is a complex instance. A length uncertainty whose value or unit cannot be read, or that
+/// is not a finite number > 0 in mm, is left out with a warning; other measures (angles) are
+/// not lengths and are passed over.
 fn read_uncertainty(ex: &Exchange<'_>, warnings: &mut Vec<String>) -> Result<Option<f64>> {
+    let mut named: Vec<u64> = Vec::new();
+    for ctx in all(ex, "GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT")? {
+        if let Some(Value::List(items)) = ctx
+            .record("GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT")
+            .and_then(|p| p.first())
+        {
+            named.extend(items.iter().filter_map(|v| match v {
+                Value::Ref(id) => Some(*id),
+                _ => None,
+            }));
+        }
+    }
     let mut largest: Option<f64> = None;
     for inst in all(ex, "UNCERTAINTY_MEASURE_WITH_UNIT")? {
-        let p = inst.record("UNCERTAINTY_MEASURE_WITH_UNIT").unwrap_or(&[]);
+        if !named.contains(&inst.id) {
+            continue;
+        }
+        // The simple entity carries value and unit first; a complex instance carries them in
+        // its MEASURE_WITH_UNIT part.
+        let p = [
+            inst.record("UNCERTAINTY_MEASURE_WITH_UNIT"),
+            inst.record("MEASURE_WITH_UNIT"),
+        ]
+        .into_iter()
+        .flatten()
+        .find(|p| matches!(p.first(), Some(Value::Typed(..))))
+        .unwrap_or(&[]);
         let value = match p.first() {
-            Some(Value::Typed(name, v)) if name == "LENGTH_MEASURE" => match **v {
-                Value::Real(r) => r,
-                Value::Int(i) => i as f64,
-                _ => continue,
-            },
+            Some(Value::Typed(name, v))
+                if name == "LENGTH_MEASURE" || name == "POSITIVE_LENGTH_MEASURE" =>
+            {
+                match **v {
+                    Value::Real(r) => r,
+                    Value::Int(i) => i as f64,
+                    _ => f64::NAN,
+                }
+            }
             _ => continue,
         };
         let unit = match p.get(1) {
@@ -508,7 +540,7 @@ fn read_uncertainty(ex: &Exchange<'_>, warnings: &mut Vec<String>) -> Result<Opt
             .and_then(|u| unit_factor(ex, u, Kind::Length, 0).ok())
             .map(|(f, _)| f);
         match factor {
-            Some(f) if value.is_finite() && value > 0.0 && (value * f).is_finite() => {
+            Some(f) if value.is_finite() && (value * f).is_finite() && value * f > 0.0 => {
                 largest = Some(largest.map_or(value * f, |l: f64| l.max(value * f)));
             }
             _ => warnings.push(format!(

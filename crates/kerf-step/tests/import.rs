@@ -986,6 +986,38 @@ fn the_files_length_uncertainty_is_read_in_its_unit_and_given_to_face_loops() {
     for c in &im.file.curves {
         assert_eq!(c.on_surface_tolerance_mm, Some(u), "{}", c.id);
     }
+    // An uncertainty no context names is not the file's: none.
+    let text = std::fs::read_to_string(fixture("sheet/plate.step")).expect("fixture");
+    let stray = text.replacen(
+        "DATA;\n",
+        "DATA;\n#9001 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n#9002 = UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(0.05),#9001,'','');\n",
+        1,
+    );
+    let im = import(&stray, &ImportOptions::default().with_edges(None)).expect("import");
+    assert_eq!(im.report.uncertainty_mm, None, "a stray uncertainty");
+    // Named by a context, in micrometres, as a complex instance: 20 um is 0.02 mm; a second,
+    // smaller one does not win; one that rounds to 0 mm is left out with a warning.
+    let named = text.replacen(
+        "DATA;\n",
+        "DATA;\n#9001 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MICRO.,.METRE.) );\n#9002 = ( MEASURE_WITH_UNIT(LENGTH_MEASURE(20.),#9001) UNCERTAINTY_MEASURE_WITH_UNIT('distance','') );\n#9004 = UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(5.),#9001,'','');\n#9005 = UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-322),#9001,'','');\n#9003 = ( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#9002,#9004,#9005)) REPRESENTATION_CONTEXT('','') );\n",
+        1,
+    );
+    let im = import(&named, &ImportOptions::default().with_edges(None)).expect("import");
+    let u = im.report.uncertainty_mm.expect("read");
+    assert!((u - 0.02).abs() < 1e-15, "{u}");
+    assert!(
+        im.report
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("#9005 UNCERTAINTY_MEASURE_WITH_UNIT")),
+        "{:?}",
+        im.report.warnings
+    );
+    assert!(im
+        .file
+        .curves
+        .iter()
+        .all(|c| c.on_surface_tolerance_mm == Some(u)));
     // A file without one: none.
     let im = import_file(
         fixture("sheet/plate.step"),

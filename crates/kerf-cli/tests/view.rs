@@ -229,6 +229,15 @@ fn check_setup(
         .map(|k| (at("axis", k) - pose.axis[k]).powi(2))
         .sum::<f64>()
         .sqrt();
+    // The machine axes shown are the set-point's (micrometres and millidegrees, f32).
+    for k in 0..5 {
+        let shown = v["at"]["axes"][k].as_f64().expect("an axis value");
+        assert!(
+            (shown - q[k + 1]).abs() <= 1e-3 + 1e-7 * q[k + 1].abs(),
+            "{name}: axis {k} shown {shown}, set-point {}",
+            q[k + 1]
+        );
+    }
     // The view holds micrometres (f32) and directions to 1e-4.
     assert!(
         tip < 2e-3,

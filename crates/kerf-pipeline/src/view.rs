@@ -42,6 +42,7 @@ pub(crate) fn scene(
     s.title = title.to_string();
     s.machine = model.name().to_string();
     s.feed_mm_per_min = feed_mm_per_min;
+    s.axis_names = model.axis_names().iter().map(|n| n.to_string()).collect();
     s.head_standoff_mm = head_standoff_mm;
     s.head = head
         .solids
@@ -232,7 +233,8 @@ fn finish_beams(cut: Option<&mut Cut>, beams: &mut Vec<[f32; 6]>) {
 
 /// The planned motion sampled every few cycles (at most [`kerf_view::MAX_TIMELINE_SAMPLES`]
 /// samples): each sample the tip and tool axis at that cycle's set-point, the speed over the
-/// cycle before it as a share of the feed, and whether the block is a traverse.
+/// cycle before it as a share of the feed, whether the block is a traverse, and the set-point's
+/// machine axes.
 fn timeline(motion: &Motion, model: &MachineModel, feed_mm_per_min: f64) -> Timeline {
     let cycles = motion.cycles();
     let stride = (cycles + 1)
@@ -263,6 +265,7 @@ fn timeline(motion: &Motion, model: &MachineModel, feed_mm_per_min: f64) -> Time
                 unit(speed / feed),
                 if rapid { 1.0 } else { 0.0 },
             ]);
+            t.samples.extend(q.map(mm));
         }
         prev = Some(tip);
     }

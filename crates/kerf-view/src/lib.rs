@@ -47,6 +47,8 @@ pub struct Scene {
     pub machine: String,
     /// The programmed cutting feed, mm/min: the speed colours are shares of it.
     pub feed_mm_per_min: f64,
+    /// The machine's axis names (`X Y Z A C`, or `B` for the tilt), as the set-points name them.
+    pub axis_names: Vec<String>,
     /// The head's solids from the nozzle tip up: `[length, bottom diameter, top diameter]`
     /// in mm each.
     pub head: Vec<[f64; 3]>,
@@ -138,12 +140,13 @@ pub struct Timeline {
     /// The interpolation cycle, seconds.
     pub cycle_s: f64,
     /// One sample per step from 0: `x, y, z` (tip), `i, j, k` (tool axis), the tip's speed as
-    /// a share of the programmed feed, and 1 on a traverse (0 while cutting): 8 numbers each.
+    /// a share of the programmed feed, 1 on a traverse (0 while cutting), and the five machine
+    /// axes of the set-point (mm and degrees, [`Scene::axis_names`]): 13 numbers each.
     pub samples: Vec<f32>,
 }
 
 /// Numbers per timeline sample.
-pub const SAMPLE_LEN: usize = 8;
+pub const SAMPLE_LEN: usize = 13;
 
 /// The page of `scene`: one HTML file with three.js, the scene and the viewer inside.
 pub fn html(scene: &Scene) -> String {

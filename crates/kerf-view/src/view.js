@@ -8,7 +8,7 @@
   console.error = (...a) => { errors.push(a.map(String).join(" ")); consoleError(...a); };
 
   const data = JSON.parse(document.getElementById("kerf-scene").textContent);
-  const SAMPLE = 8;
+  const SAMPLE = 13;
   const el = (id) => document.getElementById(id);
   const view = el("view");
 
@@ -179,7 +179,7 @@
 
   let setup = 0;
   let time = 0;
-  const state = { tip: [0, 0, 0], axis: [0, 0, 1], speed: 0, rapid: false };
+  const state = { tip: [0, 0, 0], axis: [0, 0, 1], speed: 0, rapid: false, axes: [0, 0, 0, 0, 0] };
 
   // The head at time t of set-up k: linear between the two samples around t.
   function setTime(k, t) {
@@ -199,10 +199,13 @@
     state.axis = [ax.x, ax.y, ax.z];
     state.speed = tl.samples[SAMPLE * i + 6] * data.feed_mm_per_min;
     state.rapid = tl.samples[SAMPLE * i + 7] > 0.5;
+    state.axes = [8, 9, 10, 11, 12].map(at);
     time = t;
     el("time").value = String(t);
+    const names = data.axis_names.length === 5 ? data.axis_names : ["X", "Y", "Z", "A", "C"];
     el("readout").textContent = "t " + t.toFixed(3) + " s of " + tl.duration_s.toFixed(2) +
-      " s, " + (state.rapid ? "traverse" : "cut") + " at " + state.speed.toFixed(0) + " mm/min, tip (" +
+      " s, " + (state.rapid ? "traverse" : "cut") + " at " + state.speed.toFixed(0) + " mm/min; " +
+      state.axes.map((v, k) => names[k] + " " + v.toFixed(3)).join(" ") + "; tip (" +
       tip.map((v) => v.toFixed(2)).join(", ") + ")";
     return { tip: state.tip, axis: state.axis };
   }
@@ -320,7 +323,7 @@
     slider.value = hash.get("t");
     slider.dispatchEvent(new Event("input"));
     render();
-    const at = { tip: state.tip, axis: state.axis, t: time, setup };
+    const at = { tip: state.tip, axis: state.axis, axes: state.axes, t: time, setup };
     el("kerf-test").textContent = JSON.stringify({ counts, at, errors });
   }
   requestAnimationFrame(loop);

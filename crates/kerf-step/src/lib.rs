@@ -298,6 +298,10 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                 ..SheetReport::default()
             });
         }
+        // With faces chosen by hand, an edge two of them share is cut once: with the first
+        // face (in file order) that has it, whose normal it takes; the later face's loop is cut
+        // in the open pieces between such edges.
+        let mut cut_with: std::collections::HashMap<u64, u64> = std::collections::HashMap::new();
         for (fi, f) in faces.iter().enumerate() {
             if let Some(only) = &opts.faces {
                 if !only.contains(&f.id) {
@@ -305,16 +309,47 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                 }
             }
             for (li, l) in f.loops.iter().enumerate() {
-                let j = contour::join(l, opts.close_gaps_mm, true);
-                note_join(&mut report, &format!("#{} face loop {}", f.id, li + 1), &j);
-                let n = j.contours.len();
-                for (k, c) in j.contours.into_iter().enumerate() {
-                    let id = if n == 1 {
+                let edge_ids = f.edge_ids.get(li).map_or(&[][..], Vec::as_slice);
+                let shared: Vec<bool> = (0..l.len())
+                    .map(|k| {
+                        opts.faces.is_some()
+                            && edge_ids.get(k).is_some_and(|e| cut_with.contains_key(e))
+                    })
+                    .collect();
+                for (k, e) in edge_ids.iter().enumerate() {
+                    if shared[k] {
+                        report.skipped.push(format!(
+                            "edge #{e} of face #{} loop {}: shared with face #{}, cut once, with that face's normal",
+                            f.id,
+                            li + 1,
+                            cut_with[e]
+                        ));
+                    }
+                }
+                // The loop whole, or its runs of edges not cut already (each open).
+                let runs: Vec<Vec<NurbsCurve>> = if shared.iter().any(|&s| s) {
+                    loop_runs(l, &shared)
+                } else {
+                    vec![l.clone()]
+                };
+                let closed = runs.len() == 1 && runs[0].len() == l.len();
+                let mut pieces = Vec::new();
+                for run in &runs {
+                    let j = contour::join(run, opts.close_gaps_mm, closed);
+                    note_join(&mut report, &format!("#{} face loop {}", f.id, li + 1), &j);
+                    pieces.extend(j.contours);
+                }
+                let n = pieces.len();
+                for (k, c) in pieces.into_iter().enumerate() {
+                    let id = if n == 1 && closed {
                         format!("face #{} loop {}", f.id, li + 1)
                     } else {
                         format!("face #{} loop {}.{}", f.id, li + 1, k + 1)
                     };
                     contours.push((id, c.curve, vec![fi], None));
+                }
+                for e in edge_ids {
+                    cut_with.entry(*e).or_insert(f.id);
                 }
             }
         }
@@ -717,6 +752,31 @@ fn note_join(report: &mut Report, what: &str, j: &contour::JoinResult) {
             d + 1
         ));
     }
+}
+
+/// The runs of consecutive edges of the closed loop `l` not marked in `skip`, in loop order
+/// (a run may wrap round the loop's start), each to be cut as an open contour.
+fn loop_runs(l: &[NurbsCurve], skip: &[bool]) -> Vec<Vec<NurbsCurve>> {
+    let n = l.len();
+    let Some(first) = (0..n).find(|&k| skip[k]) else {
+        return vec![l.to_vec()];
+    };
+    let mut runs = Vec::new();
+    let mut run: Vec<NurbsCurve> = Vec::new();
+    for step in 1..=n {
+        let k = (first + step) % n;
+        if skip[k] {
+            if !run.is_empty() {
+                runs.push(std::mem::take(&mut run));
+            }
+        } else {
+            run.push(l[k].clone());
+        }
+    }
+    if !run.is_empty() {
+        runs.push(run);
+    }
+    runs
 }
 
 fn raw_curve(id: String, c: &NurbsCurve, surface: Option<SurfaceRef>) -> RawCurve {

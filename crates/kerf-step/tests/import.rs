@@ -1031,3 +1031,49 @@ fn the_files_length_uncertainty_is_read_in_its_unit_and_given_to_face_loops() {
         .iter()
         .all(|c| c.on_surface_tolerance_mm.is_none()));
 }
+
+#[test]
+fn an_edge_two_chosen_faces_share_is_cut_once_with_the_first_faces_normal() {
+    // The plate's top face #170 (the outline, 320 mm, and the hole) and its front wall #298
+    // (100 x 2 mm, 204 mm round) share the top front edge #74 (100 mm). Chosen together, the
+    // edge is cut once, with #170 (first in the file, whichever order --faces gives); the
+    // wall is cut in the open piece of its other three edges, 104 mm.
+    let path = fixture("sheet/plate.step");
+    for order in [vec![170, 298], vec![298, 170]] {
+        let im = import_file(
+            path.clone(),
+            &ImportOptions::default().with_edges(Some(order.clone())),
+        )
+        .expect("import");
+        let lengths: Vec<(String, f64)> = im
+            .file
+            .curves
+            .iter()
+            .map(|c| (c.id.clone(), curve(c).arc_length()))
+            .collect();
+        let ids: Vec<&str> = lengths.iter().map(|(id, _)| id.as_str()).collect();
+        assert_eq!(
+            ids,
+            ["face #170 loop 1", "face #170 loop 2", "face #298 loop 1.1"],
+            "{order:?}"
+        );
+        assert!((lengths[0].1 - 320.0).abs() < 1e-9, "{lengths:?}");
+        assert!((lengths[2].1 - 104.0).abs() < 1e-9, "{lengths:?}");
+        // The wall's piece is open: its ends are the shared edge's ends, 100 mm apart.
+        let wall = curve(&im.file.curves[2]);
+        let (a, b) = wall.domain();
+        assert!(((wall.point(a) - wall.point(b)).norm() - 100.0).abs() < 1e-9);
+        assert!(
+            im.report.skipped.iter().any(|s| s
+                == "edge #74 of face #298 loop 1: shared with face #170, cut once, with that face's normal"),
+            "{:?}",
+            im.report.skipped
+        );
+    }
+    // Alone, the wall's loop is whole.
+    let im =
+        import_file(path, &ImportOptions::default().with_edges(Some(vec![298]))).expect("import");
+    assert_eq!(im.file.curves.len(), 1);
+    assert_eq!(im.file.curves[0].id, "face #298 loop 1");
+    assert!((curve(&im.file.curves[0]).arc_length() - 204.0).abs() < 1e-9);
+}

@@ -6,7 +6,7 @@
 //! and [`check()`] measures every segment's chord error by brute force ([`segment_chord_error`]: dense
 //! sampling between the two params including every knot inside, then golden-section
 //! refinement of each local maximum), and checks every rule of the format
-//! (`shared/formats.md`): same ids in the same order, params strictly increasing from one end
+//! (`docs/formats.md`): same ids in the same order, params strictly increasing from one end
 //! of the domain to the other, every point on the curve at its param (to `1e-9` of the curve
 //! size, plus two ulps of the point's coordinates), every C0 corner a cutting point, unit
 //! normals, every segment's chord error at most the tolerance and a `max_chord_error` claim that

@@ -1,7 +1,7 @@
 //! The chord error of one segment, measured by dense sampling and local refinement.
 //!
 //! For neighbouring cutting points `P0`, `P1` at parameters `t0 < t1`, the chord error is
-//! `max over t in [t0, t1] of dist(C(t), segment P0 P1)` (`shared/formats.md`). It is measured
+//! `max over t in [t0, t1] of dist(C(t), segment P0 P1)` (`docs/formats.md`). It is measured
 //! here without any bound from the discretizer:
 //!
 //! 1. `[t0, t1]` is cut at every knot inside it, so that every knot (where the curve may have

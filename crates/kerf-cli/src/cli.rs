@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand};
     name = "kerf",
     version,
     propagate_version = true,
-    after_help = "Examples:\n  kerf validate fixtures/mixed.json\n  kerf discretize fixtures/mixed.json --tolerance 0.01 -o mixed.toolpath.json\n  kerf validate --json part.json > summary.json\n\nExit status: 0 success, 1 invalid or unreadable input, 2 usage error.\nFile formats: shared/formats.md (kerf.curves/1 in, kerf.toolpath/1 out)."
+    after_help = "Examples:\n  kerf validate fixtures/mixed.json\n  kerf discretize fixtures/mixed.json --tolerance 0.01 -o mixed.toolpath.json\n  kerf validate --json part.json > summary.json\n\nExit status: 0 success, 1 invalid or unreadable input, 2 usage error.\nFile formats: docs/formats.md (kerf.curves/1 in, kerf.toolpath/1 out)."
 )]
 pub(crate) struct Cli {
     /// What to do.

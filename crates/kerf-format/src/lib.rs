@@ -1,6 +1,6 @@
 //! Reads and writes kerf's file formats: `kerf.curves/1` in, `kerf.toolpath/1` out.
 //!
-//! The formats are specified in `shared/formats.md`; this crate is their one implementation.
+//! The formats are specified in `docs/formats.md`; this crate is their one implementation.
 //!
 //! - [`curves`] reads cut contours: JSON to raw serde structs mirroring the file
 //!   ([`curves::RawCurvesFile`]), then to a validated model ([`CurvesFile`]) of

@@ -131,7 +131,7 @@ pub enum KinematicsError {
     },
     /// A value of a `kerf.machine/1` (or `kerf.axes/1`) document is missing, of the wrong type or
     /// out of range; `path` is its JSON path, e.g. `kinematics.r_a` or `limits.A`.
-    /// Fix: see `shared/formats.md` and the message.
+    /// Fix: see `docs/formats.md` and the message.
     #[error("{path}: {message}")]
     Document {
         /// The JSON path of the defect (`format`, `kinematics.type`, `limits.A[0]`, ...).

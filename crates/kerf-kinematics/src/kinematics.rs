@@ -24,7 +24,7 @@ pub trait Kinematics: fmt::Debug + Send + Sync {
     fn tilt_name(&self) -> &'static str;
 
     /// The pose (tool tip and unit tool axis in the workpiece frame) that the axes put the tool
-    /// in: exactly the formula of `shared/formats.md`.
+    /// in: exactly the formula of `docs/formats.md`.
     fn forward(&self, axes: &Axes) -> Pose;
 
     /// Both inverse solutions of `pose`: `[(t, C), (-t, C + 180)]` with `t` and `C` from
@@ -55,13 +55,13 @@ pub trait Kinematics: fmt::Debug + Send + Sync {
     }
 
     /// The parameters as written in the `kinematics` object of a machine file (without
-    /// `type`), in the order of `shared/formats.md`: typed values, which the machine file's
+    /// `type`), in the order of `docs/formats.md`: typed values, which the machine file's
     /// writer ([`crate::Machine::to_json`]) turns into JSON (the maths does not speak JSON).
     fn parameters(&self) -> Vec<(&'static str, Parameter)>;
 }
 
 /// One parameter of a machine type, typed (lengths in mm; the meaning of each is documented
-/// on the machine type and in `shared/formats.md`).
+/// on the machine type and in `docs/formats.md`).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum Parameter {

@@ -1,7 +1,7 @@
 //! Five-axis kinematics: poses `(x, y, z, i, j, k)` to machine axes `[X, Y, Z, A|B, C]`.
 //!
 //! The stage after the discretizer (and its normals): a cutting point with its tool axis is a
-//! [`Pose`]; a [`Machine`] (`kerf.machine/1`, `shared/formats.md`) turns it into [`Axes`] by
+//! [`Pose`]; a [`Machine`] (`kerf.machine/1`, `docs/formats.md`) turns it into [`Axes`] by
 //! inverse kinematics, and [`solve_path`] does so along a whole path, keeping the axes
 //! continuous and within their limits, handling the pole, and inserting poses where the
 //! controller's linear axis interpolation would take the tool tip off the path

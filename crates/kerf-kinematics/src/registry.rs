@@ -12,7 +12,7 @@ use crate::kinematics::Kinematics;
 use crate::params::{KinematicsType, Params};
 use crate::{ac_head, fork_head, head_table, table_table};
 
-/// Every known kinematic type, in the order of `shared/formats.md`.
+/// Every known kinematic type, in the order of `docs/formats.md`.
 pub(crate) const TYPES: &[KinematicsType] = &[
     ac_head::TYPE,
     fork_head::TYPE,

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 #[non_exhaustive]
 pub enum Error {
     /// An input file is unreadable or invalid; the message names the file and the JSON path of
-    /// the defect. Fix: the file (see `shared/formats.md`).
+    /// the defect. Fix: the file (see `docs/formats.md`).
     #[error(transparent)]
     Format(#[from] kerf_format::FormatError),
     /// A STEP file could not be read into contours ([`crate::Job::from_step`]); the message names

@@ -351,19 +351,20 @@ fn run_placed(
     let mut head_report: Vec<serde_json::Value> = Vec::new();
     let mut head_tip_zone: Option<f64> = None;
     let mut head_warnings: Vec<String> = Vec::new();
+    // The machine's head (or kerf's default) and the nozzle's standoff above the tip: the
+    // head check's and the 3D view's.
+    let head = machine
+        .head
+        .clone()
+        .unwrap_or_else(kerf_kinematics::Head::laser_default);
+    let head_standoff_mm = machine
+        .process
+        .standoff_mm
+        .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM);
     if let Some(clearance) = o.cut_clearance_mm {
-        let head = machine
-            .head
-            .clone()
-            .unwrap_or_else(kerf_kinematics::Head::laser_default);
         let hopts = kerf_process::HeadCheckOptions::default()
             .with_clearance_mm(clearance)
-            .with_standoff_mm(
-                machine
-                    .process
-                    .standoff_mm
-                    .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
-            )
+            .with_standoff_mm(head_standoff_mm)
             .with_max_tilt_deg(popts.tilt_tolerance_deg.max(HEAD_CHECK_MIN_TILT_DEG))
             // The controller's tip leaves the chords by the non-linearity error and its
             // blending (an infinite tolerance leaves the check unproven).
@@ -733,14 +734,8 @@ fn run_placed(
         &cuts,
         &view_setups,
         &model,
-        &machine
-            .head
-            .clone()
-            .unwrap_or_else(kerf_kinematics::Head::laser_default),
-        machine
-            .process
-            .standoff_mm
-            .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
+        &head,
+        head_standoff_mm,
         o.feed_mm_per_min,
         process.pierce_standoff,
     );

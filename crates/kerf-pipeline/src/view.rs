@@ -203,15 +203,7 @@ fn paths(
         for j in 1..=n {
             let (tip, tilt, cc) = b.pose_at(b.length() * j as f64 / n as f64);
             c.points.extend(flat(&tip));
-            let u = model.tool_axis(tilt, cc);
-            beams.push([
-                mm(tip.x),
-                mm(tip.y),
-                mm(tip.z),
-                unit(u.x),
-                unit(u.y),
-                unit(u.z),
-            ]);
+            beams.push(pose_numbers(&tip, &model.tool_axis(tilt, cc)));
         }
     }
     if in_cut {
@@ -249,27 +241,37 @@ fn timeline(motion: &Motion, model: &MachineModel, feed_mm_per_min: f64) -> Time
     let mut prev: Option<Point3<f64>> = None;
     t.samples.reserve((cycles / stride + 2) * SAMPLE_LEN);
     for (i, q) in motion.iter(model).enumerate() {
+        // The tip only where a sample needs it: at the sample and the cycle before (its speed).
+        let sample = i % stride == 0;
+        if !sample && (i + 1) % stride != 0 {
+            continue;
+        }
         let tip = model.tip(&q);
-        if i % stride == 0 {
-            let u = model.tool_axis(q[3], q[4]);
+        if sample {
             let speed = prev.map_or(0.0, |p| (tip - p).norm() / cycle);
             let (block, _) = motion.locate(i as f64 * cycle);
             let rapid = motion.blocks().get(block).is_some_and(|b| b.rapid);
-            t.samples.extend([
-                mm(tip.x),
-                mm(tip.y),
-                mm(tip.z),
-                unit(u.x),
-                unit(u.y),
-                unit(u.z),
-                unit(speed / feed),
-                if rapid { 1.0 } else { 0.0 },
-            ]);
+            t.samples
+                .extend(pose_numbers(&tip, &model.tool_axis(q[3], q[4])));
+            t.samples
+                .extend([unit(speed / feed), if rapid { 1.0 } else { 0.0 }]);
             t.samples.extend(q.map(mm));
         }
         prev = Some(tip);
     }
     t
+}
+
+/// A tip and a unit direction as the view holds them: `x, y, z, i, j, k`.
+fn pose_numbers(tip: &Point3<f64>, u: &nalgebra::Vector3<f64>) -> [f32; 6] {
+    [
+        mm(tip.x),
+        mm(tip.y),
+        mm(tip.z),
+        unit(u.x),
+        unit(u.y),
+        unit(u.z),
+    ]
 }
 
 /// A coordinate as the view holds it: to the micrometre (the page's text stays short; the

@@ -269,7 +269,10 @@ pub(crate) fn expand_knots(inst: &Instance, k: &[Value]) -> Result<Vec<f64>> {
 }
 
 /// The curve on `[a, b]` (inside its domain), clamped at both ends.
-pub(crate) fn sub_curve(c: &NurbsCurve, a: f64, b: f64) -> kerf_nurbs::Result<NurbsCurve> {
+///
+/// # Errors
+/// What knot insertion refuses (a parameter outside the domain).
+pub fn sub_curve(c: &NurbsCurve, a: f64, b: f64) -> kerf_nurbs::Result<NurbsCurve> {
     let (da, db) = c.domain();
     let mut c = clamp(c)?;
     if b < db {
@@ -466,7 +469,7 @@ fn trim_param(
 /// How far a point the file puts on a curve or a surface (a trim point on its curve, an edge
 /// on its face) may lie from it, mm: above the edge tolerances CAD files carry (0.01-0.07 mm),
 /// far below a point that belongs elsewhere.
-pub(crate) const ON_GEOMETRY_TOLERANCE_MM: f64 = 0.1;
+pub const ON_GEOMETRY_TOLERANCE_MM: f64 = 0.1;
 
 /// Any bounded curve entity as one NURBS curve per segment (a composite gives its segments,
 /// senses applied; others one). Full conics give the closed curve starting at angle 0.

@@ -7,11 +7,11 @@ use std::f64::consts::TAU;
 use kerf_nurbs::{NurbsCurve, NurbsSurface};
 use nalgebra::{Point3, Vector3};
 
-use crate::curves::{basis, oriented_piece, Basis, ON_GEOMETRY_TOLERANCE_MM};
+use crate::curves::{basis, oriented_piece, Basis};
 use crate::error::{Result, StepError};
-use crate::model::{boolean, err, name_of, refs, Charge, Model};
+use crate::model::{boolean, err, name_of, refs, Model};
 use crate::parser::{Instance, Value};
-use crate::surfaces::{angle_range, geometry, Geometry};
+use crate::surfaces::geometry;
 
 /// Samples per edge for the parameter range (2 degrees apart on a full circle).
 pub(crate) const EDGE_SAMPLES: usize = 181;
@@ -20,9 +20,13 @@ pub(crate) const EDGE_SAMPLES: usize = 181;
 /// round (a full cylinder, a torus tube).
 pub(crate) const FULL_TURN_GAP: f64 = 3.0 * std::f64::consts::PI / 180.0;
 
-/// One face, converted.
-pub(crate) struct Face {
-    /// The `#id` of the `ADVANCED_FACE` (or `FACE_SURFACE`).
+/// One face, converted ([`crate::cad::face`]): its surface cut to its boundary, `Su x Sv`
+/// outward, and its boundary loops.
+#[derive(Debug, Clone)]
+pub struct Face {
+    /// How the format writes an entity number (`#` in STEP, `D` in IGES).
+    pub(crate) sigil: &'static str,
+    /// The entity number of the face (STEP: the `ADVANCED_FACE` or `FACE_SURFACE`).
     pub(crate) id: u64,
     /// Its name attribute.
     pub(crate) name: String,
@@ -35,6 +39,28 @@ pub(crate) struct Face {
     /// The `EDGE_CURVE` `#id` of each edge of `loops` (the same edge in two faces' loops is
     /// the edge they share).
     pub(crate) edge_ids: Vec<Vec<u64>>,
+}
+
+impl Face {
+    /// The face's entity number in its file.
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// The face's id in `kerf.curves/1` (`face #12`, `face D45`).
+    pub fn label(&self) -> String {
+        format!("face {}{}", self.sigil, self.id)
+    }
+
+    /// The surface, cut to the face's parameter range, `Su x Sv` outward, mm.
+    pub fn surface(&self) -> &NurbsSurface {
+        &self.surface
+    }
+
+    /// The boundary loops, each as its edges in loop order.
+    pub fn loops(&self) -> &[Vec<NurbsCurve>] {
+        &self.loops
+    }
 }
 
 /// The faces of the file, in file order; a face that cannot be converted is returned as an
@@ -127,140 +153,23 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         edge_ids.push(edges.iter().map(|e| e.0).collect());
         loops.push(edges.into_iter().map(|e| e.1).collect());
     }
-    // The parameter range: every boundary sample mapped to natural parameters.
-    let mut us = Vec::new();
-    let mut vs = Vec::new();
-    let mut add = |q: &Point3<f64>| {
-        let (u, v) = g.params_of(q);
-        us.push(u);
-        vs.push(v);
-    };
-    let uses: usize = loops.iter().map(Vec::len).sum();
-    m.charge(inst, Charge::FaceTests, uses * EDGE_SAMPLES)?;
-    for l in &loops {
-        for e in l {
-            let (a, b) = e.domain();
-            for k in 0..EDGE_SAMPLES {
-                add(&e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64));
-            }
-        }
-    }
-    for q in &vertices {
-        add(q);
-    }
-    let (pu, pv) = g.periodic();
-    let whole = loops.is_empty();
-    if whole && !matches!(g, Geometry::Sphere(..) | Geometry::Torus(..)) {
-        return Err(err(inst, "a face without a boundary edge"));
-    }
-    let range = |x: &[f64], periodic: bool| {
-        if periodic {
-            angle_range(x, FULL_TURN_GAP)
-        } else {
-            let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            (lo, hi)
-        }
-    };
-    // A sphere or torus bounded by vertex loops only (as Open CASCADE writes a whole sphere)
-    // is the whole closed surface.
-    let mut u = if whole { (0.0, TAU) } else { range(&us, pu) };
-    let mut v = match (&g, whole) {
-        (Geometry::Sphere(..), true) => (-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2),
-        (_, true) => (0.0, TAU),
-        _ => range(&vs, pv),
-    };
-    if let Geometry::Nurbs(s) = &g {
-        // Parameters come from projection: keep them inside the domain.
-        let (a, b) = s.domain_u();
-        let (c, d) = s.domain_v();
-        u = (u.0.max(a), u.1.min(b));
-        v = (v.0.max(c), v.1.min(d));
-        // Within rounding of the whole domain: the whole domain (no knot insertion).
-        let near = |x: f64, y: f64, span: f64| (x - y).abs() <= 1e-9 * span.max(1.0);
-        if near(u.0, a, b - a) {
-            u.0 = a;
-        }
-        if near(u.1, b, b - a) {
-            u.1 = b;
-        }
-        if near(v.0, c, d - c) {
-            v.0 = c;
-        }
-        if near(v.1, d, d - c) {
-            v.1 = d;
-        }
-    }
-    if let Geometry::Sphere(..) = &g {
-        // A cap bounded by one circle has its pole inside: the boundary alone shows no v
-        // extent. Not resolved here.
-        if v.1 - v.0 < 1e-9 {
-            return Err(err(
-                inst,
-                "a spherical face whose boundary does not reach its pole is not supported",
-            ));
-        }
-    }
-    let mut surface = g.to_nurbs(inst, u, v)?;
-    edges_on_surface(m, inst, &surface, g.kind(), &loops, &edge_ids)?;
-    if same_sense == flip {
-        surface = reverse_u(&surface);
-    }
-    Ok(Face {
-        id: inst.id,
-        name: name_of(inst),
-        kind: g.kind(),
-        surface,
+    let place = crate::StepPlace { m, inst };
+    crate::cad::face(
+        &place,
+        "#",
+        inst.id,
+        name_of(inst),
+        &g,
         loops,
         edge_ids,
-    })
+        &vertices,
+        None,
+        same_sense == flip,
+    )
 }
 
 /// Samples of each edge use checked against its face's surface.
 pub(crate) const EDGE_CHECK_SAMPLES: usize = 5;
-
-/// Every edge of a face lies on the face's surface, within [`ON_GEOMETRY_TOLERANCE_MM`]:
-/// [`EDGE_CHECK_SAMPLES`] points inside each edge use (the ends are vertices the neighbouring
-/// edges share) projected onto the surface.
-///
-/// A file whose edge runs off its face (an inconsistent wall, a face given the wrong plane)
-/// would otherwise get the face's parameter range from points that are not on it and its
-/// normal, which decides the scrap side of a cut, from the wrong place. The face is refused
-/// naming the edge and the distance (the caller skips it and says why).
-fn edges_on_surface(
-    m: &Model<'_>,
-    inst: &Instance,
-    surface: &NurbsSurface,
-    kind: &str,
-    loops: &[Vec<NurbsCurve>],
-    edge_ids: &[Vec<u64>],
-) -> Result<()> {
-    let uses: usize = loops.iter().map(Vec::len).sum();
-    m.charge(inst, Charge::FaceTests, uses * EDGE_CHECK_SAMPLES)?;
-    for (l, ids) in loops.iter().zip(edge_ids) {
-        for (e, id) in l.iter().zip(ids) {
-            let (a, b) = e.domain();
-            let mut warm = None;
-            for k in 0..EDGE_CHECK_SAMPLES {
-                let t = a + (b - a) * (k as f64 + 0.5) / EDGE_CHECK_SAMPLES as f64;
-                let q = e.point(t);
-                let pr = surface.closest_point(&q, warm);
-                warm = Some((pr.u, pr.v));
-                // NaN fails the comparison and is refused too.
-                if !(pr.distance <= ON_GEOMETRY_TOLERANCE_MM) {
-                    return Err(err(
-                        inst,
-                        format!(
-                            "edge #{id} lies {:.6} mm off the face's {kind} at ({:.6}, {:.6}, {:.6}) (at most {ON_GEOMETRY_TOLERANCE_MM} mm): the edge does not bound this face",
-                            pr.distance, q.x, q.y, q.z
-                        ),
-                    ));
-                }
-            }
-        }
-    }
-    Ok(())
-}
 
 /// The same surface with u reversed: `Su x Sv` flips.
 pub(crate) fn reverse_u(s: &NurbsSurface) -> NurbsSurface {
@@ -383,13 +292,13 @@ pub(crate) fn edge_curve(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
 ///
 /// # Errors
 /// What `charge` returns (a budget crossed).
-pub(crate) fn associate(
+pub(crate) fn associate<E>(
     curve: &NurbsCurve,
     faces: &[Face],
     same_as: &[usize],
     tolerance: f64,
-    mut charge: impl FnMut(usize) -> Result<()>,
-) -> Result<std::result::Result<Vec<usize>, f64>> {
+    mut charge: impl FnMut(usize) -> std::result::Result<(), E>,
+) -> std::result::Result<std::result::Result<Vec<usize>, f64>, E> {
     let samples = sample(curve);
     let (mut clo, mut chi) = (samples[0], samples[0]);
     for p in &samples {
@@ -488,7 +397,7 @@ pub(crate) fn associate(
 
 /// For each face, the first face with the same surface (itself if none): [`associate`]
 /// projects onto each surface once.
-pub(crate) fn first_with_same_surface(faces: &[Face]) -> Vec<usize> {
+pub fn first_with_same_surface(faces: &[Face]) -> Vec<usize> {
     let mut first: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();
     faces
         .iter()

@@ -43,6 +43,7 @@
 // comparison in this crate guards file data that may be NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod cad;
 mod contour;
 mod curves;
 mod error;
@@ -54,8 +55,8 @@ mod surfaces;
 
 use std::path::Path;
 
-use kerf_format::curves::{RawCurve, RawCurvesFile, RawNurbsSurface, RawSurface, SurfaceRef};
-use kerf_nurbs::{NurbsCurve, NurbsSurface};
+use kerf_format::curves::RawCurvesFile;
+use kerf_nurbs::NurbsCurve;
 
 pub use error::{FileError, Result, StepError};
 pub use model::{Units, Work};
@@ -298,61 +299,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                 ..SheetReport::default()
             });
         }
-        // With faces chosen by hand, an edge two of them share is cut once: with the first
-        // face (in file order) that has it, whose normal it takes; the later face's loop is cut
-        // in the open pieces between such edges.
-        let mut cut_with: std::collections::HashMap<u64, u64> = std::collections::HashMap::new();
-        for (fi, f) in faces.iter().enumerate() {
-            if let Some(only) = &opts.faces {
-                if !only.contains(&f.id) {
-                    continue;
-                }
-            }
-            for (li, l) in f.loops.iter().enumerate() {
-                let edge_ids = f.edge_ids.get(li).map_or(&[][..], Vec::as_slice);
-                let shared: Vec<bool> = (0..l.len())
-                    .map(|k| {
-                        opts.faces.is_some()
-                            && edge_ids.get(k).is_some_and(|e| cut_with.contains_key(e))
-                    })
-                    .collect();
-                for (k, e) in edge_ids.iter().enumerate() {
-                    if shared[k] {
-                        report.skipped.push(format!(
-                            "edge #{e} of face #{} loop {}: shared with face #{}, cut once, with that face's normal",
-                            f.id,
-                            li + 1,
-                            cut_with[e]
-                        ));
-                    }
-                }
-                // The loop whole, or its runs of edges not cut already (each open).
-                let runs: Vec<Vec<NurbsCurve>> = if shared.iter().any(|&s| s) {
-                    loop_runs(l, &shared)
-                } else {
-                    vec![l.clone()]
-                };
-                let closed = runs.len() == 1 && runs[0].len() == l.len();
-                let mut pieces = Vec::new();
-                for run in &runs {
-                    let j = contour::join(run, opts.close_gaps_mm, closed);
-                    note_join(&mut report, &format!("#{} face loop {}", f.id, li + 1), &j);
-                    pieces.extend(j.contours);
-                }
-                let n = pieces.len();
-                for (k, c) in pieces.into_iter().enumerate() {
-                    let id = if n == 1 && closed {
-                        format!("face #{} loop {}", f.id, li + 1)
-                    } else {
-                        format!("face #{} loop {}.{}", f.id, li + 1, k + 1)
-                    };
-                    contours.push((id, c.curve, vec![fi], None));
-                }
-                for e in edge_ids {
-                    cut_with.entry(*e).or_insert(f.id);
-                }
-            }
-        }
+        contours.extend(cad::face_loop_contours(&faces, opts, &mut report));
         if let Some(only) = &opts.faces {
             for id in only {
                 if !faces.iter().any(|f| f.id == *id) {
@@ -415,82 +362,23 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                         .push(format!("#{eid} {}: not a curve kerf cuts", e.name()));
                     continue;
                 }
-                let segs = curves::bounded_segments(&m, e)?;
-                let curves_only: Vec<NurbsCurve> = segs.iter().map(|(c, _)| c.clone()).collect();
-                let closed_hint = {
-                    let a = &curves_only[0];
-                    let b = &curves_only[curves_only.len() - 1];
-                    (a.point(a.domain().0) - b.point(b.domain().1)).norm() <= opts.close_gaps_mm
-                };
-                let j = contour::join(&curves_only, opts.close_gaps_mm, closed_hint);
-                for (before, after, gap) in &j.opened {
-                    report.opened.push(format!(
-                        "#{eid} {}: segment {} (#{}) does not join segment {} (#{}) (gap {gap:.3} mm): opened there",
-                        e.name(),
-                        before + 1,
-                        segs[*before].1,
-                        after + 1,
-                        segs[*after].1
-                    ));
-                }
-                note_join(&mut report, &format!("#{eid} {}", e.name()), &j);
+                let segs: Vec<(NurbsCurve, String)> = curves::bounded_segments(&m, e)?
+                    .into_iter()
+                    .map(|(c, id)| (c, format!("#{id}")))
+                    .collect();
+                let place = StepPlace { m: &m, inst: e };
                 let mut name = name_of(e);
-                if let Err(defect) = kerf_io::check_text(&name) {
-                    // Ids reach G-code comments: a line break in one would add blocks to the
-                    // program. Keep the contour under its #id alone, and say why.
-                    report.skipped.push(format!(
-                        "#{eid} {}: its name {defect}; the contour is named #{eid} alone",
-                        e.name()
-                    ));
-                    name.clear();
-                }
-                if name.chars().count() > MAX_NAME_CHARS {
-                    // An id is written into every output (toolpath, axes, report, picture): a
-                    // 20 MB name made 140 MB of files. Its head identifies it.
-                    report.skipped.push(format!(
-                        "#{eid} {}: its name of {} characters is cut to its first {MAX_NAME_CHARS}",
-                        e.name(),
-                        name.chars().count()
-                    ));
-                    name = name.chars().take(MAX_NAME_CHARS).collect();
-                }
-                let base = if name.is_empty() {
-                    format!("#{eid}")
-                } else {
-                    format!("{name} #{eid}")
-                };
-                let n = j.contours.len();
-                if n == 0 {
-                    report.skipped.push(format!(
-                        "#{eid} {}: every segment has zero length",
-                        e.name()
-                    ));
-                }
-                for (k, c) in j.contours.into_iter().enumerate() {
-                    let id = if n == 1 {
-                        base.clone()
-                    } else {
-                        format!("{base}.{}", k + 1)
-                    };
-                    let charge = |n: usize| m.charge(e, model::Charge::FaceTests, n);
-                    let named = match faces::associate(
-                        &c.curve,
-                        &faces,
-                        &same_surface,
-                        opts.face_tolerance_mm,
-                        charge,
-                    )? {
-                        Ok(f) => f,
-                        Err(worst) => {
-                            report.skipped.push(format!(
-                                "{id}: on no face (a sample is {worst:.3e} mm from every face, more than {} mm): cut without a surface",
-                                opts.face_tolerance_mm
-                            ));
-                            Vec::new()
-                        }
-                    };
-                    contours.push((id, c.curve, named, None));
-                }
+                contours.extend(cad::curve_contours(
+                    &place,
+                    &format!("#{eid} {}", e.name()),
+                    &format!("#{eid}"),
+                    std::mem::take(&mut name),
+                    &segs,
+                    &faces,
+                    &same_surface,
+                    opts,
+                    &mut report,
+                )?);
             }
         }
     }
@@ -528,73 +416,10 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         };
         return Err(StepError::NoContour { reason });
     }
-    // Surfaces: the faces named, in file order.
-    let mut used: Vec<usize> = contours.iter().flat_map(|c| c.2.iter().copied()).collect();
-    // A sheet's cuts name only the side they run on; the other side and the walls are part of
-    // the solid the head must clear (traverses), so every face goes in.
-    if opts.all_faces || matches!(sheet, Some(Ok(_))) {
-        used = (0..faces.len()).collect();
-    }
-    used.sort_unstable();
-    used.dedup();
-    let face_id = |f: &Face| format!("face #{}", f.id);
-    for &fi in &used {
-        let f = &faces[fi];
-        report.surfaces.push(format!(
-            "{} ({}{})",
-            face_id(f),
-            f.kind,
-            if f.name.is_empty() {
-                String::new()
-            } else {
-                format!(", {:?}", f.name)
-            }
-        ));
-    }
-    let surfaces: Vec<RawSurface> = used
-        .iter()
-        .map(|&fi| RawSurface::Nurbs(raw_surface(&face_id(&faces[fi]), &faces[fi].surface)))
-        .collect();
-    let edge_tolerance = m
-        .uncertainty_mm
-        .map(|u| u.min(kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM));
+    let everything = opts.all_faces || matches!(sheet, Some(Ok(_)));
+    let face_edges = opts.edges || sheet.as_ref().is_some_and(|s| s.is_ok());
     report.uncertainty_mm = m.uncertainty_mm;
-    let mut raw_curves = Vec::with_capacity(contours.len());
-    for (id, c, named, scrap) in contours {
-        let surface = match named.len() {
-            0 => None,
-            1 => Some(SurfaceRef::One(face_id(&faces[named[0]]))),
-            _ => Some(SurfaceRef::Many(
-                named.iter().map(|&f| face_id(&faces[f])).collect(),
-            )),
-        };
-        report.taken.push(format!(
-            "{id}: degree {}, {} control points, {:.3} mm{}",
-            c.degree(),
-            c.len(),
-            c.arc_length(),
-            match &surface {
-                None => " (no face)".to_string(),
-                Some(s) => format!(" on {}", s.ids().join(", ")),
-            }
-        ));
-        let mut raw = raw_curve(id, &c, surface);
-        raw.scrap = scrap.map(str::to_owned);
-        // A face's edge lies on the face within the file's own tolerance (the reader took
-        // it within ON_GEOMETRY_TOLERANCE_MM): the curve says so, and the normals stage takes
-        // the looser of it and the run's on-surface tolerance. Face edges are the contours of
-        // `edges` and of a sheet recognised without it.
-        if (opts.edges || sheet.as_ref().is_some_and(|s| s.is_ok())) && raw.surface.is_some() {
-            raw.on_surface_tolerance_mm = edge_tolerance;
-        }
-        raw_curves.push(raw);
-    }
-    let file = RawCurvesFile {
-        format: kerf_format::CURVES_FORMAT.into(),
-        units: "mm".into(),
-        curves: raw_curves,
-        surfaces,
-    };
+    let file = cad::finish(&faces, contours, everything, face_edges, &mut report);
     report.work = m.work();
     Ok(Import { file, report })
 }
@@ -602,8 +427,26 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
 /// The most characters of a STEP entity's name kept in a contour's id.
 pub const MAX_NAME_CHARS: usize = 120;
 
-/// One contour of the import: its id, curve, the faces it names (indices) and its scrap side.
-type Contour = (String, NurbsCurve, Vec<usize>, Option<&'static str>);
+use crate::cad::Contour;
+
+/// Where the STEP reader is: the entity being read names errors and pays for projections
+/// (the model's face-test budget).
+pub(crate) struct StepPlace<'m, 'a> {
+    pub(crate) m: &'m Model<'a>,
+    pub(crate) inst: &'m parser::Instance,
+}
+
+impl cad::Place for StepPlace<'_, '_> {
+    type Error = StepError;
+
+    fn defect(&self, message: String) -> StepError {
+        model::err(self.inst, message)
+    }
+
+    fn charge(&self, n: usize) -> Result<()> {
+        self.m.charge(self.inst, model::Charge::FaceTests, n)
+    }
+}
 
 /// The contours of a recognised sheet (each feature once, in pieces where it must be), with
 /// the sheet's account in `report.sheet`.
@@ -637,7 +480,7 @@ fn sheet_contours(
             };
             let edges: Vec<NurbsCurve> = piece.iter().map(|&e| f.edges[e].clone()).collect();
             let j = contour::join(&edges, opts.close_gaps_mm, closed);
-            note_join(report, &pid, &j);
+            cad::note_join(report, &pid, &j);
             let n = j.contours.len();
             for (i, c) in j.contours.into_iter().enumerate() {
                 let cid = if n == 1 {
@@ -653,7 +496,12 @@ fn sheet_contours(
                         named.push(fi);
                     }
                 }
-                out.push((cid, c.curve, named, Some(scrap)));
+                out.push(Contour {
+                    id: cid,
+                    curve: c.curve,
+                    faces: named,
+                    scrap: Some(scrap),
+                });
             }
         }
         let loops: Vec<String> = f
@@ -739,73 +587,4 @@ fn check_no_placed_parts(m: &Model<'_>) -> Result<()> {
         }
     }
     Ok(())
-}
-
-fn note_join(report: &mut Report, what: &str, j: &contour::JoinResult) {
-    for c in &j.contours {
-        report.gaps_closed += c.closed.len();
-        report.largest_move = report.largest_move.max(c.largest_move);
-    }
-    for d in &j.dropped {
-        report.skipped.push(format!(
-            "{what}: segment {} has zero length, dropped",
-            d + 1
-        ));
-    }
-}
-
-/// The runs of consecutive edges of the closed loop `l` not marked in `skip`, in loop order
-/// (a run may wrap round the loop's start), each to be cut as an open contour.
-fn loop_runs(l: &[NurbsCurve], skip: &[bool]) -> Vec<Vec<NurbsCurve>> {
-    let n = l.len();
-    let Some(first) = (0..n).find(|&k| skip[k]) else {
-        return vec![l.to_vec()];
-    };
-    let mut runs = Vec::new();
-    let mut run: Vec<NurbsCurve> = Vec::new();
-    for step in 1..=n {
-        let k = (first + step) % n;
-        if skip[k] {
-            if !run.is_empty() {
-                runs.push(std::mem::take(&mut run));
-            }
-        } else {
-            run.push(l[k].clone());
-        }
-    }
-    if !run.is_empty() {
-        runs.push(run);
-    }
-    runs
-}
-
-fn raw_curve(id: String, c: &NurbsCurve, surface: Option<SurfaceRef>) -> RawCurve {
-    RawCurve {
-        id,
-        degree: c.degree(),
-        knots: c.knots().to_vec(),
-        control_points: c.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
-        weights: c.is_rational().then(|| c.weights()),
-        surface,
-        start: None,
-        scrap: None,
-        on_surface_tolerance_mm: None,
-    }
-}
-
-fn raw_surface(id: &str, s: &NurbsSurface) -> RawNurbsSurface {
-    RawNurbsSurface {
-        id: id.to_owned(),
-        degree_u: s.degree_u(),
-        degree_v: s.degree_v(),
-        knots_u: s.knots_u().to_vec(),
-        knots_v: s.knots_v().to_vec(),
-        control_points: s
-            .control_points()
-            .iter()
-            .map(|row| row.iter().map(|p| [p.x, p.y, p.z]).collect())
-            .collect(),
-        weights: s.is_rational().then(|| s.weights()),
-        flip: false,
-    }
 }

@@ -20,15 +20,15 @@ pub(crate) const ANGLE_UNIT_RAD: (f64, f64) = (1e-6, 10.0);
 
 /// A right-handed frame: origin, unit axes `x`, `y = z x x`, `z`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Frame {
+pub struct Frame {
     /// Origin, mm.
-    pub(crate) origin: Point3<f64>,
+    pub origin: Point3<f64>,
     /// Unit x axis (the reference direction).
-    pub(crate) x: Vector3<f64>,
+    pub x: Vector3<f64>,
     /// Unit y axis.
-    pub(crate) y: Vector3<f64>,
+    pub y: Vector3<f64>,
     /// Unit z axis (the placement's axis).
-    pub(crate) z: Vector3<f64>,
+    pub z: Vector3<f64>,
 }
 
 /// The units of a file: factors that bring its lengths to mm and its plane angles to radians.

@@ -15,8 +15,11 @@ use crate::error::Result;
 use crate::model::{err, int, list, real, reals, refs, Charge, Frame, Model};
 use crate::parser::{Instance, Value};
 
-/// A STEP surface with its natural parametrization.
-pub(crate) enum Geometry {
+/// A surface with its natural parametrization (the one Open CASCADE gives it, so that
+/// `Su x Sv` points the same way): what a face lies on, before it is cut to the face.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum Geometry {
     /// `O + u x + v y`.
     Plane(Frame),
     /// `O + r (cos u x + sin u y) + v z`.
@@ -126,14 +129,17 @@ impl Geometry {
         }
     }
 
-    /// The exact NURBS surface over `[u0, u1] x [v0, v1]` of the natural parameters.
-    pub(crate) fn to_nurbs(
+    /// The exact NURBS surface over `[u0, u1] x [v0, v1]` of the natural parameters; the
+    /// error says what is wrong with the range or the geometry.
+    ///
+    /// # Errors
+    /// An empty range, or a range outside a B-spline surface's domain.
+    pub fn to_nurbs(
         &self,
-        inst: &Instance,
         u: (f64, f64),
         v: (f64, f64),
-    ) -> Result<NurbsSurface> {
-        let bad = |what: &str| err(inst, format!("empty parameter range of the face: {what}"));
+    ) -> std::result::Result<NurbsSurface, String> {
+        let bad = |what: &str| format!("empty parameter range of the face: {what}");
         if !(u.1 > u.0) {
             return Err(bad("u"));
         }
@@ -163,7 +169,7 @@ impl Geometry {
             Geometry::Sphere(f, r) => revolve_profile(f, u, &circle_profile(0.0, *r, v)),
             Geometry::Torus(f, big, r) => revolve_profile(f, u, &circle_profile(*big, *r, v)),
             Geometry::Extrusion(c, d) => {
-                let c = sub_curve(c, u.0, u.1).map_err(|e| err(inst, e.to_string()))?;
+                let c = sub_curve(c, u.0, u.1).map_err(|e| e.to_string())?;
                 let p = c.degree();
                 let rows: Vec<Vec<Point3<f64>>> = c
                     .control_points()
@@ -186,12 +192,12 @@ impl Geometry {
                 axis,
                 x0,
             } => {
-                let c = sub_curve(profile, v.0, v.1).map_err(|e| err(inst, e.to_string()))?;
+                let c = sub_curve(profile, v.0, v.1).map_err(|e| e.to_string())?;
                 revolution(origin, axis, x0, u, &c)
             }
             Geometry::Nurbs(s) => cut(s, u, v),
         };
-        s.map_err(|e| err(inst, e.to_string()))
+        s.map_err(|e| e.to_string())
     }
 }
 
@@ -591,12 +597,8 @@ mod tests {
             (Geometry::Sphere(frame(), 4.0), (0.0, TAU), (-1.2, 1.5)),
             (Geometry::Torus(frame(), 6.0, 1.5), (1.0, 4.0), (-2.5, 3.0)),
         ];
-        let inst = Instance {
-            id: 1,
-            records: vec![],
-        };
         for (g, u, v) in &cases {
-            let s = g.to_nurbs(&inst, *u, *v).expect("converts");
+            let s = g.to_nurbs(*u, *v).expect("converts");
             let (ua, ub) = s.domain_u();
             let (va, vb) = s.domain_v();
             for i in 0..=20 {

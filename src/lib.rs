@@ -15,8 +15,8 @@
 //! The stage crates are re-exported in pipeline order; read them in that order:
 //!
 //! 1. [`nurbs`]: rational curves and surfaces (evaluation, derivatives, Bezier pieces).
-//! 2. [`format`](mod@format): `kerf.curves/1` in, `kerf.toolpath/1` out; [`step`]: the same
-//!    contours and faces read from a STEP file.
+//! 2. [`format`](mod@format): `kerf.curves/1` in, `kerf.toolpath/1` out; [`step`] and
+//!    [`iges`]: the same contours and faces read from a STEP or an IGES file.
 //! 3. [`discretize`]: cutting points with a certified chord error.
 //! 4. [`normals`]: the surface normal of every cutting point.
 //! 5. [`process`]: scrap sides, start points, lead-ins and the cutting order.
@@ -31,6 +31,7 @@
 pub use kerf_check as check;
 pub use kerf_discretize as discretize;
 pub use kerf_format as format;
+pub use kerf_iges as iges;
 pub use kerf_interp as interp;
 pub use kerf_io as io;
 pub use kerf_kinematics as kinematics;

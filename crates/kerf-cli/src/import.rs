@@ -1,5 +1,5 @@
-//! `kerf import`: a STEP file's cut contours and the faces they lie on, as `kerf.curves/1`.
-//! Also the loader that lets `kerf run` take a STEP file directly.
+//! `kerf import`: a STEP or IGES file's cut contours and the faces they lie on, as
+//! `kerf.curves/1`. Also the loader that lets `kerf run` take a CAD file directly.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -46,7 +46,7 @@ pub(crate) struct StepArgs {
 /// Arguments of `kerf import`.
 #[derive(Debug, Args)]
 pub(crate) struct ImportArgs {
-    /// The STEP file (AP203, AP214, AP242; .step or .stp).
+    /// The CAD file: STEP (AP203, AP214, AP242; .step, .stp) or IGES (5.x; .igs, .iges).
     #[arg(value_name = "PART.step")]
     pub(crate) step: PathBuf,
 
@@ -68,11 +68,13 @@ pub(crate) struct ImportArgs {
     pub(crate) quiet: bool,
 }
 
-/// Whether `path` names a STEP file (by its extension).
-pub(crate) fn is_step(path: &Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "step" | "stp" | "p21"))
+/// Whether `path` names a CAD file, STEP or IGES (by its extension).
+pub(crate) fn is_cad(path: &Path) -> bool {
+    kerf_pipeline::is_iges(path)
+        || path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "step" | "stp" | "p21"))
 }
 
 /// The import options the arguments ask for. The numbers were checked by their parsers
@@ -119,10 +121,15 @@ pub(crate) fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
     Ok(o)
 }
 
-/// Reads a STEP file into a checked curves file (and the import's account).
+/// Reads a STEP or IGES file (by its extension) into a checked curves file (and the import's
+/// account).
 pub(crate) fn load_step(path: &Path, a: &StepArgs) -> Result<(CurvesFile, Import), CliError> {
     let opts = options(a)?;
-    let import = kerf_step::import_file(path, &opts).map_err(|e| CliError::Input(e.to_string()))?;
+    let import = if kerf_pipeline::is_iges(path) {
+        kerf_iges::import_file(path, &opts).map_err(|e| CliError::Input(e.to_string()))?
+    } else {
+        kerf_step::import_file(path, &opts).map_err(|e| CliError::Input(e.to_string()))?
+    };
     let file = curves::from_raw(import.file.clone(), Path::new(".")).map_err(|e| {
         CliError::Input(format!(
             "{}: the import is not valid kerf.curves/1: {e}",
@@ -145,9 +152,12 @@ pub(crate) fn print_account(path: &Path, r: &kerf_step::Report, file: &CurvesFil
         r.faces_read
     );
     if let Some(u) = r.uncertainty_mm {
+        // Six significant digits: an inch file's 3.937e-9 inch is 1.00000054e-7 mm.
+        let sig6 = |x: f64| format!("{x:.5e}").parse::<f64>().unwrap_or(x);
         eprintln!(
-            "  the file's length tolerance: {u} mm (face-loop contours may lie up to {} mm from their faces)",
-            u.min(kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM)
+            "  the file's length tolerance: {} mm (face-loop contours may lie up to {} mm from their faces)",
+            sig6(u),
+            sig6(u.min(kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM))
         );
     }
     if let Some(s) = &r.sheet {

@@ -75,12 +75,12 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     refuse(&kerf_pipeline::OUTPUTS.map(str::to_owned))?;
     let mut read = Timings::default();
     let lap = Lap::start();
-    let job = if crate::import::is_step(path) {
+    let job = if crate::import::is_cad(path) {
         let machine = crate::input::load_machine(&args.machine)?;
-        // The library reads the STEP file (and puts what it had to assume among the report's
-        // warnings); the account is printed here.
+        // The library reads the STEP or IGES file (and puts what it had to assume among the
+        // report's warnings); the account is printed here.
         let opts = crate::import::options(&args.step_args)?;
-        let (job, report) = Job::from_step(path, machine, &opts)?;
+        let (job, report) = Job::from_cad(path, machine, &opts)?;
         if !args.quiet && !args.json {
             crate::import::print_account(path, &report, job.curves());
         }

@@ -350,3 +350,67 @@ fn an_edge_within_its_files_tolerance_is_cut_and_named_and_beyond_it_refused() {
         assert!(!out.exists(), "{name}: nothing written");
     }
 }
+
+#[test]
+fn run_takes_an_iges_file_and_import_refuses_a_broken_one_by_line() {
+    // The free curves of the IGES fixture (Open CASCADE wrote it): five on the plate and the
+    // tube, one 3D curve on no face, which a laser without its surface cannot orient: cut the
+    // plate's and tube's with --place auto on the gantry.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let (code, _, err) = run(kerf()
+        .arg("import")
+        .arg(fixture("iges/curves.igs"))
+        .arg("-o")
+        .arg(dir.path().join("c.json")));
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("IGES 5.3 (mm; lengths x1 to mm): 6 contours"),
+        "{err}"
+    );
+    assert!(
+        err.contains("took D69: degree 2, 9 control points, 31.416 mm on face D3"),
+        "{err}"
+    );
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(fixture("iges/faces.igs"))
+        .arg("--edges")
+        .arg("--faces")
+        .arg("5,197")
+        .arg("-m")
+        .arg(fixture("machines/gantry_ac.json"))
+        .arg("--place")
+        .arg("auto")
+        .arg("--out")
+        .arg(&out));
+    assert_eq!(code, 0, "{err}");
+    let tp = kerf_format::toolpath::load(out.join("toolpath.json")).unwrap();
+    let ids: Vec<&str> = tp.paths.iter().map(|p| p.id.as_str()).collect();
+    assert_eq!(ids.len(), 2, "{ids:?}");
+    assert!(
+        ids.iter()
+            .all(|i| i.starts_with("face D5 ") || i.starts_with("face D197 ")),
+        "{ids:?}"
+    );
+    assert!(out.join("program.nc").is_file());
+
+    // A file whose directory line was cut short: exit 1, the line named, nothing written.
+    let text = std::fs::read_to_string(fixture("iges/curves.igs")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    let k = lines
+        .iter()
+        .position(|l| l.len() > 72 && &l[72..73] == "D")
+        .unwrap();
+    lines[k].truncate(50);
+    let bad = dir.path().join("bad.igs");
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    let dest = dir.path().join("bad.curves.json");
+    let (code, _, err) = run(kerf().arg("import").arg(&bad).arg("-o").arg(&dest));
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains(&format!("bad.igs: line {}: an IGES record", k + 1)),
+        "{err}"
+    );
+    assert!(!dest.exists(), "nothing written");
+}

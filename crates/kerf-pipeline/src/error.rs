@@ -20,11 +20,16 @@ pub enum Error {
     /// file, or the import options (`--edges` for a solid without cut curves).
     #[error(transparent)]
     Step(#[from] kerf_step::FileError),
-    /// A STEP import gave a curves document that does not pass `kerf.curves/1`'s checks (a
-    /// reader defect, reported rather than run). Fix: report the file.
+    /// An IGES file could not be read into contours ([`crate::Job::from_cad`]); the message
+    /// names the file and the entity by its directory entry (`D45 (126 rational B-spline
+    /// curve): ...`). Fix: the file, or the import options.
+    #[error(transparent)]
+    Iges(#[from] kerf_iges::FileError),
+    /// A STEP or IGES import gave a curves document that does not pass `kerf.curves/1`'s
+    /// checks (a reader defect, reported rather than run). Fix: report the file.
     #[error("{}: the import is not valid kerf.curves/1: {source}", file.display())]
     StepDocument {
-        /// The STEP file.
+        /// The STEP or IGES file.
         file: PathBuf,
         /// Why the document is invalid.
         #[source]

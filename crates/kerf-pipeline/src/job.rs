@@ -454,6 +454,36 @@ impl Job {
     ) -> Result<(Self, kerf_step::Report)> {
         let path = step.as_ref();
         let import = kerf_step::import_file(path, opts)?;
+        Self::from_import(path, import, machine)
+    }
+
+    /// A job on the contours of a CAD file, STEP or IGES by its extension ([`is_iges`]: `.igs`,
+    /// `.iges`; anything else is read as STEP, [`Job::from_step`]), read with `opts`: with
+    /// [`kerf_step::ImportOptions::with_edges`] the faces' boundary loops are the contours
+    /// (for IGES, the trimmed surfaces' loops; IGES has no topology to recognise a sheet by).
+    ///
+    /// # Errors
+    /// [`crate::Error::Step`] or [`crate::Error::Iges`] naming the file and the entity,
+    /// [`crate::Error::StepDocument`] if the import's document fails `kerf.curves/1`'s checks.
+    pub fn from_cad(
+        path: impl AsRef<Path>,
+        machine: Machine,
+        opts: &kerf_step::ImportOptions,
+    ) -> Result<(Self, kerf_step::Report)> {
+        let path = path.as_ref();
+        if is_iges(path) {
+            let import = kerf_iges::import_file(path, opts)?;
+            Self::from_import(path, import, machine)
+        } else {
+            Self::from_step(path, machine, opts)
+        }
+    }
+
+    fn from_import(
+        path: &Path,
+        import: kerf_step::Import,
+        machine: Machine,
+    ) -> Result<(Self, kerf_step::Report)> {
         let file =
             kerf_format::curves::from_raw(import.file, Path::new(".")).map_err(|source| {
                 crate::Error::StepDocument {
@@ -671,4 +701,11 @@ impl Job {
     pub fn source(&self) -> Option<&Path> {
         self.source.as_deref()
     }
+}
+
+/// Whether `path` names an IGES file by its extension (`.igs`, `.iges`, any case).
+pub fn is_iges(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "igs" | "iges"))
 }

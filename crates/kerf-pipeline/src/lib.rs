@@ -56,7 +56,7 @@ pub use discretize::{
 };
 pub use error::{Error, Result};
 pub use job::{
-    Job, JobOptions, MissingSurface, OrientOptions, DEFAULT_MAX_TOTAL_POINTS_RUN,
+    is_iges, Job, JobOptions, MissingSurface, OrientOptions, DEFAULT_MAX_TOTAL_POINTS_RUN,
     DEFAULT_TILT_TOLERANCE_DEG,
 };
 pub use motion::{fit_options, path_report, plan_program, MotionInput, MotionOptions, Program};

@@ -17,6 +17,7 @@ use crate::{ImportOptions, Report, MAX_NAME_CHARS};
 
 pub use crate::curves::sub_curve;
 pub use crate::faces::Face;
+pub use crate::model::Charge;
 pub use crate::model::Frame;
 pub use crate::surfaces::Geometry;
 
@@ -30,6 +31,22 @@ pub fn join_one(segments: &[NurbsCurve], close_below: f64) -> Option<NurbsCurve>
 
 /// How far an edge may lie from its face's surface (and a trim point from its curve), mm.
 pub use crate::curves::ON_GEOMETRY_TOLERANCE_MM;
+
+/// Why `opts` cannot be used (a gap or face tolerance that is negative or not finite).
+///
+/// # Errors
+/// The message naming the option.
+pub fn check_options(opts: &ImportOptions) -> Result<(), String> {
+    for (name, v) in [
+        ("close_gaps_mm", opts.close_gaps_mm),
+        ("face_tolerance_mm", opts.face_tolerance_mm),
+    ] {
+        if !(v >= 0.0 && v.is_finite()) {
+            return Err(format!("{name} must be a finite number >= 0 mm, got {v}"));
+        }
+    }
+    Ok(())
+}
 
 /// A surface's parameter box `((u0, u1), (v0, v1))`.
 pub type ParamBox = ((f64, f64), (f64, f64));
@@ -71,7 +88,7 @@ impl Contour {
 }
 
 /// Builds a face: the surface `g` cut to the parameter range its boundary covers (every
-/// boundary sample, [`EDGE_SAMPLES`] per edge, mapped to natural parameters; an angle range
+/// boundary sample, 181 per edge, mapped to natural parameters; an angle range
 /// that leaves less than 3 degrees out is the full turn), each edge checked to lie on the cut
 /// surface within [`ON_GEOMETRY_TOLERANCE_MM`], `Su x Sv` reversed when `reversed`.
 ///

@@ -395,7 +395,7 @@ pub(crate) fn associate<E>(
     Ok(Ok(chosen))
 }
 
-/// For each face, the first face with the same surface (itself if none): [`associate`]
+/// For each face, the first face with the same surface (itself if none): the association
 /// projects onto each surface once.
 pub fn first_with_same_surface(faces: &[Face]) -> Vec<usize> {
     let mut first: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();

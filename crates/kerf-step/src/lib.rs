@@ -252,16 +252,7 @@ pub fn check_syntax(text: &str) -> Result<usize> {
 /// [`StepError::Options`] for a non-positive or non-finite option.
 pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    for (name, v) in [
-        ("close_gaps_mm", opts.close_gaps_mm),
-        ("face_tolerance_mm", opts.face_tolerance_mm),
-    ] {
-        if !(v >= 0.0 && v.is_finite()) {
-            return Err(StepError::Options(format!(
-                "{name} must be a finite number >= 0 mm, got {v}"
-            )));
-        }
-    }
+    cad::check_options(opts).map_err(StepError::Options)?;
     let ex = parser::parse(text)?;
     let m = Model::new(&ex)?;
     let mut report = Report {

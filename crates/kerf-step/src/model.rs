@@ -54,7 +54,8 @@ impl Default for Units {
 
 /// A quantity of work the reader counts against a budget ([`Charge::limit`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Charge {
+#[non_exhaustive]
+pub enum Charge {
     /// Curve segments produced for contours (composites expanded).
     Segments,
     /// Control points of the curves read (contours and face edges).
@@ -68,7 +69,7 @@ pub(crate) enum Charge {
 
 impl Charge {
     /// The budget: far above a real part (docs/step.md), far below what exhausts the machine.
-    pub(crate) fn limit(self) -> u64 {
+    pub fn limit(self) -> u64 {
         match self {
             Charge::Segments => 1_000_000,
             Charge::CurvePoints => 4_000_000,
@@ -77,7 +78,8 @@ impl Charge {
         }
     }
 
-    fn what(self) -> &'static str {
+    /// What is counted, for the budget's error message.
+    pub fn what(self) -> &'static str {
         match self {
             Charge::Segments => "contour segments",
             Charge::CurvePoints => "curve control points",

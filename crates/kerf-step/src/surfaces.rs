@@ -51,6 +51,32 @@ pub enum Geometry {
 
 /// Which parameters are angles (periodic with period 2 pi).
 impl Geometry {
+    /// The surface swept by `profile` turned about the axis through `origin` along unit
+    /// `axis`, angle 0 at the profile (its radial direction taken from the control point
+    /// farthest from the axis); `None` if the profile lies on the axis (no area).
+    pub fn revolution(
+        profile: NurbsCurve,
+        origin: Point3<f64>,
+        axis: Vector3<f64>,
+    ) -> Option<Self> {
+        let x0 = profile
+            .control_points()
+            .iter()
+            .map(|q| {
+                let d = q - origin;
+                d - axis * d.dot(&axis)
+            })
+            .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+            .filter(|r| r.norm() > 1e-12)
+            .map(|r| r.normalize())?;
+        Some(Geometry::Revolution {
+            profile,
+            origin,
+            axis,
+            x0,
+        })
+    }
+
     /// `(u periodic, v periodic)`.
     pub(crate) fn periodic(&self) -> (bool, bool) {
         match self {
@@ -427,25 +453,8 @@ pub(crate) fn geometry(m: &Model<'_>, inst: &Instance) -> Result<Geometry> {
             Some(crate::parser::Value::Ref(_)) => m.direction(&m.param_ref(ax, ap, 2)?)?,
             _ => Vector3::z(),
         };
-        // The profile's radial direction: from its control points (a profile entirely on the
-        // axis has none and no area).
-        let x0 = profile
-            .control_points()
-            .iter()
-            .map(|q| {
-                let d = q - origin;
-                d - axis * d.dot(&axis)
-            })
-            .max_by(|a, b| a.norm().total_cmp(&b.norm()))
-            .filter(|r| r.norm() > 1e-12)
-            .map(|r| r.normalize())
-            .ok_or_else(|| err(inst, "the profile lies on the axis"))?;
-        return Ok(Geometry::Revolution {
-            profile,
-            origin,
-            axis,
-            x0,
-        });
+        return Geometry::revolution(profile, origin, axis)
+            .ok_or_else(|| err(inst, "the profile lies on the axis"));
     }
     if inst.is("B_SPLINE_SURFACE_WITH_KNOTS") || inst.is("B_SPLINE_SURFACE") {
         return bspline_surface(m, inst).map(Geometry::Nurbs);

@@ -19,6 +19,9 @@ Files:
   rounded rectangle corner) on the plate, a circle of radius 20 round the cylinder at y = 40
   (a vertical circle in the plane y = 40), and a 3D B-spline on no face.
 - curves_inch.igs: the same, written in inches.
+- sheet.igs: a sheet-metal plate 100 x 60 x 2 mm (z from 0 to 2) with a round hole of radius 8
+  about (25, 30) and a rectangular cut-out 30 x 20 from (55, 20) to (85, 40), made by Boolean
+  cuts of a box; read with --edges, a sheet of three through-features.
 
 Their start and global sections carry the time they were written; regenerate them all at once.
 """
@@ -28,6 +31,8 @@ from pathlib import Path
 
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
 from OCP.BRep import BRep_Builder
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
 from OCP.GC import GC_MakeArcOfCircle, GC_MakeArcOfEllipse
 from OCP.Geom import Geom_BSplineCurve, Geom_CylindricalSurface
 from OCP.gp import gp_Ax2, gp_Ax3, gp_Dir, gp_Elips, gp_Pln, gp_Pnt, gp_Circ
@@ -97,6 +102,13 @@ def curves_part():
     return compound([plate, tube, circle, ellipse, spline, w.Wire(), ring, free3d])
 
 
+def sheet_part():
+    plate = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), gp_Pnt(100, 60, 2)).Shape()
+    hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(25, 30, -1), gp_Dir(0, 0, 1)), 8.0, 4.0).Shape()
+    cut = BRepPrimAPI_MakeBox(gp_Pnt(55, 20, -1), gp_Pnt(85, 40, 3)).Shape()
+    return BRepAlgoAPI_Cut(BRepAlgoAPI_Cut(plate, hole).Shape(), cut).Shape()
+
+
 def edge_seg(a, b):
     return BRepBuilderAPI_MakeEdge(gp_Pnt(a[0], a[1], 0), gp_Pnt(b[0], b[1], 0)).Edge()
 
@@ -113,6 +125,7 @@ def main():
     part = curves_part()
     write(part, out / "curves.igs")
     write(part, out / "curves_inch.igs", "IN")
+    write(sheet_part(), out / "sheet.igs")
 
 
 if __name__ == "__main__":

@@ -115,3 +115,8 @@ fn step_syntax_corpus() {
 fn step_import_corpus() {
     replay("step_import", 10, harness::step_import);
 }
+
+#[test]
+fn iges_import_corpus() {
+    replay("iges_import", 8, harness::iges_import);
+}

@@ -480,7 +480,6 @@ fn safe_id(what: &str, id: &str) {
 
 /// The whole STEP import (`kerf_step::import`), options chosen by [`step_options`].
 pub fn step_import(data: &[u8]) {
-    use kerf_format::curves::{RawSurface, SurfaceRef};
     use kerf_step::StepError;
 
     let (opts, body) = step_options(data);
@@ -508,6 +507,23 @@ pub fn step_import(data: &[u8]) {
     };
     let instances = syntax.expect("accepted above");
     assert!(instances >= 1, "a contour from a file of no instance");
+    check_import(&import, &opts);
+}
+
+/// The IGES reader (`kerf_iges::import`) on arbitrary bytes, options chosen by the first byte
+/// as for `step_import`; an accepted import must pass [`check_import`]'s checks.
+pub fn iges_import(data: &[u8]) {
+    let (opts, body) = step_options(data);
+    if let Ok(import) = kerf_iges::import(body, &opts) {
+        check_import(&import, &opts);
+    }
+}
+
+/// What every accepted CAD import must be: a valid `kerf.curves/1` document with a contour,
+/// only NURBS surfaces, every number finite (weights > 0), no id with a control character, one
+/// report line per surface, the largest gap-closing move within `close_gaps_mm`.
+fn check_import(import: &kerf_step::Import, opts: &kerf_step::ImportOptions) {
+    use kerf_format::curves::{RawSurface, SurfaceRef};
     let file = &import.file;
     assert!(!file.curves.is_empty(), "an accepted import has a contour");
     for c in &file.curves {
@@ -528,7 +544,7 @@ pub fn step_import(data: &[u8]) {
     }
     for s in &file.surfaces {
         let RawSurface::Nurbs(n) = s else {
-            panic!("the STEP reader writes NURBS surfaces only, got {s:?}");
+            panic!("the CAD readers write NURBS surfaces only, got {s:?}");
         };
         safe_id("surface id", &n.id);
         finite(

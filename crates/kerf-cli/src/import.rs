@@ -168,7 +168,7 @@ pub(crate) fn print_account(path: &Path, r: &kerf_step::Report, file: &CurvesFil
                     "  one sheet {:.3} mm thick: {} features, each cut once on the side of faces {} ({} faces on the other side, {} walls not cut)",
                     s.thickness_mm,
                     s.features.len(),
-                    ids(&s.side),
+                    ids(s.id_prefix, &s.side),
                     s.other_side.len(),
                     s.walls.len()
                 );
@@ -202,9 +202,9 @@ pub(crate) fn print_account(path: &Path, r: &kerf_step::Report, file: &CurvesFil
 }
 
 /// Face ids as `#1, #2, ...`.
-fn ids(v: &[u64]) -> String {
+fn ids(prefix: &str, v: &[u64]) -> String {
     v.iter()
-        .map(|i| format!("#{i}"))
+        .map(|i| format!("{prefix}{i}"))
         .collect::<Vec<_>>()
         .join(", ")
 }

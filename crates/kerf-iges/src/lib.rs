@@ -167,6 +167,12 @@ fn free_standing(e: &Entry) -> bool {
     matches!(e.status[1], 0 | 2)
 }
 
+/// The sewing tolerance of a file that gives no resolution, mm.
+const SEW_DEFAULT_MM: f64 = 1e-3;
+/// The least sewing tolerance, mm: above the rounding of 10 printed digits on a metre-sized
+/// part (two copies of one edge written through different matrices).
+const SEW_FLOOR_MM: f64 = 1e-6;
+
 /// The entity types that are curves kerf cuts.
 const CURVE_TYPES: [i64; 6] = [100, 102, 104, 106, 110, 126];
 /// The entity types that are surfaces kerf reads.
@@ -243,18 +249,18 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
         }
     }
 
-    // Faces: every trimmed surface, and every surface nothing uses (untrimmed).
-    let mut faces: Vec<Face> = Vec::new();
+    // Faces: every trimmed surface, and every surface nothing uses (untrimmed): read, their
+    // edges sewn (IGES faces share no edge entities), then built.
+    let mut pending: Vec<Pending<'_>> = Vec::new();
     for e in &iges.entries {
-        let independent = free_standing(e);
-        let face = match e.ty {
-            144 => Some(trimmed_face(&reader, e)),
+        let outline = match e.ty {
+            144 => Some(trimmed_outline(&reader, e)),
             ty if SURFACE_TYPES.contains(&ty)
-                && independent
+                && free_standing(e)
                 && !used.contains(&e.de)
                 && ty != 108 =>
             {
-                Some(untrimmed_face(&reader, e))
+                Some(untrimmed_outline(&reader, e))
             }
             141 | 143 => {
                 report.skipped.push(format!(
@@ -276,17 +282,72 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
             }
             _ => None,
         };
-        match face {
-            Some(Ok(f)) => faces.push(f),
+        match outline {
+            Some(Ok(p)) => pending.push(p),
             Some(Err(x @ IgesError::Budget { .. })) => return Err(x),
             Some(Err(x)) => report.skipped.push(format!("face {x}")),
             None => {}
         }
     }
+    // Two faces' copies of one edge coincide to the file's resolution (what the writer cannot
+    // tell apart); parts have real features a few micrometres wide (S06298's 0.002 mm steps),
+    // so nothing looser. A file without a resolution: 0.001 mm, STEP's usual uncertainty.
+    let sew_tolerance = report
+        .uncertainty_mm
+        .unwrap_or(SEW_DEFAULT_MM)
+        .clamp(SEW_FLOOR_MM, cad::ON_GEOMETRY_TOLERANCE_MM);
+    let sewn = {
+        let loops: Vec<&[Vec<NurbsCurve>]> = pending.iter().map(|p| p.loops.as_slice()).collect();
+        let ids: Vec<Vec<Vec<u64>>> = pending.iter().map(|p| p.ids.clone()).collect();
+        cad::sew(&loops, &ids, sew_tolerance, |f, n| {
+            reader.charge(pending[f].entry, Charge::FaceTests, n)
+        })?
+    };
+    let mut faces: Vec<Face> = Vec::new();
+    for (p, ids) in pending.into_iter().zip(sewn) {
+        let place = IgesPlace {
+            reader: &reader,
+            entry: p.entry,
+        };
+        let reversed = revolution_reversed(&p.g);
+        match cad::face(
+            &place,
+            "D",
+            p.entry.de as u64,
+            p.entry.label.clone(),
+            &p.g,
+            p.loops,
+            ids,
+            &[],
+            p.natural,
+            reversed,
+        ) {
+            Ok(f) => faces.push(f),
+            Err(x @ IgesError::Budget { .. }) => return Err(x),
+            Err(x) => report.skipped.push(format!("face {x}")),
+        }
+    }
     report.faces_read = faces.len();
+    let charge = |f: usize, n: usize| {
+        let e = iges
+            .entry(faces[f].id() as usize)
+            .unwrap_or(&iges.entries[0]);
+        reader.charge(e, Charge::FaceTests, n)
+    };
 
     let mut contours = Vec::new();
-    if opts.edges {
+    // Sheet recognition: every face of a solid, no face chosen by hand.
+    let mut sheet = if opts.edges && opts.faces.is_none() && opts.sheet {
+        Some(cad::recognise_sheet(&faces, charge)?)
+    } else {
+        None
+    };
+    if let Some(Ok(s)) = &sheet {
+        contours = cad::sheet_contours(s, &faces, opts, &mut report);
+    } else if opts.edges {
+        if let Some(Err(why)) = &sheet {
+            report.sheet = Some(not_a_sheet(why));
+        }
         if let Some(only) = &opts.faces {
             for id in only {
                 if !faces.iter().any(|f| f.id() == *id) {
@@ -357,6 +418,20 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
                 &mut report,
             )?);
         }
+        // No free curve, and the faces are one sheet: its features are what there is to cut
+        // (as with --edges), said in a warning.
+        if contours.is_empty() && opts.sheet && !faces.is_empty() {
+            if let Ok(s) = cad::recognise_sheet(&faces, charge)? {
+                report.warnings.push(format!(
+                    "no free curve: the {} faces form one sheet {:.3} mm thick, whose {} features are cut (as with --edges)",
+                    faces.len(),
+                    s.thickness_mm(),
+                    s.feature_count()
+                ));
+                contours = cad::sheet_contours(&s, &faces, opts, &mut report);
+                sheet = Some(Ok(s));
+            }
+        }
     }
     if contours.is_empty() {
         let reason = if opts.edges {
@@ -371,13 +446,20 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
             )
         } else {
             format!(
-                "no independent curve ({} faces read; try --edges to cut their boundary loops)",
+                "no free-standing curve ({} faces read; try --edges to cut their boundary loops)",
                 faces.len()
             )
         };
         return Err(IgesError::NoContour { reason });
     }
-    let file = cad::finish(&faces, contours, opts.all_faces, opts.edges, &mut report);
+    let is_sheet = matches!(sheet, Some(Ok(_)));
+    let file = cad::finish(
+        &faces,
+        contours,
+        opts.all_faces || is_sheet,
+        opts.edges || is_sheet,
+        &mut report,
+    );
     let mut work = Work::default();
     work.instances = iges.entries.len() as u64;
     work.segments = reader.spent(Charge::Segments);
@@ -409,8 +491,25 @@ fn version(iges: &parser::Iges) -> String {
     format!("IGES {name}")
 }
 
-/// A 144: its surface cut to its boundary loops (the 142s' model-space curves).
-fn trimmed_face(reader: &Reader<'_>, e: &Entry) -> Result<Face> {
+/// A face read but not yet built: its surface and loops, with the loops' edge ids (their
+/// curve entities) until they are sewn.
+struct Pending<'e> {
+    entry: &'e Entry,
+    g: kerf_step::cad::Geometry,
+    natural: Option<kerf_step::cad::ParamBox>,
+    loops: Vec<Vec<NurbsCurve>>,
+    ids: Vec<Vec<u64>>,
+}
+
+/// The account of a sheet not found.
+fn not_a_sheet(why: &str) -> kerf_step::SheetReport {
+    let mut r = kerf_step::SheetReport::default();
+    r.not_a_sheet = Some(why.to_owned());
+    r
+}
+
+/// A 144: its surface and its boundary loops (the 142s' model-space curves).
+fn trimmed_outline<'e>(reader: &Reader<'e>, e: &'e Entry) -> Result<Pending<'e>> {
     let s = reader.get(e, int(e, 0, "surface")?, "its surface")?;
     let (g, natural) = reader.surface(s)?;
     let n1 = int(e, 1, "N1")?;
@@ -446,20 +545,29 @@ fn trimmed_face(reader: &Reader<'_>, e: &Entry) -> Result<Face> {
         loops.push(l);
         ids.push(i);
     }
-    let place = IgesPlace { reader, entry: e };
-    let reversed = revolution_reversed(&g);
-    cad::face(
-        &place,
-        "D",
-        e.de as u64,
-        e.label.clone(),
-        &g,
+    Ok(Pending {
+        entry: e,
+        g,
+        natural,
         loops,
         ids,
-        &[],
+    })
+}
+
+/// An untrimmed surface, bounded by its parameter box.
+fn untrimmed_outline<'e>(reader: &Reader<'e>, e: &'e Entry) -> Result<Pending<'e>> {
+    let (g, natural) = reader.surface(e)?;
+    let Some(b) = natural else {
+        return Err(err(e, "an unbounded plane has no boundary to cut".into()));
+    };
+    let (l, i) = box_loop(e, &g, b)?;
+    Ok(Pending {
+        entry: e,
+        g,
         natural,
-        reversed,
-    )
+        loops: vec![l],
+        ids: vec![i],
+    })
 }
 
 /// IGES parametrizes a surface of revolution (120) with u along the generatrix and v the
@@ -470,29 +578,6 @@ fn trimmed_face(reader: &Reader<'_>, e: &Entry) -> Result<Face> {
 /// [`Geometry::Revolution`]: kerf_step::cad::Geometry::Revolution
 fn revolution_reversed(g: &kerf_step::cad::Geometry) -> bool {
     matches!(g, kerf_step::cad::Geometry::Revolution { .. })
-}
-
-/// An untrimmed surface as a face bounded by its parameter box.
-fn untrimmed_face(reader: &Reader<'_>, e: &Entry) -> Result<Face> {
-    let (g, natural) = reader.surface(e)?;
-    let Some(b) = natural else {
-        return Err(err(e, "an unbounded plane has no boundary to cut".into()));
-    };
-    let (l, i) = box_loop(e, &g, b)?;
-    let place = IgesPlace { reader, entry: e };
-    let reversed = revolution_reversed(&g);
-    cad::face(
-        &place,
-        "D",
-        e.de as u64,
-        e.label.clone(),
-        &g,
-        vec![l],
-        vec![i],
-        &[],
-        natural,
-        reversed,
-    )
 }
 
 /// The boundary of the parameter box as a loop of four edges (the surface's iso-curves at

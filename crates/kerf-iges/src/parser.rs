@@ -199,19 +199,30 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
                     ),
                 ));
             }
-            // The parameter lines are the `count` lines from `pointer` (at least one, and on
-            // while they point back at this entry, for writers that leave the count out).
+            // The parameter lines are those from `pointer` on that point back at this entry
+            // (columns 65-72), up to the record delimiter. Every line names one entry, so each
+            // line is read once however the directory points: a file whose entries all point
+            // at one long parameter block costs that block once, not once per entry.
             let mut text = Vec::new();
             let mut n = 0;
             while start + n < p.len() {
-                let line = p[start + n].1;
-                let back = trim_int(&line[64..72.min(line.len())]);
-                if n >= count.max(1) as usize && back != Some(de as i64) {
+                let (line_no, line) = p[start + n];
+                let back = trim_int(&line[64..72]);
+                if back != Some(de as i64) {
+                    if n == 0 {
+                        return Err(syntax(
+                            line_no,
+                            format!(
+                                "directory entry {de} (type {ty}) points at P line {pointer}, which belongs to directory entry {} (columns 65-72)",
+                                String::from_utf8_lossy(&line[64..72]).trim()
+                            ),
+                        ));
+                    }
                     break;
                 }
                 text.extend_from_slice(&line[..64]);
                 n += 1;
-                if n >= count.max(1) as usize && text.contains(&rdelim) {
+                if line[..64].contains(&rdelim) && n >= count.max(1) as usize {
                     break;
                 }
             }

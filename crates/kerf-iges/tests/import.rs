@@ -558,3 +558,89 @@ fn no_prefix_or_byte_flip_of_a_real_file_panics() {
         let _ = import(&b, &opts.clone().with_edges(None));
     }
 }
+
+#[test]
+fn a_sheet_metal_solid_is_cut_once_per_feature() {
+    // The plate 100 x 60 x 2 with a hole of radius 8 and a 30 x 20 cut-out (Open CASCADE's
+    // Boolean cuts): IGES faces share no edges, so the reader sews them (ends and interior
+    // points within the file's resolution) before it recognises the sheet.
+    let opts = ImportOptions::default().with_edges(None);
+    let imp = import_file(fixture("iges", "sheet.igs"), &opts).expect("imports");
+    let sheet = imp.report.sheet.as_ref().expect("sheet recognition ran");
+    assert!(sheet.not_a_sheet.is_none(), "{:?}", sheet.not_a_sheet);
+    assert!(
+        (sheet.thickness_mm - 2.0).abs() < 1e-9,
+        "{}",
+        sheet.thickness_mm
+    );
+    assert_eq!(
+        (sheet.side.len(), sheet.other_side.len(), sheet.walls.len()),
+        (1, 1, 9)
+    );
+    assert_eq!(sheet.id_prefix, "D");
+    let mut lengths: Vec<f64> = imp
+        .file
+        .curves
+        .iter()
+        .map(|c| curve(c).arc_length())
+        .collect();
+    lengths.sort_by(f64::total_cmp);
+    let want = [16.0 * std::f64::consts::PI, 100.0, 320.0];
+    assert_eq!(
+        lengths.len(),
+        3,
+        "each feature once: {:?}",
+        imp.report.taken
+    );
+    for (l, w) in lengths.iter().zip(want) {
+        assert!((l - w).abs() < 1e-6, "feature of {l} mm, want {w}");
+    }
+    // Every feature on the cut side, at one height (z = 0 or z = 2 throughout).
+    for c in &imp.file.curves {
+        let z: Vec<f64> = samples(&curve(c), 50).iter().map(|p| p.z).collect();
+        assert!(
+            z.iter()
+                .all(|&v| (v - z[0]).abs() < 1e-9 && (v.abs() < 1e-9 || (v - 2.0).abs() < 1e-9)),
+            "{}: {z:?}",
+            c.id
+        );
+    }
+    // Every face loop on request: both sides' three loops and the walls'.
+    let all = import_file(
+        fixture("iges", "sheet.igs"),
+        &opts.clone().with_sheet(false),
+    )
+    .expect("all");
+    assert_eq!(all.file.curves.len(), 15, "{:?}", all.report.taken);
+}
+
+#[test]
+fn an_edge_two_chosen_faces_share_is_cut_once() {
+    // The top face D35 (the outline, the hole, the cut-out) and the wall D19 beside its
+    // outline: sewn, they share one edge, cut with the first face in the file (the wall, whole);
+    // the top's outline is cut in the open piece that is left (three of its four sides).
+    let opts = ImportOptions::default().with_edges(Some(vec![35, 19]));
+    let imp = import_file(fixture("iges", "sheet.igs"), &opts).expect("imports");
+    let ids: Vec<&str> = imp.file.curves.iter().map(|c| c.id.as_str()).collect();
+    assert_eq!(ids.len(), 4, "{ids:?}");
+    let wall = curve(by_id(&imp.file, "face D19 loop 1"));
+    assert!(wall.is_closed(), "the wall, cut whole");
+    let outline = curve(by_id(&imp.file, "face D35 loop 1.1"));
+    assert!(
+        !outline.is_closed(),
+        "the outline less the shared edge is open"
+    );
+    let shared = 320.0 - outline.arc_length();
+    assert!(
+        (shared - 100.0).abs() < 1e-6 || (shared - 60.0).abs() < 1e-6,
+        "one side of the plate left out: {shared} mm"
+    );
+    assert!(
+        imp.report
+            .skipped
+            .iter()
+            .any(|s| s.contains("of face D35 loop 1: shared with face D19")),
+        "{:?}",
+        imp.report.skipped
+    );
+}

@@ -8,17 +8,15 @@ use std::collections::HashMap;
 
 use kerf_format::curves::{RawCurve, RawCurvesFile, RawNurbsSurface, RawSurface, SurfaceRef};
 use kerf_nurbs::{NurbsCurve, NurbsSurface};
-use nalgebra::Point3;
 
 use crate::contour;
-use crate::faces::{reverse_u, EDGE_CHECK_SAMPLES, EDGE_SAMPLES, FULL_TURN_GAP};
-use crate::surfaces::angle_range;
-use crate::{ImportOptions, Report, MAX_NAME_CHARS};
+use crate::{ImportOptions, Report, SheetReport, MAX_NAME_CHARS};
 
 pub use crate::curves::sub_curve;
-pub use crate::faces::Face;
 pub use crate::model::Charge;
 pub use crate::model::Frame;
+use crate::shape::associate;
+pub use crate::shape::{face, first_with_same_surface, sew, Face, ParamBox, Place};
 pub use crate::surfaces::Geometry;
 
 /// `segments` (in order) joined into one curve with a C0 knot at each join, gaps up to
@@ -48,23 +46,6 @@ pub fn check_options(opts: &ImportOptions) -> Result<(), String> {
     Ok(())
 }
 
-/// A surface's parameter box `((u0, u1), (v0, v1))`.
-pub type ParamBox = ((f64, f64), (f64, f64));
-
-/// Where the reader is working (the entity being converted): it names errors and pays for
-/// projections from the reader's budget.
-pub trait Place {
-    /// The reader's error.
-    type Error;
-    /// An error naming this place, with `message` as the defect.
-    fn defect(&self, message: String) -> Self::Error;
-    /// Charges `n` point projections to the reader's budget before they are made.
-    ///
-    /// # Errors
-    /// The reader's budget error once its budget is crossed.
-    fn charge(&self, n: usize) -> Result<(), Self::Error>;
-}
-
 /// One contour to write: its id, curve, the faces it names (indices into the faces) and its
 /// scrap side (`left`/`right`, where the reader knows it).
 #[derive(Debug, Clone)]
@@ -85,172 +66,6 @@ impl Contour {
     pub fn curve(&self) -> &NurbsCurve {
         &self.curve
     }
-}
-
-/// Builds a face: the surface `g` cut to the parameter range its boundary covers (every
-/// boundary sample, 181 per edge, mapped to natural parameters; an angle range
-/// that leaves less than 3 degrees out is the full turn), each edge checked to lie on the cut
-/// surface within [`ON_GEOMETRY_TOLERANCE_MM`], `Su x Sv` reversed when `reversed`.
-///
-/// `sigil` and `id` name the face (`face #12` for STEP, `face D45` for IGES); `edge_ids[l][k]`
-/// names edge `k` of loop `l` (the same id in two faces is the edge they share; give distinct
-/// ids where the format has no shared edges). `vertices` are boundary points of vertex loops.
-/// `natural` is the surface's own parameter box where the format gives one (an IGES surface
-/// of revolution's start and end angles): a direction in which the boundary samples span
-/// nothing (a whole sphere bounded by its seam, run down and back) takes its range from it.
-///
-/// # Errors
-/// `place`'s defect for a face without a boundary edge, an empty range, an edge off the
-/// surface; `place`'s budget error.
-#[allow(clippy::too_many_arguments)]
-pub fn face<P: Place>(
-    place: &P,
-    sigil: &'static str,
-    id: u64,
-    name: String,
-    g: &Geometry,
-    loops: Vec<Vec<NurbsCurve>>,
-    edge_ids: Vec<Vec<u64>>,
-    vertices: &[Point3<f64>],
-    natural: Option<ParamBox>,
-    reversed: bool,
-) -> Result<Face, P::Error> {
-    use std::f64::consts::{FRAC_PI_2, TAU};
-    // The parameter range: every boundary sample mapped to natural parameters.
-    let mut us = Vec::new();
-    let mut vs = Vec::new();
-    let mut add = |q: &Point3<f64>| {
-        let (u, v) = g.params_of(q);
-        us.push(u);
-        vs.push(v);
-    };
-    let uses: usize = loops.iter().map(Vec::len).sum();
-    place.charge(uses * EDGE_SAMPLES)?;
-    for l in &loops {
-        for e in l {
-            let (a, b) = e.domain();
-            for k in 0..EDGE_SAMPLES {
-                add(&e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64));
-            }
-        }
-    }
-    for q in vertices {
-        add(q);
-    }
-    let (pu, pv) = g.periodic();
-    let whole = loops.is_empty();
-    if whole && !matches!(g, Geometry::Sphere(..) | Geometry::Torus(..)) {
-        return Err(place.defect("a face without a boundary edge".into()));
-    }
-    let range = |x: &[f64], periodic: bool| {
-        if periodic {
-            angle_range(x, FULL_TURN_GAP)
-        } else {
-            let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            (lo, hi)
-        }
-    };
-    // A sphere or torus bounded by vertex loops only (as Open CASCADE writes a whole sphere)
-    // is the whole closed surface.
-    let mut u = if whole { (0.0, TAU) } else { range(&us, pu) };
-    let mut v = match (g, whole) {
-        (Geometry::Sphere(..), true) => (-FRAC_PI_2, FRAC_PI_2),
-        (_, true) => (0.0, TAU),
-        _ => range(&vs, pv),
-    };
-    if let Some((nu, nv)) = natural {
-        if !(u.1 - u.0 > 1e-12) {
-            u = nu;
-        }
-        if !(v.1 - v.0 > 1e-12) {
-            v = nv;
-        }
-    }
-    if let Geometry::Nurbs(s) = g {
-        // Parameters come from projection: keep them inside the domain.
-        let (a, b) = s.domain_u();
-        let (c, d) = s.domain_v();
-        u = (u.0.max(a), u.1.min(b));
-        v = (v.0.max(c), v.1.min(d));
-        // Within rounding of the whole domain: the whole domain (no knot insertion).
-        let near = |x: f64, y: f64, span: f64| (x - y).abs() <= 1e-9 * span.max(1.0);
-        if near(u.0, a, b - a) {
-            u.0 = a;
-        }
-        if near(u.1, b, b - a) {
-            u.1 = b;
-        }
-        if near(v.0, c, d - c) {
-            v.0 = c;
-        }
-        if near(v.1, d, d - c) {
-            v.1 = d;
-        }
-    }
-    if let Geometry::Sphere(..) = g {
-        // A cap bounded by one circle has its pole inside: the boundary alone shows no v
-        // extent. Not resolved here.
-        if v.1 - v.0 < 1e-9 {
-            return Err(place.defect(
-                "a spherical face whose boundary does not reach its pole is not supported".into(),
-            ));
-        }
-    }
-    let mut surface = g.to_nurbs(u, v).map_err(|m| place.defect(m))?;
-    edges_on_surface(place, sigil, &surface, g.kind(), &loops, &edge_ids)?;
-    if reversed {
-        surface = reverse_u(&surface);
-    }
-    Ok(Face {
-        sigil,
-        id,
-        name,
-        kind: g.kind(),
-        surface,
-        loops,
-        edge_ids,
-    })
-}
-
-/// Every edge of a face lies on the face's surface, within [`ON_GEOMETRY_TOLERANCE_MM`]:
-/// [`EDGE_CHECK_SAMPLES`] points inside each edge use (the ends are vertices the neighbouring
-/// edges share) projected onto the surface.
-///
-/// A file whose edge runs off its face (an inconsistent wall, a face given the wrong plane)
-/// would otherwise get the face's parameter range from points that are not on it and its
-/// normal, which decides the scrap side of a cut, from the wrong place. The face is refused
-/// naming the edge and the distance (the caller skips it and says why).
-fn edges_on_surface<P: Place>(
-    place: &P,
-    sigil: &str,
-    surface: &NurbsSurface,
-    kind: &str,
-    loops: &[Vec<NurbsCurve>],
-    edge_ids: &[Vec<u64>],
-) -> Result<(), P::Error> {
-    let uses: usize = loops.iter().map(Vec::len).sum();
-    place.charge(uses * EDGE_CHECK_SAMPLES)?;
-    for (l, ids) in loops.iter().zip(edge_ids) {
-        for (e, id) in l.iter().zip(ids) {
-            let (a, b) = e.domain();
-            let mut warm = None;
-            for k in 0..EDGE_CHECK_SAMPLES {
-                let t = a + (b - a) * (k as f64 + 0.5) / EDGE_CHECK_SAMPLES as f64;
-                let q = e.point(t);
-                let pr = surface.closest_point(&q, warm);
-                warm = Some((pr.u, pr.v));
-                // NaN fails the comparison and is refused too.
-                if !(pr.distance <= ON_GEOMETRY_TOLERANCE_MM) {
-                    return Err(place.defect(format!(
-                        "edge {sigil}{id} lies {:.6} mm off the face's {kind} at ({:.6}, {:.6}, {:.6}) (at most {ON_GEOMETRY_TOLERANCE_MM} mm): the edge does not bound this face",
-                        pr.distance, q.x, q.y, q.z
-                    )));
-                }
-            }
-        }
-    }
-    Ok(())
 }
 
 /// The contours of the faces' boundary loops (`opts.faces`: only those faces; `None`: all),
@@ -410,13 +225,9 @@ pub fn curve_contours<P: Place>(
         } else {
             format!("{base}.{}", k + 1)
         };
-        let named = match crate::faces::associate(
-            &c.curve,
-            faces,
-            same_surface,
-            opts.face_tolerance_mm,
-            |n| place.charge(n),
-        )? {
+        let named = match associate(&c.curve, faces, same_surface, opts.face_tolerance_mm, |n| {
+            place.charge(n)
+        })? {
             Ok(f) => f,
             Err(worst) => {
                 report.skipped.push(if worst.is_finite() {
@@ -443,7 +254,32 @@ pub fn curve_contours<P: Place>(
     Ok(contours)
 }
 
-pub use crate::faces::first_with_same_surface;
+pub use crate::sheet::Sheet;
+
+/// Whether `faces` form one sheet-metal solid (two sides at a constant thickness joined by
+/// walls, every edge shared by two faces: `docs/step.md` "Sheet-metal solids"), and its features;
+/// `Ok(Err(reason))` when they do not. `charge(face index, n)` pays for the projections.
+///
+/// # Errors
+/// Only what `charge` returns.
+pub fn recognise_sheet<E>(
+    faces: &[Face],
+    charge: impl Fn(usize, usize) -> Result<(), E>,
+) -> Result<Result<Sheet, String>, E> {
+    crate::sheet::recognise(faces, charge)
+}
+
+impl Sheet {
+    /// The sheet's thickness, mm.
+    pub fn thickness_mm(&self) -> f64 {
+        self.thickness_mm
+    }
+
+    /// How many through-features (holes, cut-outs, the outline) it has.
+    pub fn feature_count(&self) -> usize {
+        self.features.len()
+    }
+}
 
 /// The `kerf.curves/1` document of `contours`: the surfaces of the faces they name (every
 /// face with `every_face`), in file order, each as `face <sigil><id>`; one `report.taken` line
@@ -602,4 +438,89 @@ fn raw_surface(id: &str, s: &NurbsSurface) -> RawNurbsSurface {
         weights: s.is_rational().then(|| s.weights()),
         flip: false,
     }
+}
+
+/// The contours of a recognised sheet ([`recognise_sheet`]): each through-feature once, on the
+/// side the sheet is cut from, in pieces where it must be, with the sheet's account in
+/// `report.sheet`.
+pub fn sheet_contours(
+    s: &Sheet,
+    faces: &[Face],
+    opts: &ImportOptions,
+    report: &mut Report,
+) -> Vec<Contour> {
+    let mut out = Vec::new();
+    let ids = |fs: &[usize]| fs.iter().map(|&f| faces[f].id).collect::<Vec<_>>();
+    let mut r = SheetReport {
+        thickness_mm: s.thickness_mm,
+        side: ids(&s.side),
+        other_side: ids(&s.other),
+        walls: ids(&s.walls),
+        id_prefix: faces.first().map_or("#", |f| f.sigil),
+        ..SheetReport::default()
+    };
+    for (k, f) in s.features.iter().enumerate() {
+        let id = format!("feature {} {}", k + 1, faces[f.faces[0]].label());
+        let scrap = match f.scrap {
+            crate::sheet::ScrapSide::Left => "left",
+            crate::sheet::ScrapSide::Right => "right",
+        };
+        let closed = f.pieces.len() == 1;
+        for (p, piece) in f.pieces.iter().enumerate() {
+            let pid = if closed {
+                id.clone()
+            } else {
+                format!("{id} piece {}", p + 1)
+            };
+            let edges: Vec<NurbsCurve> = piece.iter().map(|&e| f.edges[e].clone()).collect();
+            let j = contour::join(&edges, opts.close_gaps_mm, closed);
+            note_join(report, &pid, &j);
+            let n = j.contours.len();
+            for (i, c) in j.contours.into_iter().enumerate() {
+                let cid = if n == 1 {
+                    pid.clone()
+                } else {
+                    format!("{pid}.{}", i + 1)
+                };
+                // The faces this piece runs along.
+                let mut named: Vec<usize> = Vec::new();
+                for &e in piece {
+                    let fi = f.edge_faces[e];
+                    if !named.contains(&fi) {
+                        named.push(fi);
+                    }
+                }
+                out.push(Contour {
+                    id: cid,
+                    curve: c.curve,
+                    faces: named,
+                    scrap: Some(scrap),
+                });
+            }
+        }
+        let loops: Vec<String> = f
+            .loops
+            .iter()
+            .map(|&(fi, li)| format!("{}{} loop {}", faces[fi].sigil, faces[fi].id, li + 1))
+            .collect();
+        let twins: Vec<String> = f
+            .twin_faces
+            .iter()
+            .map(|&fi| format!("{}{}", faces[fi].sigil, faces[fi].id))
+            .collect();
+        r.features.push(format!(
+            "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut",
+            f.length_mm,
+            if closed {
+                "one closed cut".to_string()
+            } else {
+                format!("{} open pieces (the side's normal turns between up and down along it)", f.pieces.len())
+            },
+            f.edges.len(),
+            loops.join(", "),
+            twins.join(", ")
+        ));
+    }
+    report.sheet = Some(r);
+    out
 }

@@ -1,67 +1,17 @@
-//! B-rep faces: their boundary loops as NURBS curves, their surface as a NURBS surface cut to
-//! the face's parameter range and oriented so that `Su x Sv` is the face's outward normal,
-//! and the association of contours to faces by projection.
+//! STEP B-rep faces: their boundary loops as NURBS curves and their surface, built into
+//! [`Face`]s by [`crate::cad::face`].
 
 use std::f64::consts::TAU;
 
-use kerf_nurbs::{NurbsCurve, NurbsSurface};
-use nalgebra::{Point3, Vector3};
+use kerf_nurbs::NurbsCurve;
+use nalgebra::Point3;
 
 use crate::curves::{basis, oriented_piece, Basis};
 use crate::error::{Result, StepError};
 use crate::model::{boolean, err, name_of, refs, Model};
 use crate::parser::{Instance, Value};
+use crate::shape::Face;
 use crate::surfaces::geometry;
-
-/// Samples per edge for the parameter range (2 degrees apart on a full circle).
-pub(crate) const EDGE_SAMPLES: usize = 181;
-
-/// A gap between boundary angles below this (3 degrees) means the face turns all the way
-/// round (a full cylinder, a torus tube).
-pub(crate) const FULL_TURN_GAP: f64 = 3.0 * std::f64::consts::PI / 180.0;
-
-/// One face, converted ([`crate::cad::face`]): its surface cut to its boundary, `Su x Sv`
-/// outward, and its boundary loops.
-#[derive(Debug, Clone)]
-pub struct Face {
-    /// How the format writes an entity number (`#` in STEP, `D` in IGES).
-    pub(crate) sigil: &'static str,
-    /// The entity number of the face (STEP: the `ADVANCED_FACE` or `FACE_SURFACE`).
-    pub(crate) id: u64,
-    /// Its name attribute.
-    pub(crate) name: String,
-    /// The kind of its surface (`plane`, `cylinder`, ...).
-    pub(crate) kind: &'static str,
-    /// The surface over the face's parameter range, `Su x Sv` outward.
-    pub(crate) surface: NurbsSurface,
-    /// The boundary loops (outer first where marked), each as its edges in loop order.
-    pub(crate) loops: Vec<Vec<NurbsCurve>>,
-    /// The `EDGE_CURVE` `#id` of each edge of `loops` (the same edge in two faces' loops is
-    /// the edge they share).
-    pub(crate) edge_ids: Vec<Vec<u64>>,
-}
-
-impl Face {
-    /// The face's entity number in its file.
-    pub fn id(&self) -> u64 {
-        self.id
-    }
-
-    /// The face's id in `kerf.curves/1` (`face #12`, `face D45`).
-    pub fn label(&self) -> String {
-        format!("face {}{}", self.sigil, self.id)
-    }
-
-    /// The surface, cut to the face's parameter range, `Su x Sv` outward, mm.
-    pub fn surface(&self) -> &NurbsSurface {
-        &self.surface
-    }
-
-    /// The boundary loops, each as its edges in loop order.
-    pub fn loops(&self) -> &[Vec<NurbsCurve>] {
-        &self.loops
-    }
-}
 
 /// The faces of the file, in file order; a face that cannot be converted is returned as an
 /// error message in the second list (it is skipped, not fatal).
@@ -168,28 +118,6 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
     )
 }
 
-/// Samples of each edge use checked against its face's surface.
-pub(crate) const EDGE_CHECK_SAMPLES: usize = 5;
-
-/// The same surface with u reversed: `Su x Sv` flips.
-pub(crate) fn reverse_u(s: &NurbsSurface) -> NurbsSurface {
-    let (nu, nv) = s.net_size();
-    let (a, b) = s.domain_u();
-    let ku: Vec<f64> = s.knots_u().iter().rev().map(|k| a + b - k).collect();
-    let pts: Vec<Vec<Point3<f64>>> = s.control_points().into_iter().rev().collect();
-    let w: Vec<Vec<f64>> = s.weights().into_iter().rev().collect();
-    let _ = (nu, nv);
-    NurbsSurface::try_new(
-        s.degree_u(),
-        s.degree_v(),
-        ku,
-        s.knots_v().to_vec(),
-        pts,
-        Some(w),
-    )
-    .unwrap_or_else(|_| s.clone())
-}
-
 fn vertex(m: &Model<'_>, v: &Instance) -> Result<Point3<f64>> {
     let p = m.rec(v, "VERTEX_POINT")?;
     m.point(&m.param_ref(v, p, 1)?)
@@ -277,155 +205,4 @@ pub(crate) fn edge_curve(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
         }
     };
     Ok(c)
-}
-
-/// Which faces a contour lies on: sample it densely, keep the faces within `tolerance` mm of
-/// some sample, and choose greedily the fewest faces that together are within tolerance of
-/// every sample. `Ok(Err(worst))` if some sample is farther than `tolerance` from every face
-/// (the contour is not on the part), with the worst distance.
-///
-/// Only the faces whose box, widened by `tolerance`, meets the samples' box are looked at,
-/// each surface once (`same_as`: [`first_with_same_surface`]), and only the samples inside a
-/// face's widened box are projected onto it; `charge` is told how many projections the contour
-/// will cost before any is made (the reader's budget: a file of a thousand faces over one plane
-/// and a thousand contours asked for 2e8 projections and took minutes).
-///
-/// # Errors
-/// What `charge` returns (a budget crossed).
-pub(crate) fn associate<E>(
-    curve: &NurbsCurve,
-    faces: &[Face],
-    same_as: &[usize],
-    tolerance: f64,
-    mut charge: impl FnMut(usize) -> std::result::Result<(), E>,
-) -> std::result::Result<std::result::Result<Vec<usize>, f64>, E> {
-    let samples = sample(curve);
-    let (mut clo, mut chi) = (samples[0], samples[0]);
-    for p in &samples {
-        for i in 0..3 {
-            clo[i] = clo[i].min(p[i]);
-            chi[i] = chi[i].max(p[i]);
-        }
-    }
-    // The faces to look at (their widened box meets the samples' box, and no earlier face has
-    // the same surface), and the projections they cost, charged before any is made.
-    let widened = |f: &Face| {
-        let (lo, hi) = f.surface.bounding_box();
-        (
-            lo - Vector3::repeat(tolerance),
-            hi + Vector3::repeat(tolerance),
-        )
-    };
-    let inside = |p: &Point3<f64>, (lo, hi): &(Point3<f64>, Point3<f64>)| {
-        (0..3).all(|i| p[i] >= lo[i] && p[i] <= hi[i])
-    };
-    let boxes: Vec<Option<(Point3<f64>, Point3<f64>)>> = faces
-        .iter()
-        .enumerate()
-        .map(|(fi, f)| {
-            let b = widened(f);
-            let apart = (0..3).any(|i| clo[i] > b.1[i] || chi[i] < b.0[i]);
-            (same_as[fi] == fi && !apart).then_some(b)
-        })
-        .collect();
-    let cost: usize = boxes
-        .iter()
-        .flatten()
-        .map(|b| samples.iter().filter(|p| inside(p, b)).count())
-        .sum();
-    charge(cost)?;
-    // near[f][k]: face f is within tolerance of sample k.
-    let mut near: Vec<Vec<bool>> = Vec::with_capacity(faces.len());
-    let mut best = vec![f64::INFINITY; samples.len()];
-    for (fi, f) in faces.iter().enumerate() {
-        if same_as[fi] != fi {
-            // The same surface as an earlier face: the same distances (a file that repeats one
-            // face a thousand times costs one face's projections).
-            near.push(near[same_as[fi]].clone());
-            continue;
-        }
-        let mut row = vec![false; samples.len()];
-        let Some(b) = &boxes[fi] else {
-            near.push(row);
-            continue;
-        };
-        let mut warm = None;
-        for (k, p) in samples.iter().enumerate() {
-            if !inside(p, b) {
-                warm = None;
-                continue;
-            }
-            let pr = f.surface.closest_point(p, warm);
-            warm = Some((pr.u, pr.v));
-            best[k] = best[k].min(pr.distance);
-            row[k] = pr.distance <= tolerance;
-        }
-        near.push(row);
-    }
-    let worst = best.iter().copied().fold(0.0, f64::max);
-    if worst > tolerance {
-        return Ok(Err(worst));
-    }
-    let mut covered = vec![false; samples.len()];
-    let mut chosen = Vec::new();
-    while covered.iter().any(|c| !c) {
-        let (f, gain) = near
-            .iter()
-            .enumerate()
-            .map(|(f, row)| {
-                (
-                    f,
-                    row.iter()
-                        .zip(&covered)
-                        .filter(|(n, c)| **n && !**c)
-                        .count(),
-                )
-            })
-            .max_by_key(|&(f, g)| (g, std::cmp::Reverse(f)))
-            .unwrap_or((0, 0));
-        if gain == 0 {
-            break;
-        }
-        chosen.push(f);
-        for (c, n) in covered.iter_mut().zip(&near[f]) {
-            *c |= *n;
-        }
-    }
-    chosen.sort_unstable();
-    Ok(Ok(chosen))
-}
-
-/// For each face, the first face with the same surface (itself if none): the association
-/// projects onto each surface once.
-pub fn first_with_same_surface(faces: &[Face]) -> Vec<usize> {
-    let mut first: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();
-    faces
-        .iter()
-        .enumerate()
-        .map(|(i, f)| {
-            let s = &f.surface;
-            let mut key: Vec<u64> = vec![s.degree_u() as u64, s.degree_v() as u64];
-            key.extend(s.knots_u().iter().chain(s.knots_v()).map(|v| v.to_bits()));
-            for (row, w) in s.control_points().iter().zip(s.weights()) {
-                for (p, w) in row.iter().zip(w) {
-                    key.extend([p.x.to_bits(), p.y.to_bits(), p.z.to_bits(), w.to_bits()]);
-                }
-            }
-            *first.entry(key).or_insert(i)
-        })
-        .collect()
-}
-
-/// Dense samples of a curve: 16 per knot span and at least 200.
-pub(crate) fn sample(curve: &NurbsCurve) -> Vec<Point3<f64>> {
-    let spans = curve.spans();
-    let per = (200 / spans.len().max(1)).max(16);
-    let mut out = Vec::with_capacity(spans.len() * per + 1);
-    for (_, a, b) in &spans {
-        for k in 0..per {
-            out.push(curve.point(a + (b - a) * k as f64 / per as f64));
-        }
-    }
-    out.push(curve.point(curve.domain().1));
-    out
 }

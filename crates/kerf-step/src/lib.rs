@@ -50,6 +50,7 @@ mod error;
 mod faces;
 mod model;
 mod parser;
+mod shape;
 mod sheet;
 mod surfaces;
 
@@ -61,8 +62,8 @@ use kerf_nurbs::NurbsCurve;
 pub use error::{FileError, Result, StepError};
 pub use model::{Units, Work};
 
-use crate::faces::Face;
 use crate::model::{name_of, refs, Model};
+use crate::shape::Face;
 
 /// Options of [`import`]. Defaults: gaps up to 0.1 mm closed, faces within 0.01 mm, contours
 /// from geometric sets.
@@ -198,7 +199,9 @@ pub struct SheetReport {
     pub not_a_sheet: Option<String>,
     /// The sheet's thickness, mm.
     pub thickness_mm: f64,
-    /// The faces of the side that is cut, the other side and the walls, as `#id`s.
+    /// How the file writes an entity number before the ids below (`#` in STEP, `D` in IGES).
+    pub id_prefix: &'static str,
+    /// The faces of the side that is cut, the other side and the walls, as entity numbers.
     pub side: Vec<u64>,
     /// The faces of the other side.
     pub other_side: Vec<u64>,
@@ -277,12 +280,14 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     let mut contours: Vec<Contour> = Vec::new();
     // Sheet recognition: every face of a solid, no face chosen by hand.
     let mut sheet = if opts.edges && opts.faces.is_none() && opts.sheet {
-        Some(sheet::recognise(&m, &faces)?)
+        Some(sheet::recognise(&faces, |f, n| {
+            step_charge(&m, &faces, f, n)
+        })?)
     } else {
         None
     };
     if let Some(Ok(s)) = &sheet {
-        contours.extend(sheet_contours(s, &faces, opts, &mut report));
+        contours.extend(cad::sheet_contours(s, &faces, opts, &mut report));
     } else if opts.edges {
         if let Some(Err(why)) = &sheet {
             report.sheet = Some(SheetReport {
@@ -311,7 +316,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
             }
         }
         let mut taken = std::collections::HashSet::new();
-        let same_surface = faces::first_with_same_surface(&faces);
+        let same_surface = cad::first_with_same_surface(&faces);
         for set in &sets {
             let p = set
                 .record("GEOMETRIC_CURVE_SET")
@@ -377,7 +382,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     // with --edges), said in a warning; any other solid still asks for --edges.
     let mut not_a_sheet = None;
     if contours.is_empty() && !opts.edges && opts.sheet && !faces.is_empty() {
-        match sheet::recognise(&m, &faces)? {
+        match sheet::recognise(&faces, |f, n| step_charge(&m, &faces, f, n))? {
             Ok(s) => {
                 report.warnings.push(format!(
                     "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET: the {} faces form one sheet {:.3} mm thick, whose {} features are cut (as with --edges)",
@@ -385,7 +390,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                     s.thickness_mm,
                     s.features.len()
                 ));
-                contours.extend(sheet_contours(&s, &faces, opts, &mut report));
+                contours.extend(cad::sheet_contours(&s, &faces, opts, &mut report));
                 sheet = Some(Ok(s));
             }
             Err(why) => not_a_sheet = Some(why),
@@ -420,6 +425,14 @@ pub const MAX_NAME_CHARS: usize = 120;
 
 use crate::cad::Contour;
 
+/// Charges `n` face tests to face `f` of `faces` (the sheet recognition's budget).
+fn step_charge(m: &Model<'_>, faces: &[Face], f: usize, n: usize) -> Result<()> {
+    if let Some(i) = m.ex.get(faces[f].id)? {
+        m.charge(&i, model::Charge::FaceTests, n)?;
+    }
+    Ok(())
+}
+
 /// Where the STEP reader is: the entity being read names errors and pays for projections
 /// (the model's face-test budget).
 pub(crate) struct StepPlace<'m, 'a> {
@@ -437,89 +450,6 @@ impl cad::Place for StepPlace<'_, '_> {
     fn charge(&self, n: usize) -> Result<()> {
         self.m.charge(self.inst, model::Charge::FaceTests, n)
     }
-}
-
-/// The contours of a recognised sheet (each feature once, in pieces where it must be), with
-/// the sheet's account in `report.sheet`.
-fn sheet_contours(
-    s: &sheet::Sheet,
-    faces: &[Face],
-    opts: &ImportOptions,
-    report: &mut Report,
-) -> Vec<Contour> {
-    let mut out = Vec::new();
-    let ids = |fs: &[usize]| fs.iter().map(|&f| faces[f].id).collect::<Vec<_>>();
-    let mut r = SheetReport {
-        thickness_mm: s.thickness_mm,
-        side: ids(&s.side),
-        other_side: ids(&s.other),
-        walls: ids(&s.walls),
-        ..SheetReport::default()
-    };
-    for (k, f) in s.features.iter().enumerate() {
-        let id = format!("feature {} face #{}", k + 1, faces[f.faces[0]].id);
-        let scrap = match f.scrap {
-            sheet::ScrapSide::Left => "left",
-            sheet::ScrapSide::Right => "right",
-        };
-        let closed = f.pieces.len() == 1;
-        for (p, piece) in f.pieces.iter().enumerate() {
-            let pid = if closed {
-                id.clone()
-            } else {
-                format!("{id} piece {}", p + 1)
-            };
-            let edges: Vec<NurbsCurve> = piece.iter().map(|&e| f.edges[e].clone()).collect();
-            let j = contour::join(&edges, opts.close_gaps_mm, closed);
-            cad::note_join(report, &pid, &j);
-            let n = j.contours.len();
-            for (i, c) in j.contours.into_iter().enumerate() {
-                let cid = if n == 1 {
-                    pid.clone()
-                } else {
-                    format!("{pid}.{}", i + 1)
-                };
-                // The faces this piece runs along.
-                let mut named: Vec<usize> = Vec::new();
-                for &e in piece {
-                    let fi = f.edge_faces[e];
-                    if !named.contains(&fi) {
-                        named.push(fi);
-                    }
-                }
-                out.push(Contour {
-                    id: cid,
-                    curve: c.curve,
-                    faces: named,
-                    scrap: Some(scrap),
-                });
-            }
-        }
-        let loops: Vec<String> = f
-            .loops
-            .iter()
-            .map(|&(fi, li)| format!("#{} loop {}", faces[fi].id, li + 1))
-            .collect();
-        let twins: Vec<String> = f
-            .twin_faces
-            .iter()
-            .map(|&fi| format!("#{}", faces[fi].id))
-            .collect();
-        r.features.push(format!(
-            "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut",
-            f.length_mm,
-            if closed {
-                "one closed cut".to_string()
-            } else {
-                format!("{} open pieces (the side's normal turns between up and down along it)", f.pieces.len())
-            },
-            f.edges.len(),
-            loops.join(", "),
-            twins.join(", ")
-        ));
-    }
-    report.sheet = Some(r);
-    out
 }
 
 /// True if two placements are one frame (to rounding): a transformation between them is the

@@ -15,9 +15,7 @@ use std::collections::HashMap;
 use kerf_nurbs::{NurbsCurve, NurbsSurface};
 use nalgebra::{Point3, Vector3};
 
-use crate::faces::Face;
-use crate::model::{Charge, Model};
-use crate::Result;
+use crate::shape::Face;
 
 /// Largest angle between the two faces' outward normals along an edge for the faces to meet
 /// tangentially (a bend's edge, the same side of the sheet), degrees. Sheet-metal bends are
@@ -76,7 +74,7 @@ pub(crate) struct Feature {
 }
 
 /// A recognised sheet.
-pub(crate) struct Sheet {
+pub struct Sheet {
     /// Thickness, mm (the median of the features' distances to the other side).
     pub(crate) thickness_mm: f64,
     /// The faces of the side that is cut (its normals point toward the head).
@@ -104,11 +102,12 @@ struct Use {
 /// edge and `THICKNESS_TESTS` per feature edge and nearby face of the other side.
 ///
 /// # Errors
-/// Only [`crate::StepError::Budget`]; a part that is not a sheet is `Ok(Err(reason))`.
-pub(crate) fn recognise(
-    m: &Model<'_>,
+/// Only what `charge` returns (the reader's budget, charged per face index); a part that is
+/// not a sheet is `Ok(Err(reason))`.
+pub(crate) fn recognise<E>(
     faces: &[Face],
-) -> Result<std::result::Result<Sheet, String>> {
+    charge: impl Fn(usize, usize) -> std::result::Result<(), E>,
+) -> std::result::Result<std::result::Result<Sheet, String>, E> {
     if faces.len() < 4 {
         return Ok(Err(format!(
             "{} faces: a sheet has at least four",
@@ -126,7 +125,6 @@ pub(crate) fn recognise(
     }
     let mut edges: Vec<(u64, Vec<Use>)> = uses.into_iter().collect();
     edges.sort_unstable_by_key(|e| e.0);
-    let inst = |f: usize| m.ex.get(faces[f].id);
     // Regions of faces joined by tangent edges (union-find).
     let mut parent: Vec<usize> = (0..faces.len()).collect();
     fn root(parent: &mut [usize], mut a: usize) -> usize {
@@ -141,9 +139,7 @@ pub(crate) fn recognise(
         match u.as_slice() {
             [a, b] if a.face == b.face => {} // a seam: inside the face
             [a, b] => {
-                if let Some(i) = inst(a.face)? {
-                    m.charge(&i, Charge::FaceTests, 2 * EDGE_TESTS)?;
-                }
+                charge(a.face, 2 * EDGE_TESTS)?;
                 let curve = &faces[a.face].loops[a.lp][a.pos];
                 if tangent(curve, &faces[a.face].surface, &faces[b.face].surface) {
                     let (ra, rb) = (root(&mut parent, a.face), root(&mut parent, b.face));
@@ -153,9 +149,12 @@ pub(crate) fn recognise(
                 }
             }
             other => {
+                let names: Vec<String> = other.iter().map(|u| faces[u.face].label()).collect();
                 return Ok(Err(format!(
-                    "edge #{id} bounds {} face loops: not a closed solid (each edge bounds two)",
-                    other.len()
+                    "edge {}{id} bounds {} face loops ({}): not a closed solid (each edge bounds two)",
+                    faces[other[0].face].sigil,
+                    other.len(),
+                    names.join(", ")
                 )));
             }
         }
@@ -199,8 +198,10 @@ pub(crate) fn recognise(
         match (class(x.face), class(y.face)) {
             (0, 1) | (1, 0) => {
                 return Ok(Err(format!(
-                    "edge #{id} joins face #{} and face #{} of the two sides directly",
-                    faces[x.face].id, faces[y.face].id
+                    "edge {}{id} joins {} and {} of the two sides directly",
+                    faces[x.face].sigil,
+                    faces[x.face].label(),
+                    faces[y.face].label()
                 )));
             }
             (s @ (0 | 1), 2) => touches.entry(region[y.face]).or_default()[s] = true,
@@ -211,8 +212,8 @@ pub(crate) fn recognise(
     for (f, face) in faces.iter().enumerate() {
         if class(f) == 2 && touches.get(&region[f]).is_none_or(|t| !(t[0] && t[1])) {
             return Ok(Err(format!(
-                "face #{} is neither side of a sheet nor a wall between them",
-                face.id
+                "{} is neither side of a sheet nor a wall between them",
+                face.label()
             )));
         }
     }
@@ -270,9 +271,7 @@ pub(crate) fn recognise(
                 // The boxes' distances, charged at 1/64 of a projection each (a box test costs
                 // about that): a sheet of thousands of faces stays far below the budget, a
                 // hostile one crosses it in bounded time.
-                if let Some(i) = inst(u.face)? {
-                    m.charge(&i, Charge::FaceTests, boxes.len().div_ceil(64))?;
-                }
+                charge(u.face, boxes.len().div_ceil(64))?;
                 let mut best = f64::INFINITY;
                 let mut order: Vec<(f64, usize)> = boxes
                     .iter()
@@ -284,9 +283,7 @@ pub(crate) fn recognise(
                     if gap >= best {
                         break;
                     }
-                    if let Some(inst) = inst(other[i])? {
-                        m.charge(&inst, Charge::FaceTests, 1)?;
-                    }
+                    charge(other[i], 1)?;
                     let pr = faces[other[i]].surface.closest_point(&p, None);
                     let d = p - pr.point;
                     if pr.distance > 0.0 && d.dot(&n) >= along * pr.distance {
@@ -331,19 +328,19 @@ pub(crate) fn recognise(
         for u in c {
             let e = &faces[u.face].loops[u.lp][u.pos];
             let (t0, t1) = e.domain();
-            if let Some(i) = inst(u.face)? {
-                m.charge(
-                    &i,
-                    Charge::FaceTests,
-                    THICKNESS_TESTS * (1 + twin_edges.len().div_ceil(64)),
-                )?;
-            }
+            charge(
+                u.face,
+                THICKNESS_TESTS * (1 + twin_edges.len().div_ceil(64)),
+            )?;
             for k in 0..THICKNESS_TESTS {
                 let p = e.point(t0 + (t1 - t0) * (k as f64 + 0.5) / THICKNESS_TESTS as f64);
                 let Some(n) = normal_at(&faces[u.face].surface, &p) else {
                     return Ok(Err(format!(
-                        "face #{} has no normal at ({:.3}, {:.3}, {:.3})",
-                        faces[u.face].id, p.x, p.y, p.z
+                        "{} has no normal at ({:.3}, {:.3}, {:.3})",
+                        faces[u.face].label(),
+                        p.x,
+                        p.y,
+                        p.z
                     )));
                 };
                 let q = p - n * t;
@@ -358,8 +355,8 @@ pub(crate) fn recognise(
                 }
                 if best > slack {
                     return Ok(Err(format!(
-                        "a wall of face #{} is not at right angles to the sheet: no edge of the other side within {slack:.4} mm of ({:.3}, {:.3}, {:.3}), {t:.3} mm behind its edge point ({:.3}, {:.3}, {:.3}): beveled or slanted walls are not cut as a sheet",
-                        faces[u.face].id, q.x, q.y, q.z, p.x, p.y, p.z
+                        "a wall of {} is not at right angles to the sheet: no edge of the other side within {slack:.4} mm of ({:.3}, {:.3}, {:.3}), {t:.3} mm behind its edge point ({:.3}, {:.3}, {:.3}): beveled or slanted walls are not cut as a sheet",
+                        faces[u.face].label(), q.x, q.y, q.z, p.x, p.y, p.z
                     )));
                 }
             }
@@ -529,8 +526,11 @@ fn chain(faces: &[Face], on: Vec<Use>) -> std::result::Result<Vec<Vec<Use>>, Str
                 }
                 _ => {
                     return Err(format!(
-                        "the sharp edges of face #{} do not close into a loop at ({:.3}, {:.3}, {:.3})",
-                        faces[on[first].face].id, end.x, end.y, end.z
+                        "the sharp edges of {} do not close into a loop at ({:.3}, {:.3}, {:.3})",
+                        faces[on[first].face].label(),
+                        end.x,
+                        end.y,
+                        end.z
                     ));
                 }
             }

@@ -351,24 +351,23 @@ impl<'a> Reader<'a> {
         .map_err(|x| err(e, x.to_string()))
     }
 
-    /// 104 form 1: the ellipse `A x^2 + B xy + C y^2 + D x + E y + F = 0` in the plane
-    /// `z = ZT`, counter-clockwise from the start to the end point.
+    /// 104: the conic `A x^2 + B xy + C y^2 + D x + E y + F = 0` in the plane `z = ZT` from the
+    /// start to the end point: an ellipse (form 1) counter-clockwise, a hyperbola (form 2) or
+    /// parabola (form 3) along its branch.
     fn conic(&self, e: &Entry) -> Result<NurbsCurve> {
-        if e.form != 1 {
-            return Err(err(
-                e,
-                format!(
-                    "form {} ({}) is not read: only ellipses (form 1) are",
-                    e.form,
-                    match e.form {
-                        2 => "hyperbola",
-                        3 => "parabola",
-                        _ => "unknown form",
-                    }
-                ),
-            ));
-        }
         let v = reals(e, 0, 11, "coefficients and end points")?;
+        match e.form {
+            1 => self.ellipse(e, &v),
+            2 | 3 => open_conic(e, &v),
+            f => Err(err(
+                e,
+                format!("form {f} is not a conic form (1 ellipse, 2 hyperbola, 3 parabola)"),
+            )),
+        }
+    }
+
+    /// 104 form 1 (see [`Reader::conic`]).
+    fn ellipse(&self, e: &Entry, v: &[f64]) -> Result<NurbsCurve> {
         let (a, b, c, d, ee, f, zt) = (v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
         // Centre: the gradient vanishes.
         let det = 4.0 * a * c - b * b;
@@ -497,29 +496,8 @@ impl<'a> Reader<'a> {
                 }
                 let z = n / nn.sqrt();
                 let origin = Point3::from(n * (v[3] / nn));
-                // x: the coordinate axis least along the normal, made perpendicular.
-                let i = (0..3)
-                    .min_by(|&a, &b| z[a].abs().total_cmp(&z[b].abs()))
-                    .unwrap_or(0);
-                let ei = Vector3::ith(i, 1.0);
-                let x = (ei - z * z.dot(&ei)).normalize();
-                let y = z.cross(&x);
-                let (x1, y1) = (t.vector(&x), t.vector(&y));
-                let (nx, ny) = (x1.norm(), y1.norm());
-                if !(nx > 0.0 && ny > 0.0) || (x1 / nx).dot(&(y1 / ny)).abs() > 1e-9 {
-                    return Err(err(
-                        e,
-                        "its matrix does not keep the plane's axes at right angles".into(),
-                    ));
-                }
-                let (x1, y1) = (x1 / nx, y1 / ny);
-                let frame = Frame {
-                    origin: t.point(&origin),
-                    x: x1,
-                    y: y1,
-                    z: x1.cross(&y1),
-                };
-                Ok((Geometry::Plane(frame), None))
+                let x = perpendicular(&z);
+                Ok((plane_frame(e, &t, origin, x, z.cross(&x))?, None))
             }
             120 => {
                 let similar = t.similarity_scale().is_some();
@@ -566,9 +544,41 @@ impl<'a> Reader<'a> {
                 let u = c.domain();
                 Ok((Geometry::Extrusion(c, d / len), Some((u, (0.0, len)))))
             }
-            190..=198 => Err(err(
+            190 => {
+                // Location point (116) and normal (123); form 1 adds the reference direction
+                // (x) of its parametrization.
+                let xyz = |what: &str, i: usize, ty: i64| -> Result<Vector3<f64>> {
+                    let p = self.get(e, int(e, i, what)?, &format!("its {what}"))?;
+                    if p.ty != ty {
+                        return Err(err(
+                            e,
+                            format!("its {what} D{} is a {} ({}), not a {ty}", p.de, p.ty, kind_name(p.ty)),
+                        ));
+                    }
+                    let v = reals(p, 0, 3, what)?;
+                    Ok(Vector3::new(v[0], v[1], v[2]))
+                };
+                let origin = Point3::from(xyz("location", 0, 116)?);
+                let n = xyz("normal", 1, 123)?;
+                if !(n.norm() > 0.0) {
+                    return Err(err(e, "its normal is zero".into()));
+                }
+                let z = n.normalize();
+                let x = if e.form == 1 {
+                    let r = xyz("reference direction", 2, 123)?;
+                    let r = r - z * z.dot(&r);
+                    if !(r.norm() > 1e-12) {
+                        return Err(err(e, "its reference direction is along its normal".into()));
+                    }
+                    r.normalize()
+                } else {
+                    perpendicular(&z)
+                };
+                Ok((plane_frame(e, &t, origin, x, z.cross(&x))?, None))
+            }
+            192..=198 => Err(err(
                 e,
-                "an analytic surface of the B-rep form (190-198) is not read: export trimmed surfaces (144)".into(),
+                "an analytic surface of the B-rep form (192-198) is not read: export trimmed surfaces (144)".into(),
             )),
             ty => Err(err(
                 e,
@@ -631,6 +641,128 @@ impl<'a> Reader<'a> {
             .to_nurbs(u, v)
             .map_err(|x| err(e, format!("parameter range: {x}")))
     }
+}
+
+/// A unit vector at right angles to unit `z`: the coordinate axis least along it, made
+/// perpendicular.
+fn perpendicular(z: &Vector3<f64>) -> Vector3<f64> {
+    let i = (0..3)
+        .min_by(|&a, &b| z[a].abs().total_cmp(&z[b].abs()))
+        .unwrap_or(0);
+    let ei = Vector3::ith(i, 1.0);
+    (ei - z * z.dot(&ei)).normalize()
+}
+
+/// The plane through `origin` with unit axes `x`, `y` (in the entity's space) moved by `t`;
+/// refused where `t` does not keep the axes at right angles.
+fn plane_frame(
+    e: &Entry,
+    t: &Affine,
+    origin: Point3<f64>,
+    x: Vector3<f64>,
+    y: Vector3<f64>,
+) -> Result<Geometry> {
+    let (x1, y1) = (t.vector(&x), t.vector(&y));
+    let (nx, ny) = (x1.norm(), y1.norm());
+    if !(nx > 0.0 && ny > 0.0) || (x1 / nx).dot(&(y1 / ny)).abs() > 1e-9 {
+        return Err(err(
+            e,
+            "its matrix does not keep the plane's axes at right angles".into(),
+        ));
+    }
+    let (x1, y1) = (x1 / nx, y1 / ny);
+    Ok(Geometry::Plane(Frame {
+        origin: t.point(&origin),
+        x: x1,
+        y: y1,
+        z: x1.cross(&y1),
+    }))
+}
+
+/// 104 forms 2 and 3: the hyperbola or parabola arc between the start and end points as one
+/// rational quadratic, which is exact: a rational quadratic with given ends `P0`, `P2` and
+/// end tangents meeting at `P1` is a conic, and one more point fixes which. That point is where
+/// the conic crosses the line from the chord's middle `M` to `P1`: the curve's middle is
+/// `(M + w P1) / (1 + w)`, so with `s` the root in (0, 1) of `Q(M + s (P1 - M)) = 0`, the
+/// middle weight is `w = s / (1 - s)` (1 for a parabola, above 1 for a hyperbola). Refused
+/// where an end point is off the conic, the tangents do not meet ahead of both ends, or no
+/// root lies in (0, 1) (the ends are on two branches).
+fn open_conic(e: &Entry, v: &[f64]) -> Result<NurbsCurve> {
+    let (a, b, c, d, ee, f, zt) = (v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
+    let q = |x: f64, y: f64| a * x * x + b * x * y + c * y * y + d * x + ee * y + f;
+    let grad = |x: f64, y: f64| (2.0 * a * x + b * y + d, b * x + 2.0 * c * y + ee);
+    let p0 = (v[7], v[8]);
+    let p2 = (v[9], v[10]);
+    for (name, p) in [("start", p0), ("end", p2)] {
+        let g = grad(p.0, p.1);
+        let gn = g.0.hypot(g.1);
+        // First-order distance from the conic.
+        let off = q(p.0, p.1).abs() / gn.max(1e-300);
+        if !(gn > 0.0) || !(off <= cad::ON_GEOMETRY_TOLERANCE_MM) {
+            return Err(err(
+                e,
+                format!(
+                    "its {name} point ({}, {}) is {off:.3e} off the conic",
+                    p.0, p.1
+                ),
+            ));
+        }
+    }
+    // The tangents (perpendicular to the gradients) and where they meet.
+    let (g0, g2) = (grad(p0.0, p0.1), grad(p2.0, p2.1));
+    let (t0, t2) = ((-g0.1, g0.0), (-g2.1, g2.0));
+    let den = t0.0 * t2.1 - t0.1 * t2.0;
+    if !(den.abs() > 1e-12 * (t0.0.hypot(t0.1) * t2.0.hypot(t2.1))) {
+        return Err(err(
+            e,
+            "its end tangents are parallel: no single arc joins them".into(),
+        ));
+    }
+    let (rx, ry) = (p2.0 - p0.0, p2.1 - p0.1);
+    let k = (rx * t2.1 - ry * t2.0) / den;
+    let p1 = (p0.0 + k * t0.0, p0.1 + k * t0.1);
+    let m = (0.5 * (p0.0 + p2.0), 0.5 * (p0.1 + p2.1));
+    let dv = (p1.0 - m.0, p1.1 - m.1);
+    // Q(M + s d) = q0 + q1 s + q2 s^2.
+    let q0 = q(m.0, m.1);
+    let gm = grad(m.0, m.1);
+    let q1 = gm.0 * dv.0 + gm.1 * dv.1;
+    let q2 = a * dv.0 * dv.0 + b * dv.0 * dv.1 + c * dv.1 * dv.1;
+    let roots: Vec<f64> = if q2.abs() <= 1e-15 * (q1.abs() + q0.abs()) {
+        vec![-q0 / q1]
+    } else {
+        let disc = q1 * q1 - 4.0 * q2 * q0;
+        if disc < 0.0 {
+            vec![]
+        } else {
+            let r = disc.sqrt();
+            // The numerically stable pair.
+            let t = -0.5 * (q1 + q1.signum() * r);
+            vec![t / q2, q0 / t]
+        }
+    };
+    let Some(sm) = roots
+        .into_iter()
+        .filter(|s| *s > 0.0 && *s < 1.0 && s.is_finite())
+        .min_by(|x, y| x.total_cmp(y))
+    else {
+        return Err(err(
+            e,
+            "its start and end points are not joined by one branch of the conic".into(),
+        ));
+    };
+    let w = sm / (1.0 - sm);
+    NurbsCurve::try_new(
+        2,
+        vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        vec![
+            Point3::new(p0.0, p0.1, zt),
+            Point3::new(p1.0, p1.1, zt),
+            Point3::new(p2.0, p2.1, zt),
+        ],
+        Some(vec![1.0, w, 1.0]),
+    )
+    .map_err(|x| err(e, x.to_string()))
 }
 
 /// The curve on `[v0, v1]` when that lies inside its domain and is not the whole of it.

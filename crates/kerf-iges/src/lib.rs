@@ -2,24 +2,26 @@
 //! `kerf.curves/1`, through the same CAD layer as the STEP reader ([`kerf_step::cad`]).
 //!
 //! - **Contours** are the free-standing curves of the file (status: not physically dependent,
-//!   entity use geometry; a curve another entity uses is part of that entity): lines (110), circular arcs (100), ellipses (104 form 1), polylines (106
+//!   entity use geometry; a curve another entity uses is part of that entity): lines (110),
+//!   circular arcs (100), conic arcs (104: ellipses, hyperbolas, parabolas), polylines (106
 //!   forms 11-13, 63), rational B-splines (126) and composites of these (102); each becomes one
 //!   NURBS curve with a C0 knot at every join, gaps up to [`ImportOptions`]'s `close_gaps_mm`
 //!   closed. With `edges` ([`ImportOptions::with_edges`]), the boundary loops of the trimmed
-//!   surfaces (144, through their model-space curves 142) are the contours instead.
-//! - **Surfaces**: every trimmed surface (144) and every independent untrimmed surface is a
-//!   face: B-spline surfaces (128), planes (108), surfaces of revolution (120) and tabulated
-//!   cylinders (122), exact, cut to the face's boundary. A contour names the faces its dense
-//!   samples lie on.
+//!   surfaces (144, through their model-space curves 142) are the contours instead; the faces
+//!   are sewn ([`kerf_step::cad::sew`]) so that a sheet-metal solid's features are cut once.
+//! - **Surfaces**: every trimmed surface (144) and every free-standing untrimmed surface is a
+//!   face: B-spline surfaces (128), planes (108, 190), surfaces of revolution (120) and
+//!   tabulated cylinders (122), exact, cut to the face's boundary. A contour names the faces
+//!   its dense samples lie on.
 //! - **Transformations** (124) apply to every entity, chained through the matrices' own.
 //! - **Units**: the global section's unit flag (inch, mm, feet, ..., 3 with the unit's name);
 //!   the file's resolution (global field 19) is the edges' tolerance, as for a STEP file's
-//!   uncertainty.
+//!   uncertainty, and the sewing tolerance.
 //! - **Errors** name the entity by its directory entry: `D45 (126 rational B-spline curve): ...`.
 //!
 //! Not read (said in the import's report, never guessed): compressed and binary IGES, the
 //! B-rep form (186 solids of 510 faces), bounded surfaces (143), offset curves and surfaces,
-//! hyperbolas and parabolas, a boundary given only in parameter space.
+//! a boundary given only in parameter space. `docs/iges.md` has the details.
 //!
 //! ```
 //! # fn main() -> Result<(), kerf_iges::IgesError> {
@@ -176,7 +178,7 @@ const SEW_FLOOR_MM: f64 = 1e-6;
 /// The entity types that are curves kerf cuts.
 const CURVE_TYPES: [i64; 6] = [100, 102, 104, 106, 110, 126];
 /// The entity types that are surfaces kerf reads.
-const SURFACE_TYPES: [i64; 4] = [108, 120, 122, 128];
+const SURFACE_TYPES: [i64; 5] = [108, 120, 122, 128, 190];
 
 /// Reads the bytes of an IGES file into a `kerf.curves/1` document (a leading byte-order mark
 /// is skipped).
@@ -249,6 +251,24 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
         }
     }
 
+    // Entities that carry no geometry kerf cuts (colours, properties, groups, notes, views):
+    // one line per type.
+    let mut ignored: std::collections::BTreeMap<i64, (usize, usize)> = Default::default();
+    for e in &iges.entries {
+        let read = CURVE_TYPES.contains(&e.ty)
+            || SURFACE_TYPES.contains(&e.ty)
+            || matches!(e.ty, 116 | 123 | 124 | 141..=144 | 186 | 192..=198 | 502..=514);
+        if !read {
+            let n = ignored.entry(e.ty).or_insert((e.de, 0));
+            n.1 += 1;
+        }
+    }
+    for (ty, (first, n)) in ignored {
+        report.skipped.push(format!(
+            "{n} entities of type {ty} ({}), the first D{first}: not geometry kerf cuts, ignored",
+            kind_name(ty)
+        ));
+    }
     // Faces: every trimmed surface, and every surface nothing uses (untrimmed): read, their
     // edges sewn (IGES faces share no edge entities), then built.
     let mut pending: Vec<Pending<'_>> = Vec::new();
@@ -258,7 +278,7 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
             ty if SURFACE_TYPES.contains(&ty)
                 && free_standing(e)
                 && !used.contains(&e.de)
-                && ty != 108 =>
+                && !matches!(ty, 108 | 190) =>
             {
                 Some(untrimmed_outline(&reader, e))
             }

@@ -20,6 +20,12 @@ Files:
 - faces.step: one solid or face of every kind: box (planes), cylinder, cone, sphere, torus,
   extrusion of a B-spline, revolution of a B-spline, rational B-spline surface; read with
   --edges (every face's boundary loops).
+- offsets.step: one face on each exact kind of OFFSET_SURFACE, as Open CASCADE writes
+  Geom_OffsetSurface: a cylinder of radius 20 offset by +3, a cone (semi-angle 15 degrees,
+  radius 0.3 at its placement) by -2, a sphere of radius 25 by +5, a plane by +4, a torus (30,
+  8) by -3; and a face on a RECTANGULAR_TRIMMED_SURFACE of a cylinder of radius 15 with its u
+  sense reversed (.F.), which this script writes in place of the face's CYLINDRICAL_SURFACE
+  (Open CASCADE writes the basis alone): the face's normal turns inward.
 - trim_composite.step: the folded panel and trim line of fixtures/trim_creases.json (written by
   examples/make_fixtures.rs; run that first): the panel's profile (four lines meeting at
   creases of 10, 25 and 40 degrees, a bend arc of radius 10 up to the vertical, the flange's
@@ -309,7 +315,50 @@ def make_trim_composite(out: Path):
     path.write_text(text)
 
 
+def make_offsets(out: Path):
+    from OCP.Geom import (
+        Geom_ConicalSurface,
+        Geom_CylindricalSurface,
+        Geom_OffsetSurface,
+        Geom_Plane,
+        Geom_SphericalSurface,
+        Geom_ToroidalSurface,
+    )
+    from OCP.gp import gp_Ax3
+
+    def face(surface, u0, u1, v0, v1):
+        return BRepBuilderAPI_MakeFace(surface, u0, u1, v0, v1, 1e-7).Face()
+
+    ax = lambda x, y, z, d=(0, 0, 1): gp_Ax3(gp_Pnt(x, y, z), gp_Dir(*d))
+    faces = [
+        face(Geom_OffsetSurface(Geom_CylindricalSurface(ax(0, 0, 0), 20.0), 3.0), 0.0, 2.0, 0.0, 30.0),
+        face(Geom_OffsetSurface(Geom_ConicalSurface(ax(100, 0, 0), 0.2617993877991494, 15.0), -2.0), 0.5, 3.0, 0.0, 20.0),
+        face(Geom_OffsetSurface(Geom_SphericalSurface(ax(0, 100, 0), 25.0), 5.0), 0.0, 2.5, -0.5, 0.8),
+        face(Geom_OffsetSurface(Geom_Plane(ax(0, -100, 0, (0, 1, 1))), 4.0), -10.0, 10.0, -5.0, 5.0),
+        face(Geom_OffsetSurface(Geom_ToroidalSurface(ax(100, 100, 0), 30.0, 8.0), -3.0), 0.0, 2.0, 0.0, 1.5),
+        face(Geom_CylindricalSurface(ax(-100, 0, 0, (1, 0, 0)), 15.0), 0.5, 2.5, -10.0, 10.0),
+    ]
+    path = out / "offsets.step"
+    write(compound(faces), path)
+    text = path.read_text()
+    # The last face's CYLINDRICAL_SURFACE (radius 15), wrapped in a RECTANGULAR_TRIMMED_SURFACE
+    # that reverses u: the face now refers to the trimmed surface.
+    cyl = re.search(r"#(\d+) ?= ?CYLINDRICAL_SURFACE\('[^']*',#\d+,15\.", text).group(1)
+    face_ref = re.compile(r"(ADVANCED_FACE\('[^']*',\([^)]*\),)#" + cyl + r",")
+    if len(face_ref.findall(text)) != 1:
+        raise SystemExit("offsets.step: the radius-15 cylinder's face not found once")
+    new_id = 1 + max(int(i) for i in re.findall(r"^#(\d+)", text, re.M))
+    text = face_ref.sub(lambda m: f"{m.group(1)}#{new_id},", text)
+    text = text.replace(
+        "ENDSEC;\nEND-ISO-10303-21;",
+        f"#{new_id} = RECTANGULAR_TRIMMED_SURFACE('',#{cyl},0.5,2.5,-10.,10.,.F.,.T.);\nENDSEC;\nEND-ISO-10303-21;",
+    )
+    text = re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", r"\1'2026-12-05T00:00:00'", text, count=1)
+    path.write_text(text)
+
+
 MAKERS = {
+    "offsets.step": make_offsets,
     "composite_mm.step": lambda out: make_composites(out, "MM", "composite_mm.step"),
     "composite_inch.step": lambda out: make_composites(out, "INCH", "composite_inch.step"),
     "faces.step": make_faces,

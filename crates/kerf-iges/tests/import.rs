@@ -184,7 +184,10 @@ fn every_face_matches_the_step_file_it_was_written_from() {
     )
     .expect("step");
     assert!(
-        iges.report.skipped.iter().all(|s| s.contains("not geometry kerf cuts")),
+        iges.report
+            .skipped
+            .iter()
+            .all(|s| s.contains("not geometry kerf cuts")),
         "no face skipped: {:?}",
         iges.report.skipped
     );

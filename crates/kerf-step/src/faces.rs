@@ -11,7 +11,7 @@ use crate::error::{Result, StepError};
 use crate::model::{boolean, err, name_of, refs, Model};
 use crate::parser::{Instance, Value};
 use crate::shape::Face;
-use crate::surfaces::geometry;
+use crate::surfaces::sensed_geometry;
 
 /// The faces of the file, in file order; a face that cannot be converted is returned as an
 /// error message in the second list (it is skipped, not fatal).
@@ -75,7 +75,8 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         .ok_or_else(|| err(inst, "expected a face"))?;
     let surf_inst = &m.param_ref(inst, p, 2)?;
     let same_sense = boolean(inst, p.get(3), "same_sense")?;
-    let g = geometry(m, surf_inst).map_err(|e| err(inst, format!("face_geometry: {e}")))?;
+    let (g, turned) =
+        sensed_geometry(m, surf_inst).map_err(|e| err(inst, format!("face_geometry: {e}")))?;
     let mut loops = Vec::new();
     let mut edge_ids = Vec::new();
     let mut vertices: Vec<Point3<f64>> = Vec::new();
@@ -114,7 +115,7 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         edge_ids,
         &vertices,
         None,
-        same_sense == flip,
+        (same_sense == flip) ^ turned,
     )
 }
 

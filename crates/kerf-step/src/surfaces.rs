@@ -12,7 +12,7 @@ use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::curves::{arc_homogeneous, basis, expand_knots, sub_curve, Basis};
 use crate::error::Result;
-use crate::model::{err, int, list, real, reals, refs, Charge, Frame, Model};
+use crate::model::{boolean, err, int, list, real, reals, refs, Charge, Frame, Model};
 use crate::parser::{Instance, Value};
 
 /// A surface with its natural parametrization (the one Open CASCADE gives it, so that
@@ -399,6 +399,89 @@ fn cut(s: &NurbsSurface, u: (f64, f64), v: (f64, f64)) -> kerf_nurbs::Result<Nur
     surface_from_h(s.degree_u(), s.degree_v(), ku, kv, nu2, nv2, &cpw)
 }
 
+/// Reads a face's surface entity, with the sense of its normal: `true` where the entity's
+/// `Su x Sv` is the opposite of the returned geometry's (a `RECTANGULAR_TRIMMED_SURFACE` that
+/// reverses one of its two directions). `RECTANGULAR_TRIMMED_SURFACE` is its basis (the face's
+/// boundary cuts it); `OFFSET_SURFACE` is exact where its basis is a plane, cylinder, cone,
+/// sphere or torus ([`offset`]), refused otherwise.
+pub(crate) fn sensed_geometry(m: &Model<'_>, inst: &Instance) -> Result<(Geometry, bool)> {
+    sensed_at(m, inst, 0)
+}
+
+/// The deepest nesting of trimmed and offset surfaces read.
+const MAX_SURFACE_NESTING: usize = 16;
+
+fn sensed_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<(Geometry, bool)> {
+    if depth > MAX_SURFACE_NESTING {
+        return Err(err(
+            inst,
+            format!("trimmed and offset surfaces nest more than {MAX_SURFACE_NESTING} deep"),
+        ));
+    }
+    if let Some(p) = inst.record("RECTANGULAR_TRIMMED_SURFACE") {
+        let basis = m.param_ref(inst, p, 1)?;
+        let (g, flipped) = sensed_at(m, &basis, depth + 1)?;
+        let usense = boolean(inst, p.get(6), "usense")?;
+        let vsense = boolean(inst, p.get(7), "vsense")?;
+        // Reversing one direction turns `Su x Sv` round; reversing both keeps it.
+        return Ok((g, flipped ^ (usense != vsense)));
+    }
+    if let Some(p) = inst.record("OFFSET_SURFACE") {
+        let basis = m.param_ref(inst, p, 1)?;
+        let (g, flipped) = sensed_at(m, &basis, depth + 1)?;
+        let d = m.length(inst, p.get(2), "distance")?;
+        // Along the basis entity's own normal, which is the geometry's turned round where
+        // `flipped`.
+        let d = if flipped { -d } else { d };
+        return Ok((offset(g, d).map_err(|why| err(inst, why))?, flipped));
+    }
+    Ok((geometry(m, inst)?, false))
+}
+
+/// The surface at distance `d` along the unit normal `Su x Sv / |Su x Sv|` of `g`, exactly:
+/// a plane moves along its normal; a cylinder, sphere or torus tube changes its radius by `d`
+/// (their natural normal points outward); a cone `O + (r + v tan a)(cos u x + sin u y) + v z`,
+/// whose unit normal is `cos a radial - sin a z`, becomes the cone of radius `r + d / cos a` at
+/// its placement with the same angle (the point `P + d n` has height `v - d sin a` and radius
+/// `r + v tan a + d cos a = r + (v - d sin a) tan a + d / cos a`). An offset that leaves no
+/// surface (a radius at or below zero) or whose basis has no exact NURBS offset (B-spline,
+/// extrusion, revolution) is refused with the reason.
+pub(crate) fn offset(g: Geometry, d: f64) -> std::result::Result<Geometry, String> {
+    let radius = |r: f64, what: &str| {
+        if r > 0.0 && r.is_finite() {
+            Ok(r)
+        } else {
+            Err(format!(
+                "offsetting the {what} by {d} mm leaves a radius of {r} mm: no surface"
+            ))
+        }
+    };
+    Ok(match g {
+        Geometry::Plane(f) => Geometry::Plane(Frame {
+            origin: f.origin + f.z * d,
+            ..f
+        }),
+        Geometry::Cylinder(f, r) => Geometry::Cylinder(f, radius(r + d, "cylinder")?),
+        Geometry::Cone(f, r, a) => {
+            let r1 = r + d / a.cos();
+            if !(r1 >= 0.0) {
+                return Err(format!(
+                    "offsetting the cone by {d} mm moves its apex past its placement (radius {r1} mm there): not read"
+                ));
+            }
+            Geometry::Cone(f, r1, a)
+        }
+        Geometry::Sphere(f, r) => Geometry::Sphere(f, radius(r + d, "sphere")?),
+        Geometry::Torus(f, big, r) => Geometry::Torus(f, big, radius(r + d, "torus tube")?),
+        other => {
+            return Err(format!(
+                "an offset of a {} surface has no exact NURBS form: not read",
+                other.kind()
+            ))
+        }
+    })
+}
+
 /// Reads a supported surface entity.
 pub(crate) fn geometry(m: &Model<'_>, inst: &Instance) -> Result<Geometry> {
     let positive = |x: f64, what: &str| {
@@ -647,6 +730,34 @@ mod tests {
                 g.kind()
             );
         }
+    }
+
+    #[test]
+    fn offsets_that_leave_no_surface_or_are_not_exact_are_refused() {
+        let cyl = Geometry::Cylinder(frame(), 3.0);
+        let e = offset(cyl, -3.0).expect_err("radius 0");
+        assert!(e.contains("leaves a radius of 0 mm"), "{e}");
+        let cone = Geometry::Cone(frame(), 1.0, 0.5);
+        assert!(offset(cone, -2.0)
+            .expect_err("past the apex")
+            .contains("apex"));
+        let s = NurbsSurface::try_new(
+            1,
+            1,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![
+                vec![Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 1.0, 0.0)],
+                vec![Point3::new(1.0, 0.0, 0.0), Point3::new(1.0, 1.0, 0.2)],
+            ],
+            None,
+        )
+        .expect("surface");
+        let e = offset(Geometry::Nurbs(s), 1.0).expect_err("not exact");
+        assert!(
+            e.contains("b-spline surface has no exact NURBS form"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -1077,3 +1077,110 @@ fn an_edge_two_chosen_faces_share_is_cut_once_with_the_first_faces_normal() {
     assert_eq!(im.file.curves[0].id, "face #298 loop 1");
     assert!((curve(&im.file.curves[0]).arc_length() - 204.0).abs() < 1e-9);
 }
+
+#[test]
+fn offset_and_rectangular_trimmed_surfaces_are_exact() {
+    // fixtures/step/offsets.step (scripts/make_step_fixtures.py): one face on each exact kind
+    // of OFFSET_SURFACE, and a cylinder of radius 15 along x whose RECTANGULAR_TRIMMED_SURFACE
+    // reverses u, so its face's normal points at the axis.
+    let imp = import_file(
+        fixture("offsets.step"),
+        &ImportOptions::default()
+            .with_edges(None)
+            .with_all_faces(true),
+    )
+    .expect("imports");
+    let by_id = |id: &str| {
+        let s = imp
+            .file
+            .surfaces
+            .iter()
+            .find(|s| matches!(s, RawSurface::Nurbs(n) if n.id == id))
+            .unwrap_or_else(|| panic!("no {id}"));
+        surface(s)
+    };
+    let a = 15f64.to_radians();
+    // (face, signed distance from the basis of each grid point (positive along the basis's
+    // outward normal), that normal at the point)
+    type Check = Box<dyn Fn(&Point3<f64>) -> (f64, Vector3<f64>)>;
+    let cases: Vec<(&str, f64, Check)> = vec![
+        (
+            "face #55",
+            3.0,
+            Box::new(|p| {
+                let r = Vector3::new(p.x, p.y, 0.0);
+                (r.norm() - 20.0, r.normalize())
+            }),
+        ),
+        (
+            "face #151",
+            -2.0,
+            Box::new(move |p| {
+                let r = Vector3::new(p.x - 100.0, p.y, 0.0);
+                let n = r.normalize() * a.cos() - Vector3::z() * a.sin();
+                ((r.norm() - 15.0 - p.z * a.tan()) * a.cos(), n)
+            }),
+        ),
+        (
+            "face #247",
+            5.0,
+            Box::new(|p| {
+                let r = p - Point3::new(0.0, 100.0, 0.0);
+                (r.norm() - 25.0, r.normalize())
+            }),
+        ),
+        (
+            "face #345",
+            4.0,
+            Box::new(|p| {
+                let n = Vector3::new(0.0, 1.0, 1.0).normalize();
+                ((p - Point3::new(0.0, -100.0, 0.0)).dot(&n), n)
+            }),
+        ),
+        (
+            "face #439",
+            -3.0,
+            Box::new(|p| {
+                let d = p - Point3::new(100.0, 100.0, 0.0);
+                let rho = Vector3::new(d.x, d.y, 0.0);
+                let c = rho.normalize() * 30.0;
+                let t = d - c;
+                (t.norm() - 8.0, t.normalize())
+            }),
+        ),
+        (
+            "face #537",
+            0.0,
+            Box::new(|p| {
+                let r = Vector3::new(0.0, p.y, p.z);
+                // The trimmed surface reverses u: its normal is the cylinder's turned round.
+                (r.norm() - 15.0, -r.normalize())
+            }),
+        ),
+    ];
+    for (id, d, check) in &cases {
+        let s = by_id(id);
+        let (u0, u1) = s.domain_u();
+        let (v0, v1) = s.domain_v();
+        for i in 0..=10 {
+            for j in 0..=10 {
+                let (u, v) = (
+                    u0 + (u1 - u0) * i as f64 / 10.0,
+                    v0 + (v1 - v0) * j as f64 / 10.0,
+                );
+                let p = s.point(u, v);
+                let (dist, n) = check(&p);
+                assert!(
+                    (dist - d).abs() < 1e-9,
+                    "{id}: {dist} mm from the basis at {p}, want {d}"
+                );
+                if let Some(sn) = s.normal(u, v) {
+                    assert!(
+                        sn.dot(&n) > 1.0 - 1e-9,
+                        "{id}: normal {sn} at {p}, want {n}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -26,6 +26,11 @@ Files:
   8) by -3; and a face on a RECTANGULAR_TRIMMED_SURFACE of a cylinder of radius 15 with its u
   sense reversed (.F.), which this script writes in place of the face's CYLINDRICAL_SURFACE
   (Open CASCADE writes the basis alone): the face's normal turns inward.
+- assembly.step: an assembly as Open CASCADE writes one (`write.step.assembly` 1: NEXT_
+  ASSEMBLY_USAGE_OCCURRENCE, representation relationships with ITEM_DEFINED_TRANSFORMATIONs): a
+  box 40 x 30 x 5 placed twice, where it is and turned 0.5 rad about z then moved by
+  (100, 20, 3); and a sub-assembly moved by (0, -60, 0) holding a cylinder (radius 5, height 8)
+  moved by (-50, 0, 0) (nested placements).
 - trim_composite.step: the folded panel and trim line of fixtures/trim_creases.json (written by
   examples/make_fixtures.rs; run that first): the panel's profile (four lines meeting at
   creases of 10, 25 and 40 degrees, a bend arc of radius 10 up to the vertical, the flange's
@@ -357,7 +362,34 @@ def make_offsets(out: Path):
     path.write_text(text)
 
 
+def make_assembly(out: Path):
+    from OCP.gp import gp_Trsf
+    from OCP.TopLoc import TopLoc_Location
+
+    box = BRepPrimAPI_MakeBox(40, 30, 5).Shape()
+    turn = gp_Trsf()
+    turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 0.5)
+    move = gp_Trsf()
+    move.SetTranslation(gp_Vec(100, 20, 3))
+    cyl = BRepPrimAPI_MakeCylinder(5, 8).Shape()
+    t3 = gp_Trsf()
+    t3.SetTranslation(gp_Vec(-50, 0, 0))
+    t4 = gp_Trsf()
+    t4.SetTranslation(gp_Vec(0, -60, 0))
+    sub = compound([cyl.Located(TopLoc_Location(t3))])
+    shape = compound([box, box.Located(TopLoc_Location(move.Multiplied(turn))), sub.Located(TopLoc_Location(t4))])
+    Interface_Static.SetIVal_s("write.step.assembly", 1)
+    try:
+        write(shape, out / "assembly.step")
+    finally:
+        Interface_Static.SetIVal_s("write.step.assembly", 0)
+    path = out / "assembly.step"
+    text = re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", r"\1'2026-12-05T00:00:00'", path.read_text(), count=1)
+    path.write_text(text)
+
+
 MAKERS = {
+    "assembly.step": make_assembly,
     "offsets.step": make_offsets,
     "composite_mm.step": lambda out: make_composites(out, "MM", "composite_mm.step"),
     "composite_inch.step": lambda out: make_composites(out, "INCH", "composite_inch.step"),

@@ -79,7 +79,7 @@ pub fn face_loop_contours(
     report: &mut Report,
 ) -> Vec<Contour> {
     let mut contours = Vec::new();
-    let mut cut_with: HashMap<u64, u64> = HashMap::new();
+    let mut cut_with: HashMap<u64, String> = HashMap::new();
     for (fi, f) in faces.iter().enumerate() {
         if let Some(only) = &opts.faces {
             if !only.contains(&f.id) {
@@ -97,11 +97,11 @@ pub fn face_loop_contours(
             for (k, e) in edge_ids.iter().enumerate() {
                 if shared[k] {
                     report.skipped.push(format!(
-                            "edge {s}{e} of face {s}{} loop {}: shared with face {s}{}, cut once, with that face's normal",
-                            f.id,
+                            "edge {}{e} of {} loop {}: shared with {}, cut once, with that face's normal",
+                            f.sigil,
+                            f.label(),
                             li + 1,
                             cut_with[e],
-                            s = f.sigil
                         ));
                 }
             }
@@ -115,11 +115,7 @@ pub fn face_loop_contours(
             let mut pieces = Vec::new();
             for run in &runs {
                 let j = contour::join(run, opts.close_gaps_mm, closed);
-                note_join(
-                    report,
-                    &format!("{}{} face loop {}", f.sigil, f.id, li + 1),
-                    &j,
-                );
+                note_join(report, &format!("{} face loop {}", f.tag(), li + 1), &j);
                 pieces.extend(j.contours);
             }
             let n = pieces.len();
@@ -137,7 +133,7 @@ pub fn face_loop_contours(
                 });
             }
             for e in edge_ids {
-                cut_with.entry(*e).or_insert(f.id);
+                cut_with.entry(*e).or_insert_with(|| f.label());
             }
         }
     }
@@ -501,13 +497,9 @@ pub fn sheet_contours(
         let loops: Vec<String> = f
             .loops
             .iter()
-            .map(|&(fi, li)| format!("{}{} loop {}", faces[fi].sigil, faces[fi].id, li + 1))
+            .map(|&(fi, li)| format!("{} loop {}", faces[fi].tag(), li + 1))
             .collect();
-        let twins: Vec<String> = f
-            .twin_faces
-            .iter()
-            .map(|&fi| format!("{}{}", faces[fi].sigil, faces[fi].id))
-            .collect();
+        let twins: Vec<String> = f.twin_faces.iter().map(|&fi| faces[fi].tag()).collect();
         r.features.push(format!(
             "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut",
             f.length_mm,

@@ -43,6 +43,7 @@
 // comparison in this crate guards file data that may be NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod assembly;
 pub mod cad;
 mod contour;
 mod curves;
@@ -271,6 +272,9 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         None
     };
     let (faces, face_errors) = faces::read_faces(&m, only)?;
+    // Assemblies: each face where its part's placements put it, once per instance.
+    let placements = assembly::placements(&m)?;
+    let faces = place_faces(faces, &placements.faces);
     report.faces_read = faces.len();
     report
         .skipped
@@ -363,18 +367,46 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
                     .map(|(c, id)| (c, format!("#{id}")))
                     .collect();
                 let place = StepPlace { m: &m, inst: e };
-                let mut name = name_of(e);
-                contours.extend(cad::curve_contours(
-                    &place,
-                    &format!("#{eid} {}", e.name()),
-                    &format!("#{eid}"),
-                    std::mem::take(&mut name),
-                    &segs,
-                    &faces,
-                    &same_surface,
-                    opts,
-                    &mut report,
-                )?);
+                // The set's placements: once where it lies, or once per instance of its part.
+                let instances: Vec<(Option<usize>, Option<assembly::Rigid>)> =
+                    match placements.sets.get(&set.id) {
+                        None => vec![(None, None)],
+                        Some(v) if v.len() == 1 => vec![(None, Some(v[0]))],
+                        Some(v) => v
+                            .iter()
+                            .enumerate()
+                            .map(|(k, t)| (Some(k + 1), Some(*t)))
+                            .collect(),
+                    };
+                for (k, t) in instances {
+                    let segs: Vec<(NurbsCurve, String)> = match t {
+                        None => segs.clone(),
+                        Some(t) => segs
+                            .iter()
+                            .map(|(c, n)| {
+                                (
+                                    shape::moved_curve(c, &|p| assembly::point(&t, p)),
+                                    n.clone(),
+                                )
+                            })
+                            .collect(),
+                    };
+                    let tag = match k {
+                        None => format!("#{eid}"),
+                        Some(k) => format!("#{eid}@{k}"),
+                    };
+                    contours.extend(cad::curve_contours(
+                        &place,
+                        &format!("{tag} {}", e.name()),
+                        &tag,
+                        name_of(e),
+                        &segs,
+                        &faces,
+                        &same_surface,
+                        opts,
+                        &mut report,
+                    )?);
+                }
             }
         }
     }
@@ -452,6 +484,42 @@ impl cad::Place for StepPlace<'_, '_> {
     }
 }
 
+/// The faces where their parts' placements put them: a face of a part placed once is moved
+/// there (same id); a face of a part placed k > 1 times becomes k faces, `#id@1` .. `#id@k`,
+/// whose edges get ids of their own per instance (two instances share no edge).
+fn place_faces(
+    faces: Vec<Face>,
+    placements: &std::collections::HashMap<u64, Vec<assembly::Rigid>>,
+) -> Vec<Face> {
+    if placements.is_empty() {
+        return faces;
+    }
+    let stride = 1 + faces
+        .iter()
+        .flat_map(|f| f.edge_ids.iter().flatten().copied())
+        .max()
+        .unwrap_or(0);
+    let mut out = Vec::with_capacity(faces.len());
+    for f in faces {
+        match placements.get(&f.id) {
+            None => out.push(f),
+            Some(v) if v.len() == 1 => {
+                if v[0].is_identity() {
+                    out.push(f);
+                } else {
+                    out.push(f.moved(&v[0].r, &v[0].t, None, 0));
+                }
+            }
+            Some(v) => {
+                for (k, t) in v.iter().enumerate() {
+                    out.push(f.moved(&t.r, &t.t, Some(k + 1), stride.saturating_mul(k as u64)));
+                }
+            }
+        }
+    }
+    out
+}
+
 /// True if two placements are one frame (to rounding): a transformation between them is the
 /// identity.
 fn same_frame(a: &model::Frame, b: &model::Frame) -> bool {
@@ -460,22 +528,11 @@ fn same_frame(a: &model::Frame, b: &model::Frame) -> bool {
         && (a.z - b.z).norm() <= 1e-12
 }
 
-/// Assembly placements are not applied: refuse a file that places a part anywhere but where
-/// its own coordinates put it, rather than write its geometry in the wrong place.
+/// Mapped items (`MAPPED_ITEM`, the other way to place a part) are not applied: refuse a file
+/// that places a part that way anywhere but where its own coordinates put it, rather than write
+/// its geometry in the wrong place. (Placements by representation relationships are applied,
+/// `assembly.rs`.)
 fn check_no_placed_parts(m: &Model<'_>) -> Result<()> {
-    for inst in m.all("ITEM_DEFINED_TRANSFORMATION")? {
-        let inst = &inst;
-        let p = m.rec(inst, "ITEM_DEFINED_TRANSFORMATION")?;
-        let a = m.placement(&m.param_ref(inst, p, 2)?)?;
-        let b = m.placement(&m.param_ref(inst, p, 3)?)?;
-        if !same_frame(&a, &b) {
-            return Err(model::err(
-                inst,
-                "places a part with a transformation that is not the identity; assemblies \
-                 are not supported (export the part alone, or as one body in its place)",
-            ));
-        }
-    }
     // The other form: a MAPPED_ITEM places a REPRESENTATION_MAP's items from its origin
     // (`mapping_origin`) at `mapping_target`; a CARTESIAN_TRANSFORMATION_OPERATOR target may
     // also scale or mirror, and is refused whatever it holds.

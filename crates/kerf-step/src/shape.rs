@@ -150,6 +150,7 @@ pub fn face<P: Place>(
         surface,
         loops,
         edge_ids,
+        instance: None,
     })
 }
 
@@ -355,6 +356,8 @@ pub struct Face {
     /// The `EDGE_CURVE` `#id` of each edge of `loops` (the same edge in two faces' loops is
     /// the edge they share).
     pub(crate) edge_ids: Vec<Vec<u64>>,
+    /// Which instance of its part this is, where the part is placed more than once (1, 2, ...).
+    pub(crate) instance: Option<usize>,
 }
 
 impl Face {
@@ -363,9 +366,63 @@ impl Face {
         self.id
     }
 
-    /// The face's id in `kerf.curves/1` (`face #12`, `face D45`).
+    /// The face's entity as the file writes it, with its instance where its part is placed
+    /// more than once: `#12`, `#12@2`, `D45`.
+    pub fn tag(&self) -> String {
+        match self.instance {
+            None => format!("{}{}", self.sigil, self.id),
+            Some(k) => format!("{}{}@{k}", self.sigil, self.id),
+        }
+    }
+
+    /// The face's id in `kerf.curves/1` (`face #12`, `face #12@2`, `face D45`).
     pub fn label(&self) -> String {
-        format!("face {}{}", self.sigil, self.id)
+        format!("face {}", self.tag())
+    }
+
+    /// The face moved by the rigid map `x -> r x + t` (exact: the control points of a NURBS
+    /// surface or curve move, its weights stay), as instance `instance` of its part, each edge
+    /// id raised by `edge_offset` (so that two instances share no edge).
+    pub(crate) fn moved(
+        &self,
+        r: &nalgebra::Matrix3<f64>,
+        t: &Vector3<f64>,
+        instance: Option<usize>,
+        edge_offset: u64,
+    ) -> Face {
+        let map = |p: &Point3<f64>| Point3::from(r * p.coords + t);
+        let s = &self.surface;
+        let surface = NurbsSurface::try_new(
+            s.degree_u(),
+            s.degree_v(),
+            s.knots_u().to_vec(),
+            s.knots_v().to_vec(),
+            s.control_points()
+                .iter()
+                .map(|row| row.iter().map(map).collect())
+                .collect(),
+            s.is_rational().then(|| s.weights()),
+        )
+        .unwrap_or_else(|_| s.clone());
+        let loops = self
+            .loops
+            .iter()
+            .map(|l| l.iter().map(|c| moved_curve(c, &map)).collect())
+            .collect();
+        Face {
+            sigil: self.sigil,
+            id: self.id,
+            name: self.name.clone(),
+            kind: self.kind,
+            surface,
+            loops,
+            edge_ids: self
+                .edge_ids
+                .iter()
+                .map(|l| l.iter().map(|e| e + edge_offset).collect())
+                .collect(),
+            instance,
+        }
     }
 
     /// The surface, cut to the face's parameter range, `Su x Sv` outward, mm.
@@ -377,6 +434,20 @@ impl Face {
     pub fn loops(&self) -> &[Vec<NurbsCurve>] {
         &self.loops
     }
+}
+
+/// A curve with its control points mapped by `map` (an affine map: exact), weights kept.
+pub(crate) fn moved_curve(
+    c: &NurbsCurve,
+    map: &impl Fn(&Point3<f64>) -> Point3<f64>,
+) -> NurbsCurve {
+    NurbsCurve::try_new(
+        c.degree(),
+        c.knots().to_vec(),
+        c.control_points().iter().map(map).collect(),
+        c.is_rational().then(|| c.weights()),
+    )
+    .unwrap_or_else(|_| c.clone())
 }
 
 /// Samples of each edge use checked against its face's surface.

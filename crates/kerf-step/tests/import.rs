@@ -559,25 +559,35 @@ fn a_sheet_metal_solid_has_each_feature_cut_once() {
 }
 
 #[test]
-fn a_placed_assembly_part_is_refused_not_misplaced() {
+fn a_placement_moves_what_its_representation_holds_and_a_cycle_is_refused() {
+    // A circle's set in representation #10, placed into #11 by the transformation taking the
+    // origin to (100, 0, 0): the circle is cut about (100, 0, 0).
     let body = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=CARTESIAN_POINT('',(100.,0.,0.));\n\
         #3=AXIS2_PLACEMENT_3D('',#1,$,$);\n#4=AXIS2_PLACEMENT_3D('',#2,$,$);\n\
-        #5=ITEM_DEFINED_TRANSFORMATION('','',#3,#4);\n#6=CIRCLE('',#3,5.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n";
-    let e = import(&step(body), &ImportOptions::default()).unwrap_err();
-    assert!(
-        e.to_string()
-            .starts_with("#5 ITEM_DEFINED_TRANSFORMATION: places a part"),
-        "{e}"
+        #5=ITEM_DEFINED_TRANSFORMATION('','',#3,#4);\n#6=CIRCLE('',#3,5.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n\
+        #10=SHAPE_REPRESENTATION('',(#3,#7),$);\n#11=SHAPE_REPRESENTATION('',(#4),$);\n\
+        #12=(REPRESENTATION_RELATIONSHIP('','',#10,#11)REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#5)SHAPE_REPRESENTATION_RELATIONSHIP());\n";
+    let imp = import(&step(body), &ImportOptions::default()).expect("placed");
+    let c = curve(&imp.file.curves[0]);
+    for p in samples(&c, 40) {
+        let r = (p - Point3::new(100.0, 0.0, 0.0)).norm();
+        assert!(
+            (r - 5.0).abs() < 1e-12,
+            "circle point {p} at {r} from (100, 0, 0)"
+        );
+    }
+    // A transformation no relationship uses places nothing.
+    let stray = body.replace("#12=", "#99=CARTESIAN_POINT('',(1.,1.,1.));\n#98=");
+    let stray = stray.replace("#98=(REPRESENTATION_RELATIONSHIP('','',#10,#11)REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#5)SHAPE_REPRESENTATION_RELATIONSHIP());", "");
+    let imp = import(&step(&stray), &ImportOptions::default()).expect("in place");
+    let c = curve(&imp.file.curves[0]);
+    assert!((c.point(c.domain().0) - Point3::new(5.0, 0.0, 0.0)).norm() < 1e-12);
+    // Each placed in the other: refused, not followed for ever.
+    let cycle = format!(
+        "{body}#13=(REPRESENTATION_RELATIONSHIP('','',#11,#10)REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#5)SHAPE_REPRESENTATION_RELATIONSHIP());\n"
     );
-    // The identity (as Open CASCADE writes for parts in place) is fine.
-    let same = body.replace(
-        "#5=ITEM_DEFINED_TRANSFORMATION('','',#3,#4)",
-        "#5=ITEM_DEFINED_TRANSFORMATION('','',#3,#3)",
-    );
-    assert!(
-        import(&step(&same), &ImportOptions::default()).is_ok(),
-        "identity accepted"
-    );
+    let e = import(&step(&cycle), &ImportOptions::default()).expect_err("a cycle");
+    assert!(e.to_string().contains("is placed in itself"), "{e}");
 }
 
 #[test]
@@ -1183,4 +1193,67 @@ fn offset_and_rectangular_trimmed_surfaces_are_exact() {
             }
         }
     }
+}
+
+#[test]
+fn an_assembly_places_each_instance_of_its_parts() {
+    // fixtures/step/assembly.step (Open CASCADE's assembly structure): a box placed where it
+    // is and again turned 0.5 rad about z and moved by (100, 20, 3); a cylinder of radius 5 and
+    // height 8 moved by (-50, 0, 0) inside a sub-assembly moved by (0, -60, 0).
+    let imp = import_file(
+        fixture("assembly.step"),
+        &ImportOptions::default()
+            .with_edges(None)
+            .with_all_faces(true),
+    )
+    .expect("imports");
+    let by_id = |id: &str| {
+        curve(
+            imp.file
+                .curves
+                .iter()
+                .find(|c| c.id == id)
+                .unwrap_or_else(|| panic!("no {id}")),
+        )
+    };
+    let (s, c) = 0.5f64.sin_cos();
+    let place = |p: &Point3<f64>| {
+        Point3::new(
+            c * p.x - s * p.y + 100.0,
+            s * p.x + c * p.y + 20.0,
+            p.z + 3.0,
+        )
+    };
+    let mut pairs = 0;
+    for k in [43, 163, 263, 310, 357, 364] {
+        let a = by_id(&format!("face #{k}@1 loop 1"));
+        let b = by_id(&format!("face #{k}@2 loop 1"));
+        for (p, q) in samples(&a, 40).iter().zip(samples(&b, 40)) {
+            assert!(
+                (place(p) - q).norm() < 1e-9,
+                "face #{k}: {p} placed is not {q}"
+            );
+            assert!(
+                (-1e-9..=40.0 + 1e-9).contains(&p.x) && (-1e-9..=5.0 + 1e-9).contains(&p.z),
+                "the first box where its coordinates put it: {p}"
+            );
+        }
+        pairs += 1;
+    }
+    assert_eq!(pairs, 6, "every face of the box twice");
+    // The cylinder, placed once through two levels: its faces keep their plain ids.
+    let mut cylinder = 0;
+    for cv in imp.file.curves.iter().filter(|c| !c.id.contains('@')) {
+        for p in samples(&curve(cv), 40) {
+            let r = ((p.x + 50.0).powi(2) + (p.y + 60.0).powi(2)).sqrt();
+            assert!(
+                r < 5.0 + 1e-9 && (-1e-9..=8.0 + 1e-9).contains(&p.z),
+                "{}: {p}",
+                cv.id
+            );
+        }
+        cylinder += 1;
+    }
+    assert_eq!(cylinder, 3, "the cylinder's two caps and side");
+    assert_eq!(imp.file.surfaces.len(), 15);
 }

@@ -1,0 +1,263 @@
+//! Assembly placements: where each face and geometric set lies in the file's root frame.
+//!
+//! A part's representation is placed into an assembly's by a `REPRESENTATION_RELATIONSHIP`
+//! (`rep_1` the part's, `rep_2` the assembly's) with a `REPRESENTATION_RELATIONSHIP_WITH_
+//! TRANSFORMATION` whose `ITEM_DEFINED_TRANSFORMATION` maps the placement `item_1` (in
+//! `rep_1`) onto `item_2` (in `rep_2`): `x_2 = F(item_2) F(item_1)^-1 x_1`, `F` a placement's
+//! frame as a rigid map (`x -> O + R x`). A relationship without a transformation (a part's
+//! shape representation and its B-rep's) joins two representations in one frame. A
+//! representation's placements are the products along every chain of relationships up to a
+//! representation that is placed in no other: one per instance of the part (a part used twice
+//! has two).
+
+use std::collections::{HashMap, HashSet};
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::error::Result;
+use crate::model::{err, refs, Frame, Model};
+use crate::parser::Value;
+
+/// The most instances of one representation an import takes (the product of the counts along a
+/// chain: a hostile file of ten levels of ten instances asks for ten billion).
+pub(crate) const MAX_INSTANCES: usize = 10_000;
+
+/// The deepest chain of placements (assemblies of assemblies) read.
+pub(crate) const MAX_DEPTH: usize = 64;
+
+/// A rigid map `x -> r x + t`, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Rigid {
+    pub(crate) r: Matrix3<f64>,
+    pub(crate) t: Vector3<f64>,
+}
+
+impl Rigid {
+    fn identity() -> Self {
+        Self {
+            r: Matrix3::identity(),
+            t: Vector3::zeros(),
+        }
+    }
+
+    fn of(f: &Frame) -> Self {
+        Self {
+            r: Matrix3::from_columns(&[f.x, f.y, f.z]),
+            t: f.origin.coords,
+        }
+    }
+
+    fn inverse(&self) -> Self {
+        let rt = self.r.transpose();
+        Self {
+            r: rt,
+            t: -(rt * self.t),
+        }
+    }
+
+    /// `self` after `inner`.
+    fn after(&self, inner: &Rigid) -> Self {
+        Self {
+            r: self.r * inner.r,
+            t: self.r * inner.t + self.t,
+        }
+    }
+
+    /// Whether the map moves nothing (to rounding: 1e-12 in rotation, 1e-9 mm).
+    pub(crate) fn is_identity(&self) -> bool {
+        (self.r - Matrix3::identity()).abs().max() <= 1e-12 && self.t.norm() <= 1e-9
+    }
+}
+
+/// Each face's and each geometric set's placements in the root frame, one per instance; an
+/// entity absent from both maps lies where its coordinates put it (once).
+#[derive(Debug, Default)]
+pub(crate) struct Placements {
+    pub(crate) faces: HashMap<u64, Vec<Rigid>>,
+    pub(crate) sets: HashMap<u64, Vec<Rigid>>,
+}
+
+fn root(parent: &mut HashMap<u64, u64>, a: u64) -> u64 {
+    let mut a = a;
+    while let Some(&p) = parent.get(&a) {
+        if p == a {
+            break;
+        }
+        let g = parent.get(&p).copied().unwrap_or(p);
+        parent.insert(a, g);
+        a = p;
+    }
+    a
+}
+
+/// The placements of the file's faces and sets (see the module).
+///
+/// # Errors
+/// A transformation that is not an `ITEM_DEFINED_TRANSFORMATION` between two placements, a cycle
+/// of placements, chains deeper than [`MAX_DEPTH`], more than [`MAX_INSTANCES`] instances of
+/// one representation.
+pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
+    // Representations in one frame (union-find) and the placements between frames.
+    let mut parent: HashMap<u64, u64> = HashMap::new();
+    let mut placed: Vec<(u64, u64, Rigid)> = Vec::new(); // (child rep, parent rep, map)
+    for inst in m.all("REPRESENTATION_RELATIONSHIP")? {
+        let p = m.rec(&inst, "REPRESENTATION_RELATIONSHIP")?;
+        let (Some(Value::Ref(r1)), Some(Value::Ref(r2))) = (p.get(2), p.get(3)) else {
+            return Err(err(&inst, "rep_1 and rep_2 must be references"));
+        };
+        match inst.record("REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION") {
+            None => {
+                let (a, b) = (root(&mut parent, *r1), root(&mut parent, *r2));
+                if a != b {
+                    parent.insert(a.max(b), a.min(b));
+                }
+            }
+            Some(t) => {
+                let op = m.param_ref(&inst, t, 0)?;
+                let Some(it) = op.record("ITEM_DEFINED_TRANSFORMATION") else {
+                    return Err(err(
+                        &op,
+                        "a placement that is not an ITEM_DEFINED_TRANSFORMATION (a transformation operator may scale or mirror): not read",
+                    ));
+                };
+                let f1 = m.placement(&m.param_ref(&op, it, 2)?)?;
+                let f2 = m.placement(&m.param_ref(&op, it, 3)?)?;
+                placed.push((*r1, *r2, Rigid::of(&f2).after(&Rigid::of(&f1).inverse())));
+            }
+        }
+    }
+    if placed.is_empty() {
+        return Ok(Placements::default());
+    }
+    // Edges between frames (classes).
+    let mut up: HashMap<u64, Vec<(u64, Rigid)>> = HashMap::new();
+    for (c, p, t) in &placed {
+        let (c, p) = (root(&mut parent, *c), root(&mut parent, *p));
+        up.entry(c).or_default().push((p, *t));
+    }
+    // Each class's placements in the root frame, memoized; a class on the current chain again
+    // is a cycle.
+    fn place(
+        c: u64,
+        up: &HashMap<u64, Vec<(u64, Rigid)>>,
+        memo: &mut HashMap<u64, Vec<Rigid>>,
+        chain: &mut Vec<u64>,
+    ) -> std::result::Result<Vec<Rigid>, String> {
+        if let Some(v) = memo.get(&c) {
+            return Ok(v.clone());
+        }
+        if chain.contains(&c) {
+            return Err(format!(
+                "representation #{c} is placed in itself (a cycle of placements)"
+            ));
+        }
+        if chain.len() >= MAX_DEPTH {
+            return Err(format!(
+                "assemblies nest more than {MAX_DEPTH} deep at representation #{c}"
+            ));
+        }
+        let out = match up.get(&c) {
+            None => vec![Rigid::identity()],
+            Some(edges) => {
+                chain.push(c);
+                let mut out = Vec::new();
+                for (p, t) in edges {
+                    for q in place(*p, up, memo, chain)? {
+                        out.push(q.after(t));
+                        if out.len() > MAX_INSTANCES {
+                            return Err(format!(
+                                "representation #{c} has more than {MAX_INSTANCES} instances"
+                            ));
+                        }
+                    }
+                }
+                chain.pop();
+                out
+            }
+        };
+        memo.insert(c, out.clone());
+        Ok(out)
+    }
+    let mut memo = HashMap::new();
+    let mut class_places: HashMap<u64, Vec<Rigid>> = HashMap::new();
+    let reps: HashSet<u64> = placed
+        .iter()
+        .flat_map(|(c, p, _)| [*c, *p])
+        .chain(parent.keys().copied())
+        .collect();
+    for &r in &reps {
+        let c = root(&mut parent, r);
+        let v = place(c, &up, &mut memo, &mut Vec::new()).map_err(|why| {
+            crate::error::StepError::Entity {
+                id: r,
+                name: "REPRESENTATION".into(),
+                message: why,
+            }
+        })?;
+        class_places.insert(r, v);
+    }
+    // The faces and sets each placed representation holds: its items, followed through the
+    // references down to faces and sets (each instance visited once).
+    let mut out = Placements::default();
+    let mut seen: HashSet<u64> = HashSet::new();
+    let mut ids: Vec<u64> = reps.into_iter().collect();
+    ids.sort_unstable();
+    for r in ids {
+        let v = &class_places[&r];
+        if v.len() == 1 && v[0].is_identity() {
+            continue;
+        }
+        let Some(rep) = m.ex.get(r)? else { continue };
+        let Some((_, params)) = rep.records.first() else {
+            continue;
+        };
+        let mut stack: Vec<u64> = refs(&rep, params.get(1), "items").unwrap_or_default();
+        while let Some(id) = stack.pop() {
+            if !seen.insert(id) {
+                continue;
+            }
+            let Some(inst) = m.ex.get(id)? else { continue };
+            if inst.is("ADVANCED_FACE") || inst.is("FACE_SURFACE") {
+                out.faces.insert(id, v.clone());
+                continue;
+            }
+            if inst.is("GEOMETRIC_SET") || inst.is("GEOMETRIC_CURVE_SET") {
+                out.sets.insert(id, v.clone());
+                continue;
+            }
+            // Down through solids, shells and models to their faces; not into geometry.
+            let through = [
+                "MANIFOLD_SOLID_BREP",
+                "BREP_WITH_VOIDS",
+                "CLOSED_SHELL",
+                "OPEN_SHELL",
+                "ORIENTED_CLOSED_SHELL",
+                "SHELL_BASED_SURFACE_MODEL",
+                "FACE_BASED_SURFACE_MODEL",
+                "CONNECTED_FACE_SET",
+                "ORIENTED_FACE",
+            ];
+            if through.iter().any(|n| inst.is(n)) {
+                for (_, ps) in &inst.records {
+                    collect_refs(ps, &mut stack);
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn collect_refs(v: &[Value], out: &mut Vec<u64>) {
+    for x in v {
+        match x {
+            Value::Ref(id) => out.push(*id),
+            Value::List(l) => collect_refs(l, out),
+            _ => {}
+        }
+    }
+}
+
+/// `x -> r x + t` on a point.
+pub(crate) fn point(m: &Rigid, p: &nalgebra::Point3<f64>) -> nalgebra::Point3<f64> {
+    nalgebra::Point3::from(m.r * p.coords + m.t)
+}

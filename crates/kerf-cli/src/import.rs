@@ -130,7 +130,7 @@ pub(crate) fn load_step(path: &Path, a: &StepArgs) -> Result<(CurvesFile, Import
     } else {
         kerf_step::import_file(path, &opts).map_err(|e| CliError::Input(e.to_string()))?
     };
-    let file = curves::from_raw(import.file.clone(), Path::new(".")).map_err(|e| {
+    let file = import.to_curves().map_err(|e| {
         CliError::Input(format!(
             "{}: the import is not valid kerf.curves/1: {e}",
             path.display()

@@ -484,12 +484,11 @@ impl Job {
         import: kerf_step::Import,
         machine: Machine,
     ) -> Result<(Self, kerf_step::Report)> {
-        let file =
-            kerf_format::curves::from_raw(import.file, Path::new(".")).map_err(|source| {
-                crate::Error::StepDocument {
-                    file: path.to_path_buf(),
-                    source,
-                }
+        let file = import
+            .to_curves()
+            .map_err(|source| crate::Error::StepDocument {
+                file: path.to_path_buf(),
+                source,
             })?;
         let job = Self::new(file, machine)
             .with_source(path)

@@ -6,7 +6,9 @@ use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::error::Result;
-use crate::model::{boolean, err, int, list, real, reals, refs, Charge, Frame, Model};
+use crate::model::{
+    boolean, err, geometry_err, int, list, real, reals, refs, Charge, Frame, Model,
+};
 use crate::parser::{Instance, Value};
 
 /// A STEP curve before trimming: what it is and how to cut a piece of it.
@@ -89,7 +91,7 @@ impl Basis {
                     return Err(err(inst, "zero-length line piece"));
                 }
                 NurbsCurve::try_new(1, vec![0.0, 0.0, len, len], vec![a, b], None)
-                    .map_err(|e| err(inst, e.to_string()))
+                    .map_err(|e| geometry_err(inst, e))
             }
             Basis::Conic { frame, rx, ry } => Ok(conic_arc(frame, *rx, *ry, t1, t2)),
             Basis::Nurbs(c) => {
@@ -174,7 +176,7 @@ fn basis_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<Basis> {
         knots.push((n - 1) as f64);
         return NurbsCurve::try_new(1, knots, pts, None)
             .map(Basis::Nurbs)
-            .map_err(|e| err(inst, e.to_string()));
+            .map_err(|e| geometry_err(inst, e));
     }
     if inst.is("B_SPLINE_CURVE_WITH_KNOTS") || inst.is("BEZIER_CURVE") {
         return bspline(m, inst).map(Basis::Nurbs);
@@ -238,8 +240,7 @@ fn bspline(m: &Model<'_>, inst: &Instance) -> Result<NurbsCurve> {
         Some(r) => Some(reals(inst, r.first(), "weights_data")?),
         None => None,
     };
-    let c =
-        NurbsCurve::try_new(degree, knots, pts, weights).map_err(|e| err(inst, e.to_string()))?;
+    let c = NurbsCurve::try_new(degree, knots, pts, weights).map_err(|e| geometry_err(inst, e))?;
     clamp(&c).map_err(|e| err(inst, format!("cannot clamp: {e}")))
 }
 

@@ -43,6 +43,19 @@ pub enum StepError {
         /// The defect.
         message: String,
     },
+    /// An entity's numbers do not make a valid curve or surface (knots out of order, a weight
+    /// that is not positive, too few control points for the degree); the evaluator's error is
+    /// the source. Fix: repair the entity named in the CAD system.
+    #[error("#{id} {name}: {source}")]
+    Geometry {
+        /// The `#id`.
+        id: u64,
+        /// The entity name.
+        name: String,
+        /// What the evaluator refused (boxed: it is larger than every other variant).
+        #[source]
+        source: Box<kerf_nurbs::NurbsError>,
+    },
     /// The file holds no contour kerf can cut: no curve in a geometric set or wireframe model
     /// (and, with `--edges`, no face with a boundary loop). Fix: export the cut lines as a
     /// geometric set / wireframe, or use `--edges` to cut the boundary loops of faces.

@@ -157,6 +157,20 @@ pub struct Import {
     pub report: Report,
 }
 
+impl Import {
+    /// The document as kerf's typed, checked curves file (`kerf_format::curves::from_raw`:
+    /// every curve and surface built and validated), what a job runs on.
+    ///
+    /// # Errors
+    /// The format's error where the document fails its checks (a reader defect: the readers
+    /// write only valid documents, which their tests and fuzz targets hold them to).
+    pub fn to_curves(
+        &self,
+    ) -> std::result::Result<kerf_format::CurvesFile, kerf_format::FormatError> {
+        kerf_format::curves::from_raw(self.file.clone(), Path::new("."))
+    }
+}
+
 /// The account of an import.
 #[derive(Debug, Clone, Default)]
 pub struct Report {

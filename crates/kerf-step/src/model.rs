@@ -123,6 +123,15 @@ pub(crate) struct Model<'a> {
 }
 
 /// Builds the error of an entity.
+/// The evaluator's refusal of an entity's numbers, keeping it as the source.
+pub(crate) fn geometry_err(inst: &Instance, source: kerf_nurbs::NurbsError) -> StepError {
+    StepError::Geometry {
+        id: inst.id,
+        name: clip(&inst.name()),
+        source: Box::new(source),
+    }
+}
+
 pub(crate) fn err(inst: &Instance, message: impl Into<String>) -> StepError {
     StepError::Entity {
         id: inst.id,

@@ -12,7 +12,9 @@ use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::curves::{arc_homogeneous, basis, expand_knots, sub_curve, Basis};
 use crate::error::Result;
-use crate::model::{boolean, err, int, list, real, reals, refs, Charge, Frame, Model};
+use crate::model::{
+    boolean, err, geometry_err, int, list, real, reals, refs, Charge, Frame, Model,
+};
 use crate::parser::{Instance, Value};
 
 /// A surface with its natural parametrization (the one Open CASCADE gives it, so that
@@ -606,7 +608,7 @@ fn bspline_surface(m: &Model<'_>, inst: &Instance) -> Result<NurbsSurface> {
         }
         None => None,
     };
-    NurbsSurface::try_new(du, dv, ku, kv, net, weights).map_err(|e| err(inst, e.to_string()))
+    NurbsSurface::try_new(du, dv, ku, kv, net, weights).map_err(|e| geometry_err(inst, e))
 }
 
 /// The smallest interval covering the angles `a` (any values) on the circle: the complement

@@ -8,7 +8,8 @@
 //! shape representation and its B-rep's) joins two representations in one frame. A
 //! representation's placements are the products along every chain of relationships up to a
 //! representation that is placed in no other: one per instance of the part (a part used twice
-//! has two).
+//! has two). A `MAPPED_ITEM` among a representation's items places its `REPRESENTATION_MAP`'s
+//! representation into that one the same way, from `mapping_origin` onto `mapping_target`.
 
 use std::collections::{HashMap, HashSet};
 
@@ -21,6 +22,19 @@ use crate::parser::Value;
 /// The most instances of one representation an import takes (the product of the counts along a
 /// chain: a hostile file of ten levels of ten instances asks for ten billion).
 pub(crate) const MAX_INSTANCES: usize = 10_000;
+
+/// The representation entities whose items a mapped item may be among.
+const REPRESENTATION_KINDS: [&str; 9] = [
+    "SHAPE_REPRESENTATION",
+    "ADVANCED_BREP_SHAPE_REPRESENTATION",
+    "MANIFOLD_SURFACE_SHAPE_REPRESENTATION",
+    "GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION",
+    "GEOMETRICALLY_BOUNDED_SURFACE_SHAPE_REPRESENTATION",
+    "FACETED_BREP_SHAPE_REPRESENTATION",
+    "EDGE_BASED_WIREFRAME_SHAPE_REPRESENTATION",
+    "SHELL_BASED_WIREFRAME_SHAPE_REPRESENTATION",
+    "REPRESENTATION",
+];
 
 /// The deepest chain of placements (assemblies of assemblies) read.
 pub(crate) const MAX_DEPTH: usize = 64;
@@ -124,6 +138,64 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
                 let f2 = m.placement(&m.param_ref(&op, it, 3)?)?;
                 placed.push((*r1, *r2, Rigid::of(&f2).after(&Rigid::of(&f1).inverse())));
             }
+        }
+    }
+    // Mapped items: a MAPPED_ITEM in a representation's items places the items of its
+    // REPRESENTATION_MAP's representation from `mapping_origin` at `mapping_target`.
+    let mapped = m.all("MAPPED_ITEM")?;
+    if !mapped.is_empty() {
+        // Which representation holds each mapped item.
+        let mut holder: HashMap<u64, u64> = HashMap::new();
+        for kind in REPRESENTATION_KINDS {
+            for rep in m.all(kind)? {
+                let Some(params) = rep.record(kind) else {
+                    continue;
+                };
+                for id in refs(&rep, params.get(1), "items").unwrap_or_default() {
+                    holder.entry(id).or_insert(rep.id);
+                }
+            }
+        }
+        for inst in &mapped {
+            let p = m.rec(inst, "MAPPED_ITEM")?;
+            let map = m.param_ref(inst, p, 1)?;
+            let mp = m.rec(&map, "REPRESENTATION_MAP")?;
+            let origin = m.param_ref(&map, mp, 0)?;
+            let Some(Value::Ref(source)) = mp.get(1) else {
+                return Err(err(&map, "mapped_representation must be a reference"));
+            };
+            let target = m.param_ref(inst, p, 2)?;
+            let is_placement = |i: &crate::parser::Instance| {
+                i.record("AXIS2_PLACEMENT_3D").is_some() || i.record("AXIS2_PLACEMENT_2D").is_some()
+            };
+            if !is_placement(&origin) || !is_placement(&target) {
+                return Err(err(
+                    inst,
+                    format!(
+                        "places the items of #{} from #{} {} at #{} {}: only a placement onto a placement is read (a transformation operator may scale or mirror)",
+                        map.id,
+                        origin.id,
+                        origin.name(),
+                        target.id,
+                        target.name()
+                    ),
+                ));
+            }
+            let t = Rigid::of(&m.placement(&target)?)
+                .after(&Rigid::of(&m.placement(&origin)?).inverse());
+            let Some(&parent_rep) = holder.get(&inst.id) else {
+                if t.is_identity() {
+                    continue; // in place: nothing moves
+                }
+                return Err(err(
+                    inst,
+                    format!(
+                        "places the items of #{} from #{} at #{}, but no representation holds it: where they go is not defined (export the part alone, or as one body in its place)",
+                        map.id, origin.id, target.id
+                    ),
+                ));
+            };
+            placed.push((*source, parent_rep, t));
         }
     }
     if placed.is_empty() {

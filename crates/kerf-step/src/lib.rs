@@ -278,7 +278,6 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         units: m.units,
         ..Report::default()
     };
-    check_no_placed_parts(&m)?;
     report.warnings = m.warnings.clone();
     let only = if opts.edges && !opts.all_faces {
         opts.faces.as_deref()
@@ -532,51 +531,4 @@ fn place_faces(
         }
     }
     out
-}
-
-/// True if two placements are one frame (to rounding): a transformation between them is the
-/// identity.
-fn same_frame(a: &model::Frame, b: &model::Frame) -> bool {
-    (a.origin - b.origin).norm() <= 1e-9 * (1.0 + a.origin.coords.norm())
-        && (a.x - b.x).norm() <= 1e-12
-        && (a.z - b.z).norm() <= 1e-12
-}
-
-/// Mapped items (`MAPPED_ITEM`, the other way to place a part) are not applied: refuse a file
-/// that places a part that way anywhere but where its own coordinates put it, rather than write
-/// its geometry in the wrong place. (Placements by representation relationships are applied,
-/// `assembly.rs`.)
-fn check_no_placed_parts(m: &Model<'_>) -> Result<()> {
-    // The other form: a MAPPED_ITEM places a REPRESENTATION_MAP's items from its origin
-    // (`mapping_origin`) at `mapping_target`; a CARTESIAN_TRANSFORMATION_OPERATOR target may
-    // also scale or mirror, and is refused whatever it holds.
-    for inst in m.all("MAPPED_ITEM")? {
-        let inst = &inst;
-        let p = m.rec(inst, "MAPPED_ITEM")?;
-        let map = &m.param_ref(inst, p, 1)?;
-        let mp = m.rec(map, "REPRESENTATION_MAP")?;
-        let origin = &m.param_ref(map, mp, 0)?;
-        let target = &m.param_ref(inst, p, 2)?;
-        let placed = |i: &parser::Instance| {
-            i.record("AXIS2_PLACEMENT_3D").is_some() || i.record("AXIS2_PLACEMENT_2D").is_some()
-        };
-        let same = placed(origin)
-            && placed(target)
-            && same_frame(&m.placement(origin)?, &m.placement(target)?);
-        if !same {
-            return Err(model::err(
-                inst,
-                format!(
-                    "places the items of #{} from #{} at #{} {}: mapped (instanced) parts are \
-                     not supported unless in place (export the part alone, or as one body in \
-                     its place)",
-                    map.id,
-                    origin.id,
-                    target.id,
-                    target.name()
-                ),
-            ));
-        }
-    }
-    Ok(())
 }

@@ -655,22 +655,36 @@ fn sheet_features_have_the_scrap_where_the_material_is_not() {
 }
 
 #[test]
-fn a_mapped_item_placed_elsewhere_is_refused_not_read_unplaced() {
-    // A MAPPED_ITEM placing a geometric set's circle 500 mm away was read where the map's own
-    // coordinates put it (exit 0, the contour 500 mm off). Refused, naming the item; in place
-    // (the same frame as origin and target) it is read.
+fn a_mapped_item_places_its_representation_where_its_holder_says() {
+    // A MAPPED_ITEM placing a geometric set's circle 500 mm away (from #3 at the origin onto
+    // #4 at (500, 0, 0)), held by the shape representation #12: the circle is cut about
+    // (500, 0, 0).
     let body = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=CARTESIAN_POINT('',(500.,0.,0.));\n\
         #3=AXIS2_PLACEMENT_3D('',#1,$,$);\n#4=AXIS2_PLACEMENT_3D('',#2,$,$);\n\
         #6=CIRCLE('',#3,5.);\n#7=GEOMETRIC_CURVE_SET('',(#6));\n\
         #8=GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION('',(#7),$);\n\
-        #9=REPRESENTATION_MAP(#3,#8);\n#10=MAPPED_ITEM('',#9,#4);\n";
-    let e = import(&step(body), &ImportOptions::default()).unwrap_err();
+        #9=REPRESENTATION_MAP(#3,#8);\n#10=MAPPED_ITEM('',#9,#4);\n\
+        #12=SHAPE_REPRESENTATION('',(#10,#3),$);\n";
+    let im = import(&step(body), &ImportOptions::default()).expect("placed");
+    let c = curve(&im.file.curves[0]);
     assert!(
-        e.to_string()
-            .starts_with("#10 MAPPED_ITEM: places the items of #9 from #3 at #4"),
+        samples(&c, 16)
+            .iter()
+            .all(|p| ((p - Point3::new(500.0, 0.0, 0.0)).norm() - 5.0).abs() < 1e-9),
+        "the circle where the mapped item puts it"
+    );
+    // Held by no representation, it says where nothing goes: refused, naming the item (it
+    // was once read where the map's own coordinates put it, 500 mm off).
+    let loose = body.replace("#12=SHAPE_REPRESENTATION('',(#10,#3),$);\n", "");
+    let e = import(&step(&loose), &ImportOptions::default()).unwrap_err();
+    assert!(
+        e.to_string().starts_with(
+            "#10 MAPPED_ITEM: places the items of #9 from #3 at #4, but no representation holds it"
+        ),
         "{e}"
     );
-    let same = body.replace("#10=MAPPED_ITEM('',#9,#4)", "#10=MAPPED_ITEM('',#9,#3)");
+    // In place (the same frame as origin and target) it is read where it is.
+    let same = loose.replace("#10=MAPPED_ITEM('',#9,#4)", "#10=MAPPED_ITEM('',#9,#3)");
     let im = import(&step(&same), &ImportOptions::default()).expect("in place");
     let c = curve(&im.file.curves[0]);
     assert!(

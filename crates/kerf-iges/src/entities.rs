@@ -120,10 +120,11 @@ impl Affine {
     }
 
     /// The same curve moved by the map (exact: an affine map of a NURBS curve is the curve of
-    /// the mapped control points with the same weights).
-    pub(crate) fn curve(&self, c: &NurbsCurve) -> NurbsCurve {
+    /// the mapped control points with the same weights); the evaluator's refusal where the
+    /// moved points are not finite (a matrix of 1e300).
+    pub(crate) fn curve(&self, c: &NurbsCurve) -> std::result::Result<NurbsCurve, String> {
         if self.is_identity() {
-            return c.clone();
+            return Ok(c.clone());
         }
         let pts: Vec<Point3<f64>> = c.control_points().iter().map(|p| self.point(p)).collect();
         NurbsCurve::try_new(
@@ -132,7 +133,7 @@ impl Affine {
             pts,
             c.is_rational().then(|| c.weights()),
         )
-        .unwrap_or_else(|_| c.clone())
+        .map_err(|x| format!("moved by its matrices and units: {x}"))
     }
 
     fn surface(&self, s: &NurbsSurface) -> std::result::Result<NurbsSurface, String> {
@@ -239,13 +240,24 @@ impl<'a> Reader<'a> {
         ))
     }
 
-    /// A curve entity as its segments in model space (mm), each with its entity's name.
-    pub(crate) fn curve(&self, e: &Entry) -> Result<Vec<(NurbsCurve, String)>> {
-        let segs = self.curve_at(e, 0)?;
-        Ok(segs
+    /// A curve entity as its segments in model space (mm), each with its entity's name; the
+    /// matrices of the entities that hold it (`within`, innermost first: a 142's, then its
+    /// 144's) applied after its own.
+    pub(crate) fn curve(&self, e: &Entry, within: &[&Entry]) -> Result<Vec<(NurbsCurve, String)>> {
+        let t = self.outer(within)?;
+        self.curve_at(e, 0)?
             .into_iter()
-            .map(|(c, n)| (self.to_mm.curve(&c), n))
-            .collect())
+            .map(|(c, n)| Ok((t.curve(&c).map_err(|x| err(e, x))?, n)))
+            .collect()
+    }
+
+    /// `to_mm` after the matrices of `within` (innermost first).
+    fn outer(&self, within: &[&Entry]) -> Result<Affine> {
+        let mut t = Affine::identity();
+        for w in within {
+            t = self.transform(w)?.after(&t);
+        }
+        Ok(self.to_mm.after(&t))
     }
 
     /// A curve entity as one curve in the space of whoever refers to it (its own matrix
@@ -315,7 +327,10 @@ impl<'a> Reader<'a> {
             }
         };
         let t = self.transform(e)?;
-        Ok(local.into_iter().map(|(c, n)| (t.curve(&c), n)).collect())
+        local
+            .into_iter()
+            .map(|(c, n)| Ok((t.curve(&c).map_err(|x| err(e, x))?, n)))
+            .collect()
     }
 
     /// 100: counter-clockwise in the plane `z = ZT` from the start to the end point about
@@ -413,7 +428,7 @@ impl<'a> Reader<'a> {
             r: Matrix3::from_columns(&[ax * rx, ay * ry, Vector3::z()]),
             t: centre.coords,
         };
-        Ok(stretch.curve(&unit))
+        stretch.curve(&unit).map_err(|x| err(e, x))
     }
 
     /// 106 forms 11, 12, 13 (open) and 63 (closed): the points as a polyline.
@@ -479,8 +494,13 @@ impl<'a> Reader<'a> {
 
     /// A surface entity as kerf's geometry in model space (mm), with its natural parameter
     /// box where it has one (not a plane): the boundary of an untrimmed surface.
-    pub(crate) fn surface(&self, e: &Entry) -> Result<(Geometry, Option<ParamBox>)> {
-        let t = self.to_mm.after(&self.transform(e)?);
+    /// `within`: the entities that hold it, whose matrices apply after its own (a 144's).
+    pub(crate) fn surface(
+        &self,
+        e: &Entry,
+        within: &[&Entry],
+    ) -> Result<(Geometry, Option<ParamBox>)> {
+        let t = self.outer(within)?.after(&self.transform(e)?);
         match e.ty {
             128 => {
                 let s = t.surface(&self.bspline_surface(e)?).map_err(|x| err(e, x))?;
@@ -508,9 +528,13 @@ impl<'a> Reader<'a> {
                 if axis_e.ty != 110 {
                     return Err(err(e, format!("its axis D{} is not a line (110)", axis_e.de)));
                 }
-                let axis_c = t.curve(&self.one_curve(e, axis_e, "axis")?);
+                let axis_c = t
+                    .curve(&self.one_curve(e, axis_e, "axis")?)
+                    .map_err(|x| err(e, x))?;
                 let gen = self.get(e, int(e, 1, "generatrix")?, "its generatrix")?;
-                let profile = t.curve(&self.one_curve(e, gen, "generatrix")?);
+                let profile = t
+                    .curve(&self.one_curve(e, gen, "generatrix")?)
+                    .map_err(|x| err(e, x))?;
                 let ends = axis_c.control_points();
                 let (p0, p1) = (ends[0], ends[ends.len() - 1]);
                 let mut axis = p1 - p0;
@@ -540,7 +564,7 @@ impl<'a> Reader<'a> {
                 if !(len > 0.0) {
                     return Err(err(e, "its generatrix has zero length".into()));
                 }
-                let c = t.curve(&c);
+                let c = t.curve(&c).map_err(|x| err(e, x))?;
                 let u = c.domain();
                 Ok((Geometry::Extrusion(c, d / len), Some((u, (0.0, len)))))
             }

@@ -228,7 +228,12 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
     let mut used: HashSet<usize> = HashSet::new();
     for e in &iges.entries {
         let refs: Vec<usize> = match e.ty {
-            102 => (1..e.params.len()).collect(),
+            // N, then N segment pointers (optional associativity and property pointers may
+            // follow: not entities this one is made of).
+            102 => {
+                let n = int(e, 0, "N").unwrap_or(0).clamp(0, e.params.len() as i64) as usize;
+                (1..=n).collect()
+            }
             120 => vec![0, 1],
             122 => vec![0],
             142 => vec![1, 2, 3],
@@ -239,7 +244,32 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
                 v
             }
             108 => vec![4],
-            141 | 143 => (0..e.params.len()).collect(),
+            190 => vec![0, 1, 2],
+            // TYPE, SPTR, N, then N boundary pointers.
+            143 => {
+                let n = int(e, 2, "N").unwrap_or(0).clamp(0, e.params.len() as i64) as usize;
+                let mut v = vec![1];
+                v.extend(3..3 + n);
+                v
+            }
+            // TYPE, PREF, SPTR, N, then per curve: CRVPT, SENSE, K, K parameter-space curves.
+            141 => {
+                let mut v = vec![2];
+                let n = int(e, 3, "N").unwrap_or(0).clamp(0, e.params.len() as i64) as usize;
+                let mut i = 4;
+                for _ in 0..n {
+                    if i + 2 >= e.params.len() {
+                        break;
+                    }
+                    v.push(i);
+                    let k = int(e, i + 2, "K")
+                        .unwrap_or(0)
+                        .clamp(0, e.params.len() as i64) as usize;
+                    v.extend(i + 3..(i + 3 + k).min(e.params.len()));
+                    i += 3 + k;
+                }
+                v
+            }
             _ => Vec::new(),
         };
         for i in refs {
@@ -409,7 +439,7 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
                 ));
                 continue;
             }
-            let segs = match reader.curve(e) {
+            let segs = match reader.curve(e, &[]) {
                 Ok(s) => s,
                 Err(x @ IgesError::Budget { .. }) => return Err(x),
                 Err(x) => {
@@ -531,7 +561,8 @@ fn not_a_sheet(why: &str) -> kerf_step::SheetReport {
 /// A 144: its surface and its boundary loops (the 142s' model-space curves).
 fn trimmed_outline<'e>(reader: &Reader<'e>, e: &'e Entry) -> Result<Pending<'e>> {
     let s = reader.get(e, int(e, 0, "surface")?, "its surface")?;
-    let (g, natural) = reader.surface(s)?;
+    // The 144's own matrix moves its surface and its boundaries (as Open CASCADE reads it).
+    let (g, natural) = reader.surface(s, &[e])?;
     let n1 = int(e, 1, "N1")?;
     let n2 = int(e, 2, "N2")?;
     let n2 = usize::try_from(n2)
@@ -576,7 +607,7 @@ fn trimmed_outline<'e>(reader: &Reader<'e>, e: &'e Entry) -> Result<Pending<'e>>
 
 /// An untrimmed surface, bounded by its parameter box.
 fn untrimmed_outline<'e>(reader: &Reader<'e>, e: &'e Entry) -> Result<Pending<'e>> {
-    let (g, natural) = reader.surface(e)?;
+    let (g, natural) = reader.surface(e, &[])?;
     let Some(b) = natural else {
         return Err(err(e, "an unbounded plane has no boundary to cut".into()));
     };
@@ -673,8 +704,9 @@ fn boundary(
         ));
     }
     let ce = reader.get(b, c, "its model-space curve")?;
+    // The curve's matrices, then the 142's, then the face's.
     let segs = reader
-        .curve(ce)
+        .curve(ce, &[b, face])
         .map_err(|x| err(face, format!("{what} D{}: {x}", b.de)))?;
     let ids = segs
         .iter()

@@ -181,7 +181,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
                 ),
             ));
         }
-        let count = field(b, 3, l2)?;
+
         let form = field(b, 4, l2)?;
         let label = String::from_utf8_lossy(&b[56..64]).trim().to_owned();
         let subscript = field(b, 8, l2)?;
@@ -200,7 +200,8 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
                 ));
             }
             // The parameter lines are those from `pointer` on that point back at this entry
-            // (columns 65-72), up to the record delimiter. Every line names one entry, so each
+            // (columns 65-72), whatever the directory's line count says; the fields end at the
+            // first record delimiter outside a string. Every line names one entry, so each
             // line is read once however the directory points: a file whose entries all point
             // at one long parameter block costs that block once, not once per entry.
             let mut text = Vec::new();
@@ -222,9 +223,6 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
                 }
                 text.extend_from_slice(&line[..64]);
                 n += 1;
-                if line[..64].contains(&rdelim) && n >= count.max(1) as usize {
-                    break;
-                }
             }
             let line = p[start].0;
             let mut t = tokens(&text, pdelim, rdelim)

@@ -659,3 +659,90 @@ fn an_edge_two_chosen_faces_share_is_cut_once() {
         imp.report.skipped
     );
 }
+
+#[test]
+fn a_trimmed_surfaces_matrix_moves_it_and_its_boundary() {
+    // A 10 x 10 square patch (128) trimmed by four lines (142 over a 102), the 144 moved by
+    // +100 in x by its own matrix: the face and its loop are cut at x = 100..110.
+    let dep = "00010000";
+    let patch = "1,1,1,1,0,0,1,0,0,0.,0.,1.,1.,0.,0.,1.,1.,1.,1.,1.,1.,0.,0.,0.,10.,0.,0.,0.,10.,0.,10.,10.,0.,0.,1.,0.,1.";
+    let imp = import(
+        iges_text(
+            "2",
+            &[
+                (128, 0, 0, dep, "", patch),
+                (110, 0, 0, dep, "", "0.,0.,0.,10.,0.,0."),
+                (110, 0, 0, dep, "", "10.,0.,0.,10.,10.,0."),
+                (110, 0, 0, dep, "", "10.,10.,0.,0.,10.,0."),
+                (110, 0, 0, dep, "", "0.,10.,0.,0.,0.,0."),
+                (102, 0, 0, dep, "", "4,3,5,7,9"),
+                (142, 0, 0, dep, "", "0,1,0,11,2"),
+                (144, 0, 17, FREE, "", "1,1,0,13"),
+                (124, 0, 0, dep, "", "1.,0.,0.,100.,0.,1.,0.,0.,0.,0.,1.,0."),
+            ],
+        )
+        .as_bytes(),
+        &ImportOptions::default().with_edges(None),
+    )
+    .expect("imports");
+    let c = curve(by_id(&imp.file, "face D15 loop 1"));
+    for p in samples(&c, 40) {
+        assert!(
+            (100.0 - 1e-12..=110.0 + 1e-12).contains(&p.x),
+            "loop point {p}"
+        );
+    }
+    let s = surface(surface_of(&imp.file, by_id(&imp.file, "face D15 loop 1")));
+    let (lo, hi) = s.bounding_box();
+    assert!(
+        (lo.x - 100.0).abs() < 1e-12 && (hi.x - 110.0).abs() < 1e-12,
+        "{lo} {hi}"
+    );
+}
+
+#[test]
+fn trailing_pointers_strings_and_huge_matrices() {
+    // A composite whose parameters end with one property pointer (to the 406 at D5): the free
+    // line D1 is not taken for one of its segments. The 406's string holds the record
+    // delimiter and runs over two parameter lines.
+    let long = format!("1,70H{};{}", "a".repeat(30), "b".repeat(39));
+    let imp = read(
+        "2",
+        &[
+            (110, 0, 0, FREE, "LINE", "0.,0.,0.,1.,0.,0."),
+            (102, 0, 0, FREE, "COMP", "2,7,9,0,1,5"),
+            (406, 15, 0, FREE, "", &long),
+            (110, 0, 0, "00010000", "", "5.,0.,0.,6.,0.,0."),
+            (110, 0, 0, "00010000", "", "6.,0.,0.,6.,1.,0."),
+        ],
+    )
+    .expect("imports");
+    let ids: Vec<&str> = imp.file.curves.iter().map(|c| c.id.as_str()).collect();
+    assert_eq!(ids, vec!["LINE D1", "COMP D3"], "{:?}", imp.report.skipped);
+    // A matrix that moves a line out of range: refused by name, not left where it was.
+    let imp = read(
+        "2",
+        &[
+            (110, 0, 3, FREE, "", "0.,0.,0.,1.E10,0.,0."),
+            (
+                124,
+                0,
+                0,
+                "00010000",
+                "",
+                "1.E300,0.,0.,0.,0.,1.E300,0.,0.,0.,0.,1.E300,0.",
+            ),
+            (110, 0, 0, FREE, "", "0.,0.,0.,1.,0.,0."),
+        ],
+    )
+    .expect("the good line");
+    assert_eq!(imp.file.curves.len(), 1);
+    assert!(
+        imp.report
+            .skipped
+            .iter()
+            .any(|s| s.starts_with("D1 (110 line)") && s.contains("moved by its matrices")),
+        "{:?}",
+        imp.report.skipped
+    );
+}

@@ -23,6 +23,28 @@ use crate::parser::Value;
 /// chain: a hostile file of ten levels of ten instances asks for ten billion).
 pub(crate) const MAX_INSTANCES: usize = 10_000;
 
+/// The entities that relate two representations.
+const RELATIONSHIP_KINDS: [&str; 3] = [
+    "REPRESENTATION_RELATIONSHIP",
+    "SHAPE_REPRESENTATION_RELATIONSHIP",
+    "REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION",
+];
+
+/// The most placed copies of faces and sets an import makes, summed over every
+/// representation (a file of thousands of representations each placed ten thousand times
+/// asked for gigabytes).
+pub(crate) const MAX_PLACED: usize = 200_000;
+
+/// A representation's items: the list that is the second parameter of one of its records (a
+/// complex representation may carry it in any of them).
+fn items(rep: &crate::parser::Instance) -> Vec<u64> {
+    rep.records
+        .iter()
+        .find(|(_, p)| matches!(p.get(1), Some(Value::List(_))))
+        .and_then(|(_, p)| refs(rep, p.get(1), "items").ok())
+        .unwrap_or_default()
+}
+
 /// The representation entities whose items a mapped item may be among.
 const REPRESENTATION_KINDS: [&str; 9] = [
     "SHAPE_REPRESENTATION",
@@ -87,8 +109,8 @@ impl Rigid {
 /// entity absent from both maps lies where its coordinates put it (once).
 #[derive(Debug, Default)]
 pub(crate) struct Placements {
-    pub(crate) faces: HashMap<u64, Vec<Rigid>>,
-    pub(crate) sets: HashMap<u64, Vec<Rigid>>,
+    pub(crate) faces: HashMap<u64, std::rc::Rc<Vec<Rigid>>>,
+    pub(crate) sets: HashMap<u64, std::rc::Rc<Vec<Rigid>>>,
 }
 
 fn root(parent: &mut HashMap<u64, u64>, a: u64) -> u64 {
@@ -114,20 +136,46 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     // Representations in one frame (union-find) and the placements between frames.
     let mut parent: HashMap<u64, u64> = HashMap::new();
     let mut placed: Vec<(u64, u64, Rigid)> = Vec::new(); // (child rep, parent rep, map)
-    for inst in m.all("REPRESENTATION_RELATIONSHIP")? {
-        let p = m.rec(&inst, "REPRESENTATION_RELATIONSHIP")?;
+                                                         // Relationships written alone (SHAPE_REPRESENTATION_RELATIONSHIP, ..._WITH_TRANSFORMATION)
+                                                         // or as one complex instance of several; each read once.
+    let mut rel_ids: Vec<u64> = Vec::new();
+    for kind in RELATIONSHIP_KINDS {
+        rel_ids.extend(m.ex.ids_of(kind));
+    }
+    rel_ids.sort_unstable();
+    rel_ids.dedup();
+    for id in rel_ids {
+        let Some(inst) = m.ex.get(id)? else { continue };
+        // rep_1 and rep_2: parameters 3 and 4 of whichever record carries the relationship's
+        // own attributes.
+        let Some(p) = RELATIONSHIP_KINDS
+            .iter()
+            .filter_map(|k| inst.record(k))
+            .find(|p| p.len() >= 4)
+        else {
+            return Err(err(
+                &inst,
+                "a representation relationship without rep_1 and rep_2",
+            ));
+        };
         let (Some(Value::Ref(r1)), Some(Value::Ref(r2))) = (p.get(2), p.get(3)) else {
             return Err(err(&inst, "rep_1 and rep_2 must be references"));
         };
-        match inst.record("REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION") {
+        // The transformation: the one parameter of the ..._WITH_TRANSFORMATION record of a
+        // complex instance, or the fifth of a lone one.
+        let op = match inst.record("REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION") {
+            None => None,
+            Some(t) if t.len() == 1 => Some(m.param_ref(&inst, t, 0)?),
+            Some(t) => Some(m.param_ref(&inst, t, 4)?),
+        };
+        match op {
             None => {
                 let (a, b) = (root(&mut parent, *r1), root(&mut parent, *r2));
                 if a != b {
                     parent.insert(a.max(b), a.min(b));
                 }
             }
-            Some(t) => {
-                let op = m.param_ref(&inst, t, 0)?;
+            Some(op) => {
                 let Some(it) = op.record("ITEM_DEFINED_TRANSFORMATION") else {
                     return Err(err(
                         &op,
@@ -146,14 +194,16 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     if !mapped.is_empty() {
         // Which representation holds each mapped item.
         let mut holder: HashMap<u64, u64> = HashMap::new();
+        let mut rep_ids: Vec<u64> = Vec::new();
         for kind in REPRESENTATION_KINDS {
-            for rep in m.all(kind)? {
-                let Some(params) = rep.record(kind) else {
-                    continue;
-                };
-                for id in refs(&rep, params.get(1), "items").unwrap_or_default() {
-                    holder.entry(id).or_insert(rep.id);
-                }
+            rep_ids.extend(m.ex.ids_of(kind));
+        }
+        rep_ids.sort_unstable();
+        rep_ids.dedup();
+        for r in rep_ids {
+            let Some(rep) = m.ex.get(r)? else { continue };
+            for id in items(&rep) {
+                holder.entry(id).or_insert(rep.id);
             }
         }
         for inst in &mapped {
@@ -207,25 +257,25 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
         let (c, p) = (root(&mut parent, *c), root(&mut parent, *p));
         up.entry(c).or_default().push((p, *t));
     }
-    // Each class's placements in the root frame, memoized; a class on the current chain again
-    // is a cycle.
+    // Each class's placements in the root frame, memoized (shared, not copied); a class on the
+    // current chain again is a cycle; every placement made is counted against MAX_PLACED.
+    type Shared = std::rc::Rc<Vec<Rigid>>;
     fn place(
         c: u64,
         up: &HashMap<u64, Vec<(u64, Rigid)>>,
-        memo: &mut HashMap<u64, Vec<Rigid>>,
+        memo: &mut HashMap<u64, Shared>,
         chain: &mut Vec<u64>,
-    ) -> std::result::Result<Vec<Rigid>, String> {
+        made: &mut usize,
+    ) -> std::result::Result<Shared, String> {
         if let Some(v) = memo.get(&c) {
             return Ok(v.clone());
         }
         if chain.contains(&c) {
-            return Err(format!(
-                "representation #{c} is placed in itself (a cycle of placements)"
-            ));
+            return Err("is placed in itself (a cycle of placements)".into());
         }
         if chain.len() >= MAX_DEPTH {
             return Err(format!(
-                "assemblies nest more than {MAX_DEPTH} deep at representation #{c}"
+                "is placed through assemblies more than {MAX_DEPTH} deep"
             ));
         }
         let out = match up.get(&c) {
@@ -234,11 +284,15 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
                 chain.push(c);
                 let mut out = Vec::new();
                 for (p, t) in edges {
-                    for q in place(*p, up, memo, chain)? {
+                    for q in place(*p, up, memo, chain, made)?.iter() {
                         out.push(q.after(t));
+                        *made += 1;
                         if out.len() > MAX_INSTANCES {
+                            return Err(format!("has more than {MAX_INSTANCES} instances"));
+                        }
+                        if *made > MAX_PLACED {
                             return Err(format!(
-                                "representation #{c} has more than {MAX_INSTANCES} instances"
+                                "takes the file past {MAX_PLACED} placements of representations"
                             ));
                         }
                     }
@@ -247,54 +301,73 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
                 out
             }
         };
+        let out = std::rc::Rc::new(out);
         memo.insert(c, out.clone());
         Ok(out)
     }
     let mut memo = HashMap::new();
-    let mut class_places: HashMap<u64, Vec<Rigid>> = HashMap::new();
-    let reps: HashSet<u64> = placed
+    let mut made = 0usize;
+    let mut class_places: HashMap<u64, Shared> = HashMap::new();
+    let mut reps: Vec<u64> = placed
         .iter()
         .flat_map(|(c, p, _)| [*c, *p])
         .chain(parent.keys().copied())
         .collect();
+    reps.sort_unstable();
+    reps.dedup();
     for &r in &reps {
         let c = root(&mut parent, r);
-        let v = place(c, &up, &mut memo, &mut Vec::new()).map_err(|why| {
-            crate::error::StepError::Entity {
-                id: r,
-                name: "REPRESENTATION".into(),
-                message: why,
+        let v = match place(c, &up, &mut memo, &mut Vec::new(), &mut made) {
+            Ok(v) => v,
+            Err(why) => {
+                return Err(match m.ex.get(r)? {
+                    Some(i) => err(&i, format!("this representation {why}")),
+                    None => crate::error::StepError::Entity {
+                        id: r,
+                        name: "REPRESENTATION".into(),
+                        message: format!("this representation {why}"),
+                    },
+                });
             }
-        })?;
+        };
         class_places.insert(r, v);
     }
     // The faces and sets each placed representation holds: its items, followed through the
     // references down to faces and sets (each instance visited once).
     let mut out = Placements::default();
     let mut seen: HashSet<u64> = HashSet::new();
-    let mut ids: Vec<u64> = reps.into_iter().collect();
-    ids.sort_unstable();
-    for r in ids {
-        let v = &class_places[&r];
+    let mut copies = 0usize;
+    for r in reps {
+        let Some(v) = class_places.get(&r).cloned() else {
+            continue;
+        };
         if v.len() == 1 && v[0].is_identity() {
             continue;
         }
         let Some(rep) = m.ex.get(r)? else { continue };
-        let Some((_, params)) = rep.records.first() else {
-            continue;
-        };
-        let mut stack: Vec<u64> = refs(&rep, params.get(1), "items").unwrap_or_default();
+        let mut stack: Vec<u64> = items(&rep);
         while let Some(id) = stack.pop() {
             if !seen.insert(id) {
                 continue;
             }
             let Some(inst) = m.ex.get(id)? else { continue };
-            if inst.is("ADVANCED_FACE") || inst.is("FACE_SURFACE") {
-                out.faces.insert(id, v.clone());
-                continue;
-            }
-            if inst.is("GEOMETRIC_SET") || inst.is("GEOMETRIC_CURVE_SET") {
-                out.sets.insert(id, v.clone());
+            let face = inst.is("ADVANCED_FACE") || inst.is("FACE_SURFACE");
+            let set = inst.is("GEOMETRIC_SET") || inst.is("GEOMETRIC_CURVE_SET");
+            if face || set {
+                copies += v.len();
+                if copies > MAX_PLACED {
+                    return Err(err(
+                        &inst,
+                        format!(
+                            "placing it takes the file past {MAX_PLACED} placed faces and sets"
+                        ),
+                    ));
+                }
+                if face {
+                    out.faces.insert(id, v.clone());
+                } else {
+                    out.sets.insert(id, v.clone());
+                }
                 continue;
             }
             // Down through solids, shells and models to their faces; not into geometry.

@@ -97,12 +97,12 @@ pub fn face_loop_contours(
             for (k, e) in edge_ids.iter().enumerate() {
                 if shared[k] {
                     report.skipped.push(format!(
-                            "edge {}{e} of {} loop {}: shared with {}, cut once, with that face's normal",
-                            f.sigil,
-                            f.label(),
-                            li + 1,
-                            cut_with[e],
-                        ));
+                        "edge {} of {} loop {}: shared with {}, cut once, with that face's normal",
+                        crate::shape::edge_tag(f.sigil, *e),
+                        f.label(),
+                        li + 1,
+                        cut_with[e],
+                    ));
                 }
             }
             // The loop whole, or its runs of edges not cut already (each open).

@@ -287,7 +287,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
     let (faces, face_errors) = faces::read_faces(&m, only)?;
     // Assemblies: each face where its part's placements put it, once per instance.
     let placements = assembly::placements(&m)?;
-    let faces = place_faces(faces, &placements.faces);
+    let faces = place_faces(faces, &placements.faces)?;
     report.faces_read = faces.len();
     report
         .skipped
@@ -499,19 +499,19 @@ impl cad::Place for StepPlace<'_, '_> {
 
 /// The faces where their parts' placements put them: a face of a part placed once is moved
 /// there (same id); a face of a part placed k > 1 times becomes k faces, `#id@1` .. `#id@k`,
-/// whose edges get ids of their own per instance (two instances share no edge).
+/// whose edge ids carry the instance in their top 16 bits ([`shape::edge_tag`] shows them as
+/// `#47@2`), so that two instances share no edge.
+///
+/// # Errors
+/// An edge entity number of 2^48 or more in a part placed more than once (no room for the
+/// instance).
 fn place_faces(
     faces: Vec<Face>,
-    placements: &std::collections::HashMap<u64, Vec<assembly::Rigid>>,
-) -> Vec<Face> {
+    placements: &std::collections::HashMap<u64, std::rc::Rc<Vec<assembly::Rigid>>>,
+) -> Result<Vec<Face>> {
     if placements.is_empty() {
-        return faces;
+        return Ok(faces);
     }
-    let stride = 1 + faces
-        .iter()
-        .flat_map(|f| f.edge_ids.iter().flatten().copied())
-        .max()
-        .unwrap_or(0);
     let mut out = Vec::with_capacity(faces.len());
     for f in faces {
         match placements.get(&f.id) {
@@ -524,11 +524,27 @@ fn place_faces(
                 }
             }
             Some(v) => {
+                if let Some(e) = f
+                    .edge_ids
+                    .iter()
+                    .flatten()
+                    .find(|&&e| e >> shape::INSTANCE_SHIFT != 0)
+                {
+                    return Err(StepError::Entity {
+                        id: f.id,
+                        name: "ADVANCED_FACE".into(),
+                        message: format!(
+                            "edge #{e} of a part placed {} times: entity numbers of 2^48 and more leave no room to tell the instances apart",
+                            v.len()
+                        ),
+                    });
+                }
                 for (k, t) in v.iter().enumerate() {
-                    out.push(f.moved(&t.r, &t.t, Some(k + 1), stride.saturating_mul(k as u64)));
+                    let tag = ((k as u64) + 1) << shape::INSTANCE_SHIFT;
+                    out.push(f.moved(&t.r, &t.t, Some(k + 1), tag));
                 }
             }
         }
     }
-    out
+    Ok(out)
 }

@@ -382,13 +382,13 @@ impl Face {
 
     /// The face moved by the rigid map `x -> r x + t` (exact: the control points of a NURBS
     /// surface or curve move, its weights stay), as instance `instance` of its part, each edge
-    /// id raised by `edge_offset` (so that two instances share no edge).
+    /// id or-ed with `edge_tag` (the instance in the top bits: two instances share no edge).
     pub(crate) fn moved(
         &self,
         r: &nalgebra::Matrix3<f64>,
         t: &Vector3<f64>,
         instance: Option<usize>,
-        edge_offset: u64,
+        edge_tag: u64,
     ) -> Face {
         let map = |p: &Point3<f64>| Point3::from(r * p.coords + t);
         let s = &self.surface;
@@ -419,7 +419,7 @@ impl Face {
             edge_ids: self
                 .edge_ids
                 .iter()
-                .map(|l| l.iter().map(|e| e + edge_offset).collect())
+                .map(|l| l.iter().map(|e| e | edge_tag).collect())
                 .collect(),
             instance,
         }
@@ -433,6 +433,20 @@ impl Face {
     /// The boundary loops, each as its edges in loop order.
     pub fn loops(&self) -> &[Vec<NurbsCurve>] {
         &self.loops
+    }
+}
+
+/// Where an edge id keeps the instance of its part (assemblies): bits 48 and up.
+pub(crate) const INSTANCE_SHIFT: u32 = 48;
+
+/// An edge id as the file writes it: `#47`, or `#47@2` for the second instance of its part.
+pub(crate) fn edge_tag(sigil: &str, e: u64) -> String {
+    let k = e >> INSTANCE_SHIFT;
+    let id = e & ((1u64 << INSTANCE_SHIFT) - 1);
+    if k == 0 {
+        format!("{sigil}{id}")
+    } else {
+        format!("{sigil}{id}@{k}")
     }
 }
 

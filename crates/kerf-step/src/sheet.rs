@@ -151,8 +151,8 @@ pub(crate) fn recognise<E>(
             other => {
                 let names: Vec<String> = other.iter().map(|u| faces[u.face].label()).collect();
                 return Ok(Err(format!(
-                    "edge {}{id} bounds {} face loops ({}): not a closed solid (each edge bounds two)",
-                    faces[other[0].face].sigil,
+                    "edge {} bounds {} face loops ({}): not a closed solid (each edge bounds two)",
+                    crate::shape::edge_tag(faces[other[0].face].sigil, *id),
                     other.len(),
                     names.join(", ")
                 )));
@@ -198,8 +198,8 @@ pub(crate) fn recognise<E>(
         match (class(x.face), class(y.face)) {
             (0, 1) | (1, 0) => {
                 return Ok(Err(format!(
-                    "edge {}{id} joins {} and {} of the two sides directly",
-                    faces[x.face].sigil,
+                    "edge {} joins {} and {} of the two sides directly",
+                    crate::shape::edge_tag(faces[x.face].sigil, *id),
                     faces[x.face].label(),
                     faces[y.face].label()
                 )));

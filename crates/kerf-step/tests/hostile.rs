@@ -242,3 +242,44 @@ fn a_long_name_is_cut_in_the_contour_id() {
         im.report.skipped
     );
 }
+
+#[test]
+fn placements_that_multiply_past_the_budget_are_refused() {
+    // Representations #100 .. #104, each placed ten times into the next (10^4 instances of
+    // #100), then 30 more placed into #100: 300,000 placements asked for, refused at the
+    // budget of 200,000 rather than built (a 300 KB file of this shape took 3.8 GB).
+    let mut b =
+        String::from("#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=AXIS2_PLACEMENT_3D('',#1,$,$);\n");
+    let mut id = 1000;
+    let mut next = || {
+        id += 1;
+        id
+    };
+    for r in 100..=104 {
+        b.push_str(&format!("#{r}=SHAPE_REPRESENTATION('',(#2),$);\n"));
+    }
+    let mut place = |b: &mut String, child: u64, parent: u64, k: usize| {
+        let (p, a, t, rel) = (next(), next(), next(), next());
+        b.push_str(&format!(
+            "#{p}=CARTESIAN_POINT('',({k}.,0.,0.));\n#{a}=AXIS2_PLACEMENT_3D('',#{p},$,$);\n\
+             #{t}=ITEM_DEFINED_TRANSFORMATION('','',#2,#{a});\n\
+             #{rel}=(REPRESENTATION_RELATIONSHIP('','',#{child},#{parent})REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#{t})SHAPE_REPRESENTATION_RELATIONSHIP());\n"
+        ));
+    };
+    for r in 100..104u64 {
+        for k in 0..10 {
+            place(&mut b, r, r + 1, k);
+        }
+    }
+    for j in 0..30u64 {
+        let r = 200 + j;
+        b.push_str(&format!("#{r}=SHAPE_REPRESENTATION('',(#2),$);\n"));
+        place(&mut b, r, 100, 1);
+    }
+    b.push_str("#9=CIRCLE('',#2,5.);\n#10=GEOMETRIC_CURVE_SET('',(#9));\n");
+    let text = format!(
+        "ISO-10303-21;\nHEADER;\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\nDATA;\n{b}ENDSEC;\nEND-ISO-10303-21;\n"
+    );
+    let e = kerf_step::import(&text, &kerf_step::ImportOptions::default()).expect_err("budget");
+    assert!(e.to_string().contains("past 200000 placements"), "{e}");
+}

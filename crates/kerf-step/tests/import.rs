@@ -576,6 +576,22 @@ fn a_placement_moves_what_its_representation_holds_and_a_cycle_is_refused() {
             "circle point {p} at {r} from (100, 0, 0)"
         );
     }
+    // The set in a wireframe representation joined to #10 by a SHAPE_REPRESENTATION_
+    // RELATIONSHIP written alone (as SolidWorks joins a part's shape and its B-rep), and #10
+    // placed by a lone REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION: moved the same.
+    let lone = body
+        .replace("#10=SHAPE_REPRESENTATION('',(#3,#7),$);", "#10=SHAPE_REPRESENTATION('',(#3),$);\n#20=GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION('',(#7),$);\n#21=SHAPE_REPRESENTATION_RELATIONSHIP('','',#20,#10);")
+        .replace("#12=(REPRESENTATION_RELATIONSHIP('','',#10,#11)REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#5)SHAPE_REPRESENTATION_RELATIONSHIP());", "#12=REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION('','',#10,#11,#5);");
+    assert!(lone.contains("#21=") && lone.contains("#12=REPRESENTATION_RELATIONSHIP_WITH"));
+    let imp = import(&step(&lone), &ImportOptions::default()).expect("placed");
+    let c = curve(&imp.file.curves[0]);
+    for p in samples(&c, 40) {
+        let r = (p - Point3::new(100.0, 0.0, 0.0)).norm();
+        assert!(
+            (r - 5.0).abs() < 1e-12,
+            "lone relationships: circle point {p}"
+        );
+    }
     // A transformation no relationship uses places nothing.
     let stray = body.replace("#12=", "#99=CARTESIAN_POINT('',(1.,1.,1.));\n#98=");
     let stray = stray.replace("#98=(REPRESENTATION_RELATIONSHIP('','',#10,#11)REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#5)SHAPE_REPRESENTATION_RELATIONSHIP());", "");

@@ -163,17 +163,9 @@ fn curve(
     w: Option<Vec<f64>>,
     surface: &str,
 ) -> RawCurve {
-    RawCurve {
-        id: id.into(),
-        degree,
-        knots,
-        control_points: cps,
-        weights: w,
-        surface: Some(surface.into()),
-        start: None,
-        scrap: None,
-        on_surface_tolerance_mm: None,
-    }
+    RawCurve::new(id, degree, knots, cps)
+        .with_weights(w)
+        .with_surface(Some(surface.into()))
 }
 
 fn document(curves: Vec<RawCurve>, surfaces: Vec<RawSurface>) -> RawCurvesFile {
@@ -1845,17 +1837,9 @@ fn trim_creases(out: &Path) {
     w.push(1.0);
     kn.extend([1.0; 3]);
     let ids: Vec<String> = faces.iter().map(|(id, _)| (*id).to_string()).collect();
-    let line = RawCurve {
-        id: "trim-over-creases".into(),
-        degree: 2,
-        knots: kn,
-        control_points: cps,
-        weights: Some(w),
-        surface: Some(curves::SurfaceRef::Many(ids)),
-        start: None,
-        scrap: None,
-        on_surface_tolerance_mm: None,
-    };
+    let line = RawCurve::new("trim-over-creases", 2, kn, cps)
+        .with_weights(Some(w))
+        .with_surface(Some(curves::SurfaceRef::Many(ids)));
     let surfaces = faces
         .iter()
         .map(|(id, f)| RawSurface::Nurbs(f.raw(id)))

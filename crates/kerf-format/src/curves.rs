@@ -68,8 +68,10 @@ pub struct RawCurvesFile {
     pub surfaces: Vec<RawSurface>,
 }
 
-/// One entry of `curves`.
+/// One entry of `curves`. Build one with [`RawCurve::new`] and the `with_*` setters (the
+/// optional keys grow with the format).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct RawCurve {
     /// Unique, non-empty name; the toolpath keeps it.
     pub id: String,
@@ -100,6 +102,59 @@ pub struct RawCurve {
     /// [`from_raw`]: finite, > 0 and at most [`MAX_CURVE_ON_SURFACE_TOLERANCE_MM`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub on_surface_tolerance_mm: Option<f64>,
+}
+
+impl RawCurve {
+    /// A curve entry with no optional key: `id`, `degree`, the full knot vector and the
+    /// control points in mm (polynomial: no weights).
+    pub fn new(
+        id: impl Into<String>,
+        degree: usize,
+        knots: Vec<f64>,
+        control_points: Vec<[f64; 3]>,
+    ) -> Self {
+        Self {
+            id: id.into(),
+            degree,
+            knots,
+            control_points,
+            weights: None,
+            surface: None,
+            start: None,
+            scrap: None,
+            on_surface_tolerance_mm: None,
+        }
+    }
+
+    /// Sets the weights (`None`: all 1).
+    pub fn with_weights(mut self, weights: Option<Vec<f64>>) -> Self {
+        self.weights = weights;
+        self
+    }
+
+    /// Sets the surface (or surfaces) carrying the curve.
+    pub fn with_surface(mut self, surface: Option<SurfaceRef>) -> Self {
+        self.surface = surface;
+        self
+    }
+
+    /// Sets the parameter where the cut of a closed curve begins.
+    pub fn with_start(mut self, start: Option<f64>) -> Self {
+        self.start = start;
+        self
+    }
+
+    /// Sets the waste side, `"left"` or `"right"`.
+    pub fn with_scrap(mut self, scrap: Option<String>) -> Self {
+        self.scrap = scrap;
+        self
+    }
+
+    /// Sets the curve's own on-surface tolerance, mm.
+    pub fn with_on_surface_tolerance_mm(mut self, tolerance: Option<f64>) -> Self {
+        self.on_surface_tolerance_mm = tolerance;
+        self
+    }
 }
 
 /// The largest `on_surface_tolerance_mm` a curve may state, mm: farther from its surface a
@@ -246,8 +301,9 @@ pub struct CurvesFile {
     pub warnings: Vec<UnknownKey>,
 }
 
-/// One cut contour.
+/// One cut contour. Build one with [`CurveRecord::new`] and the `with_*` setters.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct CurveRecord {
     /// Its id, unique among the curves.
     pub id: String,
@@ -267,6 +323,47 @@ pub struct CurveRecord {
     /// The curve's own on-surface tolerance, mm (the `on_surface_tolerance_mm` key): the
     /// normals stage takes the looser of it and the run's.
     pub on_surface_tolerance_mm: Option<f64>,
+}
+
+impl CurveRecord {
+    /// A contour with no surface, start, scrap side or tolerance of its own.
+    pub fn new(id: impl Into<String>, curve: NurbsCurve) -> Self {
+        Self {
+            id: id.into(),
+            curve,
+            surface: None,
+            surfaces: Vec::new(),
+            start: None,
+            scrap: None,
+            on_surface_tolerance_mm: None,
+        }
+    }
+
+    /// Sets the surfaces carrying it (the first is `surface`); the caller keeps them
+    /// existing in the file's surfaces.
+    pub fn with_surfaces(mut self, surfaces: Vec<String>) -> Self {
+        self.surface = surfaces.first().cloned();
+        self.surfaces = surfaces;
+        self
+    }
+
+    /// Sets the parameter where the cut of this closed curve begins.
+    pub fn with_start(mut self, start: Option<f64>) -> Self {
+        self.start = start;
+        self
+    }
+
+    /// Sets the waste side.
+    pub fn with_scrap(mut self, scrap: Option<ScrapSide>) -> Self {
+        self.scrap = scrap;
+        self
+    }
+
+    /// Sets the curve's own on-surface tolerance, mm.
+    pub fn with_on_surface_tolerance_mm(mut self, tolerance: Option<f64>) -> Self {
+        self.on_surface_tolerance_mm = tolerance;
+        self
+    }
 }
 
 /// The side of a curve that is waste, seen along the curve's direction with the normal toward

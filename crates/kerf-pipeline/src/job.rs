@@ -534,16 +534,10 @@ impl Job {
         curve: NurbsCurve,
         surface: Option<&str>,
     ) -> Self {
-        let surface = surface.map(str::to_owned);
-        self.curves.curves.push(CurveRecord {
-            id: id.into(),
-            curve,
-            surfaces: surface.iter().cloned().collect(),
-            surface,
-            start: None,
-            scrap: None,
-            on_surface_tolerance_mm: None,
-        });
+        self.curves.curves.push(
+            CurveRecord::new(id, curve)
+                .with_surfaces(surface.map(str::to_owned).into_iter().collect()),
+        );
         self
     }
 

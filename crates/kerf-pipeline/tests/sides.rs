@@ -26,15 +26,9 @@ fn hole(side: ScrapSide) -> CurvesFile {
     CurvesFile {
         warnings: Vec::new(),
         units: kerf_format::Units::Millimetres,
-        curves: vec![CurveRecord {
-            id: "edge".into(),
-            curve: edge,
-            surface: Some("wall".into()),
-            surfaces: vec!["wall".into()],
-            start: None,
-            scrap: Some(side),
-            on_surface_tolerance_mm: None,
-        }],
+        curves: vec![CurveRecord::new("edge", edge)
+            .with_surfaces(vec!["wall".into()])
+            .with_scrap(Some(side))],
         surfaces: vec![SurfaceRecord {
             id: "wall".into(),
             geometry: SurfaceGeometry::Nurbs(wall),
@@ -152,14 +146,8 @@ fn a_contour_under_a_roof_keeps_its_side_when_the_head_cannot_reach_the_other() 
         .expect("plate")
     };
     let (floor, roof) = (plate(0.0), plate(10.0));
-    let record = |id: &str, curve: NurbsCurve, surface: &str| CurveRecord {
-        id: id.into(),
-        curve,
-        surface: Some(surface.into()),
-        surfaces: vec![surface.into()],
-        start: None,
-        scrap: None,
-        on_surface_tolerance_mm: None,
+    let record = |id: &str, curve: NurbsCurve, surface: &str| {
+        CurveRecord::new(id, curve).with_surfaces(vec![surface.into()])
     };
     let surface = |id: &str, s: NurbsSurface| SurfaceRecord {
         id: id.into(),

@@ -406,17 +406,14 @@ fn loop_runs(l: &[NurbsCurve], skip: &[bool]) -> Vec<Vec<NurbsCurve>> {
 }
 
 fn raw_curve(id: String, c: &NurbsCurve, surface: Option<SurfaceRef>) -> RawCurve {
-    RawCurve {
+    RawCurve::new(
         id,
-        degree: c.degree(),
-        knots: c.knots().to_vec(),
-        control_points: c.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
-        weights: c.is_rational().then(|| c.weights()),
-        surface,
-        start: None,
-        scrap: None,
-        on_surface_tolerance_mm: None,
-    }
+        c.degree(),
+        c.knots().to_vec(),
+        c.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+    )
+    .with_weights(c.is_rational().then(|| c.weights()))
+    .with_surface(surface)
 }
 
 fn raw_surface(id: &str, s: &NurbsSurface) -> RawNurbsSurface {

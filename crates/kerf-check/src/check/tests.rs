@@ -461,15 +461,7 @@ fn parabola(offset: [f64; 3]) -> (CurveRecord, RawPathRecord) {
         point_count: None,
         kerf_offset: None,
     };
-    let curve = CurveRecord {
-        id: "parabola".into(),
-        curve,
-        surface: None,
-        surfaces: Vec::new(),
-        start: None,
-        scrap: None,
-        on_surface_tolerance_mm: None,
-    };
+    let curve = CurveRecord::new("parabola", curve);
     (curve, record)
 }
 

@@ -35,6 +35,10 @@ const RELATIONSHIP_KINDS: [&str; 3] = [
 /// asked for gigabytes).
 pub(crate) const MAX_PLACED: usize = 200_000;
 
+/// The most control points the placed copies of faces may have in all (the surface-point
+/// budget of the reader).
+pub(crate) const MAX_PLACED_POINTS: usize = 10_000_000;
+
 /// A representation's items: the list that is the second parameter of one of its records (a
 /// complex representation may carry it in any of them).
 fn items(rep: &crate::parser::Instance) -> Vec<u64> {
@@ -126,6 +130,14 @@ fn root(parent: &mut HashMap<u64, u64>, a: u64) -> u64 {
     a
 }
 
+/// Puts `a` and `b` in one frame.
+fn join(parent: &mut HashMap<u64, u64>, a: u64, b: u64) {
+    let (a, b) = (root(parent, a), root(parent, b));
+    if a != b {
+        parent.insert(a.max(b), a.min(b));
+    }
+}
+
 /// The placements of the file's faces and sets (see the module).
 ///
 /// # Errors
@@ -136,8 +148,10 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     // Representations in one frame (union-find) and the placements between frames.
     let mut parent: HashMap<u64, u64> = HashMap::new();
     let mut placed: Vec<(u64, u64, Rigid)> = Vec::new(); // (child rep, parent rep, map)
-                                                         // Relationships written alone (SHAPE_REPRESENTATION_RELATIONSHIP, ..._WITH_TRANSFORMATION)
-                                                         // or as one complex instance of several; each read once.
+                                                         // Every representation a relationship or a mapped item names (the walk below visits each).
+    let mut named: Vec<u64> = Vec::new();
+    // Relationships written alone (SHAPE_REPRESENTATION_RELATIONSHIP, ..._WITH_TRANSFORMATION)
+    // or as one complex instance of several; each read once.
     let mut rel_ids: Vec<u64> = Vec::new();
     for kind in RELATIONSHIP_KINDS {
         rel_ids.extend(m.ex.ids_of(kind));
@@ -168,13 +182,9 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
             Some(t) if t.len() == 1 => Some(m.param_ref(&inst, t, 0)?),
             Some(t) => Some(m.param_ref(&inst, t, 4)?),
         };
+        named.extend([*r1, *r2]);
         match op {
-            None => {
-                let (a, b) = (root(&mut parent, *r1), root(&mut parent, *r2));
-                if a != b {
-                    parent.insert(a.max(b), a.min(b));
-                }
-            }
+            None => join(&mut parent, *r1, *r2),
             Some(op) => {
                 let Some(it) = op.record("ITEM_DEFINED_TRANSFORMATION") else {
                     return Err(err(
@@ -193,7 +203,7 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     let mapped = m.all("MAPPED_ITEM")?;
     if !mapped.is_empty() {
         // Which representation holds each mapped item.
-        let mut holder: HashMap<u64, u64> = HashMap::new();
+        let mut holder: HashMap<u64, Vec<u64>> = HashMap::new();
         let mut rep_ids: Vec<u64> = Vec::new();
         for kind in REPRESENTATION_KINDS {
             rep_ids.extend(m.ex.ids_of(kind));
@@ -203,7 +213,7 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
         for r in rep_ids {
             let Some(rep) = m.ex.get(r)? else { continue };
             for id in items(&rep) {
-                holder.entry(id).or_insert(rep.id);
+                holder.entry(id).or_default().push(rep.id);
             }
         }
         for inst in &mapped {
@@ -233,19 +243,22 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
             }
             let t = Rigid::of(&m.placement(&target)?)
                 .after(&Rigid::of(&m.placement(&origin)?).inverse());
-            let Some(&parent_rep) = holder.get(&inst.id) else {
+            let Some(holders) = holder.get(&inst.id) else {
                 if t.is_identity() {
                     continue; // in place: nothing moves
                 }
                 return Err(err(
                     inst,
                     format!(
-                        "places the items of #{} from #{} at #{}, but no representation holds it: where they go is not defined (export the part alone, or as one body in its place)",
+                        "places the items of #{} from #{} at #{}, but no representation kerf knows holds it: where they go is not defined (export the part alone, or as one body in its place)",
                         map.id, origin.id, target.id
                     ),
                 ));
             };
-            placed.push((*source, parent_rep, t));
+            for &h in holders {
+                named.extend([*source, h]);
+                placed.push((*source, h, t));
+            }
         }
     }
     if placed.is_empty() {
@@ -255,6 +268,9 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     let mut up: HashMap<u64, Vec<(u64, Rigid)>> = HashMap::new();
     for (c, p, t) in &placed {
         let (c, p) = (root(&mut parent, *c), root(&mut parent, *p));
+        if c == p && t.is_identity() {
+            continue; // a frame placed in place in itself (an in-place map of its own B-rep)
+        }
         up.entry(c).or_default().push((p, *t));
     }
     // Each class's placements in the root frame, memoized (shared, not copied); a class on the
@@ -308,11 +324,7 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     let mut memo = HashMap::new();
     let mut made = 0usize;
     let mut class_places: HashMap<u64, Shared> = HashMap::new();
-    let mut reps: Vec<u64> = placed
-        .iter()
-        .flat_map(|(c, p, _)| [*c, *p])
-        .chain(parent.keys().copied())
-        .collect();
+    let mut reps: Vec<u64> = named;
     reps.sort_unstable();
     reps.dedup();
     for &r in &reps {

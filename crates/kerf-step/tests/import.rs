@@ -583,6 +583,21 @@ fn a_placement_moves_what_its_representation_holds_and_a_cycle_is_refused() {
         .replace("#10=SHAPE_REPRESENTATION('',(#3,#7),$);", "#10=SHAPE_REPRESENTATION('',(#3),$);\n#20=GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION('',(#7),$);\n#21=SHAPE_REPRESENTATION_RELATIONSHIP('','',#20,#10);")
         .replace("#12=(REPRESENTATION_RELATIONSHIP('','',#10,#11)REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#5)SHAPE_REPRESENTATION_RELATIONSHIP());", "#12=REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION('','',#10,#11,#5);");
     assert!(lone.contains("#21=") && lone.contains("#12=REPRESENTATION_RELATIONSHIP_WITH"));
+    // The same with the wireframe representation numbered below the one it is joined to (the
+    // lower number of a pair once went unvisited and its curves unplaced).
+    let low = lone.replace("#20=", "#8=").replace(
+        "#21=SHAPE_REPRESENTATION_RELATIONSHIP('','',#20,#10);",
+        "#21=SHAPE_REPRESENTATION_RELATIONSHIP('','',#8,#10);",
+    );
+    let imp = import(&step(&low), &ImportOptions::default()).expect("placed");
+    let c = curve(&imp.file.curves[0]);
+    for p in samples(&c, 40) {
+        let r = (p - Point3::new(100.0, 0.0, 0.0)).norm();
+        assert!(
+            (r - 5.0).abs() < 1e-12,
+            "lower-numbered representation: circle point {p}"
+        );
+    }
     let imp = import(&step(&lone), &ImportOptions::default()).expect("placed");
     let c = curve(&imp.file.curves[0]);
     for p in samples(&c, 40) {
@@ -695,7 +710,7 @@ fn a_mapped_item_places_its_representation_where_its_holder_says() {
     let e = import(&step(&loose), &ImportOptions::default()).unwrap_err();
     assert!(
         e.to_string().starts_with(
-            "#10 MAPPED_ITEM: places the items of #9 from #3 at #4, but no representation holds it"
+            "#10 MAPPED_ITEM: places the items of #9 from #3 at #4, but no representation kerf knows holds it"
         ),
         "{e}"
     );
@@ -709,6 +724,15 @@ fn a_mapped_item_places_its_representation_where_its_holder_says() {
             .all(|p| (p.coords.norm() - 5.0).abs() < 1e-9),
         "the circle where the file puts it"
     );
+    // A representation that holds an in-place map of a representation it is also joined to
+    // (a part's shape holding its own B-rep): no placement, not a cycle.
+    let own = body.replace("#10=MAPPED_ITEM('',#9,#4)", "#10=MAPPED_ITEM('',#9,#3)")
+        + "#13=SHAPE_REPRESENTATION_RELATIONSHIP('','',#8,#12);\n";
+    let im = import(&step(&own), &ImportOptions::default()).expect("in place, joined");
+    let c = curve(&im.file.curves[0]);
+    assert!(samples(&c, 16)
+        .iter()
+        .all(|p| (p.coords.norm() - 5.0).abs() < 1e-9));
     // A transformation operator as the target (it may scale or mirror): refused.
     let op = body.replace(
         "#10=MAPPED_ITEM('',#9,#4)",

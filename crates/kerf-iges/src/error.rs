@@ -7,8 +7,9 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum IgesError {
-    /// The file could not be read. Fix: check the path and permissions.
-    #[error("{}: cannot read: {source}", path.display())]
+    /// The file could not be read. Fix: check the path and permissions. (The message leaves
+    /// the path to the [`FileError`] around it, which names the file once.)
+    #[error("cannot read: {source}")]
     Read {
         /// The file.
         path: PathBuf,

@@ -6,8 +6,9 @@ use std::path::PathBuf;
 /// What can go wrong reading a STEP file.
 #[derive(Debug, thiserror::Error)]
 pub enum StepError {
-    /// The file could not be read. Fix: check the path and permissions.
-    #[error("{}: cannot read: {source}", path.display())]
+    /// The file could not be read. Fix: check the path and permissions. (The message leaves
+    /// the path to the [`FileError`] around it, which names the file once.)
+    #[error("cannot read: {source}")]
     Read {
         /// The file.
         path: PathBuf,

@@ -143,12 +143,14 @@ fn join(parent: &mut HashMap<u64, u64>, a: u64, b: u64) {
 /// # Errors
 /// A transformation that is not an `ITEM_DEFINED_TRANSFORMATION` between two placements, a cycle
 /// of placements, chains deeper than [`MAX_DEPTH`], more than [`MAX_INSTANCES`] instances of
-/// one representation.
+/// one representation or [`MAX_PLACED`] placements in all, a moving mapped item no
+/// representation holds.
 pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     // Representations in one frame (union-find) and the placements between frames.
     let mut parent: HashMap<u64, u64> = HashMap::new();
-    let mut placed: Vec<(u64, u64, Rigid)> = Vec::new(); // (child rep, parent rep, map)
-                                                         // Every representation a relationship or a mapped item names (the walk below visits each).
+    // (child representation, parent representation, the map from the child's frame).
+    let mut placed: Vec<(u64, u64, Rigid)> = Vec::new();
+    // Every representation a relationship or a mapped item names (the walk below visits each).
     let mut named: Vec<u64> = Vec::new();
     // Relationships written alone (SHAPE_REPRESENTATION_RELATIONSHIP, ..._WITH_TRANSFORMATION)
     // or as one complex instance of several; each read once.

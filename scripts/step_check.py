@@ -52,6 +52,9 @@ from OCP.OCP.TopoDS import TopoDS
 
 TOL = 1e-9
 IGES_TOL = 1e-8
+# Open CASCADE's read.surfacecurve.mode for IGES (3: the model-space curves; --iges-mode 0 shows
+# its default, the approximated edges).
+SURFACE_CURVE_MODE = 3
 
 
 def distinct(knots):
@@ -104,7 +107,7 @@ def occ_by_id(path):
         from OCP.OCP.IGESControl import IGESControl_Controller
 
         IGESControl_Controller.Init_s()
-        Interface_Static.SetIVal_s("read.surfacecurve.mode", 3)
+        Interface_Static.SetIVal_s("read.surfacecurve.mode", SURFACE_CURVE_MODE)
     r = IGESControl_Reader() if iges else STEPControl_Reader()
     if r.ReadFile(str(path)) != IFSelect_RetDone:
         raise SystemExit(f"{path}: Open CASCADE cannot read it")
@@ -203,7 +206,7 @@ def nearest_on(curves, p, boxes=None):
     return best
 
 
-def check_file(kerf, step, edges, failures, counts):
+def check_file(kerf, step, edges, failures, counts, iges_tol=IGES_TOL):
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "part.curves.json"
         cmd = [kerf, "import", str(step), "-o", str(out), "--all-faces", "--json"]
@@ -220,8 +223,8 @@ def check_file(kerf, step, edges, failures, counts):
     truth_cover = edge_curves(face_edges if edges else free, with_seams=False)
     truth_boxes = np.array([cv[4] for cv in truth])
     iges = step.suffix.lower() in (".igs", ".iges")
-    curve_tol = IGES_TOL if iges else TOL
-    surface_tol = IGES_TOL if iges else TOL
+    curve_tol = iges_tol if iges else TOL
+    surface_tol = iges_tol if iges else TOL
     gap_tol = curve_tol + summary["largest_pole_move_mm"]
     kcurves = []
     for c in doc["curves"]:
@@ -342,13 +345,17 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--kerf", default="target/release/kerf")
     ap.add_argument("--edges", action="store_true", help="import with --edges (face boundary loops)")
+    ap.add_argument("--iges-tol", type=float, default=IGES_TOL, help="tolerance for IGES files, mm (default 1e-8)")
+    ap.add_argument("--iges-mode", type=int, default=3, help="Open CASCADE's read.surfacecurve.mode for IGES (default 3)")
     ap.add_argument("files", nargs="+", type=Path)
     args = ap.parse_args()
+    global SURFACE_CURVE_MODE
+    SURFACE_CURVE_MODE = args.iges_mode
     failures = []
     counts = {"curves": 0, "edges": 0, "surfaces": 0}
     for f in args.files:
         before = len(failures)
-        check_file(args.kerf, f, args.edges, failures, counts)
+        check_file(args.kerf, f, args.edges, failures, counts, args.iges_tol)
         print(f"{f}: {'ok' if len(failures) == before else 'FAILED'}")
     for m in failures:
         print("FAIL", m)

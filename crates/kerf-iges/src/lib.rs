@@ -396,19 +396,10 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
         contours = cad::sheet_contours(s, &faces, opts, &mut report);
     } else if opts.edges {
         if let Some(Err(why)) = &sheet {
-            report.sheet = Some(not_a_sheet(why));
+            report.sheet = Some(kerf_step::SheetReport::not_a_sheet(why));
         }
-        if let Some(only) = &opts.faces {
-            for id in only {
-                if !faces.iter().any(|f| f.id() == *id) {
-                    return Err(IgesError::NoContour {
-                        reason: format!(
-                            "D{id} is not a face kerf could read ({} faces read)",
-                            faces.len()
-                        ),
-                    });
-                }
-            }
+        if let Some(reason) = cad::unknown_face(&faces, opts, "D") {
+            return Err(IgesError::NoContour { reason });
         }
         contours = cad::face_loop_contours(&faces, opts, &mut report);
     } else {
@@ -549,13 +540,6 @@ struct Pending<'e> {
     natural: Option<kerf_step::cad::ParamBox>,
     loops: Vec<Vec<NurbsCurve>>,
     ids: Vec<Vec<u64>>,
-}
-
-/// The account of a sheet not found.
-fn not_a_sheet(why: &str) -> kerf_step::SheetReport {
-    let mut r = kerf_step::SheetReport::default();
-    r.not_a_sheet = Some(why.to_owned());
-    r
 }
 
 /// A 144: its surface and its boundary loops (the 142s' model-space curves).

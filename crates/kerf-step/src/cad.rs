@@ -68,6 +68,21 @@ impl Contour {
     }
 }
 
+/// Why `opts.faces` (the faces chosen by hand) cannot be cut: the first id that is no face
+/// read, as `{sigil}{id} is not a face kerf could read (N faces read)`; `None` when every one
+/// is (or none was chosen).
+pub fn unknown_face(faces: &[Face], opts: &ImportOptions, sigil: &str) -> Option<String> {
+    let only = opts.faces.as_ref()?;
+    only.iter()
+        .find(|id| !faces.iter().any(|f| f.id == **id))
+        .map(|id| {
+            format!(
+                "{sigil}{id} is not a face kerf could read ({} faces read)",
+                faces.len()
+            )
+        })
+}
+
 /// The contours of the faces' boundary loops (`opts.faces`: only those faces; `None`: all),
 /// each loop closed where its edges join. With faces chosen by hand, an edge two of them
 /// share is cut once: with the first face (in file order) that has it, whose normal it takes;

@@ -227,6 +227,17 @@ pub struct SheetReport {
     pub features: Vec<String>,
 }
 
+impl SheetReport {
+    /// The account of faces that are not one sheet, with the reason (every face loop is then a
+    /// contour).
+    pub fn not_a_sheet(why: &str) -> Self {
+        Self {
+            not_a_sheet: Some(why.to_owned()),
+            ..Self::default()
+        }
+    }
+}
+
 /// Reads a STEP file from disk through kerf's one reader (`kerf_io::read_file`: at most 1 GiB,
 /// a leading UTF-8 byte-order mark skipped); see [`import`].
 ///
@@ -307,23 +318,11 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         contours.extend(cad::sheet_contours(s, &faces, opts, &mut report));
     } else if opts.edges {
         if let Some(Err(why)) = &sheet {
-            report.sheet = Some(SheetReport {
-                not_a_sheet: Some(why.clone()),
-                ..SheetReport::default()
-            });
+            report.sheet = Some(SheetReport::not_a_sheet(why));
         }
         contours.extend(cad::face_loop_contours(&faces, opts, &mut report));
-        if let Some(only) = &opts.faces {
-            for id in only {
-                if !faces.iter().any(|f| f.id == *id) {
-                    return Err(StepError::NoContour {
-                        reason: format!(
-                            "#{id} is not a face kerf could read ({} faces read)",
-                            faces.len()
-                        ),
-                    });
-                }
-            }
+        if let Some(reason) = cad::unknown_face(&faces, opts, "#") {
+            return Err(StepError::NoContour { reason });
         }
     } else {
         let mut sets = m.all("GEOMETRIC_SET")?;

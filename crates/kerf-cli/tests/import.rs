@@ -6,15 +6,12 @@ use std::process::Command;
 mod common;
 use common::{fixture, kerf};
 
-/// `../shared/realdata/step` (the real STEP parts), if present; says so when it is not.
-fn real_step_dir() -> Option<std::path::PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipped: {} not present", dir.display());
-        None
-    }
+/// `fixtures/realdata/step` (the real STEP parts, shipped with the repository: a test on them
+/// cannot pass by skipping them).
+fn real_step_dir() -> std::path::PathBuf {
+    let dir = fixture("realdata/step");
+    assert!(dir.is_dir(), "{} is missing", dir.display());
+    dir
 }
 
 fn run(c: &mut Command) -> (i32, String, String) {
@@ -123,9 +120,7 @@ fn run_takes_a_step_file_and_normals_come_from_the_nearest_face() {
 
 #[test]
 fn real_parts_import_with_edges_and_discretize_with_normals() {
-    let Some(dir_real) = real_step_dir() else {
-        return;
-    };
+    let dir_real = real_step_dir();
     let dir = tempfile::tempdir().unwrap();
     for name in ["S01094.stp", "S06298.stp"] {
         let curves = dir.path().join(format!("{name}.json"));
@@ -178,9 +173,7 @@ fn a_real_sheet_metal_part_is_cut_once_per_feature_and_every_loop_on_request() {
     // S06298.stp, a 3 mm tray with lips: sheet recognition (the default with --edges) gives
     // two features (the outline in pieces, the 100 mm hole) where every face loop gives 78;
     // `kerf run --place auto` cuts them on the gantry, each once.
-    let Some(dir_real) = real_step_dir() else {
-        return;
-    };
+    let dir_real = real_step_dir();
     let part = dir_real.join("S06298.stp");
     let dir = tempfile::tempdir().unwrap();
     let curves = dir.path().join("sheet.json");

@@ -284,13 +284,9 @@ fn step_parts_run_with_place_auto() {
     for f in ["step/composite_mm.step", "step/composite_inch.step"] {
         run_placed(f, "gantry_ac.json", "auto");
     }
-    // The real sheet-metal parts, their faces' boundary loops as contours, where the shared
-    // data is present (CI lays it beside the checkout).
-    let real = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
-    let Ok(dir) = std::fs::read_dir(&real) else {
-        eprintln!("{} not found: real STEP parts skipped", real.display());
-        return;
-    };
+    // The real sheet-metal parts (shipped in fixtures/realdata/step).
+    let real = fixture("realdata/step");
+    let dir = std::fs::read_dir(&real).expect("fixtures/realdata/step");
     let mut files: Vec<PathBuf> = dir.filter_map(|e| e.ok().map(|e| e.path())).collect();
     files.retain(|p| p.extension().is_some_and(|x| x == "stp" || x == "step"));
     files.sort();

@@ -296,13 +296,11 @@ fn real_parts_views_open_and_show_the_part() {
             vec!["--place", "auto"],
         ),
     ];
-    let step =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step/S06298.stp");
-    if step.is_file() {
-        parts.push(("S06298".into(), step, vec!["--edges", "--place", "auto"]));
-    } else {
-        eprintln!("skipped S06298: {} not present", step.display());
-    }
+    parts.push((
+        "S06298".into(),
+        fixture("realdata/step/S06298.stp"),
+        vec!["--edges", "--place", "auto"],
+    ));
     for (name, input, more) in parts {
         let out = run(&input, "machines/gantry_ac.json", &more);
         check_page(&name, out.path(), "machines/gantry_ac.json");

@@ -44,15 +44,12 @@ fn surface(s: &RawSurface) -> NurbsSurface {
     .expect("valid surface")
 }
 
-/// `../shared/realdata/step` (the real STEP parts), if present; says so when it is not.
-fn real_step_dir() -> Option<std::path::PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/step");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipped: {} not present", dir.display());
-        None
-    }
+/// `fixtures/realdata/step` (the real STEP parts, shipped with the repository: a test on them
+/// cannot pass by skipping them).
+fn real_step_dir() -> std::path::PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/realdata/step");
+    assert!(dir.is_dir(), "{} is missing", dir.display());
+    dir
 }
 
 fn samples(c: &NurbsCurve, n: usize) -> Vec<Point3<f64>> {
@@ -390,9 +387,7 @@ fn gaps_above_the_threshold_open_the_contour() {
 #[test]
 fn real_sheet_metal_parts_read_with_edges() {
     // Every face loop (`with_sheet(false)`): every face read, every loop closed.
-    let Some(dir) = real_step_dir() else {
-        return;
-    };
+    let dir = real_step_dir();
     for (name, faces) in [("S01094.stp", 24), ("S06298.stp", 75)] {
         let opts = ImportOptions::default().with_edges(None).with_sheet(false);
         let im = import_file(dir.join(name), &opts).expect(name);
@@ -427,9 +422,7 @@ fn a_sheet_metal_solid_has_each_feature_cut_once() {
     // borders a wall is cut (within 1e-6 mm of a contour), and no contour runs beside another
     // at the sheet's thickness (its twin on the other face); the hole of S06298 is a circle of
     // radius 50 mm.
-    let Some(dir) = real_step_dir() else {
-        return;
-    };
+    let dir = real_step_dir();
     for (name, thickness, features) in [("S01094.stp", 2.65, 2), ("S06298.stp", 3.0, 2)] {
         let im =
             import_file(dir.join(name), &ImportOptions::default().with_edges(None)).expect(name);

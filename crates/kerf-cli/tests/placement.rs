@@ -312,10 +312,92 @@ fn step_parts_run_with_place_auto() {
             f.display(),
             String::from_utf8_lossy(&r.stderr)
         );
-        assert!(
-            out.path().join("report.json").exists(),
-            "{}: report",
+        // A recognised sheet's features lie on the side the head reaches (each piece that
+        // faces down was taken on its twin) and carry the sheet's thickness: none is turned
+        // over, which would stand the nozzle off from the far face, inside the sheet.
+        let report = read_json(&out.path().join("report.json"));
+        assert_eq!(
+            report["placement"]["flipped_paths"],
+            serde_json::json!([]),
+            "{}",
             f.display()
         );
+    }
+}
+
+/// A plate at z = 0 whose face looks down (-z), with a 40 mm circle on it; with
+/// `sheet_thickness_mm` where given.
+fn plate_facing_down(thickness: Option<f64>) -> String {
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    let mut curve = serde_json::json!({
+        "id": "hole",
+        "degree": 2,
+        "knots": [0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1],
+        "control_points": [[20, 0, 0], [20, -20, 0], [0, -20, 0], [-20, -20, 0], [-20, 0, 0],
+            [-20, 20, 0], [0, 20, 0], [20, 20, 0], [20, 0, 0]],
+        "weights": [1, w, 1, w, 1, w, 1, w, 1],
+        "surface": "plate",
+        "scrap": "left"
+    });
+    if let Some(t) = thickness {
+        curve["sheet_thickness_mm"] = serde_json::json!(t);
+    }
+    serde_json::json!({
+        "format": "kerf.curves/1",
+        "units": "mm",
+        "curves": [curve],
+        "surfaces": [{
+            "id": "plate", "type": "nurbs", "degree_u": 1, "degree_v": 1,
+            "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+            "control_points": [[[-50, -50, 0], [-50, 50, 0]], [[50, -50, 0], [50, 50, 0]]],
+            "flip": true
+        }]
+    })
+    .to_string()
+}
+
+#[test]
+fn a_thick_sheets_contour_is_never_turned_over() {
+    // The plate's face looks down, out of the A/C head's reach: a contour with no thickness
+    // is taken for a thin sheet's and turned over (the beam from above, through the same
+    // points); one on a 3 mm sheet is not (the nozzle would stand 2 mm inside the plate), so
+    // the part is turned instead, and the report says why the contour keeps its side.
+    let dir = tempfile::tempdir().expect("temporary directory");
+    for (thickness, turned) in [(None, true), (Some(3.0), false)] {
+        let input = dir.path().join("plate.json");
+        std::fs::write(&input, plate_facing_down(thickness)).expect("write");
+        let out = dir.path().join(format!("out-{turned}"));
+        let r = kerf()
+            .arg("run")
+            .arg(&input)
+            .arg("--machine")
+            .arg(fixture("machines/gantry_ac.json"))
+            .arg("--place")
+            .arg("auto")
+            .arg("--out")
+            .arg(&out)
+            .arg("-q")
+            .output()
+            .expect("run kerf");
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let report = read_json(&out.join("report.json"));
+        let placement = &report["placement"];
+        assert_eq!(
+            placement["flipped_paths"] == serde_json::json!(["hole"]),
+            turned,
+            "{thickness:?}: {placement}"
+        );
+        // The tool axes as written: with the plate turned over by the placement, or the
+        // contour turned, the beam comes from above either way.
+        let axes = read_json(&out.join("axes.json"));
+        assert!(axes["paths"].as_array().is_some_and(|p| !p.is_empty()));
+        if !turned {
+            let rot = placement["setups"][0]["rotation_deg"].clone();
+            assert_ne!(
+                rot,
+                serde_json::json!([0.0, 0.0, 0.0]),
+                "the part is turned: {rot}"
+            );
+        }
     }
 }

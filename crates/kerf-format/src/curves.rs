@@ -102,6 +102,13 @@ pub struct RawCurve {
     /// [`from_raw`]: finite, > 0 and at most [`MAX_CURVE_ON_SURFACE_TOLERANCE_MM`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub on_surface_tolerance_mm: Option<f64>,
+    /// The thickness of the sheet whose face the curve lies on, mm (optional
+    /// `sheet_thickness_mm` key): the beam enters at this face and leaves the thickness behind
+    /// it, so the curve is cut from its surface's side only (turned to the other side, the
+    /// nozzle would stand off from the far face, inside the sheet). Checked by [`from_raw`]:
+    /// finite, > 0 and at most [`MAX_SHEET_THICKNESS_MM`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sheet_thickness_mm: Option<f64>,
 }
 
 impl RawCurve {
@@ -123,6 +130,7 @@ impl RawCurve {
             start: None,
             scrap: None,
             on_surface_tolerance_mm: None,
+            sheet_thickness_mm: None,
         }
     }
 
@@ -155,7 +163,17 @@ impl RawCurve {
         self.on_surface_tolerance_mm = tolerance;
         self
     }
+
+    /// Sets the thickness of the sheet the curve's face bounds, mm.
+    pub fn with_sheet_thickness_mm(mut self, thickness: Option<f64>) -> Self {
+        self.sheet_thickness_mm = thickness;
+        self
+    }
 }
+
+/// The largest `sheet_thickness_mm` a curve may state, mm (a plate far thicker than any a laser
+/// cuts; the key exists to keep a thick sheet's contours on their side).
+pub const MAX_SHEET_THICKNESS_MM: f64 = 1000.0;
 
 /// The largest `on_surface_tolerance_mm` a curve may state, mm: farther from its surface a
 /// curve is not on it (its normals would be another place's).
@@ -323,6 +341,9 @@ pub struct CurveRecord {
     /// The curve's own on-surface tolerance, mm (the `on_surface_tolerance_mm` key): the
     /// normals stage takes the looser of it and the run's.
     pub on_surface_tolerance_mm: Option<f64>,
+    /// The thickness of the sheet whose face the curve lies on, mm (the `sheet_thickness_mm`
+    /// key): the curve is cut from its surface's side only, never turned to the other side.
+    pub sheet_thickness_mm: Option<f64>,
 }
 
 impl CurveRecord {
@@ -336,6 +357,7 @@ impl CurveRecord {
             start: None,
             scrap: None,
             on_surface_tolerance_mm: None,
+            sheet_thickness_mm: None,
         }
     }
 
@@ -362,6 +384,12 @@ impl CurveRecord {
     /// Sets the curve's own on-surface tolerance, mm.
     pub fn with_on_surface_tolerance_mm(mut self, tolerance: Option<f64>) -> Self {
         self.on_surface_tolerance_mm = tolerance;
+        self
+    }
+
+    /// Sets the thickness of the sheet whose face the curve lies on, mm.
+    pub fn with_sheet_thickness_mm(mut self, thickness: Option<f64>) -> Self {
+        self.sheet_thickness_mm = thickness;
         self
     }
 }
@@ -594,6 +622,8 @@ fn raw_in_one_pass(bytes: &[u8]) -> Option<(RawCurvesFile, Vec<UnknownKey>)> {
         scrap: Option<String>,
         #[serde(default)]
         on_surface_tolerance_mm: Option<f64>,
+        #[serde(default)]
+        sheet_thickness_mm: Option<f64>,
     }
     let body: Body = serde_json::from_slice(kerf_io::strip_bom(bytes)).ok()?;
     if body.format != CURVES_FORMAT || Units::from_name(&body.units).is_none() {
@@ -629,6 +659,7 @@ fn raw_in_one_pass(bytes: &[u8]) -> Option<(RawCurvesFile, Vec<UnknownKey>)> {
             start: c.start,
             scrap: c.scrap,
             on_surface_tolerance_mm: c.on_surface_tolerance_mm,
+            sheet_thickness_mm: c.sheet_thickness_mm,
         })
         .collect();
     let raw = RawCurvesFile {
@@ -753,6 +784,16 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
                 });
             }
         }
+        if let Some(t) = c.sheet_thickness_mm {
+            if !(t > 0.0 && t <= MAX_SHEET_THICKNESS_MM) {
+                return Err(FormatError::Shape {
+                    path: format!("curves[{index}].sheet_thickness_mm"),
+                    message: format!(
+                        "must be > 0 and at most {MAX_SHEET_THICKNESS_MM} mm (got {t})"
+                    ),
+                });
+            }
+        }
         curves.push(CurveRecord {
             id: c.id,
             curve,
@@ -761,6 +802,7 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
             start,
             scrap,
             on_surface_tolerance_mm: c.on_surface_tolerance_mm,
+            sheet_thickness_mm: c.sheet_thickness_mm,
         });
     }
 

@@ -32,7 +32,7 @@ pub mod toolpath;
 
 pub use curves::{
     CurveRecord, CurvesFile, ScrapSide, SurfaceGeometry, SurfaceRecord, SurfaceRef, SurfaceSource,
-    UnknownKey, MAX_CURVE_ON_SURFACE_TOLERANCE_MM,
+    UnknownKey, MAX_CURVE_ON_SURFACE_TOLERANCE_MM, MAX_SHEET_THICKNESS_MM,
 };
 pub use error::{FormatError, MeshDefect, Result, StlProblem};
 pub use toolpath::{KerfOffset, ToolpathFile, ToolpathPoints, ToolpathRecord};

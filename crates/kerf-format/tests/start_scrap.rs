@@ -144,3 +144,27 @@ fn a_curves_own_on_surface_tolerance_is_read_checked_and_written_back() {
         Some(0.02)
     );
 }
+
+#[test]
+fn a_curves_sheet_thickness_is_read_checked_and_written_back() {
+    let f = read(&doc(r#", "sheet_thickness_mm": 3"#, "")).expect("valid key");
+    assert_eq!(f.curves[1].sheet_thickness_mm, Some(3.0));
+    assert_eq!(f.curves[0].sheet_thickness_mm, None, "absent");
+    assert!(f.warnings.is_empty(), "not a near miss: {:?}", f.warnings);
+    for bad in ["0", "-2", "1000.5", "1e300"] {
+        let e = read(&doc(&format!(r#", "sheet_thickness_mm": {bad}"#), "")).expect_err("refused");
+        assert!(
+            e.contains("curves[1].sheet_thickness_mm")
+                && e.contains("must be > 0 and at most 1000 mm"),
+            "{bad}: {e}"
+        );
+    }
+    let raw =
+        curves::raw_from_slice(doc(r#", "sheet_thickness_mm": 2.5"#, "").as_bytes()).expect("raw");
+    let text = serde_json::to_string(&raw).expect("JSON");
+    assert!(text.contains(r#""sheet_thickness_mm":2.5"#), "{text}");
+    assert_eq!(
+        read(&text).expect("again").curves[1].sheet_thickness_mm,
+        Some(2.5)
+    );
+}

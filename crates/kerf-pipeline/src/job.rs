@@ -604,6 +604,14 @@ impl Job {
                     )));
                 }
             }
+            if let Some(t) = c.sheet_thickness_mm {
+                if !(t > 0.0 && t <= kerf_format::MAX_SHEET_THICKNESS_MM) {
+                    return Err(invalid(format!(
+                        "sheet_thickness_mm must be > 0 and at most {} mm (got {t})",
+                        kerf_format::MAX_SHEET_THICKNESS_MM
+                    )));
+                }
+            }
         }
         for (i, c) in self.curves.curves.iter().enumerate() {
             for sid in c.surface.iter().chain(&c.surfaces) {

@@ -7,9 +7,7 @@
 //! coordinates; the axes file, the program and the report are in workpiece coordinates, and
 //! the report says which placement was used.
 
-use kerf_kinematics::{
-    auto_setups, AutoPlaceOptions, Machine, PathOptions, Placement, Pose, Setup, SetupPlan,
-};
+use kerf_kinematics::{auto_setups, AutoPlaceOptions, Machine, Placement, Pose, Setup, SetupPlan};
 use serde_json::{json, Value};
 
 use crate::error::{kin, Error};
@@ -72,6 +70,9 @@ enum SideReason {
     HeadLinesUnreachable,
     /// Kept: the nozzle meets the part from both sides.
     BothSides,
+    /// Kept: the nozzle meets the part from the given side, but the contour lies on a thick
+    /// sheet's face, which the beam must enter.
+    Sheet,
 }
 
 impl Placed {
@@ -98,6 +99,7 @@ impl Placed {
             (true, true) => Some(SideReason::HeadLines),
             (true, false) => Some(SideReason::Reach),
             (false, true) => Some(SideReason::HeadLinesUnreachable),
+            (false, false) if h.on_sheet && h.given > 0 => Some(SideReason::Sheet),
             (false, false) => (h.given > 0 && h.other > 0).then_some(SideReason::BothSides),
         }
     }
@@ -133,6 +135,13 @@ impl Placed {
                         format!(
                             "the nozzle's line meets the part from both sides: the given side at {} of {} points (from {:.1} mm along the axis), the other at {} (from {:.1} mm)",
                             h.given, h.points, h.given_from_mm, h.other, h.other_from_mm
+                        ),
+                    ),
+                    SideReason::Sheet => (
+                        "given",
+                        format!(
+                            "the nozzle's line meets the part from the given side at {} of {} points (from {:.1} mm along the axis), but the contour lies on the face of a sheet of known thickness (sheet_thickness_mm), which the beam enters: it is never turned over",
+                            h.given, h.points, h.given_from_mm
                         ),
                     ),
                 };
@@ -223,9 +232,11 @@ impl Placed {
     }
 }
 
-/// The placement of the paths `ids` with `poses` for `mode`. [`PlaceMode::Auto`] keeps
-/// `clearance_mm` from every linear limit (the retract between contours moves the head that
-/// far along the tool axis); `file` is named in errors.
+/// The placement of the paths `ids` with `poses` for `mode`. [`PlaceMode::Auto`] searches
+/// with `auto`: its margin keeps the retract between contours (which moves the head along
+/// the tool axis) inside every linear limit, and its `flip` must be false for a thick sheet's
+/// contours (turned over, the nozzle would stand off from the far face); `file` is named in
+/// errors.
 ///
 /// # Errors
 /// [`Error::Kinematics`] when `auto` finds nothing that fits (the message names the axis and
@@ -235,8 +246,7 @@ pub fn place(
     ids: &[&str],
     poses: &[Vec<Pose>],
     mode: PlaceMode,
-    path_options: &PathOptions,
-    clearance_mm: f64,
+    auto: &AutoPlaceOptions,
     file: Option<&std::path::Path>,
 ) -> Result<Placed, Error> {
     let single = |placement: Placement| Placed {
@@ -262,14 +272,7 @@ pub fn place(
                 .copied()
                 .zip(poses.iter().map(Vec::as_slice))
                 .collect();
-            let plan = auto_setups(
-                machine,
-                &refs,
-                &AutoPlaceOptions::default()
-                    .with_path_options(*path_options)
-                    .with_margin_mm(clearance_mm),
-            )
-            .map_err(kin(file))?;
+            let plan = auto_setups(machine, &refs, auto).map_err(kin(file))?;
             Ok(Placed {
                 plan,
                 auto: true,
@@ -311,6 +314,16 @@ pub(crate) fn sides_by_head_lines(
             })
             .collect()
     };
+    // A thick sheet's contour stays on its side (the import put it on the side that faces
+    // up; turned over, the nozzle would stand off from the far face, inside the sheet).
+    let heads: Vec<kerf_process::HeadLines> = heads
+        .into_iter()
+        .zip(&file.curves)
+        .map(|(h, c)| match c.sheet_thickness_mm {
+            Some(_) => h.kept_on_sheet(),
+            None => h,
+        })
+        .collect();
     let turned = poses
         .iter()
         .zip(&heads)

@@ -89,8 +89,11 @@ pub fn post_toolpath(
         &ids,
         &poses,
         mode,
-        options,
-        AUTO_CLEARANCE_MM,
+        // A toolpath names no sheet thickness: its paths may be turned where only the other
+        // side is reachable, as a thin sheet's (the default).
+        &kerf_kinematics::AutoPlaceOptions::default()
+            .with_path_options(*options)
+            .with_margin_mm(AUTO_CLEARANCE_MM),
         source,
     )?;
     let poses = placed.apply(&poses);

@@ -261,8 +261,12 @@ fn run_placed(
         &id_refs,
         head_lines.as_ref().map_or(&poses, |(_, turned)| turned),
         o.place,
-        &popts,
-        placement_margin,
+        &kerf_kinematics::AutoPlaceOptions::default()
+            .with_path_options(popts)
+            .with_margin_mm(placement_margin)
+            // A thick sheet's contours are never turned over (the import put each on the
+            // side that faces up): with any in the file, the placement turns none.
+            .with_flip(!file.curves.iter().any(|c| c.sheet_thickness_mm.is_some())),
         path,
     )?;
     let placed = match head_lines {

@@ -26,6 +26,9 @@ pub struct HeadLines {
     pub given_from_mm: f64,
     /// The same on the other side, mm.
     pub other_from_mm: f64,
+    /// The contour lies on a face of a sheet of known thickness and is cut from that side
+    /// whatever its lines say ([`HeadLines::kept_on_sheet`]).
+    pub on_sheet: bool,
 }
 
 impl Default for HeadLines {
@@ -36,6 +39,7 @@ impl Default for HeadLines {
             other: 0,
             given_from_mm: f64::INFINITY,
             other_from_mm: f64::INFINITY,
+            on_sheet: false,
         }
     }
 }
@@ -44,7 +48,17 @@ impl HeadLines {
     /// True if the head meets the part from the given side and nowhere from the other: the
     /// contour is better cut from the other side of the sheet.
     pub fn prefers_other_side(&self) -> bool {
-        self.given > 0 && self.other == 0
+        self.given > 0 && self.other == 0 && !self.on_sheet
+    }
+
+    /// The same lines for a contour on a face of a thick sheet (a recognised sheet's
+    /// feature, the `sheet_thickness_mm` key): it is never turned to the other side, where
+    /// the nozzle would stand off from the far face, inside the sheet.
+    pub fn kept_on_sheet(self) -> Self {
+        Self {
+            on_sheet: true,
+            ..self
+        }
     }
 }
 

@@ -54,6 +54,8 @@ pub struct Contour {
     pub(crate) curve: NurbsCurve,
     pub(crate) faces: Vec<usize>,
     pub(crate) scrap: Option<&'static str>,
+    /// The thickness of the sheet whose face it lies on (a recognised sheet's feature), mm.
+    pub(crate) sheet_thickness_mm: Option<f64>,
 }
 
 impl Contour {
@@ -145,6 +147,7 @@ pub fn face_loop_contours(
                     curve: c.curve,
                     faces: vec![fi],
                     scrap: None,
+                    sheet_thickness_mm: None,
                 });
             }
             for e in edge_ids {
@@ -260,6 +263,7 @@ pub fn curve_contours<P: Place>(
             curve: c.curve,
             faces: named,
             scrap: None,
+            sheet_thickness_mm: None,
         });
     }
     Ok(contours)
@@ -344,6 +348,7 @@ pub fn finish(
         curve: c,
         faces: named,
         scrap,
+        sheet_thickness_mm,
     } in contours
     {
         let surface = match named.len() {
@@ -365,6 +370,9 @@ pub fn finish(
         ));
         let mut raw = raw_curve(id, &c, surface);
         raw.scrap = scrap.map(str::to_owned);
+        // A sheet's feature is cut from its side only (the import already put each piece on
+        // the side that faces up): the pipeline never turns it over.
+        raw.sheet_thickness_mm = sheet_thickness_mm;
         // A face's edge lies on the face within the file's own tolerance (the reader took
         // it within ON_GEOMETRY_TOLERANCE_MM): the curve says so, and the normals stage takes
         // the looser of it and the run's on-surface tolerance. Face edges are the contours of
@@ -480,7 +488,15 @@ pub fn sheet_contours(
             } else {
                 format!("{id} piece {}", p + 1)
             };
-            let edges: Vec<NurbsCurve> = piece.iter().map(|&e| f.edges[e].clone()).collect();
+            // A piece whose side faces down is cut on its twin, from the other side.
+            let twin = f.twins.get(p).and_then(Option::as_ref);
+            let (edges, edge_faces): (Vec<NurbsCurve>, Vec<usize>) = match twin {
+                Some(t) => (t.edges.clone(), t.edge_faces.clone()),
+                None => (
+                    piece.iter().map(|&e| f.edges[e].clone()).collect(),
+                    piece.iter().map(|&e| f.edge_faces[e]).collect(),
+                ),
+            };
             let j = contour::join(&edges, opts.close_gaps_mm, closed);
             note_join(report, &pid, &j);
             let n = j.contours.len();
@@ -492,8 +508,7 @@ pub fn sheet_contours(
                 };
                 // The faces this piece runs along.
                 let mut named: Vec<usize> = Vec::new();
-                for &e in piece {
-                    let fi = f.edge_faces[e];
+                for &fi in &edge_faces {
                     if !named.contains(&fi) {
                         named.push(fi);
                     }
@@ -503,6 +518,7 @@ pub fn sheet_contours(
                     curve: c.curve,
                     faces: named,
                     scrap: Some(scrap),
+                    sheet_thickness_mm: Some(s.thickness_mm),
                 });
             }
         }
@@ -512,8 +528,34 @@ pub fn sheet_contours(
             .map(|&(fi, li)| format!("{} loop {}", faces[fi].tag(), li + 1))
             .collect();
         let twins: Vec<String> = f.twin_faces.iter().map(|&fi| faces[fi].tag()).collect();
+        // Pieces that face down: cut on their twins, or (no twin found) as they are.
+        let down = |on_twin: bool| -> Vec<String> {
+            (0..f.pieces.len())
+                .filter(|&p| f.facing[p] < 0 && f.twins[p].is_some() == on_twin)
+                .map(|p| (p + 1).to_string())
+                .collect()
+        };
+        let (turned, kept) = (down(true), down(false));
+        let which = |ps: &[String]| match (closed, ps.len()) {
+            (true, _) => "it faces".to_string(),
+            (false, 1) => format!("piece {} faces", ps[0]),
+            _ => format!("pieces {} face", ps.join(", ")),
+        };
+        let mut other_side = String::new();
+        if !turned.is_empty() {
+            other_side += &format!(
+                "; {} down on this side: cut on the twin behind, on the other side, which faces up",
+                which(&turned)
+            );
+        }
+        if !kept.is_empty() {
+            other_side += &format!(
+                "; {} down and no twin was found behind: cut as on this side",
+                which(&kept)
+            );
+        }
         r.features.push(format!(
-            "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut",
+            "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut{other_side}",
             f.length_mm,
             if closed {
                 "one closed cut".to_string()

@@ -69,8 +69,22 @@ pub(crate) struct Feature {
     /// The chain cut into pieces whose side's normals face one way along z (indices into
     /// `edges`, in chain order): one piece for a feature the head reaches from one side, more
     /// where the side's normal turns from up to down (a flange's lip): each piece is then an
-    /// open contour, cut from the side the placement chooses for it.
+    /// open contour.
     pub(crate) pieces: Vec<Vec<usize>>,
+    /// Which way each piece's side normals face along z: +1 up, -1 down, 0 sideways.
+    pub(crate) facing: Vec<i8>,
+    /// For each piece, the stretch of the twin chain behind it where the piece faces down:
+    /// what is cut instead, from the other side of the sheet, which faces up there.
+    pub(crate) twins: Vec<Option<Twin>>,
+}
+
+/// The stretch of a feature's twin chain (on the other side of the sheet) behind one of its
+/// pieces, as the other side's loops run it.
+pub(crate) struct Twin {
+    /// The edges (the first and last cut where the piece's ends lie behind them).
+    pub(crate) edges: Vec<NurbsCurve>,
+    /// The face of the other side each edge bounds.
+    pub(crate) edge_faces: Vec<usize>,
 }
 
 /// A recognised sheet.
@@ -305,6 +319,12 @@ pub(crate) fn recognise<E>(
     thickness.sort_by(f64::total_cmp);
     let t = thickness[thickness.len() / 2];
     let (lo, hi) = (thickness[0], thickness[thickness.len() - 1]);
+    if t > kerf_format::MAX_SHEET_THICKNESS_MM {
+        return Ok(Err(format!(
+            "the walls are {t:.1} mm wide: thicker than any sheet ({} mm, the largest `sheet_thickness_mm`)",
+            kerf_format::MAX_SHEET_THICKNESS_MM
+        )));
+    }
     if !(t > 0.0) || hi - lo > THICKNESS_SPREAD * t + THICKNESS_SLACK_MM {
         return Ok(Err(format!(
             "the features' distance to the other side runs from {lo:.4} to {hi:.4} mm: not one sheet of constant thickness (or beveled walls)"
@@ -394,6 +414,16 @@ pub(crate) fn recognise<E>(
                 }
             }
             f.twin_faces = fs;
+            // A piece whose side faces down is cut from the other side: its twin stretch
+            // there faces up (the nozzle stands off from the face the beam enters).
+            for (j, piece) in f.pieces.iter().enumerate() {
+                if f.facing[j] >= 0 {
+                    continue;
+                }
+                charge(c[piece[0]].face, 2 * theirs[k].len())?;
+                f.twins[j] =
+                    twin_stretch(faces, c, piece, &theirs[k], t, slack, f.pieces.len() == 1);
+            }
         }
     }
     features.sort_by(|x, y| y.length_mm.total_cmp(&x.length_mm));
@@ -604,8 +634,22 @@ fn feature(faces: &[Face], sharp: &[(u64, Use, Use)], c: &[Use]) -> Feature {
             }
         })
         .collect();
+    let pieces = pieces(&facing);
+    // Sideways edges joined the run before them, so each run's first edge that faces one way
+    // gives the run's facing (0 only for a chain that is sideways throughout).
+    let piece_facing: Vec<i8> = pieces
+        .iter()
+        .map(|run| {
+            run.iter()
+                .map(|&e| facing[e])
+                .find(|&x| x != 0)
+                .unwrap_or(0)
+        })
+        .collect();
     Feature {
-        pieces: pieces(&facing),
+        twins: pieces.iter().map(|_| None).collect(),
+        facing: piece_facing,
+        pieces,
         edge_faces: c.iter().map(|u| u.face).collect(),
         edges,
         faces: fs,
@@ -614,6 +658,87 @@ fn feature(faces: &[Face], sharp: &[(u64, Use, Use)], c: &[Use]) -> Feature {
         scrap,
         length_mm: lengths.iter().sum(),
     }
+}
+
+/// The stretch of the twin chain `twin` (uses of the other side's loops, in their order) that
+/// lies the thickness `t` behind the piece `piece` of the chain `ours`: from behind the piece's
+/// end to behind its start, since the other side's loops run the other way round (each side's
+/// loops keep their face on the left seen from outside). The whole twin chain for a closed
+/// piece (`whole`). `None` where a piece end's point behind it is farther than `slack` from
+/// the twin chain, or the stretch is much longer than the piece (not its twin).
+fn twin_stretch(
+    faces: &[Face],
+    ours: &[Use],
+    piece: &[usize],
+    twin: &[Use],
+    t: f64,
+    slack: f64,
+    whole: bool,
+) -> Option<Twin> {
+    let edge = |u: &Use| &faces[u.face].loops[u.lp][u.pos];
+    if whole {
+        return Some(Twin {
+            edges: twin.iter().map(|u| edge(u).clone()).collect(),
+            edge_faces: twin.iter().map(|u| u.face).collect(),
+        });
+    }
+    let (first, last) = (&ours[*piece.first()?], &ours[*piece.last()?]);
+    let behind = |u: &Use, at_end: bool| -> Option<Point3<f64>> {
+        let e = edge(u);
+        let (a, b) = e.domain();
+        let p = e.point(if at_end { b } else { a });
+        Some(p - normal_at(&faces[u.face].surface, &p)? * t)
+    };
+    // Where a point lies on the twin chain: (edge, parameter), moved to the next edge's start
+    // when it is the end of its edge.
+    let n = twin.len();
+    let locate = |q: Point3<f64>| -> Option<(usize, f64)> {
+        let (i, pr) = twin
+            .iter()
+            .enumerate()
+            .map(|(i, u)| (i, edge(u).closest_point(&q)))
+            .min_by(|x, y| x.1.distance.total_cmp(&y.1.distance))?;
+        if pr.distance > slack {
+            return None;
+        }
+        let (a, b) = edge(&twin[i]).domain();
+        if b - pr.t <= 1e-9 * (b - a) {
+            let j = (i + 1) % n;
+            Some((j, edge(&twin[j]).domain().0))
+        } else {
+            Some((i, pr.t))
+        }
+    };
+    let (mut i, mut from) = locate(behind(last, true)?)?;
+    let (i_end, to) = locate(behind(first, false)?)?;
+    let mut out = Twin {
+        edges: Vec::new(),
+        edge_faces: Vec::new(),
+    };
+    for step in 0..=n {
+        let e = edge(&twin[i]);
+        let (a, b) = e.domain();
+        let eps = 1e-9 * (b - a);
+        if i == i_end && (step > 0 || to >= from) {
+            if to > from + eps {
+                out.edges.push(crate::curves::sub_curve(e, from, to).ok()?);
+                out.edge_faces.push(twin[i].face);
+            }
+            break;
+        }
+        if from < b - eps {
+            out.edges.push(crate::curves::sub_curve(e, from, b).ok()?);
+            out.edge_faces.push(twin[i].face);
+        }
+        i = (i + 1) % n;
+        from = edge(&twin[i]).domain().0;
+        if step == n {
+            return None;
+        }
+    }
+    let piece_len: f64 = piece.iter().map(|&k| edge(&ours[k]).arc_length()).sum();
+    let twin_len: f64 = out.edges.iter().map(NurbsCurve::arc_length).sum();
+    (!out.edges.is_empty() && twin_len <= 1.5 * piece_len + 10.0 * t).then_some(out)
 }
 
 /// `|n_z|` below which an edge's side normal counts as sideways (reachable from either side of

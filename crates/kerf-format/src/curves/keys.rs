@@ -21,6 +21,7 @@ const CURVE: &[&str] = &[
     "start",
     "scrap",
     "on_surface_tolerance_mm",
+    "sheet_thickness_mm",
 ];
 /// The keys of a `"type": "nurbs"` surface.
 const NURBS: &[&str] = &[

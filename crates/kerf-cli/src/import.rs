@@ -165,7 +165,7 @@ pub(crate) fn print_account(path: &Path, r: &kerf_step::Report, file: &CurvesFil
             Some(why) => eprintln!("  not one sheet ({why}): every face loop is cut"),
             None => {
                 eprintln!(
-                    "  one sheet {:.3} mm thick: {} features, each cut once on the side of faces {} ({} faces on the other side, {} walls not cut)",
+                    "  one sheet {:.3} mm thick: {} features, each cut once on the side of faces {} (or on the other side where that side faces down: {} faces; {} walls not cut)",
                     s.thickness_mm,
                     s.features.len(),
                     ids(s.id_prefix, &s.side),

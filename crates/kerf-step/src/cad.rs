@@ -555,7 +555,7 @@ pub fn sheet_contours(
             );
         }
         r.features.push(format!(
-            "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut{other_side}",
+            "{id}: {:.3} mm, scrap {scrap}, {}, from {} edges of {}; its twin on faces {} and the walls between not cut where this side is{other_side}",
             f.length_mm,
             if closed {
                 "one closed cut".to_string()

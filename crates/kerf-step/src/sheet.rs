@@ -7,7 +7,8 @@
 //! the sides at sharp edges. Every through-feature is a closed chain of sharp edges between one
 //! side and the walls, with a twin chain on the other side. kerf cuts each chain of the chosen
 //! side once, on that side's faces (the beam along their normal, through the sheet), with the
-//! scrap where the wall's outward normal points. The derivation and its limits are in
+//! scrap where the wall's outward normal points; a stretch where that side faces down is cut on
+//! its twin instead, from the other side, which faces up there. The derivation and its limits are in
 //! `docs/step.md` ("Sheet-metal solids").
 
 use std::collections::HashMap;
@@ -383,7 +384,8 @@ pub(crate) fn recognise<E>(
         }
     }
     let mut features: Vec<Feature> = ours.iter().map(|c| feature(faces, &sharp, c)).collect();
-    // Twins by the nearest chain centroid (for the report).
+    // Twins by the nearest chain centroid: for the report, and the chain a piece that faces
+    // down is cut on (`twin_stretch` checks that it lies behind the piece).
     let centroid = |c: &[Use]| -> Point3<f64> {
         // Length-weighted mean of points along every edge (a one-edge hole's middle point is
         // on the circle, not at its centre).
@@ -420,9 +422,10 @@ pub(crate) fn recognise<E>(
                 if f.facing[j] >= 0 {
                     continue;
                 }
-                charge(c[piece[0]].face, 2 * theirs[k].len())?;
-                f.twins[j] =
-                    twin_stretch(faces, c, piece, &theirs[k], t, slack, f.pieces.len() == 1);
+                let whole = f.pieces.len() == 1;
+                let tests = if whole { WHOLE_TWIN_TESTS } else { 2 };
+                charge(c[piece[0]].face, tests * (theirs[k].len() + 1))?;
+                f.twins[j] = twin_stretch(faces, c, piece, &theirs[k], t, slack, whole);
             }
         }
     }
@@ -660,12 +663,16 @@ fn feature(faces: &[Face], sharp: &[(u64, Use, Use)], c: &[Use]) -> Feature {
     }
 }
 
+/// Points of a closed chain checked to lie behind its twin before the whole twin is cut.
+const WHOLE_TWIN_TESTS: usize = 8;
+
 /// The stretch of the twin chain `twin` (uses of the other side's loops, in their order) that
 /// lies the thickness `t` behind the piece `piece` of the chain `ours`: from behind the piece's
 /// end to behind its start, since the other side's loops run the other way round (each side's
 /// loops keep their face on the left seen from outside). The whole twin chain for a closed
-/// piece (`whole`). `None` where a piece end's point behind it is farther than `slack` from
-/// the twin chain, or the stretch is much longer than the piece (not its twin).
+/// piece (`whole`), once up to [`WHOLE_TWIN_TESTS`] points of the chain have their points behind
+/// on it. `None` where a point behind is farther than `slack` from the twin chain, or the
+/// stretch is much longer than the piece (not its twin).
 fn twin_stretch(
     faces: &[Face],
     ours: &[Use],
@@ -676,19 +683,35 @@ fn twin_stretch(
     whole: bool,
 ) -> Option<Twin> {
     let edge = |u: &Use| &faces[u.face].loops[u.lp][u.pos];
+    let behind_at = |u: &Use, s: f64| -> Option<Point3<f64>> {
+        let e = edge(u);
+        let (a, b) = e.domain();
+        let p = e.point(a + (b - a) * s);
+        Some(p - normal_at(&faces[u.face].surface, &p)? * t)
+    };
+    let behind = |u: &Use, at_end: bool| behind_at(u, if at_end { 1.0 } else { 0.0 });
+    let piece_len: f64 = piece.iter().map(|&k| edge(&ours[k]).arc_length()).sum();
+    let plausible = |twin_len: f64| twin_len <= 1.5 * piece_len + 10.0 * t;
     if whole {
-        return Some(Twin {
+        // The chain was matched by its centroid: its points must lie behind this one's.
+        let near = |q: Point3<f64>| {
+            twin.iter()
+                .map(|u| edge(u).closest_point(&q).distance)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let step = piece.len().div_ceil(WHOLE_TWIN_TESTS).max(1);
+        for &k in piece.iter().step_by(step) {
+            if near(behind_at(&ours[k], 0.5)?) > slack {
+                return None;
+            }
+        }
+        let twin_len: f64 = twin.iter().map(|u| edge(u).arc_length()).sum();
+        return plausible(twin_len).then(|| Twin {
             edges: twin.iter().map(|u| edge(u).clone()).collect(),
             edge_faces: twin.iter().map(|u| u.face).collect(),
         });
     }
     let (first, last) = (&ours[*piece.first()?], &ours[*piece.last()?]);
-    let behind = |u: &Use, at_end: bool| -> Option<Point3<f64>> {
-        let e = edge(u);
-        let (a, b) = e.domain();
-        let p = e.point(if at_end { b } else { a });
-        Some(p - normal_at(&faces[u.face].surface, &p)? * t)
-    };
     // Where a point lies on the twin chain: (edge, parameter), moved to the next edge's start
     // when it is the end of its edge.
     let n = twin.len();
@@ -701,10 +724,15 @@ fn twin_stretch(
         if pr.distance > slack {
             return None;
         }
-        let (a, b) = edge(&twin[i]).domain();
-        if b - pr.t <= 1e-9 * (b - a) {
+        // Within the slack of an end of its edge: that end (a wall a little off square puts
+        // the point behind a hair short of the twin's vertex; no sliver is cut for it).
+        let e = edge(&twin[i]);
+        let (a, b) = e.domain();
+        if (e.point(b) - pr.point).norm() <= slack {
             let j = (i + 1) % n;
             Some((j, edge(&twin[j]).domain().0))
+        } else if (e.point(a) - pr.point).norm() <= slack {
+            Some((i, a))
         } else {
             Some((i, pr.t))
         }
@@ -736,9 +764,8 @@ fn twin_stretch(
             return None;
         }
     }
-    let piece_len: f64 = piece.iter().map(|&k| edge(&ours[k]).arc_length()).sum();
     let twin_len: f64 = out.edges.iter().map(NurbsCurve::arc_length).sum();
-    (!out.edges.is_empty() && twin_len <= 1.5 * piece_len + 10.0 * t).then_some(out)
+    (!out.edges.is_empty() && plausible(twin_len)).then_some(out)
 }
 
 /// `|n_z|` below which an edge's side normal counts as sideways (reachable from either side of

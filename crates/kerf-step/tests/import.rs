@@ -524,6 +524,54 @@ fn a_sheet_metal_solid_has_each_feature_cut_once() {
                 );
             }
         }
+        // The scrap side's name holds on every contour, the twins too (their normal and
+        // direction both reversed): `left` is the side of n x t, and the wall beside the
+        // contour has its outward normal (toward the scrap) that way.
+        for (c, k) in im.file.curves.iter().zip(&cut) {
+            let (a, b) = k.domain();
+            let mut votes = [0usize; 2];
+            for j in 1..8 {
+                let u = a + (b - a) * j as f64 / 8.0;
+                let (p, tangent) = (k.point(u), k.tangent(u).expect("a tangent"));
+                let normal_of = |fs: &[&NurbsSurface]| {
+                    let (f, at) = fs
+                        .iter()
+                        .map(|f| (f, f.closest_point(&p, None)))
+                        .min_by(|x, y| x.1.distance.total_cmp(&y.1.distance))
+                        .expect("a face");
+                    f.normal(at.u, at.v).expect("a normal")
+                };
+                let named: Vec<&NurbsSurface> = c
+                    .surface
+                    .as_ref()
+                    .expect("a face")
+                    .ids()
+                    .iter()
+                    .map(|i| &surf[i])
+                    .collect();
+                let n = normal_of(&named);
+                // The wall beside the contour: on it, and along it (at a corner another wall
+                // touches the point too, across the contour).
+                let w = walls
+                    .iter()
+                    .filter_map(|f| {
+                        let at = f.closest_point(&p, None);
+                        let w = f.normal(at.u, at.v)?;
+                        (at.distance < 1e-6).then_some(w)
+                    })
+                    .min_by(|x, y| x.dot(&tangent).abs().total_cmp(&y.dot(&tangent).abs()))
+                    .expect("a wall beside the contour");
+                votes[usize::from(n.cross(&tangent).dot(&w) > 0.0)] += 1;
+            }
+            let left = c.scrap.as_deref() == Some("left");
+            assert_eq!(
+                votes[usize::from(left)],
+                7,
+                "{name}: {} scrap {:?}, votes (right, left) {votes:?}",
+                c.id,
+                c.scrap
+            );
+        }
         // S06298's outline runs over a flange lip whose cut side faces down: three pieces.
         let lip = if name == "S06298.stp" { 3 } else { 0 };
         assert_eq!(on_other, lip, "{name}: pieces on the other side");

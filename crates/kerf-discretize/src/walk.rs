@@ -224,7 +224,7 @@ impl Walker<'_> {
         out: &mut Discretization,
     ) -> Result<()> {
         #[cfg(target_arch = "x86_64")]
-        if x86_64_v3() && !tests::generic_only() {
+        if x86_64_v3() && !generic_only() {
             // SAFETY: `piece_v3` only needs the target features that `x86_64_v3` has just
             // found on this processor.
             return unsafe { self.piece_v3(a, b, pb, out) };
@@ -604,11 +604,17 @@ fn next_step(model: &Taylor, h: f64, err: f64, target: f64) -> f64 {
     }
 }
 
-#[cfg(not(test))]
-mod tests {
-    /// Outside the tests, the walk always takes the fastest code the processor runs.
-    #[inline(always)]
-    pub(super) fn generic_only() -> bool {
+/// Whether this thread's walks are held to the code compiled for any processor: only the test
+/// that compares the two walks asks for it; outside the tests the walk always takes the fastest
+/// code the processor runs.
+#[inline(always)]
+fn generic_only() -> bool {
+    #[cfg(test)]
+    {
+        tests::generic_only()
+    }
+    #[cfg(not(test))]
+    {
         false
     }
 }

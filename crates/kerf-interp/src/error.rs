@@ -176,7 +176,7 @@ pub enum InterpError {
     /// key, as `process.beam_on[0]: must not be empty`). Fix: correct the `process` object of
     /// the machine file.
     #[error("{0}")]
-    Process(String),
+    Process(#[source] kerf_kinematics::BoxedKinematicsError),
     /// A program for a dialect whose blocks join neighbouring poses only holds an arc or a line
     /// merged over several poses: the raw-axis dialects (`generic`, `linuxcnc`: the controller
     /// interpolates every axis linearly, so the chords would move the rotary axes in steps the

@@ -231,7 +231,7 @@ pub fn plan_cuts(contours: &[Contour<'_>], options: &LeadOptions) -> Result<CutP
     let leads: Vec<lead::Leads> = (0..n)
         .map(|i| lead::Leads::new(&contours[i], projected[i].as_ref(), sides[i], options))
         .collect();
-    Ok(order::plan(contours, &inside, sides, leads, options))
+    Ok(order::plan(contours, &inside, sides, leads))
 }
 
 /// The scrap side of every contour, as [`plan_cuts`] decides it: the curve's own `scrap` key,

@@ -1,7 +1,7 @@
 //! The cutting order: holes before the contours around them, then the shortest traverse.
 
 use crate::geometry::position;
-use crate::lead::{LeadIn, LeadOptions, Leads};
+use crate::lead::{LeadIn, Leads};
 use crate::{Contour, PoseArray, Side};
 
 /// Most cost evaluations (each one pass over the order) the 2-opt improvement may spend: the
@@ -57,7 +57,6 @@ pub(crate) fn plan(
     inside: &[Vec<usize>],
     sides: Vec<Option<Side>>,
     leads: Vec<Leads>,
-    _options: &LeadOptions,
 ) -> CutPlan {
     let n = contours.len();
     // before[a][b]: a must be cut before b (a lies inside b).

@@ -140,7 +140,7 @@ impl ProcessCodes {
     pub fn resolve(dialect: Dialect, process: &kerf_kinematics::Process) -> Result<Self> {
         process
             .validate()
-            .map_err(|e| InterpError::Process(e.to_string()))?;
+            .map_err(|e| InterpError::Process(e.into()))?;
         let d = dialect.default_process();
         Ok(Self {
             beam_on: process.beam_on.clone().unwrap_or(d.beam_on),

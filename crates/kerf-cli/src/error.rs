@@ -73,15 +73,30 @@ impl std::error::Error for CliError {
     }
 }
 
-/// The command-line options that change the outcome of a discretizer error.
+/// The command-line options that change the outcome of an error (the library's messages name
+/// its options, the command line's flags are named here).
 fn hint(e: &kerf_pipeline::Error) -> Option<&'static str> {
     use kerf_discretize::DiscretizeError as E;
+    use kerf_pipeline::Error as P;
+    let discretize = |source: &E| match source {
+        E::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-points"),
+        E::ToleranceBelowPrecision { .. } => Some("option: a larger --tolerance"),
+        E::TurnUnreachable { .. } => Some("option: a larger --max-turn (degrees)"),
+        _ => None,
+    };
     match e {
-        kerf_pipeline::Error::Discretize { source, .. } => match source {
-            E::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-points"),
-            E::ToleranceBelowPrecision { .. } => Some("option: a larger --tolerance"),
+        P::Discretize { source, .. } => discretize(source),
+        P::Normals { source, .. } => match source {
+            kerf_normals::NormalsError::TooManyInserted { .. } => {
+                Some("option: a larger --max-normal-step (degrees)")
+            }
+            kerf_normals::NormalsError::Discretize(d) => discretize(d),
             _ => None,
         },
+        P::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-total-points"),
+        P::NoNormals { .. } => {
+            Some("run kerf discretize --normals on curves that name their surface")
+        }
         _ => None,
     }
 }

@@ -725,3 +725,26 @@ fn a_beam_code_of_megabytes_is_refused_by_name() {
     );
     assert!(!out.exists(), "nothing written");
 }
+
+#[test]
+fn the_library_names_its_options_and_the_command_line_its_flags() {
+    // A job over its point budget: the pipeline's message names the option
+    // (`max_total_points`), the command line adds the flags that change it.
+    let out = tempfile::tempdir().expect("temporary directory");
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(fixture("circle.json"))
+        .arg("-m")
+        .arg(fixture(MACHINE))
+        .arg("--max-total-points")
+        .arg("4")
+        .arg("--out")
+        .arg(out.path().join("o")));
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("raise the limit (max_total_points)")
+            && err.contains("[options: a larger --tolerance, or --max-total-points]"),
+        "{err}"
+    );
+    assert!(!out.path().join("o").exists(), "nothing written");
+}

@@ -61,9 +61,9 @@ pub enum DiscretizeError {
     },
     /// No step after `t`, however short, keeps the tangent's turn within `max_turn`: the
     /// tangent turns abruptly there (a corner or cusp inside a knot span). Fix: raise
-    /// `max_turn` (`--max-turn`), or split the curve at the corner so that it becomes a C0
+    /// [`crate::Options::max_turn_rad`], or split the curve at the corner so that it becomes a C0
     /// break.
-    #[error("the tangent turns by more than max_turn = {max_turn_deg:.3} degrees at t = {} however short the segment (a corner inside a knot span); raise --max-turn or split the curve there", Readable(*.t))]
+    #[error("the tangent turns by more than max_turn = {max_turn_deg:.3} degrees at t = {} however short the segment (a corner inside a knot span); raise max_turn_rad or split the curve there", Readable(*.t))]
     TurnUnreachable {
         /// Parameter where the walk got stuck.
         t: f64,
@@ -72,7 +72,7 @@ pub enum DiscretizeError {
     },
     /// The discretization would exceed [`crate::Options::max_points`]. Fix: raise the
     /// tolerance, or raise the limit if the count is really wanted.
-    #[error("more than {limit} cutting points would be needed (estimated {}); raise the tolerance, or the limit with --max-points (Options::max_points)", Readable(.estimate.round()))]
+    #[error("more than {limit} cutting points would be needed (estimated {}); raise the tolerance, or the limit (Options::max_points)", Readable(.estimate.round()))]
     TooManyPoints {
         /// The limit.
         limit: usize,

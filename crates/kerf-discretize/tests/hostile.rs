@@ -503,7 +503,7 @@ fn messages_print_readable_numbers() {
     assert_eq!(
         e.to_string(),
         "more than 50000000 cutting points would be needed (estimated 3.2e15); raise the \
-         tolerance, or the limit with --max-points (Options::max_points)",
+         tolerance, or the limit (Options::max_points)",
         "readable and names the option"
     );
     let e = DiscretizeError::ToleranceBelowPrecision {

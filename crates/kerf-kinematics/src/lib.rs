@@ -71,7 +71,7 @@ pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, Solve
 pub use path::{LIMIT_SLACK, MAX_TILT_TOLERANCE_DEG, UNIT_AXIS_TOLERANCE};
 pub use placement::{
     auto_place, auto_setups, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement,
-    Placement, Setup, SetupPlan,
+    Placement, PlacementParseError, Setup, SetupPlan, MAX_PLACEMENT_VALUE,
 };
 pub use pose::{Axes, Axis, Pose};
 pub use registry::kinematics_types;

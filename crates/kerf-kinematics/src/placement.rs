@@ -128,26 +128,23 @@ impl Placement {
     /// Reads `X,Y,Z` or `X,Y,Z,RX,RY,RZ` (mm and degrees), as the CLI's `--place` takes it.
     ///
     /// # Errors
-    /// A message naming the bad field.
-    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+    /// [`PlacementParseError`] naming the bad field.
+    pub fn parse(text: &str) -> std::result::Result<Self, PlacementParseError> {
         let fields: Vec<&str> = text.split(',').map(str::trim).collect();
         if fields.len() != 3 && fields.len() != 6 {
-            return Err(format!(
-                "expected X,Y,Z or X,Y,Z,RX,RY,RZ (mm, degrees) or auto, got {} values",
-                fields.len()
-            ));
+            return Err(PlacementParseError::Count(fields.len()));
         }
-        let names = ["X", "Y", "Z", "RX", "RY", "RZ"];
+        const NAMES: [&str; 6] = ["X", "Y", "Z", "RX", "RY", "RZ"];
         let mut v = [0.0; 6];
         for (k, f) in fields.iter().enumerate() {
+            let field = NAMES[k];
+            let text = (*f).to_owned();
             let x: f64 = f
                 .parse()
-                .map_err(|_| format!("{}: not a number: {f:?}", names[k]))?;
-            if !x.is_finite() || x.abs() > 1e7 {
-                return Err(format!(
-                    "{}: must be finite and within 1e7 (got {f})",
-                    names[k]
-                ));
+                .map_err(|_| PlacementParseError::NotANumber { field, text })?;
+            if !x.is_finite() || x.abs() > MAX_PLACEMENT_VALUE {
+                let text = (*f).to_owned();
+                return Err(PlacementParseError::OutOfRange { field, text });
             }
             v[k] = x;
         }
@@ -156,6 +153,34 @@ impl Placement {
             [v[3], v[4], v[5]],
         ))
     }
+}
+
+/// The largest magnitude of a value of a placement's text (mm or degrees).
+pub const MAX_PLACEMENT_VALUE: f64 = 1e7;
+
+/// What is wrong with a placement's text ([`Placement::parse`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlacementParseError {
+    /// Neither three values nor six.
+    #[error("expected X,Y,Z or X,Y,Z,RX,RY,RZ (mm, degrees) or auto, got {0} values")]
+    Count(usize),
+    /// A field that is not a number.
+    #[error("{field}: not a number: {text:?}")]
+    NotANumber {
+        /// The field's name (`X`, ..., `RZ`).
+        field: &'static str,
+        /// Its text.
+        text: String,
+    },
+    /// A field that is not finite or beyond [`MAX_PLACEMENT_VALUE`].
+    #[error("{field}: must be finite and within 1e7 (got {text})")]
+    OutOfRange {
+        /// The field's name (`X`, ..., `RZ`).
+        field: &'static str,
+        /// Its text.
+        text: String,
+    },
 }
 
 impl std::fmt::Display for Placement {

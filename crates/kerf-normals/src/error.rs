@@ -55,7 +55,7 @@ pub enum NormalsError {
     Discretize(#[from] kerf_discretize::DiscretizeError),
     /// Inserting points against the normal step would exceed the limit. Fix: raise
     /// `max_normal_step_rad`.
-    #[error("more than {limit} points inserted for the normal step; raise max_normal_step_rad (--max-normal-step, degrees)")]
+    #[error("more than {limit} points inserted for the normal step; raise the options' max_normal_step_rad")]
     TooManyInserted {
         /// The limit.
         limit: usize,

@@ -69,9 +69,9 @@ pub enum Error {
     /// [`crate::JobOptions`] or [`crate::discretize_curves_within`]), found from the
     /// discretizer's estimate before a curve's points are allocated or from the running total.
     /// Nothing after discretization was computed. Fix: a coarser tolerance, fewer curves, or a
-    /// higher limit (`kerf run --max-total-points`).
+    /// higher limit.
     #[error(
-        "{}the job needs more than {limit} cutting points (at least {reached:.0} by curves[{index}] ({id:?})); raise the limit (--max-total-points) or the tolerance",
+        "{}the job needs more than {limit} cutting points (at least {reached:.0} by curves[{index}] ({id:?})); raise the limit (max_total_points) or the tolerance",
         at(file)
     )]
     TooManyPoints {
@@ -102,7 +102,7 @@ pub enum Error {
     /// ([`crate::MissingSurface::Error`]). Fix: add `"surface": "<id>"` to the curve, or cut it
     /// with a vertical beam ([`crate::MissingSurface::Vertical`]).
     #[error(
-        "{}curves[{index}] ({id:?}): --normals needs a surface, but the curve names none (add \"surface\": \"<id>\")",
+        "{}curves[{index}] ({id:?}): normals need a surface, but the curve names none (add \"surface\": \"<id>\")",
         at(file)
     )]
     MissingSurface {
@@ -144,9 +144,10 @@ pub enum Error {
         surface: String,
     },
     /// A toolpath's points have no normals, so they cannot be put on a 5-axis machine. Fix:
-    /// discretize with normals (`kerf discretize --normals`) on curves that name their surface.
+    /// discretize with normals ([`crate::orient_curves`], `kerf discretize --normals`) curves
+    /// that name their surface.
     #[error(
-        "{}paths[{index}] ({id:?}): points have no normals; run `kerf discretize --normals` on curves that name their surface",
+        "{}paths[{index}] ({id:?}): points have no normals; discretize with normals curves that name their surface",
         at(file)
     )]
     NoNormals {

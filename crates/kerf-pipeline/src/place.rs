@@ -35,8 +35,8 @@ impl PlaceMode {
     /// Reads `auto` or `X,Y,Z[,RX,RY,RZ]` (mm, degrees; `p' = Rz Ry Rx p + t`).
     ///
     /// # Errors
-    /// A message saying what is wrong with the text.
-    pub fn parse(text: &str) -> Result<PlaceMode, String> {
+    /// [`kerf_kinematics::PlacementParseError`] naming what is wrong with the text.
+    pub fn parse(text: &str) -> Result<PlaceMode, kerf_kinematics::PlacementParseError> {
         if text.trim().eq_ignore_ascii_case("auto") {
             Ok(PlaceMode::Auto)
         } else {

@@ -101,7 +101,7 @@ fn a_job_above_its_point_limit_is_refused_before_the_points_are_made() {
         }
         other => panic!("not TooManyPoints: {other:?}"),
     }
-    assert!(e.to_string().contains("--max-total-points"), "{e}");
+    assert!(e.to_string().contains("max_total_points"), "{e}");
     // Forty circles of 50 mm at 0.01 mm: 157 points each, 6,280 in all. Each fits, together
     // they do not.
     let mut file = kerf_pipeline::Job::on_machine(machine());

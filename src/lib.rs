@@ -19,8 +19,10 @@
 //!    [`iges`]: the same contours and faces read from a STEP or an IGES file.
 //! 3. [`discretize`]: cutting points with a certified chord error.
 //! 4. [`normals`]: the surface normal of every cutting point.
-//! 5. [`process`]: scrap sides, start points, lead-ins and the cutting order.
-//! 6. [`kinematics`]: poses to machine axes, `kerf.axes/1`.
+//! 5. [`kinematics`]: poses to machine axes, `kerf.axes/1`.
+//! 6. [`process`]: scrap sides, start points, lead-ins, the cutting order, kerf offsets, the
+//!    head's clearance and the checked traverses (it places and solves poses with
+//!    [`kinematics`], so it comes after it).
 //! 7. [`interp`]: time-division interpolation, feed planning, set-points and G-code.
 //! 8. [`pipeline`]: the stages chained ([`Job`]); its items are also here at the top.
 //!

@@ -1,6 +1,7 @@
 //! The whole chain on every shipped fixture with surfaces, through the built `kerf` binary:
-//! `validate`, `discretize --normals`, `check`, `post`, `interpolate`, `gcode` (both dialects)
-//! and `plot`, each output read back and checked against the fixture and the machine.
+//! `validate`, `discretize --normals`, `check`, `post`, `interpolate`, `gcode` (generic and
+//! Sinumerik; the other dialects have tests of their own) and `plot`, each output read back and
+//! checked against the fixture and the machine.
 //!
 //! The fixtures come from `cargo run --release --example make_fixtures` (see
 //! `fixtures/README.md`); the machines from `fixtures/machines/`.
@@ -215,7 +216,7 @@ fn pipeline(name: &str, machine: &str, curves: usize) {
         "{name}: the start and one row per cycle"
     );
 
-    // gcode, both dialects: one program, every curve announced.
+    // gcode, generic and Sinumerik: one program, every curve announced.
     for (dialect, out) in [("generic", &nc), ("sinumerik", &mpf)] {
         run(&[
             "gcode".as_ref(),

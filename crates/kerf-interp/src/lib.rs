@@ -14,7 +14,9 @@
 //!    machine is at rest), the linear axes from the machine model (eq 16 for paper 000's head,
 //!    [`AxisModel`] in general). [`Block::constant_feed`] keeps paper 000's own interpolation
 //!    of one block (eq 3-12).
-//! 4. [`write_csv`], [`gcode`]: the set-points CSV of `formats.md`, generic and Sinumerik-style G-code.
+//! 4. [`write_csv`], [`gcode`]: the set-points CSV of `formats.md`, and G-code in every
+//!    [`Dialect`]: generic, LinuxCNC (joint space and tool tip), Sinumerik, Fanuc (G43.4 and
+//!    G43.5) and HEIDENHAIN (LN and axis blocks).
 //!
 //! The machine is any [`AxisModel`]: [`MachineModel`] for kerf's `kerf.machine/1` machines
 //! (all four types, from `kerf-kinematics`; [`stations_from_solved`] takes its solved paths),

@@ -55,7 +55,7 @@ pub fn read_file(path: &Path) -> io::Result<Vec<u8>> {
 /// link is followed): for files named *inside* a document (an STL surface's `path`), which the
 /// user did not hand to kerf on the command line and which must not make kerf wait or read
 /// without end. A FIFO is refused before it is opened (opening one blocks until a writer
-/// comes: the review's STL path naming a FIFO hung forever), a device without reading from it
+/// comes: an STL path naming a FIFO hung forever before this check), a device without reading from it
 /// (`/dev/zero` was read 1 GiB deep before the limit refused it). The file is opened
 /// non-blocking and checked again, so one swapped for a FIFO in between cannot block either.
 ///

@@ -116,7 +116,7 @@ pub struct JobOptions {
     /// a job that needs more is refused from the discretizer's estimate before the points are
     /// allocated, or as soon as the running total passes it. Every later stage (normals,
     /// machine axes, the program, the set-points, the plot) grows with the cutting points, at
-    /// about 3 KB each in all: the review's 600-byte circle at `-t 1e-8` made 594,000 points,
+    /// about 3 KB each in all: a 600-byte circle at `-t 1e-8` made 594,000 points,
     /// 1.9 GB and 55 s. Default [`DEFAULT_MAX_TOTAL_POINTS_RUN`] (1,000,000).
     pub max_total_points: usize,
     /// A contour whose only named surface is a wall at most this wide across it (a hole's or

@@ -38,6 +38,11 @@ pub(crate) enum CliError {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            CliError::Pipeline(
+                e @ (kerf_pipeline::Error::Step(_) | kerf_pipeline::Error::Iges(_)),
+            ) => {
+                write!(f, "{}", with_flags(e.to_string()))
+            }
             CliError::Pipeline(e) => {
                 write!(f, "{e}")?;
                 if let Some(hint) = hint(e) {
@@ -70,6 +75,15 @@ impl std::error::Error for CliError {
             CliError::Check(e) => Some(e),
             _ => None,
         }
+    }
+}
+
+/// A reader's message with the command line's flag for the option it names.
+pub(crate) fn with_flags(message: String) -> String {
+    if message.contains("ImportOptions::with_edges") {
+        format!("{message} [option: --edges]")
+    } else {
+        message
     }
 }
 

@@ -126,9 +126,11 @@ pub(crate) fn options(a: &StepArgs) -> Result<ImportOptions, CliError> {
 pub(crate) fn load_step(path: &Path, a: &StepArgs) -> Result<(CurvesFile, Import), CliError> {
     let opts = options(a)?;
     let import = if kerf_pipeline::is_iges(path) {
-        kerf_iges::import_file(path, &opts).map_err(|e| CliError::Input(e.to_string()))?
+        kerf_iges::import_file(path, &opts)
+            .map_err(|e| CliError::Input(crate::error::with_flags(e.to_string())))?
     } else {
-        kerf_step::import_file(path, &opts).map_err(|e| CliError::Input(e.to_string()))?
+        kerf_step::import_file(path, &opts)
+            .map_err(|e| CliError::Input(crate::error::with_flags(e.to_string())))?
     };
     let file = import.to_curves().map_err(|e| {
         CliError::Input(format!(

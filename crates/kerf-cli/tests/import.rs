@@ -61,6 +61,25 @@ fn no_usable_contour_exits_1_and_writes_nothing() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("no usable contour"), "{err}");
     assert!(!out.exists(), "nothing written");
+    // Faces without cut curves: the reader names its option, the command line its flag.
+    for cmd in ["import", "run"] {
+        let mut c = kerf();
+        c.arg(cmd).arg(fixture("step/faces.step"));
+        if cmd == "run" {
+            c.arg("-m")
+                .arg(fixture("machines/gantry_ac.json"))
+                .arg("--out")
+                .arg(dir.path().join("run"));
+        } else {
+            c.arg("-o").arg(&out);
+        }
+        let (code, _, err) = run(&mut c);
+        assert_eq!(code, 1, "{err}");
+        assert!(
+            err.contains("ImportOptions::with_edges") && err.ends_with("[option: --edges]\n"),
+            "{cmd}: {err}"
+        );
+    }
 
     std::fs::write(&step, "ISO-10303-21;\nDATA;\n#1=CIRCLE('',#2,3.;\n").unwrap();
     let (code, _, err) = run(kerf().arg("import").arg(&step).arg("-o").arg(&out));

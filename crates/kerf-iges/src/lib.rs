@@ -464,7 +464,7 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
         if contours.is_empty() && opts.sheet && !faces.is_empty() {
             if let Ok(s) = cad::recognise_sheet(&faces, charge)? {
                 report.warnings.push(format!(
-                    "no free curve: the {} faces form one sheet {:.3} mm thick, whose {} features are cut (as with --edges)",
+                    "no free curve: the {} faces form one sheet {:.3} mm thick, whose {} features are cut (as with the edges option)",
                     faces.len(),
                     s.thickness_mm(),
                     s.feature_count()
@@ -487,7 +487,7 @@ pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Import> {
             )
         } else {
             format!(
-                "no free-standing curve ({} faces read; try --edges to cut their boundary loops)",
+                "no free-standing curve ({} faces read; the edges option, ImportOptions::with_edges, cuts their boundary loops)",
                 faces.len()
             )
         };

@@ -429,7 +429,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
         match sheet::recognise(&faces, |f, n| step_charge(&m, &faces, f, n))? {
             Ok(s) => {
                 report.warnings.push(format!(
-                    "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET: the {} faces form one sheet {:.3} mm thick, whose {} features are cut (as with --edges)",
+                    "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET: the {} faces form one sheet {:.3} mm thick, whose {} features are cut (as with the edges option)",
                     faces.len(),
                     s.thickness_mm,
                     s.features.len()
@@ -449,7 +449,7 @@ pub fn import(text: &str, opts: &ImportOptions) -> Result<Import> {
             )
         } else {
             format!(
-                "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET ({} faces read{}; try --edges to cut their boundary loops)",
+                "no curve in a GEOMETRIC_SET or GEOMETRIC_CURVE_SET ({} faces read{}; the edges option, ImportOptions::with_edges, cuts their boundary loops)",
                 faces.len(),
                 not_a_sheet.map_or_else(String::new, |why| format!(", not one sheet: {why}"))
             )

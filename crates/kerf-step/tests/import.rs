@@ -297,7 +297,7 @@ fn errors_name_the_entity() {
     )
     .unwrap_err();
     assert!(matches!(e, StepError::NoContour { .. }), "{e}");
-    assert!(e.to_string().contains("try --edges"), "{e}");
+    assert!(e.to_string().contains("ImportOptions::with_edges"), "{e}");
 
     let e = import(
         "ISO-10303-21;\nDATA;\n#1=LINE('',#2,#3;\n",

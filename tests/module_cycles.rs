@@ -5,9 +5,13 @@
 //! A module depends on another where its source names it: `crate::b` (in `use` or in a path,
 //! also inside `use crate::{b::X, c}`), `super::b` from a top-level module, or an item that the
 //! crate root re-exports from `b` (`crate::X` with `pub use b::X` in `lib.rs`/`main.rs`).
-//! Comments are skipped. Modules nested inside a top-level module (`src/a/x.rs`) count as `a`:
-//! a parent and its children may use each other. The crate root itself is not a node (it
-//! declares and re-exports every module).
+//! Comments are skipped. Modules nested inside a top-level module (`src/a/x.rs`) count as `a`
+//! in that graph: a parent and its children may use each other. The crate root itself is not a
+//! node (it declares and re-exports every module).
+//!
+//! Siblings get the same rule one level down: the child modules of any module (`src/a/x.rs`,
+//! `src/a/y.rs`, ...) must use each other without a cycle, where `x` uses `y` when its source
+//! names `super::y` or `crate::a::y` (the parent, which declares them, is not a node).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -217,6 +221,58 @@ fn find_cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
     None
 }
 
+/// For every module directory under `src` (`src/a/`, `src/a/b/`, ...), the dependency graph of
+/// its child modules through `super::y` and `crate::a::y`.
+fn sibling_graphs(src: &Path) -> Vec<(PathBuf, BTreeMap<String, BTreeSet<String>>)> {
+    let mut out = Vec::new();
+    let mut stack: Vec<PathBuf> = fs::read_dir(src)
+        .expect("read src")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.is_dir())
+        .collect();
+    while let Some(dir) = stack.pop() {
+        let mut children: BTreeMap<String, Option<String>> = BTreeMap::new();
+        for entry in fs::read_dir(&dir).expect("read module dir") {
+            let path = entry.expect("entry").path();
+            let name = path
+                .file_stem()
+                .expect("a name")
+                .to_string_lossy()
+                .to_string();
+            if path.is_dir() {
+                stack.push(path);
+                children.entry(name).or_insert(None);
+            } else if path.extension().is_some_and(|e| e == "rs") && name != "mod" {
+                let text = fs::read_to_string(&path).expect("read source");
+                children.insert(name, Some(strip_comments(&text)));
+            }
+        }
+        let module_path: Vec<String> = dir
+            .strip_prefix(src)
+            .expect("under src")
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy().to_string())
+            .collect();
+        let absolute = format!("crate::{}", module_path.join("::"));
+        let mut g: BTreeMap<String, BTreeSet<String>> = children
+            .keys()
+            .map(|m| (m.clone(), BTreeSet::new()))
+            .collect();
+        for (name, text) in &children {
+            let Some(text) = text else { continue };
+            let mut used = first_segments(text, "super");
+            used.extend(first_segments(text, &absolute));
+            for u in used {
+                if &u != name && children.contains_key(&u) {
+                    g.get_mut(name).expect("node").insert(u);
+                }
+            }
+        }
+        out.push((dir, g));
+    }
+    out
+}
+
 fn crate_dirs() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut dirs: Vec<PathBuf> = fs::read_dir(root.join("crates"))
@@ -238,6 +294,40 @@ fn no_crate_has_a_module_cycle() {
         }
     }
     assert!(cycles.is_empty(), "module cycles:\n{}", cycles.join("\n"));
+}
+
+#[test]
+fn no_module_has_a_cycle_among_its_children() {
+    let mut cycles = Vec::new();
+    for src in crate_dirs() {
+        for (dir, g) in sibling_graphs(&src) {
+            if let Some(c) = find_cycle(&g) {
+                cycles.push(format!("{}: {}", dir.display(), c.join(" -> ")));
+            }
+        }
+    }
+    assert!(cycles.is_empty(), "module cycles:\n{}", cycles.join("\n"));
+}
+
+#[test]
+fn the_scanner_sees_a_cycle_between_children() {
+    // `a/x.rs` uses its sibling `y` through `super::`, `y` uses `x` through `crate::a::`.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let src = dir.path();
+    fs::create_dir(src.join("a")).expect("mkdir");
+    fs::write(src.join("lib.rs"), "mod a;\n").expect("write");
+    fs::write(src.join("a.rs"), "mod x; mod y;\n").expect("write");
+    fs::write(src.join("a/x.rs"), "use super::y::Y;\npub struct X;\n").expect("write");
+    fs::write(src.join("a/y.rs"), "use crate::a::x::X;\npub struct Y;\n").expect("write");
+    let graphs = sibling_graphs(src);
+    assert_eq!(graphs.len(), 1);
+    let g = &graphs[0].1;
+    assert!(g["x"].contains("y") && g["y"].contains("x"), "{g:?}");
+    assert!(find_cycle(g).is_some(), "x <-> y");
+    // The top-level graph does not see it (both are `a`).
+    assert_eq!(find_cycle(&graph(src)), None);
+    fs::write(src.join("a/y.rs"), "pub struct Y;\n").expect("write");
+    assert_eq!(find_cycle(&sibling_graphs(src)[0].1), None, "no cycle left");
 }
 
 #[test]

@@ -32,7 +32,7 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::basis::binomial;
 use crate::bezier::RationalBezier;
@@ -428,9 +428,16 @@ pub(crate) fn float_before(t: f64) -> f64 {
 
 /// Distance from `p` to the axis-aligned box of the piece's projected control points.
 fn box_distance(piece: &RationalBezier, p: &Point3<f64>) -> f64 {
+    hull_box_distance(piece.homogeneous(), p)
+}
+
+/// Distance from `p` to the axis-aligned box of the projected homogeneous control points
+/// `net` (of a curve piece or a surface patch): a lower bound on the distance to the piece
+/// (convex hull property, positive weights).
+pub(crate) fn hull_box_distance(net: &[Vector4<f64>], p: &Point3<f64>) -> f64 {
     let mut lo = Vector3::repeat(f64::INFINITY);
     let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for c in piece.homogeneous() {
+    for c in net {
         let x = project(c).coords;
         lo = lo.inf(&x);
         hi = hi.sup(&x);

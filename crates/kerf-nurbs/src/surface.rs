@@ -30,17 +30,11 @@
 //! # Ok::<(), kerf_nurbs::NurbsError>(())
 //! ```
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+use nalgebra::{Point3, Vector4};
 
-use nalgebra::{Point3, Vector3, Vector4};
-
-use crate::basis::{basis_funs, basis_funs_m, binomial, ders_basis_funs_m};
-use crate::closest::float_before;
-use crate::curve::{project, NurbsCurve};
+use crate::curve::project;
 use crate::error::{NurbsError, Result};
 use crate::knots;
-use crate::MAX_ORDER;
 
 mod closest;
 mod eval;

@@ -1,7 +1,7 @@
 //! The G-code dialects, the laser process codes and the escaping of comment text.
 
 use super::dialects;
-use super::rules::Rules;
+use super::writer::Rules;
 use crate::error::{InterpError, Result};
 
 /// G-code dialect.
@@ -105,7 +105,7 @@ impl Dialect {
     /// last beam-off, so that a last `M63` fires too. Micro-joints always switch with the
     /// synchronized `M63`/`M62`.)
     pub fn default_process(self) -> ProcessCodes {
-        super::rules::default_process(self.rules())
+        super::writer::default_process(self.rules())
     }
 
     /// One whole-line comment in the dialect's syntax, its text escaped as by

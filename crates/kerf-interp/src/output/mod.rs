@@ -1,5 +1,5 @@
 //! Outputs: the set-points CSV of `formats.md` and G-code in eight dialects (one file each under
-//! `dialects/`, their decisions the `Rules` trait of `rules.rs`), written atomically.
+//! `dialects/`, their decisions the `Rules` trait of `writer.rs`), written atomically.
 //!
 //! - **CSV**: header `t,X,Y,Z,<tilt>,C`, one row per cycle, `t` in seconds, axes in mm and
 //!   degrees; values are written in Rust's shortest round-trip form, so they read back exactly.
@@ -50,7 +50,6 @@ mod csv;
 mod dialect;
 mod dialects;
 mod power;
-mod rules;
 mod writer;
 
 pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};

@@ -1,10 +1,20 @@
 //! Closest point on a surface: a global branch-and-bound over Bezier sub-patches (net boxes
 //! as lower bounds), a warm-started walking Newton, and the edge and corner minima.
 
-#[allow(unused_imports)]
-use super::net::*;
-#[allow(unused_imports)]
-use super::*;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use nalgebra::{Point3, Vector3, Vector4};
+
+use super::net::{simple_net, split_net, stationarity_sign, Edge, Span};
+use super::{
+    clamp, NurbsSurface, SurfaceProjection, LEAF_SAMPLES, MAX_SUBDIVISION, MIN_LEAF_DEPTH,
+    NEWTON_ITERATIONS, ORTHOGONALITY, SUBPATCH_BUDGET, WARM_REACH,
+};
+use crate::closest::{float_before, hull_box_distance};
+use crate::curve::{project, NurbsCurve};
+use crate::knots;
+use crate::MAX_ORDER;
 
 /// A candidate closest point.
 #[derive(Debug, Clone, Copy)]
@@ -13,9 +23,6 @@ pub(super) struct Candidate {
     v: f64,
     distance: f64,
 }
-
-/// A knot span as `(span index, start, end)`.
-pub(super) type Span = (usize, f64, f64);
 
 /// A knot-span cell: one rational polynomial patch.
 #[derive(Debug, Clone, Copy)]
@@ -72,19 +79,6 @@ impl Ord for SubPatch {
             .total_cmp(&self.lower_bound)
             .then(other.order.cmp(&self.order))
     }
-}
-
-/// An edge of a parameter rectangle.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Edge {
-    /// `u = u0`.
-    U0,
-    /// `u = u1`.
-    U1,
-    /// `v = v0`.
-    V0,
-    /// `v = v1`.
-    V1,
 }
 
 impl NurbsSurface {
@@ -344,7 +338,7 @@ impl NurbsSurface {
                     .collect();
                 let cell = self.patch(spans_u, spans_v, iu, iv);
                 let sub = SubPatch {
-                    lower_bound: net_box_distance(&flat, p),
+                    lower_bound: hull_box_distance(&flat, p),
                     order,
                     depth: 0,
                     cell: (iu, iv),
@@ -406,7 +400,7 @@ impl NurbsSurface {
                 let (low, high) = split_net(&half, deg_u, deg_v, false);
                 for (quarter, (c, d)) in [(low, (v0, vm)), (high, (vm, v1))] {
                     let child = SubPatch {
-                        lower_bound: net_box_distance(&quarter, p),
+                        lower_bound: hull_box_distance(&quarter, p),
                         order,
                         depth: sub.depth + 1,
                         cell: sub.cell,

@@ -1,12 +1,13 @@
 //! Evaluation of a surface: points and partial derivatives (Piegl and Tiller A3.5, A3.6,
 //! A4.4), in fixed-size scratch for the common degrees.
 
-#[allow(unused_imports)]
-use super::closest::*;
-#[allow(unused_imports)]
-use super::net::*;
-#[allow(unused_imports)]
-use super::*;
+use nalgebra::{Point3, Vector3, Vector4};
+
+use super::NurbsSurface;
+use crate::basis::{basis_funs_m, ders_basis_funs_m};
+use crate::curve::project;
+use crate::knots;
+use crate::MAX_ORDER;
 
 /// Binomial coefficients `C(n, k)` for `n < 8`, for the Leibniz rule of the rational
 /// derivatives (orders up to [`TAYLOR_ORDER`] + 1 = 5).

@@ -2,10 +2,28 @@
 //! flatness measures, box distances, subdivision and the sign tests of the closest-point
 //! search.
 
-#[allow(unused_imports)]
-use super::closest::*;
-#[allow(unused_imports)]
-use super::*;
+use nalgebra::{Point3, Vector3, Vector4};
+
+use super::{NurbsSurface, COEFFICIENT_NOISE, LEAF_NORMAL_CONE, LEAF_TURNING};
+use crate::basis::binomial;
+use crate::curve::project;
+use crate::MAX_ORDER;
+
+/// A knot span as `(span index, start, end)`.
+pub(super) type Span = (usize, f64, f64);
+
+/// An edge of a parameter rectangle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Edge {
+    /// `u = u0`.
+    U0,
+    /// `u = u1`.
+    U1,
+    /// `v = v0`.
+    V0,
+    /// `v = v1`.
+    V1,
+}
 
 impl NurbsSurface {
     /// The homogeneous Bezier net of the knot-span cell `[u0, u1] x [v0, v1]` (spans `su`,
@@ -143,22 +161,6 @@ pub(super) fn polygon_turning(points: impl Iterator<Item = Point3<f64>>) -> f64 
         prev_point = Some(pt);
     }
     total
-}
-
-/// Distance from `p` to the axis-aligned box of the projected control points of a net: a
-/// lower bound on the distance to the patch (convex hull property).
-pub(super) fn net_box_distance(net: &[Vector4<f64>], p: &Point3<f64>) -> f64 {
-    let mut lo = Vector3::repeat(f64::INFINITY);
-    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for c in net {
-        let x = project(c).coords;
-        lo = lo.inf(&x);
-        hi = hi.sup(&x);
-    }
-    (lo - p.coords)
-        .sup(&(p.coords - hi))
-        .sup(&Vector3::zeros())
-        .norm()
 }
 
 /// Splits a flat `(p + 1) x (q + 1)` rational Bezier net at the middle of its u (`along_u`)

@@ -1,12 +1,13 @@
 //! Unit normals, with their limits on collapsed edges (the poles of a sphere, the apex of a
 //! cone) and at degenerate points without one (Taylor expansion of the cross product).
 
-#[allow(unused_imports)]
-use super::closest::*;
-#[allow(unused_imports)]
-use super::net::*;
-#[allow(unused_imports)]
-use super::*;
+use nalgebra::{Vector3, Vector4};
+
+use super::{boundary_span_len, NurbsSurface, NEAR_EDGE, NOISE, TAYLOR_ORDER};
+use crate::basis::{basis_funs, binomial};
+use crate::curve::project;
+use crate::knots;
+use crate::MAX_ORDER;
 
 impl NurbsSurface {
     /// The unit normal `Su x Sv / |Su x Sv|` at `(u, v)` (clamped to the domain), with a

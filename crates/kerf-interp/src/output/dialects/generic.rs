@@ -5,7 +5,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::super::rules::Rules;
+use super::super::writer::Rules;
 use super::super::writer::{feed_number, rs274_feed, Writer};
 use crate::block::Block;
 

@@ -24,7 +24,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::super::rules::Rules;
+use super::super::writer::Rules;
 use super::super::writer::{rs274_feed, Writer};
 use crate::block::Block;
 use crate::error::Result;

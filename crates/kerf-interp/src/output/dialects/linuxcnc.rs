@@ -7,7 +7,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::super::rules::Rules;
+use super::super::writer::Rules;
 use super::super::writer::{digital_output, feed_number, Writer};
 use super::super::{LaserPower, ProcessCodes};
 use super::generic::axes_rapid;

@@ -34,7 +34,7 @@
 use kerf_kinematics::{Machine, Parameter};
 use nalgebra::{Point3, Vector3};
 
-use super::super::rules::Rules;
+use super::super::writer::Rules;
 use super::super::writer::{feed_number, rs274_feed, Writer};
 use super::super::{LaserPower, ProcessCodes};
 use super::Linuxcnc;

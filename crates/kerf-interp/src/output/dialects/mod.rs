@@ -1,4 +1,4 @@
-//! One file per G-code dialect, each implementing [`Rules`](super::rules::Rules); adding a
+//! One file per G-code dialect, each implementing [`Rules`](super::writer::Rules); adding a
 //! controller is a new file here, its variant in [`Dialect`](super::Dialect) and one line in
 //! [`Dialect::rules`](super::Dialect::rules).
 

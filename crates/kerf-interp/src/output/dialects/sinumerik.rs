@@ -8,7 +8,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::super::rules::Rules;
+use super::super::writer::Rules;
 use super::super::writer::{feed_number, Writer};
 use super::super::{LaserPower, ProcessCodes};
 use crate::block::{Block, Geometry};

@@ -128,16 +128,20 @@ pub fn ders_basis_funs_m<const M: usize>(
     }
 }
 
-/// Binomial coefficient `C(n, k)` as `f64` (exact for the small arguments used here).
+/// Binomial coefficient `C(n, k)` as `f64` (exact for the small arguments used here: every
+/// partial product `C(n, i)` is an integer below 2^53). A `const fn`, so that tables of it are
+/// built at compile time (the surface evaluator's Leibniz-rule table).
 #[inline]
-pub fn binomial(n: usize, k: usize) -> f64 {
+pub const fn binomial(n: usize, k: usize) -> f64 {
     if k > n {
         return 0.0;
     }
-    let k = k.min(n - k);
+    let k = if k < n - k { k } else { n - k };
     let mut c = 1.0;
-    for i in 0..k {
+    let mut i = 0;
+    while i < k {
         c = c * (n - i) as f64 / (i + 1) as f64;
+        i += 1;
     }
     c
 }

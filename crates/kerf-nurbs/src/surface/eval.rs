@@ -4,7 +4,7 @@
 use nalgebra::{Point3, Vector3, Vector4};
 
 use super::NurbsSurface;
-use crate::basis::{basis_funs_m, ders_basis_funs_m};
+use crate::basis::{basis_funs_m, binomial, ders_basis_funs_m};
 use crate::curve::project;
 use crate::knots;
 use crate::MAX_ORDER;
@@ -15,10 +15,9 @@ pub(super) const BINOMIAL: [[f64; 8]; 8] = {
     let mut t = [[0.0; 8]; 8];
     let mut n = 0;
     while n < 8 {
-        t[n][0] = 1.0;
-        let mut k = 1;
+        let mut k = 0;
         while k <= n {
-            t[n][k] = t[n - 1][k - 1] + t[n - 1][k];
+            t[n][k] = binomial(n, k);
             k += 1;
         }
         n += 1;

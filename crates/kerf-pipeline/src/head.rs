@@ -1,12 +1,13 @@
 //! The head along the cuts: every cut of a set-up checked against the part it lies on
-//! ([`kerf_process::check_cut`]); where the head comes too close, the tool axis is tilted
-//! within the tilt tolerance, away from the surface in the way, and the path solved again
-//! (`docs/process.md`, "The head along the cuts").
+//! ([`kerf_process::check_cut_along`], counting the rotary axes' linear interpolation); where
+//! the head comes too close, the tool axis is tilted within the tilt tolerance, away from the
+//! surface in the way, and the path solved again (`docs/process.md`, "The head along the
+//! cuts").
 
 use kerf_kinematics::{
     solve_path, tilt_within_cones, Cone, Head, Machine, PathInput, PathOptions, Pose, SolvedPath,
 };
-use kerf_process::{check_cut, CutClearance, HeadCheckOptions, Obstacles};
+use kerf_process::{check_cut, check_cut_along, CutClearance, HeadCheckOptions, Obstacles};
 use nalgebra::{Point3, Vector3};
 use serde_json::{json, Value};
 
@@ -159,7 +160,13 @@ pub(crate) fn check_and_clear(
         let obs = &own;
         // One work budget for the cut: the checks and the tilt search.
         let mut budget = hopts.max_queries;
-        let mut c = check_cut(obs, head, &solved[k].poses, hopts);
+        let mut c = check_cut_along(
+            obs,
+            head,
+            &solved[k].poses,
+            &rotary_curvature(&solved[k]),
+            hopts,
+        );
         budget = budget.saturating_sub(c.queries);
         out.tip_zone_mm = Some(c.tip_zone_mm);
         let normals = inputs[k].poses;
@@ -251,7 +258,13 @@ pub(crate) fn check_and_clear(
                 }
             }
             let left = hopts.with_max_queries(budget);
-            c = check_cut(obs, head, &solved[k].poses, &left);
+            c = check_cut_along(
+                obs,
+                head,
+                &solved[k].poses,
+                &rotary_curvature(&solved[k]),
+                &left,
+            );
             budget = budget.saturating_sub(c.queries);
         }
         let tilted_poses = applied.iter().filter(|n| n.is_some()).count();
@@ -471,4 +484,21 @@ mod tests {
             "{s}"
         );
     }
+}
+
+/// A bound on the tool axis' second derivative on each move between the poses of `s`
+/// ([`kerf_process::axis_curvature`] from the tilt and C steps): the machine moves its rotary
+/// axes linearly between the poses, which takes the tool axis off the great circle the head
+/// check's samples follow ([`kerf_process::check_cut_along`]).
+fn rotary_curvature(s: &kerf_kinematics::SolvedPath) -> Vec<f64> {
+    s.axes
+        .windows(2)
+        .map(|w| {
+            kerf_process::axis_curvature(
+                w[0].tilt.to_radians(),
+                (w[1].tilt - w[0].tilt).to_radians(),
+                (w[1].c - w[0].c).to_radians(),
+            )
+        })
+        .collect()
 }

@@ -481,11 +481,56 @@ fn samples(poses: &[Pose], reach: f64) -> Vec<Sample> {
 
 /// The head standing on every pose of one cut (`poses`: tip on the surface, unit tool axis
 /// toward the head, workpiece frame) and moving between them, against `obstacles`: the
-/// smallest distance proven and the stretches closer than the clearance.
+/// smallest distance proven and the stretches closer than the clearance. Between two poses the
+/// tool axis is taken to turn along the great circle; [`check_cut_along`] counts a machine's
+/// linear rotary interpolation instead.
 pub fn check_cut(
     obstacles: &Obstacles,
     head: &Head,
     poses: &[Pose],
+    opts: &HeadCheckOptions,
+) -> CutClearance {
+    check_cut_along(obstacles, head, poses, &[], opts)
+}
+
+/// How far the tool axis may leave the great circle between two poses whose axes are
+/// `angle_rad` apart when the machine moves its rotary axes linearly from one to the other and
+/// the axis `a(s)` of that move (`s` from 0 to 1) has `|a''| <= curvature` ([`axis_curvature`]
+/// for kerf's machines), radians. `a(s)` and the great circle `g(s)` share their ends, so
+/// `|a - g| <= max |a'' - g''| / 8` (the error of linear interpolation of `a - g`), with
+/// `|g''| = angle^2`; the chord bound is turned into an angle.
+pub fn rotary_departure_rad(curvature: f64, angle_rad: f64) -> f64 {
+    let chord = (curvature + angle_rad * angle_rad) / 8.0;
+    2.0 * (0.5 * chord).min(1.0).asin()
+}
+
+/// A bound on `|a''|` for the tool axis `a(s) = R_C(c(s)) R_T(t(s)) z` of a machine whose C
+/// axis is the tool axis at tilt 0 and whose tilt axis is at right angles to it (every kerf
+/// machine: A/C and fork heads, double tables, head-table, seen in the workpiece frame), with
+/// the tilt and C moving linearly by `tilt_step_rad` and `c_step_rad` from a tilt of
+/// `tilt_start_rad` to `tilt_start_rad + tilt_step_rad`: the second partial derivatives are
+/// `|a_tt| = 1`, `|a_tc| = |cos t| <= 1`, `|a_cc| = |sin t|` (the axis turning about C at its
+/// distance `sin t` from it), so `|a''| <= dt^2 + 2 |dt dc| + sin(max |t|) dc^2`.
+pub fn axis_curvature(tilt_start_rad: f64, tilt_step_rad: f64, c_step_rad: f64) -> f64 {
+    let (dt, dc) = (tilt_step_rad.abs(), c_step_rad.abs());
+    let t_max = tilt_start_rad
+        .abs()
+        .max((tilt_start_rad + tilt_step_rad).abs())
+        .min(std::f64::consts::FRAC_PI_2);
+    dt * dt + 2.0 * dt * dc + t_max.sin() * dc * dc
+}
+
+/// [`check_cut`] for a machine that interpolates its rotary axes linearly between the poses:
+/// `axis_curvature[k]` bounds `|a''|` of the tool axis on the move from pose `k` to pose
+/// `k + 1` ([`axis_curvature`]), and every head point may then also lie
+/// [`rotary_departure_rad`] times its distance from the tip off the great-circle motion the
+/// samples follow; each sample stands for that much more motion. Steps the slice does not
+/// reach count as great circles.
+pub fn check_cut_along(
+    obstacles: &Obstacles,
+    head: &Head,
+    poses: &[Pose],
+    axis_curvature: &[f64],
     opts: &HeadCheckOptions,
 ) -> CutClearance {
     let zone = tip_zone_mm(head, opts);
@@ -504,6 +549,17 @@ pub fn check_cut(
         out.unproven = Some(why);
         return out;
     }
+    if let Some(k) = axis_curvature
+        .iter()
+        .position(|t| !(t.is_finite() && *t >= 0.0))
+    {
+        out.proven = false;
+        out.unproven = Some(format!(
+            "the tool axis' curvature bound from pose {k} is not a finite size ({})",
+            axis_curvature[k]
+        ));
+        return out;
+    }
     let reach = (opts.standoff_mm + head.length_mm()).hypot(head.max_radius_mm());
     let samples = samples(poses, reach);
     out.samples = samples.len();
@@ -512,14 +568,36 @@ pub fn check_cut(
         return out;
     }
     let disp = |a: &Sample, b: &Sample| (a.tip - b.tip).norm() + reach * a.axis.angle(&b.axis);
-    // Half the larger step from each sample to its neighbours: the motion it stands for.
+    // How far the head may leave the great-circle motion on each step between poses.
+    let departure: Vec<f64> = (0..poses.len().saturating_sub(1))
+        .map(|k| {
+            let curvature = axis_curvature.get(k).copied().unwrap_or(0.0);
+            if curvature == 0.0 {
+                return 0.0;
+            }
+            reach * rotary_departure_rad(curvature, poses[k].axis.angle(&poses[k + 1].axis))
+        })
+        .collect();
+    let step_departure = |k: usize| departure.get(k).copied().unwrap_or(0.0);
+    // Half the larger step from each sample to its neighbours, and the rotary departure of
+    // the steps it lies on: the motion it stands for.
     let half_step: Vec<f64> = (0..samples.len())
         .map(|k| {
+            let own = &samples[k];
+            let leave = if own.exact {
+                own.pose
+                    .checked_sub(1)
+                    .map_or(0.0, step_departure)
+                    .max(step_departure(own.pose))
+            } else {
+                step_departure(own.pose)
+            };
             [k.checked_sub(1), (k + 1 < samples.len()).then_some(k + 1)]
                 .into_iter()
                 .flatten()
                 .map(|n| disp(&samples[n], &samples[k]) / 2.0)
                 .fold(0.0, f64::max)
+                + leave
         })
         .collect();
     // The head at sample `k`, required to clear the clearance plus `slack`.

@@ -38,8 +38,8 @@ mod traverse;
 mod wall;
 
 pub use head::{
-    check_cut, tip_zone_mm, CloseStretch, CutClearance, HeadCheckOptions, RESOLUTION_MM,
-    SAMPLE_STEP_MM, STRETCH_SLACK_MM,
+    axis_curvature, check_cut, check_cut_along, rotary_departure_rad, tip_zone_mm, CloseStretch,
+    CutClearance, HeadCheckOptions, RESOLUTION_MM, SAMPLE_STEP_MM, STRETCH_SLACK_MM,
 };
 pub use lead::{LeadIn, LeadOptions};
 pub use offset::{offset, OffsetInput, OffsetOptions, OffsetPath};

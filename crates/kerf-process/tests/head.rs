@@ -209,3 +209,104 @@ fn unusable_inputs_are_not_proven_clear() {
     let inf = HeadCheckOptions::default().with_path_deviation_mm(f64::INFINITY);
     assert!(!check_cut(&obs, &head, &poses, &inf).proven);
 }
+
+/// The tool axis of paper 000's A/C head at `a`, `c` (radians).
+fn ac_axis(a: f64, c: f64) -> Vector3<f64> {
+    Vector3::new(a.sin() * c.sin(), -a.sin() * c.cos(), a.cos())
+}
+
+#[test]
+fn the_rotary_departure_bounds_the_linear_move_of_an_ac_head() {
+    // Independent truth: the A/C head's axis under linear A and C interpolation, sampled
+    // densely, against the great circle between its ends: the largest angle between them
+    // never exceeds `rotary_departure_rad`, and on a 10-degree C step at 45 degrees of tilt
+    // (the figure docs/process.md quoted, 0.11 deg) the bound is within a few times of it.
+    let mut worst_ratio: f64 = 0.0;
+    for (a0, a1, c0, c1) in [
+        (45.0, 45.0, 0.0, 10.0),
+        (10.0, 30.0, -20.0, 40.0),
+        (80.0, 5.0, 0.0, 90.0),
+        (1.0, 1.0, 0.0, 180.0),
+        (30.0, 35.0, 100.0, 101.0),
+        (60.0, -60.0, 0.0, 0.0),
+    ] {
+        let (a0, a1, c0, c1): (f64, f64, f64, f64) = (
+            f64::to_radians(a0),
+            f64::to_radians(a1),
+            f64::to_radians(c0),
+            f64::to_radians(c1),
+        );
+        let (p, q) = (ac_axis(a0, c0), ac_axis(a1, c1));
+        let angle = p.angle(&q);
+        let rot = nalgebra::UnitQuaternion::rotation_between(&p, &q)
+            .unwrap_or_else(nalgebra::UnitQuaternion::identity);
+        let mut worst: f64 = 0.0;
+        for k in 0..=2000 {
+            let s = k as f64 / 2000.0;
+            let linear = ac_axis(a0 + (a1 - a0) * s, c0 + (c1 - c0) * s);
+            let great = nalgebra::UnitQuaternion::identity().slerp(&rot, s) * p;
+            worst = worst.max(linear.angle(&great));
+        }
+        let curvature = kerf_process::axis_curvature(a0, a1 - a0, c1 - c0);
+        let bound = kerf_process::rotary_departure_rad(curvature, angle);
+        assert!(
+            worst <= bound,
+            "A {a0}..{a1}, C {c0}..{c1}: {worst} > {bound}"
+        );
+        if worst > 1e-4 {
+            worst_ratio = worst_ratio.max(bound / worst);
+        }
+    }
+    let (a, c) = (45f64.to_radians(), 10f64.to_radians());
+    let first = kerf_process::rotary_departure_rad(
+        kerf_process::axis_curvature(a, 0.0, c),
+        ac_axis(a, 0.0).angle(&ac_axis(a, c)),
+    );
+    assert!(first.to_degrees() < 0.5, "{}", first.to_degrees());
+    assert!(
+        worst_ratio < 8.0,
+        "the bound is not wildly loose: {worst_ratio}"
+    );
+}
+
+#[test]
+fn the_linear_rotary_move_widens_the_bound_by_its_departure() {
+    // Two upright poses 1 mm apart beside a wall 1.75 mm from the head's body (exact): with
+    // the great circle between them (the axes agree) the head is proven to keep the 1 mm
+    // clearance (each sample standing for 0.5 mm of motion); with the rotary axes swinging
+    // between them (a 20-degree C turn at 10 degrees of tilt, 0.52 mm of departure at the
+    // head's reach) 1.75 mm no longer covers the motion, and the bound falls below the
+    // clearance, below the exact distance less the departure.
+    let head = Head::laser_default();
+    let mut obs = Obstacles::new();
+    let x_wall = BODY_R + 1.0 + 1.75;
+    obs.add_nurbs(wall(x_wall));
+    let poses: Vec<Pose> = [0.0, 1.0]
+        .iter()
+        .map(|&x| Pose {
+            position: Point3::new(x, 0.0, 0.0),
+            axis: Vector3::z(),
+        })
+        .collect();
+    let opts = HeadCheckOptions::default();
+    let plain = kerf_process::check_cut_along(&obs, &head, &poses, &[], &opts);
+    let curvature = kerf_process::axis_curvature(0.17, 0.0, 0.34);
+    let swung = kerf_process::check_cut_along(&obs, &head, &poses, &[curvature], &opts);
+    let reach = (opts.standoff_mm + head.length_mm()).hypot(head.max_radius_mm());
+    let departure = reach * kerf_process::rotary_departure_rad(curvature, 0.0);
+    let exact = x_wall - BODY_R - 1.0; // the body at the pose x = 1
+    assert!(plain.proven && swung.proven);
+    assert!(departure > 0.5, "{departure}");
+    assert!(
+        plain.close.is_empty() && plain.min_distance_mm >= opts.clearance_mm,
+        "{plain:?}"
+    );
+    assert!(
+        swung.min_distance_mm < opts.clearance_mm
+            && swung.min_distance_mm <= exact - departure + 1e-9,
+        "{swung:?}, departure {departure} mm"
+    );
+    // A bound that is not a size is not proven.
+    let bad = kerf_process::check_cut_along(&obs, &head, &poses, &[f64::NAN], &opts);
+    assert!(!bad.proven, "{bad:?}");
+}

@@ -455,6 +455,72 @@ pub(crate) fn head_json(
 mod tests {
     use super::*;
 
+    /// The pipeline's bound on the tool axis' second derivative, from the solved axes in
+    /// degrees, against the machines' own forward kinematics: on every move of a tilted
+    /// cone of poses (C turning all round, the tilt changing), the axis of the linear joint
+    /// move sampled densely never leaves the great circle by more than the departure the
+    /// bound gives, and the bound is not wildly larger (a degree read as a radian would be
+    /// 57 times too large, the other way round 57 times too small).
+    #[test]
+    fn the_rotary_curvature_bounds_each_machines_linear_moves() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/machines/");
+        for name in ["ac_head", "fork_head", "table_table"] {
+            let machine = Machine::read(format!("{dir}{name}.json")).expect("machine");
+            let poses: Vec<Pose> = (0..=24)
+                .map(|k| {
+                    let u = std::f64::consts::TAU * k as f64 / 24.0;
+                    let tilt = (12.0 + 8.0 * (2.0 * u).sin()).to_radians();
+                    Pose {
+                        position: Point3::new(30.0 * u.cos(), 30.0 * u.sin(), 0.0),
+                        axis: Vector3::new(tilt.sin() * u.cos(), tilt.sin() * u.sin(), tilt.cos()),
+                    }
+                })
+                .collect();
+            let input = kerf_kinematics::PathInput {
+                id: "cone",
+                poses: &poses,
+                curve: None,
+            };
+            let solved = kerf_kinematics::solve_path(
+                &machine,
+                &input,
+                &kerf_kinematics::PathOptions::default(),
+            )
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let bounds = rotary_curvature(&solved);
+            assert_eq!(bounds.len(), solved.axes.len() - 1);
+            let mut worst_ratio: f64 = 0.0;
+            for (k, w) in solved.axes.windows(2).enumerate() {
+                let (p, q) = (solved.poses[k].axis, solved.poses[k + 1].axis);
+                let angle = p.angle(&q);
+                let rot = nalgebra::UnitQuaternion::rotation_between(&p, &q)
+                    .unwrap_or_else(nalgebra::UnitQuaternion::identity);
+                let mut worst: f64 = 0.0;
+                for j in 0..=200 {
+                    let s = j as f64 / 200.0;
+                    let mut a = w[0];
+                    a.tilt += (w[1].tilt - w[0].tilt) * s;
+                    a.c += (w[1].c - w[0].c) * s;
+                    let axis = machine.kinematics.forward(&a).axis;
+                    let great = nalgebra::UnitQuaternion::identity().slerp(&rot, s) * p;
+                    worst = worst.max(axis.angle(&great));
+                }
+                let bound = kerf_process::rotary_departure_rad(bounds[k], angle);
+                assert!(
+                    worst <= bound + 2e-6,
+                    "{name}: move {k}: departure {worst} rad above the bound {bound}"
+                );
+                if worst > 1e-5 {
+                    worst_ratio = worst_ratio.max(bound / worst);
+                }
+            }
+            assert!(
+                worst_ratio < 20.0,
+                "{name}: bound / departure {worst_ratio}"
+            );
+        }
+    }
+
     /// A refusal whose search for a clearing tilt ran out of work says so, instead of
     /// claiming that no tilt up to 60 degrees clears the head.
     #[test]

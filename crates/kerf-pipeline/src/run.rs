@@ -372,7 +372,17 @@ fn run_placed(
             .with_max_tilt_deg(popts.tilt_tolerance_deg.max(HEAD_CHECK_MIN_TILT_DEG))
             // The controller's tip leaves the chords by the non-linearity error and its
             // blending (an infinite tolerance leaves the check unproven).
-            .with_path_deviation_mm(popts.linearization_tolerance_mm + o.blend_tolerance_mm);
+            .with_path_deviation_mm(popts.linearization_tolerance_mm + o.blend_tolerance_mm)
+            // Where the program's blocks merge poses (lines and arcs over several), each
+            // pose's axis is held within the fit's orientation tolerance only.
+            .with_axis_deviation_rad({
+                let fit = crate::motion::fit_options(dopts.tolerance_mm, Some(o.dialect), 0.0);
+                if fit.merge_lines || fit.arcs {
+                    fit.orientation_tolerance_deg.to_radians()
+                } else {
+                    0.0
+                }
+            });
         for setup in 0..placed.plan.setups.len() {
             let ks: Vec<usize> = (0..solved.len())
                 .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)

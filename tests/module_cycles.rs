@@ -79,6 +79,9 @@ fn first_segments(text: &str, prefix: &str) -> Vec<String> {
         if start > 0 && text[..start].chars().next_back().is_some_and(is_ident) {
             continue; // `foo_crate::` is not `crate::`
         }
+        if text[..start].ends_with("::") {
+            continue; // `super::super::x` is not `super::x`
+        }
         let rest = &text[at..];
         if let Some(group) = rest.strip_prefix('{') {
             // Top-level items of the group.
@@ -123,6 +126,7 @@ fn root_reexports(root: &str) -> BTreeMap<String, String> {
         let Some(rest) = stmt
             .strip_prefix("pub use ")
             .or_else(|| stmt.strip_prefix("pub(crate) use "))
+            .or_else(|| stmt.strip_prefix("pub(super) use "))
         else {
             continue;
         };
@@ -222,7 +226,10 @@ fn find_cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
 }
 
 /// For every module directory under `src` (`src/a/`, `src/a/b/`, ...), the dependency graph of
-/// its child modules through `super::y` and `crate::a::y`.
+/// its child modules: child `x` is `x.rs` and every file under `x/` (`mod.rs` included), and it
+/// uses its sibling `y` where one of its files names `y` through the path that leads from that
+/// file to the parent (`super::y` from `x.rs` or `x/mod.rs`, `super::super::y` from `x/z.rs`,
+/// ...; or `crate::a::y`), directly or through an item the parent re-exports from `y`.
 fn sibling_graphs(src: &Path) -> Vec<(PathBuf, BTreeMap<String, BTreeSet<String>>)> {
     let mut out = Vec::new();
     let mut stack: Vec<PathBuf> = fs::read_dir(src)
@@ -231,7 +238,8 @@ fn sibling_graphs(src: &Path) -> Vec<(PathBuf, BTreeMap<String, BTreeSet<String>
         .filter(|p| p.is_dir())
         .collect();
     while let Some(dir) = stack.pop() {
-        let mut children: BTreeMap<String, Option<String>> = BTreeMap::new();
+        // Each child's files, with the number of `super::` that lead back to the parent.
+        let mut children: BTreeMap<String, Vec<(usize, String)>> = BTreeMap::new();
         for entry in fs::read_dir(&dir).expect("read module dir") {
             let path = entry.expect("entry").path();
             let name = path
@@ -240,13 +248,37 @@ fn sibling_graphs(src: &Path) -> Vec<(PathBuf, BTreeMap<String, BTreeSet<String>
                 .to_string_lossy()
                 .to_string();
             if path.is_dir() {
-                stack.push(path);
-                children.entry(name).or_insert(None);
+                stack.push(path.clone());
+                let files = children.entry(name).or_default();
+                let mut inner = vec![(path, 0usize)];
+                while let Some((d, depth)) = inner.pop() {
+                    for e in fs::read_dir(&d).expect("read module dir") {
+                        let f = e.expect("entry").path();
+                        if f.is_dir() {
+                            inner.push((f, depth + 1));
+                        } else if f.extension().is_some_and(|x| x == "rs") {
+                            let is_mod = f.file_stem().is_some_and(|s| s == "mod");
+                            let ups = depth + if is_mod { 1 } else { 2 };
+                            let text = fs::read_to_string(&f).expect("read source");
+                            files.push((ups, strip_comments(&text)));
+                        }
+                    }
+                }
             } else if path.extension().is_some_and(|e| e == "rs") && name != "mod" {
                 let text = fs::read_to_string(&path).expect("read source");
-                children.insert(name, Some(strip_comments(&text)));
+                children
+                    .entry(name)
+                    .or_default()
+                    .push((1, strip_comments(&text)));
             }
         }
+        // What the parent re-exports from its children.
+        let parent_text = [dir.with_extension("rs"), dir.join("mod.rs")]
+            .iter()
+            .filter_map(|p| fs::read_to_string(p).ok())
+            .map(|t| strip_comments(&t))
+            .collect::<String>();
+        let reexports = root_reexports(&parent_text);
         let module_path: Vec<String> = dir
             .strip_prefix(src)
             .expect("under src")
@@ -258,13 +290,20 @@ fn sibling_graphs(src: &Path) -> Vec<(PathBuf, BTreeMap<String, BTreeSet<String>
             .keys()
             .map(|m| (m.clone(), BTreeSet::new()))
             .collect();
-        for (name, text) in &children {
-            let Some(text) = text else { continue };
-            let mut used = first_segments(text, "super");
-            used.extend(first_segments(text, &absolute));
-            for u in used {
-                if &u != name && children.contains_key(&u) {
-                    g.get_mut(name).expect("node").insert(u);
+        for (name, files) in &children {
+            for (ups, text) in files {
+                let up = vec!["super"; *ups].join("::");
+                let mut used = first_segments(text, &up);
+                used.extend(first_segments(text, &absolute));
+                for u in used {
+                    let target = if children.contains_key(&u) {
+                        Some(u)
+                    } else {
+                        reexports.get(&u).cloned()
+                    };
+                    if let Some(t) = target.filter(|t| t != name && children.contains_key(t)) {
+                        g.get_mut(name).expect("node").insert(t);
+                    }
                 }
             }
         }
@@ -328,6 +367,25 @@ fn the_scanner_sees_a_cycle_between_children() {
     assert_eq!(find_cycle(&graph(src)), None);
     fs::write(src.join("a/y.rs"), "pub struct Y;\n").expect("write");
     assert_eq!(find_cycle(&sibling_graphs(src)[0].1), None, "no cycle left");
+    // Through the parent's re-export, from a child kept as a directory (its `mod.rs` and a
+    // file below it, whose way back to the parent is `super::super::`).
+    fs::write(
+        src.join("a.rs"),
+        "mod x; mod y; mod z;\npub(crate) use x::X;\n",
+    )
+    .expect("write");
+    fs::create_dir(src.join("a/z")).expect("mkdir");
+    fs::write(src.join("a/z/mod.rs"), "mod w;\n").expect("write");
+    fs::write(src.join("a/z/w.rs"), "use super::super::X;\n").expect("write");
+    fs::write(src.join("a/y.rs"), "use super::X;\npub struct Y;\n").expect("write");
+    let graphs = sibling_graphs(src);
+    let g = &graphs.iter().find(|(d, _)| d.ends_with("a")).expect("a").1;
+    assert!(
+        g["y"].contains("x"),
+        "y uses x through a's re-export: {g:?}"
+    );
+    assert!(g["z"].contains("x"), "z's file below it uses x: {g:?}");
+    assert!(find_cycle(g).is_some(), "x <-> y through the re-export");
 }
 
 #[test]

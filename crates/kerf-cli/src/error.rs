@@ -92,11 +92,15 @@ pub(crate) fn with_flags(message: String) -> String {
 fn hint(e: &kerf_pipeline::Error) -> Option<&'static str> {
     use kerf_discretize::DiscretizeError as E;
     use kerf_pipeline::Error as P;
-    let discretize = |source: &E| match source {
-        E::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-points"),
+    let discretize = |source: &E| {
+        match source {
+        E::TooManyPoints { .. } => {
+            Some("options: a larger --tolerance, or a larger point limit (--max-points of kerf discretize, --max-total-points of kerf run)")
+        }
         E::ToleranceBelowPrecision { .. } => Some("option: a larger --tolerance"),
         E::TurnUnreachable { .. } => Some("option: a larger --max-turn (degrees)"),
         _ => None,
+    }
     };
     match e {
         P::Discretize { source, .. } => discretize(source),
@@ -107,7 +111,9 @@ fn hint(e: &kerf_pipeline::Error) -> Option<&'static str> {
             kerf_normals::NormalsError::Discretize(d) => discretize(d),
             _ => None,
         },
-        P::TooManyPoints { .. } => Some("options: a larger --tolerance, or --max-total-points"),
+        P::TooManyPoints { .. } => Some(
+            "options: a larger --tolerance, or a larger point limit (--max-total-points of kerf run)",
+        ),
         P::NoNormals { .. } => {
             Some("run kerf discretize --normals on curves that name their surface")
         }

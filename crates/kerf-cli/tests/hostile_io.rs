@@ -743,7 +743,7 @@ fn the_library_names_its_options_and_the_command_line_its_flags() {
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("raise the limit (max_total_points)")
-            && err.contains("[options: a larger --tolerance, or --max-total-points]"),
+            && err.contains("[options: a larger --tolerance, or a larger point limit (--max-total-points of kerf run)]"),
         "{err}"
     );
     assert!(!out.path().join("o").exists(), "nothing written");

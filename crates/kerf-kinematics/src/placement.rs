@@ -174,7 +174,7 @@ pub enum PlacementParseError {
         text: String,
     },
     /// A field that is not finite or beyond [`MAX_PLACEMENT_VALUE`].
-    #[error("{field}: must be finite and within 1e7 (got {text})")]
+    #[error("{field}: must be finite and within {max:e} (got {text})", max = MAX_PLACEMENT_VALUE)]
     OutOfRange {
         /// The field's name (`X`, ..., `RZ`).
         field: &'static str,

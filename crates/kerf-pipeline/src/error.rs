@@ -147,7 +147,7 @@ pub enum Error {
     /// discretize with normals ([`crate::orient_curves`], `kerf discretize --normals`) curves
     /// that name their surface.
     #[error(
-        "{}paths[{index}] ({id:?}): points have no normals; discretize with normals curves that name their surface",
+        "{}paths[{index}] ({id:?}): points have no normals; discretize with normals the curves that name their surface",
         at(file)
     )]
     NoNormals {

@@ -46,14 +46,16 @@ use crate::error::{positive, InterpError, Result};
 use crate::model::AxisModel;
 use crate::DEFAULT_BLEND_TOLERANCE;
 
+mod codes;
 mod csv;
 mod dialect;
 mod dialects;
 mod power;
 mod writer;
 
+pub use codes::{comment_text, ProcessCodes, MAX_COMMENT};
 pub use csv::{csv_string, write_atomic, write_csv, write_csv_to};
-pub use dialect::{comment_text, Dialect, ProcessCodes, MAX_COMMENT};
+pub use dialect::Dialect;
 pub use dialects::{linuxcnc_kinematics, LinuxcncKinematics};
 pub use power::LaserPower;
 use writer::Writer;

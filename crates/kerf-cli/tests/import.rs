@@ -1,7 +1,6 @@
 //! `kerf import` and `kerf run PART.step` through the binary, on the STEP fixtures (made with
 //! Open CASCADE, checked against its reader by scripts/step_check.py) and the real parts.
 
-use std::path::Path;
 use std::process::Command;
 mod common;
 use common::{fixture, kerf};

@@ -6,7 +6,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use kerf_kinematics::{Axes, Machine};
 use nalgebra::{Matrix3, Vector3};

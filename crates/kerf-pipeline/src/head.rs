@@ -451,6 +451,23 @@ pub(crate) fn head_json(
     })
 }
 
+/// A bound on the tool axis' second derivative on each move between the poses of `s`
+/// ([`kerf_process::axis_curvature`] from the tilt and C steps): the machine moves its rotary
+/// axes linearly between the poses, which takes the tool axis off the great circle the head
+/// check's samples follow ([`kerf_process::check_cut_along`]).
+fn rotary_curvature(s: &kerf_kinematics::SolvedPath) -> Vec<f64> {
+    s.axes
+        .windows(2)
+        .map(|w| {
+            kerf_process::axis_curvature(
+                w[0].tilt.to_radians(),
+                (w[1].tilt - w[0].tilt).to_radians(),
+                (w[1].c - w[0].c).to_radians(),
+            )
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -550,21 +567,4 @@ mod tests {
             "{s}"
         );
     }
-}
-
-/// A bound on the tool axis' second derivative on each move between the poses of `s`
-/// ([`kerf_process::axis_curvature`] from the tilt and C steps): the machine moves its rotary
-/// axes linearly between the poses, which takes the tool axis off the great circle the head
-/// check's samples follow ([`kerf_process::check_cut_along`]).
-fn rotary_curvature(s: &kerf_kinematics::SolvedPath) -> Vec<f64> {
-    s.axes
-        .windows(2)
-        .map(|w| {
-            kerf_process::axis_curvature(
-                w[0].tilt.to_radians(),
-                (w[1].tilt - w[0].tilt).to_radians(),
-                (w[1].c - w[0].c).to_radians(),
-            )
-        })
-        .collect()
 }

@@ -685,66 +685,6 @@ pub(super) fn pierce_point<M: AxisModel + ?Sized>(
     (pierce, q, u)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn trunnion() -> crate::MachineModel {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../fixtures/machines/xyzac_trt.json"
-        );
-        crate::MachineModel::new(kerf_kinematics::Machine::read(path).expect("machine"))
-            .expect("model")
-    }
-
-    #[test]
-    fn rapids_are_split_until_their_tip_follows_the_traverse_or_refused() {
-        let m = trunnion();
-        // A straight move of the linear axes alone: one piece, on the traverse.
-        let (p, worst) = rapid_pieces(&m, &[0.0; 5], &[100.0, 50.0, 20.0, 0.0, 0.0]);
-        assert_eq!(p.len(), 1);
-        assert!(worst < 1e-9, "{worst}");
-        // Half a turn of C with the tip 200 mm from the C axis: the tip's circle, split into
-        // pieces of at most 10 degrees and then until every piece's middle is within the
-        // tolerance, by the fewest halvings.
-        let from = [200.0, 0.0, 0.0, 0.0, 0.0];
-        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 180.0]);
-        assert!(worst <= RAPID_TCP_TOLERANCE_MM, "{worst}");
-        // The tip turns about the C axis through rot_point (3, -2) of xyzac_trt.json.
-        let t = m.tip(&from);
-        let r = (t.x - 3.0).hypot(t.y + 2.0);
-        // An arc of `turn` degrees and radius r in n pieces has its chords' middles
-        // r (1 - cos(turn / 2n)) inside it: the fewest n = 2^k with pieces of at most 10
-        // degrees and that at most 0.1 mm.
-        let need = |turn: f64| {
-            (0..20)
-                .map(|k| 1usize << k)
-                .find(|n| {
-                    let piece = turn / *n as f64;
-                    piece <= RAPID_TCP_MAX_STEP_DEG
-                        && r * (1.0 - (piece.to_radians() / 2.0).cos()) <= 0.1
-                })
-                .expect("a count")
-        };
-        assert_eq!(p.len(), need(180.0), "r = {r}");
-        // Two whole turns: the tip comes back to its start at the middle too, yet the rapid
-        // swings it round twice; pieces of 10 degrees see the circle.
-        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 720.0]);
-        assert_eq!(p.len(), need(720.0), "r = {r}");
-        assert!(worst <= RAPID_TCP_TOLERANCE_MM, "{worst}");
-        // A hundred turns at the same distance: 4096 pieces of 8.8 degrees leave 0.59 mm, more
-        // than RAPID_TCP_MAX_PIECES would be needed: the distance left is reported, and the
-        // writer refuses the program.
-        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 36000.0]);
-        assert_eq!(p.len(), RAPID_TCP_MAX_PIECES);
-        assert!(worst > RAPID_TCP_TOLERANCE_MM, "{worst}");
-        // Two thousand turns cannot even be cut into 10-degree pieces: refused at once.
-        let (_, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 720000.0]);
-        assert!(worst.is_infinite());
-    }
-}
-
 /// The decisions of one dialect. Methods with a default are the RS274/NGC habit most
 /// controllers share.
 pub(super) trait Rules: Sync {
@@ -893,5 +833,65 @@ pub(super) fn default_process(rules: &dyn Rules) -> ProcessCodes {
         beam_off: vec![off.to_string()],
         pierce_dwell_s: 0.2,
         pierce_standoff: 1.5,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn trunnion() -> crate::MachineModel {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/machines/xyzac_trt.json"
+        );
+        crate::MachineModel::new(kerf_kinematics::Machine::read(path).expect("machine"))
+            .expect("model")
+    }
+
+    #[test]
+    fn rapids_are_split_until_their_tip_follows_the_traverse_or_refused() {
+        let m = trunnion();
+        // A straight move of the linear axes alone: one piece, on the traverse.
+        let (p, worst) = rapid_pieces(&m, &[0.0; 5], &[100.0, 50.0, 20.0, 0.0, 0.0]);
+        assert_eq!(p.len(), 1);
+        assert!(worst < 1e-9, "{worst}");
+        // Half a turn of C with the tip 200 mm from the C axis: the tip's circle, split into
+        // pieces of at most 10 degrees and then until every piece's middle is within the
+        // tolerance, by the fewest halvings.
+        let from = [200.0, 0.0, 0.0, 0.0, 0.0];
+        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 180.0]);
+        assert!(worst <= RAPID_TCP_TOLERANCE_MM, "{worst}");
+        // The tip turns about the C axis through rot_point (3, -2) of xyzac_trt.json.
+        let t = m.tip(&from);
+        let r = (t.x - 3.0).hypot(t.y + 2.0);
+        // An arc of `turn` degrees and radius r in n pieces has its chords' middles
+        // r (1 - cos(turn / 2n)) inside it: the fewest n = 2^k with pieces of at most 10
+        // degrees and that at most 0.1 mm.
+        let need = |turn: f64| {
+            (0..20)
+                .map(|k| 1usize << k)
+                .find(|n| {
+                    let piece = turn / *n as f64;
+                    piece <= RAPID_TCP_MAX_STEP_DEG
+                        && r * (1.0 - (piece.to_radians() / 2.0).cos()) <= 0.1
+                })
+                .expect("a count")
+        };
+        assert_eq!(p.len(), need(180.0), "r = {r}");
+        // Two whole turns: the tip comes back to its start at the middle too, yet the rapid
+        // swings it round twice; pieces of 10 degrees see the circle.
+        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 720.0]);
+        assert_eq!(p.len(), need(720.0), "r = {r}");
+        assert!(worst <= RAPID_TCP_TOLERANCE_MM, "{worst}");
+        // A hundred turns at the same distance: 4096 pieces of 8.8 degrees leave 0.59 mm, more
+        // than RAPID_TCP_MAX_PIECES would be needed: the distance left is reported, and the
+        // writer refuses the program.
+        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 36000.0]);
+        assert_eq!(p.len(), RAPID_TCP_MAX_PIECES);
+        assert!(worst > RAPID_TCP_TOLERANCE_MM, "{worst}");
+        // Two thousand turns cannot even be cut into 10-degree pieces: refused at once.
+        let (_, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 720000.0]);
+        assert!(worst.is_infinite());
     }
 }

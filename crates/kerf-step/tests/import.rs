@@ -471,6 +471,16 @@ fn a_sheet_metal_solid_has_each_feature_cut_once() {
             by_ids(&sheet.other_side),
             by_ids(&sheet.walls),
         );
+        // The surfaces a contour names.
+        let named_of = |c: &RawCurve| -> Vec<&NurbsSurface> {
+            c.surface
+                .as_ref()
+                .expect("a face")
+                .ids()
+                .iter()
+                .map(|i| &surf[i])
+                .collect()
+        };
         let cut: Vec<NurbsCurve> = im.file.curves.iter().map(curve).collect();
         let cut_samples: Vec<Vec<Point3<f64>>> = cut.iter().map(|c| samples(c, 200)).collect();
         // Every contour runs along a wall on one side of the sheet (the cut side, or the other
@@ -486,14 +496,7 @@ fn a_sheet_metal_solid_has_each_feature_cut_once() {
                 "{name}: {}",
                 c.id
             );
-            let named: Vec<&NurbsSurface> = c
-                .surface
-                .as_ref()
-                .expect("a face")
-                .ids()
-                .iter()
-                .map(|i| &surf[i])
-                .collect();
+            let named = named_of(c);
             let sided = if distance_to(&side, &s[s.len() / 2]) < 1e-6 {
                 &side
             } else {
@@ -541,14 +544,7 @@ fn a_sheet_metal_solid_has_each_feature_cut_once() {
                         .expect("a face");
                     f.normal(at.u, at.v).expect("a normal")
                 };
-                let named: Vec<&NurbsSurface> = c
-                    .surface
-                    .as_ref()
-                    .expect("a face")
-                    .ids()
-                    .iter()
-                    .map(|i| &surf[i])
-                    .collect();
+                let named = named_of(c);
                 let n = normal_of(&named);
                 // The wall beside the contour: on it, and along it (at a corner another wall
                 // touches the point too, across the contour).

@@ -11,8 +11,8 @@ shipped, and the IGES copies in `target/iges-real/` when they exist
 STEP and IGES parts run with `--edges` (sheet recognition: each feature cut once).
 
 For each file, the fastest of `--runs` whole `kerf run` processes by wall time: its wall time,
-its user + system CPU from the operating system (`wait4`), and the per-stage CPU and wall times
-of that run's `report.json` (`timings`, docs/formats.md). Prints the load average before and
+its user + system CPU from the operating system (`wait4`), and the per-stage CPU times of that
+run's `report.json` (`timings`, docs/formats.md; its wall times are there too). Prints the load average before and
 after, since the machine is shared: read the figures with it. `--threads N` sets
 `RAYON_NUM_THREADS` (default: rayon's, one thread per core).
 

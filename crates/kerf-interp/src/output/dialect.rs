@@ -111,8 +111,8 @@ impl Dialect {
     }
 
     /// One whole-line comment in the dialect's syntax, its text escaped as by
-    /// [`comment_text`] but not cut (text from the input must already have been through
-    /// [`comment_text`], which cuts it).
+    /// [`comment_text`](super::comment_text) but not cut (text from the input must already
+    /// have been through it, which cuts it).
     pub(super) fn comment(self, text: &str) -> String {
         self.rules().comment(&escape(text, usize::MAX))
     }

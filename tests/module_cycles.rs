@@ -11,7 +11,9 @@
 //!
 //! Siblings get the same rule one level down: the child modules of any module (`src/a/x.rs`,
 //! `src/a/y.rs`, ...) must use each other without a cycle, where `x` uses `y` when its source
-//! names `super::y` or `crate::a::y` (the parent, which declares them, is not a node).
+//! names `super::y` or `crate::a::y` (the parent, which declares them, is not a node). A glob
+//! `use super::*` hides which of the parent's imports a child uses and is not followed (test
+//! modules use it for their own parent): children that use their siblings should name them.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;

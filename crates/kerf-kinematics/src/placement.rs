@@ -36,12 +36,13 @@ use crate::machine::{Machine, Range};
 use crate::path::{solve_paths, PathInput, PathOptions, SolvedPath};
 use crate::pose::{Axes, Pose};
 
+mod directions;
 mod setups;
 mod shift;
 mod work;
 
+use directions::{reachable_directions, turn_up, up_directions};
 pub use setups::{auto_setups, Setup, SetupPlan};
-use setups::{reachable_directions, turn_up, up_directions};
 use shift::translation;
 use work::Work;
 

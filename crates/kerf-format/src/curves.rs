@@ -171,6 +171,33 @@ impl RawCurve {
     }
 }
 
+/// The first of a curve's optional lengths (`on_surface_tolerance_mm`, `sheet_thickness_mm`)
+/// outside its range, as its key and what is wrong (`must be > 0 and at most 0.1 mm (got
+/// 0.2)`): the one rule for files ([`from_raw`]) and for curves built in code.
+pub fn length_key_error(
+    on_surface_tolerance_mm: Option<f64>,
+    sheet_thickness_mm: Option<f64>,
+) -> Option<(&'static str, String)> {
+    [
+        (
+            "on_surface_tolerance_mm",
+            on_surface_tolerance_mm,
+            MAX_CURVE_ON_SURFACE_TOLERANCE_MM,
+        ),
+        (
+            "sheet_thickness_mm",
+            sheet_thickness_mm,
+            MAX_SHEET_THICKNESS_MM,
+        ),
+    ]
+    .into_iter()
+    .find_map(|(key, value, max)| {
+        let t = value?;
+        (!(t > 0.0 && t <= max))
+            .then(|| (key, format!("must be > 0 and at most {max} mm (got {t})")))
+    })
+}
+
 /// The largest `sheet_thickness_mm` a curve may state, mm (a plate far thicker than any a laser
 /// cuts; the key exists to keep a thick sheet's contours on their side).
 pub const MAX_SHEET_THICKNESS_MM: f64 = 1000.0;
@@ -774,25 +801,13 @@ pub fn from_raw(raw: RawCurvesFile, base_dir: &Path) -> Result<CurvesFile> {
             });
         }
         let (start, scrap) = start_and_scrap(index, &curve, c.start, c.scrap.as_deref())?;
-        if let Some(t) = c.on_surface_tolerance_mm {
-            if !(t > 0.0 && t <= MAX_CURVE_ON_SURFACE_TOLERANCE_MM) {
-                return Err(FormatError::Shape {
-                    path: format!("curves[{index}].on_surface_tolerance_mm"),
-                    message: format!(
-                        "must be > 0 and at most {MAX_CURVE_ON_SURFACE_TOLERANCE_MM} mm (got {t})"
-                    ),
-                });
-            }
-        }
-        if let Some(t) = c.sheet_thickness_mm {
-            if !(t > 0.0 && t <= MAX_SHEET_THICKNESS_MM) {
-                return Err(FormatError::Shape {
-                    path: format!("curves[{index}].sheet_thickness_mm"),
-                    message: format!(
-                        "must be > 0 and at most {MAX_SHEET_THICKNESS_MM} mm (got {t})"
-                    ),
-                });
-            }
+        if let Some((key, message)) =
+            length_key_error(c.on_surface_tolerance_mm, c.sheet_thickness_mm)
+        {
+            return Err(FormatError::Shape {
+                path: format!("curves[{index}].{key}"),
+                message,
+            });
         }
         curves.push(CurveRecord {
             id: c.id,

@@ -595,22 +595,12 @@ impl Job {
             if kerf_format::curves::is_a_point(&c.curve) {
                 return Err(invalid(kerf_format::curves::POINT_CURVE.to_owned()));
             }
-            // A curve built in code states its own tolerance as a file must.
-            if let Some(t) = c.on_surface_tolerance_mm {
-                if !(t > 0.0 && t <= kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM) {
-                    return Err(invalid(format!(
-                        "on_surface_tolerance_mm must be > 0 and at most {} mm (got {t})",
-                        kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM
-                    )));
-                }
-            }
-            if let Some(t) = c.sheet_thickness_mm {
-                if !(t > 0.0 && t <= kerf_format::MAX_SHEET_THICKNESS_MM) {
-                    return Err(invalid(format!(
-                        "sheet_thickness_mm must be > 0 and at most {} mm (got {t})",
-                        kerf_format::MAX_SHEET_THICKNESS_MM
-                    )));
-                }
+            // A curve built in code states its own lengths as a file must.
+            if let Some((key, message)) = kerf_format::curves::length_key_error(
+                c.on_surface_tolerance_mm,
+                c.sheet_thickness_mm,
+            ) {
+                return Err(invalid(format!("{key} {message}")));
             }
         }
         for (i, c) in self.curves.curves.iter().enumerate() {

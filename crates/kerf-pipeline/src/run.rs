@@ -365,6 +365,9 @@ fn run_placed(
         .process
         .standoff_mm
         .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM);
+    // The program's fit follows from the dialect, no option can change it (the head check
+    // needs its orientation tolerance, the interpolation the rest).
+    let fit = crate::motion::fit_options(dopts.tolerance_mm, Some(o.dialect), o.retract_mm);
     if let Some(clearance) = o.cut_clearance_mm {
         let hopts = kerf_process::HeadCheckOptions::default()
             .with_clearance_mm(clearance)
@@ -375,13 +378,10 @@ fn run_placed(
             .with_path_deviation_mm(popts.linearization_tolerance_mm + o.blend_tolerance_mm)
             // Where the program's blocks merge poses (lines and arcs over several), each
             // pose's axis is held within the fit's orientation tolerance only.
-            .with_axis_deviation_rad({
-                let fit = crate::motion::fit_options(dopts.tolerance_mm, Some(o.dialect), 0.0);
-                if fit.merge_lines || fit.arcs {
-                    fit.orientation_tolerance_deg.to_radians()
-                } else {
-                    0.0
-                }
+            .with_axis_deviation_rad(if fit.merge_lines || fit.arcs {
+                fit.orientation_tolerance_deg.to_radians()
+            } else {
+                0.0
             });
         for setup in 0..placed.plan.setups.len() {
             let ks: Vec<usize> = (0..solved.len())
@@ -437,8 +437,6 @@ fn run_placed(
     progress(Progress::new(Stage::Interpolate, 0, 1));
     let model = MachineModel::new(machine.clone()).map_err(interp(path))?;
     let dialect = o.dialect;
-    // The generic-dialect rule: the fit follows from the dialect, no option can change it.
-    let fit = crate::motion::fit_options(dopts.tolerance_mm, Some(dialect), o.retract_mm);
     let mut plan = PlanOptions::new(o.feed_mm_per_min, o.cycle_s);
     plan.blend_tolerance_mm = o.blend_tolerance_mm; // the planner's blend and the controller's
     let source_name = path.map(|p| p.display().to_string());

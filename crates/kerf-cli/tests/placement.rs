@@ -224,6 +224,14 @@ fn every_real_part_runs_with_place_auto() {
         n > 1,
         "sheet metal needs several set-ups on a +-135 deg head"
     );
+    // On the trunnion table a rapid between two of its pieces turns C by 251 degrees at
+    // A = 90: planned along the tip's line instead of the joints' (the way G0 runs it), it
+    // swung Z out of the travel and the part got no program.
+    let table = run_placed("realdata/nori_sheetmetal.json", "table_table.json", "auto");
+    assert!(
+        table["placement"]["setups"].as_array().map_or(0, Vec::len) > 1,
+        "several set-ups on the trunnion table too"
+    );
 }
 
 #[test]

@@ -270,6 +270,14 @@ impl<const D: usize> Spline<D> {
 }
 
 /// One run: blocks `first..=last` of the program, smooth inside, at rest at both ends.
+///
+/// A cutting run moves the tip along its splines (the controller's tool-tip interpolation);
+/// a rapid is one block, a run of its own, moved in the joints ([`Run::joint`]): the machine
+/// runs a `G0` straight in its axes (the joint dialects write its end, the tool-tip ones split
+/// it until it follows that line, `RAPID_TCP_TOLERANCE_MM`), and the traverse was checked
+/// against the part along that line, so the plan moves the same way. Planned along the tip's
+/// straight line instead, a rapid that turned a table by 251 degrees swung the linear axes
+/// 470 mm past both ends, out of the machine's travel.
 #[derive(Debug, Clone)]
 pub(crate) struct Run {
     /// First block (index into the planned blocks).
@@ -286,8 +294,11 @@ pub(crate) struct Run {
     pub(crate) tip_len: f64,
     /// True for cutting runs: the programmed feed caps the tip speed.
     pub(crate) cutting: bool,
-    /// The tip moves (false for pure rotations: no feed or chord cap).
+    /// The tip moves (false for pure rotations and rapids: no feed or chord cap).
     pub(crate) moves_tip: bool,
+    /// A rapid: `tip` holds the linear machine axes, not the tip, and the axes move straight
+    /// from the block's start to its end (both splines linear).
+    pub(crate) joint: bool,
     /// The share of the programmed feed this run cuts at (a small hole's feed factor, the
     /// least of its paths' [`crate::PlanOptions::feed_factors`]; 1 otherwise).
     pub(crate) feed_factor: f64,
@@ -380,6 +391,9 @@ impl Run {
     #[inline]
     pub(crate) fn axes_raw<M: AxisModel + ?Sized>(&self, model: &M, s: f64) -> [f64; 5] {
         let (tip, r) = self.pose(s);
+        if self.joint {
+            return [tip.x, tip.y, tip.z, r[0], r[1]];
+        }
         let xyz = model.linear_axes(&tip, r[0], r[1]);
         [xyz[0], xyz[1], xyz[2], r[0], r[1]]
     }
@@ -544,7 +558,8 @@ const GRADE_RATIO: f64 = 4.0;
 /// True when blocks `a` and `a + 1` meet at a true corner (or must not share a run).
 fn breaks(blocks: &[Block], a: usize, opts: &PathOptions) -> bool {
     let (x, y) = (&blocks[a], &blocks[a + 1]);
-    if x.rapid != y.rapid || x.path != y.path {
+    // A rapid is a run of its own (a straight line of the joints, [`Run`]).
+    if x.rapid || y.rapid || x.path != y.path {
         return true;
     }
     let (lx, ly) = (
@@ -660,6 +675,9 @@ pub(crate) fn runs(blocks: &[Block], opts: &PathOptions) -> Vec<Run> {
 }
 
 fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run {
+    if first == last && blocks[first].rapid {
+        return build_rapid(blocks, first, opts);
+    }
     let run = &blocks[first..=last];
     let mut starts = Vec::with_capacity(run.len() + 1);
     let mut ratio = Vec::with_capacity(run.len());
@@ -840,6 +858,7 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         last,
         cutting: !run[0].rapid,
         moves_tip,
+        joint: false,
         feed_factor: 1.0,
         corners: (Vec::new(), 0.0, 1.0),
         nodes: ts,
@@ -854,6 +873,46 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
         } else {
             0.0
         },
+    }
+}
+
+/// The run of rapid `b`: its joints straight from the start to the end ([`Run::joint`]), over
+/// the block's path parameter ([`block_param_length`]).
+fn build_rapid(blocks: &[Block], b: usize, opts: &PathOptions) -> Run {
+    let blk = &blocks[b];
+    let len = block_param_length(blk, opts.rotary_mm_per_deg);
+    let (q0, q1) = (blk.start_axes, blk.end_axes);
+    // Straight in the rotary axes themselves (both ends are within their ranges, so is the
+    // line), not in the soft-limit coordinates of a cutting run.
+    let soft = [SoftRange::new(None), SoftRange::new(None)];
+    let (r0, r1) = ([q0[3], q0[4]], [q1[3], q1[4]]);
+    let slope = |a: &[f64], b: &[f64]| -> Vec<f64> {
+        a.iter().zip(b).map(|(a, b)| (b - a) / len).collect()
+    };
+    let (dl, dr) = (slope(&q0[..3], &q1[..3]), slope(&r0, &r1));
+    let dl = [dl[0], dl[1], dl[2]];
+    let dr = [dr[0], dr[1]];
+    Run {
+        first: b,
+        last: b,
+        cutting: false,
+        moves_tip: false,
+        joint: true,
+        feed_factor: 1.0,
+        corners: (Vec::new(), 0.0, 1.0),
+        nodes: vec![0.0, len],
+        tip: Spline::clamped(
+            vec![0.0, len],
+            vec![[q0[0], q0[1], q0[2]], [q1[0], q1[1], q1[2]]],
+            dl,
+            dl,
+        ),
+        rot: Spline::clamped(vec![0.0, len], vec![r0, r1], dr, dr),
+        soft,
+        blend: 0.0,
+        starts: vec![0.0, len],
+        ratio: vec![blk.length() / len],
+        tip_len: 0.0,
     }
 }
 

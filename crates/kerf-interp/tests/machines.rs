@@ -115,3 +115,68 @@ fn every_machine_type_plans_within_its_limits() {
         );
     }
 }
+
+/// A rapid is planned as the machine runs a `G0`: straight in the joints. On a table-table
+/// machine at A = 90 degrees a rapid between two points 5 mm apart on the part that turns C
+/// by 200 degrees swings the part's point about the C axis: planned along the tip's straight
+/// line, the linear axes followed that swing (Z went ~400 mm below both ends and left the
+/// machine's travel on a real sheet-metal part); planned in the joints, every set-point of the
+/// rapid lies on the straight line between its ends.
+#[test]
+fn a_rapid_is_planned_straight_in_the_joints() {
+    let m = load("table_table");
+    let station = |tip: Point3<f64>, a: f64, c: f64| {
+        let xyz = m.linear_axes(&tip, a, c);
+        let q = [xyz[0], xyz[1], xyz[2], a, c];
+        let u = m.tool_axis(a, c);
+        (q, [tip.x, tip.y, tip.z, u.x, u.y, u.z])
+    };
+    let path = |tips: [Point3<f64>; 2], c: f64| {
+        let (q0, p0) = station(tips[0], 90.0, c);
+        let (q1, p1) = station(tips[1], 90.0, c);
+        let st = stations_from_axes(&[q0, q1], &[p0, p1]).expect("stations");
+        kerf_interp::link_paths(vec![
+            fit_blocks(&m, &st, None, 0, &FitOptions::default()).expect("fit")
+        ])
+    };
+    let first = path(
+        [Point3::new(150.0, 0.0, 0.0), Point3::new(150.0, 10.0, 0.0)],
+        0.0,
+    );
+    let mut second = path(
+        [Point3::new(150.0, 15.0, 0.0), Point3::new(150.0, 25.0, 0.0)],
+        200.0,
+    );
+    for b in &mut second {
+        b.path = 1;
+    }
+    let blocks = kerf_interp::link_paths(vec![first, second]);
+    let r = blocks.iter().position(|b| b.rapid).expect("a rapid");
+    let (q0, q1) = (blocks[r].start_axes, blocks[r].end_axes);
+    assert!((q1[4] - q0[4]).abs() > 150.0, "C turns: {q0:?} -> {q1:?}");
+    let motion = plan(&m, &blocks, &PlanOptions::new(6000.0, 0.001)).expect("plan");
+    let rows = motion.setpoints(&m);
+    let mut seen = 0;
+    for (i, q) in rows.iter().enumerate() {
+        let (b, _) = motion.locate(i as f64 * motion.cycle());
+        if b != r {
+            continue;
+        }
+        seen += 1;
+        // Where on the line (by the largest travel), and how far each axis is from it.
+        let k = (0..5)
+            .max_by(|&a, &b| (q1[a] - q0[a]).abs().total_cmp(&(q1[b] - q0[b]).abs()))
+            .unwrap();
+        let f = (q[k] - q0[k]) / (q1[k] - q0[k]);
+        assert!((-1e-6..=1.0 + 1e-6).contains(&f), "cycle {i}: {f}");
+        for j in 0..5 {
+            let on_line = q0[j] + f * (q1[j] - q0[j]);
+            assert!(
+                (q[j] - on_line).abs() < 1e-6,
+                "cycle {i} axis {j}: {} off the joint line ({q:?}, {q0:?} -> {q1:?})",
+                q[j] - on_line
+            );
+        }
+    }
+    assert!(seen > 10, "the rapid's set-points were checked ({seen})");
+}

@@ -449,8 +449,11 @@ pub fn plan_rapids(
                         })
                     })
                 };
-                // Each move as the interpolator runs it (tip straight, rotaries linear),
-                // sampled: where the rotaries turn, the linear axes swing past the ends.
+                // The machine runs each move straight in its axes (inside the limits when
+                // its ends are), but a move that swings too close is split at points of the
+                // tip's straight line with the rotaries linear (`rapid_moves_within`), and
+                // there, where the rotaries turn, the linear axes swing past the ends: those
+                // points, sampled, must be inside too.
                 (0..n).all(|i| {
                     let (a, ra) = (way[i], rot(i));
                     let (b, rb) = if i + 1 < n {

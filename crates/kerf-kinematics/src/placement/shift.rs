@@ -88,7 +88,6 @@ pub(super) fn translation(
     Ok(best_t)
 }
 
-
 /// The minimiser of the table machines' `f(t)` over `rows` (the linear axes of each pose and
 /// their sensitivity to the translation; see [`translation`]): `(f, t, worst axis)`. With
 /// `working_set`, over a working set of the rows that grows until it certifies its minimiser
@@ -163,8 +162,7 @@ fn minimax(
             }
             let step = pg / gpg.sqrt();
             centre -= step / (n + 1.0);
-            shape =
-                (shape - step * step.transpose() * (2.0 / (n + 1.0))) * (n * n / (n * n - 1.0));
+            shape = (shape - step * step.transpose() * (2.0 / (n + 1.0))) * (n * n / (n * n - 1.0));
             // Stop when the ellipsoid is smaller than a micrometre.
             if shape.trace().sqrt() < 1e-4 {
                 break;

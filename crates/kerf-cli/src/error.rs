@@ -38,13 +38,8 @@ pub(crate) enum CliError {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CliError::Pipeline(
-                e @ (kerf_pipeline::Error::Step(_) | kerf_pipeline::Error::Iges(_)),
-            ) => {
-                write!(f, "{}", with_flags(e.to_string()))
-            }
             CliError::Pipeline(e) => {
-                write!(f, "{e}")?;
+                write!(f, "{}", with_flags(e.to_string()))?;
                 if let Some(hint) = hint(e) {
                     write!(f, " [{hint}]")?;
                 }
@@ -78,12 +73,29 @@ impl std::error::Error for CliError {
     }
 }
 
-/// A reader's message with the command line's flag for the option it names.
+/// The library's option names in its messages, and the command line's flag for each.
+const OPTION_FLAGS: [(&str, &str); 6] = [
+    ("ImportOptions::with_edges", "--edges"),
+    ("accept_head_collisions", "--accept-head-collisions"),
+    ("tilt_tolerance_deg", "--tilt-tolerance (degrees)"),
+    ("cut_clearance_mm", "--cut-clearance"),
+    ("the run's kerf_width_mm", "--kerf-width"),
+    ("the run's feed_mm_per_min", "--feed"),
+];
+
+/// A library message (an error, a warning) with the command line's flags for the options it
+/// names (the library names its options, `JobOptions::tilt_tolerance_deg`; a process engineer
+/// types `--tilt-tolerance`).
 pub(crate) fn with_flags(message: String) -> String {
-    if message.contains("ImportOptions::with_edges") {
-        format!("{message} [option: --edges]")
-    } else {
-        message
+    let flags: Vec<&str> = OPTION_FLAGS
+        .iter()
+        .filter(|(option, _)| message.contains(option))
+        .map(|(_, flag)| *flag)
+        .collect();
+    match flags.as_slice() {
+        [] => message,
+        [one] => format!("{message} [option: {one}]"),
+        more => format!("{message} [options: {}]", more.join(", ")),
     }
 }
 

@@ -128,7 +128,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     out.prepend_timings(read);
     if !args.quiet {
         for w in &out.warnings {
-            eprintln!("warning: {}: {w}", path.display());
+            eprintln!(
+                "warning: {}: {}",
+                path.display(),
+                crate::error::with_flags(w.clone())
+            );
         }
     }
     // Several set-ups number their programs: check those names too.

@@ -423,7 +423,7 @@ pub(crate) fn compensation_json(
     let Some(k) = kerf else {
         return json!({
             "kerf_width_mm": null,
-            "note": "no kerf width (--kerf-width or the machine's process.kerf_width_mm): the path is the contour itself",
+            "note": "no kerf width (the run's kerf_width_mm, the technology entry's or the machine's process.kerf_width_mm): the path is the contour itself",
         });
     };
     let paths: Vec<Value> = compensated
@@ -668,7 +668,7 @@ pub(crate) fn traverse_report(
     })
     .collect();
     let Some(o) = opts else {
-        return json!({ "checked": false, "note": "--clearance 0: retract along the tool axis, one straight move, approach; not checked against the part" });
+        return json!({ "checked": false, "note": "no traverse options (a clearance of 0): retract along the tool axis, one straight move, approach; not checked against the part" });
     };
     json!({
         "checked": true,

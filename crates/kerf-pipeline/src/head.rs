@@ -308,7 +308,7 @@ pub(crate) fn check_and_clear(
         out.report.push(entry);
         if accept {
             out.warnings
-                .push(format!("{e} (accepted: --accept-head-collisions)"));
+                .push(format!("{e} (accepted: accept_head_collisions)"));
         } else if out.refusal.is_none() {
             out.refusal = Some(e);
         }
@@ -354,7 +354,7 @@ fn needed_tilt(
             kerf_kinematics::MAX_TILT_TOLERANCE_DEG
         ),
         Some(a) => format!(
-            "at cutting point {i} a tilt of {a:.1} deg away from surface {surface} would clear it (tilt tolerance {tolerance_deg} deg; --tilt-tolerance {} allows it)",
+            "at cutting point {i} a tilt of {a:.1} deg away from surface {surface} would clear it (tilt tolerance {tolerance_deg} deg; a tilt_tolerance_deg of {} allows it)",
             (a / kerf_kinematics::TILT_WORKING_FRACTION).ceil()
         ),
         None if unproven.is_some() => format!(
@@ -436,7 +436,7 @@ pub(crate) fn head_json(
     paths: Vec<Value>,
 ) -> Value {
     let Some(clearance) = clearance else {
-        return json!({ "checked": false, "note": "cuts not checked against the head (--cut-clearance MM checks them)" });
+        return json!({ "checked": false, "note": "cuts not checked against the head (cut_clearance_mm checks them)" });
     };
     let head = machine.head.clone().unwrap_or_else(Head::laser_default);
     json!({

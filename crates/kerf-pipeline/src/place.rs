@@ -201,7 +201,7 @@ impl Placed {
             "paths_solved": if self.auto { Some(self.plan.paths_solved) } else { None },
             "flipped_paths": ids.iter().zip(&self.plan.flipped).filter(|(_, f)| **f).map(|(id, _)| *id).collect::<Vec<_>>(),
             "sides": self.sides_json(ids),
-            "sides_note": "side: given = the tool axis is the surface's normal, other = reversed (the beam comes from the other side of the sheet); with --place auto and checked traverses a contour is turned where the nozzle's line along the tool axis (from 3/4 of the clearance to the retract plus the nozzle, at up to 64 of its points) comes within half the clearance of a surface of the file from the given side and from the other side nowhere, reach permitting; the lead-ins stay on the scrap side decided with the given normal",
+            "sides_note": "side: given = the tool axis is the surface's normal, other = reversed (the beam comes from the other side of the sheet); with the placement auto and checked traverses a contour is turned where the nozzle's line along the tool axis (from 3/4 of the clearance to the retract plus the nozzle, at up to 64 of its points) comes within half the clearance of a surface of the file from the given side and from the other side nowhere, reach permitting; the lead-ins stay on the scrap side decided with the given normal",
         })
     }
 

@@ -155,7 +155,7 @@ fn run_placed(
     // With a kerf width, each path is first offset by half of it toward the scrap.
     let kerf = o
         .kerf_width_mm
-        .map(|w| (w, "--kerf-width"))
+        .map(|w| (w, "the run's kerf_width_mm"))
         .or_else(|| {
             o.technology
                 .as_ref()
@@ -971,7 +971,7 @@ fn laser_power(t: &kerf_kinematics::TechnologyEntry) -> kerf_interp::LaserPower 
 fn technology_header(t: Option<&kerf_kinematics::TechnologyEntry>) -> Vec<String> {
     let Some(t) = t else {
         return vec![
-            "technology: none (feed from --feed, process codes from the machine file)".into(),
+            "technology: none (feed from the run's feed_mm_per_min, process codes from the machine file)".into(),
         ];
     };
     let pierce = t.pierce.map_or(String::new(), |p| {
@@ -1029,7 +1029,7 @@ fn technology_json(
         "corner": t.corner.map(|c| json!({ "min_turn_deg": c.min_turn_deg, "length_mm": c.length_mm, "feed_factor": c.feed_factor })),
         "power_min_percent": t.power_min(),
         "small_holes": small_holes,
-        "note": format!("the entry's feed is the run's unless --feed was given; its pierce, standoff and kerf width replace the machine file's; {power}; holes within the small-hole rule run at its {holes}, corners within its corner rule at its feed factor; gas and focus are stated, not commanded"),
+        "note": format!("the entry's feed is the run's unless the run sets its own feed_mm_per_min; its pierce, standoff and kerf width replace the machine file's; {power}; holes within the small-hole rule run at its {holes}, corners within its corner rule at its feed factor; gas and focus are stated, not commanded"),
     })
 }
 

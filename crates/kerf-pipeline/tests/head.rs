@@ -277,7 +277,8 @@ fn a_trim_line_on_a_bend_leans_away_from_the_flange() {
 fn without_a_tilt_tolerance_the_refusal_says_which_tilt_would_clear() {
     let e = job(3.0, false).expect_err("refused").to_string();
     assert!(
-        e.contains("deg away from surface wall would clear it") && e.contains("--tilt-tolerance"),
+        e.contains("deg away from surface wall would clear it")
+            && e.contains("a tilt_tolerance_deg of"),
         "{e}"
     );
 }

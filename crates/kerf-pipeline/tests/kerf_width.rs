@@ -185,7 +185,7 @@ fn sheet_metal_holes_shrink_by_half_the_kerf_and_the_outline_grows() {
     let header = &out.programs[0].text;
     assert!(
         header.contains(
-            "kerf compensation in the computer: kerf 0.2 mm from --kerf-width, 8 paths offset 0.1 mm"
+            "kerf compensation in the computer: kerf 0.2 mm from the run's kerf_width_mm, 8 paths offset 0.1 mm"
         ),
         "{}",
         &header[..600]
@@ -347,7 +347,7 @@ fn the_controller_compensates_the_contours_themselves_with_g41_and_g42() {
     }
     assert!(
         text.contains(
-            "kerf compensation in the controller: G41.1/G42.1 D0.2 from --kerf-width on 8 paths"
+            "kerf compensation in the controller: G41.1/G42.1 D0.2 from the run's kerf_width_mm on 8 paths"
         ),
         "header"
     );

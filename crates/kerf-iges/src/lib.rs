@@ -623,7 +623,7 @@ fn box_loop(
     g: &kerf_step::cad::Geometry,
     b: ((f64, f64), (f64, f64)),
 ) -> Result<(Vec<NurbsCurve>, Vec<u64>)> {
-    let s = g.to_nurbs(b.0, b.1).map_err(|m| err(e, m))?;
+    let s = g.to_nurbs(b.0, b.1).map_err(|m| err(e, m.to_string()))?;
     let (nu, nv) = s.net_size();
     let pts = s.control_points();
     let w = s.weights();

@@ -17,7 +17,7 @@ pub use crate::model::Charge;
 pub use crate::model::Frame;
 use crate::shape::associate;
 pub use crate::shape::{face, first_with_same_surface, sew, Face, ParamBox, Place};
-pub use crate::surfaces::Geometry;
+pub use crate::surfaces::{Geometry, SurfaceRangeError};
 
 /// `segments` (in order) joined into one curve with a C0 knot at each join, gaps up to
 /// `close_below` mm closed by moving the shared pole (a swept surface's profile given as a

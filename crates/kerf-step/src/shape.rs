@@ -137,7 +137,7 @@ pub fn face<P: Place>(
             ));
         }
     }
-    let mut surface = g.to_nurbs(u, v).map_err(|m| place.defect(m))?;
+    let mut surface = g.to_nurbs(u, v).map_err(|m| place.defect(m.to_string()))?;
     edges_on_surface(place, sigil, &surface, g.kind(), &loops, &edge_ids)?;
     if reversed {
         surface = reverse_u(&surface);

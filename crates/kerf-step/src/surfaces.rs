@@ -157,22 +157,22 @@ impl Geometry {
         }
     }
 
-    /// The exact NURBS surface over `[u0, u1] x [v0, v1]` of the natural parameters; the
-    /// error says what is wrong with the range or the geometry.
+    /// The exact NURBS surface over `[u0, u1] x [v0, v1]` of the natural parameters.
     ///
     /// # Errors
-    /// An empty range, or a range outside a B-spline surface's domain.
+    /// [`SurfaceRangeError::Empty`] for an empty (or NaN) range,
+    /// [`SurfaceRangeError::Nurbs`] where the range leaves a B-spline's domain or the
+    /// surface cannot be built (the NURBS error kept as the source).
     pub fn to_nurbs(
         &self,
         u: (f64, f64),
         v: (f64, f64),
-    ) -> std::result::Result<NurbsSurface, String> {
-        let bad = |what: &str| format!("empty parameter range of the face: {what}");
+    ) -> std::result::Result<NurbsSurface, SurfaceRangeError> {
         if !(u.1 > u.0) {
-            return Err(bad("u"));
+            return Err(SurfaceRangeError::Empty { direction: 'u' });
         }
         if !(v.1 > v.0) {
-            return Err(bad("v"));
+            return Err(SurfaceRangeError::Empty { direction: 'v' });
         }
         let s = match self {
             Geometry::Plane(f) => {
@@ -197,7 +197,7 @@ impl Geometry {
             Geometry::Sphere(f, r) => revolve_profile(f, u, &circle_profile(0.0, *r, v)),
             Geometry::Torus(f, big, r) => revolve_profile(f, u, &circle_profile(*big, *r, v)),
             Geometry::Extrusion(c, d) => {
-                let c = sub_curve(c, u.0, u.1).map_err(|e| e.to_string())?;
+                let c = sub_curve(c, u.0, u.1)?;
                 let p = c.degree();
                 let rows: Vec<Vec<Point3<f64>>> = c
                     .control_points()
@@ -220,13 +220,28 @@ impl Geometry {
                 axis,
                 x0,
             } => {
-                let c = sub_curve(profile, v.0, v.1).map_err(|e| e.to_string())?;
+                let c = sub_curve(profile, v.0, v.1)?;
                 revolution(origin, axis, x0, u, &c)
             }
             Geometry::Nurbs(s) => cut(s, u, v),
         };
-        s.map_err(|e| e.to_string())
+        Ok(s?)
     }
+}
+
+/// Why [`Geometry::to_nurbs`] has no surface for a parameter range.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SurfaceRangeError {
+    /// The range is empty in one direction (a face whose boundary has no extent there).
+    #[error("empty parameter range of the face: {direction}")]
+    Empty {
+        /// `'u'` or `'v'`.
+        direction: char,
+    },
+    /// The NURBS surface could not be cut or built over the range.
+    #[error(transparent)]
+    Nurbs(#[from] kerf_nurbs::NurbsError),
 }
 
 /// Projects a curve along `dir` onto the plane through `base` normal to `dir` (same knots
@@ -760,6 +775,25 @@ mod tests {
             e.contains("b-spline surface has no exact NURBS form"),
             "{e}"
         );
+    }
+
+    /// An empty range is a typed error naming its direction, with the reader's message.
+    #[test]
+    fn an_empty_range_is_a_typed_error() {
+        let cyl = Geometry::Cylinder(frame(), 3.0);
+        for (u, v, dir) in [((0.0, 1.0), (2.0, 2.0), 'v'), ((1.0, 1.0), (0.0, 2.0), 'u')] {
+            match cyl.to_nurbs(u, v) {
+                Err(e @ SurfaceRangeError::Empty { direction }) => {
+                    assert_eq!(direction, dir);
+                    assert_eq!(
+                        e.to_string(),
+                        format!("empty parameter range of the face: {dir}")
+                    );
+                }
+                other => panic!("{other:?}"),
+            }
+        }
+        assert!(cyl.to_nurbs((0.0, 1.0), (f64::NAN, 2.0)).is_err(), "NaN");
     }
 
     #[test]

@@ -282,8 +282,9 @@ pub(crate) struct PostArgs {
     #[arg(long, value_name = "auto|X,Y,Z[,RX,RY,RZ]", value_parser = kerf_pipeline::PlaceMode::parse, allow_hyphen_values = true)]
     pub(crate) place: Option<kerf_pipeline::PlaceMode>,
 
-    /// Tool axes within this angle of the C axis count as the pole, in radians (default 1e-6).
-    #[arg(long, value_name = "RAD", value_parser = crate::guard::small_angle_rad)]
+    /// Tool axes within this angle of the C axis count as the pole, in degrees (default
+    /// 5.73e-5, which is 1e-6 rad).
+    #[arg(long, value_name = "DEG", value_parser = crate::guard::small_angle_deg)]
     pub(crate) pole_tolerance: Option<f64>,
 
     /// Print the summary as one JSON object.

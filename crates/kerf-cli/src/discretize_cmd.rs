@@ -26,7 +26,7 @@ pub(crate) fn options(args: &DiscretizeArgs) -> Options {
         .with_band(args.band.unwrap_or(d.band))
         .with_max_segment_length_mm(args.max_segment_length.unwrap_or(d.max_segment_length_mm))
         .with_min_segment_length_mm(args.min_segment_length.unwrap_or(d.min_segment_length_mm))
-        .with_max_turn_rad(args.max_turn.map_or(d.max_turn_rad, f64::to_radians))
+        .with_max_turn_deg(args.max_turn.unwrap_or(d.max_turn_deg))
         .with_strategy(args.strategy.into())
         .with_max_points(
             args.max_points
@@ -43,10 +43,7 @@ fn orient_options(args: &DiscretizeArgs) -> OrientOptions {
             args.on_surface_tolerance
                 .unwrap_or(d.on_surface_tolerance_mm),
         )
-        .with_max_normal_step_rad(
-            args.max_normal_step
-                .map_or(d.max_normal_step_rad, f64::to_radians),
-        );
+        .with_max_normal_step_deg(args.max_normal_step.unwrap_or(d.max_normal_step_deg));
     let o = OrientOptions::default()
         .with_normals(normals)
         .with_missing_surface(MissingSurface::Error);

@@ -86,8 +86,8 @@ const TILT_DEG: OptionRange = own(
     true,
     "degrees",
 );
-/// `--pole-tolerance` (0.1 rad is 5.7 degrees).
-const POLE_RAD: OptionRange = own(0.0, false, 0.1, true, "rad");
+/// `--pole-tolerance`: a tolerance, not a tilt (5 degrees is 0.087 rad).
+const POLE_DEG: OptionRange = own(0.0, false, 5.0, true, "degrees");
 /// `--close-gaps` of a STEP import: a gap of more than 10 mm between two segments is no
 /// modelling slack but an opening.
 pub(crate) const CLOSE_GAPS_MM: OptionRange = own(0.0, true, 10.0, true, "mm");
@@ -204,9 +204,9 @@ pub(crate) fn normal_step_deg(s: &str) -> Result<f64, String> {
     within(s, NORMAL_STEP_DEG)
 }
 
-/// A small angle in radians: 0 < x <= 0.1.
-pub(crate) fn small_angle_rad(s: &str) -> Result<f64, String> {
-    within(s, POLE_RAD)
+/// A small angle in degrees: 0 < x <= 5.
+pub(crate) fn small_angle_deg(s: &str) -> Result<f64, String> {
+    within(s, POLE_DEG)
 }
 
 /// A feed in mm/min ([`ranges::FEED_MM_PER_MIN`]).
@@ -293,7 +293,7 @@ mod tests {
             "the normal step is below a half turn"
         );
         assert_eq!(normal_step_deg("179.9"), Ok(179.9), "normal step");
-        assert!(small_angle_rad("0.2").is_err(), "pole tolerance");
+        assert!(small_angle_deg("6").is_err(), "pole tolerance");
         assert_eq!(cycle_s("0.001"), Ok(0.001), "1 ms");
         assert_eq!(cycle_s("1e-5"), Ok(1e-5), "lower end");
         let e = cycle_s("1e9").expect_err("a cycle of 30 years");

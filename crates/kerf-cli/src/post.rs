@@ -21,7 +21,7 @@ pub(crate) fn options(args: &PostArgs) -> PathOptions {
             .unwrap_or(d.linearization_tolerance_mm),
     )
     .with_max_rotary_step_deg(args.max_rotary_step.unwrap_or(d.max_rotary_step_deg))
-    .with_pole_tolerance_rad(args.pole_tolerance.unwrap_or(d.pole_tolerance_rad))
+    .with_pole_tolerance_deg(args.pole_tolerance.unwrap_or(d.pole_tolerance_deg))
     .with_tilt_tolerance_deg(
         args.tilt_tolerance
             .unwrap_or(kerf_pipeline::DEFAULT_TILT_TOLERANCE_DEG),

@@ -20,7 +20,7 @@ fn job_options(args: &RunArgs) -> JobOptions {
     discretize.max_segment_length_mm = args.max_segment_length.unwrap_or(f64::INFINITY);
     let mut normals = NormalOptions::default();
     if let Some(deg) = args.max_normal_step {
-        normals.max_normal_step_rad = deg.to_radians();
+        normals.max_normal_step_deg = deg;
     }
     let d = PathOptions::default();
     let path = d

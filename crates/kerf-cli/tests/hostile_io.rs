@@ -295,8 +295,8 @@ fn every_numeric_option_has_an_upper_end_and_says_its_range() {
         ),
         (
             &post,
-            "--pole-tolerance=1",
-            "must be > 0 rad and <= 0.1 rad (got 1)",
+            "--pole-tolerance=10",
+            "must be > 0 degrees and <= 5 degrees (got 10)",
         ),
         (
             &post,

@@ -61,7 +61,7 @@ pub enum DiscretizeError {
     },
     /// No step after `t`, however short, keeps the tangent's turn within `max_turn`: the
     /// tangent turns abruptly there (a corner or cusp inside a knot span). Fix: raise
-    /// [`crate::Options::max_turn_rad`], or split the curve at the corner so that it becomes a C0
+    /// [`crate::Options::max_turn_deg`], or split the curve at the corner so that it becomes a C0
     /// break.
     #[error("the tangent turns by more than max_turn = {max_turn_deg:.3} degrees at t = {} however short the segment (a corner inside a knot span); raise max_turn_rad or split the curve there", Readable(*.t))]
     TurnUnreachable {

@@ -506,8 +506,8 @@ pub fn discretize_range(
     } else {
         0.0
     };
-    let by_turn = if opts.max_turn_rad.is_finite() {
-        minimum::estimate_turning(curve) / opts.max_turn_rad
+    let by_turn = if opts.max_turn_deg.is_finite() {
+        minimum::estimate_turning(curve) / opts.max_turn_deg.to_radians()
     } else {
         0.0
     };

@@ -41,9 +41,9 @@ pub struct Options {
     /// it needs shorter segments, and the last segment before a C0 break or the end may be
     /// shorter, mm. Default 0.
     pub min_segment_length_mm: f64,
-    /// The largest turn of the tangent between the two ends of a segment, in radians.
+    /// The largest turn of the tangent between the two ends of a segment, in degrees.
     /// `f64::INFINITY` (the default) for none.
-    pub max_turn_rad: f64,
+    pub max_turn_deg: f64,
     /// Which method to use. Default [`Strategy::ReferenceSphere`].
     pub strategy: Strategy,
     /// Refuse curves that would need more points than this (protects against a tolerance
@@ -58,7 +58,7 @@ impl Default for Options {
             band: 0.97,
             max_segment_length_mm: f64::INFINITY,
             min_segment_length_mm: 0.0,
-            max_turn_rad: f64::INFINITY,
+            max_turn_deg: f64::INFINITY,
             strategy: Strategy::ReferenceSphere,
             max_points: 50_000_000,
         }
@@ -86,10 +86,10 @@ impl Options {
         self
     }
 
-    /// Sets [`max_turn_rad`](Self::max_turn_rad): the largest turn of the tangent between the two
-    /// ends of a segment, in radians.
-    pub fn with_max_turn_rad(mut self, max_turn_rad: f64) -> Self {
-        self.max_turn_rad = max_turn_rad;
+    /// Sets [`max_turn_deg`](Self::max_turn_deg): the largest turn of the tangent between the two
+    /// ends of a segment, in degrees.
+    pub fn with_max_turn_deg(mut self, max_turn_deg: f64) -> Self {
+        self.max_turn_deg = max_turn_deg;
         self
     }
 
@@ -160,8 +160,8 @@ impl Options {
                 "must not exceed max_segment_length_mm",
             );
         }
-        if self.max_turn_rad.is_nan() || self.max_turn_rad <= 0.0 {
-            return bad("max_turn_rad", self.max_turn_rad, "must be > 0 (radians)");
+        if self.max_turn_deg.is_nan() || self.max_turn_deg <= 0.0 {
+            return bad("max_turn_deg", self.max_turn_deg, "must be > 0 (degrees)");
         }
         Ok(())
     }

@@ -28,7 +28,7 @@ enum Fail {
     Chord,
     /// The chord is longer than `max_segment_length_mm`.
     Length,
-    /// The tangent turns more than `max_turn_rad`.
+    /// The tangent turns more than `max_turn_deg`.
     Turn,
 }
 
@@ -293,9 +293,8 @@ impl Walker<'_> {
         if (p1 - start.p).norm() > self.opts.max_segment_length_mm {
             return (bound, Some(Fail::Length));
         }
-        if self.opts.max_turn_rad.is_finite()
-            && self.cert.turn_bound(start.t, t1, self.opts.max_turn_rad) > self.opts.max_turn_rad
-        {
+        let max_turn = self.opts.max_turn_deg.to_radians();
+        if max_turn.is_finite() && self.cert.turn_bound(start.t, t1, max_turn) > max_turn {
             return (bound, Some(Fail::Turn));
         }
         (bound, None)
@@ -513,7 +512,7 @@ impl Walker<'_> {
                 return Err(if last_fail == Fail::Turn {
                     DiscretizeError::TurnUnreachable {
                         t: t0,
-                        max_turn_deg: self.opts.max_turn_rad.to_degrees(),
+                        max_turn_deg: self.opts.max_turn_deg,
                     }
                 } else if stuck || next_float_gap(t0) * 4.0 >= b - t0 {
                     DiscretizeError::ParameterResolution { t: t0 }

@@ -401,7 +401,7 @@ fn max_turn_bounds_the_turn_inside_the_segment() {
     // The S-curve's end tangents are equal; its tangent swings about 90 degrees inside.
     let (_, c) = fixture("hostile/hostile_s_curve.json").remove(0);
     let max_turn = 10f64.to_radians();
-    let opts = Options::with_tolerance(1.0).with_max_turn_rad(max_turn);
+    let opts = Options::with_tolerance(1.0).with_max_turn_deg(10.0);
     let (r, work) = run(&c, &opts);
     let d = r.expect("reachable");
     assert!(work <= walk_budget(&c, &d), "{work} evaluations");
@@ -432,7 +432,7 @@ fn max_turn_at_a_corner_inside_a_span_puts_a_point_on_the_corner() {
     // corner (to the coordinates' resolution) instead of giving up or ignoring the turn.
     let (_, c) = fixture("hostile/hostile_corner_simple_knot.json").remove(0);
     let max_turn = 10f64.to_radians();
-    let opts = Options::with_tolerance(0.01).with_max_turn_rad(max_turn);
+    let opts = Options::with_tolerance(0.01).with_max_turn_deg(10.0);
     let (r, work) = run(&c, &opts);
     let d = r.expect("a point lands on the corner");
     assert!(work <= walk_budget(&c, &d), "{work} evaluations");
@@ -457,7 +457,7 @@ fn max_turn_that_needs_too_many_points_is_refused_up_front() {
     // The S-curve turns about 180 degrees in all; 1e-7 degrees per segment would need more
     // than 1e9 points: refused from the estimate, before the walk.
     let (_, c) = fixture("hostile/hostile_s_curve.json").remove(0);
-    let opts = Options::with_tolerance(0.01).with_max_turn_rad(1e-7f64.to_radians());
+    let opts = Options::with_tolerance(0.01).with_max_turn_deg(1e-7);
     let (r, work) = run(&c, &opts);
     assert!(
         matches!(r, Err(DiscretizeError::TooManyPoints { .. })),

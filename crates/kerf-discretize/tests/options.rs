@@ -31,7 +31,7 @@ fn every_bad_option_is_named() {
                 .with_max_segment_length_mm(1.0),
             "min_segment_length_mm",
         ),
-        (Options::default().with_max_turn_rad(-1.0), "max_turn_rad"),
+        (Options::default().with_max_turn_deg(-1.0), "max_turn_deg"),
     ];
     for (opts, name) in cases {
         match discretize(&c, &opts) {
@@ -44,7 +44,7 @@ fn every_bad_option_is_named() {
 #[test]
 fn max_turn_limits_the_tangent_turn_per_segment() {
     let c = arc(100.0, 2.0);
-    let opts = Options::with_tolerance(0.1).with_max_turn_rad(0.05);
+    let opts = Options::with_tolerance(0.1).with_max_turn_deg(0.05f64.to_degrees());
     let d = discretize(&c, &opts).unwrap();
     check(&c, &d, 0.1);
     for w in d.params().windows(2) {

@@ -23,10 +23,10 @@ use crate::model::{AxisLimits, AxisModel};
 pub struct MachineModel {
     /// The machine.
     pub machine: Machine,
-    /// A tool axis within this angle (radians) of the C axis is at the pole, where C keeps its
+    /// A tool axis within this angle (degrees) of the C axis is at the pole, where C keeps its
     /// previous value ([`AxisModel::inverse`] only; kerf-kinematics' `solve_path` has its own
-    /// option). Default 1e-6, as `formats.md`.
-    pub pole_tolerance_rad: f64,
+    /// option). Default 1e-6 rad, as `formats.md` ([`kerf_kinematics::DEFAULT_POLE_TOLERANCE_DEG`]).
+    pub pole_tolerance_deg: f64,
     limits: AxisLimits,
 }
 
@@ -44,7 +44,7 @@ impl MachineModel {
         limits.validate()?;
         Ok(Self {
             machine,
-            pole_tolerance_rad: 1e-6,
+            pole_tolerance_deg: kerf_kinematics::DEFAULT_POLE_TOLERANCE_DEG,
             limits,
         })
     }
@@ -92,7 +92,7 @@ impl AxisModel for MachineModel {
             axis: *axis,
         };
         let (prev_t, prev_c) = previous.map_or((0.0, 0.0), |p| (p[3], p[4]));
-        let candidates: Vec<Axes> = if k.pole_angle(axis) <= self.pole_tolerance_rad {
+        let candidates: Vec<Axes> = if k.pole_angle(axis) <= self.pole_tolerance_deg.to_radians() {
             vec![k.inverse_with_c(&pose, prev_c)]
         } else {
             k.inverse(&pose).to_vec()

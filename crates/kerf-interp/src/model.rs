@@ -205,9 +205,10 @@ pub struct PaperAcHead {
     pub r_c: f64,
     /// Limits (per second).
     pub limits: AxisLimits,
-    /// A pose whose tool axis is within this angle (radians) of +z counts as at the pole, where
-    /// C keeps its previous value (`formats.md`: `pole_tolerance`, default 1e-6 rad).
-    pub pole_tolerance_rad: f64,
+    /// A pose whose tool axis is within this angle (degrees) of +z counts as at the pole, where
+    /// C keeps its previous value (`formats.md`: `pole_tolerance`, default 1e-6 rad,
+    /// [`kerf_kinematics::DEFAULT_POLE_TOLERANCE_DEG`]).
+    pub pole_tolerance_deg: f64,
 }
 
 impl PaperAcHead {
@@ -232,7 +233,7 @@ impl PaperAcHead {
             r_a: 180.0,
             r_c: 95.0,
             limits,
-            pole_tolerance_rad: 1e-6,
+            pole_tolerance_deg: kerf_kinematics::DEFAULT_POLE_TOLERANCE_DEG,
         }
     }
 
@@ -275,7 +276,7 @@ impl AxisModel for PaperAcHead {
         let a = u.z.clamp(-1.0, 1.0).acos().to_degrees();
         let sin_a = (u.x * u.x + u.y * u.y).sqrt();
         let candidates: Vec<(f64, f64)> =
-            if sin_a.atan2(u.z.abs()) < self.pole_tolerance_rad && u.z > 0.0 {
+            if sin_a.atan2(u.z.abs()) < self.pole_tolerance_deg.to_radians() && u.z > 0.0 {
                 vec![(0.0, prev_c)]
             } else {
                 let c = u.x.atan2(-u.y).to_degrees();

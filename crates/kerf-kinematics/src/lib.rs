@@ -68,7 +68,9 @@ pub use machine::{
 };
 pub use nonlinear::{interpolate, linearization_error, slerp, Deviation};
 pub use path::{solve_path, solve_paths, PathCurve, PathInput, PathOptions, SolvedPath};
-pub use path::{LIMIT_SLACK, MAX_TILT_TOLERANCE_DEG, UNIT_AXIS_TOLERANCE};
+pub use path::{
+    DEFAULT_POLE_TOLERANCE_DEG, LIMIT_SLACK, MAX_TILT_TOLERANCE_DEG, UNIT_AXIS_TOLERANCE,
+};
 pub use placement::{
     auto_place, auto_setups, axis_aligned_rotations, place_paths, AutoPlaceOptions, AutoPlacement,
     Placement, PlacementParseError, Setup, SetupPlan, MAX_PLACEMENT_VALUE,

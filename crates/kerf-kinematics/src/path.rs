@@ -20,9 +20,9 @@
 //! whose A only goes to -10 degrees turns C by 180 at the pole instead of tilting the wrong
 //! way. A path that starts at the pole starts with the C it leaves the pole with.
 //!
-//! **The pole.** A pose whose tool axis is within `pole_tolerance_rad` of the C axis keeps the
+//! **The pole.** A pose whose tool axis is within `pole_tolerance_deg` of the C axis keeps the
 //! previous C; its tilt is the one bringing the tool axis closest to the pose's, and X, Y, Z
-//! put the tip exactly on the point. The tool axis is then off by at most `pole_tolerance_rad`;
+//! put the tip exactly on the point. The tool axis is then off by at most `pole_tolerance_deg`;
 //! [`SolvedPath::pole_tip_error`] reports `pivot_length * angle`: the tip error that angle
 //! would cause had X, Y, Z been computed for the requested tool axis instead (kerf re-places
 //! the tip, so what remains is the orientation error `angle`). Leaving the pole in a direction other than the kept C needs C to
@@ -60,13 +60,18 @@ pub const UNIT_AXIS_TOLERANCE: f64 = 1e-6;
 /// The most poses one split may insert at once (larger splits happen in several rounds).
 pub(super) const MAX_PIECES: f64 = 1024.0;
 
+/// The default pole tolerance of [`PathOptions::pole_tolerance_deg`]: 1e-6 rad in degrees
+/// (a tool axis this close to the C axis is at the pole; `docs/formats.md`).
+pub const DEFAULT_POLE_TOLERANCE_DEG: f64 = 1e-6 * (180.0 / std::f64::consts::PI);
+
 /// Options of [`solve_path`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct PathOptions {
-    /// A pose whose tool axis is within this angle (radians) of the C axis is at the pole: C
-    /// keeps its previous value. Finite and >= 0; default 1e-6.
-    pub pole_tolerance_rad: f64,
+    /// A pose whose tool axis is within this angle (degrees) of the C axis is at the pole: C
+    /// keeps its previous value. Finite and >= 0; default [`DEFAULT_POLE_TOLERANCE_DEG`]
+    /// (1e-6 rad).
+    pub pole_tolerance_deg: f64,
     /// The largest move of a rotary axis between two points (degrees); longer moves are
     /// split. > 0; default `f64::INFINITY` (no limit).
     pub max_rotary_step_deg: f64,
@@ -89,7 +94,7 @@ pub const MAX_TILT_TOLERANCE_DEG: f64 = 10.0;
 impl Default for PathOptions {
     fn default() -> Self {
         Self {
-            pole_tolerance_rad: 1e-6,
+            pole_tolerance_deg: DEFAULT_POLE_TOLERANCE_DEG,
             max_rotary_step_deg: f64::INFINITY,
             linearization_tolerance_mm: 0.005,
             max_inserted: 1_000_000,
@@ -99,10 +104,10 @@ impl Default for PathOptions {
 }
 
 impl PathOptions {
-    /// Sets [`pole_tolerance_rad`](Self::pole_tolerance_rad): a pose whose tool axis is
-    /// within this angle (radians) of the C axis is at the pole.
-    pub fn with_pole_tolerance_rad(mut self, pole_tolerance_rad: f64) -> Self {
-        self.pole_tolerance_rad = pole_tolerance_rad;
+    /// Sets [`pole_tolerance_deg`](Self::pole_tolerance_deg): a pose whose tool axis is
+    /// within this angle (degrees) of the C axis is at the pole.
+    pub fn with_pole_tolerance_deg(mut self, pole_tolerance_deg: f64) -> Self {
+        self.pole_tolerance_deg = pole_tolerance_deg;
         self
     }
 
@@ -146,11 +151,11 @@ impl PathOptions {
                 reason,
             })
         };
-        if !(self.pole_tolerance_rad.is_finite() && self.pole_tolerance_rad >= 0.0) {
+        if !(self.pole_tolerance_deg.is_finite() && self.pole_tolerance_deg >= 0.0) {
             return bad(
-                "pole_tolerance_rad",
-                self.pole_tolerance_rad,
-                "must be finite and >= 0 (radians)",
+                "pole_tolerance_deg",
+                self.pole_tolerance_deg,
+                "must be finite and >= 0 (degrees)",
             );
         }
         if self.max_rotary_step_deg.is_nan() || self.max_rotary_step_deg <= 0.0 {

@@ -40,7 +40,7 @@ fn assert_exact(machine: &Machine, path: &SolvedPath, options: &PathOptions) {
             .norm()
             .atan2(back.axis.dot(&pose.axis));
         assert!(
-            angle <= options.pole_tolerance_rad + 1e-12,
+            angle <= options.pole_tolerance_deg.to_radians() + 1e-12,
             "point {n}: axis off by {angle:e}"
         );
     }

@@ -26,12 +26,12 @@ fn bad_options_are_named() {
     };
     for (options, name) in [
         (
-            PathOptions::default().with_pole_tolerance_rad(f64::NAN),
-            "pole_tolerance_rad",
+            PathOptions::default().with_pole_tolerance_deg(f64::NAN),
+            "pole_tolerance_deg",
         ),
         (
-            PathOptions::default().with_pole_tolerance_rad(-1.0),
-            "pole_tolerance_rad",
+            PathOptions::default().with_pole_tolerance_deg(-1.0),
+            "pole_tolerance_deg",
         ),
         (
             PathOptions::default().with_max_rotary_step_deg(0.0),

@@ -91,7 +91,7 @@ proptest! {
             let back = kin.forward(q);
             prop_assert!((back.position - pose.position).norm() < 1e-9, "point {}: tip", n);
             let angle = back.axis.cross(&pose.axis).norm().atan2(back.axis.dot(&pose.axis));
-            prop_assert!(angle <= options.pole_tolerance_rad + 1e-12, "point {}: axis off by {:e}", n, angle);
+            prop_assert!(angle <= options.pole_tolerance_deg.to_radians() + 1e-12, "point {}: axis off by {:e}", n, angle);
         }
         for (n, w) in path.axes.windows(2).enumerate() {
             prop_assert!(w[0].rotary_step(&w[1]) <= max_step + 1e-9, "move {}: step {}", n, w[0].rotary_step(&w[1]));

@@ -54,8 +54,8 @@ pub enum NormalsError {
     #[error(transparent)]
     Discretize(#[from] kerf_discretize::DiscretizeError),
     /// Inserting points against the normal step would exceed the limit. Fix: raise
-    /// `max_normal_step_rad`.
-    #[error("more than {limit} points inserted for the normal step; raise the options' max_normal_step_rad")]
+    /// `max_normal_step_deg`.
+    #[error("more than {limit} points inserted for the normal step; raise the options' max_normal_step_deg")]
     TooManyInserted {
         /// The limit.
         limit: usize,

@@ -7,7 +7,7 @@
 //!
 //! - rejects a curve that does not lie on its surface (`on_surface_tolerance_mm`),
 //! - inserts cutting points (on the curve) until neighbouring normals differ by at most
-//!   `max_normal_step_rad`, re-certifying every new segment so the chord-error guarantee holds,
+//!   `max_normal_step_deg`, re-certifying every new segment so the chord-error guarantee holds,
 //! - refuses a normal that reverses between neighbouring points (inconsistent orientation),
 //!   and reports normal jumps that insertion cannot remove (a curve crossing a sharp mesh edge).
 //!
@@ -33,9 +33,8 @@ pub struct NormalOptions {
     /// A cutting point farther than this from its surface is an error. Default 0.01 mm.
     pub on_surface_tolerance_mm: f64,
     /// The largest angle between the normals of neighbouring cutting points; points are
-    /// inserted until it holds, radians (strictly between 0 and pi). Default 1 degree
-    /// (`1f64.to_radians()`).
-    pub max_normal_step_rad: f64,
+    /// inserted until it holds, degrees (strictly between 0 and 180). Default 1.
+    pub max_normal_step_deg: f64,
     /// Refuse a curve that needs more inserted points than this (a count). Default 1,000,000.
     pub max_inserted: usize,
 }
@@ -44,7 +43,7 @@ impl Default for NormalOptions {
     fn default() -> Self {
         Self {
             on_surface_tolerance_mm: 0.01,
-            max_normal_step_rad: 1f64.to_radians(),
+            max_normal_step_deg: 1.0,
             max_inserted: 1_000_000,
         }
     }
@@ -58,10 +57,10 @@ impl NormalOptions {
         self
     }
 
-    /// Sets [`max_normal_step_rad`](Self::max_normal_step_rad): the largest angle between
+    /// Sets [`max_normal_step_deg`](Self::max_normal_step_deg): the largest angle between
     /// the normals of neighbouring cutting points.
-    pub fn with_max_normal_step_rad(mut self, max_normal_step_rad: f64) -> Self {
-        self.max_normal_step_rad = max_normal_step_rad;
+    pub fn with_max_normal_step_deg(mut self, max_normal_step_deg: f64) -> Self {
+        self.max_normal_step_deg = max_normal_step_deg;
         self
     }
 
@@ -84,10 +83,10 @@ impl NormalOptions {
                 reason: "must be finite and > 0",
             });
         }
-        if !(self.max_normal_step_rad > 0.0 && self.max_normal_step_rad < std::f64::consts::PI) {
+        if !(self.max_normal_step_deg > 0.0 && self.max_normal_step_deg < 180.0) {
             return Err(NormalsError::BadOption {
-                name: "max_normal_step_rad",
-                value: self.max_normal_step_rad,
+                name: "max_normal_step_deg",
+                value: self.max_normal_step_deg,
                 reason: "must lie strictly between 0 and 180 degrees",
             });
         }
@@ -287,7 +286,7 @@ impl Ctx<'_> {
     fn segment(&mut self, a: Sample, b: Sample, certified: bool) -> Result<()> {
         let angle = a.n_after.angle(&b.n);
         let tm = 0.5 * (a.t + b.t);
-        if angle > self.nopts.max_normal_step_rad {
+        if angle > self.nopts.max_normal_step_deg.to_radians() {
             // Stop splitting when the interval is tiny, or so close to the float spacing that
             // its midpoint is no longer strictly inside (large parameter values).
             if b.t - a.t <= self.min_dt || !(a.t < tm && tm < b.t) {
@@ -345,7 +344,7 @@ impl Ctx<'_> {
 
 /// Gives every cutting point of `disc` (a discretization of `curve` with options `dopts`) the
 /// unit normal of `surface`, inserting points where neighbouring normals differ by more than
-/// `nopts.max_normal_step_rad`.
+/// `nopts.max_normal_step_deg`.
 ///
 /// # Errors
 /// [`NormalsError::OffSurface`] naming the parameter and distance, [`NormalsError::NoNormal`],
@@ -378,7 +377,7 @@ pub fn orient(
     for i in 1..disc.params().len() {
         let s = ctx.sample(disc.params()[i], disc.points()[i], prev.hint)?;
         ctx.segment(prev, s, true)?;
-        if s.n.angle(&s.n_after) > ctx.nopts.max_normal_step_rad {
+        if s.n.angle(&s.n_after) > ctx.nopts.max_normal_step_deg.to_radians() {
             // The normal jumps at a degenerate point of the surface (a cone's apex): the head
             // turns in place there; no insertion can remove it.
             ctx.out.jumps.push(s.t);

@@ -378,8 +378,8 @@ fn run_placed(
             .with_path_deviation_mm(popts.linearization_tolerance_mm + o.blend_tolerance_mm)
             // Where the program's blocks merge poses (lines and arcs over several), each
             // pose's axis is held within the fit's orientation tolerance only.
-            .with_axis_deviation_rad(if fit.merge_lines || fit.arcs {
-                fit.orientation_tolerance_deg.to_radians()
+            .with_axis_deviation_deg(if fit.merge_lines || fit.arcs {
+                fit.orientation_tolerance_deg
             } else {
                 0.0
             });

@@ -70,11 +70,11 @@ pub struct HeadCheckOptions {
     /// The deviation of the machine's tip path from the chords between poses, mm (the
     /// tolerance budget's non-linearity term).
     pub path_deviation_mm: f64,
-    /// How far the machine's tool axis may lie from the poses' own axes, radians: a program
+    /// How far the machine's tool axis may lie from the poses' own axes, degrees: a program
     /// whose blocks merge several poses holds each pose's axis within its fit's orientation
     /// tolerance only; every head point may then lie that angle times its distance from the
     /// tip farther. Default 0 (one block per pose).
-    pub axis_deviation_rad: f64,
+    pub axis_deviation_deg: f64,
     /// The most exact distance queries one cut may make: past it the rest of the cut is not
     /// proven clear ([`CutClearance::proven`] false).
     pub max_queries: usize,
@@ -87,7 +87,7 @@ impl Default for HeadCheckOptions {
             standoff_mm: kerf_kinematics::DEFAULT_STANDOFF_MM,
             max_tilt_deg: 10.0,
             path_deviation_mm: 0.0,
-            axis_deviation_rad: 0.0,
+            axis_deviation_deg: 0.0,
             max_queries: 2_000_000,
         }
     }
@@ -114,9 +114,9 @@ impl HeadCheckOptions {
         self.path_deviation_mm = path_deviation_mm;
         self
     }
-    /// Sets [`axis_deviation_rad`](Self::axis_deviation_rad).
-    pub fn with_axis_deviation_rad(mut self, axis_deviation_rad: f64) -> Self {
-        self.axis_deviation_rad = axis_deviation_rad;
+    /// Sets [`axis_deviation_deg`](Self::axis_deviation_deg).
+    pub fn with_axis_deviation_deg(mut self, axis_deviation_deg: f64) -> Self {
+        self.axis_deviation_deg = axis_deviation_deg;
         self
     }
     /// Sets [`max_queries`](Self::max_queries).
@@ -193,11 +193,11 @@ fn unusable(head: &Head, poses: &[Pose], opts: &HeadCheckOptions, zone: f64) -> 
         && (0.0..=80.0).contains(&o.max_tilt_deg)
         && o.path_deviation_mm.is_finite()
         && o.path_deviation_mm >= 0.0
-        && (0.0..=1.0).contains(&o.axis_deviation_rad);
+        && (0.0..=57.0).contains(&o.axis_deviation_deg);
     if !usable {
         return Some(format!(
-            "the options are not usable (clearance {} mm, standoff {} mm, tilt {} deg, path deviation {} mm, axis deviation {} rad)",
-            o.clearance_mm, o.standoff_mm, o.max_tilt_deg, o.path_deviation_mm, o.axis_deviation_rad
+            "the options are not usable (clearance {} mm, standoff {} mm, tilt {} deg, path deviation {} mm, axis deviation {} deg)",
+            o.clearance_mm, o.standoff_mm, o.max_tilt_deg, o.path_deviation_mm, o.axis_deviation_deg
         ));
     }
     if head.validate().is_err() {
@@ -592,7 +592,7 @@ pub fn check_cut_along(
         .collect();
     // A fitted block's axis within the fit's orientation tolerance of the poses' own: every
     // head point that much farther, on every sample.
-    let axis_slack = reach * opts.axis_deviation_rad;
+    let axis_slack = reach * opts.axis_deviation_deg.to_radians();
     let step_departure = |k: usize| departure.get(k).copied().unwrap_or(0.0);
     // Half the larger step from each sample to its neighbours, and the rotary departure of
     // the steps it lies on: the motion it stands for.

@@ -308,7 +308,7 @@ fn the_linear_rotary_move_widens_the_bound_by_its_departure() {
     );
     // A program whose blocks hold each pose's axis within 0.15 degrees only: every head
     // point that angle times its reach farther, the same loss of the proof.
-    let fitted = opts.with_axis_deviation_rad(0.15f64.to_radians());
+    let fitted = opts.with_axis_deviation_deg(0.15);
     let held = kerf_process::check_cut_along(&obs, &head, &poses, &[], &fitted);
     assert!(
         held.proven && held.min_distance_mm < opts.clearance_mm,
@@ -317,6 +317,6 @@ fn the_linear_rotary_move_widens_the_bound_by_its_departure() {
     // A bound that is not a size is not proven, nor an axis deviation out of its range.
     let bad = kerf_process::check_cut_along(&obs, &head, &poses, &[f64::NAN], &opts);
     assert!(!bad.proven, "{bad:?}");
-    let wild = opts.with_axis_deviation_rad(f64::INFINITY);
+    let wild = opts.with_axis_deviation_deg(f64::INFINITY);
     assert!(!kerf_process::check_cut_along(&obs, &head, &poses, &[], &wild).proven);
 }

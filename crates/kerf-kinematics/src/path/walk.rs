@@ -80,7 +80,7 @@ impl Ctx<'_> {
     }
 
     fn is_pole(&self, pose: &Pose) -> bool {
-        self.kin.pole_angle(&pose.axis) <= self.options.pole_tolerance_rad
+        self.kin.pole_angle(&pose.axis) <= self.options.pole_tolerance_deg.to_radians()
     }
 
     fn cutting(&self, n: usize) -> Node {
@@ -343,7 +343,7 @@ impl Ctx<'_> {
         let mid = self.kin.forward(&prev.lerp(q, 0.5)).axis;
         let great = slerp(ua, ub, 0.5);
         angle_between(&mid, &great)
-            <= angle_between(ua, ub).max(self.options.pole_tolerance_rad) + 1e-12
+            <= angle_between(ua, ub).max(self.options.pole_tolerance_deg.to_radians()) + 1e-12
     }
 
     /// The node a fraction `s` of the way from `a` to `b`.

@@ -160,7 +160,7 @@ impl<'a> Work<'a> {
             return None;
         }
         let kin = self.machine.kinematics.as_ref();
-        let pole = self.options.path_options.pole_tolerance_rad;
+        let pole = self.options.path_options.pole_tolerance_deg.to_radians();
         let mut low = [f64::NEG_INFINITY; 3]; // max over poses of the range's low end
         let mut high = [f64::INFINITY; 3]; // min over poses of the range's high end
         for pose in sided.iter().flatten() {
@@ -285,7 +285,11 @@ mod tests {
             for (a, src) in solved.axes.iter().zip(&solved.source) {
                 let Some(n) = src else { continue };
                 let range = work
-                    .axes_range(kin, &poses[*n], options.path_options.pole_tolerance_rad)
+                    .axes_range(
+                        kin,
+                        &poses[*n],
+                        options.path_options.pole_tolerance_deg.to_radians(),
+                    )
                     .expect("a known range");
                 pole += usize::from(kin.pole_angle(&poses[*n].axis) <= 1e-6);
                 let q = a.xyz();

@@ -38,6 +38,11 @@ fn vec3(v: &Value) -> Vector3<f64> {
 
 /// Runs `kerf run` with `place` and checks the outputs; returns the report.
 fn run_placed(curves: &str, machine: &str, place: &str) -> Value {
+    run_placed_in(curves, machine, place).0
+}
+
+/// [`run_placed`], with the run's directory (its files for further checks).
+fn run_placed_in(curves: &str, machine: &str, place: &str) -> (Value, tempfile::TempDir) {
     let dir = tempfile::tempdir().expect("temporary directory");
     let machine_path = fixture("machines").join(machine);
     let out = kerf()
@@ -198,7 +203,7 @@ fn run_placed(curves: &str, machine: &str, place: &str) -> Value {
         }
     }
     assert_eq!(seen, tpaths.len(), "every path in exactly one set-up");
-    report
+    (report, dir)
 }
 
 #[test]
@@ -224,14 +229,50 @@ fn every_real_part_runs_with_place_auto() {
         n > 1,
         "sheet metal needs several set-ups on a +-135 deg head"
     );
-    // On the trunnion table a rapid between two of its pieces turns C by 251 degrees at
+    // On the table machines a rapid between two of its pieces turns C by 251 degrees at
     // A = 90: planned along the tip's line instead of the joints' (the way G0 runs it), it
-    // swung Z out of the travel and the part got no program.
-    let table = run_placed("realdata/nori_sheetmetal.json", "table_table.json", "auto");
-    assert!(
-        table["placement"]["setups"].as_array().map_or(0, Vec::len) > 1,
-        "several set-ups on the trunnion table too"
-    );
+    // swung Z out of the travel and the part got no program. And every traverse is checked:
+    // a route was refused where the tip's straight line (not the machine's straight move in
+    // its axes) left the travel, and two gaps fell back to unchecked moves. The written
+    // traverses' waypoints are within the travel (the machine runs each rapid straight in its
+    // axes, so between them too).
+    for machine in ["table_table.json", "head_table.json"] {
+        let (table, dir) = run_placed_in("realdata/nori_sheetmetal.json", machine, "auto");
+        assert!(
+            table["placement"]["setups"].as_array().map_or(0, Vec::len) > 1,
+            "{machine}: several set-ups"
+        );
+        let t = &table["traverses"];
+        assert_eq!(t["unchecked"], serde_json::json!([]), "{machine}: {t}");
+        assert_eq!(
+            t["checked_count"], t["count"],
+            "{machine}: every gap routed"
+        );
+        let axes = read_json(&dir.path().join("axes.json"));
+        let m = Machine::read(fixture("machines").join(machine)).expect("machine");
+        let mut waypoints = 0;
+        for p in axes["paths"].as_array().expect("paths") {
+            let Some(rows) = p["traverse"]["positions"].as_array() else {
+                continue;
+            };
+            for row in rows {
+                waypoints += 1;
+                for (k, v) in row.as_array().expect("row").iter().enumerate() {
+                    let v = v.as_f64().expect("number");
+                    if let Some(r) = m.limits[k] {
+                        assert!(
+                            v >= r.min - 1e-9 && v <= r.max + 1e-9,
+                            "{machine}: path {}: axis {k} = {v} outside [{}, {}]",
+                            p["id"],
+                            r.min,
+                            r.max
+                        );
+                    }
+                }
+            }
+        }
+        assert!(waypoints > 100, "{machine}: {waypoints} waypoints checked");
+    }
 }
 
 #[test]

@@ -173,8 +173,22 @@ pub fn rapid_moves(
     rapid_moves_within(kin, obs, end_axes, start_axes, traverse, opts, None)
 }
 
-/// [`rapid_moves`] with the waypoints' rotaries chosen within `tilt`, the tilt axis' range
-/// (where a waypoint turns the head to another tool axis, [`waypoint_rotaries`]).
+/// True when every limited axis of `q` lies inside its range, a thousandth of the range
+/// from either end.
+fn inside_limits(q: &[f64; 5], limits: &[Option<(f64, f64)>; 5]) -> bool {
+    q.iter().zip(limits).all(|(v, l)| {
+        l.is_none_or(|(lo, hi)| {
+            let m = 1e-3 * (hi - lo);
+            *v >= lo + m && *v <= hi - m
+        })
+    })
+}
+
+/// [`rapid_moves`] within the machine's `limits`, where given: the waypoints' rotaries chosen
+/// within the tilt axis' range (where a waypoint turns the head to another tool axis,
+/// [`waypoint_rotaries`]), and a move split only at points inside every range (a split point
+/// lies on the tip's straight line with the rotaries shared out, where the linear axes can
+/// swing past both ends; the machine's own straight moves between in-range ends cannot).
 fn rapid_moves_within(
     kin: &dyn Kinematics,
     obs: &Obstacles,
@@ -182,8 +196,9 @@ fn rapid_moves_within(
     start_axes: [f64; 5],
     traverse: &Traverse,
     opts: &TraverseOptions,
-    tilt: Option<(f64, f64)>,
+    limits: Option<&[Option<(f64, f64)>; 5]>,
 ) -> Result<RapidMoves> {
+    let tilt = limits.and_then(|l| l[3]);
     let c = opts.clearance_mm;
     let step = c / 8.0;
     let rot = waypoint_rotaries(kin, &traverse.waypoints, &end_axes, &start_axes, tilt);
@@ -262,7 +277,32 @@ fn rapid_moves_within(
                         ),
                     })));
                 }
-                Some(_) => pieces *= 2,
+                Some((at, d)) => {
+                    pieces *= 2;
+                    // The points of the finer split, where the machine must reach them.
+                    let outside = limits.is_some_and(|l| {
+                        (1..pieces).any(|j| {
+                            let f = j as f64 / pieces as f64;
+                            let q = linear_at(
+                                kin,
+                                &(ta + (tb - ta) * f),
+                                a[3] + (b[3] - a[3]) * f,
+                                a[4] + (b[4] - a[4]) * f,
+                            );
+                            !inside_limits(&q, l)
+                        })
+                    });
+                    if outside {
+                        return Err(ProcessError::TraverseBlocked(Box::new(crate::Blockage {
+                            from: [ta.x, ta.y, ta.z],
+                            to: [tb.x, tb.y, tb.z],
+                            at: [at.x, at.y, at.z],
+                            distance_mm: d,
+                            clearance_mm: c,
+                            why: "the machine's rapid move swings too close, and the points that would split it leave the axis limits".into(),
+                        })));
+                    }
+                }
             }
         }
     }
@@ -431,52 +471,14 @@ pub fn plan_rapids(
             // out; only where no route clears then, with all those in the cuts' way.
             let first = cuts_way(obs, g, opts, false);
             // A route is tried only if the machine reaches its waypoints (with the rotary
-            // axes as [`rapid_moves`] sets them).
+            // axes as [`rapid_moves`] sets them): the machine runs each rapid straight in its
+            // axes, inside the limits when its ends are (the points a split move adds are
+            // checked where it is split, `rapid_moves_within`).
             let reachable = |way: &[PoseArray]| {
-                let n = way.len();
                 let rots = waypoint_rotaries(kin, way, &g.from_axes, &g.to_axes, limits[3]);
-                let rot = |i: usize| {
-                    let mut r = g.from_axes;
-                    r[3] = rots[i][0];
-                    r[4] = rots[i][1];
-                    r
-                };
-                let inside = |q: &[f64; 5]| {
-                    q.iter().zip(limits).all(|(v, l)| {
-                        l.is_none_or(|(lo, hi)| {
-                            let m = 1e-3 * (hi - lo);
-                            *v >= lo + m && *v <= hi - m
-                        })
-                    })
-                };
-                // The machine runs each move straight in its axes (inside the limits when
-                // its ends are), but a move that swings too close is split at points of the
-                // tip's straight line with the rotaries linear (`rapid_moves_within`), and
-                // there, where the rotaries turn, the linear axes swing past the ends: those
-                // points, sampled, must be inside too.
-                (0..n).all(|i| {
-                    let (a, ra) = (way[i], rot(i));
-                    let (b, rb) = if i + 1 < n {
-                        (way[i + 1], rot(i + 1))
-                    } else {
-                        (a, ra)
-                    };
-                    let k = if i + 1 < n && ra != rb { 32 } else { 1 };
-                    (0..=k).all(|j| {
-                        let f = j as f64 / k as f64;
-                        let tip = Point3::new(
-                            a[0] + (b[0] - a[0]) * f,
-                            a[1] + (b[1] - a[1]) * f,
-                            a[2] + (b[2] - a[2]) * f,
-                        );
-                        let q = linear_at(
-                            kin,
-                            &tip,
-                            ra[3] + (rb[3] - ra[3]) * f,
-                            ra[4] + (rb[4] - ra[4]) * f,
-                        );
-                        inside(&q)
-                    })
+                way.iter().zip(&rots).all(|(w, r)| {
+                    let tip = Point3::new(w[0], w[1], w[2]);
+                    inside_limits(&linear_at(kin, &tip, r[0], r[1]), limits)
                 })
             };
             // Where no route clears with `first` left out and more surfaces are in the cuts'
@@ -492,13 +494,19 @@ pub fn plan_rapids(
                     opts,
                     &reachable,
                     &mut |t| {
-                        rapid_moves_within(kin, &here, g.from_axes, g.to_axes, t, opts, limits[3])
-                            .map_err(|e| match e {
-                                ProcessError::TraverseBlocked(b) => {
-                                    (Point3::from(b.at), b.distance_mm)
-                                }
-                                _ => (Point3::from(g.from_contour), 0.0),
-                            })
+                        rapid_moves_within(
+                            kin,
+                            &here,
+                            g.from_axes,
+                            g.to_axes,
+                            t,
+                            opts,
+                            Some(limits),
+                        )
+                        .map_err(|e| match e {
+                            ProcessError::TraverseBlocked(b) => (Point3::from(b.at), b.distance_mm),
+                            _ => (Point3::from(g.from_contour), 0.0),
+                        })
                     },
                     explain,
                 )

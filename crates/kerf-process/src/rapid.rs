@@ -227,20 +227,23 @@ fn rapid_moves_within(
             let tb = kin
                 .forward(&Axes::new(b[0], b[1], b[2], b[3], b[4]))
                 .position;
+            // The axes at fraction `f` of the tip's straight line, the rotaries shared out.
+            let split_at = |f: f64| {
+                linear_at(
+                    kin,
+                    &(ta + (tb - ta) * f),
+                    a[3] + (b[3] - a[3]) * f,
+                    a[4] + (b[4] - a[4]) * f,
+                )
+            };
             let ends: Vec<[f64; 5]> = (0..=pieces)
                 .map(|j| {
-                    let f = j as f64 / pieces as f64;
                     if j == 0 {
                         a
                     } else if j == pieces {
                         b
                     } else {
-                        linear_at(
-                            kin,
-                            &(ta + (tb - ta) * f),
-                            a[3] + (b[3] - a[3]) * f,
-                            a[4] + (b[4] - a[4]) * f,
-                        )
+                        split_at(j as f64 / pieces as f64)
                     }
                 })
                 .collect();
@@ -281,16 +284,7 @@ fn rapid_moves_within(
                     pieces *= 2;
                     // The points of the finer split, where the machine must reach them.
                     let outside = limits.is_some_and(|l| {
-                        (1..pieces).any(|j| {
-                            let f = j as f64 / pieces as f64;
-                            let q = linear_at(
-                                kin,
-                                &(ta + (tb - ta) * f),
-                                a[3] + (b[3] - a[3]) * f,
-                                a[4] + (b[4] - a[4]) * f,
-                            );
-                            !inside_limits(&q, l)
-                        })
+                        (1..pieces).any(|j| !inside_limits(&split_at(j as f64 / pieces as f64), l))
                     });
                     if outside {
                         return Err(ProcessError::TraverseBlocked(Box::new(crate::Blockage {

@@ -63,7 +63,7 @@ pub enum DiscretizeError {
     /// tangent turns abruptly there (a corner or cusp inside a knot span). Fix: raise
     /// [`crate::Options::max_turn_deg`], or split the curve at the corner so that it becomes a C0
     /// break.
-    #[error("the tangent turns by more than max_turn = {max_turn_deg:.3} degrees at t = {} however short the segment (a corner inside a knot span); raise max_turn_rad or split the curve there", Readable(*.t))]
+    #[error("the tangent turns by more than max_turn = {max_turn_deg:.3} degrees at t = {} however short the segment (a corner inside a knot span); raise max_turn_deg or split the curve there", Readable(*.t))]
     TurnUnreachable {
         /// Parameter where the walk got stuck.
         t: f64,

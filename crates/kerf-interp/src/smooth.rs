@@ -6,7 +6,10 @@
 //! ([`Geometry::Turn`]) and path changes also end a run. The planner brings the machine to rest
 //! at every run end (a true corner cannot be passed at speed) and nowhere else.
 //!
-//! Along a run the tip is a clamped C2 cubic spline through the block ends, the arcs'
+//! A rapid is a run of its own, straight in the machine's axes (the way a `G0` runs and its
+//! traverse was checked; [`Run`]): its two splines are that line, not the tip's.
+//!
+//! Along a cutting run the tip is a clamped C2 cubic spline through the block ends, the arcs'
 //! intermediate points and points of every arc at most [`ARC_NODE_DEG`] apart (so the spline
 //! follows the arcs within a few micrometres), parameterized by `s`, which counts each block's
 //! tip travel or, where larger, its rotary travel in millimetre equivalents

@@ -119,7 +119,7 @@ fn every_machine_type_plans_within_its_limits() {
 /// A rapid is planned as the machine runs a `G0`: straight in the joints. On a table-table
 /// machine at A = 90 degrees a rapid between two points 5 mm apart on the part that turns C
 /// by 200 degrees swings the part's point about the C axis: planned along the tip's straight
-/// line, the linear axes followed that swing (Z went ~400 mm below both ends and left the
+/// line, the linear axes followed that swing (Z went more than 470 mm below both ends and left the
 /// machine's travel on a real sheet-metal part); planned in the joints, every set-point of the
 /// rapid lies on the straight line between its ends.
 #[test]

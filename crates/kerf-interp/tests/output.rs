@@ -265,3 +265,82 @@ fn sinumerik_gcode_parses_back_to_tips_orientations_and_arcs() {
         "planned feed within the programmed one: {f}"
     );
 }
+
+/// A Sinumerik rapid under `TRAORI` (`RTLION`) moves the tip straight between its `G0` ends;
+/// kerf's traverse is a straight move of the machine's axes. A rapid that turns C by half a
+/// turn is split until the middle of every piece (the machine's axes halfway, through the
+/// model) lies within `RAPID_TCP_TOLERANCE_MM` of the piece's straight tip line, and the
+/// pieces' ends carry the tool axis of those axes.
+#[test]
+fn sinumerik_rapids_follow_the_machines_straight_moves() {
+    let m = PaperAcHead::paper_000();
+    let c1 = circle(20.0, 0.0, 0.0, 0.0);
+    let c2 = circle(20.0, 60.0, 0.0, 0.0);
+    let out = |_: &nalgebra::Point3<f64>| Vector3::new(0.4, 0.0, 1.0).normalize();
+    let back = |_: &nalgebra::Point3<f64>| Vector3::new(-0.4, 0.0, 1.0).normalize();
+    let f1 = |t: f64| c1.point(t);
+    let f2 = |t: f64| c2.point(t);
+    let paths = [
+        kerf_interp::ProgramPath {
+            id: "a".into(),
+            stations: stations(&m, &c1, 0.01, out),
+            curve: Some(&f1),
+        },
+        kerf_interp::ProgramPath {
+            id: "b".into(),
+            stations: stations(&m, &c2, 0.01, back),
+            curve: Some(&f2),
+        },
+    ];
+    let blocks = kerf_interp::fit_program(&m, &paths, &FitOptions::default()).expect("fit");
+    let motion = plan(&m, &blocks, &PlanOptions::new(5000.0, 0.001)).expect("plan");
+    let text = gcode(
+        &m,
+        &blocks,
+        &["a".to_string(), "b".to_string()],
+        Some(&motion.block_feeds()),
+        &GcodeOptions::new(Dialect::Sinumerik, 5000.0),
+    )
+    .expect("program");
+    assert!(
+        text.lines().any(|l| l.trim() == "RTLION"),
+        "G0 along the tip's line"
+    );
+    let moves: Vec<(String, HashMap<String, f64>)> = text
+        .lines()
+        .map(words)
+        .filter(|(h, _)| h == "G0" || h == "G1" || h == "CIP")
+        .collect();
+    // The machine's axes of each written line, the inverse taken nearest the line before.
+    let mut prev: Option<[f64; 5]> = None;
+    let mut axes = Vec::new();
+    for (_, w) in &moves {
+        let tip = nalgebra::Point3::new(w["X"], w["Y"], w["Z"]);
+        let u = Vector3::new(w["A3"], w["B3"], w["C3"]).normalize();
+        let q = m.inverse(&tip, &u, prev.as_ref()).expect("reachable");
+        prev = Some(q);
+        axes.push((tip, q));
+    }
+    let mut pieces = 0;
+    let mut worst = 0.0f64;
+    for k in 1..moves.len() {
+        if moves[k].0 != "G0" {
+            continue;
+        }
+        let ((ta, qa), (tb, qb)) = (axes[k - 1], axes[k]);
+        if (qa[4] - qb[4]).abs() > 1e-6 {
+            pieces += 1;
+        }
+        let mid: [f64; 5] = std::array::from_fn(|n| 0.5 * (qa[n] + qb[n]));
+        let d = (m.tip(&mid) - nalgebra::center(&ta, &tb)).norm();
+        worst = worst.max(d);
+    }
+    assert!(
+        pieces >= 18,
+        "the half turn of C split into pieces: {pieces}"
+    );
+    assert!(
+        worst <= kerf_interp::RAPID_TCP_TOLERANCE_MM + 1e-5,
+        "a piece's middle {worst} mm off the machine's straight move"
+    );
+}

@@ -193,7 +193,7 @@ fn unusable(head: &Head, poses: &[Pose], opts: &HeadCheckOptions, zone: f64) -> 
         && (0.0..=80.0).contains(&o.max_tilt_deg)
         && o.path_deviation_mm.is_finite()
         && o.path_deviation_mm >= 0.0
-        && (0.0..=57.0).contains(&o.axis_deviation_deg);
+        && (0.0..=1f64.to_degrees()).contains(&o.axis_deviation_deg);
     if !usable {
         return Some(format!(
             "the options are not usable (clearance {} mm, standoff {} mm, tilt {} deg, path deviation {} mm, axis deviation {} deg)",

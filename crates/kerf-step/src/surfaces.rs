@@ -239,8 +239,9 @@ pub enum SurfaceRangeError {
         /// `'u'` or `'v'`.
         direction: char,
     },
-    /// The NURBS surface could not be cut or built over the range.
-    #[error(transparent)]
+    /// The NURBS surface could not be cut or built over the range (the NURBS error as the
+    /// source).
+    #[error("{0}")]
     Nurbs(#[from] kerf_nurbs::NurbsError),
 }
 

@@ -241,7 +241,15 @@ pub(super) fn run_grid<M: AxisModel + ?Sized>(
     let feed = opts.feed_mm_per_min / 60.0 * run.feed_factor;
     for (&si, &(a, b, c)) in s.iter().zip(&fine_d) {
         let (t1, t2) = run.tip_derivatives(si);
-        let speed = t1.norm();
+        // A rapid's splines are the machine's axes (`Run::joint`): its tip speed (what its
+        // reported peak is made of) by a central difference of the tip through the model.
+        let speed = if run.joint {
+            let h = 1e-3_f64.min(0.25 * run.len());
+            let at = |v: f64| model.tip(&run.axes_raw(model, v));
+            (at(si + h) - at(si - h)).norm() / (2.0 * h)
+        } else {
+            t1.norm()
+        };
         let mut x = f64::INFINITY;
         let scale = opts.planned_limit_scale;
         for k in 0..5 {

@@ -18,7 +18,8 @@ pub(super) fn tip_to_axes(machine: &Machine, axes: &Axes) -> Matrix3<f64> {
 
 /// Rows a round adds to the working set of [`translation`].
 const WORKING_ADD: usize = 64;
-/// Rounds of the working set before [`translation`] minimises over every row.
+/// Rounds of the working set before [`translation`] minimises over every row (as it does
+/// once the set holds a quarter of the rows).
 const WORKING_ROUNDS: usize = 64;
 
 /// The translation that puts every solved pose within the linear limits (less the margin),
@@ -72,7 +73,7 @@ pub(super) fn translation(
         }
         return Ok(t);
     }
-    let (best_f, best_t, best_axis) = minimax(&rows, &ranges, margin, true);
+    let (best_f, best_t, best_axis, _) = minimax(&rows, &ranges, margin, true);
     if best_f > 0.0 {
         let r = ranges[best_axis].unwrap_or(Range::new(0.0, 0.0));
         let missing = best_f * 0.5 * (r.max - r.min);
@@ -92,12 +93,13 @@ pub(super) fn translation(
 /// their sensitivity to the translation; see [`translation`]): `(f, t, worst axis)`. With
 /// `working_set`, over a working set of the rows that grows until it certifies its minimiser
 /// for every row; without, over every row at each cut (the reference the tests compare with).
+/// The last value is true where the working set's certificate ended it.
 fn minimax(
     rows: &[(Vector3<f64>, Matrix3<f64>)],
     ranges: &[Option<Range>; 3],
     margin: f64,
     working_set: bool,
-) -> (f64, Vector3<f64>, usize) {
+) -> (f64, Vector3<f64>, usize, bool) {
     // Table machines: minimise the largest normalised violation f(t) =
     // max over poses n and limited axes k of (lo_k + margin - (q_nk + (M_n t)_k)) / w_k and
     // ((q_nk + (M_n t)_k) - hi_k + margin) / w_k, w_k the half-width of the travel. Convex and
@@ -191,8 +193,10 @@ fn minimax(
     }
     let mut round = 0;
     loop {
-        if !working_set || round == WORKING_ROUNDS {
-            break minimise(&all);
+        // Past a quarter of the rows a working set costs more than every row.
+        if !working_set || round == WORKING_ROUNDS || 4 * set.len() > rows.len() {
+            let (f, t, axis) = minimise(&all);
+            break (f, t, axis, false);
         }
         round += 1;
         let (f, t, axis) = minimise(&set);
@@ -204,7 +208,7 @@ fn minimax(
             .filter(|&(v, _)| v > own)
             .collect();
         if worse.is_empty() {
-            break (f, t, axis);
+            break (f, t, axis, true);
         }
         worse.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         for &(_, i) in worse.iter().take(WORKING_ADD) {
@@ -253,8 +257,12 @@ mod tests {
                     (q, m)
                 })
                 .collect();
-            let (fw, tw, _) = minimax(&rows, &ranges, 2.0, true);
-            let (fr, _, _) = minimax(&rows, &ranges, 2.0, false);
+            let (fw, tw, _, certified) = minimax(&rows, &ranges, 2.0, true);
+            let (fr, _, _, _) = minimax(&rows, &ranges, 2.0, false);
+            assert!(
+                certified,
+                "case {case}: ended by the certificate, not every row"
+            );
             let all: f64 = rows
                 .iter()
                 .flat_map(|(q, m)| {

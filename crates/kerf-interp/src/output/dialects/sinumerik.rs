@@ -53,6 +53,9 @@ impl Rules for Sinumerik {
         w.line("TRAORI");
         w.line("ORIWKS");
         w.line("ORIVECT");
+        // G0 interpolated along the tip's line (not axis by axis): each rapid piece below runs
+        // as written.
+        w.line("RTLION");
         w.line("G60");
         if w.power().is_some() {
             w.line("ID=1 WHENEVER TRUE DO SYNFCT(1,$A_OUTA[1],$AC_VACTW)");
@@ -65,11 +68,23 @@ impl Rules for Sinumerik {
         );
     }
 
+    /// A rapid under `TRAORI` moves the tip straight (`RTLION`); kerf's traverse is checked
+    /// (and planned) as a straight move of the machine's axes, so it is split into pieces
+    /// whose tips follow that move within [`crate::RAPID_TCP_TOLERANCE_MM`], as the
+    /// tool-tip LinuxCNC dialect's ([`Writer::tip_rapid`]).
     fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], u: Vector3<f64>) {
-        let l = format!("G0 {}", tip_words(w, &p, &u));
-        w.line(&l);
+        let model = w.model;
+        w.tip_rapid("G0", p, q, |w, tip, a| {
+            // The last piece's orientation is the caller's own `u` (exactly the pose's).
+            let axis = if a == &q {
+                u
+            } else {
+                model.tool_axis(a[3], a[4])
+            };
+            tip_words(w, tip, &axis)
+        });
+        // As before the split: the printed position of the machine's axes.
         w.last = Some(w.printed(&q));
-        w.last_axes = Some(q);
     }
 
     fn dwell(&self, s: f64) -> String {
@@ -83,7 +98,7 @@ impl Rules for Sinumerik {
     fn descent(
         &self,
         w: &mut Writer<'_>,
-        _b: &Block,
+        b: &Block,
         start: Point3<f64>,
         u: Vector3<f64>,
         _t: f64,
@@ -93,6 +108,8 @@ impl Rules for Sinumerik {
         let l = format!("G1 {} F{f}", tip_words(w, &start, &u));
         w.line(&l);
         w.last_f = Some(f);
+        // Where the next rapid starts from (its split follows the machine's axes).
+        w.last_axes = Some(b.start_axes);
     }
 
     fn blend_off(&self, w: &mut Writer<'_>) {
@@ -126,6 +143,7 @@ impl Rules for Sinumerik {
             }
         }
         w.line(&l);
+        w.last_axes = Some(b.end_axes);
     }
 
     fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower) {

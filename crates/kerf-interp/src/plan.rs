@@ -9,7 +9,8 @@
 //!    blend); the rotary axes never leave their ranges (soft-range coordinates). A rapid is a
 //!    run of its own, straight in the machine's axes, as its `G0` runs and its traverse was
 //!    checked.
-//! 2. Along a run the machine axes are `q(s)` of the tip's arc length `s`; with `x = (ds/dt)^2`
+//! 2. Along a run the machine axes are `q(s)` of the run's path parameter `s` (the tip's arc
+//!    length, or the rotary travel in mm equivalents where larger); with `x = (ds/dt)^2`
 //!    and `u = d2s/dt2` every axis must satisfy `-A_k <= q'_k(s) u + q''_k(s) x <= A_k` and
 //!    `|q'_k| sqrt(x) <= V_k`, the tip `|tip'| sqrt(x) <= F` (the programmed feed), the chord
 //!    between two set-points on a curve within `chord_tolerance`. The module `topp` solves the

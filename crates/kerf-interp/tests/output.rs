@@ -274,9 +274,12 @@ fn sinumerik_gcode_parses_back_to_tips_orientations_and_arcs() {
 #[test]
 fn sinumerik_rapids_follow_the_machines_straight_moves() {
     let m = PaperAcHead::paper_000();
-    let c1 = circle(20.0, 0.0, 0.0, 0.0);
+    // An open curve whose tool axis turns along it (so the cut ends on other rotary axes than
+    // it pierced with: the rapid after it must start from the cut's end), then a ring tilted
+    // the other way.
+    let c1 = freeform();
     let c2 = circle(20.0, 60.0, 0.0, 0.0);
-    let out = |_: &nalgebra::Point3<f64>| Vector3::new(0.4, 0.0, 1.0).normalize();
+    let out = |p: &nalgebra::Point3<f64>| Vector3::new(0.4, 0.004 * p.x, 1.0).normalize();
     let back = |_: &nalgebra::Point3<f64>| Vector3::new(-0.4, 0.0, 1.0).normalize();
     let f1 = |t: f64| c1.point(t);
     let f2 = |t: f64| c2.point(t);

@@ -21,7 +21,8 @@ use super::{comment_text, ChordTerm, GcodeOptions, LaserPower, ProcessCodes};
 /// writer does not write it again: 0.5 %, a tenth of what the power check allows.
 pub(super) const POWER_STEP: f64 = 0.005;
 
-/// How far (mm) the tip of a tool-tip dialect's rapid (`linuxcnc-tcp`, `fanuc`) may run from
+/// How far (mm) the tip of a tool-tip dialect's rapid (`linuxcnc-tcp`, `fanuc`, `heidenhain`,
+/// `sinumerik`) may run from
 /// kerf's joint-space traverse at the middle of each `G0`: LinuxCNC (and Fanuc, by a machine
 /// parameter) moves the tip on a straight line between the `G0` ends (with the rotary axes
 /// linear, as in joint space), so a traverse is split until each
@@ -509,9 +510,9 @@ impl<'a> Writer<'a> {
         }
     }
 
-    /// A rapid of a tool-tip dialect to the tip `p` with the axes `q`: LinuxCNC and Fanuc
-    /// move the tip straight between `G0` ends (or the axes linearly, by a machine
-    /// parameter), so the rapid is split along kerf's checked joint-space traverse from the
+    /// A rapid of a tool-tip dialect to the tip `p` with the axes `q`: LinuxCNC, Fanuc,
+    /// HEIDENHAIN and Sinumerik (`RTLION`) move the tip straight between `G0` ends (Fanuc may
+    /// move the axes linearly, by a machine parameter), so the rapid is split along kerf's checked joint-space traverse from the
     /// last axes ([`rapid_pieces`]), each piece `<g0> <words(tip, axes)>`,
     /// the last ending exactly at `p`.
     pub(super) fn tip_rapid(

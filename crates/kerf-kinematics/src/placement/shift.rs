@@ -19,7 +19,7 @@ pub(super) fn tip_to_axes(machine: &Machine, axes: &Axes) -> Matrix3<f64> {
 /// Rows a round adds to the working set of [`translation`].
 const WORKING_ADD: usize = 64;
 /// Rounds of the working set before [`translation`] minimises over every row (as it does
-/// once the set holds a quarter of the rows).
+/// once the set holds more than a quarter of the rows).
 const WORKING_ROUNDS: usize = 64;
 
 /// The translation that puts every solved pose within the linear limits (less the margin),

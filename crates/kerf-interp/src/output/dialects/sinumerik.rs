@@ -1,7 +1,9 @@
 //! `sinumerik`: Sinumerik-style `TRAORI`: the tool tip `X Y Z` and the orientation vector
 //! `A3= B3= C3=` in workpiece coordinates (`ORIWKS`, `ORIVECT`), arcs as `CIP` through the
 //! intermediate point, `G54`, `SOFT`, `G642` with `CTOL`/`OTOL` from the blending term, `F`
-//! the tip's mean planned speed of the block (modal), `;` comments, `TRAFOOF` and `M30`. Power
+//! the tip's mean planned speed of the block (modal), `;` comments, `TRAFOOF` and `M30`. Rapids
+//! `G0` under `RTLION` and `G60`, split until their tips follow kerf's traverse (a straight move
+//! of the machine's axes) within [`crate::RAPID_TCP_TOLERANCE_MM`]. Power
 //! by the synchronized action `SYNFCT` on `$AC_VACTW` with `FCTDEF` per cut (written to
 //! Siemens' documented pattern, not executed here). No micro-joints: its arcs and merged lines
 //! are not split.
@@ -28,7 +30,10 @@ impl Rules for Sinumerik {
     fn describe(&self, _n: [&str; 5]) -> (String, String, &'static str) {
         (
             "kerf Sinumerik-style program: TRAORI, tool tip X Y Z and orientation vector A3 B3 C3 in workpiece coordinates".to_string(),
-            "feed: G94, F in mm/min of the tool tip (TRAORI), the block's mean planned speed".to_string(),
+            format!(
+                "feed: G94, F in mm/min of the tool tip (TRAORI), the block's mean planned speed;\nfeed: rapids G0 (RTLION) in exact stop G60, split so that the tip follows kerf's traverse (a straight move of the machine's axes) within {} mm; each piece stops, so a split rapid takes longer than planned",
+                crate::RAPID_TCP_TOLERANCE_MM
+            ),
             "arcs as CIP through the intermediate point",
         )
     }
@@ -71,7 +76,11 @@ impl Rules for Sinumerik {
     /// A rapid under `TRAORI` moves the tip straight (`RTLION`); kerf's traverse is checked
     /// (and planned) as a straight move of the machine's axes, so it is split into pieces
     /// whose tips follow that move within [`crate::RAPID_TCP_TOLERANCE_MM`], as the
-    /// tool-tip LinuxCNC dialect's ([`Writer::tip_rapid`]).
+    /// tool-tip LinuxCNC dialect's ([`Writer::tip_rapid`]). Under `G60` each piece stops
+    /// (the plan has one rest-to-rest move: the header says so), and within a piece the
+    /// controller turns the orientation on a great circle (`ORIVECT`), not the rotary axes
+    /// linearly: the tip follows within the tolerance, the head within about its distance
+    /// from the tip times the square of the piece's turn.
     fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], u: Vector3<f64>) {
         let model = w.model;
         w.tip_rapid("G0", p, q, |w, tip, a| {
@@ -83,8 +92,6 @@ impl Rules for Sinumerik {
             };
             tip_words(w, tip, &axis)
         });
-        // As before the split: the printed position of the machine's axes.
-        w.last = Some(w.printed(&q));
     }
 
     fn dwell(&self, s: f64) -> String {

@@ -279,8 +279,8 @@ impl<const D: usize> Spline<D> {
 /// runs a `G0` straight in its axes (the joint dialects write its end, the tool-tip ones split
 /// it until it follows that line, `RAPID_TCP_TOLERANCE_MM`), and the traverse was checked
 /// against the part along that line, so the plan moves the same way. Planned along the tip's
-/// straight line instead, a rapid that turned a table by 251 degrees swung the linear axes
-/// 470 mm past both ends, out of the machine's travel.
+/// straight line instead, a rapid that turned a table by 251 degrees swung Z more than 470 mm
+/// below both ends, out of the machine's travel (`docs/interpolation.md`).
 #[derive(Debug, Clone)]
 pub(crate) struct Run {
     /// First block (index into the planned blocks).

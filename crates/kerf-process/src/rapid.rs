@@ -259,6 +259,17 @@ fn rapid_moves_within(
                     }
                 }
             }
+            // The move still too close at `at` (`d` mm from the part), and why it stays so.
+            let blocked = |at: Point3<f64>, d: f64, why: String| {
+                ProcessError::TraverseBlocked(Box::new(crate::Blockage {
+                    from: [ta.x, ta.y, ta.z],
+                    to: [tb.x, tb.y, tb.z],
+                    at: [at.x, at.y, at.z],
+                    distance_mm: d,
+                    clearance_mm: c,
+                    why,
+                }))
+            };
             match worst {
                 None => {
                     least = least.min(here);
@@ -269,16 +280,13 @@ fn rapid_moves_within(
                     break;
                 }
                 Some((at, d)) if pieces >= MAX_SPLIT => {
-                    return Err(ProcessError::TraverseBlocked(Box::new(crate::Blockage {
-                        from: [ta.x, ta.y, ta.z],
-                        to: [tb.x, tb.y, tb.z],
-                        at: [at.x, at.y, at.z],
-                        distance_mm: d,
-                        clearance_mm: c,
-                        why: format!(
+                    return Err(blocked(
+                        at,
+                        d,
+                        format!(
                             "the machine's rapid move swings too close even split {MAX_SPLIT} times"
                         ),
-                    })));
+                    ));
                 }
                 Some((at, d)) => {
                     pieces *= 2;
@@ -287,14 +295,11 @@ fn rapid_moves_within(
                         (1..pieces).any(|j| !inside_limits(&split_at(j as f64 / pieces as f64), l))
                     });
                     if outside {
-                        return Err(ProcessError::TraverseBlocked(Box::new(crate::Blockage {
-                            from: [ta.x, ta.y, ta.z],
-                            to: [tb.x, tb.y, tb.z],
-                            at: [at.x, at.y, at.z],
-                            distance_mm: d,
-                            clearance_mm: c,
-                            why: "the machine's rapid move swings too close, and the points that would split it leave the axis limits".into(),
-                        })));
+                        return Err(blocked(
+                            at,
+                            d,
+                            "the machine's rapid move swings too close, and the points that would split it leave the axis limits".into(),
+                        ));
                     }
                 }
             }

@@ -330,6 +330,7 @@ impl<'a> Writer<'a> {
         if h > 0.0 {
             let t = self.process.descent_s(self.opts.feed_mm_per_min);
             self.rules.descent(self, b, start, u, t, h);
+            self.last_axes = Some(b.start_axes);
         }
     }
 
@@ -366,9 +367,11 @@ impl<'a> Writer<'a> {
         self.in_cut = false;
     }
 
-    /// The cutting block `b`, taking `t` seconds.
+    /// The cutting block `b`, taking `t` seconds; the next rapid's split starts from its end
+    /// ([`Writer::tip_rapid`]), whatever the dialect wrote.
     pub(super) fn cut(&mut self, b: &Block, t: f64) {
         self.rules.cut(self, b, t);
+        self.last_axes = Some(b.end_axes);
     }
 
     /// A block of a dialect that joins poses with `G1` lines, in the pieces it is written as:

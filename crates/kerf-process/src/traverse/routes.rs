@@ -171,8 +171,8 @@ const FINE_SAMPLES: usize = 1 << 22;
 
 /// The share of [`FINE_SAMPLES`] the finer margins get before the search around the part:
 /// routes that hug the part can spend the whole budget and clear none where the search finds
-/// a path cheaply (the propeller on `head_table`: ten such routes took all 4.2 M samples,
-/// 4.4 M exact distances and 19 s; the search then found a path with 3,648).
+/// a path cheaply (the propeller on `head_table`: ten such routes took all 4.2 M samples and
+/// 4.4 M exact distances; the search then found a path with 3,648).
 const FINE_FIRST: usize = 1 << 18;
 
 /// The work the search around the part may spend on one gap where no route shape clears
@@ -226,6 +226,17 @@ impl Tally {
                 None
             }
         }
+    }
+}
+
+/// The clear route of `route`'s shape through `waypoints` (`length_mm` long), keeping
+/// `least` mm from the part.
+fn traverse_of(length_mm: f64, route: Route, waypoints: &[PoseArray], least: f64) -> Traverse {
+    Traverse {
+        length_mm,
+        waypoints: waypoints.to_vec(),
+        route,
+        min_distance_mm: least,
     }
 }
 
@@ -458,12 +469,7 @@ pub(crate) fn plan_traverse_accepting<T>(
         let checked = tip_ends(waypoints, None);
         match checked {
             Ok(least) => {
-                let t = Traverse {
-                    length_mm: *length_mm,
-                    waypoints: waypoints.clone(),
-                    route: *route,
-                    min_distance_mm: least,
-                };
+                let t = traverse_of(*length_mm, *route, waypoints, least);
                 match accept(&t) {
                     Ok(v) => return Ok((t, v)),
                     Err((at, distance)) => {
@@ -529,12 +535,7 @@ pub(crate) fn plan_traverse_accepting<T>(
                     let (length_mm, route, waypoints) = &routes[k];
                     match tip_ends(waypoints, None) {
                         Ok(least) => {
-                            let t = Traverse {
-                                length_mm: *length_mm,
-                                waypoints: waypoints.clone(),
-                                route: *route,
-                                min_distance_mm: least,
-                            };
+                            let t = traverse_of(*length_mm, *route, waypoints, least);
                             match accept(&t) {
                                 Ok(v) => return Ok((t, v)),
                                 Err((at, distance)) => Coarse::Refused(Blocked::at(at, distance)),
@@ -582,12 +583,7 @@ pub(crate) fn plan_traverse_accepting<T>(
             }
             match tip_ends(waypoints, Some(&mut *fine)) {
                 Ok(least) => {
-                    let t = Traverse {
-                        length_mm: *length_mm,
-                        waypoints: waypoints.clone(),
-                        route: *route,
-                        min_distance_mm: least,
-                    };
+                    let t = traverse_of(*length_mm, *route, waypoints, least);
                     if let Some(done) = tally.offer(t, accept) {
                         return Ok(done);
                     }

@@ -105,7 +105,7 @@ impl Rules for Sinumerik {
     fn descent(
         &self,
         w: &mut Writer<'_>,
-        b: &Block,
+        _b: &Block,
         start: Point3<f64>,
         u: Vector3<f64>,
         _t: f64,
@@ -115,8 +115,6 @@ impl Rules for Sinumerik {
         let l = format!("G1 {} F{f}", tip_words(w, &start, &u));
         w.line(&l);
         w.last_f = Some(f);
-        // Where the next rapid starts from (its split follows the machine's axes).
-        w.last_axes = Some(b.start_axes);
     }
 
     fn blend_off(&self, w: &mut Writer<'_>) {
@@ -150,7 +148,6 @@ impl Rules for Sinumerik {
             }
         }
         w.line(&l);
-        w.last_axes = Some(b.end_axes);
     }
 
     fn pierce_power(&self, w: &mut Writer<'_>, power: &LaserPower) {

@@ -44,15 +44,7 @@ fn the_integrator_program_cuts_the_circle_within_the_tolerance() {
     let r = 30.0;
     let tol = 0.01;
     let digits = 1e-3; // the program's rounding, generously
-    let codes = |key: &str| -> Vec<String> {
-        let list = out.report["program"][key]
-            .as_array()
-            .expect("process codes");
-        list.iter()
-            .map(|c| c.as_str().expect("a code").to_string())
-            .collect()
-    };
-    let (beam_on, beam_off) = (codes("beam_on"), codes("beam_off"));
+    let (beam_on, beam_off) = (&out.report.program.beam_on, &out.report.program.beam_off);
     let radial = |p: &Point3<f64>| {
         let d = p - centre;
         (d - normal * d.dot(&normal)).norm()
@@ -194,11 +186,7 @@ fn a_step_part_runs_through_the_library_in_a_few_lines() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/step/composite_mm.step");
     let out = integrator::cut_step(&step, false).expect("the example runs");
     assert_eq!(out.toolpath.paths.len(), 5);
-    assert_eq!(
-        out.report["program"]["cuts"], 5,
-        "{}",
-        out.report["program"]
-    );
+    assert_eq!(out.report.program.cuts, 5, "{:?}", out.report.program);
     assert!(
         out.programs[0].text.contains("composite_mm.step"),
         "the program names its source"

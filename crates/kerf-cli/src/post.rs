@@ -76,7 +76,7 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
             "linearization_tolerance": opts.linearization_tolerance_mm,
             "pole_points": pole,
             "pole_tip_error": pole_err,
-            "placement": placed.json(&ids),
+            "placement": placed.report(&ids),
             "seconds": elapsed,
         });
         if dest == Path::new("-") {

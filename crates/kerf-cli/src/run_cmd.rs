@@ -140,14 +140,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
     let lap = Lap::start();
     out.write_dir(&args.out)?;
     // The whole write, report and picture included (`report.json` states what came before it).
-    lap.stop(&mut out.timings, "write");
-    out.report["timings"] = out.timings.to_json();
+    lap.stop(&mut out.report.timings, "write");
     let r = &out.report;
     if args.json {
-        println!("{r}");
+        println!("{}", serde_json::to_string(r).unwrap_or_default());
     } else if !args.quiet {
-        let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
-        let int = |v: &serde_json::Value| v.as_u64().unwrap_or(0);
         eprintln!(
             "{}: {} curves -> {} cutting points (N* {:.1}), {} poses on {:?}, {} lines + {} arcs, \
              {:.2} s of motion at {} mm/min; wrote {} in {:.2} s (CPU {:.2} s: {}){}",
@@ -158,17 +155,17 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
                 .iter()
                 .map(|p| p.params.len())
                 .sum::<usize>(),
-            num(&r["discretize"]["n_star"]),
+            r.discretize.n_star,
             out.solved.iter().map(|s| s.poses.len()).sum::<usize>(),
             job.machine().name,
-            int(&r["interpolation"]["lines"]),
-            int(&r["interpolation"]["arcs"]),
-            num(&r["interpolation"]["duration_s"]),
+            r.interpolation.lines,
+            r.interpolation.arcs,
+            r.interpolation.duration_s,
             feed,
             args.out.display(),
             start.elapsed().as_secs_f64(),
-            out.timings.cpu_s(),
-            out.timings.summary(3),
+            r.timings.cpu_s(),
+            r.timings.summary(3),
             if out.placement.is_identity() {
                 String::new()
             } else {

@@ -335,3 +335,13 @@ impl Head {
         serde_json::json!({ "solids": solids })
     }
 }
+
+/// Serialized as `kerf.machine/1`'s `head` ([`Head::to_value`]).
+impl serde::Serialize for Head {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        self.to_value().serialize(serializer)
+    }
+}

@@ -79,8 +79,8 @@ pub use pose::{Axes, Axis, Pose};
 pub use registry::kinematics_types;
 pub use table_table::TableTable;
 pub use technology::{
-    Pierce, SmallHole, Technology, TechnologyEntry, DEFAULT_POWER_MIN_SHARE,
-    MAX_TECHNOLOGY_ENTRIES, TECHNOLOGY_FORMAT,
+    CornerRule, MicroJoints, Pierce, SmallHole, Technology, TechnologyEntry,
+    DEFAULT_POWER_MIN_SHARE, MAX_TECHNOLOGY_ENTRIES, TECHNOLOGY_FORMAT,
 };
 pub use tilt::{
     tilt_within_cone, tilt_within_cones, Cone, TiltChoice, TiltReport, TILT_WORKING_FRACTION,

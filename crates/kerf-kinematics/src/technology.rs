@@ -19,7 +19,7 @@
 
 use std::path::Path;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use crate::error::{json_type_name, KinematicsError, Result};
@@ -36,7 +36,7 @@ pub const DEFAULT_POWER_MIN_SHARE: f64 = 0.2;
 
 /// The pierce of an entry: how long and with what power the beam stands at the pierce point,
 /// and how high above the surface.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Pierce {
     /// The dwell with the beam on before the head moves, s.
@@ -48,7 +48,7 @@ pub struct Pierce {
 }
 
 /// The small-hole rule of an entry: holes up to a diameter are cut slower with less power.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SmallHole {
     /// Holes (closed contours) of at most this diameter follow the rule, mm.
@@ -61,9 +61,9 @@ pub struct SmallHole {
 
 /// The corner rule of an entry: near sharp corners the cut runs slower (the power, following
 /// the speed, comes down with it).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
-pub struct Corner {
+pub struct CornerRule {
     /// The least turn of the path that makes a corner, degrees, in (0, 180).
     pub min_turn_deg: f64,
     /// How far on each side of the corner the cut runs slower, mm, in (0, 100].
@@ -126,7 +126,7 @@ pub struct TechnologyEntry {
     pub micro_joints: Option<MicroJoints>,
     /// The corner rule.
     #[serde(default)]
-    pub corner: Option<Corner>,
+    pub corner: Option<CornerRule>,
 }
 
 impl TechnologyEntry {

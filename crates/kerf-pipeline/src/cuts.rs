@@ -18,10 +18,13 @@ use kerf_process::{
     OffsetPath, PoseArray,
 };
 use nalgebra::Point3;
-use serde_json::{json, Value};
 
 use crate::error::Error;
 use crate::place::Placed;
+use crate::report::{
+    CompensationPath, CompensationReport, OwnSurfaces, ProcessReport, SearchedTraverse,
+    ShortenedLead, TraversesReport, UncheckedTraverse, WallReport,
+};
 
 /// A point function of a cut path (part coordinates).
 type PointFn = Box<dyn Fn(f64) -> Point3<f64> + Sync>;
@@ -82,24 +85,26 @@ pub(crate) fn walls(
 }
 
 /// The `walls` entries of the report: every curve cut along its wall, with the width found.
-pub(crate) fn walls_json(file: &CurvesFile, walls: &[Option<kerf_process::Wall>]) -> Value {
-    json!(file
-        .curves
+pub(crate) fn walls_report(
+    file: &CurvesFile,
+    walls: &[Option<kerf_process::Wall>],
+) -> Vec<WallReport> {
+    file.curves
         .iter()
         .zip(walls)
         .filter_map(|(c, w)| {
             let w = w.as_ref()?;
-            Some(json!({
-                "id": c.id,
-                "width_mm": w.width_mm,
-                "scrap": w.scrap.name(),
-                "reason": format!(
+            Some(WallReport {
+                id: c.id.clone(),
+                width_mm: w.width_mm,
+                scrap: w.scrap.name().to_string(),
+                reason: format!(
                     "its surface is at most {:.3} mm wide across the contour: a wall through the sheet; the beam runs along the wall, the scrap is where the wall's normal points",
                     w.width_mm
                 ),
-            }))
+            })
         })
-        .collect::<Vec<_>>())
+        .collect()
 }
 
 /// With a kerf, the share of the chord tolerance the contour's own chords get; the offset's
@@ -415,55 +420,74 @@ pub(crate) fn kerf_header(kerf: Option<&Kerf>, compensated: &[Compensated]) -> S
 }
 
 /// The `compensation` object of `report.json`.
-pub(crate) fn compensation_json(
+pub(crate) fn compensation_report(
     file: &CurvesFile,
     kerf: Option<&Kerf>,
     compensated: &[Compensated],
-) -> Value {
+) -> CompensationReport {
     let Some(k) = kerf else {
-        return json!({
-            "kerf_width_mm": null,
-            "note": "no kerf width (the run's kerf_width_mm, the technology entry's or the machine's process.kerf_width_mm): the path is the contour itself",
-        });
+        return CompensationReport {
+            kerf_width_mm: None,
+            source: None,
+            mode: None,
+            offset_mm: None,
+            tolerance_mm: None,
+            proven: None,
+            paths: None,
+            note: "no kerf width (the run's kerf_width_mm, the technology entry's or the machine's process.kerf_width_mm): the path is the contour itself".into(),
+        };
     };
-    let paths: Vec<Value> = compensated
+    let paths: Vec<CompensationPath> = compensated
         .iter()
         .map(|c| {
-            let id = &file.curves[c.curve].id;
+            let mut entry = CompensationPath {
+                id: file.curves[c.curve].id.clone(),
+                side: None,
+                offset_mm: 0.0,
+                points: None,
+                inserted: None,
+                max_chord_error_mm: None,
+                proven: None,
+                outside_corners: None,
+                inside_corners: None,
+                max_corner_material_mm: None,
+                crossing_checked: None,
+                in_control: None,
+                reason: None,
+            };
             match &c.outcome {
-                Outcome::InControl(side) => json!({
-                    "id": id,
-                    "side": side.name(),
-                    "offset_mm": 0.5 * k.width_mm,
-                    "in_control": true,
-                }),
-                Outcome::Offset(p) => json!({
-                    "id": id,
-                    "side": p.side.name(),
-                    "offset_mm": p.offset_mm,
-                    "points": p.poses.len(),
-                    "inserted": p.inserted,
-                    "max_chord_error_mm": p.max_chord_error_mm,
-                    "proven": p.proven,
-                    "outside_corners": p.outside_corners,
-                    "inside_corners": p.inside_corners,
-                    "max_corner_material_mm": p.max_corner_material_mm,
-                    "crossing_checked": p.crossing_checked,
-                }),
-                Outcome::Uncompensated(why) => json!({ "id": id, "offset_mm": 0.0, "reason": why }),
+                Outcome::InControl(side) => {
+                    entry.side = Some(side.name().to_string());
+                    entry.offset_mm = 0.5 * k.width_mm;
+                    entry.in_control = Some(true);
+                }
+                Outcome::Offset(p) => {
+                    entry.side = Some(p.side.name().to_string());
+                    entry.offset_mm = p.offset_mm;
+                    entry.points = Some(p.poses.len());
+                    entry.inserted = Some(p.inserted);
+                    entry.max_chord_error_mm = Some(p.max_chord_error_mm);
+                    entry.proven = Some(p.proven);
+                    entry.outside_corners = Some(p.outside_corners);
+                    entry.inside_corners = Some(p.inside_corners);
+                    entry.max_corner_material_mm = Some(p.max_corner_material_mm);
+                    entry.crossing_checked = Some(p.crossing_checked);
+                }
+                Outcome::Uncompensated(why) => entry.reason = Some(why.clone()),
             }
+            entry
         })
         .collect();
-    json!({
-        "kerf_width_mm": k.width_mm,
-        "source": k.source,
-        "mode": if k.in_control { "controller" } else { "computer" },
-        "offset_mm": 0.5 * k.width_mm,
-        "tolerance_mm": k.tolerance_mm,
-        "proven": !compensated.is_empty() && compensated.iter().all(|c| matches!(&c.outcome, Outcome::Offset(p) if p.proven)),
-        "paths": paths,
-        "note": "in the computer, each path moved half the kerf toward its scrap side, at right angles to the path and the tool axis; outside corners swung round on an arc about the corner, inside corners cut back to where the offsets cross (the round beam leaves max_corner_material_mm there); proven: every chord within the tolerance of the exact offset (flat contours at a fixed tool axis), else measured at 15 points per chord; in the controller, the program holds the contours with G41.1/G42.1 D<kerf> from the lead-in on and G40 after the beam is off (docs/process.md, Kerf compensation)",
-    })
+    CompensationReport {
+        kerf_width_mm: Some(k.width_mm),
+        source: Some(k.source.to_string()),
+        mode: Some(if k.in_control { "controller" } else { "computer" }.to_string()),
+        offset_mm: Some(0.5 * k.width_mm),
+        tolerance_mm: Some(k.tolerance_mm),
+        proven: Some(!compensated.is_empty() && compensated.iter().all(|c| matches!(&c.outcome, Outcome::Offset(p) if p.proven))),
+        paths: Some(paths),
+        note: "in the computer, each path moved half the kerf toward its scrap side, at right angles to the path and the tool axis; outside corners swung round on an arc about the corner, inside corners cut back to where the offsets cross (the round beam leaves max_corner_material_mm there); proven: every chord within the tolerance of the exact offset (flat contours at a fixed tool axis), else measured at 15 points per chord; in the controller, the program holds the contours with G41.1/G42.1 D<kerf> from the lead-in on and G40 after the beam is off (docs/process.md, Kerf compensation)".into(),
+    }
 }
 
 /// The controller's compensation of every cut (`cuts[k]`, solved as `solved[k]`): the side
@@ -587,7 +611,7 @@ pub(crate) fn polyline_length(p: &[PoseArray]) -> f64 {
 }
 
 /// The `process` object of `report.json`: pierces, lengths, order and what each cut got.
-pub(crate) fn report(file: &CurvesFile, cuts: &[CutPath], plans: &SetupPlans) -> Value {
+pub(crate) fn report(file: &CurvesFile, cuts: &[CutPath], plans: &SetupPlans) -> ProcessReport {
     let len = polyline_length;
     let cut_length: f64 = cuts
         .iter()
@@ -606,31 +630,31 @@ pub(crate) fn report(file: &CurvesFile, cuts: &[CutPath], plans: &SetupPlans) ->
         traverse += plan.traverse_mm;
         file_order += plan.file_order_traverse_mm;
         for (k, &i) in paths.iter().enumerate() {
-            let id = file.curves[i].id.as_str();
+            let id = file.curves[i].id.clone();
             if plan.is_hole(k) {
-                holes.push(id);
+                holes.push(id.clone());
             }
             let l = &plan.leads[k];
             if l.pierce_on_contour {
                 on_contour.push(id);
             } else if l.scale < 1.0 {
-                shortened.push(json!({ "id": id, "scale": l.scale }));
+                shortened.push(ShortenedLead { id, scale: l.scale });
             }
         }
     }
-    json!({
-        "pierces": cuts.len(),
-        "order": cuts.iter().map(|c| file.curves[c.curve].id.as_str()).collect::<Vec<_>>(),
-        "holes_cut_first": holes,
-        "cut_length_mm": cut_length,
-        "lead_length_mm": lead_length,
-        "traverse_mm": traverse,
-        "file_order_traverse_mm": file_order,
-        "traverse_saved_mm": file_order - traverse,
-        "lead_ins_shortened": shortened,
-        "pierce_on_contour": on_contour,
-        "traverse_note": "straight distances from each cut's exit to the next pierce point, in part coordinates, within each set-up; the program adds the retract and approach along the tool axes",
-    })
+    ProcessReport {
+        pierces: cuts.len(),
+        order: cuts.iter().map(|c| file.curves[c.curve].id.clone()).collect(),
+        holes_cut_first: holes,
+        cut_length_mm: cut_length,
+        lead_length_mm: lead_length,
+        traverse_mm: traverse,
+        file_order_traverse_mm: file_order,
+        traverse_saved_mm: file_order - traverse,
+        lead_ins_shortened: shortened,
+        pierce_on_contour: on_contour,
+        traverse_note: "straight distances from each cut's exit to the next pierce point, in part coordinates, within each set-up; the program adds the retract and approach along the tool axes".into(),
+    }
 }
 
 /// The `traverses` object of `report.json`: how the traverses between cuts were checked
@@ -642,20 +666,20 @@ pub(crate) fn traverse_report(
         kerf_process::RapidMoves,
         Vec<String>,
     )],
-    blocked: Vec<Value>,
-    own: Vec<Value>,
-    searched: Vec<Value>,
-) -> Value {
-    let mut unchecked: Vec<&str> = Vec::new();
+    blocked: Vec<UncheckedTraverse>,
+    own: Vec<OwnSurfaces>,
+    searched: Vec<SearchedTraverse>,
+) -> TraversesReport {
+    let mut unchecked: Vec<String> = Vec::new();
     for (_, _, absent) in rapids {
         for id in absent {
-            if !unchecked.contains(&id.as_str()) {
-                unchecked.push(id);
+            if !unchecked.contains(id) {
+                unchecked.push(id.clone());
             }
         }
     }
     // How many traverses took each route.
-    let routes: serde_json::Map<String, Value> = [
+    let routes: std::collections::BTreeMap<String, usize> = [
         kerf_process::Route::Straight,
         kerf_process::Route::Lifted,
         kerf_process::Route::SafePlane,
@@ -664,32 +688,53 @@ pub(crate) fn traverse_report(
     .iter()
     .map(|k| {
         let n = rapids.iter().filter(|(t, _, _)| t.route == *k).count();
-        (k.name().to_string(), json!(n))
+        (k.name().to_string(), n)
     })
     .collect();
     let Some(o) = opts else {
-        return json!({ "checked": false, "note": "no traverse options (a clearance of 0): retract along the tool axis, one straight move, approach; not checked against the part" });
+        return TraversesReport {
+            checked: false,
+            clearance_mm: None,
+            retract_mm: None,
+            nozzle_mm: None,
+            count: None,
+            checked_count: None,
+            unchecked: None,
+            lifted: None,
+            routes: None,
+            searched: None,
+            split_moves: None,
+            length_mm: None,
+            min_distance_mm: None,
+            surfaces_in_the_cuts_way: None,
+            surfaces_note: None,
+            own_surface_over_the_head: None,
+            unchecked_note: None,
+            searched_note: None,
+            note: Some("no traverse options (a clearance of 0): retract along the tool axis, one straight move, approach; not checked against the part".into()),
+        };
     };
-    json!({
-        "checked": true,
-        "clearance_mm": o.clearance_mm,
-        "retract_mm": o.retract_mm,
-        "nozzle_mm": o.nozzle_mm,
-        "count": rapids.len() + blocked.len(),
-        "checked_count": rapids.len(),
-        "unchecked": blocked,
-        "lifted": rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count(),
-        "routes": routes,
-        "searched": searched,
-        "split_moves": rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>(),
-        "length_mm": rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>(),
-        "min_distance_mm": rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min),
-        "surfaces_in_the_cuts_way": unchecked,
-        "surfaces_note": "surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)",
-        "own_surface_over_the_head": own,
-        "unchecked_note": "where no route keeps the clearance (unchecked, with the reason and the surfaces the routes were checked without), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning; a reason that starts 'proven' shows that no route can exist (the retract or approach line itself is blocked)",
-        "searched_note": "searched: the gaps where no route shape (straight, lifted, over the safe plane) cleared and a search around the part found a path, the head turned to one tool axis for the travel; lifted counts every route that is not straight",
-    })
+    TraversesReport {
+        checked: true,
+        clearance_mm: Some(o.clearance_mm),
+        retract_mm: Some(o.retract_mm),
+        nozzle_mm: Some(o.nozzle_mm),
+        count: Some(rapids.len() + blocked.len()),
+        checked_count: Some(rapids.len()),
+        unchecked: Some(blocked),
+        lifted: Some(rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count()),
+        routes: Some(routes),
+        searched: Some(searched),
+        split_moves: Some(rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>()),
+        length_mm: Some(rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>()),
+        min_distance_mm: Some(rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min)),
+        surfaces_in_the_cuts_way: Some(unchecked),
+        surfaces_note: Some("surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)".into()),
+        own_surface_over_the_head: Some(own),
+        unchecked_note: Some("where no route keeps the clearance (unchecked, with the reason and the surfaces the routes were checked without), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning; a reason that starts 'proven' shows that no route can exist (the retract or approach line itself is blocked)".into()),
+        searched_note: Some("searched: the gaps where no route shape (straight, lifted, over the safe plane) cleared and a search around the part found a path, the head turned to one tool axis for the travel; lifted counts every route that is not straight".into()),
+        note: None,
+    }
 }
 
 /// Per cut (indexed like `cuts`): true for a small hole of a technology's small-hole rule: a

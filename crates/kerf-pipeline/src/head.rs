@@ -9,7 +9,8 @@ use kerf_kinematics::{
 };
 use kerf_process::{check_cut, check_cut_along, CutClearance, HeadCheckOptions, Obstacles};
 use nalgebra::{Point3, Vector3};
-use serde_json::{json, Value};
+
+use crate::report::{HeadPath, HeadReport, HeadStretch, HeadTilt};
 
 /// Rounds of tilting and checking again a path may take.
 const MAX_ROUNDS: usize = 4;
@@ -24,7 +25,7 @@ const MAX_NEEDED_TILT_DEG: f64 = 60.0;
 #[derive(Debug, Default)]
 pub(crate) struct HeadOutcome {
     /// One report entry per path.
-    pub report: Vec<Value>,
+    pub report: Vec<HeadPath>,
     /// Collisions accepted as warnings.
     pub warnings: Vec<String>,
     /// The tip zone the check left out, mm.
@@ -409,46 +410,69 @@ fn report_entry(
     rounds: usize,
     tilted_poses: usize,
     max_tilt_deg: f64,
-) -> Value {
-    json!({
-        "path": s.id,
-        "min_distance_mm": if c.min_distance_mm.is_finite() { json!(c.min_distance_mm) } else { Value::Null },
-        "at_pose": c.at_pose,
-        "close": c.close.iter().map(|st| json!({
-            "poses": st.poses,
-            "length_mm": st.length_mm,
-            "distance_mm": st.distance_mm,
-            "at_height_mm": st.at_height_mm,
-            "surface": st.surface,
-        })).collect::<Vec<_>>(),
-        "proven": c.proven,
-        "tilted": { "rounds": rounds, "cutting_points": tilted_poses, "max_tilt_deg": max_tilt_deg },
-        "samples": c.samples,
-        "queries": c.queries,
-    })
+) -> HeadPath {
+    HeadPath {
+        path: s.id.clone(),
+        min_distance_mm: c.min_distance_mm.is_finite().then_some(c.min_distance_mm),
+        at_pose: c.at_pose,
+        close: c
+            .close
+            .iter()
+            .map(|st| HeadStretch {
+                poses: st.poses,
+                length_mm: st.length_mm,
+                distance_mm: st.distance_mm,
+                at_height_mm: st.at_height_mm,
+                surface: st.surface.clone(),
+            })
+            .collect(),
+        proven: c.proven,
+        tilted: HeadTilt {
+            rounds,
+            cutting_points: tilted_poses,
+            max_tilt_deg,
+        },
+        samples: c.samples,
+        queries: c.queries,
+    }
 }
 
 /// The report's `head` object: the check's settings and its figures per path.
-pub(crate) fn head_json(
+pub(crate) fn head_report(
     clearance: Option<f64>,
     machine: &Machine,
     tip_zone: Option<f64>,
-    paths: Vec<Value>,
-) -> Value {
+    paths: Vec<HeadPath>,
+) -> HeadReport {
     let Some(clearance) = clearance else {
-        return json!({ "checked": false, "note": "cuts not checked against the head (cut_clearance_mm checks them)" });
+        return HeadReport {
+            checked: false,
+            clearance_mm: None,
+            head: None,
+            head_source: None,
+            standoff_mm: None,
+            tip_zone_mm: None,
+            paths: None,
+            note: "cuts not checked against the head (cut_clearance_mm checks them)".into(),
+        };
     };
-    let head = machine.head.clone().unwrap_or_else(Head::laser_default);
-    json!({
-        "checked": true,
-        "clearance_mm": clearance,
-        "head": head.to_value(),
-        "head_source": if machine.head.is_some() { "machine file" } else { "default laser head" },
-        "standoff_mm": machine.process.standoff_mm.unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
-        "tip_zone_mm": tip_zone,
-        "paths": paths,
-        "note": "min_distance_mm: a proven lower bound of the distance from the head above the tip zone (the nozzle's lowest tip_zone_mm, meant to be near the cut) to the part the cut lies on (the surfaces its curve names and those joined to them; every surface of the file for a curve that names none) over the cut's poses and the motion between them; close: stretches where a head point was found within the clearance; tilted: cutting points whose tool axis was tilted (within the tilt tolerance, away from the surface in the way) to clear it",
-    })
+    HeadReport {
+        checked: true,
+        clearance_mm: Some(clearance),
+        head: Some(machine.head.clone().unwrap_or_else(Head::laser_default)),
+        head_source: Some(
+            if machine.head.is_some() { "machine file" } else { "default laser head" }.into(),
+        ),
+        standoff_mm: Some(
+            machine
+                .process
+                .standoff_mm
+                .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
+        ),
+        tip_zone_mm: Some(tip_zone),
+        paths: Some(paths),
+        note: "min_distance_mm: a proven lower bound of the distance from the head above the tip zone (the nozzle's lowest tip_zone_mm, meant to be near the cut) to the part the cut lies on (the surfaces its curve names and those joined to them; every surface of the file for a curve that names none) over the cut's poses and the motion between them; close: stretches where a head point was found within the clearance; tilted: cutting points whose tool axis was tilted (within the tilt tolerance, away from the surface in the way) to clear it".into(),
+    }
 }
 
 /// A bound on the tool axis' second derivative on each move between the poses of `s`

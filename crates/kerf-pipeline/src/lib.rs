@@ -45,6 +45,7 @@ mod output;
 mod place;
 mod post;
 pub mod ranges;
+mod report;
 mod run;
 mod timing;
 mod view;
@@ -64,6 +65,13 @@ pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};
 pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};
 pub use post::{post_toolpath, toolpath_poses, MissingNormals, Posted};
 pub use ranges::OptionRange;
+pub use report::{
+    CompensationPath, CompensationReport, DiscretizeReport, HeadPath, HeadReport, HeadStretch,
+    HeadTilt, InterpolationReport, KinematicsReport, MicroJoint, MicroJointPath, MicroJointsReport,
+    NormalsReport, OwnSurfaces, PathMotion, PlacementReport, ProcessReport, ProgramReport, Report,
+    SearchedTraverse, SetupReport, ShortenedLead, SideReport, TechnologyReport, TiltPath,
+    TiltTotals, TraversesReport, UncheckedTraverse, WallReport,
+};
 pub use run::PLACEMENT_RETRIES;
 pub use timing::{process_cpu_time, Lap, StageTime, Timings};
 

@@ -14,6 +14,7 @@ use kerf_normals::Oriented;
 
 use crate::error::{Error, Result};
 use crate::place::Placed;
+use crate::report::Report;
 use crate::timing::{Lap, Timings};
 
 /// One set-up's program: the part is clamped anew between set-ups, so each is a job of its
@@ -78,9 +79,11 @@ pub struct Output {
     pub axes: AxesFile,
     /// Stage 4: one program per set-up.
     pub programs: Vec<SetupProgram>,
-    /// The report (`report.json`): the tolerance budget, every stage's figures, the placement
-    /// and the cuts.
-    pub report: serde_json::Value,
+    /// The report (`report.json` is its JSON): the tolerance budget, every stage's figures,
+    /// the placement, the cuts and the time each stage took ([`Report::timings`]; the CLI
+    /// adds `read` before them with [`Output::prepend_timings`], and [`Output::write_dir`]
+    /// adds `write` to what it writes).
+    pub report: Report,
     /// The picture (`plot.svg`): the curves, points and tool axes, chord errors and the axes
     /// against the machine's limits.
     pub plot_svg: String,
@@ -90,21 +93,17 @@ pub struct Output {
     /// What the caller should be told: traverses that could not be checked against the part
     /// (they fall back to the unchecked retract traverse; `traverses.unchecked` in the report).
     pub warnings: Vec<String>,
-    /// Wall and CPU seconds of each stage (`report.json`'s `timings`; the CLI adds `read` before
-    /// them with [`Output::prepend_timings`], and [`Output::write_dir`] adds `write`).
-    pub timings: Timings,
     pub(crate) model: MachineModel,
     pub(crate) cycle_s: f64,
 }
 
 impl Output {
     /// Puts `earlier` (stages that ran before the job, such as reading its files) before the
-    /// run's own stage times, in the report too.
+    /// run's own stage times ([`Report::timings`]).
     pub fn prepend_timings(&mut self, earlier: Timings) {
         let mut t = earlier;
-        t.merge(&self.timings);
-        self.timings = t;
-        self.report["timings"] = self.timings.to_json();
+        t.merge(&self.report.timings);
+        self.report.timings = t;
     }
 
     /// The names of the files [`Output::write_dir`] writes, in order.
@@ -192,15 +191,12 @@ impl Output {
     /// The page [`Output::write_view`] writes.
     pub fn view_html(&self) -> String {
         let mut scene = self.scene.clone();
-        scene.warnings = self.report["warnings"]
-            .as_array()
-            .map(|ws| {
-                ws.iter()
-                    .filter_map(|w| w.as_str())
-                    .map(kerf_view::Warning::new)
-                    .collect()
-            })
-            .unwrap_or_default();
+        scene.warnings = self
+            .report
+            .warnings
+            .iter()
+            .map(|w| kerf_view::Warning::new(w))
+            .collect();
         kerf_view::html(&scene)
     }
 
@@ -216,7 +212,7 @@ impl Output {
 
     /// The report as pretty JSON text.
     pub fn report_text(&self) -> String {
-        serde_json::to_string_pretty(&self.report).unwrap_or_else(|_| self.report.to_string())
+        serde_json::to_string_pretty(&self.report).unwrap_or_default()
     }
 
     /// Writes every file ([`Output::file_names`]) into `dir` (created if needed), all or
@@ -240,7 +236,6 @@ impl Output {
         let toolpath = &self.toolpath;
         let axes = &self.axes;
         let report = &self.report;
-        let timings = &self.timings;
         // The files before `report.json` are written (in order) by the time its contents are
         // made: their time is the `write` stage it states.
         let lap = Lap::start();
@@ -284,10 +279,8 @@ impl Output {
             name: OUTPUTS[4],
             // The text of `report_text`, streamed.
             contents: Box::new(move |w| {
-                let mut t = timings.clone();
-                lap.stop(&mut t, "write");
                 let mut report = report.clone();
-                report["timings"] = t.to_json();
+                lap.stop(&mut report.timings, "write");
                 serde_json::to_writer_pretty(w, &report).map_err(std::io::Error::from)
             }),
         });

@@ -8,9 +8,9 @@
 //! the report says which placement was used.
 
 use kerf_kinematics::{auto_setups, AutoPlaceOptions, Machine, Placement, Pose, Setup, SetupPlan};
-use serde_json::{json, Value};
 
 use crate::error::{kin, Error};
+use crate::report::{PlacementReport, SetupReport, SideReport};
 
 /// The clearance `kerf post --place auto` keeps from the linear limits, mm: room for the
 /// default 10 mm retract of `kerf gcode` plus 1 mm.
@@ -106,7 +106,7 @@ impl Placed {
 
     /// The `sides` entries of the report: every path turned, or kept on the given side
     /// although its nozzle meets the part there, with the reason.
-    fn sides_json(&self, ids: &[&str]) -> Vec<Value> {
+    fn sides_report(&self, ids: &[&str]) -> Vec<SideReport> {
         (0..ids.len())
             .filter_map(|i| {
                 let why = self.side_reason(i)?;
@@ -145,11 +145,11 @@ impl Placed {
                         ),
                     ),
                 };
-                Some(json!({
-                    "id": ids.get(i).copied().unwrap_or(""),
-                    "side": side,
-                    "reason": reason,
-                }))
+                Some(SideReport {
+                    id: ids.get(i).copied().unwrap_or("").to_string(),
+                    side: side.to_string(),
+                    reason,
+                })
             })
             .collect()
     }
@@ -178,31 +178,45 @@ impl Placed {
             && !self.plan.flipped.contains(&true)
     }
 
-    /// The `placement` object of `report.json`.
-    pub fn json(&self, ids: &[&str]) -> Value {
-        let setups: Vec<Value> = self
+    /// The `placement` object of `report.json` (`ids` are the paths' ids in order); the run
+    /// adds the walls and the search's margin.
+    pub fn report(&self, ids: &[&str]) -> PlacementReport {
+        let setups = self
             .plan
             .setups
             .iter()
             .map(|s| {
                 let t = s.placement.translation_mm;
-                json!({
-                    "paths": s.paths.iter().map(|&i| ids.get(i).copied().unwrap_or("")).collect::<Vec<_>>(),
-                    "translation_mm": [t.x, t.y, t.z],
-                    "rotation_deg": s.placement.rotation_deg,
-                    "clearance_mm": if self.auto { Some(s.clearance_mm) } else { None },
-                })
+                SetupReport {
+                    paths: s
+                        .paths
+                        .iter()
+                        .map(|&i| ids.get(i).copied().unwrap_or("").to_string())
+                        .collect(),
+                    translation_mm: [t.x, t.y, t.z],
+                    rotation_deg: s.placement.rotation_deg,
+                    clearance_mm: self.auto.then_some(s.clearance_mm),
+                }
             })
             .collect();
-        json!({
-            "mode": if self.auto { "auto" } else { "given" },
-            "rotation_order": "Rz Ry Rx (about fixed workpiece axes, x first); p' = R p + t",
-            "setups": setups,
-            "paths_solved": if self.auto { Some(self.plan.paths_solved) } else { None },
-            "flipped_paths": ids.iter().zip(&self.plan.flipped).filter(|(_, f)| **f).map(|(id, _)| *id).collect::<Vec<_>>(),
-            "sides": self.sides_json(ids),
-            "sides_note": "side: given = the tool axis is the surface's normal, other = reversed (the beam comes from the other side of the sheet); with the placement auto and checked traverses a contour is turned where the nozzle's line along the tool axis (from 3/4 of the clearance to the retract plus the nozzle, at up to 64 of its points) comes within half the clearance of a surface of the file from the given side and from the other side nowhere, reach permitting; the lead-ins stay on the scrap side decided with the given normal",
-        })
+        PlacementReport {
+            mode: if self.auto { "auto" } else { "given" }.into(),
+            rotation_order: "Rz Ry Rx (about fixed workpiece axes, x first); p' = R p + t".into(),
+            setups,
+            paths_solved: self.auto.then_some(self.plan.paths_solved),
+            flipped_paths: ids
+                .iter()
+                .zip(&self.plan.flipped)
+                .filter(|(_, f)| **f)
+                .map(|(id, _)| id.to_string())
+                .collect(),
+            sides: self.sides_report(ids),
+            walls: None,
+            margin_mm: None,
+            searches: None,
+            walls_note: None,
+            sides_note: "side: given = the tool axis is the surface's normal, other = reversed (the beam comes from the other side of the sheet); with the placement auto and checked traverses a contour is turned where the nozzle's line along the tool axis (from 3/4 of the clearance to the retract plus the nozzle, at up to 64 of its points) comes within half the clearance of a surface of the file from the given side and from the other side nowhere, reach permitting; the lead-ins stay on the scrap side decided with the given normal".into(),
+        }
     }
 
     /// One line for the summary.

@@ -12,12 +12,16 @@ use kerf_interp::{
 };
 use kerf_kinematics::{solve_paths, AxesFile, PathCurve, PathInput, Pose};
 use kerf_normals::Oriented;
-use serde_json::json;
 
 use crate::discretize::{discretize_curves_within, orient_curves, toolpath_of_poses};
 use crate::error::{interp, kin, Result};
 use crate::job::Job;
 use crate::output::{program_names, Output, SetupProgram};
+use crate::report::{
+    DiscretizeReport, InterpolationReport, KinematicsReport, MicroJoint, MicroJointPath,
+    MicroJointsReport, NormalsReport, OwnSurfaces, ProgramReport, Report, SearchedTraverse,
+    TechnologyReport, TiltPath, TiltTotals, UncheckedTraverse,
+};
 use crate::timing::{Lap, Timings};
 use crate::{Progress, Stage};
 
@@ -327,7 +331,7 @@ fn run_placed(
         }
         None => (vec![Vec::new(); cuts.len()], Vec::new()),
     };
-    let joints_report: Vec<serde_json::Value> = cuts
+    let joints_report: Vec<MicroJointPath> = cuts
         .iter()
         .zip(&joints)
         .enumerate()
@@ -337,22 +341,25 @@ fn run_placed(
                 .iter()
                 .map(|p| [p.position.x, p.position.y, p.position.z])
                 .collect();
-            json!({
-                "id": file.curves[c.curve].id,
-                "joints": j.iter().map(|&[a, b]| json!({
-                    "start_mm": a,
-                    "end_mm": b,
-                    "start": crate::cuts::point_along(&placed, a),
-                    "end": crate::cuts::point_along(&placed, b),
-                })).collect::<Vec<_>>(),
-            })
+            MicroJointPath {
+                id: file.curves[c.curve].id.clone(),
+                joints: j
+                    .iter()
+                    .map(|&[a, b]| MicroJoint {
+                        start_mm: a,
+                        end_mm: b,
+                        start: crate::cuts::point_along(&placed, a),
+                        end: crate::cuts::point_along(&placed, b),
+                    })
+                    .collect(),
+            }
         })
         .collect();
     let mut solved = solve_paths(machine, &inputs, &popts).map_err(kin(path))?;
     lap.split(&mut timings, "kinematics");
     // 3d. The head against every surface of the file along every cut, set-up by set-up; the
     // tool axis tilted within the tilt tolerance where it comes too close.
-    let mut head_report: Vec<serde_json::Value> = Vec::new();
+    let mut head_report = Vec::new();
     let mut head_tip_zone: Option<f64> = None;
     let mut head_warnings: Vec<String> = Vec::new();
     // The machine's head (or kerf's default) and the nozzle's standoff above the tip: the
@@ -575,12 +582,12 @@ fn run_placed(
                         // The surfaces the routes were checked without (the last attempt
                         // leaves out all those in the cuts' way).
                         let left_out = kerf_process::in_the_cuts_way(obs, gap, topts);
-                        blocked_report.push(json!({
-                            "after": solved[w[0]].id,
-                            "before": solved[w[1]].id,
-                            "reason": e.to_string(),
-                            "surfaces_left_out": left_out,
-                        }));
+                        blocked_report.push(UncheckedTraverse {
+                            after: solved[w[0]].id.clone(),
+                            before: solved[w[1]].id.clone(),
+                            reason: e.to_string(),
+                            surfaces_left_out: left_out,
+                        });
                         traverses.push(Vec::new());
                         // The plot: the unchecked retract, straight move and approach.
                         let up = |q: &kerf_process::PoseArray, r: f64| {
@@ -616,22 +623,26 @@ fn run_placed(
                 // Surfaces left out that a neighbouring cut names itself: its own surface
                 // curls over its head line (the cut meets it, whatever the traverse does).
                 let over = kerf_process::own_surfaces_over_the_head(obs, gap, topts);
-                let own: Vec<&String> = absent.iter().filter(|id| over.contains(id)).collect();
+                let own: Vec<String> = absent
+                    .iter()
+                    .filter(|id| over.contains(id))
+                    .cloned()
+                    .collect();
                 if !own.is_empty() {
-                    own_report.push(json!({
-                        "after": solved[w[0]].id,
-                        "before": solved[w[1]].id,
-                        "surfaces": own,
-                    }));
+                    own_report.push(OwnSurfaces {
+                        after: solved[w[0]].id.clone(),
+                        before: solved[w[1]].id.clone(),
+                        surfaces: own,
+                    });
                 }
                 if t.route == kerf_process::Route::Searched {
-                    searched_report.push(json!({
-                        "after": solved[w[0]].id,
-                        "before": solved[w[1]].id,
-                        "waypoints": t.waypoints.len(),
-                        "length_mm": t.length_mm,
-                        "surfaces_left_out": absent,
-                    }));
+                    searched_report.push(SearchedTraverse {
+                        after: solved[w[0]].id.clone(),
+                        before: solved[w[1]].id.clone(),
+                        waypoints: t.waypoints.len(),
+                        length_mm: t.length_mm,
+                        surfaces_left_out: absent.clone(),
+                    });
                 }
                 rapid_report.push((t.clone(), r.clone(), absent.clone()));
                 // The plot: the checked traverse back in part coordinates.
@@ -809,12 +820,12 @@ fn run_placed(
     let segments: usize = discs.iter().map(Discretization::segments).sum();
     // The budget as the program's header states it (a `fit` term where arcs and merged lines
     // are written), and its total.
-    let mut budget: serde_json::Map<String, serde_json::Value> = gopts
+    let mut budget: std::collections::BTreeMap<String, Option<f64>> = gopts
         .budget()
         .into_iter()
-        .map(|(k, v)| (k.to_string(), json!(v)))
+        .map(|(k, v)| (k.to_string(), v))
         .collect();
-    budget.insert("total".into(), json!(gopts.budget_total()));
+    budget.insert("total".into(), Some(gopts.budget_total()));
     let spline_bound = motions
         .iter()
         .map(Motion::spline_deviation_bound)
@@ -826,16 +837,16 @@ fn run_placed(
         .filter_map(|(_, v)| v)
         .sum::<f64>()
         + spline_bound;
-    let placement_json = {
-        let mut p = placed.json(&id_refs);
-        p["walls"] = crate::cuts::walls_json(file, &walls);
+    let placement_report = {
+        let mut p = placed.report(&id_refs);
+        p.walls = Some(crate::cuts::walls_report(file, &walls));
         if placed.auto {
             // The margin the search kept from the linear limits, and how many searches it took
             // for every move of the program to stay within the travel.
-            p["margin_mm"] = json!(placement_margin);
-            p["searches"] = json!(attempt + 1);
+            p.margin_mm = Some(placement_margin);
+            p.searches = Some(attempt + 1);
         }
-        p["walls_note"] = json!(format!(
+        p.walls_note = Some(format!(
             "contours whose only named surface is a wall at most {} mm wide across them (its control net's extent along n x t, the wall's direction across the contour; 0 = off): a hole's or slot's wall, the sheet's edge face, named instead of the sheet's face. The beam runs along the wall (side 'given' is the head on the face of the sheet that holds the contour, away from the wall), the lead-ins lie across it, on the side the wall's outward normal points to (the scrap); curves with a scrap key or several surfaces are not looked at",
             o.wall_axis_max_mm
         ));
@@ -857,88 +868,121 @@ fn run_placed(
         .chain(warnings.iter().cloned())
         .collect();
     lap.split(&mut timings, "report");
-    let report = json!({
-        "input": source_name,
-        "machine": machine.name,
-        "warnings": all_warnings,
-        "tolerance_budget_mm": budget,
-        "program": {
-            "dialect": dialect.name(),
-            "beam_on": process.beam_on,
-            "beam_off": process.beam_off,
-            "pierce_dwell_s": process.pierce_dwell_s,
-            "pierce_standoff_mm": process.pierce_standoff,
-            "cuts": motions.iter().map(|motion| motion.blocks().iter().enumerate().filter(|(i, b)| !b.rapid && (*i == 0 || motion.blocks()[i - 1].rapid)).count()).sum::<usize>(),
-            "files": program_names(programs.len()),
+    let report = Report {
+        input: source_name,
+        machine: machine.name.clone(),
+        warnings: all_warnings,
+        tolerance_budget_mm: budget,
+        program: ProgramReport {
+            dialect: dialect.name().to_string(),
+            beam_on: process.beam_on.clone(),
+            beam_off: process.beam_off.clone(),
+            pierce_dwell_s: process.pierce_dwell_s,
+            pierce_standoff_mm: process.pierce_standoff,
+            // A cut: a stretch of cutting blocks after a rapid (or at the start).
+            cuts: motions
+                .iter()
+                .map(|m| {
+                    let b = m.blocks();
+                    (0..b.len())
+                        .filter(|&i| !b[i].rapid && (i == 0 || b[i - 1].rapid))
+                        .count()
+                })
+                .sum(),
+            files: program_names(programs.len()),
         },
-        "compensation": crate::cuts::compensation_json(file, kerf.as_ref(), &compensated),
-        "technology": technology_json(o.technology.as_ref(), &small_ids, o.dialect.commands_power()),
-        "micro_joints": o.micro_joints.map(|(length, spacing)| json!({
-            "length_mm": length,
-            "spacing_mm": spacing,
-            "paths": joints_report,
-            "left_out": joint_warnings,
-        })),
-        "head": crate::head::head_json(o.cut_clearance_mm, machine, head_tip_zone, head_report),
-        "discretize": {
-            "curves": file.curves.len(),
-            "segments": segments,
-            "n_star": nstar,
-            "max_chord_error": tp.paths.iter().map(|p| p.max_chord_error).fold(0.0, f64::max),
-            "c0_breaks": discs.iter().map(|d| d.c0_breaks().len()).sum::<usize>(),
+        compensation: crate::cuts::compensation_report(file, kerf.as_ref(), &compensated),
+        technology: technology_report(
+            o.technology.as_ref(),
+            &small_ids,
+            o.dialect.commands_power(),
+        ),
+        micro_joints: o
+            .micro_joints
+            .map(|(length_mm, spacing_mm)| MicroJointsReport {
+                length_mm,
+                spacing_mm,
+                paths: joints_report,
+                left_out: joint_warnings,
+            }),
+        head: crate::head::head_report(o.cut_clearance_mm, machine, head_tip_zone, head_report),
+        discretize: DiscretizeReport {
+            curves: file.curves.len(),
+            segments,
+            n_star: nstar,
+            max_chord_error: tp
+                .paths
+                .iter()
+                .map(|p| p.max_chord_error)
+                .fold(0.0, f64::max),
+            c0_breaks: discs.iter().map(|d| d.c0_breaks().len()).sum(),
         },
-        "normals": {
-            "points": oriented.iter().map(|o| o.points().len()).sum::<usize>(),
-            "inserted": oriented.iter().map(|o| o.inserted).sum::<usize>(),
-            "max_surface_distance": oriented.iter().map(|o| o.max_surface_distance).fold(0.0, f64::max),
-            "jumps": oriented.iter().map(|o| o.jumps.len()).sum::<usize>(),
-            "curves_without_surface": file.curves.iter().filter(|c| c.surface.is_none()).count(),
+        normals: NormalsReport {
+            points: oriented.iter().map(|o| o.points().len()).sum(),
+            inserted: oriented.iter().map(|o| o.inserted).sum(),
+            max_surface_distance: oriented
+                .iter()
+                .map(|o| o.max_surface_distance)
+                .fold(0.0, f64::max),
+            jumps: oriented.iter().map(|o| o.jumps.len()).sum(),
+            curves_without_surface: file.curves.iter().filter(|c| c.surface.is_none()).count(),
         },
-        "kinematics": {
-            "poses": solved.iter().map(|s| s.poses.len()).sum::<usize>(),
-            "inserted": solved.iter().map(|s| s.inserted).sum::<usize>(),
-            "max_rotary_step_between_cutting_points": solved.iter().map(|s| s.max_rotary_step_between_cutting_points).fold(0.0, f64::max),
-            "max_linearization_error": solved.iter().map(|s| s.max_linearization_error).fold(0.0, f64::max),
-            "pole_points": solved.iter().map(|s| s.pole_points).sum::<usize>(),
-            "pole_tip_error": solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
-            "tilt": tilt_report(&solved, popts.tilt_tolerance_deg),
+        kinematics: KinematicsReport {
+            poses: solved.iter().map(|s| s.poses.len()).sum(),
+            inserted: solved.iter().map(|s| s.inserted).sum(),
+            max_rotary_step_between_cutting_points: solved
+                .iter()
+                .map(|s| s.max_rotary_step_between_cutting_points)
+                .fold(0.0, f64::max),
+            max_linearization_error: solved
+                .iter()
+                .map(|s| s.max_linearization_error)
+                .fold(0.0, f64::max),
+            pole_points: solved.iter().map(|s| s.pole_points).sum(),
+            pole_tip_error: solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
+            tilt: tilt_report(&solved, popts.tilt_tolerance_deg),
         },
-        "placement": placement_json,
-        "process": crate::cuts::report(file, &cuts, &cut_plans),
-        "traverses": crate::cuts::traverse_report(topts.as_ref(), &rapid_report, blocked_report, own_report, searched_report),
-        "interpolation": {
-            "feed_mm_per_min": o.feed_mm_per_min,
-            "cycle_s": o.cycle_s,
+        placement: placement_report,
+        process: crate::cuts::report(file, &cuts, &cut_plans),
+        traverses: crate::cuts::traverse_report(
+            topts.as_ref(),
+            &rapid_report,
+            blocked_report,
+            own_report,
+            searched_report,
+        ),
+        interpolation: InterpolationReport {
+            feed_mm_per_min: o.feed_mm_per_min,
+            cycle_s: o.cycle_s,
             // The set-points follow a smooth spline through the blocks' nodes: a proven bound
             // of its distance from the blocks, and the set-points' own budget (the blocks'
             // chord and fit terms, the spline, the interpolation chord, the blend; the
             // linearization does not apply: the set-points put the tip on the path).
-            "spline_deviation_bound_mm": spline_bound,
-            "setpoints_budget_mm": setpoints_budget,
-            "lines": counts.lines,
-            "arcs": counts.arcs,
-            "turns": counts.turns,
-            "cycles": cycles,
-            "duration_s": duration,
-            "time_share_at_feed": if duration > 0.0 {
-                motions.iter().map(|m| m.time_share_at_feed() * m.duration()).sum::<f64>() / duration
+            spline_deviation_bound_mm: spline_bound,
+            setpoints_budget_mm: setpoints_budget,
+            lines: counts.lines,
+            arcs: counts.arcs,
+            turns: counts.turns,
+            cycles,
+            duration_s: duration,
+            time_share_at_feed: if duration > 0.0 {
+                motions
+                    .iter()
+                    .map(|m| m.time_share_at_feed() * m.duration())
+                    .sum::<f64>()
+                    / duration
             } else {
                 0.0
             },
-            "paths": motions
+            paths: motions
                 .iter()
                 .zip(&setup_ids)
-                .flat_map(|(m, ids)| {
-                    crate::motion::path_report(m, ids)
-                        .as_array()
-                        .cloned()
-                        .unwrap_or_default()
-                })
-                .collect::<Vec<_>>(),
+                .flat_map(|(m, ids)| crate::motion::path_report(m, ids))
+                .collect(),
         },
-        "seconds": start.elapsed().as_secs_f64(),
-        "timings": timings.to_json(),
-    });
+        seconds: start.elapsed().as_secs_f64(),
+        timings,
+    };
     let programs = SetupProgram::numbered(motions, programs, setup_ids);
     Ok(Output {
         discretizations: discs,
@@ -952,7 +996,6 @@ fn run_placed(
         plot_svg: svg,
         scene: view,
         warnings,
-        timings,
         model,
         cycle_s: o.cycle_s,
     })
@@ -1000,36 +1043,34 @@ fn technology_header(t: Option<&kerf_kinematics::TechnologyEntry>) -> Vec<String
 
 /// The report's `technology` object: the entry used and the ids of the cuts its small-hole
 /// rule slowed, or null.
-fn technology_json(
+fn technology_report(
     t: Option<&kerf_kinematics::TechnologyEntry>,
     small_holes: &[&str],
     commands_power: bool,
-) -> serde_json::Value {
-    let Some(t) = t else {
-        return serde_json::Value::Null;
-    };
+) -> Option<TechnologyReport> {
+    let t = t?;
     let (power, holes) = if commands_power {
         ("its power is commanded following the tip speed (its power at its feed, down to power_min_percent), its pierce power at the pierce", "feed and power factors")
     } else {
         ("its power is not commanded (the dialect has no power word that acts with the motion: the program's header says why)", "feed factor")
     };
-    json!({
-        "entry": t.label(),
-        "material": t.material,
-        "thickness_mm": t.thickness_mm,
-        "gas": t.gas,
-        "gas_pressure_bar": t.gas_pressure_bar,
-        "feed_mm_per_min": t.feed_mm_per_min,
-        "power_percent": t.power_percent,
-        "focus_mm": t.focus_mm,
-        "standoff_mm": t.standoff_mm,
-        "kerf_width_mm": t.kerf_width_mm,
-        "pierce": t.pierce.map(|p| json!({ "time_s": p.time_s, "power_percent": p.power_percent, "height_mm": p.height_mm })),
-        "small_hole": t.small_hole.map(|h| json!({ "max_diameter_mm": h.max_diameter_mm, "feed_factor": h.feed_factor, "power_factor": h.power_factor })),
-        "corner": t.corner.map(|c| json!({ "min_turn_deg": c.min_turn_deg, "length_mm": c.length_mm, "feed_factor": c.feed_factor })),
-        "power_min_percent": t.power_min(),
-        "small_holes": small_holes,
-        "note": format!("the entry's feed is the run's unless the run sets its own feed_mm_per_min; its pierce, standoff and kerf width replace the machine file's; {power}; holes within the small-hole rule run at its {holes}, corners within its corner rule at its feed factor; gas and focus are stated, not commanded"),
+    Some(TechnologyReport {
+        entry: t.label(),
+        material: t.material.clone(),
+        thickness_mm: t.thickness_mm,
+        gas: t.gas.clone(),
+        gas_pressure_bar: t.gas_pressure_bar,
+        feed_mm_per_min: t.feed_mm_per_min,
+        power_percent: t.power_percent,
+        focus_mm: t.focus_mm,
+        standoff_mm: t.standoff_mm,
+        kerf_width_mm: t.kerf_width_mm,
+        pierce: t.pierce,
+        small_hole: t.small_hole,
+        corner: t.corner,
+        power_min_percent: t.power_min(),
+        small_holes: small_holes.iter().map(|s| s.to_string()).collect(),
+        note: format!("the entry's feed is the run's unless the run sets its own feed_mm_per_min; its pierce, standoff and kerf width replace the machine file's; {power}; holes within the small-hole rule run at its {holes}, corners within its corner rule at its feed factor; gas and focus are stated, not commanded"),
     })
 }
 
@@ -1045,9 +1086,9 @@ const HEAD_CHECK_MIN_TILT_DEG: f64 = 10.0;
 /// angle between a tool axis and its surface normal with the path and the place, and the
 /// rotary travel `sum |d tilt| + |d C|` (degrees) of the exact normals and of the chosen axes,
 /// in all and per path. `null` without a tolerance.
-fn tilt_report(solved: &[kerf_kinematics::SolvedPath], tolerance_deg: f64) -> serde_json::Value {
+fn tilt_report(solved: &[kerf_kinematics::SolvedPath], tolerance_deg: f64) -> Option<TiltTotals> {
     if tolerance_deg <= 0.0 {
-        return serde_json::Value::Null;
+        return None;
     }
     let mut worst: Option<(f64, &str, [f64; 3])> = None;
     let mut paths = Vec::new();
@@ -1068,25 +1109,25 @@ fn tilt_report(solved: &[kerf_kinematics::SolvedPath], tolerance_deg: f64) -> se
         }
         exact += t.rotary_travel_exact_deg;
         chosen += t.rotary_travel_deg;
-        paths.push(json!({
-            "id": s.id,
-            "max_deg": t.max_deviation_deg,
-            "at_mm": at,
-            "rotary_travel_exact_deg": t.rotary_travel_exact_deg,
-            "rotary_travel_deg": t.rotary_travel_deg,
-            "strings_over_budget": t.strings_over_budget,
-        }));
+        paths.push(TiltPath {
+            id: s.id.clone(),
+            max_deg: t.max_deviation_deg,
+            at_mm: at,
+            rotary_travel_exact_deg: t.rotary_travel_exact_deg,
+            rotary_travel_deg: t.rotary_travel_deg,
+            strings_over_budget: t.strings_over_budget,
+        });
     }
     let (max_deg, max_path, max_at) = worst.map_or((0.0, None, None), |(d, id, at)| {
         (d, Some(id.to_owned()), Some(at))
     });
-    json!({
-        "tolerance_deg": tolerance_deg,
-        "max_deg": max_deg,
-        "max_path": max_path,
-        "max_at_mm": max_at,
-        "rotary_travel_exact_deg": exact,
-        "rotary_travel_deg": chosen,
-        "paths": paths,
+    Some(TiltTotals {
+        tolerance_deg,
+        max_deg,
+        max_path,
+        max_at_mm: max_at,
+        rotary_travel_exact_deg: exact,
+        rotary_travel_deg: chosen,
+        paths,
     })
 }

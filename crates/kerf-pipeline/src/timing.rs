@@ -8,7 +8,7 @@
 use std::time::{Duration, Instant};
 
 /// One stage's time.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct StageTime {
     /// The stage (`read`, `discretize`, `normals`, `sides`, `place`, `cuts`, `kinematics`,
@@ -70,20 +70,6 @@ impl Timings {
         self.stages.iter().map(|s| s.cpu_s).sum()
     }
 
-    /// `report.json`'s `timings`: the stages in order with their wall and CPU seconds, and the
-    /// totals.
-    pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
-            "wall_s": self.wall_s(),
-            "cpu_s": self.cpu_s(),
-            "stages": self.stages.iter().map(|s| serde_json::json!({
-                "stage": s.stage,
-                "wall_s": s.wall_s,
-                "cpu_s": s.cpu_s,
-            })).collect::<Vec<_>>(),
-        })
-    }
-
     /// The stages that took the most CPU, largest first, as `plan 1.20 s, traverses 0.80 s`
     /// (at most `n`; stages under 5 % of the total left out).
     pub fn summary(&self, n: usize) -> String {
@@ -99,6 +85,19 @@ impl Timings {
             .map(|s| format!("{} {:.2} s", s.stage, s.cpu_s))
             .collect::<Vec<_>>()
             .join(", ")
+    }
+}
+
+/// `report.json`'s `timings`: `wall_s` and `cpu_s` (the totals) and `stages`, in the order
+/// they ran, each `{stage, wall_s, cpu_s}`.
+impl serde::Serialize for Timings {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut t = serializer.serialize_struct("Timings", 3)?;
+        t.serialize_field("wall_s", &self.wall_s())?;
+        t.serialize_field("cpu_s", &self.cpu_s())?;
+        t.serialize_field("stages", &self.stages)?;
+        t.end()
     }
 }
 

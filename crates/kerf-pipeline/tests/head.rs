@@ -25,20 +25,20 @@ fn job(clearance: f64, accept: bool) -> Result<kerf_pipeline::Output, kerf_pipel
 #[test]
 fn the_head_clears_the_wall_at_one_millimetre() {
     let out = job(1.0, false).expect("run");
-    let head = &out.report["head"];
-    assert_eq!(head["checked"], true);
-    for p in head["paths"].as_array().expect("paths") {
-        let d = p["min_distance_mm"].as_f64().expect("bound");
+    let head = &out.report.head;
+    assert!(head.checked);
+    for p in head.paths.as_ref().expect("paths") {
+        let d = p.min_distance_mm.expect("bound");
         // Proven at least the clearance less the check's resolution, and never above the
         // exact 2 mm the body passes from the wall.
         assert!(
             d >= 1.0 - kerf_process::RESOLUTION_MM - kerf_process::SAMPLE_STEP_MM / 2.0,
-            "{p}"
+            "{p:?}"
         );
-        if p["path"] == "hole-near-wall" {
-            assert!(d <= 2.0 + 1e-9, "{p}");
+        if p.path == "hole-near-wall" {
+            assert!(d <= 2.0 + 1e-9, "{p:?}");
         }
-        assert!(p["close"].as_array().expect("close").is_empty(), "{p}");
+        assert!(p.close.is_empty(), "{p:?}");
     }
 }
 
@@ -60,20 +60,20 @@ fn the_wall_is_named_when_the_clearance_is_three_millimetres() {
         "{:?}",
         out.warnings
     );
-    let paths = out.report["head"]["paths"].as_array().expect("paths");
+    let paths = out.report.head.paths.as_ref().expect("paths");
     let near = paths
         .iter()
-        .find(|p| p["path"] == "hole-near-wall")
+        .find(|p| p.path == "hole-near-wall")
         .expect("near");
-    let close = near["close"].as_array().expect("close");
-    assert_eq!(close.len(), 1, "{near}");
-    assert_eq!(close[0]["surface"], "wall");
+    let close = &near.close;
+    assert_eq!(close.len(), 1, "{near:?}");
+    assert_eq!(close[0].surface.as_deref(), Some("wall"));
     // The exact stretch within 3 mm: 5 cos(theta) > 4, an arc of 2 x 0.6435 x 5 = 6.4 mm;
     // the reported one is witnessed inside it.
-    let len = close[0]["length_mm"].as_f64().expect("length");
-    assert!(len > 3.0 && len <= 6.44 + 1.0, "{near}");
-    let far = paths.iter().find(|p| p["path"] == "hole-far").expect("far");
-    assert!(far["close"].as_array().expect("close").is_empty(), "{far}");
+    let len = close[0].length_mm;
+    assert!(len > 3.0 && len <= 6.44 + 1.0, "{near:?}");
+    let far = paths.iter().find(|p| p.path == "hole-far").expect("far");
+    assert!(far.close.is_empty(), "{far:?}");
 }
 
 /// An exact surface of the fixtures: a rectangle (origin, two edges) or the quarter cylinder
@@ -225,17 +225,18 @@ fn tilted_fixture(
     let e = run(0.0).expect_err("upright: refused").to_string();
     assert!(e.contains(id) && e.contains("would clear it"), "{e}");
     let out = run(10.0).expect("tilted to clear");
-    let head = &out.report["head"];
-    let zone = head["tip_zone_mm"].as_f64().expect("zone");
-    let entry = head["paths"]
-        .as_array()
+    let head = &out.report.head;
+    let zone = head.tip_zone_mm.flatten().expect("zone");
+    let entry = head
+        .paths
+        .as_ref()
         .expect("paths")
         .iter()
-        .find(|p| p["path"] == id)
+        .find(|p| p.path == id)
         .expect("path")
         .clone();
-    let tilt = entry["tilted"]["max_tilt_deg"].as_f64().expect("tilt");
-    assert!(tilt > 0.5 && tilt <= 10.0, "{entry}");
+    let tilt = entry.tilted.max_tilt_deg;
+    assert!(tilt > 0.5 && tilt <= 10.0, "{entry:?}");
     let surfaces = exact_surfaces(name);
     let poses = written_poses(&curves, &out, id);
     let d = sampled_distance(&poses, zone, &surfaces);

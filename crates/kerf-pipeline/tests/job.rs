@@ -80,8 +80,7 @@ fn a_job_from_files_gives_every_stage_and_its_toolpath_passes_the_independent_ch
         }
     }
     assert_eq!(
-        out.report["discretize"]["curves"].as_u64(),
-        Some(n as u64),
+        out.report.discretize.curves, n,
         "the report counts the curves"
     );
 }

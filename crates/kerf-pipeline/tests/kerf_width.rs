@@ -102,12 +102,12 @@ fn check(name: &str, place: PlaceMode, slack: f64) -> Vec<(String, &'static str)
     let r = 0.1;
     let (file, out) = run(name, Some(0.2), place);
     let mut sides = Vec::new();
-    let report = &out.report["compensation"];
-    assert_eq!(report["kerf_width_mm"], 0.2, "{name}: the width used");
-    for path in report["paths"].as_array().expect("paths") {
-        let id = path["id"].as_str().expect("id");
-        if path.get("side").is_none() {
-            let why = path["reason"].as_str().expect("reason");
+    let report = &out.report.compensation;
+    assert_eq!(report.kerf_width_mm, Some(0.2), "{name}: the width used");
+    for path in report.paths.as_ref().expect("paths") {
+        let id = path.id.as_str();
+        if path.side.is_none() {
+            let why = path.reason.as_deref().expect("reason");
             assert!(
                 why.contains("scrap side is not known"),
                 "{name} {id}: {why}"
@@ -118,7 +118,7 @@ fn check(name: &str, place: PlaceMode, slack: f64) -> Vec<(String, &'static str)
         let poses = cut_poses(&out, &file, id);
         let cut: Vec<Point3<f64>> = poses.iter().map(|p| p.0).collect();
         // A cut-back inside corner keeps the beam farther off: r plus the material left.
-        let most = r + slack.max(path["max_corner_material_mm"].as_f64().expect("material") + 1e-9);
+        let most = r + slack.max(path.max_corner_material_mm.expect("material") + 1e-9);
         for p in &cut {
             let d = distance(p, &contour);
             assert!(
@@ -181,7 +181,7 @@ fn sheet_metal_holes_shrink_by_half_the_kerf_and_the_outline_grows() {
             }
         }
     }
-    assert!(plain.report["compensation"]["kerf_width_mm"].is_null());
+    assert!(plain.report.compensation.kerf_width_mm.is_none());
     let header = &out.programs[0].text;
     assert!(
         header.contains(
@@ -227,11 +227,14 @@ fn the_real_parts_run_with_a_kerf_and_say_which_contours_were_not_compensated() 
         let sides = check(name, PlaceMode::Auto, TOL + 2e-3);
         assert!(!sides.is_empty(), "{name}: some closed contours");
         let (_, out) = run(name, Some(0.2), PlaceMode::Auto);
-        let open = out.report["compensation"]["paths"]
-            .as_array()
+        let open = out
+            .report
+            .compensation
+            .paths
+            .as_ref()
             .expect("paths")
             .iter()
-            .filter(|p| p.get("reason").is_some())
+            .filter(|p| p.reason.is_some())
             .count();
         if open > 0 {
             assert!(
@@ -253,14 +256,14 @@ fn the_machine_files_kerf_width_is_used_and_the_runs_wins() {
     let out = Job::new(curves.clone(), machine.clone())
         .run()
         .expect("run");
-    let c = &out.report["compensation"];
-    assert_eq!(c["kerf_width_mm"], 0.3);
-    assert!(c["source"].as_str().expect("source").contains("machine"));
+    let c = &out.report.compensation;
+    assert_eq!(c.kerf_width_mm, Some(0.3));
+    assert!(c.source.as_deref().expect("source").contains("machine"));
     let out = Job::new(curves, machine)
         .with_options(JobOptions::default().with_kerf_width_mm(Some(0.1)))
         .run()
         .expect("run");
-    assert_eq!(out.report["compensation"]["kerf_width_mm"], 0.1);
+    assert_eq!(out.report.compensation.kerf_width_mm, Some(0.1));
     let e = JobOptions::default()
         .with_kerf_width_mm(Some(-1.0))
         .validate()
@@ -289,16 +292,18 @@ fn in_control(
 fn the_controller_compensates_the_contours_themselves_with_g41_and_g42() {
     let (file, out) =
         in_control("sheet_metal_holes.json", kerf_interp::Dialect::Linuxcnc).expect("run");
-    let c = &out.report["compensation"];
-    assert_eq!(c["mode"], "controller", "{c}");
+    let c = &out.report.compensation;
+    assert_eq!(c.mode.as_deref(), Some("controller"), "{c:?}");
     // The sides the computer's offset takes (checked by the geometry above).
     let (_, computer) = run("sheet_metal_holes.json", Some(0.2), PlaceMode::AsModelled);
-    let sides = |o: &Output| -> Vec<(String, String)> {
-        o.report["compensation"]["paths"]
-            .as_array()
+    let sides = |o: &Output| -> Vec<(String, Option<String>)> {
+        o.report
+            .compensation
+            .paths
+            .as_ref()
             .expect("paths")
             .iter()
-            .map(|p| (p["id"].to_string(), p["side"].to_string()))
+            .map(|p| (p.id.clone(), p.side.clone()))
             .collect()
     };
     assert_eq!(sides(&out), sides(&computer), "the same sides");
@@ -326,7 +331,10 @@ fn the_controller_compensates_the_contours_themselves_with_g41_and_g42() {
     assert_eq!(on.len(), 8, "eight cuts");
     let left = lines.iter().filter(|l| l.starts_with("G41.1 D0.2")).count();
     let right = lines.iter().filter(|l| l.starts_with("G42.1 D0.2")).count();
-    let want_left = sides(&out).iter().filter(|s| s.1 == "\"left\"").count();
+    let want_left = sides(&out)
+        .iter()
+        .filter(|s| s.1.as_deref() == Some("left"))
+        .count();
     assert_eq!(
         (left, right),
         (want_left, 8 - want_left),
@@ -475,9 +483,9 @@ fn a_hole_with_roundings_tighter_than_the_kerf_is_cut_back_and_checked() {
         .with_options(JobOptions::default().with_kerf_width_mm(Some(0.2)))
         .run()
         .expect("run");
-    let p = &out.report["compensation"]["paths"][0];
-    assert_eq!(p["inside_corners"], 4, "{p}");
-    assert_eq!(p["side"], "right", "{p}");
+    let p = &out.report.compensation.paths.as_ref().expect("paths")[0];
+    assert_eq!(p.inside_corners, Some(4), "{p:?}");
+    assert_eq!(p.side.as_deref(), Some("right"), "{p:?}");
     let raw = kerf_check::RawToolpath::from(&out.toolpath);
     let report = kerf_check::check(&curves.curves, &raw, &kerf_check::CheckOptions::default());
     assert!(report.passed(), "{:?}", report.violations);

@@ -73,15 +73,12 @@ fn a_hole_edge_is_cut_from_the_other_side_and_its_lead_in_stays_in_the_scrap() {
     for side in [ScrapSide::Left, ScrapSide::Right] {
         let out = run(side, true);
         assert_eq!(out.placement.plan.flipped, [true], "{side:?}: turned");
-        let sides = &out.report["placement"]["sides"];
-        assert_eq!(sides[0]["id"], "edge", "{sides}");
-        assert_eq!(sides[0]["side"], "other", "{sides}");
+        let sides = &out.report.placement.sides;
+        assert_eq!(sides[0].id, "edge", "{sides:?}");
+        assert_eq!(sides[0].side, "other", "{sides:?}");
         assert!(
-            sides[0]["reason"]
-                .as_str()
-                .unwrap()
-                .contains("from the given side at"),
-            "{sides}"
+            sides[0].reason.contains("from the given side at"),
+            "{sides:?}"
         );
         // Closed form: the edge runs counter-clockwise about +z, the wall's normal n points
         // to the axis, so n x t = -z: the left (scrap) side is below the sheet (z < 0), the
@@ -178,11 +175,11 @@ fn a_contour_under_a_roof_keeps_its_side_when_the_head_cannot_reach_the_other() 
         .run()
         .expect("run");
     assert_eq!(out.placement.plan.flipped, [false, false]);
-    let sides = out.report["placement"]["sides"].as_array().expect("sides");
+    let sides = &out.report.placement.sides;
     assert_eq!(sides.len(), 1, "{sides:?}");
-    assert_eq!(sides[0]["id"], "under");
-    assert_eq!(sides[0]["side"], "given");
-    let why = sides[0]["reason"].as_str().unwrap();
+    assert_eq!(sides[0].id, "under");
+    assert_eq!(sides[0].side, "given");
+    let why = &sides[0].reason;
     assert!(why.contains("cannot reach the other side"), "{why}");
     // The head lines (part coordinates): every point's line up meets the roof.
     let h = out.placement.head_lines[0];
@@ -209,7 +206,7 @@ fn a_hole_wall_without_a_scrap_key_is_cut_along_the_holes_axis() {
             .expect("run");
         let pl = out.placement.placement_of(0);
         let r = pl.rotation().inverse();
-        let walls = out.report["placement"]["walls"].as_array().expect("walls");
+        let walls = out.report.placement.walls.as_ref().expect("walls");
         for q in &out.axes.paths[0].poses {
             let axis = r * Vector3::new(q[3], q[4], q[5]);
             if max_wall > 0.0 {
@@ -224,8 +221,8 @@ fn a_hole_wall_without_a_scrap_key_is_cut_along_the_holes_axis() {
             continue;
         }
         assert_eq!(walls.len(), 1, "{walls:?}");
-        assert_eq!(walls[0]["id"], "edge");
-        assert!((walls[0]["width_mm"].as_f64().unwrap() - 2.0).abs() < 1e-9);
+        assert_eq!(walls[0].id, "edge");
+        assert!((walls[0].width_mm - 2.0).abs() < 1e-9);
         let lead = lead_in(&out);
         assert!(lead.len() > 2, "{} lead-in points", lead.len());
         for (p, _) in &lead[..lead.len() - 1] {

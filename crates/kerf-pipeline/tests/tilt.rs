@@ -120,26 +120,20 @@ fn near_the_pole_c_stands_still_and_the_cut_is_faster() {
         duration(&exact)
     );
     assert!(e.tilt_max_deg.is_none(), "no tolerance, no tilt reported");
-    assert!(exact.report["kinematics"]["tilt"].is_null());
+    assert!(exact.report.kinematics.tilt.is_none());
     // The report: the largest deviation, where, and the rotary travel it saved.
-    let t = &cone.report["kinematics"]["tilt"];
-    assert_eq!(t["tolerance_deg"], 1.0);
-    let max = t["max_deg"].as_f64().expect("max_deg");
-    assert!(max > 0.0 && max <= 1.0, "{t}");
-    let at = t["max_at_mm"].as_array().expect("where");
-    let r = (0..3)
-        .map(|i| at[i].as_f64().expect("mm").powi(2))
-        .sum::<f64>()
-        .sqrt();
+    let t = cone.report.kinematics.tilt.as_ref().expect("a tilt report");
+    assert_eq!(t.tolerance_deg, 1.0);
+    let max = t.max_deg;
+    assert!(max > 0.0 && max <= 1.0, "{t:?}");
+    let at = t.max_at_mm.expect("where");
+    let r = at.iter().map(|x| x * x).sum::<f64>().sqrt();
     assert!(
         (r - RADIUS).abs() < 0.1,
-        "the place is a tip on the sphere: {t}"
+        "the place is a tip on the sphere: {t:?}"
     );
-    let (before, after) = (
-        t["rotary_travel_exact_deg"].as_f64().expect("exact"),
-        t["rotary_travel_deg"].as_f64().expect("chosen"),
-    );
-    assert!(after < before - 300.0, "{t}");
+    let (before, after) = (t.rotary_travel_exact_deg, t.rotary_travel_deg);
+    assert!(after < before - 300.0, "{t:?}");
 }
 
 /// The shipped propeller's blade edge `prop-propeller-e40` on a fork head with a B tilt, a

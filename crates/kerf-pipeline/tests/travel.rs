@@ -68,9 +68,9 @@ fn a_part_filling_the_travel_to_a_millimetre_gets_a_program_within_it() {
     let machine = machine_with(limits, None);
     let out = job(machine.clone()).run().expect("placed and planned");
     assert_setpoints_within_limits("tight travel", &machine, &out, 0.001);
-    let p = &out.report["placement"];
-    assert_eq!(p["margin_mm"], 11.0, "{p}");
-    assert_eq!(p["searches"], 1, "{p}");
+    let p = &out.report.placement;
+    assert_eq!(p.margin_mm, Some(11.0), "{p:?}");
+    assert_eq!(p.searches, Some(1), "{p:?}");
 }
 
 #[test]

@@ -22,8 +22,7 @@ use nalgebra::Point3;
 use crate::error::Error;
 use crate::place::Placed;
 use crate::report::{
-    CompensationPath, CompensationReport, OwnSurfaces, ProcessReport, SearchedTraverse,
-    ShortenedLead, TraversesReport, UncheckedTraverse, WallReport,
+    CompensationPath, CompensationReport, ProcessReport, ShortenedLead, WallReport,
 };
 
 /// A point function of a cut path (part coordinates).
@@ -654,86 +653,6 @@ pub(crate) fn report(file: &CurvesFile, cuts: &[CutPath], plans: &SetupPlans) ->
         lead_ins_shortened: shortened,
         pierce_on_contour: on_contour,
         traverse_note: "straight distances from each cut's exit to the next pierce point, in part coordinates, within each set-up; the program adds the retract and approach along the tool axes".into(),
-    }
-}
-
-/// The `traverses` object of `report.json`: how the traverses between cuts were checked
-/// against the part and what they came to.
-pub(crate) fn traverse_report(
-    opts: Option<&kerf_process::TraverseOptions>,
-    rapids: &[(
-        kerf_process::Traverse,
-        kerf_process::RapidMoves,
-        Vec<String>,
-    )],
-    blocked: Vec<UncheckedTraverse>,
-    own: Vec<OwnSurfaces>,
-    searched: Vec<SearchedTraverse>,
-) -> TraversesReport {
-    let mut unchecked: Vec<String> = Vec::new();
-    for (_, _, absent) in rapids {
-        for id in absent {
-            if !unchecked.contains(id) {
-                unchecked.push(id.clone());
-            }
-        }
-    }
-    // How many traverses took each route.
-    let routes: std::collections::BTreeMap<String, usize> = [
-        kerf_process::Route::Straight,
-        kerf_process::Route::Lifted,
-        kerf_process::Route::SafePlane,
-        kerf_process::Route::Searched,
-    ]
-    .iter()
-    .map(|k| {
-        let n = rapids.iter().filter(|(t, _, _)| t.route == *k).count();
-        (k.name().to_string(), n)
-    })
-    .collect();
-    let Some(o) = opts else {
-        return TraversesReport {
-            checked: false,
-            clearance_mm: None,
-            retract_mm: None,
-            nozzle_mm: None,
-            count: None,
-            checked_count: None,
-            unchecked: None,
-            lifted: None,
-            routes: None,
-            searched: None,
-            split_moves: None,
-            length_mm: None,
-            min_distance_mm: None,
-            surfaces_in_the_cuts_way: None,
-            surfaces_note: None,
-            own_surface_over_the_head: None,
-            unchecked_note: None,
-            searched_note: None,
-            note: Some("no traverse options (a clearance of 0): retract along the tool axis, one straight move, approach; not checked against the part".into()),
-        };
-    };
-    TraversesReport {
-        checked: true,
-        clearance_mm: Some(o.clearance_mm),
-        retract_mm: Some(o.retract_mm),
-        nozzle_mm: Some(o.nozzle_mm),
-        count: Some(rapids.len() + blocked.len()),
-        checked_count: Some(rapids.len()),
-        unchecked: Some(blocked),
-        lifted: Some(rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count()),
-        routes: Some(routes),
-        searched: Some(searched),
-        split_moves: Some(rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>()),
-        length_mm: Some(rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>()),
-        min_distance_mm: Some(rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min)),
-        surfaces_in_the_cuts_way: Some(unchecked),
-        surfaces_note: Some("surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)".into()),
-        own_surface_over_the_head: Some(own),
-        unchecked_note: Some("where no route keeps the clearance (unchecked, with the reason and the surfaces the routes were checked without), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning; a reason that starts 'proven' shows that no route can exist (the retract or approach line itself is blocked)".into()),
-        searched_note: Some("searched: the gaps where no route shape (straight, lifted, over the safe plane) cleared and a search around the part found a path, the head turned to one tool axis for the travel; lifted counts every route that is not straight".into()),
-        note: None,
     }
 }
 

@@ -48,6 +48,7 @@ pub mod ranges;
 mod report;
 mod run;
 mod timing;
+mod traverses;
 mod view;
 
 pub use certify::CertifiedToolpath;
@@ -60,17 +61,17 @@ pub use job::{
     is_iges, Job, JobOptions, MissingSurface, OrientOptions, DEFAULT_MAX_TOTAL_POINTS_RUN,
     DEFAULT_TILT_TOLERANCE_DEG,
 };
-pub use motion::{fit_options, path_report, plan_program, MotionInput, MotionOptions, Program};
+pub use motion::{fit_options, plan_program, MotionInput, MotionOptions, Program};
 pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};
 pub use place::{place, PlaceMode, Placed, AUTO_CLEARANCE_MM};
 pub use post::{post_toolpath, toolpath_poses, MissingNormals, Posted};
 pub use ranges::OptionRange;
 pub use report::{
-    CompensationPath, CompensationReport, DiscretizeReport, HeadPath, HeadReport, HeadStretch,
-    HeadTilt, InterpolationReport, KinematicsReport, MicroJoint, MicroJointPath, MicroJointsReport,
-    NormalsReport, OwnSurfaces, PathMotion, PlacementReport, ProcessReport, ProgramReport, Report,
-    SearchedTraverse, SetupReport, ShortenedLead, SideReport, TechnologyReport, TiltPath,
-    TiltTotals, TraversesReport, UncheckedTraverse, WallReport,
+    path_report, CompensationPath, CompensationReport, DiscretizeReport, HeadPath, HeadReport,
+    HeadStretch, HeadTilt, InterpolationReport, KinematicsReport, MicroJoint, MicroJointPath,
+    MicroJointsReport, NormalsReport, OwnSurfaces, PathMotion, PlacementReport, ProcessReport,
+    ProgramReport, Report, SearchedTraverse, SetupReport, ShortenedLead, SideReport,
+    TechnologyReport, TiltPath, TiltTotals, TraversesReport, UncheckedTraverse, WallReport,
 };
 pub use run::PLACEMENT_RETRIES;
 pub use timing::{process_cpu_time, Lap, StageTime, Timings};

@@ -13,7 +13,6 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::report::PathMotion;
 use kerf_format::toolpath::{self, ToolpathFile};
 use kerf_interp::{
     gcode_motion, stations_from_axes, stations_from_solved, write_csv_to, AxisModel, ChordTerm,
@@ -399,27 +398,6 @@ impl Program {
     pub fn options(&self) -> &MotionOptions {
         &self.options
     }
-}
-
-/// The planned time of every path and the share at the programmed feed, for the summaries
-/// (`ids[k]` names the motion's path `k`; `path k` where it has none).
-pub fn path_report(motion: &Motion, ids: &[String]) -> Vec<PathMotion> {
-    let share = |part: f64, whole: f64| if whole > 0.0 { part / whole } else { 0.0 };
-    motion
-        .path_stats()
-        .iter()
-        .map(|p| PathMotion {
-            id: ids
-                .get(p.path)
-                .cloned()
-                .unwrap_or_else(|| format!("path {}", p.path)),
-            duration_s: p.duration,
-            cutting_time_s: p.cutting_time,
-            cutting_length_mm: p.cutting_length,
-            time_share_at_feed: share(p.time_at_feed, p.cutting_time),
-            length_share_at_feed: share(p.length_at_feed, p.cutting_length),
-        })
-        .collect()
 }
 
 /// The G-code options of a program for `dialect`: the budget terms, the machine's process

@@ -10,6 +10,12 @@
 
 use std::collections::BTreeMap;
 
+use kerf_discretize::Discretization;
+use kerf_format::toolpath::ToolpathFile;
+use kerf_format::CurvesFile;
+use kerf_interp::{Dialect, GcodeOptions, Motion, ProcessCodes};
+use kerf_kinematics::SolvedPath;
+use kerf_normals::Oriented;
 use serde::Serialize;
 
 use crate::timing::Timings;
@@ -660,4 +666,189 @@ pub struct PathMotion {
     pub time_share_at_feed: f64,
     /// The share of its cutting length at the full feed.
     pub length_share_at_feed: f64,
+}
+
+/// The program's tolerance budget as its header states it (a `fit` term where arcs and merged
+/// lines are written) and its `total`.
+pub(crate) fn budget(gopts: &GcodeOptions) -> BTreeMap<String, Option<f64>> {
+    let mut budget: BTreeMap<String, Option<f64>> = gopts
+        .budget()
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
+    budget.insert("total".into(), Some(gopts.budget_total()));
+    budget
+}
+
+impl ProgramReport {
+    /// The programs of `motions` (one per set-up, written into `files`) in `dialect` with the
+    /// resolved process codes.
+    pub(crate) fn of(
+        dialect: Dialect,
+        process: &ProcessCodes,
+        motions: &[Motion],
+        files: Vec<String>,
+    ) -> Self {
+        Self {
+            dialect: dialect.name().to_string(),
+            beam_on: process.beam_on.clone(),
+            beam_off: process.beam_off.clone(),
+            pierce_dwell_s: process.pierce_dwell_s,
+            pierce_standoff_mm: process.pierce_standoff,
+            // A cut: a stretch of cutting blocks after a rapid (or at the start).
+            cuts: motions
+                .iter()
+                .map(|m| {
+                    let b = m.blocks();
+                    (0..b.len())
+                        .filter(|&i| !b[i].rapid && (i == 0 || b[i - 1].rapid))
+                        .count()
+                })
+                .sum(),
+            files,
+        }
+    }
+}
+
+impl DiscretizeReport {
+    /// The figures of the discretizations `discs` of `file`'s curves (at `tolerance_mm`) and
+    /// their toolpath.
+    pub(crate) fn of(
+        file: &CurvesFile,
+        discs: &[Discretization],
+        tp: &ToolpathFile,
+        tolerance_mm: f64,
+    ) -> Self {
+        Self {
+            curves: file.curves.len(),
+            segments: discs.iter().map(Discretization::segments).sum(),
+            // From the curvature the walk evaluated at its points.
+            n_star: discs.iter().map(|d| d.n_star(tolerance_mm)).sum(),
+            max_chord_error: tp
+                .paths
+                .iter()
+                .map(|p| p.max_chord_error)
+                .fold(0.0, f64::max),
+            c0_breaks: discs.iter().map(|d| d.c0_breaks().len()).sum(),
+        }
+    }
+}
+
+impl NormalsReport {
+    /// The figures of the oriented points of `file`'s curves.
+    pub(crate) fn of(file: &CurvesFile, oriented: &[Oriented]) -> Self {
+        Self {
+            points: oriented.iter().map(|o| o.points().len()).sum(),
+            inserted: oriented.iter().map(|o| o.inserted).sum(),
+            max_surface_distance: oriented
+                .iter()
+                .map(|o| o.max_surface_distance)
+                .fold(0.0, f64::max),
+            jumps: oriented.iter().map(|o| o.jumps.len()).sum(),
+            curves_without_surface: file.curves.iter().filter(|c| c.surface.is_none()).count(),
+        }
+    }
+}
+
+impl KinematicsReport {
+    /// The figures of the solved paths, with what the tilt tolerance did.
+    pub(crate) fn of(solved: &[SolvedPath], tilt: Option<TiltTotals>) -> Self {
+        Self {
+            poses: solved.iter().map(|s| s.poses.len()).sum(),
+            inserted: solved.iter().map(|s| s.inserted).sum(),
+            max_rotary_step_between_cutting_points: solved
+                .iter()
+                .map(|s| s.max_rotary_step_between_cutting_points)
+                .fold(0.0, f64::max),
+            max_linearization_error: solved
+                .iter()
+                .map(|s| s.max_linearization_error)
+                .fold(0.0, f64::max),
+            pole_points: solved.iter().map(|s| s.pole_points).sum(),
+            pole_tip_error: solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
+            tilt,
+        }
+    }
+}
+
+impl InterpolationReport {
+    /// The figures of the planned `motions` (one per set-up, `setup_ids[k]` naming the paths
+    /// of the k-th) at `feed_mm_per_min` and `cycle_s`, written with `gopts`.
+    pub(crate) fn of(
+        motions: &[Motion],
+        setup_ids: &[Vec<String>],
+        feed_mm_per_min: f64,
+        cycle_s: f64,
+        gopts: &GcodeOptions,
+    ) -> Self {
+        let (mut lines, mut arcs, mut turns) = (0, 0, 0);
+        for m in motions {
+            let c = m.counts();
+            lines += c.lines;
+            arcs += c.arcs;
+            turns += c.turns;
+        }
+        let duration: f64 = motions.iter().map(Motion::duration).sum();
+        // The set-points follow a smooth spline through the blocks' nodes: a proven bound of
+        // its distance from the blocks, and the set-points' own budget (the blocks' chord and
+        // fit terms, the spline, the interpolation chord, the blend; the linearization does
+        // not apply: the set-points put the tip on the path).
+        let spline_bound = motions
+            .iter()
+            .map(Motion::spline_deviation_bound)
+            .fold(0.0, f64::max);
+        let setpoints_budget = gopts
+            .budget()
+            .into_iter()
+            .filter(|(k, _)| *k != "linearization")
+            .filter_map(|(_, v)| v)
+            .sum::<f64>()
+            + spline_bound;
+        Self {
+            feed_mm_per_min,
+            cycle_s,
+            spline_deviation_bound_mm: spline_bound,
+            setpoints_budget_mm: setpoints_budget,
+            lines,
+            arcs,
+            turns,
+            cycles: motions.iter().map(Motion::cycles).sum(),
+            duration_s: duration,
+            time_share_at_feed: if duration > 0.0 {
+                motions
+                    .iter()
+                    .map(|m| m.time_share_at_feed() * m.duration())
+                    .sum::<f64>()
+                    / duration
+            } else {
+                0.0
+            },
+            paths: motions
+                .iter()
+                .zip(setup_ids)
+                .flat_map(|(m, ids)| path_report(m, ids))
+                .collect(),
+        }
+    }
+}
+
+/// The planned time of every path and the share at the programmed feed, for the summaries
+/// (`ids[k]` names the motion's path `k`; `path k` where it has none).
+pub fn path_report(motion: &Motion, ids: &[String]) -> Vec<PathMotion> {
+    let share = |part: f64, whole: f64| if whole > 0.0 { part / whole } else { 0.0 };
+    motion
+        .path_stats()
+        .iter()
+        .map(|p| PathMotion {
+            id: ids
+                .get(p.path)
+                .cloned()
+                .unwrap_or_else(|| format!("path {}", p.path)),
+            duration_s: p.duration,
+            cutting_time_s: p.cutting_time,
+            cutting_length_mm: p.cutting_length,
+            time_share_at_feed: share(p.time_at_feed, p.cutting_time),
+            length_share_at_feed: share(p.length_at_feed, p.cutting_length),
+        })
+        .collect()
 }

@@ -7,20 +7,18 @@ use std::path::Path;
 use std::time::Instant;
 
 use kerf_discretize::Discretization;
-use kerf_interp::{
-    gcode_motion, stations_from_solved, ChordTerm, MachineModel, Motion, PlanOptions,
-};
+use kerf_interp::{gcode_motion, stations_from_solved, ChordTerm, MachineModel, PlanOptions};
 use kerf_kinematics::{solve_paths, AxesFile, PathCurve, PathInput, Pose};
 use kerf_normals::Oriented;
 
 use crate::discretize::{discretize_curves_within, orient_curves, toolpath_of_poses};
 use crate::error::{interp, kin, Result};
 use crate::job::Job;
-use crate::output::{program_names, Output, SetupProgram};
+use crate::output::{Output, SetupProgram};
 use crate::report::{
     DiscretizeReport, InterpolationReport, KinematicsReport, MicroJoint, MicroJointPath,
-    MicroJointsReport, NormalsReport, OwnSurfaces, ProgramReport, Report, SearchedTraverse,
-    TechnologyReport, TiltPath, TiltTotals, UncheckedTraverse,
+    MicroJointsReport, NormalsReport, ProgramReport, Report, TechnologyReport, TiltPath,
+    TiltTotals,
 };
 use crate::timing::{Lap, Timings};
 use crate::{Progress, Stage};
@@ -478,14 +476,9 @@ fn run_placed(
     let mut motions = Vec::new();
     let mut programs = Vec::new();
     let mut setup_ids: Vec<Vec<String>> = Vec::new();
-    let limits = machine.limits.map(|r| r.map(|r| (r.min, r.max)));
-    let mut rapid_report = Vec::new();
-    let mut blocked_report = Vec::new();
-    let mut own_report = Vec::new();
-    let mut searched_report = Vec::new();
-    // The traverses for the plot, part coordinates, and a cut's last pose.
+    let mut traverse_tally = crate::traverses::Tally::default();
+    // The traverses for the plot, part coordinates.
     let mut plot_traverses: Vec<Vec<nalgebra::Point3<f64>>> = Vec::new();
-    let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
     let mut warnings: Vec<String> = edge_warnings;
     warnings.extend(head_warnings);
     warnings.extend(joint_warnings.iter().cloned());
@@ -524,142 +517,26 @@ fn run_placed(
         let in_setup: Vec<usize> = (0..solved.len())
             .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
             .collect();
-        // Traverses that clear the part's surfaces, placed with this set-up.
-        let mut traverses = Vec::new();
-        // The surfaces the set-up's curves name, placed with it, for the traverses.
-        let obstacles = match in_setup.first() {
-            Some(&first) if topts.is_some() => {
-                let placement = placed.placement_of(cuts[first].curve);
-                Some(
-                    kerf_process::Obstacles::from_file(
-                        file,
-                        &placed.plan.setups[setup].paths,
-                        |p| placement.apply_point(p),
-                    )
-                    .map_err(|source| crate::Error::Process {
-                        file: path.map(Path::to_path_buf),
-                        source,
-                    })?,
-                )
-            }
-            _ => None,
-        };
-        if let (Some(topts), Some(obs), Some(&first)) = (&topts, &obstacles, in_setup.first()) {
-            let placement = placed.placement_of(cuts[first].curve);
-            let gaps: Vec<kerf_process::Gap> = in_setup
-                .windows(2)
-                .map(|w| {
-                    let (a, b) = (&solved[w[0]], &solved[w[1]]);
-                    let ax = |q: &kerf_kinematics::Axes| [q.x, q.y, q.z, q.tilt, q.c];
-                    // The solved pose of a cut's k-th pose (lead-in, contour, lead-out).
-                    let at = |s: &kerf_kinematics::SolvedPath, k: usize| {
-                        let j = s.source.iter().position(|v| *v == Some(k)).unwrap_or(0);
-                        let p = s.poses[j].position;
-                        [p.x, p.y, p.z]
-                    };
-                    let [m, c, _] = cuts[w[0]].counts;
-                    kerf_process::Gap {
-                        from: a.poses[a.poses.len() - 1].to_array(),
-                        from_axes: ax(&a.axes[a.axes.len() - 1]),
-                        to: b.poses[0].to_array(),
-                        to_axes: ax(&b.axes[0]),
-                        from_contour: at(a, m + c - 1),
-                        to_contour: at(b, cuts[w[1]].counts[0]),
-                        from_surfaces: file.curves[cuts[w[0]].curve].surfaces.clone(),
-                        to_surfaces: file.curves[cuts[w[1]].curve].surfaces.clone(),
-                    }
-                })
-                .collect();
-            let rapids =
-                kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, obs, &gaps, topts);
-            for ((w, planned), gap) in in_setup.windows(2).zip(&rapids).zip(&gaps) {
-                let (t, r, absent) = match planned {
-                    Ok(p) => p,
-                    Err(e) => {
-                        // No checked route: the unchecked retract traverse, said loudly
-                        // (`Output::warnings`, and `traverses.unchecked` in the report).
-                        warnings.push(format!("{e}; this traverse is NOT checked"));
-                        // The surfaces the routes were checked without (the last attempt
-                        // leaves out all those in the cuts' way).
-                        let left_out = kerf_process::in_the_cuts_way(obs, gap, topts);
-                        blocked_report.push(UncheckedTraverse {
-                            after: solved[w[0]].id.clone(),
-                            before: solved[w[1]].id.clone(),
-                            reason: e.to_string(),
-                            surfaces_left_out: left_out,
-                        });
-                        traverses.push(Vec::new());
-                        // The plot: the unchecked retract, straight move and approach.
-                        let up = |q: &kerf_process::PoseArray, r: f64| {
-                            nalgebra::Point3::new(q[0], q[1], q[2])
-                                + nalgebra::Vector3::new(q[3], q[4], q[5]) * r
-                        };
-                        let (ea, pb) = (cut_end(w[0]), &cuts[w[1]].poses[0]);
-                        plot_traverses.push(vec![
-                            up(&ea, 0.0),
-                            up(&ea, o.retract_mm),
-                            up(pb, o.retract_mm),
-                            up(pb, 0.0),
-                        ]);
-                        continue;
-                    }
-                };
-                axes.paths[w[1]].traverse = Some(kerf_kinematics::AxesMove {
-                    positions: r.axes.clone(),
-                    poses: r.poses.clone(),
-                });
-                traverses.push(
-                    r.axes
-                        .iter()
-                        .zip(&r.poses)
-                        .map(|(a, p)| kerf_interp::Station {
-                            tip: nalgebra::Point3::new(p[0], p[1], p[2]),
-                            axis: nalgebra::Vector3::new(p[3], p[4], p[5]),
-                            param: None,
-                            axes: *a,
-                        })
-                        .collect::<Vec<_>>(),
-                );
-                // Surfaces left out that a neighbouring cut names itself: its own surface
-                // curls over its head line (the cut meets it, whatever the traverse does).
-                let over = kerf_process::own_surfaces_over_the_head(obs, gap, topts);
-                let own: Vec<String> = absent
-                    .iter()
-                    .filter(|id| over.contains(id))
-                    .cloned()
-                    .collect();
-                if !own.is_empty() {
-                    own_report.push(OwnSurfaces {
-                        after: solved[w[0]].id.clone(),
-                        before: solved[w[1]].id.clone(),
-                        surfaces: own,
-                    });
-                }
-                if t.route == kerf_process::Route::Searched {
-                    searched_report.push(SearchedTraverse {
-                        after: solved[w[0]].id.clone(),
-                        before: solved[w[1]].id.clone(),
-                        waypoints: t.waypoints.len(),
-                        length_mm: t.length_mm,
-                        surfaces_left_out: absent.clone(),
-                    });
-                }
-                rapid_report.push((t.clone(), r.clone(), absent.clone()));
-                // The plot: the checked traverse back in part coordinates.
-                let (rot, shift) = (placement.rotation(), placement.translation_mm);
-                let part = |q: &[f64; 6]| {
-                    nalgebra::Point3::from(
-                        rot.inverse() * (nalgebra::Point3::new(q[0], q[1], q[2]) - shift).coords,
-                    )
-                };
-                let ea = cut_end(w[0]);
-                let pb = cuts[w[1]].poses[0];
-                let mut line = vec![nalgebra::Point3::new(ea[0], ea[1], ea[2])];
-                line.extend(r.poses.iter().map(part));
-                line.push(nalgebra::Point3::new(pb[0], pb[1], pb[2]));
-                plot_traverses.push(line);
-            }
-        }
+        // 3e. Traverses that clear the part's surfaces, placed with this set-up.
+        let routed = crate::traverses::route_setup(
+            &crate::traverses::SetupCuts {
+                file,
+                path,
+                placed: &placed,
+                cuts: &cuts,
+                solved: &solved,
+                setup,
+                in_setup: &in_setup,
+            },
+            machine,
+            topts.as_ref(),
+            o.retract_mm,
+            &mut axes,
+            &mut traverse_tally,
+        )?;
+        warnings.extend(routed.warnings);
+        plot_traverses.extend(routed.plot);
+        let traverses = routed.stations;
         lap.split(&mut timings, "traverses");
         for (k, s) in solved.iter().enumerate() {
             if placed.plan.setup_of(cuts[k].curve) != setup {
@@ -764,79 +641,19 @@ fn run_placed(
     );
     drop(view_setups);
     lap.split(&mut timings, "view");
-    let mut scene = kerf_plot::Scene::new(file, &tp, &kerf_plot::SceneOptions::default())?;
-    scene.title = format!("kerf run \u{2014} {input_name} on {}", machine.name);
-    scene.axes = Some(kerf_plot::AxesChart::new(&axes, Some(machine))?);
-    // The process over the paths (part coordinates): pierces numbered in cutting order,
-    // lead-ins, lead-outs and the traverses, set-up by set-up as the programs run them.
-    let pt = |q: &kerf_process::PoseArray| nalgebra::Point3::new(q[0], q[1], q[2]);
-    let mut order: Vec<usize> = (0..cuts.len()).collect();
-    order.sort_by_key(|&k| placed.plan.setup_of(cuts[k].curve));
-    scene.process = Some(kerf_plot::ProcessPicture {
-        cuts: order
-            .iter()
-            .map(|&k| {
-                let c = &cuts[k];
-                let [m, n, _] = c.counts;
-                kerf_plot::CutPicture {
-                    id: file.curves[c.curve].id.clone(),
-                    pierce: pt(&c.poses[0]),
-                    lead_in: if m > 0 {
-                        c.poses[..=m].iter().map(pt).collect()
-                    } else {
-                        Vec::new()
-                    },
-                    lead_out: if m + n < c.poses.len() {
-                        c.poses[m + n - 1..].iter().map(pt).collect()
-                    } else {
-                        Vec::new()
-                    },
-                    micro_joints: {
-                        let part: Vec<[f64; 3]> =
-                            c.poses.iter().map(|q| [q[0], q[1], q[2]]).collect();
-                        let at =
-                            |s: f64| nalgebra::Point3::from(crate::cuts::point_along(&part, s));
-                        joints[k].iter().map(|&[a, b]| [at(a), at(b)]).collect()
-                    },
-                }
-            })
-            .collect(),
-        traverses: plot_traverses,
-    });
-    let mut svg = kerf_plot::render(&scene);
-    drop(scene);
-    svg.shrink_to_fit();
-    let mut counts = motions[0].counts();
-    for m in &motions[1..] {
-        let c = m.counts();
-        counts.lines += c.lines;
-        counts.arcs += c.arcs;
-        counts.turns += c.turns;
-    }
-    let duration: f64 = motions.iter().map(|m| m.duration()).sum();
-    let cycles: usize = motions.iter().map(|m| m.cycles()).sum();
-    // N* from the curvature the walk evaluated at its points (`Discretization::n_star`).
-    let nstar: f64 = discs.iter().map(|d| d.n_star(dopts.tolerance_mm)).sum();
-    let segments: usize = discs.iter().map(Discretization::segments).sum();
-    // The budget as the program's header states it (a `fit` term where arcs and merged lines
-    // are written), and its total.
-    let mut budget: std::collections::BTreeMap<String, Option<f64>> = gopts
-        .budget()
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect();
-    budget.insert("total".into(), Some(gopts.budget_total()));
-    let spline_bound = motions
-        .iter()
-        .map(Motion::spline_deviation_bound)
-        .fold(0.0, f64::max);
-    let setpoints_budget = gopts
-        .budget()
-        .into_iter()
-        .filter(|(k, _)| *k != "linearization")
-        .filter_map(|(_, v)| v)
-        .sum::<f64>()
-        + spline_bound;
+    let svg = picture(
+        &Picture {
+            file,
+            tp: &tp,
+            axes: &axes,
+            machine,
+            input_name: &input_name,
+            cuts: &cuts,
+            placed: &placed,
+            joints: &joints,
+        },
+        plot_traverses,
+    )?;
     let placement_report = {
         let mut p = placed.report(&id_refs);
         p.walls = Some(crate::cuts::walls_report(file, &walls));
@@ -872,25 +689,8 @@ fn run_placed(
         input: source_name,
         machine: machine.name.clone(),
         warnings: all_warnings,
-        tolerance_budget_mm: budget,
-        program: ProgramReport {
-            dialect: dialect.name().to_string(),
-            beam_on: process.beam_on.clone(),
-            beam_off: process.beam_off.clone(),
-            pierce_dwell_s: process.pierce_dwell_s,
-            pierce_standoff_mm: process.pierce_standoff,
-            // A cut: a stretch of cutting blocks after a rapid (or at the start).
-            cuts: motions
-                .iter()
-                .map(|m| {
-                    let b = m.blocks();
-                    (0..b.len())
-                        .filter(|&i| !b[i].rapid && (i == 0 || b[i - 1].rapid))
-                        .count()
-                })
-                .sum(),
-            files: program_names(programs.len()),
-        },
+        tolerance_budget_mm: crate::report::budget(&gopts),
+        program: ProgramReport::of(dialect, &process, &motions, program_files.clone()),
         compensation: crate::cuts::compensation_report(file, kerf.as_ref(), &compensated),
         technology: technology_report(
             o.technology.as_ref(),
@@ -906,80 +706,19 @@ fn run_placed(
                 left_out: joint_warnings,
             }),
         head: crate::head::head_report(o.cut_clearance_mm, machine, head_tip_zone, head_report),
-        discretize: DiscretizeReport {
-            curves: file.curves.len(),
-            segments,
-            n_star: nstar,
-            max_chord_error: tp
-                .paths
-                .iter()
-                .map(|p| p.max_chord_error)
-                .fold(0.0, f64::max),
-            c0_breaks: discs.iter().map(|d| d.c0_breaks().len()).sum(),
-        },
-        normals: NormalsReport {
-            points: oriented.iter().map(|o| o.points().len()).sum(),
-            inserted: oriented.iter().map(|o| o.inserted).sum(),
-            max_surface_distance: oriented
-                .iter()
-                .map(|o| o.max_surface_distance)
-                .fold(0.0, f64::max),
-            jumps: oriented.iter().map(|o| o.jumps.len()).sum(),
-            curves_without_surface: file.curves.iter().filter(|c| c.surface.is_none()).count(),
-        },
-        kinematics: KinematicsReport {
-            poses: solved.iter().map(|s| s.poses.len()).sum(),
-            inserted: solved.iter().map(|s| s.inserted).sum(),
-            max_rotary_step_between_cutting_points: solved
-                .iter()
-                .map(|s| s.max_rotary_step_between_cutting_points)
-                .fold(0.0, f64::max),
-            max_linearization_error: solved
-                .iter()
-                .map(|s| s.max_linearization_error)
-                .fold(0.0, f64::max),
-            pole_points: solved.iter().map(|s| s.pole_points).sum(),
-            pole_tip_error: solved.iter().map(|s| s.pole_tip_error).fold(0.0, f64::max),
-            tilt: tilt_report(&solved, popts.tilt_tolerance_deg),
-        },
+        discretize: DiscretizeReport::of(file, &discs, &tp, dopts.tolerance_mm),
+        normals: NormalsReport::of(file, &oriented),
+        kinematics: KinematicsReport::of(&solved, tilt_report(&solved, popts.tilt_tolerance_deg)),
         placement: placement_report,
         process: crate::cuts::report(file, &cuts, &cut_plans),
-        traverses: crate::cuts::traverse_report(
-            topts.as_ref(),
-            &rapid_report,
-            blocked_report,
-            own_report,
-            searched_report,
+        traverses: traverse_tally.report(topts.as_ref()),
+        interpolation: InterpolationReport::of(
+            &motions,
+            &setup_ids,
+            o.feed_mm_per_min,
+            o.cycle_s,
+            &gopts,
         ),
-        interpolation: InterpolationReport {
-            feed_mm_per_min: o.feed_mm_per_min,
-            cycle_s: o.cycle_s,
-            // The set-points follow a smooth spline through the blocks' nodes: a proven bound
-            // of its distance from the blocks, and the set-points' own budget (the blocks'
-            // chord and fit terms, the spline, the interpolation chord, the blend; the
-            // linearization does not apply: the set-points put the tip on the path).
-            spline_deviation_bound_mm: spline_bound,
-            setpoints_budget_mm: setpoints_budget,
-            lines: counts.lines,
-            arcs: counts.arcs,
-            turns: counts.turns,
-            cycles,
-            duration_s: duration,
-            time_share_at_feed: if duration > 0.0 {
-                motions
-                    .iter()
-                    .map(|m| m.time_share_at_feed() * m.duration())
-                    .sum::<f64>()
-                    / duration
-            } else {
-                0.0
-            },
-            paths: motions
-                .iter()
-                .zip(&setup_ids)
-                .flat_map(|(m, ids)| crate::motion::path_report(m, ids))
-                .collect(),
-        },
         seconds: start.elapsed().as_secs_f64(),
         timings,
     };
@@ -999,6 +738,67 @@ fn run_placed(
         model,
         cycle_s: o.cycle_s,
     })
+}
+
+/// What the picture (`plot.svg`) shows of a run.
+struct Picture<'a> {
+    file: &'a kerf_format::CurvesFile,
+    tp: &'a kerf_format::toolpath::ToolpathFile,
+    axes: &'a AxesFile,
+    machine: &'a kerf_kinematics::Machine,
+    input_name: &'a str,
+    cuts: &'a [crate::cuts::CutPath],
+    placed: &'a crate::place::Placed,
+    /// Per cut, its micro-joints (mm along the cut).
+    joints: &'a [Vec<[f64; 2]>],
+}
+
+/// The picture: the paths and their axes, the process over them (pierces numbered in cutting
+/// order, leads, micro-joints) and `traverses` (part coordinates), set-up by set-up as the
+/// programs run them.
+fn picture(p: &Picture<'_>, traverses: Vec<Vec<nalgebra::Point3<f64>>>) -> Result<String> {
+    let mut scene = kerf_plot::Scene::new(p.file, p.tp, &kerf_plot::SceneOptions::default())?;
+    scene.title = format!("kerf run \u{2014} {} on {}", p.input_name, p.machine.name);
+    scene.axes = Some(kerf_plot::AxesChart::new(p.axes, Some(p.machine))?);
+    // The process over the paths (part coordinates): pierces numbered in cutting order,
+    // lead-ins, lead-outs and the traverses, set-up by set-up as the programs run them.
+    let pt = |q: &kerf_process::PoseArray| nalgebra::Point3::new(q[0], q[1], q[2]);
+    let mut order: Vec<usize> = (0..p.cuts.len()).collect();
+    order.sort_by_key(|&k| p.placed.plan.setup_of(p.cuts[k].curve));
+    scene.process = Some(kerf_plot::ProcessPicture {
+        cuts: order
+            .iter()
+            .map(|&k| {
+                let c = &p.cuts[k];
+                let [m, n, _] = c.counts;
+                kerf_plot::CutPicture {
+                    id: p.file.curves[c.curve].id.clone(),
+                    pierce: pt(&c.poses[0]),
+                    lead_in: if m > 0 {
+                        c.poses[..=m].iter().map(pt).collect()
+                    } else {
+                        Vec::new()
+                    },
+                    lead_out: if m + n < c.poses.len() {
+                        c.poses[m + n - 1..].iter().map(pt).collect()
+                    } else {
+                        Vec::new()
+                    },
+                    micro_joints: {
+                        let part: Vec<[f64; 3]> =
+                            c.poses.iter().map(|q| [q[0], q[1], q[2]]).collect();
+                        let at =
+                            |s: f64| nalgebra::Point3::from(crate::cuts::point_along(&part, s));
+                        p.joints[k].iter().map(|&[a, b]| [at(a), at(b)]).collect()
+                    },
+                }
+            })
+            .collect(),
+        traverses,
+    });
+    let mut svg = kerf_plot::render(&scene);
+    svg.shrink_to_fit();
+    Ok(svg)
 }
 
 /// The power of a technology entry: its cutting power at its feed, following the tip's

@@ -1,0 +1,291 @@
+//! The traverses between the cuts of one set-up (stage 3e of [`crate::Job::run`]): each gap
+//! between two cuts routed and checked against the set-up's surfaces
+//! ([`kerf_process::plan_rapids`]), written into the axes document, turned into the
+//! interpolator's stations and the picture's lines; a gap no route clears falls back to the
+//! unchecked retract, straight move and approach, with a warning. [`Tally`] keeps what the
+//! report's `traverses` section says about every set-up.
+
+use std::path::Path;
+
+use kerf_format::CurvesFile;
+use kerf_interp::Station;
+use kerf_kinematics::{AxesFile, AxesMove, Machine, SolvedPath};
+use kerf_process::{Gap, Obstacles, PoseArray, RapidMoves, Route, Traverse, TraverseOptions};
+use nalgebra::{Point3, Vector3};
+
+use crate::cuts::CutPath;
+use crate::error::Result;
+use crate::place::Placed;
+use crate::report::{OwnSurfaces, SearchedTraverse, TraversesReport, UncheckedTraverse};
+
+/// What the traverses of every set-up came to, for the report.
+#[derive(Debug, Default)]
+pub(crate) struct Tally {
+    /// Each checked traverse: its route, its moves, the surfaces left out of its check.
+    checked: Vec<(Traverse, RapidMoves, Vec<String>)>,
+    /// The gaps no route cleared.
+    unchecked: Vec<UncheckedTraverse>,
+    /// Gaps where a cut's own surface comes back over the head line.
+    own: Vec<OwnSurfaces>,
+    /// Gaps a search around the part cleared.
+    searched: Vec<SearchedTraverse>,
+}
+
+/// The traverses of one set-up.
+pub(crate) struct SetupTraverses {
+    /// Per gap between consecutive cuts of the set-up, the checked route as the interpolator's
+    /// stations (empty: the unchecked retract traverse); empty without traverse options.
+    pub(crate) stations: Vec<Vec<Station>>,
+    /// Per gap, the traverse's line for the picture (part coordinates).
+    pub(crate) plot: Vec<Vec<Point3<f64>>>,
+    /// A warning per gap that fell back to the unchecked traverse.
+    pub(crate) warnings: Vec<String>,
+}
+
+/// The set-up's cuts and where they come from.
+pub(crate) struct SetupCuts<'a> {
+    /// The curves file (ids, named surfaces).
+    pub(crate) file: &'a CurvesFile,
+    /// The input's path, for errors.
+    pub(crate) path: Option<&'a Path>,
+    /// The placement of every path.
+    pub(crate) placed: &'a Placed,
+    /// Every cut, in cutting order.
+    pub(crate) cuts: &'a [CutPath],
+    /// Every cut solved to machine axes.
+    pub(crate) solved: &'a [SolvedPath],
+    /// The set-up's index.
+    pub(crate) setup: usize,
+    /// Indices (into `cuts` and `solved`) of the set-up's cuts, in order.
+    pub(crate) in_setup: &'a [usize],
+}
+
+/// Routes and checks the traverses of one set-up ([`SetupCuts`]) with `opts` (`None`: none
+/// checked, no stations), writing each checked route into `axes` and its figures into
+/// `tally`. The unchecked fallback's picture rises `retract_mm` along the tool axes.
+///
+/// # Errors
+/// [`crate::Error::Process`] if the set-up's surfaces cannot be placed as obstacles.
+pub(crate) fn route_setup(
+    s: &SetupCuts<'_>,
+    machine: &Machine,
+    opts: Option<&TraverseOptions>,
+    retract_mm: f64,
+    axes: &mut AxesFile,
+    tally: &mut Tally,
+) -> Result<SetupTraverses> {
+    let mut out = SetupTraverses {
+        stations: Vec::new(),
+        plot: Vec::new(),
+        warnings: Vec::new(),
+    };
+    let (Some(opts), Some(&first)) = (opts, s.in_setup.first()) else {
+        return Ok(out);
+    };
+    let (file, cuts, solved) = (s.file, s.cuts, s.solved);
+    let placement = s.placed.placement_of(cuts[first].curve);
+    // The surfaces the set-up's curves name, placed with it.
+    let obs = Obstacles::from_file(file, &s.placed.plan.setups[s.setup].paths, |p| {
+        placement.apply_point(p)
+    })
+    .map_err(|source| crate::Error::Process {
+        file: s.path.map(Path::to_path_buf),
+        source,
+    })?;
+    let limits = machine.limits.map(|r| r.map(|r| (r.min, r.max)));
+    let gaps: Vec<Gap> = s
+        .in_setup
+        .windows(2)
+        .map(|w| gap(file, cuts, solved, w[0], w[1]))
+        .collect();
+    let rapids = kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, &obs, &gaps, opts);
+    let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
+    for ((w, planned), gap) in s.in_setup.windows(2).zip(&rapids).zip(&gaps) {
+        let (after, before) = (&solved[w[0]].id, &solved[w[1]].id);
+        let (t, r, absent) = match planned {
+            Ok(p) => p,
+            Err(e) => {
+                // No checked route: the unchecked retract traverse, said loudly
+                // (`Output::warnings`, and `traverses.unchecked` in the report).
+                out.warnings
+                    .push(format!("{e}; this traverse is NOT checked"));
+                // The surfaces the routes were checked without (the last attempt leaves out
+                // all those in the cuts' way).
+                tally.unchecked.push(UncheckedTraverse {
+                    after: after.clone(),
+                    before: before.clone(),
+                    reason: e.to_string(),
+                    surfaces_left_out: kerf_process::in_the_cuts_way(&obs, gap, opts),
+                });
+                out.stations.push(Vec::new());
+                // The plot: the unchecked retract, straight move and approach.
+                let up = |q: &PoseArray, r: f64| {
+                    Point3::new(q[0], q[1], q[2]) + Vector3::new(q[3], q[4], q[5]) * r
+                };
+                let (ea, pb) = (cut_end(w[0]), &cuts[w[1]].poses[0]);
+                out.plot.push(vec![
+                    up(&ea, 0.0),
+                    up(&ea, retract_mm),
+                    up(pb, retract_mm),
+                    up(pb, 0.0),
+                ]);
+                continue;
+            }
+        };
+        axes.paths[w[1]].traverse = Some(AxesMove {
+            positions: r.axes.clone(),
+            poses: r.poses.clone(),
+        });
+        out.stations.push(
+            r.axes
+                .iter()
+                .zip(&r.poses)
+                .map(|(a, p)| Station {
+                    tip: Point3::new(p[0], p[1], p[2]),
+                    axis: Vector3::new(p[3], p[4], p[5]),
+                    param: None,
+                    axes: *a,
+                })
+                .collect(),
+        );
+        // Surfaces left out that a neighbouring cut names itself: its own surface curls over
+        // its head line (the cut meets it, whatever the traverse does).
+        let over = kerf_process::own_surfaces_over_the_head(&obs, gap, opts);
+        let own: Vec<String> = absent
+            .iter()
+            .filter(|id| over.contains(id))
+            .cloned()
+            .collect();
+        if !own.is_empty() {
+            tally.own.push(OwnSurfaces {
+                after: after.clone(),
+                before: before.clone(),
+                surfaces: own,
+            });
+        }
+        if t.route == Route::Searched {
+            tally.searched.push(SearchedTraverse {
+                after: after.clone(),
+                before: before.clone(),
+                waypoints: t.waypoints.len(),
+                length_mm: t.length_mm,
+                surfaces_left_out: absent.clone(),
+            });
+        }
+        tally.checked.push((t.clone(), r.clone(), absent.clone()));
+        // The plot: the checked traverse back in part coordinates.
+        let (rot, shift) = (placement.rotation(), placement.translation_mm);
+        let part = |q: &[f64; 6]| {
+            Point3::from(rot.inverse() * (Point3::new(q[0], q[1], q[2]) - shift).coords)
+        };
+        let (ea, pb) = (cut_end(w[0]), cuts[w[1]].poses[0]);
+        let mut line = vec![Point3::new(ea[0], ea[1], ea[2])];
+        line.extend(r.poses.iter().map(part));
+        line.push(Point3::new(pb[0], pb[1], pb[2]));
+        out.plot.push(line);
+    }
+    Ok(out)
+}
+
+/// The gap from cut `a` to cut `b`: the end and start poses with their axes, the contour's
+/// own end and start (where the head meets the part whatever the traverse does), and the
+/// surfaces the two curves name.
+fn gap(file: &CurvesFile, cuts: &[CutPath], solved: &[SolvedPath], a: usize, b: usize) -> Gap {
+    let (sa, sb) = (&solved[a], &solved[b]);
+    let ax = |q: &kerf_kinematics::Axes| [q.x, q.y, q.z, q.tilt, q.c];
+    // The solved pose of a cut's k-th pose (lead-in, contour, lead-out).
+    let at = |s: &SolvedPath, k: usize| {
+        let j = s.source.iter().position(|v| *v == Some(k)).unwrap_or(0);
+        let p = s.poses[j].position;
+        [p.x, p.y, p.z]
+    };
+    let [m, c, _] = cuts[a].counts;
+    Gap {
+        from: sa.poses[sa.poses.len() - 1].to_array(),
+        from_axes: ax(&sa.axes[sa.axes.len() - 1]),
+        to: sb.poses[0].to_array(),
+        to_axes: ax(&sb.axes[0]),
+        from_contour: at(sa, m + c - 1),
+        to_contour: at(sb, cuts[b].counts[0]),
+        from_surfaces: file.curves[cuts[a].curve].surfaces.clone(),
+        to_surfaces: file.curves[cuts[b].curve].surfaces.clone(),
+    }
+}
+
+impl Tally {
+    /// The `traverses` object of `report.json`: how the traverses between cuts were checked
+    /// against the part and what they came to.
+    pub(crate) fn report(self, opts: Option<&TraverseOptions>) -> TraversesReport {
+        let Tally {
+            checked: rapids,
+            unchecked: blocked,
+            own,
+            searched,
+        } = self;
+        let mut unchecked: Vec<String> = Vec::new();
+        for (_, _, absent) in &rapids {
+            for id in absent {
+                if !unchecked.contains(id) {
+                    unchecked.push(id.clone());
+                }
+            }
+        }
+        // How many traverses took each route.
+        let routes: std::collections::BTreeMap<String, usize> = [
+            kerf_process::Route::Straight,
+            kerf_process::Route::Lifted,
+            kerf_process::Route::SafePlane,
+            kerf_process::Route::Searched,
+        ]
+        .iter()
+        .map(|k| {
+            let n = rapids.iter().filter(|(t, _, _)| t.route == *k).count();
+            (k.name().to_string(), n)
+        })
+        .collect();
+        let Some(o) = opts else {
+            return TraversesReport {
+                checked: false,
+                clearance_mm: None,
+                retract_mm: None,
+                nozzle_mm: None,
+                count: None,
+                checked_count: None,
+                unchecked: None,
+                lifted: None,
+                routes: None,
+                searched: None,
+                split_moves: None,
+                length_mm: None,
+                min_distance_mm: None,
+                surfaces_in_the_cuts_way: None,
+                surfaces_note: None,
+                own_surface_over_the_head: None,
+                unchecked_note: None,
+                searched_note: None,
+                note: Some("no traverse options (a clearance of 0): retract along the tool axis, one straight move, approach; not checked against the part".into()),
+            };
+        };
+        TraversesReport {
+            checked: true,
+            clearance_mm: Some(o.clearance_mm),
+            retract_mm: Some(o.retract_mm),
+            nozzle_mm: Some(o.nozzle_mm),
+            count: Some(rapids.len() + blocked.len()),
+            checked_count: Some(rapids.len()),
+            unchecked: Some(blocked),
+            lifted: Some(rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count()),
+            routes: Some(routes),
+            searched: Some(searched),
+            split_moves: Some(rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>()),
+            length_mm: Some(rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>()),
+            min_distance_mm: Some(rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min)),
+            surfaces_in_the_cuts_way: Some(unchecked),
+            surfaces_note: Some("surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)".into()),
+            own_surface_over_the_head: Some(own),
+            unchecked_note: Some("where no route keeps the clearance (unchecked, with the reason and the surfaces the routes were checked without), the program falls back to the unchecked retract along the tool axis, straight move and approach, with a warning; a reason that starts 'proven' shows that no route can exist (the retract or approach line itself is blocked)".into()),
+            searched_note: Some("searched: the gaps where no route shape (straight, lifted, over the safe plane) cleared and a search around the part found a path, the head turned to one tool axis for the travel; lifted counts every route that is not straight".into()),
+            note: None,
+        }
+    }
+}

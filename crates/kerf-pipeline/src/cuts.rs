@@ -192,48 +192,19 @@ pub(crate) fn plan(
             })
             .collect();
         // The offset paths of this set-up, by position in it.
-        let offsets: Vec<Option<Arc<OffsetPath>>> = match kerf {
+        let offsets = match kerf {
             None => vec![None; contours.len()],
-            Some(k) => {
-                let sides = scrap_sides(&contours, options).map_err(process_error)?;
-                let mut out = Vec::with_capacity(contours.len());
-                for (j, &i) in setup.paths.iter().enumerate() {
-                    let Some(side) = sides[j] else {
-                        compensated.push(Compensated {
-                            curve: i,
-                            outcome: Outcome::Uncompensated("its scrap side is not known (an open contour, or a loop round a tube, without a `scrap` key), so it is cut on the contour itself".into()),
-                        });
-                        out.push(None);
-                        continue;
-                    };
-                    if k.in_control {
-                        compensated.push(Compensated {
-                            curve: i,
-                            outcome: Outcome::InControl(side),
-                        });
-                        out.push(None);
-                        continue;
-                    }
-                    let input = OffsetInput {
-                        id: &file.curves[i].id,
-                        curve: &file.curves[i].curve,
-                        params: oriented[i].params(),
-                        poses: &poses[i],
-                        surface_normals: None,
-                        scrap: side,
-                        closed: is_closed(&poses[i], options.closed_tolerance_mm),
-                    };
-                    let path = offset(&input, &OffsetOptions::new(k.width_mm, k.tolerance_mm))
-                        .map_err(process_error)?;
-                    let path = Arc::new(path);
-                    compensated.push(Compensated {
-                        curve: i,
-                        outcome: Outcome::Offset(Arc::clone(&path)),
-                    });
-                    out.push(Some(path));
-                }
-                out
-            }
+            Some(k) => offset_setup(
+                file,
+                oriented,
+                &poses,
+                &setup.paths,
+                &contours,
+                options,
+                k,
+                &mut compensated,
+            )
+            .map_err(process_error)?,
         };
         let offset_poses: Vec<Option<Vec<PoseArray>>> = offsets
             .iter()
@@ -284,6 +255,62 @@ pub(crate) fn plan(
         plans.push((setup.paths.clone(), plan));
     }
     Ok((cuts, plans, compensated))
+}
+
+/// The offset paths of one set-up's contours (`paths[j]` the curve of `contours[j]`), by
+/// position in it, with a kerf `k`: `None` for a contour whose scrap side is not known or that
+/// the controller compensates; what each got is pushed onto `compensated`.
+///
+/// # Errors
+/// The offset's refusal (a loop smaller than the kerf, a feature narrower than it, ...).
+#[allow(clippy::too_many_arguments)]
+fn offset_setup(
+    file: &CurvesFile,
+    oriented: &[Oriented],
+    poses: &[Vec<PoseArray>],
+    paths: &[usize],
+    contours: &[Contour<'_>],
+    options: &LeadOptions,
+    k: &Kerf,
+    compensated: &mut Vec<Compensated>,
+) -> Result<Vec<Option<Arc<OffsetPath>>>, kerf_process::ProcessError> {
+    let sides = scrap_sides(contours, options)?;
+    let mut out = Vec::with_capacity(contours.len());
+    for (j, &i) in paths.iter().enumerate() {
+        let Some(side) = sides[j] else {
+            compensated.push(Compensated {
+                curve: i,
+                outcome: Outcome::Uncompensated("its scrap side is not known (an open contour, or a loop round a tube, without a `scrap` key), so it is cut on the contour itself".into()),
+            });
+            out.push(None);
+            continue;
+        };
+        if k.in_control {
+            compensated.push(Compensated {
+                curve: i,
+                outcome: Outcome::InControl(side),
+            });
+            out.push(None);
+            continue;
+        }
+        let input = OffsetInput {
+            id: &file.curves[i].id,
+            curve: &file.curves[i].curve,
+            params: oriented[i].params(),
+            poses: &poses[i],
+            surface_normals: None,
+            scrap: side,
+            closed: is_closed(&poses[i], options.closed_tolerance_mm),
+        };
+        let path = offset(&input, &OffsetOptions::new(k.width_mm, k.tolerance_mm))?;
+        let path = Arc::new(path);
+        compensated.push(Compensated {
+            curve: i,
+            outcome: Outcome::Offset(Arc::clone(&path)),
+        });
+        out.push(Some(path));
+    }
+    Ok(out)
 }
 
 /// True if the contour's last point is within `tol` of its first.

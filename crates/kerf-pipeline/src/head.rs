@@ -151,7 +151,6 @@ pub(crate) fn check_and_clear(
     let mut out = HeadOutcome::default();
     let theta =
         popts.tilt_tolerance_deg.max(0.0).to_radians() * kerf_kinematics::TILT_WORKING_FRACTION;
-    let fixed = (*popts).with_tilt_tolerance_deg(0.0);
     for &k in ks {
         // After a refusal the run stops: the other cuts are not checked.
         if out.refusal.is_some() {
@@ -179,82 +178,31 @@ pub(crate) fn check_and_clear(
         let mut unclearable: Vec<String> = Vec::new();
         while !c.close.is_empty() && theta > 0.0 && rounds < MAX_ROUNDS && unclearable.is_empty() {
             rounds += 1;
-            for st in &c.close {
-                let [lo, hi] = input_range(&solved[k], st.poses);
-                for i in lo..=hi {
-                    let p = normals[i].position;
-                    let n = normals[i].axis;
-                    // Away from what this cutting point's own head meets (upright on its
-                    // normal), else from the stretch's witness.
-                    let w = witness(obs, head, hopts, p, n, &mut budget).unwrap_or(st.point);
-                    let d = escape(obs, &n, &w).unwrap_or_else(|| away(&n, &p, &w));
-                    let start = need[i].map_or(0, |(a, _)| {
-                        ((a / theta) * TILT_STEPS as f64).round() as usize
-                    });
-                    let found = (start + 1..=TILT_STEPS)
-                        .map(|j| theta * j as f64 / TILT_STEPS as f64)
-                        .find(|&a| clears(obs, head, hopts, p, tilted(&n, &d, a), &mut budget));
-                    match found {
-                        Some(a) => need[i] = Some((a, d)),
-                        None => {
-                            unclearable.push(needed_tilt(
-                                obs,
-                                head,
-                                hopts,
-                                &normals[i],
-                                i,
-                                st,
-                                popts.tilt_tolerance_deg,
-                                &mut budget,
-                            ));
-                            break;
-                        }
-                    }
-                }
-                if !unclearable.is_empty() {
-                    break;
-                }
-            }
-            if !unclearable.is_empty() {
+            let found = find_tilts(
+                &Tilting {
+                    obs,
+                    head,
+                    hopts,
+                    popts,
+                    theta,
+                },
+                &solved[k],
+                normals,
+                &c.close,
+                &mut need,
+                &mut budget,
+            );
+            if let Err(why) = found {
+                unclearable.push(why);
                 break;
             }
-            // The cones: a tilted pose holds its clearing axis, the others their tolerance.
-            let cones: Vec<Cone> = normals
-                .iter()
-                .zip(&need)
-                .map(|(pose, req)| match req {
-                    Some((a, d)) => Cone {
-                        axis: tilted(&pose.axis, d, *a),
-                        half_angle_deg: 0.0,
-                    },
-                    None => Cone {
-                        axis: pose.axis,
-                        half_angle_deg: popts.tilt_tolerance_deg,
-                    },
-                })
-                .collect();
-            let choice = tilt_within_cones(normals, &cones, popts.tilt_tolerance_deg);
-            let poses: Vec<Pose> = normals
-                .iter()
-                .zip(&choice.axes)
-                .map(|(p, a)| Pose {
-                    position: p.position,
-                    axis: *a,
-                })
-                .collect();
-            let input = PathInput {
-                id: inputs[k].id,
-                poses: &poses,
-                curve: inputs[k].curve,
-            };
-            match solve_path(machine, &input, &fixed) {
-                Ok(mut s) => {
-                    s.tilt = Some(choice.report);
+            match solve_tilted(machine, &inputs[k], &need, popts) {
+                Ok(s) => {
                     solved[k] = s;
                     applied = need.clone();
                 }
-                Err(e) => {
-                    unclearable.push(format!("the tilted path cannot be solved: {e}"));
+                Err(why) => {
+                    unclearable.push(why);
                     break;
                 }
             }
@@ -281,25 +229,15 @@ pub(crate) fn check_and_clear(
         }
         let mut reasons = describe(&solved[k], &c, hopts.clearance_mm);
         if theta == 0.0 {
-            // What tilt would clear the worst stretch at its middle cutting point.
-            if let Some(st) = c
-                .close
-                .iter()
-                .min_by(|a, b| a.distance_mm.total_cmp(&b.distance_mm))
-            {
-                let [lo, hi] = input_range(&solved[k], st.poses);
-                let i = (lo + hi) / 2;
-                reasons.push(needed_tilt(
-                    obs,
-                    head,
-                    hopts,
-                    &normals[i],
-                    i,
-                    st,
-                    0.0,
-                    &mut budget,
-                ));
-            }
+            reasons.extend(worst_needed_tilt(
+                obs,
+                head,
+                hopts,
+                &solved[k],
+                normals,
+                &c.close,
+                &mut budget,
+            ));
         }
         reasons.extend(unclearable);
         let e = kerf_process::ProcessError::HeadTooClose {
@@ -315,6 +253,142 @@ pub(crate) fn check_and_clear(
         }
     }
     out
+}
+
+/// Without a tilt tolerance: what tilt would clear the worst of the `close` stretches of `s`
+/// at its middle cutting point (of `normals`), in words.
+fn worst_needed_tilt(
+    obs: &Obstacles,
+    head: &Head,
+    hopts: &HeadCheckOptions,
+    s: &SolvedPath,
+    normals: &[Pose],
+    close: &[kerf_process::CloseStretch],
+    budget: &mut usize,
+) -> Option<String> {
+    let st = close
+        .iter()
+        .min_by(|a, b| a.distance_mm.total_cmp(&b.distance_mm))?;
+    let [lo, hi] = input_range(s, st.poses);
+    let i = (lo + hi) / 2;
+    Some(needed_tilt(
+        obs,
+        head,
+        hopts,
+        &normals[i],
+        i,
+        st,
+        0.0,
+        budget,
+    ))
+}
+
+/// What the tilt search of one cut works with.
+struct Tilting<'a> {
+    obs: &'a Obstacles,
+    head: &'a Head,
+    hopts: &'a HeadCheckOptions,
+    popts: &'a PathOptions,
+    /// The largest tilt the search tries, radians (the working share of the tolerance).
+    theta: f64,
+}
+
+/// The tilt that clears every cutting point of the `close` stretches of `s` (the cut's
+/// `normals`), raised in [`TILT_STEPS`] steps of `theta` from what `need` already holds, away
+/// from the surface its own head meets (else the stretch's witness), into `need`.
+///
+/// # Errors
+/// Where no tilt within the tolerance clears a point: the tilt that would, in words.
+fn find_tilts(
+    t: &Tilting<'_>,
+    s: &SolvedPath,
+    normals: &[Pose],
+    close: &[kerf_process::CloseStretch],
+    need: &mut [Option<(f64, Vector3<f64>)>],
+    budget: &mut usize,
+) -> Result<(), String> {
+    let (obs, head, hopts, theta) = (t.obs, t.head, t.hopts, t.theta);
+    for st in close {
+        let [lo, hi] = input_range(s, st.poses);
+        for i in lo..=hi {
+            let p = normals[i].position;
+            let n = normals[i].axis;
+            // Away from what this cutting point's own head meets (upright on its normal),
+            // else from the stretch's witness.
+            let w = witness(obs, head, hopts, p, n, budget).unwrap_or(st.point);
+            let d = escape(obs, &n, &w).unwrap_or_else(|| away(&n, &p, &w));
+            let start = need[i].map_or(0, |(a, _)| {
+                ((a / theta) * TILT_STEPS as f64).round() as usize
+            });
+            let found = (start + 1..=TILT_STEPS)
+                .map(|j| theta * j as f64 / TILT_STEPS as f64)
+                .find(|&a| clears(obs, head, hopts, p, tilted(&n, &d, a), budget));
+            match found {
+                Some(a) => need[i] = Some((a, d)),
+                None => {
+                    return Err(needed_tilt(
+                        obs,
+                        head,
+                        hopts,
+                        &normals[i],
+                        i,
+                        st,
+                        t.popts.tilt_tolerance_deg,
+                        budget,
+                    ))
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The cut `input` solved again with its tool axes chosen within the cones: a pose that
+/// `need`s a tilt holds its clearing axis, the others their tolerance (the path options'
+/// own tilt tolerance then 0: the axes are given).
+///
+/// # Errors
+/// The solver's refusal, in words.
+fn solve_tilted(
+    machine: &Machine,
+    input: &PathInput<'_>,
+    need: &[Option<(f64, Vector3<f64>)>],
+    popts: &PathOptions,
+) -> Result<SolvedPath, String> {
+    let normals = input.poses;
+    let cones: Vec<Cone> = normals
+        .iter()
+        .zip(need)
+        .map(|(pose, req)| match req {
+            Some((a, d)) => Cone {
+                axis: tilted(&pose.axis, d, *a),
+                half_angle_deg: 0.0,
+            },
+            None => Cone {
+                axis: pose.axis,
+                half_angle_deg: popts.tilt_tolerance_deg,
+            },
+        })
+        .collect();
+    let choice = tilt_within_cones(normals, &cones, popts.tilt_tolerance_deg);
+    let poses: Vec<Pose> = normals
+        .iter()
+        .zip(&choice.axes)
+        .map(|(p, a)| Pose {
+            position: p.position,
+            axis: *a,
+        })
+        .collect();
+    let tilted_input = PathInput {
+        id: input.id,
+        poses: &poses,
+        curve: input.curve,
+    };
+    let fixed = (*popts).with_tilt_tolerance_deg(0.0);
+    let mut s = solve_path(machine, &tilted_input, &fixed)
+        .map_err(|e| format!("the tilted path cannot be solved: {e}"))?;
+    s.tilt = Some(choice.report);
+    Ok(s)
 }
 
 /// The tilt away from the surface in the way that would clear cutting point `i` (`pose`, its

@@ -47,6 +47,7 @@ mod post;
 pub mod ranges;
 mod report;
 mod run;
+mod stages;
 mod timing;
 mod traverses;
 mod view;

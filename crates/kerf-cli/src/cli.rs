@@ -87,8 +87,9 @@ pub(crate) enum Command {
     )]
     Interpolate(InterpolateArgs),
 
-    /// Write the G-code program of a path: generic `G1 X Y Z A C F` or Sinumerik TRAORI with
-    /// `CIP` arcs.
+    /// Write the G-code program of a path in one of eight dialects (--dialect): raw machine
+    /// axes (generic, linuxcnc) or the controller's tool-tip control (sinumerik TRAORI with
+    /// CIP arcs, linuxcnc-tcp, fanuc, fanuc-ijk, heidenhain, heidenhain-axes).
     #[command(
         after_help = "Examples:\n  kerf gcode part.axes.json -m fixtures/machines/ac_head.json --feed 6000 -o part.nc\n  kerf gcode part.toolpath.json -m fixtures/machines/ac_head.json --feed 6000 --dialect sinumerik -o part.mpf\n  kerf gcode part.axes.json -m fixtures/machines/ac_head.json --feed 6000 --dialect linuxcnc -o part.ngc"
     )]
@@ -120,7 +121,7 @@ pub(crate) enum Command {
     )]
     Plot(crate::plot::PlotArgs),
 
-    /// Read a STEP file's cut contours and the faces they lie on into kerf.curves/1.
+    /// Read a STEP or IGES file's cut contours and the faces they lie on into kerf.curves/1.
     ///
     /// Takes the curves of the geometric sets (composite curves joined into one NURBS curve
     /// each, C0 at every join, gaps up to --close-gaps closed, larger gaps opened), or with

@@ -218,6 +218,28 @@ fn every_reference_in_the_docs_resolves_inside_the_repository() {
     );
 }
 
+/// The picture of the architecture names every crate of the workspace (redraw it with
+/// `scripts/architecture_svg.py` when one is added).
+#[test]
+fn the_architecture_picture_names_every_crate() {
+    let svg = std::fs::read_to_string(root().join("docs/architecture.svg")).expect("the picture");
+    let crates: Vec<String> = std::fs::read_dir(root().join("crates"))
+        .expect("crates/")
+        .flatten()
+        .filter(|e| e.path().join("Cargo.toml").exists())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(crates.len() >= 10, "{crates:?}");
+    let missing: Vec<&String> = crates
+        .iter()
+        .filter(|c| !svg.contains(&format!(">{c}</text>")))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "not in docs/architecture.svg: {missing:?}"
+    );
+}
+
 #[test]
 fn the_checks_catch_what_they_look_for() {
     assert_eq!(slug(" The head along the cuts"), "the-head-along-the-cuts");

@@ -170,7 +170,14 @@ pub fn rapid_moves(
     traverse: &Traverse,
     opts: &TraverseOptions,
 ) -> Result<RapidMoves> {
-    rapid_moves_within(kin, obs, end_axes, start_axes, traverse, opts, None)
+    rapid_moves_within(kin, obs, end_axes, start_axes, traverse, opts, None).map_err(|r| r.error)
+}
+
+/// Why the machine's own moves along a route are refused: the blockage, and whether the split
+/// that would clear it leaves the axis limits.
+struct MovesRefused {
+    error: ProcessError,
+    outside_limits: bool,
 }
 
 /// True when every limited axis of `q` lies inside its range, a thousandth of the range
@@ -197,7 +204,7 @@ fn rapid_moves_within(
     traverse: &Traverse,
     opts: &TraverseOptions,
     limits: Option<&[Option<(f64, f64)>; 5]>,
-) -> Result<RapidMoves> {
+) -> std::result::Result<RapidMoves, MovesRefused> {
     let tilt = limits.and_then(|l| l[3]);
     let c = opts.clearance_mm;
     let step = c / 8.0;
@@ -280,13 +287,16 @@ fn rapid_moves_within(
                     break;
                 }
                 Some((at, d)) if pieces >= MAX_SPLIT => {
-                    return Err(blocked(
-                        at,
-                        d,
-                        format!(
+                    return Err(MovesRefused {
+                        outside_limits: false,
+                        error: blocked(
+                            at,
+                            d,
+                            format!(
                             "the machine's rapid move swings too close even split {MAX_SPLIT} times"
                         ),
-                    ));
+                        ),
+                    });
                 }
                 Some((at, d)) => {
                     pieces *= 2;
@@ -295,11 +305,14 @@ fn rapid_moves_within(
                         (1..pieces).any(|j| !inside_limits(&split_at(j as f64 / pieces as f64), l))
                     });
                     if outside {
-                        return Err(blocked(
+                        return Err(MovesRefused {
+                            outside_limits: true,
+                            error: blocked(
                             at,
                             d,
                             "the machine's rapid move swings too close, and the points that would split it leave the axis limits".into(),
-                        ));
+                        ),
+                        });
                     }
                 }
             }
@@ -502,9 +515,18 @@ pub fn plan_rapids(
                             opts,
                             Some(limits),
                         )
-                        .map_err(|e| match e {
-                            ProcessError::TraverseBlocked(b) => (Point3::from(b.at), b.distance_mm),
-                            _ => (Point3::from(g.from_contour), 0.0),
+                        .map_err(|r| {
+                            let (at, distance) = match r.error {
+                                ProcessError::TraverseBlocked(b) => {
+                                    (Point3::from(b.at), b.distance_mm)
+                                }
+                                _ => (Point3::from(g.from_contour), 0.0),
+                            };
+                            crate::traverse::Refusal {
+                                at,
+                                distance,
+                                outside_limits: r.outside_limits,
+                            }
                         })
                     },
                     explain,

@@ -23,5 +23,5 @@ mod tessellated;
 pub use check::check_move;
 pub use obstacles::Obstacles;
 pub use options::TraverseOptions;
-pub(crate) use routes::plan_traverse_accepting;
 pub use routes::{plan_traverse, plan_traverse_within, Route, Traverse};
+pub(crate) use routes::{plan_traverse_accepting, Refusal};

@@ -125,8 +125,9 @@ fn move_key(a: &PoseArray, b: &PoseArray) -> MoveKey {
 enum Coarse {
     /// Outside the machine's axis limits (not checked).
     Unreachable,
-    /// Clear, but refused by the caller's check, at this point.
-    Refused(Blocked),
+    /// Clear, but refused by the caller's check, at this point; `true` where the split that
+    /// would clear the machine's own move leaves the axis limits.
+    Refused(Blocked, bool),
     /// Its check failed so.
     Failed(Blocked),
     /// A point of it was measured closer than the clearance: its check cannot pass, and is
@@ -186,6 +187,9 @@ struct Tally {
     unreachable: usize,
     /// Clear, but refused by the caller's check (the machine's rapid swing).
     refused: usize,
+    /// Of those, the routes whose swing a split would clear but whose split points leave the
+    /// axis limits.
+    refused_limits: usize,
     /// A sample measured closer than the clearance.
     closer: usize,
     /// Not proven: within the finest margin, or the work budget ran out.
@@ -220,12 +224,21 @@ impl Tally {
     ) -> Option<(Traverse, T)> {
         match accept(&t) {
             Ok(v) => Some((t, v)),
-            Err((at, distance)) => {
-                self.refused += 1;
-                self.note(Blocked::at(at, distance));
+            Err(r) => {
+                self.refuse(Blocked::at(r.at, r.distance), r.outside_limits);
                 None
             }
         }
+    }
+
+    /// A clear route the caller's check refused at `b` (`outside_limits`: its split would
+    /// leave the axis limits).
+    fn refuse(&mut self, b: Blocked, outside_limits: bool) {
+        self.refused += 1;
+        if outside_limits {
+            self.refused_limits += 1;
+        }
+        self.note(b);
     }
 }
 
@@ -240,9 +253,17 @@ fn traverse_of(length_mm: f64, route: Route, waypoints: &[PoseArray], least: f64
     }
 }
 
-/// Why a route was refused by the caller's own check (e.g. the machine's rapid swing): the
-/// first offending point and its distance, mm.
-pub(crate) type Refusal = (Point3<f64>, f64);
+/// Why a route was refused by the caller's own check (e.g. the machine's rapid swing).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Refusal {
+    /// The first offending point.
+    pub(crate) at: Point3<f64>,
+    /// Its distance from the part, mm.
+    pub(crate) distance: f64,
+    /// True where the move could be cleared by splitting it but the split points leave the
+    /// machine's axis limits.
+    pub(crate) outside_limits: bool,
+}
 
 /// An axial move's check: the retract point reached, or why it is blocked.
 type AxialOutcome = std::result::Result<PoseArray, Blocked>;
@@ -472,8 +493,11 @@ pub(crate) fn plan_traverse_accepting<T>(
                 let t = traverse_of(*length_mm, *route, waypoints, least);
                 match accept(&t) {
                     Ok(v) => return Ok((t, v)),
-                    Err((at, distance)) => {
-                        outcomes.push(Coarse::Refused(Blocked::at(at, distance)));
+                    Err(r) => {
+                        outcomes.push(Coarse::Refused(
+                            Blocked::at(r.at, r.distance),
+                            r.outside_limits,
+                        ));
                     }
                 }
             }
@@ -538,7 +562,9 @@ pub(crate) fn plan_traverse_accepting<T>(
                             let t = traverse_of(*length_mm, *route, waypoints, least);
                             match accept(&t) {
                                 Ok(v) => return Ok((t, v)),
-                                Err((at, distance)) => Coarse::Refused(Blocked::at(at, distance)),
+                                Err(r) => {
+                                    Coarse::Refused(Blocked::at(r.at, r.distance), r.outside_limits)
+                                }
                             }
                         }
                         Err(e) => Coarse::Failed(e),
@@ -548,10 +574,7 @@ pub(crate) fn plan_traverse_accepting<T>(
             };
             match outcome {
                 Coarse::Unreachable => tally.unreachable += 1,
-                Coarse::Refused(b) => {
-                    tally.refused += 1;
-                    tally.note(b);
-                }
+                Coarse::Refused(b, outside_limits) => tally.refuse(b, outside_limits),
                 Coarse::Failed(e) if e.within_margin(c) => marginal.push((k, e)),
                 Coarse::Failed(e) => tally.failed(e, c),
                 Coarse::Deferred | Coarse::Absent => unreachable!("traced or left out above"),
@@ -619,12 +642,20 @@ pub(crate) fn plan_traverse_accepting<T>(
             format!("none of the {n} routes lies within the machine's axis limits")
         } else {
             format!(
-                "{} of {n} routes come too close ({} measured closer than the clearance, {} not proven within a margin of {:.4} mm or the work budget), {} of them only in the machine's rapid swing, {} leave the axis limits",
+                "{} of {n} routes come too close ({} measured closer than the clearance, {} not proven within a margin of {:.4} mm or the work budget), {} of them only in the machine's rapid swing{}, {} leave the axis limits",
                 n - tally.unreachable,
                 tally.closer,
                 tally.undecided,
                 c * super::check::FINEST_MARGIN,
                 tally.refused,
+                if tally.refused_limits > 0 {
+                    format!(
+                        " ({} where the split that would clear it leaves the axis limits)",
+                        tally.refused_limits
+                    )
+                } else {
+                    String::new()
+                },
                 tally.unreachable
             )
         }
@@ -722,4 +753,57 @@ pub(crate) fn plan_traverse_accepting<T>(
     let why = tally_text(&tally, n) + &search_note;
     let b = tally.nearest.unwrap_or(Blocked::at(position(&from), 0.0));
     Err(blocked_err(b, why))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every route clear of an empty part, every one refused by the caller: the gap's error
+    /// counts them as the machine's swing, and says how many of those only a split outside
+    /// the axis limits would clear.
+    fn refused_everywhere(outside_limits: bool) -> String {
+        let obs = Obstacles::new();
+        let from = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        let to = [50.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        let mut offered = 0;
+        let e = plan_traverse_accepting(
+            &obs,
+            &from,
+            &to,
+            &TraverseOptions::default(),
+            &|_: &[PoseArray]| true,
+            &mut |t: &Traverse| -> std::result::Result<(), Refusal> {
+                offered += 1;
+                let w = t.waypoints[t.waypoints.len() / 2];
+                Err(Refusal {
+                    at: Point3::new(w[0], w[1], w[2]),
+                    distance: 1.0,
+                    outside_limits,
+                })
+            },
+            true,
+        )
+        .expect_err("every route refused");
+        assert!(offered > 0, "routes were offered");
+        let text = e.to_string();
+        assert!(
+            text.contains(&format!(
+                "{offered} of them only in the machine's rapid swing"
+            )),
+            "{offered} offered: {text}"
+        );
+        text
+    }
+
+    #[test]
+    fn routes_whose_split_leaves_the_limits_are_told_apart() {
+        let within = refused_everywhere(false);
+        assert!(!within.contains("leaves the axis limits"), "{within}");
+        let outside = refused_everywhere(true);
+        assert!(
+            outside.contains("where the split that would clear it leaves the axis limits"),
+            "{outside}"
+        );
+    }
 }

@@ -31,7 +31,7 @@ use crate::block::{Block, Station, MIN_TRAVEL};
 use crate::error::{positive, InterpError, Result};
 use crate::geometry::SpaceArc;
 use crate::model::AxisModel;
-use kerf_nurbs::nearest_on_segment;
+use kerf_nurbs::{nearest_on_segment, CurvePoint};
 
 /// Options of [`fit_blocks`].
 #[derive(Debug, Clone, PartialEq)]
@@ -186,8 +186,9 @@ impl BlockCounts {
     }
 }
 
-/// A curve point at a parameter: `|t| curve.point(t)`.
-pub type CurveFn<'a> = &'a dyn Fn(f64) -> Point3<f64>;
+/// A path's curve for the arc fit's curve test: any [`CurvePoint`] (a NURBS curve, a
+/// closure `|t| curve.point(t)`, a placed or offset contour).
+pub type CurveFn<'a> = &'a dyn CurvePoint;
 
 /// Fits blocks to the stations of one path (see the module documentation). Without a curve
 /// (or when a station has no parameter) the polyline stands in for the curve.
@@ -231,7 +232,7 @@ pub fn fit_blocks<M: AxisModel + ?Sized>(
             let k = opts.curve_samples;
             Some(
                 (1..=k)
-                    .map(|m| f(a + (b - a) * m as f64 / (k + 1) as f64))
+                    .map(|m| f.point_at(a + (b - a) * m as f64 / (k + 1) as f64))
                     .collect(),
             )
         })

@@ -37,7 +37,6 @@
 //! circle ([`crate::nonlinear::slerp`]). Inserted poses are solved with the same continuity
 //! rule, and split again if needed.
 
-use nalgebra::Point3;
 use rayon::prelude::*;
 
 use crate::error::{KinematicsError, Result};
@@ -189,8 +188,9 @@ pub struct PathCurve<'a> {
     /// The curve parameter of each cutting point (`params` of `kerf.toolpath/1`); strictly
     /// increasing, one per pose.
     pub params: &'a [f64],
-    /// The curve point at a parameter.
-    pub point: &'a (dyn Fn(f64) -> Point3<f64> + Sync),
+    /// The curve point at a parameter (any [`kerf_nurbs::CurvePoint`]: a NURBS curve, a
+    /// closure, a placed or offset contour).
+    pub point: &'a (dyn kerf_nurbs::CurvePoint + Sync),
 }
 
 impl std::fmt::Debug for PathCurve<'_> {

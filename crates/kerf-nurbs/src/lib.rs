@@ -33,6 +33,7 @@ mod error;
 mod geom;
 mod knots;
 mod local;
+mod param;
 #[cfg(feature = "samples")]
 mod samples;
 mod shapes;
@@ -54,6 +55,7 @@ pub use error::{NurbsError, Readable, Result};
 pub use geom::{distance_to_segment, nearest_on_segment, Segment};
 pub use knots::{find_span, interior_knots, multiplicity, validate as validate_knots};
 pub use local::{is_power_of_two, LocalCurve};
+pub use param::CurvePoint;
 #[cfg(feature = "samples")]
 pub use samples::{smooth_random_curves, Lcg};
 pub use surface::{NurbsSurface, SurfaceProjection};

@@ -26,7 +26,7 @@ use crate::report::{
 };
 
 /// A point function of a cut path (part coordinates).
-type PointFn = Box<dyn Fn(f64) -> Point3<f64> + Sync>;
+type PointFn = Box<dyn kerf_nurbs::CurvePoint + Sync>;
 
 /// One cut: a contour with its lead-in and lead-out, ready for the kinematics.
 pub(crate) struct CutPath {
@@ -386,9 +386,9 @@ fn cut_path(
         } else if u > u_e && q > 0 {
             along(&lead_out, (u - u_e) / step)
         } else if u > t_end {
-            contour((u - period).clamp(t0, t_end))
+            contour.point_at((u - period).clamp(t0, t_end))
         } else {
-            contour(u.clamp(t0, t_end))
+            contour.point_at(u.clamp(t0, t_end))
         }
     });
     CutPath {

@@ -355,7 +355,7 @@ pub(crate) fn record_offsets(toolpath: &mut ToolpathFile, compensated: &[Compens
 }
 
 /// Each cut's exact point function, placed (workpiece coordinates).
-pub(crate) type PlacedCurve<'a> = Box<dyn Fn(f64) -> Point3<f64> + Sync + 'a>;
+pub(crate) type PlacedCurve<'a> = Box<dyn kerf_nurbs::CurvePoint + Sync + 'a>;
 
 /// The placed point function of every cut.
 pub(crate) fn placed_curves<'a>(cuts: &'a [CutPath], placed: &Placed) -> Vec<PlacedCurve<'a>> {
@@ -363,7 +363,7 @@ pub(crate) fn placed_curves<'a>(cuts: &'a [CutPath], placed: &Placed) -> Vec<Pla
         .map(|c| {
             let placement = placed.placement_of(c.curve);
             let f = &c.point;
-            Box::new(move |u| placement.apply_point(&f(u))) as PlacedCurve<'a>
+            Box::new(move |u| placement.apply_point(&f.point_at(u))) as PlacedCurve<'a>
         })
         .collect()
 }
@@ -742,7 +742,7 @@ fn setup_program(
     let mut ids: Vec<String> = Vec::new();
     for &k in &in_setup {
         let sp = &solved[k];
-        let curve: &(dyn Fn(f64) -> Point3<f64> + Sync) = s.points[k].as_ref();
+        let curve: &dyn kerf_nurbs::CurvePoint = s.points[k].as_ref();
         // What `kerf_interp::interpolate_through` does, path by path.
         let stations = stations_from_solved(sp, Some(&cuts[k].params)).map_err(interp(path))?;
         fitted.push(

@@ -354,7 +354,7 @@ impl Ctx<'_> {
         };
         let position = match (param, self.curve) {
             (Some(t), Some(curve)) => {
-                let p = (curve.point)(t);
+                let p = curve.point.point_at(t);
                 if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
                     return Err(KinematicsError::BadPose {
                         path_id: self.id.to_owned(),

@@ -24,7 +24,7 @@ STAGES = [
     ("kerf-format", ["read and check every value", "(kerf-io: bounded, atomic I/O)"], "kerf validate"),
     ("kerf-discretize", ["cutting points, chord error", "proven per segment"], "stages::discretize"),
     ("kerf-normals", ["surface normal per point,", "normal-step insertion"], "stages::orient"),
-    ("kerf-process", ["scrap side, kerf offset, start,", "leads, order, head, traverses"], "stages::plan_cuts"),
+    ("kerf-process", ["scrap side, kerf offset, start,", "leads, order, head, traverses"], "plan_cuts, solve, programs"),
     ("kerf-kinematics", ["placement, inverse kinematics,", "limits, pole, non-linearity"], "stages::place, solve; kerf post"),
     ("kerf-interp", ["fit, feed plan within every", "axis limit, G-code (8 dialects)"], "stages::programs; kerf gcode"),
     ("kerf-view / kerf-plot", ["3D view, picture,", "typed report"], "stages::output; kerf view"),
@@ -96,7 +96,7 @@ def main():
     x0, y0 = 20, 120
     out.append(text(width / 2, 30, "kerf: the stages of a run, the files between them, and the crates", 18, "bold"))
     out.append(text(x0, 62, "in: " + "  |  ".join(FILES_IN), 12, anchor="start"))
-    out.append(text(x0, 82, "kerf run (kerf_pipeline::Job::run; run_placed calls the stages of stages.rs in this order):", 12, anchor="start", fill="#555"))
+    out.append(text(x0, 82, "kerf run (kerf_pipeline::Job::run): the crates that do the work, in data-flow order, with the functions of stages.rs (and the commands) that call them:", 12, anchor="start", fill="#555"))
     for i, (crate, lines, cmd) in enumerate(STAGES):
         x = x0 + i * (box_w + gap)
         out.append(f'<rect x="{x}" y="{y0}" width="{box_w}" height="{box_h}" rx="6" fill="#eef4fb" stroke="#4a77a8"/>')

@@ -61,7 +61,7 @@ fn anchors(text: &str) -> HashSet<String> {
     let mut out = HashSet::new();
     let mut code = false;
     for line in text.lines() {
-        if line.starts_with("```") {
+        if line.trim_start().starts_with("```") {
             code = !code;
         }
         if code || !line.starts_with('#') {
@@ -98,22 +98,27 @@ fn links(text: &str) -> Vec<String> {
     out
 }
 
-/// The spans in backticks of `text` (outside code blocks).
+/// The spans in backticks of `text` outside code blocks (a span may wrap onto the next
+/// line, so the text is split as a whole, not line by line).
 fn code_spans(text: &str) -> Vec<String> {
-    let mut out = Vec::new();
+    let mut prose = String::new();
     let mut code = false;
     for line in text.lines() {
-        if line.starts_with("```") {
+        if line.trim_start().starts_with("```") {
             code = !code;
             continue;
         }
-        if code {
-            continue;
+        if !code {
+            prose.push_str(line);
+            prose.push('\n');
         }
-        let parts: Vec<&str> = line.split('`').collect();
-        out.extend(parts.iter().skip(1).step_by(2).map(|s| s.to_string()));
     }
-    out
+    prose
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(|s| s.replace('\n', " "))
+        .collect()
 }
 
 /// Paths the docs name in other projects' sources or as a pattern, not in kerf's: LinuxCNC's
@@ -253,4 +258,8 @@ fn the_checks_catch_what_they_look_for() {
     assert!(repository_path("docs/nothing-here.md").is_some_and(|p| !p[0].exists()));
     assert!(repository_path("kerf run --place auto").is_none());
     assert!(repository_path("fixtures/machines/*.json").is_none());
+    assert_eq!(
+        code_spans("a `b\nc` d `docs/x.md`\n```\n`not`\n```\n`e`"),
+        ["b c", "docs/x.md", "e"]
+    );
 }

@@ -1,12 +1,14 @@
 //! [`Report`]: what a run did, stage by stage, as typed fields; `report.json` is its
 //! serialization (`docs/formats.md`, "report.json", names every key).
 //!
-//! Each stage's figures are a struct of their own, in the order the stages run. Sections that
-//! only exist with an option are `Option`s (`technology`, `micro_joints`, `kinematics.tilt`);
-//! sections that say they did nothing without one (`compensation`, `head`, `traverses`) carry a
-//! `note` and leave their figures `None` (left out of the JSON). Lengths are mm, times s,
-//! angles degrees, as each field's name says. Points are `[x, y, z]` in the set-up's workpiece
-//! frame unless a field says otherwise.
+//! Each stage's figures are a struct of their own, in the order the stages run; the JSON keys
+//! come in the order of the fields. Sections that only exist with an option are `Option`s,
+//! `null` without it (`technology`, `micro_joints`, `kinematics.tilt`); sections that say they
+//! did nothing without one (`compensation`, `head`, `traverses`) carry their flag
+//! (`checked: false`) or a `null` `kerf_width_mm` and a `note`, and leave their other figures
+//! `None`, which the JSON leaves out. Lengths are mm, times s, angles degrees, as each field's
+//! name says. Points are `[x, y, z]` in the set-up's workpiece frame unless a field says
+//! otherwise.
 
 use std::collections::BTreeMap;
 
@@ -60,7 +62,9 @@ pub struct Report {
     pub traverses: TraversesReport,
     /// The planned motion.
     pub interpolation: InterpolationReport,
-    /// Wall seconds of the run (the job's stages, not the CLI's reading of its files).
+    /// Wall seconds of the run's last pass through the stages: not the CLI's reading of its
+    /// files, nor the `--place auto` searches a wider margin replaced (those are in
+    /// [`timings`](Self::timings) as `earlier placements`).
     pub seconds: f64,
     /// Wall and CPU seconds per stage, the CLI's `read` and `write` included once it adds them.
     pub timings: Timings,
@@ -156,7 +160,7 @@ pub struct TiltTotals {
     pub rotary_travel_exact_deg: f64,
     /// The rotary travel of the chosen axes, degrees.
     pub rotary_travel_deg: f64,
-    /// The same per path.
+    /// The same per path whose axes the tolerance chose.
     pub paths: Vec<TiltPath>,
 }
 
@@ -200,7 +204,7 @@ pub struct CompensationReport {
     /// Every path offset with a proven certificate.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub proven: Option<bool>,
-    /// Per path.
+    /// Per contour, in the file's order (`None` without a kerf).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub paths: Option<Vec<CompensationPath>>,
     /// What the figures mean.
@@ -297,7 +301,7 @@ pub struct MicroJointsReport {
     pub length_mm: f64,
     /// The cut between joints, mm.
     pub spacing_mm: f64,
-    /// Per contour with joints.
+    /// Per contour with joints (contours without any are not listed).
     pub paths: Vec<MicroJointPath>,
     /// The joints no place was found for, as warnings.
     pub left_out: Vec<String>,
@@ -323,7 +327,7 @@ pub struct MicroJoint {
     pub end_mm: f64,
     /// Its start, mm, in the set-up's workpiece frame.
     pub start: [f64; 3],
-    /// Its end, mm.
+    /// Its end, mm, in the same frame.
     pub end: [f64; 3],
 }
 
@@ -349,7 +353,7 @@ pub struct HeadReport {
     /// was checked).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tip_zone_mm: Option<Option<f64>>,
-    /// Per path.
+    /// Per path checked, in cutting order within each set-up (`None` without the check).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub paths: Option<Vec<HeadPath>>,
     /// What the figures mean.
@@ -415,13 +419,15 @@ pub struct PlacementReport {
     pub mode: String,
     /// How `rotation_deg` turns the part.
     pub rotation_order: String,
-    /// One per set-up.
+    /// One per set-up (the part clamped anew), in the order the programs run.
     pub setups: Vec<SetupReport>,
     /// Paths solved by the search (`None` for a given placement).
     pub paths_solved: Option<usize>,
     /// Paths cut from the other side of the sheet.
     pub flipped_paths: Vec<String>,
-    /// Each path's side and why.
+    /// The paths turned to the other side of the sheet, or kept on the given side although
+    /// the nozzle meets the part there, each with the reason (paths cut as given without a
+    /// question are not listed).
     pub sides: Vec<SideReport>,
     /// What the sides mean.
     pub sides_note: String,
@@ -461,7 +467,8 @@ pub struct SideReport {
     pub id: String,
     /// `given` (the tool axis is the surface's normal) or `other`.
     pub side: String,
-    /// Why.
+    /// Why it is cut from that side, in words (how many of the nozzle line's points meet the
+    /// part from each side, or the reach).
     pub reason: String,
 }
 
@@ -646,7 +653,7 @@ pub struct InterpolationReport {
     pub duration_s: f64,
     /// The share of the cutting time at the full feed.
     pub time_share_at_feed: f64,
-    /// Per path.
+    /// Per path of every set-up, in cutting order.
     pub paths: Vec<PathMotion>,
 }
 

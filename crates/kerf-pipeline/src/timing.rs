@@ -12,8 +12,8 @@ use std::time::{Duration, Instant};
 #[non_exhaustive]
 pub struct StageTime {
     /// The stage (`read`, `discretize`, `normals`, `sides`, `place`, `cuts`, `kinematics`,
-    /// `traverses`, `plan`, `gcode`, `report`, `write`; `earlier placements` for the searches
-    /// that a wider margin replaced).
+    /// `head` (with a cut clearance), `traverses`, `plan`, `gcode`, `view`, `report`, `write`;
+    /// `earlier placements` for the searches that a wider margin replaced).
     pub stage: &'static str,
     /// Wall-clock seconds.
     pub wall_s: f64,

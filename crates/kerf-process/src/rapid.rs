@@ -287,15 +287,12 @@ fn rapid_moves_within(
                     break;
                 }
                 Some((at, d)) if pieces >= MAX_SPLIT => {
+                    let why = format!(
+                        "the machine's rapid move swings too close even split {MAX_SPLIT} times"
+                    );
                     return Err(MovesRefused {
                         outside_limits: false,
-                        error: blocked(
-                            at,
-                            d,
-                            format!(
-                            "the machine's rapid move swings too close even split {MAX_SPLIT} times"
-                        ),
-                        ),
+                        error: blocked(at, d, why),
                     });
                 }
                 Some((at, d)) => {
@@ -305,13 +302,10 @@ fn rapid_moves_within(
                         (1..pieces).any(|j| !inside_limits(&split_at(j as f64 / pieces as f64), l))
                     });
                     if outside {
+                        let why = "the machine's rapid move swings too close, and the points that would split it leave the axis limits";
                         return Err(MovesRefused {
                             outside_limits: true,
-                            error: blocked(
-                            at,
-                            d,
-                            "the machine's rapid move swings too close, and the points that would split it leave the axis limits".into(),
-                        ),
+                            error: blocked(at, d, why.into()),
                         });
                     }
                 }

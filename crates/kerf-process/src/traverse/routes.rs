@@ -801,8 +801,16 @@ mod tests {
         let within = refused_everywhere(false);
         assert!(!within.contains("leaves the axis limits"), "{within}");
         let outside = refused_everywhere(true);
+        // Every route refused so: the count is every route offered.
+        let offered = outside
+            .split(" of them only in the machine's rapid swing")
+            .next()
+            .and_then(|s| s.rsplit(", ").next())
+            .expect("the swing count");
         assert!(
-            outside.contains("where the split that would clear it leaves the axis limits"),
+            outside.contains(&format!(
+                "({offered} where the split that would clear it leaves the axis limits)"
+            )),
             "{outside}"
         );
     }

@@ -12,8 +12,9 @@
 //! Siblings get the same rule one level down: the child modules of any module (`src/a/x.rs`,
 //! `src/a/y.rs`, ...) must use each other without a cycle, where `x` uses `y` when its source
 //! names `super::y` or `crate::a::y` (the parent, which declares them, is not a node). A glob
-//! `use super::*` hides which of the parent's imports a child uses and is not followed (test
-//! modules use it for their own parent): children that use their siblings should name them.
+//! `use super::*` would hide which of the parent's imports a child uses, so no library module
+//! has one (`no_library_module_imports_a_glob`; test modules, `tests.rs` files and inline
+//! `mod tests`, use it for their own parent).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -335,6 +336,70 @@ fn no_crate_has_a_module_cycle() {
         }
     }
     assert!(cycles.is_empty(), "module cycles:\n{}", cycles.join("\n"));
+}
+
+/// Every `.rs` file under `dir`, recursively.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in fs::read_dir(dir).expect("readable").flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// The glob imports of the crate's own modules (`use super::*;`, `use crate::a::*;`,
+/// `use self::b::*;`) in a library file's module scope: lines that start at column 0 (an
+/// inline `mod tests` indents its own). Another crate's prelude (`rayon::prelude::*`) is not
+/// one of them.
+fn module_globs(text: &str) -> Vec<String> {
+    text.lines()
+        .filter(|l| {
+            let l = l.trim_end();
+            let path = l
+                .strip_prefix("pub(crate) use ")
+                .or_else(|| l.strip_prefix("pub use "))
+                .or_else(|| l.strip_prefix("use "));
+            path.is_some_and(|p| {
+                ["super::", "crate::", "self::"]
+                    .iter()
+                    .any(|k| p.starts_with(k))
+                    && p.ends_with("::*;")
+            })
+        })
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn no_library_module_imports_a_glob() {
+    assert_eq!(
+        module_globs("use super::*;\n    use super::*;\nuse a::b;"),
+        ["use super::*;"]
+    );
+    let mut found = Vec::new();
+    for src in crate_dirs() {
+        let mut files = Vec::new();
+        rust_files(&src, &mut files);
+        for f in files {
+            if f.file_name().is_some_and(|n| n == "tests.rs") {
+                continue;
+            }
+            let text = fs::read_to_string(&f).expect("readable");
+            found.extend(
+                module_globs(&text)
+                    .into_iter()
+                    .map(|g| format!("{}: {g}", f.display())),
+            );
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "glob imports hide which modules a module uses:\n{}",
+        found.join("\n")
+    );
 }
 
 #[test]

@@ -33,15 +33,15 @@ use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
 
 use crate::error::{KinematicsError, Result};
 use crate::machine::{Machine, Range};
-use crate::path::{solve_paths, PathInput, PathOptions, SolvedPath};
-use crate::pose::{Axes, Pose};
+use crate::path::{PathOptions, SolvedPath};
+use crate::pose::Pose;
 
 mod directions;
 mod setups;
 mod shift;
 mod work;
 
-use directions::{reachable_directions, turn_up, up_directions};
+use directions::{turn_up, up_directions};
 pub use setups::{auto_setups, Setup, SetupPlan};
 use shift::translation;
 use work::Work;

@@ -1,7 +1,11 @@
 //! The directions of the part that may point up, and which of them the machine's tilt axis
 //! serves for each path: what the set-up search and the candidate solves share.
 
-use super::*;
+use nalgebra::{Point3, Rotation3, Vector3};
+
+use super::tilt_reachable_within;
+use crate::machine::Machine;
+use crate::pose::Pose;
 
 /// The directions of the part that may be turned to point up: a Fibonacci lattice of 2,048
 /// unit vectors, evenly spread over the sphere (neighbours about 4.5 degrees apart).

@@ -1,6 +1,13 @@
 //! Set-ups: groups of contours placed separately when the part does not fit in one.
 
-use super::*;
+use nalgebra::Vector3;
+
+use super::directions::up_directions;
+use super::work::Work;
+use super::{auto_place, place_paths, search, validate, AutoPlaceOptions, Placement};
+use crate::error::{KinematicsError, Result};
+use crate::machine::Machine;
+use crate::pose::Pose;
 /// One set-up: contours cut with the part clamped in one placement.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Setup {

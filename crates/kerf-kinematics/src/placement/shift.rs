@@ -1,6 +1,11 @@
 //! The translation that puts the placed part's poses within the linear limits.
 
-use super::*;
+use nalgebra::{Matrix3, Vector3};
+
+use super::Shortfall;
+use crate::machine::{Machine, Range};
+use crate::path::SolvedPath;
+use crate::pose::Axes;
 /// `M` of a pose: how the linear axes move when the tip moves, with the rotary axes fixed
 /// (`XYZ = M P + b`). The forward kinematics is affine in `XYZ` at fixed rotaries, so the
 /// columns of its matrix `N` are exact differences, and `M = N^-1`.

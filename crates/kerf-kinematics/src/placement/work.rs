@@ -9,8 +9,15 @@ use std::sync::{Mutex, OnceLock};
 
 use rayon::prelude::*;
 
-use super::*;
+use nalgebra::{Matrix3, Rotation3};
+
+use super::directions::{reachable_directions, up_directions};
+use super::{AutoPlaceOptions, Shortfall};
+use crate::error::Result;
+use crate::machine::{Machine, Range};
 use crate::path::solve_path;
+use crate::path::{solve_paths, PathInput, SolvedPath};
+use crate::pose::{Axes, Pose};
 
 /// A solved path (linear axes free), or why it does not solve.
 type Solve = Result<SolvedPath>;
@@ -65,7 +72,7 @@ impl<'a> Work<'a> {
         let head = [(0.0, 0.0), (30.0, 45.0), (-60.0, 200.0), (90.0, -120.0)]
             .iter()
             .all(|&(t, c)| {
-                let m = shift::tip_to_axes(machine, &Axes::new(0.0, 0.0, 0.0, t, c));
+                let m = super::shift::tip_to_axes(machine, &Axes::new(0.0, 0.0, 0.0, t, c));
                 (m - Matrix3::identity()).amax() <= 1e-9
             });
         Self {
@@ -239,6 +246,7 @@ impl<'a> Work<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::{Point3, Vector3};
 
     /// The ranges the cheap bound rests on hold the solver's own choice: every solved cutting
     /// point's linear axes lie in its range, on and off the pole, on both head types.

@@ -98,27 +98,36 @@ fn links(text: &str) -> Vec<String> {
     out
 }
 
-/// The spans in backticks of `text` outside code blocks (a span may wrap onto the next
-/// line, so the text is split as a whole, not line by line).
-fn code_spans(text: &str) -> Vec<String> {
+/// The spans in backticks of `text` outside code blocks, paragraph by paragraph (a span may
+/// wrap onto the next line, never past a blank one); a paragraph with an odd number of
+/// backticks is an error (a stray backtick would turn the rest into unchecked prose).
+fn code_spans(text: &str) -> Result<Vec<String>, String> {
     let mut prose = String::new();
     let mut code = false;
     for line in text.lines() {
         if line.trim_start().starts_with("```") {
             code = !code;
+            prose.push('\n');
             continue;
         }
         if !code {
             prose.push_str(line);
-            prose.push('\n');
         }
+        prose.push('\n');
     }
-    prose
-        .split('`')
-        .skip(1)
-        .step_by(2)
-        .map(|s| s.replace('\n', " "))
-        .collect()
+    let mut out = Vec::new();
+    for para in prose.split("\n\n") {
+        if para.matches('`').count() % 2 == 1 {
+            return Err(format!("a stray backtick in: {}", para.trim()));
+        }
+        out.extend(
+            para.split('`')
+                .skip(1)
+                .step_by(2)
+                .map(|s| s.replace('\n', " ")),
+        );
+    }
+    Ok(out)
 }
 
 /// Paths the docs name in other projects' sources or as a pattern, not in kerf's: LinuxCNC's
@@ -204,7 +213,11 @@ fn every_reference_in_the_docs_resolves_inside_the_repository() {
                 }
             }
         }
-        for span in code_spans(&text) {
+        let spans = code_spans(&text).unwrap_or_else(|e| {
+            broken.push(format!("{name}: {e}"));
+            Vec::new()
+        });
+        for span in spans {
             let Some(places) = repository_path(&span) else {
                 continue;
             };
@@ -259,7 +272,11 @@ fn the_checks_catch_what_they_look_for() {
     assert!(repository_path("kerf run --place auto").is_none());
     assert!(repository_path("fixtures/machines/*.json").is_none());
     assert_eq!(
-        code_spans("a `b\nc` d `docs/x.md`\n```\n`not`\n```\n`e`"),
+        code_spans("a `b\nc` d `docs/x.md`\n```\n`not`\n```\n`e`").expect("balanced"),
         ["b c", "docs/x.md", "e"]
+    );
+    assert!(
+        code_spans("a `b\n\nc` d").is_err(),
+        "a span never crosses a blank line"
     );
 }

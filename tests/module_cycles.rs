@@ -351,33 +351,53 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 }
 
 /// The glob imports of the crate's own modules (`use super::*;`, `use crate::a::*;`,
-/// `use self::b::*;`) in a library file's module scope: lines that start at column 0 (an
-/// inline `mod tests` indents its own). Another crate's prelude (`rayon::prelude::*`) is not
-/// one of them.
+/// `use self::b::{*, X};`, at any visibility, over several lines) in a library file's module
+/// scope: `use` items that start at column 0 (an inline `mod tests` indents its own). Another
+/// crate's prelude (`rayon::prelude::*`) is not one of them.
 fn module_globs(text: &str) -> Vec<String> {
-    text.lines()
-        .filter(|l| {
-            let l = l.trim_end();
-            let path = l
-                .strip_prefix("pub(crate) use ")
-                .or_else(|| l.strip_prefix("pub use "))
-                .or_else(|| l.strip_prefix("use "));
-            path.is_some_and(|p| {
-                ["super::", "crate::", "self::"]
-                    .iter()
-                    .any(|k| p.starts_with(k))
-                    && p.ends_with("::*;")
-            })
-        })
-        .map(str::to_string)
-        .collect()
+    let text = strip_comments(text);
+    let mut out = Vec::new();
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        let head = line
+            .strip_prefix("pub(crate) ")
+            .or_else(|| line.strip_prefix("pub(super) "))
+            .or_else(|| line.strip_prefix("pub "))
+            .unwrap_or(line);
+        let Some(path) = head.strip_prefix("use ") else {
+            continue;
+        };
+        // The whole item, to its `;`.
+        let mut item = path.to_string();
+        while !item.contains(';') {
+            match lines.next() {
+                Some(l) => item.push_str(l.trim()),
+                None => break,
+            }
+        }
+        let own = ["super::", "crate::", "self::"]
+            .iter()
+            .any(|k| item.starts_with(k));
+        let glob = item.contains("::*") || item.contains("{*") || item.contains(", *");
+        if own && glob {
+            out.push(format!("use {}", item.trim()));
+        }
+    }
+    out
 }
 
 #[test]
 fn no_library_module_imports_a_glob() {
     assert_eq!(
-        module_globs("use super::*;\n    use super::*;\nuse a::b;"),
-        ["use super::*;"]
+        module_globs(
+            "use super::*;\n    use super::*;\nuse a::b;\nuse rayon::prelude::*;\n\
+             pub(super) use crate::{\n    a::*,\n    b,\n};\nuse self::c::{*, D}; // x\n"
+        ),
+        [
+            "use super::*;",
+            "use crate::{a::*,b,};",
+            "use self::c::{*, D};"
+        ]
     );
     let mut found = Vec::new();
     for src in crate_dirs() {

@@ -277,7 +277,7 @@ pub struct AutoPlacement {
 }
 
 impl AutoPlacement {
-    /// The placed poses of every path (flips applied), ready for [`solve_paths`].
+    /// The placed poses of every path (flips applied), ready for [`solve_paths`](crate::path::solve_paths).
     pub fn apply(&self, paths: &[Vec<Pose>]) -> Vec<Vec<Pose>> {
         place_paths(&self.placement, &self.flipped, paths)
     }
@@ -356,7 +356,7 @@ struct Shortfall {
 ///
 /// # Errors
 /// [`KinematicsError::NoPlacement`] naming the axis and how much travel (or tilt) is missing
-/// for the best candidate; the errors of [`solve_paths`] for unusable poses.
+/// for the best candidate; the errors of [`solve_paths`](crate::path::solve_paths) for unusable poses.
 pub fn auto_place(
     machine: &Machine,
     paths: &[(&str, &[Pose])],

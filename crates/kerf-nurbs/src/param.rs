@@ -8,9 +8,11 @@ use crate::NurbsCurve;
 
 /// A curve evaluated at a parameter, mm.
 ///
-/// Implemented by [`NurbsCurve`] (its [`NurbsCurve::point`]) and by every closure
-/// `Fn(f64) -> Point3<f64>`, so a caller passes `&|t| ...` where a curve is wanted. Where
-/// paths are solved in parallel (`kerf_kinematics::PathCurve`) the curve must also be `Sync`.
+/// Implemented by [`NurbsCurve`] (its [`NurbsCurve::point`]) and by every sized
+/// `Fn(f64) -> Point3<f64>`, so a caller passes `&|t: f64| ...` (the parameter's type named: a
+/// trait object gives the closure no type to infer it from) where a curve is wanted, and an
+/// existing `f: &dyn Fn(f64) -> Point3<f64>` as `&f` (a reference to a `Fn` is one). Where paths are solved in parallel
+/// (`kerf_kinematics::PathCurve`) the curve must also be `Sync`.
 pub trait CurvePoint {
     /// The point at parameter `t`, which the caller keeps within the curve's domain.
     fn point_at(&self, t: f64) -> Point3<f64>;
@@ -43,7 +45,9 @@ mod tests {
         .expect("a line");
         // The line's own closed form, independent of the evaluator.
         let f = |t: f64| Point3::new(2.0 * t, 4.0 * t, 6.0 * t);
-        let curves: [&dyn CurvePoint; 2] = [&c, &f];
+        // A caller's own trait object is a curve too.
+        let g: &dyn Fn(f64) -> Point3<f64> = &f;
+        let curves: [&dyn CurvePoint; 3] = [&c, &f, &g];
         for k in curves {
             for t in [0.0, 0.25, 0.7, 1.0] {
                 assert!((k.point_at(t) - f(t)).norm() < 1e-15, "at {t}");

@@ -1,8 +1,8 @@
 //! [`Report`]: what a run did, stage by stage, as typed fields; `report.json` is its
 //! serialization (`docs/formats.md`, "report.json", names every key).
 //!
-//! Each stage's figures are a struct of their own, in the order the stages run; the JSON keys
-//! come in the order of the fields. Sections that only exist with an option are `Option`s,
+//! Each stage's figures are a struct of their own; the JSON keys come in the order of the
+//! fields (the maps `tolerance_budget_mm` and `traverses.routes` sorted by name). Sections that only exist with an option are `Option`s,
 //! `null` without it (`technology`, `micro_joints`, `kinematics.tilt`); sections that say they
 //! did nothing without one (`compensation`, `head`, `traverses`) carry their flag
 //! (`checked: false`) or a `null` `kerf_width_mm` and a `note`, and leave their other figures
@@ -204,7 +204,7 @@ pub struct CompensationReport {
     /// Every path offset with a proven certificate.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub proven: Option<bool>,
-    /// Per contour, in the file's order (`None` without a kerf).
+    /// Per contour, set-up by set-up in each set-up's order of paths (`None` without a kerf).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub paths: Option<Vec<CompensationPath>>,
     /// What the figures mean.

@@ -25,7 +25,8 @@ type Solve = Result<SolvedPath>;
 /// A free solve's key: the path, the bits of the rotation's matrix, the side.
 type Key = (usize, [u64; 9], bool);
 
-/// The shared work of [`auto_place`] and [`auto_setups`] on one set of paths.
+/// The shared work of [`auto_place`](super::auto_place) and [`auto_setups`](super::auto_setups)
+/// on one set of paths.
 pub(super) struct Work<'a> {
     /// The machine, real limits.
     pub(super) machine: &'a Machine,

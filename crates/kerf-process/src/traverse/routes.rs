@@ -789,7 +789,7 @@ mod tests {
         let text = e.to_string();
         assert!(
             text.contains(&format!(
-                "{offered} of them only in the machine's rapid swing"
+                ", {offered} of them only in the machine's rapid swing"
             )),
             "{offered} offered: {text}"
         );

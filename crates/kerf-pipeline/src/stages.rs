@@ -47,6 +47,7 @@ pub(crate) struct Clock {
 }
 
 impl Clock {
+    /// A clock started now, no stage timed yet.
     pub(crate) fn start() -> Self {
         Self {
             lap: Lap::start(),
@@ -566,7 +567,8 @@ pub(crate) struct Programs {
     pub(crate) warnings: Vec<String>,
 }
 
-/// What one set-up's program is made of, per path.
+/// What every set-up's program is made from: the run's cuts, their axes and the options and
+/// per-cut decisions all set-ups share ([`setup_program`] takes one set-up's paths of them).
 struct SetupShared<'a> {
     r: &'a Run<'a>,
     cuts: &'a Cuts,

@@ -862,7 +862,6 @@ pub(crate) fn output(
     let placement = placement_report(r, &part, attempt);
     let all_warnings = all_warnings(r, &programs.warnings);
     clock.split("report");
-    let small_ids: Vec<&str> = programs.small_ids.iter().map(String::as_str).collect();
     let report = Report {
         input: path.map(|p| p.display().to_string()),
         machine: machine.name.clone(),
@@ -872,7 +871,7 @@ pub(crate) fn output(
         compensation: crate::cuts::compensation_report(file, r.kerf.as_ref(), &cuts.compensated),
         technology: technology_report(
             o.technology.as_ref(),
-            &small_ids,
+            programs.small_ids,
             o.dialect.commands_power(),
         ),
         micro_joints: o
@@ -1117,7 +1116,7 @@ fn technology_header(t: Option<&kerf_kinematics::TechnologyEntry>) -> Vec<String
 /// rule slowed, or null.
 fn technology_report(
     t: Option<&kerf_kinematics::TechnologyEntry>,
-    small_holes: &[&str],
+    small_holes: Vec<String>,
     commands_power: bool,
 ) -> Option<TechnologyReport> {
     let t = t?;
@@ -1141,7 +1140,7 @@ fn technology_report(
         small_hole: t.small_hole,
         corner: t.corner,
         power_min_percent: t.power_min(),
-        small_holes: small_holes.iter().map(|s| s.to_string()).collect(),
+        small_holes,
         note: format!("the entry's feed is the run's unless the run sets its own feed_mm_per_min; its pierce, standoff and kerf width replace the machine file's; {power}; holes within the small-hole rule run at its {holes}, corners within its corner rule at its feed factor; gas and focus are stated, not commanded"),
     })
 }

@@ -10,7 +10,7 @@ use std::path::Path;
 use kerf_format::CurvesFile;
 use kerf_interp::Station;
 use kerf_kinematics::{AxesFile, AxesMove, Machine, SolvedPath};
-use kerf_process::{Gap, Obstacles, PoseArray, RapidMoves, Route, Traverse, TraverseOptions};
+use kerf_process::{Gap, Obstacles, PoseArray, Route, TraverseOptions};
 use nalgebra::{Point3, Vector3};
 
 use crate::cuts::CutPath;
@@ -21,14 +21,29 @@ use crate::report::{OwnSurfaces, SearchedTraverse, TraversesReport, UncheckedTra
 /// What the traverses of every set-up came to, for the report.
 #[derive(Debug, Default)]
 pub(crate) struct Tally {
-    /// Each checked traverse: its route, its moves, the surfaces left out of its check.
-    checked: Vec<(Traverse, RapidMoves, Vec<String>)>,
+    /// Each checked traverse.
+    checked: Vec<Checked>,
     /// The gaps no route cleared.
     unchecked: Vec<UncheckedTraverse>,
     /// Gaps where a cut's own surface comes back over the head line.
     own: Vec<OwnSurfaces>,
     /// Gaps a search around the part cleared.
     searched: Vec<SearchedTraverse>,
+}
+
+/// What the report keeps of one checked traverse.
+#[derive(Debug)]
+struct Checked {
+    /// Its route's shape.
+    route: Route,
+    /// The route's length, mm.
+    length_mm: f64,
+    /// The least distance from the part proven for the route and the machine's moves, mm.
+    min_distance_mm: f64,
+    /// The machine's moves split so that they clear.
+    split_moves: usize,
+    /// The surfaces left out of its check.
+    absent: Vec<String>,
 }
 
 /// The traverses of one set-up.
@@ -172,7 +187,13 @@ pub(crate) fn route_setup(
                 surfaces_left_out: absent.clone(),
             });
         }
-        tally.checked.push((t.clone(), r.clone(), absent.clone()));
+        tally.checked.push(Checked {
+            route: t.route,
+            length_mm: t.length_mm,
+            min_distance_mm: t.min_distance_mm.min(r.min_distance_mm),
+            split_moves: r.split_moves,
+            absent: absent.clone(),
+        });
         // The plot: the checked traverse back in part coordinates.
         let (rot, shift) = (placement.rotation(), placement.translation_mm);
         let part = |q: &[f64; 6]| {
@@ -223,7 +244,7 @@ impl Tally {
             searched,
         } = self;
         let mut unchecked: Vec<String> = Vec::new();
-        for (_, _, absent) in &rapids {
+        for Checked { absent, .. } in &rapids {
             for id in absent {
                 if !unchecked.contains(id) {
                     unchecked.push(id.clone());
@@ -232,14 +253,14 @@ impl Tally {
         }
         // How many traverses took each route.
         let routes: std::collections::BTreeMap<String, usize> = [
-            kerf_process::Route::Straight,
-            kerf_process::Route::Lifted,
-            kerf_process::Route::SafePlane,
-            kerf_process::Route::Searched,
+            Route::Straight,
+            Route::Lifted,
+            Route::SafePlane,
+            Route::Searched,
         ]
         .iter()
         .map(|k| {
-            let n = rapids.iter().filter(|(t, _, _)| t.route == *k).count();
+            let n = rapids.iter().filter(|c| c.route == *k).count();
             (k.name().to_string(), n)
         })
         .collect();
@@ -274,12 +295,12 @@ impl Tally {
             count: Some(rapids.len() + blocked.len()),
             checked_count: Some(rapids.len()),
             unchecked: Some(blocked),
-            lifted: Some(rapids.iter().filter(|(t, _, _)| t.route != kerf_process::Route::Straight).count()),
+            lifted: Some(rapids.iter().filter(|c| c.route != Route::Straight).count()),
             routes: Some(routes),
             searched: Some(searched),
-            split_moves: Some(rapids.iter().map(|(_, r, _)| r.split_moves).sum::<usize>()),
-            length_mm: Some(rapids.iter().map(|(t, _, _)| t.length_mm).sum::<f64>()),
-            min_distance_mm: Some(rapids.iter().map(|(t, r, _)| t.min_distance_mm.min(r.min_distance_mm)).fold(f64::INFINITY, f64::min)),
+            split_moves: Some(rapids.iter().map(|c| c.split_moves).sum::<usize>()),
+            length_mm: Some(rapids.iter().map(|c| c.length_mm).sum::<f64>()),
+            min_distance_mm: Some(rapids.iter().map(|c| c.min_distance_mm).fold(f64::INFINITY, f64::min)),
             surfaces_in_the_cuts_way: Some(unchecked),
             surfaces_note: Some("surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)".into()),
             own_surface_over_the_head: Some(own),

@@ -7,6 +7,7 @@
 //!   [`kerf_nurbs::NurbsCurve`]s and their carrying surfaces (NURBS, inline meshes, STL files
 //!   read by [`stl`]).
 //! - [`toolpath`] writes (atomically) and reads back cutting points ([`ToolpathFile`]).
+//! - [`Pose`], a cutting point with its tool axis: the one pose type of every stage.
 //!
 //! Every error names the JSON path of the defect, in the style
 //! `curves[3].knots[5]: knots must be non-decreasing (0.5 after 0.7)`; errors of functions that
@@ -27,6 +28,7 @@ use serde::{Deserialize, Serialize};
 pub mod curves;
 pub mod error;
 mod json;
+mod pose;
 pub mod stl;
 pub mod toolpath;
 
@@ -35,6 +37,7 @@ pub use curves::{
     UnknownKey, MAX_CURVE_ON_SURFACE_TOLERANCE_MM, MAX_SHEET_THICKNESS_MM,
 };
 pub use error::{FormatError, MeshDefect, Result, StlProblem};
+pub use pose::Pose;
 pub use toolpath::{KerfOffset, ToolpathFile, ToolpathPoints, ToolpathRecord};
 
 /// The `format` string of curve files.

@@ -1,6 +1,7 @@
 //! Blocks: the lines and arcs a program is made of, with the rotary axes along them, and the
 //! constant-feed time-division interpolation of one block (paper 000 eq 1-12).
 
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 use crate::error::{positive, InterpError, Result};
@@ -21,7 +22,7 @@ pub struct Station {
     /// Curve parameter of the point (`params` of `kerf.toolpath/1`), if known.
     pub param: Option<f64>,
     /// Machine axes `[X, Y, Z, tilt, C]` (mm, degrees) that reach the pose.
-    pub axes: [f64; 5],
+    pub axes: Axes,
 }
 
 /// Solves the machine axes of a path's poses with continuity (each solution nearest the
@@ -38,7 +39,7 @@ pub fn solve_stations<M: AxisModel + ?Sized>(
     tips: &[Point3<f64>],
     axes: Option<&[Vector3<f64>]>,
     params: Option<&[f64]>,
-    start: Option<&[f64; 5]>,
+    start: Option<&Axes>,
 ) -> Result<Vec<Station>> {
     if tips.is_empty() {
         return Err(InterpError::TooFewPoints { got: 0, need: 1 });
@@ -119,11 +120,11 @@ pub struct Block {
     /// The tip path.
     pub geometry: Geometry,
     /// Machine axes at the start (exactly the start station's).
-    pub start_axes: [f64; 5],
+    pub start_axes: Axes,
     /// Machine axes at the arc's intermediate point (equal to `start_axes` for lines).
-    pub mid_axes: [f64; 5],
+    pub mid_axes: Axes,
     /// Machine axes at the end (exactly the end station's).
-    pub end_axes: [f64; 5],
+    pub end_axes: Axes,
     /// Tool axis at the end (for programs that give the orientation vector).
     pub end_tool_axis: Vector3<f64>,
     /// Tool axis at the arc's intermediate point (the end's for lines).
@@ -287,7 +288,7 @@ impl Block {
     /// through [`AxisModel::linear_axes`]. At `s >= length` exactly `end_axes`, at `s <= 0`
     /// exactly `start_axes`.
     #[inline]
-    pub fn axes_at<M: AxisModel + ?Sized>(&self, model: &M, s: f64) -> [f64; 5] {
+    pub fn axes_at<M: AxisModel + ?Sized>(&self, model: &M, s: f64) -> Axes {
         if s.is_nan() || s >= self.length {
             return self.end_axes;
         }
@@ -296,7 +297,7 @@ impl Block {
         }
         let (tip, tilt, c) = self.pose_at(s);
         let xyz = model.linear_axes(&tip, tilt, c);
-        [xyz[0], xyz[1], xyz[2], tilt, c]
+        Axes::new(xyz[0], xyz[1], xyz[2], tilt, c)
     }
 
     /// Paper 000's time-division interpolation of this block alone at constant feed: the
@@ -317,7 +318,7 @@ impl Block {
         model: &M,
         feed: f64,
         cycle: f64,
-    ) -> Result<Vec<[f64; 5]>> {
+    ) -> Result<Vec<Axes>> {
         let dl = positive("feed", feed)? / 60.0 * positive("cycle", cycle)?;
         let steps = (self.length / dl).ceil();
         if steps.is_nan() || steps > 1e8 {
@@ -338,7 +339,7 @@ impl Block {
 
 /// Per-cycle increments of a set-point sequence: `q[i] - q[i - 1]` for `i = 1..`; what a
 /// time-division interpolator sends to the axis drives (paper 000, after eq 16).
-pub fn increments(setpoints: &[[f64; 5]]) -> Vec<[f64; 5]> {
+pub fn increments(setpoints: &[Axes]) -> Vec<[f64; 5]> {
     setpoints
         .windows(2)
         .map(|w| std::array::from_fn(|k| w[1][k] - w[0][k]))

@@ -214,8 +214,8 @@ pub fn fit_blocks<M: AxisModel + ?Sized>(
             .coords
             .iter()
             .chain(s.axis.iter())
-            .chain(s.axes.iter())
             .all(|v| v.is_finite())
+            && s.axes.is_finite()
             && s.param.is_none_or(f64::is_finite);
         if !finite {
             return Err(InterpError::NonFinite { index: i });

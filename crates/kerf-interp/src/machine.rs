@@ -49,7 +49,7 @@ impl MachineModel {
         })
     }
 
-    fn in_range(&self, q: &[f64; 5]) -> bool {
+    fn in_range(&self, q: &Axes) -> bool {
         (0..5).all(|k| {
             self.limits.range[k].is_none_or(|[lo, hi]| q[k] >= lo - 1e-9 && q[k] <= hi + 1e-9)
         })
@@ -78,8 +78,8 @@ impl AxisModel for MachineModel {
         &self,
         tip: &Point3<f64>,
         axis: &Vector3<f64>,
-        previous: Option<&[f64; 5]>,
-    ) -> Result<[f64; 5]> {
+        previous: Option<&Axes>,
+    ) -> Result<Axes> {
         let k = &self.machine.kinematics;
         let n = axis.norm();
         if !(n.is_finite() && (n - 1.0).abs() < 1e-6 && tip.coords.iter().all(|v| v.is_finite())) {
@@ -98,8 +98,7 @@ impl AxisModel for MachineModel {
             k.inverse(&pose).to_vec()
         };
         let previous = Axes::new(0.0, 0.0, 0.0, prev_t, prev_c);
-        nearest_solution(candidates, &previous, |q| self.in_range(&q.to_array()))
-            .map(|q| q.to_array())
+        nearest_solution(candidates, &previous, |q| self.in_range(q))
             .ok_or_else(|| InterpError::unreachable("no solution within the axis ranges"))
     }
 
@@ -128,11 +127,8 @@ impl AxisModel for MachineModel {
     }
 
     /// kerf-kinematics' forward kinematics.
-    fn tip(&self, q: &[f64; 5]) -> Point3<f64> {
-        self.machine
-            .kinematics
-            .forward(&Axes::from_array(*q))
-            .position
+    fn tip(&self, q: &Axes) -> Point3<f64> {
+        self.machine.kinematics.forward(q).position
     }
 
     fn machine(&self) -> Option<&Machine> {
@@ -168,13 +164,13 @@ pub fn stations_from_solved(solved: &SolvedPath, params: Option<&[f64]>) -> Resu
             tip: pose.position,
             axis: pose.axis,
             param: params.zip(*src).map(|(ps, i)| ps[i]),
-            axes: a.to_array(),
+            axes: *a,
         })
         .collect())
 }
 
-/// Stations from a `kerf.axes/1` path: `positions[n]` reaches `poses[n]` (`[x, y, z, i, j,
-/// k]`); no curve parameters (the file has none).
+/// Stations from a `kerf.axes/1` path in the file's arrays: `positions[n]` (`[X, Y, Z, tilt,
+/// C]`) reaches `poses[n]` (`[x, y, z, i, j, k]`); no curve parameters (the file has none).
 ///
 /// # Errors
 /// [`InterpError::LengthMismatch`] when the two arrays differ in length.
@@ -193,7 +189,7 @@ pub fn stations_from_axes(positions: &[[f64; 5]], poses: &[[f64; 6]]) -> Result<
             tip: Point3::new(p[0], p[1], p[2]),
             axis: Vector3::new(p[3], p[4], p[5]),
             param: None,
-            axes: *q,
+            axes: Axes::from_array(*q),
         })
         .collect())
 }

@@ -112,8 +112,8 @@ pub trait AxisModel {
         &self,
         tip: &Point3<f64>,
         axis: &Vector3<f64>,
-        previous: Option<&[f64; 5]>,
-    ) -> Result<[f64; 5]>;
+        previous: Option<&Axes>,
+    ) -> Result<Axes>;
 
     /// The linear axes `[X, Y, Z]` that put the tip at `tip` when the rotary axes stand at
     /// `tilt` and `c` (degrees). Called once per interpolation cycle: keep it cheap.
@@ -129,7 +129,7 @@ pub trait AxisModel {
     /// `o` is the image of the origin, `M`'s columns the images of the unit vectors less `o`,
     /// and `tip = M^T (XYZ - o)` (four calls). A model with its own forward kinematics should
     /// say so.
-    fn tip(&self, q: &[f64; 5]) -> Point3<f64> {
+    fn tip(&self, q: &Axes) -> Point3<f64> {
         let (tilt, c) = (q[3], q[4]);
         let at = |p: Point3<f64>| Vector3::from(self.linear_axes(&p, tilt, c));
         let o = at(Point3::origin());
@@ -168,8 +168,8 @@ impl<T: AxisModel + ?Sized> AxisModel for &T {
         &self,
         tip: &Point3<f64>,
         axis: &Vector3<f64>,
-        previous: Option<&[f64; 5]>,
-    ) -> Result<[f64; 5]> {
+        previous: Option<&Axes>,
+    ) -> Result<Axes> {
         (**self).inverse(tip, axis, previous)
     }
 
@@ -181,7 +181,7 @@ impl<T: AxisModel + ?Sized> AxisModel for &T {
         (**self).tool_axis(tilt, c)
     }
 
-    fn tip(&self, q: &[f64; 5]) -> Point3<f64> {
+    fn tip(&self, q: &Axes) -> Point3<f64> {
         (**self).tip(q)
     }
 
@@ -262,8 +262,8 @@ impl AxisModel for PaperAcHead {
         &self,
         tip: &Point3<f64>,
         axis: &Vector3<f64>,
-        previous: Option<&[f64; 5]>,
-    ) -> Result<[f64; 5]> {
+        previous: Option<&Axes>,
+    ) -> Result<Axes> {
         let kin = |reason: String| InterpError::unreachable(reason);
         let n = axis.norm();
         if !(n.is_finite() && (n - 1.0).abs() < 1e-6 && tip.coords.iter().all(|v| v.is_finite())) {
@@ -290,10 +290,8 @@ impl AxisModel for PaperAcHead {
         });
         let previous = Axes::new(0.0, 0.0, 0.0, prev_a, prev_c);
         nearest_solution(solutions, &previous, |q| {
-            let q = q.to_array();
             (0..5).all(|k| self.in_range(k, q[k]))
         })
-        .map(|q| q.to_array())
         .ok_or_else(|| kin("no solution within the axis ranges".into()))
     }
 
@@ -341,7 +339,7 @@ mod tests {
         let m = PaperAcHead::paper_000();
         let tip = Point3::origin();
         let u = m.tool_axis(-20.0, 370.0 + 180.0);
-        let prev = [0.0, 0.0, 0.0, -19.0, 545.0];
+        let prev = Axes::new(0.0, 0.0, 0.0, -19.0, 545.0);
         let q = m.inverse(&tip, &u, Some(&prev)).expect("reachable");
         assert!((q[3] + 20.0).abs() < 1e-9, "A {}", q[3]);
         assert!((q[4] - 550.0).abs() < 1e-9, "C {}", q[4]);

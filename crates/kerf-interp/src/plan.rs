@@ -48,6 +48,8 @@ use assemble::assemble;
 use profile::{run_feeds, run_grid, time_run, Timed};
 use verify::verify;
 
+use kerf_kinematics::Axes;
+
 use crate::block::{Block, Geometry};
 use crate::error::{positive, InterpError, Result};
 use crate::model::AxisModel;
@@ -359,8 +361,7 @@ pub fn plan_owned<M: AxisModel + ?Sized>(
         let finite = b.length().is_finite()
             && [b.start_axes, b.mid_axes, b.end_axes]
                 .iter()
-                .flatten()
-                .all(|v| v.is_finite());
+                .all(Axes::is_finite);
         if !finite {
             return Err(InterpError::NonFinite { index: bi });
         }

@@ -29,6 +29,8 @@
 
 use std::sync::OnceLock;
 
+use kerf_kinematics::Axes;
+
 use crate::block::{Station, MIN_TRAVEL};
 use crate::error::{positive, InterpError, Result};
 use crate::model::AxisModel;
@@ -487,7 +489,7 @@ pub fn spline_setpoints<M: AxisModel + ?Sized>(
     feed: f64,
     cycle: f64,
     kind: Recurrence,
-) -> Result<Vec<[f64; 5]>> {
+) -> Result<Vec<Axes>> {
     let dl = positive("feed", feed)? / 60.0 * positive("cycle", cycle)?;
     let segments = spline_through(stations)?;
     let total: f64 = segments.iter().map(|(_, h)| (h / dl).ceil()).sum();
@@ -503,7 +505,7 @@ pub fn spline_setpoints<M: AxisModel + ?Sized>(
         let n = ((h / dl).ceil() as usize).max(1);
         for v in seg.steps(n, kind).skip(1).take(n - 1) {
             let xyz = model.linear_axes(&nalgebra::Point3::new(v[0], v[1], v[2]), v[3], v[4]);
-            out.push([xyz[0], xyz[1], xyz[2], v[3], v[4]]);
+            out.push(Axes::new(xyz[0], xyz[1], xyz[2], v[3], v[4]));
         }
         out.push(stations[i + 1].axes);
     }

@@ -26,6 +26,8 @@
 //! so the rotary axes pass every station exactly and never leave their ranges. The math is in
 //! `docs/interpolation.md`.
 
+use kerf_kinematics::Axes;
+
 use crate::block::{Block, Geometry};
 use crate::model::AxisModel;
 use nalgebra::{Point3, Vector3};
@@ -392,13 +394,13 @@ impl Run {
 
     /// Machine axes at `s` without clamping (for derivatives by differences).
     #[inline]
-    pub(crate) fn axes_raw<M: AxisModel + ?Sized>(&self, model: &M, s: f64) -> [f64; 5] {
+    pub(crate) fn axes_raw<M: AxisModel + ?Sized>(&self, model: &M, s: f64) -> Axes {
         let (tip, r) = self.pose(s);
         if self.joint {
-            return [tip.x, tip.y, tip.z, r[0], r[1]];
+            return Axes::new(tip.x, tip.y, tip.z, r[0], r[1]);
         }
         let xyz = model.linear_axes(&tip, r[0], r[1]);
-        [xyz[0], xyz[1], xyz[2], r[0], r[1]]
+        Axes::new(xyz[0], xyz[1], xyz[2], r[0], r[1])
     }
 
     /// Machine axes at `s`: exactly the first block's start axes at `s <= 0`, the last block's
@@ -409,7 +411,7 @@ impl Run {
         model: &M,
         blocks: &[Block],
         s: f64,
-    ) -> [f64; 5] {
+    ) -> Axes {
         if s.is_nan() || s >= self.len() {
             return blocks[self.last].end_axes;
         }
@@ -892,7 +894,8 @@ fn build_rapid(blocks: &[Block], b: usize, opts: &PathOptions) -> Run {
     let slope = |a: &[f64], b: &[f64]| -> Vec<f64> {
         a.iter().zip(b).map(|(a, b)| (b - a) / len).collect()
     };
-    let (dl, dr) = (slope(&q0[..3], &q1[..3]), slope(&r0, &r1));
+    let (l0, l1) = (q0.to_array(), q1.to_array());
+    let (dl, dr) = (slope(&l0[..3], &l1[..3]), slope(&r0, &r1));
     let dl = [dl[0], dl[1], dl[2]];
     let dr = [dr[0], dr[1]];
     Run {

@@ -9,7 +9,7 @@ use kerf_interp::{
     gcode_motion, interpolate, AxisModel, ChordTerm, Dialect, FitOptions, GcodeOptions,
     InterpError, Motion, PaperAcHead, PlanOptions, ProgramPath,
 };
-use kerf_kinematics::Process;
+use kerf_kinematics::{Axes, Process};
 use nalgebra::{Point3, Vector3};
 
 const DIALECTS: [Dialect; 3] = [Dialect::Generic, Dialect::Sinumerik, Dialect::Linuxcnc];
@@ -68,13 +68,13 @@ fn word(code: &str, key: &str) -> Option<f64> {
     })
 }
 
-fn u_of(m: &PaperAcHead, q: &[f64; 5]) -> Vector3<f64> {
+fn u_of(m: &PaperAcHead, q: &Axes) -> Vector3<f64> {
     // u = Rz(C) Rx(A) ez, written out (formats.md), not the model's own function.
     let (a, c) = (q[3].to_radians(), q[4].to_radians());
     Vector3::new(a.sin() * c.sin(), -a.sin() * c.cos(), a.cos()) + 0.0 * m.tool_axis(0.0, 0.0)
 }
 
-fn tip_of(m: &PaperAcHead, q: &[f64; 5]) -> Point3<f64> {
+fn tip_of(m: &PaperAcHead, q: &Axes) -> Point3<f64> {
     // Paper 000 eq 16 solved for the tip.
     let u = u_of(m, q);
     let c = q[4].to_radians();
@@ -145,7 +145,9 @@ fn every_cut_is_framed_and_no_beam_during_rapids() {
                     );
                     d.norm()
                 } else {
-                    let q = |l: &str| ["X", "Y", "Z", "A", "C"].map(|k| word(l, k).unwrap());
+                    let q = |l: &str| {
+                        Axes::from_array(["X", "Y", "Z", "A", "C"].map(|k| word(l, k).unwrap()))
+                    };
                     let (qp, qd) = (q(&pierce), q(descent));
                     assert_eq!(
                         (qp[3], qp[4]),

@@ -3,18 +3,19 @@
 #[cfg(feature = "research")]
 use kerf_interp::{chord_error, max_feed, paper_eq19};
 use kerf_interp::{increments, AxisModel, Block, InterpError, PaperAcHead, Station};
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 /// Paper 000 eq 16, written out independently of the crate.
-fn eq16(m: &PaperAcHead, p: Point3<f64>, a_deg: f64, c_deg: f64) -> [f64; 5] {
+fn eq16(m: &PaperAcHead, p: Point3<f64>, a_deg: f64, c_deg: f64) -> Axes {
     let (a, c) = (a_deg.to_radians(), c_deg.to_radians());
-    [
+    Axes::new(
         p.x + m.r_a * a.sin() * c.sin() - m.r_c * c.cos(),
         p.y - m.r_a * a.sin() * c.cos() - m.r_c * c.sin(),
         p.z + m.r_a * a.cos(),
         a_deg,
         c_deg,
-    ]
+    )
 }
 
 fn station(m: &PaperAcHead, p: Point3<f64>, a: f64, c: f64) -> Station {
@@ -26,7 +27,7 @@ fn station(m: &PaperAcHead, p: Point3<f64>, a: f64, c: f64) -> Station {
     }
 }
 
-fn assert_close(got: &[f64; 5], want: &[f64; 5], tol: f64, what: &str) {
+fn assert_close(got: &Axes, want: &Axes, tol: f64, what: &str) {
     for k in 0..5 {
         assert!(
             (got[k] - want[k]).abs() <= tol,
@@ -320,7 +321,7 @@ mod prop {
             let rows = b.constant_feed(&m, feed, cycle).expect("interpolates");
             // Rotary axes constant: X, Y, Z = tip + the head's offset (eq 16 at the origin).
             let off = eq16(&m, Point3::origin(), 10.0, 20.0);
-            let tip = |q: &[f64; 5]| Point3::new(q[0] - off[0], q[1] - off[1], q[2] - off[2]);
+            let tip = |q: &Axes| Point3::new(q[0] - off[0], q[1] - off[1], q[2] - off[2]);
             for w in rows.windows(2) {
                 let (p, q) = (tip(&w[0]), tip(&w[1]));
                 prop_assert!(((q - o).norm() - r).abs() < 1e-9 * r.max(1.0));

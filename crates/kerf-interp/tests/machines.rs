@@ -5,7 +5,7 @@ use kerf_interp::{
     fit_blocks, plan, stations_from_axes, stations_from_solved, AxisModel, FitOptions,
     MachineModel, PaperAcHead, PlanOptions,
 };
-use kerf_kinematics::{solve_path, Machine, PathInput, PathOptions, Pose};
+use kerf_kinematics::{solve_path, Axes, Machine, PathInput, PathOptions, Pose};
 use nalgebra::{Point3, Vector3};
 
 fn load(name: &str) -> MachineModel {
@@ -32,7 +32,7 @@ fn ac_head_file_agrees_with_the_reference_head() {
         );
         let u = r.tool_axis(t, c);
         let q = m
-            .inverse(&tip, &u, Some(&[0.0, 0.0, 0.0, t, c]))
+            .inverse(&tip, &u, Some(&Axes::new(0.0, 0.0, 0.0, t, c)))
             .expect("reachable");
         assert!((q[3] - t).abs() < 1e-9 && (q[4] - c).abs() < 1e-9, "{q:?}");
     }

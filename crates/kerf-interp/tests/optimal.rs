@@ -9,6 +9,7 @@ mod common;
 
 use common::{circle, gantry, one_line_per_pose, ratios, stations};
 use kerf_interp::{fit_blocks, plan, FitOptions, PaperAcHead, PlanOptions, Station};
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 /// Dense phase-plane reference for a full circle of radius `r` in the XY plane traversed
@@ -137,7 +138,7 @@ fn circles_plan_within_five_percent_of_the_dense_reference() {
 /// Share of the length at the programmed feed `feed` (mm/min, within 0.1 %) from set-points
 /// alone, cycle `t`; the tool vertical and the path in a plane of constant Z, so the tip moves
 /// as X and Y do.
-fn share_at_feed(rows: &[[f64; 5]], feed: f64, t: f64) -> f64 {
+fn share_at_feed(rows: &[Axes], feed: f64, t: f64) -> f64 {
     let (mut total, mut at_feed) = (0.0, 0.0);
     for w in rows.windows(2) {
         let step = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();

@@ -10,6 +10,7 @@ use kerf_interp::{
     csv_string, fit_blocks, gcode, plan, write_csv, write_gcode, AxisModel, Dialect, FitOptions,
     GcodeOptions, Geometry, PaperAcHead, PlanOptions, EXIT_RETRACT_MIN_MM,
 };
+use kerf_kinematics::Axes;
 use nalgebra::Vector3;
 
 /// Words of one G-code line: `G1 X1.5 A3=0.2` -> {"G": 1, "X": 1.5, "A3": 0.2}; comments
@@ -149,7 +150,7 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
         text.rfind("G0 X").expect("G0") > text.rfind("M5").expect("beam off"),
         "the retract follows the last beam-off"
     );
-    let q = |w: &HashMap<String, f64>| -> [f64; 5] { ["X", "Y", "Z", "A", "C"].map(|k| w[k]) };
+    let q = |w: &HashMap<String, f64>| Axes::from_array(["X", "Y", "Z", "A", "C"].map(|k| w[k]));
     // G0 to the pierce point, then the descent to the start.
     assert_eq!(
         q(&moves[1]),
@@ -315,7 +316,7 @@ fn sinumerik_rapids_follow_the_machines_straight_moves() {
         .filter(|(h, _)| h == "G0" || h == "G1" || h == "CIP")
         .collect();
     // The machine's axes of each written line, the inverse taken nearest the line before.
-    let mut prev: Option<[f64; 5]> = None;
+    let mut prev: Option<Axes> = None;
     let mut axes = Vec::new();
     for (_, w) in &moves {
         let tip = nalgebra::Point3::new(w["X"], w["Y"], w["Z"]);
@@ -334,7 +335,7 @@ fn sinumerik_rapids_follow_the_machines_straight_moves() {
         if (qa[4] - qb[4]).abs() > 1e-6 {
             pieces += 1;
         }
-        let mid: [f64; 5] = std::array::from_fn(|n| 0.5 * (qa[n] + qb[n]));
+        let mid = qa.lerp(&qb, 0.5);
         let d = (m.tip(&mid) - nalgebra::center(&ta, &tb)).norm();
         worst = worst.max(d);
     }

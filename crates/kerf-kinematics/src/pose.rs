@@ -1,41 +1,9 @@
-//! Poses (tool tip and tool axis in the workpiece frame) and machine axis vectors.
+//! Machine axis vectors. The pose (tool tip and tool axis in the workpiece frame) is
+//! [`kerf_format::Pose`], re-exported here: one pose type from the normals to the G-code.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::Vector3;
 
-/// A pose `(x, y, z, i, j, k)` in the workpiece frame: the tool tip (the laser focus) and the
-/// tool axis, pointing from the tip toward the head (for a laser, the outward surface normal;
-/// the beam travels along `-(i, j, k)`). Millimetres.
-///
-/// The inverse kinematics use only the direction of `axis`, so it need not be exactly unit;
-/// [`crate::solve_path`] checks that it is (within 1e-6) and normalises it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pose {
-    /// The tool tip `(x, y, z)`.
-    pub position: Point3<f64>,
-    /// The tool axis `(i, j, k)`.
-    pub axis: Vector3<f64>,
-}
-
-impl Pose {
-    /// The pose `(x, y, z, i, j, k)`.
-    pub fn new(x: f64, y: f64, z: f64, i: f64, j: f64, k: f64) -> Self {
-        Self {
-            position: Point3::new(x, y, z),
-            axis: Vector3::new(i, j, k),
-        }
-    }
-
-    /// The pose from `[x, y, z, i, j, k]` (a toolpath point with its normal).
-    pub fn from_array(a: [f64; 6]) -> Self {
-        Self::new(a[0], a[1], a[2], a[3], a[4], a[5])
-    }
-
-    /// `[x, y, z, i, j, k]`.
-    pub fn to_array(&self) -> [f64; 6] {
-        let (p, u) = (self.position, self.axis);
-        [p.x, p.y, p.z, u.x, u.y, u.z]
-    }
-}
+pub use kerf_format::Pose;
 
 /// One of the five axes of a machine, in the order of an axis vector `[X, Y, Z, tilt, C]`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -109,6 +77,21 @@ impl Axes {
         [self.x, self.y, self.z, self.tilt, self.c]
     }
 
+    /// The five values in the order `[X, Y, Z, tilt, C]`.
+    pub fn iter(&self) -> impl Iterator<Item = f64> {
+        self.to_array().into_iter()
+    }
+
+    /// True when all five values are finite.
+    pub fn is_finite(&self) -> bool {
+        self.iter().all(f64::is_finite)
+    }
+
+    /// `f` applied to every axis value (as `array::map`).
+    pub fn map(&self, f: impl FnMut(f64) -> f64) -> Axes {
+        Axes::from_array(self.to_array().map(f))
+    }
+
     /// The value of one axis.
     pub fn get(&self, axis: Axis) -> f64 {
         self.to_array()[axis.index()]
@@ -136,5 +119,54 @@ impl Axes {
     /// continuity rule minimises.
     pub fn rotary_travel(&self, other: &Axes) -> f64 {
         (other.tilt - self.tilt).abs() + (other.c - self.c).abs()
+    }
+}
+
+/// `axes[k]`: the axis at position `k` of `[X, Y, Z, tilt, C]` ([`Axis::index`]), for loops
+/// over all five axes.
+///
+/// # Panics
+/// For `k >= 5`, like an array.
+impl std::ops::Index<usize> for Axes {
+    type Output = f64;
+
+    fn index(&self, k: usize) -> &f64 {
+        match k {
+            0 => &self.x,
+            1 => &self.y,
+            2 => &self.z,
+            3 => &self.tilt,
+            4 => &self.c,
+            _ => panic!("axis index {k} out of range (five axes)"),
+        }
+    }
+}
+
+/// `axes[k] = v`: sets the axis at position `k` of `[X, Y, Z, tilt, C]`.
+///
+/// # Panics
+/// For `k >= 5`, like an array.
+impl std::ops::IndexMut<usize> for Axes {
+    fn index_mut(&mut self, k: usize) -> &mut f64 {
+        match k {
+            0 => &mut self.x,
+            1 => &mut self.y,
+            2 => &mut self.z,
+            3 => &mut self.tilt,
+            4 => &mut self.c,
+            _ => panic!("axis index {k} out of range (five axes)"),
+        }
+    }
+}
+
+impl From<[f64; 5]> for Axes {
+    fn from(a: [f64; 5]) -> Self {
+        Axes::from_array(a)
+    }
+}
+
+impl From<Axes> for [f64; 5] {
+    fn from(a: Axes) -> Self {
+        a.to_array()
     }
 }

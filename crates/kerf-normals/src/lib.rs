@@ -23,6 +23,7 @@ pub use surface::{Hint, NormalSource, NurbsNormals, Projection};
 
 use kerf_discretize::{discretize_range, Discretization, Options};
 use kerf_discretize::{Certifier, Scratch};
+use kerf_format::Pose;
 use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3};
 
@@ -171,12 +172,12 @@ impl Oriented {
         self.max_chord_error
     }
 
-    /// `[x, y, z, i, j, k]` per point.
-    pub fn poses(&self) -> Vec<[f64; 6]> {
+    /// Each point with its normal as the tool axis.
+    pub fn poses(&self) -> Vec<Pose> {
         self.points
             .iter()
             .zip(&self.normals)
-            .map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
+            .map(|(&position, &axis)| Pose { position, axis })
             .collect()
     }
 }

@@ -15,7 +15,7 @@ use std::sync::Arc;
 
 use kerf_process::{
     offset, plan_cuts, scrap_sides, Contour, CutPlan, LeadOptions, OffsetInput, OffsetOptions,
-    OffsetPath, PoseArray,
+    OffsetPath, Pose,
 };
 use nalgebra::Point3;
 
@@ -34,7 +34,7 @@ pub(crate) struct CutPath {
     pub(crate) curve: usize,
     /// Lead-in poses, then the cut from its start point, then the lead-out (part
     /// coordinates, the surface's normals).
-    pub(crate) poses: Vec<PoseArray>,
+    pub(crate) poses: Vec<Pose>,
     /// The parameter of every pose (strictly increasing; see the module documentation).
     pub(crate) params: Vec<f64>,
     /// The point at a parameter (part coordinates).
@@ -161,7 +161,7 @@ pub(crate) fn plan(
     kerf: Option<&Kerf>,
     source: Option<&std::path::Path>,
 ) -> Result<(Vec<CutPath>, SetupPlans, Vec<Compensated>), Error> {
-    let poses: Vec<Vec<PoseArray>> = oriented
+    let poses: Vec<Vec<Pose>> = oriented
         .iter()
         .enumerate()
         .map(|(i, o)| match walls.get(i) {
@@ -206,7 +206,7 @@ pub(crate) fn plan(
             )
             .map_err(process_error)?,
         };
-        let offset_poses: Vec<Option<Vec<PoseArray>>> = offsets
+        let offset_poses: Vec<Option<Vec<Pose>>> = offsets
             .iter()
             .map(|o| o.as_ref().map(|p| p.poses.clone()))
             .collect();
@@ -267,7 +267,7 @@ pub(crate) fn plan(
 fn offset_setup(
     file: &CurvesFile,
     oriented: &[Oriented],
-    poses: &[Vec<PoseArray>],
+    poses: &[Vec<Pose>],
     paths: &[usize],
     contours: &[Contour<'_>],
     options: &LeadOptions,
@@ -314,9 +314,13 @@ fn offset_setup(
 }
 
 /// True if the contour's last point is within `tol` of its first.
-fn is_closed(poses: &[PoseArray], tol: f64) -> bool {
+fn is_closed(poses: &[Pose], tol: f64) -> bool {
     let (a, b) = (poses[0], poses[poses.len() - 1]);
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt() <= tol
+    ((a.position.x - b.position.x).powi(2)
+        + (a.position.y - b.position.y).powi(2)
+        + (a.position.z - b.position.z).powi(2))
+    .sqrt()
+        <= tol
         && poses.len() >= 4
 }
 
@@ -325,7 +329,7 @@ fn is_closed(poses: &[PoseArray], tol: f64) -> bool {
 fn cut_path(
     contour: PointFn,
     t: &[f64],
-    poses: &[PoseArray],
+    poses: &[Pose],
     curve: usize,
     plan: &CutPlan,
     k: usize,
@@ -357,7 +361,7 @@ fn cut_path(
     all.extend_from_slice(&cut);
     all.extend_from_slice(&lead.lead_out);
     // Polylines of the lead-in (ending at the start) and the lead-out (from the cut's end).
-    let pt = |p: &PoseArray| Point3::new(p[0], p[1], p[2]);
+    let pt = |p: &Pose| p.position;
     let lead_in: Vec<Point3<f64>> = lead
         .lead_in
         .iter()
@@ -407,7 +411,7 @@ pub(crate) fn kerf_offset_record(p: &OffsetPath) -> kerf_format::KerfOffset {
         offset_mm: p.offset_mm,
         side: p.side.into(),
         params: p.source.clone(),
-        points: p.poses.clone(),
+        points: p.poses.iter().map(Pose::to_array).collect(),
         max_chord_error: p.max_chord_error_mm,
         proven: p.proven,
     }
@@ -570,7 +574,7 @@ pub(crate) fn controller_compensation(
             let [m, _, _] = cut.counts;
             let entry = if m > 0 {
                 let (a, b) = (cut.poses[0], cut.poses[1]);
-                ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt()
+                ((b.position.x - a.position.x).powi(2) + (b.position.y - a.position.y).powi(2)).sqrt()
             } else {
                 0.0
             };
@@ -625,12 +629,12 @@ pub(crate) fn split_axes(
 }
 
 /// The length of the polyline through the poses' points, mm.
-pub(crate) fn polyline_length(p: &[PoseArray]) -> f64 {
+pub(crate) fn polyline_length(p: &[Pose]) -> f64 {
     p.windows(2)
         .map(|w| {
-            ((w[1][0] - w[0][0]).powi(2)
-                + (w[1][1] - w[0][1]).powi(2)
-                + (w[1][2] - w[0][2]).powi(2))
+            ((w[1].position.x - w[0].position.x).powi(2)
+                + (w[1].position.y - w[0].position.y).powi(2)
+                + (w[1].position.z - w[0].position.z).powi(2))
             .sqrt()
         })
         .sum()
@@ -698,12 +702,15 @@ pub(crate) fn small_holes(cuts: &[CutPath], plans: &SetupPlans, max_diameter_mm:
             }
             let contour = &c.poses[c.counts[0]..c.counts[0] + c.counts[1]];
             let stride = contour.len().div_ceil(SMALL_HOLE_SAMPLES).max(1);
-            let pts: Vec<&PoseArray> = contour.iter().step_by(stride).collect();
+            let pts: Vec<&Pose> = contour.iter().step_by(stride).collect();
             let mut d2 = 0.0f64;
             for (a, p) in pts.iter().enumerate() {
                 for q in &pts[a + 1..] {
-                    d2 = d2
-                        .max((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2));
+                    d2 = d2.max(
+                        (p.position.x - q.position.x).powi(2)
+                            + (p.position.y - q.position.y).powi(2)
+                            + (p.position.z - q.position.z).powi(2),
+                    );
                 }
             }
             // A hole of exactly the rule's diameter is one (its points lie on the circle, a
@@ -757,9 +764,9 @@ pub(crate) fn micro_joints(
             let p = &c.poses;
             let mut cum = vec![0.0];
             for w in p.windows(2) {
-                let d = ((w[1][0] - w[0][0]).powi(2)
-                    + (w[1][1] - w[0][1]).powi(2)
-                    + (w[1][2] - w[0][2]).powi(2))
+                let d = ((w[1].position.x - w[0].position.x).powi(2)
+                    + (w[1].position.y - w[0].position.y).powi(2)
+                    + (w[1].position.z - w[0].position.z).powi(2))
                 .sqrt();
                 cum.push(cum[cum.len() - 1] + d);
             }
@@ -775,8 +782,8 @@ pub(crate) fn micro_joints(
                 return Vec::new();
             }
             // Corners of the contour, as distances along the cut.
-            let dir = |a: &PoseArray, b: &PoseArray| {
-                nalgebra::Vector3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2])
+            let dir = |a: &Pose, b: &Pose| {
+                b.position - a.position
             };
             let corners: Vec<f64> = (first + 1..last)
                 .filter(|&i| {

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use kerf_discretize::{Discretization, DiscretizeError, Options};
 use kerf_format::toolpath::{ToolpathFile, ToolpathPoints, ToolpathRecord};
-use kerf_format::{CurvesFile, SurfaceGeometry};
+use kerf_format::{CurvesFile, Pose, SurfaceGeometry};
 use kerf_normals::{orient, Hint, MeshNormals, NormalSource, NurbsNormals, Oriented, Projection};
 use rayon::prelude::*;
 
@@ -184,7 +184,7 @@ pub fn toolpath_of_poses(
         oriented.iter().map(|o| {
             (
                 o.params(),
-                ToolpathPoints::Poses(o.poses()),
+                ToolpathPoints::Poses(o.poses().iter().map(Pose::to_array).collect()),
                 o.max_chord_error(),
             )
         }),

@@ -322,10 +322,7 @@ pub(crate) fn sides_by_head_lines(
         use rayon::prelude::*;
         poses
             .par_iter()
-            .map(|p| {
-                let arrays: Vec<kerf_process::PoseArray> = p.iter().map(Pose::to_array).collect();
-                kerf_process::head_lines(&obs, &arrays, opts)
-            })
+            .map(|p| kerf_process::head_lines(&obs, p, opts))
             .collect()
     };
     // A thick sheet's contour stays on its side (the import put it on the side that faces

@@ -272,8 +272,8 @@ pub(crate) fn place(
         .iter()
         .zip(&walls)
         .map(|(o, w)| match w {
-            Some(w) => w.poses.iter().copied().map(Pose::from_array).collect(),
-            None => o.poses().into_iter().map(Pose::from_array).collect(),
+            Some(w) => w.poses.clone(),
+            None => o.poses(),
         })
         .collect();
     let head_lines = match (o.place, &r.traverse) {
@@ -396,10 +396,7 @@ pub(crate) fn solve(r: &Run<'_>, cuts: &Cuts, part: &Part, clock: &mut Clock) ->
     let cut_poses: Vec<Vec<Pose>> = cuts
         .cuts
         .iter()
-        .map(|c| {
-            let p: Vec<Pose> = c.poses.iter().copied().map(Pose::from_array).collect();
-            placed.apply_one(c.curve, &p)
-        })
+        .map(|c| placed.apply_one(c.curve, &c.poses))
         .collect();
     let points = placed_curves(&cuts.cuts, placed);
     let inputs: Vec<PathInput<'_>> = cuts
@@ -1033,7 +1030,7 @@ fn picture(p: &Picture<'_>, traverses: Vec<Vec<nalgebra::Point3<f64>>>) -> Resul
     scene.axes = Some(kerf_plot::AxesChart::new(p.axes, Some(p.machine))?);
     // The process over the paths (part coordinates): pierces numbered in cutting order,
     // lead-ins, lead-outs and the traverses, set-up by set-up as the programs run them.
-    let pt = |q: &kerf_process::PoseArray| nalgebra::Point3::new(q[0], q[1], q[2]);
+    let pt = |q: &Pose| q.position;
     let mut order: Vec<usize> = (0..p.cuts.len()).collect();
     order.sort_by_key(|&k| p.placed.plan.setup_of(p.cuts[k].curve));
     scene.process = Some(kerf_plot::ProcessPicture {
@@ -1057,7 +1054,7 @@ fn picture(p: &Picture<'_>, traverses: Vec<Vec<nalgebra::Point3<f64>>>) -> Resul
                     },
                     micro_joints: {
                         let part: Vec<[f64; 3]> =
-                            c.poses.iter().map(|q| [q[0], q[1], q[2]]).collect();
+                            c.poses.iter().map(|q| q.position.into()).collect();
                         let at =
                             |s: f64| nalgebra::Point3::from(crate::cuts::point_along(&part, s));
                         p.joints[k].iter().map(|&[a, b]| [at(a), at(b)]).collect()

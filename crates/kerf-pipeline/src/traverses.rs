@@ -9,9 +9,9 @@ use std::path::Path;
 
 use kerf_format::CurvesFile;
 use kerf_interp::Station;
-use kerf_kinematics::{AxesFile, AxesMove, Machine, SolvedPath};
-use kerf_process::{Gap, Obstacles, PoseArray, Route, TraverseOptions};
-use nalgebra::{Point3, Vector3};
+use kerf_kinematics::{Axes, AxesFile, AxesMove, Machine, SolvedPath};
+use kerf_process::{Gap, Obstacles, Pose, Route, TraverseOptions};
+use nalgebra::Point3;
 
 use crate::cuts::CutPath;
 use crate::error::Result;
@@ -134,9 +134,7 @@ pub(crate) fn route_setup(
                 });
                 out.stations.push(Vec::new());
                 // The plot: the unchecked retract, straight move and approach.
-                let up = |q: &PoseArray, r: f64| {
-                    Point3::new(q[0], q[1], q[2]) + Vector3::new(q[3], q[4], q[5]) * r
-                };
+                let up = |q: &Pose, r: f64| q.position + q.axis * r;
                 let (ea, pb) = (cut_end(w[0]), &cuts[w[1]].poses[0]);
                 out.plot.push(vec![
                     up(&ea, 0.0),
@@ -148,16 +146,16 @@ pub(crate) fn route_setup(
             }
         };
         axes.paths[w[1]].traverse = Some(AxesMove {
-            positions: r.axes.clone(),
-            poses: r.poses.clone(),
+            positions: r.axes.iter().map(Axes::to_array).collect(),
+            poses: r.poses.iter().map(Pose::to_array).collect(),
         });
         out.stations.push(
             r.axes
                 .iter()
                 .zip(&r.poses)
                 .map(|(a, p)| Station {
-                    tip: Point3::new(p[0], p[1], p[2]),
-                    axis: Vector3::new(p[3], p[4], p[5]),
+                    tip: p.position,
+                    axis: p.axis,
                     param: None,
                     axes: *a,
                 })
@@ -196,13 +194,11 @@ pub(crate) fn route_setup(
         });
         // The plot: the checked traverse back in part coordinates.
         let (rot, shift) = (placement.rotation(), placement.translation_mm);
-        let part = |q: &[f64; 6]| {
-            Point3::from(rot.inverse() * (Point3::new(q[0], q[1], q[2]) - shift).coords)
-        };
+        let part = |q: &Pose| Point3::from(rot.inverse() * (q.position - shift).coords);
         let (ea, pb) = (cut_end(w[0]), cuts[w[1]].poses[0]);
-        let mut line = vec![Point3::new(ea[0], ea[1], ea[2])];
+        let mut line = vec![ea.position];
         line.extend(r.poses.iter().map(part));
-        line.push(Point3::new(pb[0], pb[1], pb[2]));
+        line.push(pb.position);
         out.plot.push(line);
     }
     Ok(out)
@@ -213,19 +209,17 @@ pub(crate) fn route_setup(
 /// surfaces the two curves name.
 fn gap(file: &CurvesFile, cuts: &[CutPath], solved: &[SolvedPath], a: usize, b: usize) -> Gap {
     let (sa, sb) = (&solved[a], &solved[b]);
-    let ax = |q: &kerf_kinematics::Axes| [q.x, q.y, q.z, q.tilt, q.c];
     // The solved pose of a cut's k-th pose (lead-in, contour, lead-out).
     let at = |s: &SolvedPath, k: usize| {
         let j = s.source.iter().position(|v| *v == Some(k)).unwrap_or(0);
-        let p = s.poses[j].position;
-        [p.x, p.y, p.z]
+        s.poses[j].position
     };
     let [m, c, _] = cuts[a].counts;
     Gap {
-        from: sa.poses[sa.poses.len() - 1].to_array(),
-        from_axes: ax(&sa.axes[sa.axes.len() - 1]),
-        to: sb.poses[0].to_array(),
-        to_axes: ax(&sb.axes[0]),
+        from: sa.poses[sa.poses.len() - 1],
+        from_axes: sa.axes[sa.axes.len() - 1],
+        to: sb.poses[0],
+        to_axes: sb.axes[0],
         from_contour: at(sa, m + c - 1),
         to_contour: at(sb, cuts[b].counts[0]),
         from_surfaces: file.curves[cuts[a].curve].surfaces.clone(),

@@ -171,10 +171,7 @@ fn paths(
             }
             for j in 0..=TRAVERSE_SAMPLES {
                 let f = j as f64 / TRAVERSE_SAMPLES as f64;
-                let q: [f64; 5] = std::array::from_fn(|a| {
-                    b.start_axes[a] + f * (b.end_axes[a] - b.start_axes[a])
-                });
-                rapid.extend(flat(&model.tip(&q)));
+                rapid.extend(flat(&model.tip(&b.start_axes.lerp(&b.end_axes, f))));
             }
             continue;
         }
@@ -255,7 +252,7 @@ fn timeline(motion: &Motion, model: &MachineModel, feed_mm_per_min: f64) -> Time
                 .extend(pose_numbers(&tip, &model.tool_axis(q[3], q[4])));
             t.samples
                 .extend([unit(speed / feed), if rapid { 1.0 } else { 0.0 }]);
-            t.samples.extend(q.map(mm));
+            t.samples.extend(q.iter().map(mm));
         }
         prev = Some(tip);
     }

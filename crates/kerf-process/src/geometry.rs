@@ -5,16 +5,16 @@
 use kerf_nurbs::Segment;
 use nalgebra::{Point3, Vector2, Vector3};
 
-use crate::PoseArray;
+use crate::Pose;
 
-/// The position of a pose.
-pub(crate) fn position(p: &PoseArray) -> Point3<f64> {
-    Point3::new(p[0], p[1], p[2])
+/// The position of a pose (for `map`).
+pub(crate) fn position(p: &Pose) -> Point3<f64> {
+    p.position
 }
 
-/// The normal of a pose.
-pub(crate) fn normal(p: &PoseArray) -> Vector3<f64> {
-    Vector3::new(p[3], p[4], p[5])
+/// The normal of a pose (for `map`).
+pub(crate) fn normal(p: &Pose) -> Vector3<f64> {
+    p.axis
 }
 
 /// A closed contour in the plane through its first point perpendicular to its mean normal.
@@ -35,7 +35,7 @@ pub(crate) struct Projected {
 impl Projected {
     /// The projection of a closed contour (first and last point within `tol`, at least three
     /// distinct points); `None` for an open one.
-    pub(crate) fn of_closed(poses: &[PoseArray], tol: f64) -> Option<Self> {
+    pub(crate) fn of_closed(poses: &[Pose], tol: f64) -> Option<Self> {
         if poses.len() < 4 {
             return None;
         }
@@ -123,7 +123,7 @@ impl Projected {
     }
 
     /// True if the contour `poses` lies inside: three of its points spread along it are.
-    pub(crate) fn contains_contour(&self, poses: &[PoseArray]) -> bool {
+    pub(crate) fn contains_contour(&self, poses: &[Pose]) -> bool {
         let n = poses.len();
         [0, n / 3, (2 * n) / 3]
             .iter()

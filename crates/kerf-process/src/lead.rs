@@ -3,7 +3,7 @@
 use nalgebra::{Point3, Vector3};
 
 use crate::geometry::{normal, position, Projected};
-use crate::{Contour, PoseArray, ProcessError, Result, Side};
+use crate::{Contour, Pose, ProcessError, Result, Side};
 
 /// Options of the lead-ins, lead-outs and start points.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -159,10 +159,10 @@ pub struct LeadIn {
     pub start: usize,
     /// The lead-in, from the pierce point up to (not including) the start point; tool axis
     /// the start point's normal. Empty when the cut pierces on the contour.
-    pub lead_in: Vec<PoseArray>,
+    pub lead_in: Vec<Pose>,
     /// After the last cutting point of the cut: the overcut along the contour and the exit
     /// into the scrap.
-    pub lead_out: Vec<PoseArray>,
+    pub lead_out: Vec<Pose>,
     /// The scale of the lead-in against the options (1 = full size; smaller where the scrap
     /// is too small, e.g. a small hole).
     pub scale: f64,
@@ -172,12 +172,12 @@ pub struct LeadIn {
 
 impl LeadIn {
     /// Where the beam pierces.
-    pub fn pierce(&self, contour: &[PoseArray]) -> PoseArray {
+    pub fn pierce(&self, contour: &[Pose]) -> Pose {
         self.lead_in.first().copied().unwrap_or(contour[self.start])
     }
 
     /// Where the head is when the cut is done.
-    pub fn exit(&self, contour: &[PoseArray]) -> PoseArray {
+    pub fn exit(&self, contour: &[Pose]) -> Pose {
         self.lead_out.last().copied().unwrap_or(if self.start == 0 {
             contour[contour.len() - 1]
         } else {
@@ -240,7 +240,7 @@ impl Leads {
 
 /// Unit tangent at cutting point `i` of a closed contour (central difference, in the tangent
 /// plane of the normal there).
-fn closed_tangent(poses: &[PoseArray], i: usize) -> (Vector3<f64>, Vector3<f64>) {
+fn closed_tangent(poses: &[Pose], i: usize) -> (Vector3<f64>, Vector3<f64>) {
     let m = poses.len() - 1; // distinct points
     let prev = position(&poses[(i + m - 1) % m]);
     let next = position(&poses[(i + 1) % m]);
@@ -253,7 +253,7 @@ fn closed_tangent(poses: &[PoseArray], i: usize) -> (Vector3<f64>, Vector3<f64>)
 /// Start candidates of a closed contour: cutting points away from corners, on the flattest
 /// stretch (discrete curvature within the lowest tenth of its range), at most 16 spread along
 /// the contour; if every point is at or next to a corner, the gentlest corner.
-fn candidates(poses: &[PoseArray], opts: &LeadOptions) -> Vec<usize> {
+fn candidates(poses: &[Pose], opts: &LeadOptions) -> Vec<usize> {
     let m = poses.len() - 1;
     let turn: Vec<(f64, f64)> = (0..m)
         .map(|i| {
@@ -298,14 +298,17 @@ fn candidates(poses: &[PoseArray], opts: &LeadOptions) -> Vec<usize> {
     flat.into_iter().step_by(step).collect()
 }
 
-fn with_axis(p: &Point3<f64>, n: &Vector3<f64>) -> PoseArray {
-    [p.x, p.y, p.z, n.x, n.y, n.z]
+fn with_axis(p: &Point3<f64>, n: &Vector3<f64>) -> Pose {
+    Pose {
+        position: *p,
+        axis: *n,
+    }
 }
 
 /// The quarter-arc-and-line lead-in and the overcut-and-exit lead-out of a closed contour
 /// starting at `s`, halved until they stay in the scrap.
 fn closed_leads(
-    poses: &[PoseArray],
+    poses: &[Pose],
     s: usize,
     poly: &Projected,
     side: Side,
@@ -397,7 +400,7 @@ fn closed_leads(
 
 /// True if `p` lies on the `side` of a closed contour in 3D: on the side of `n x t` (times the
 /// side's sign) at the contour's nearest cutting point, and off the contour.
-fn side_in_3d(poses: &[PoseArray], p: &Point3<f64>, side: Side) -> bool {
+fn side_in_3d(poses: &[Pose], p: &Point3<f64>, side: Side) -> bool {
     let m = poses.len() - 1;
     let Some(i) = (0..m).min_by(|&a, &b| {
         (position(&poses[a]) - p)
@@ -414,11 +417,11 @@ fn side_in_3d(poses: &[PoseArray], p: &Point3<f64>, side: Side) -> bool {
 /// The cutting points past `s` up to `length` mm along the contour (the last one interpolated
 /// on its chord), with the point and the direction of the exit into the scrap there.
 fn overcut(
-    poses: &[PoseArray],
+    poses: &[Pose],
     s: usize,
     length: f64,
     side: Side,
-) -> (Vec<PoseArray>, Point3<f64>, Vector3<f64>) {
+) -> (Vec<Pose>, Point3<f64>, Vector3<f64>) {
     let m = poses.len() - 1;
     let mut out = Vec::new();
     let mut left = length;
@@ -436,7 +439,10 @@ fn overcut(
             let p = here + (next - here) * f;
             let a = normal(&poses[i]) * (1.0 - f) + normal(&poses[j]) * f;
             let a = a.try_normalize(1e-300).unwrap_or_else(|| normal(&poses[j]));
-            out.push([p.x, p.y, p.z, a.x, a.y, a.z]);
+            out.push(Pose {
+                position: p,
+                axis: a,
+            });
             here = p;
             i = j;
             break;
@@ -454,7 +460,7 @@ fn overcut(
 }
 
 /// Lead-in and lead-out of an open contour: straight along its tangent extensions.
-fn open_leads(poses: &[PoseArray], opts: &LeadOptions) -> LeadIn {
+fn open_leads(poses: &[Pose], opts: &LeadOptions) -> LeadIn {
     let n = poses.len();
     let p0 = position(&poses[0]);
     let p1 = position(&poses[1]);

@@ -57,9 +57,7 @@ pub use wall::{wall_axis, Wall};
 use geometry::Projected;
 use thiserror::Error;
 
-/// A cutting point with its unit normal: `[x, y, z, i, j, k]` (mm; the normal is the tool axis,
-/// pointing from the tip toward the head).
-pub type PoseArray = [f64; 6];
+pub use kerf_format::Pose;
 
 /// The side of a contour, seen along the contour's direction with the normal toward the
 /// viewer (`kerf.curves/1`'s `scrap` key): `Left` is the side of `normal x tangent`.
@@ -124,7 +122,7 @@ pub struct Contour<'a> {
     pub id: &'a str,
     /// The cutting points with normals, in curve order (a closed contour repeats its first
     /// point at the end).
-    pub poses: &'a [PoseArray],
+    pub poses: &'a [Pose],
     /// The scrap side, if the file says (`scrap` key); else it is decided.
     pub scrap: Option<Side>,
     /// The index of the cutting point where a closed cut must start (from the curve's `start`
@@ -279,7 +277,7 @@ fn nesting(
                 reason: format!("{} cutting points; a cut needs two", c.poses.len()),
             });
         }
-        if c.poses.iter().flatten().any(|v| !v.is_finite()) {
+        if !c.poses.iter().all(Pose::is_finite) {
             return Err(ProcessError::BadContour {
                 id: c.id.to_string(),
                 reason: "a cutting point holds a non-finite value".into(),

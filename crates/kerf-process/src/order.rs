@@ -2,7 +2,7 @@
 
 use crate::geometry::position;
 use crate::lead::{LeadIn, Leads};
-use crate::{Contour, PoseArray, Side};
+use crate::{Contour, Pose, Side};
 
 /// Most cost evaluations (each one pass over the order) the 2-opt improvement may spend: the
 /// work budget that keeps large files fast.
@@ -36,7 +36,7 @@ impl CutPlan {
 
     /// The cut of contour `i` as it runs: for a closed contour from its start all the way
     /// round to the start again; an open contour as it is.
-    pub fn cut(&self, i: usize, poses: &[PoseArray]) -> Vec<PoseArray> {
+    pub fn cut(&self, i: usize, poses: &[Pose]) -> Vec<Pose> {
         let s = self.leads[i].start;
         if !self.closed[i] || s == 0 {
             return poses.to_vec();
@@ -48,7 +48,7 @@ impl CutPlan {
     }
 }
 
-fn dist(a: &PoseArray, b: &PoseArray) -> f64 {
+fn dist(a: &Pose, b: &Pose) -> f64 {
     (position(a) - position(b)).norm()
 }
 
@@ -77,7 +77,7 @@ pub(crate) fn plan(
     let mut done = vec![false; n];
     let mut order = Vec::with_capacity(n);
     let mut choice = vec![0usize; n];
-    let mut here: Option<PoseArray> = None;
+    let mut here: Option<Pose> = None;
     while order.len() < n {
         let mut best: Option<(f64, usize, usize)> = None;
         for i in 0..n {
@@ -141,7 +141,7 @@ pub(crate) fn plan(
         }
     }
     // Starts again, given the order: each the candidate nearest to where the head comes from.
-    let mut here: Option<PoseArray> = None;
+    let mut here: Option<Pose> = None;
     for &i in &order {
         if let Some(h) = here {
             let k = (0..leads[i].options.len())

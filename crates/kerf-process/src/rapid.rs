@@ -4,11 +4,11 @@
 //! swings; each move is sampled through the forward kinematics and checked, and a move that
 //! comes too close is split into shorter ones along the straight line until it clears.
 
-use kerf_kinematics::{Axes, Kinematics, Pose};
+use kerf_kinematics::{Axes, Kinematics};
 use nalgebra::{Point3, Vector3};
 
 use crate::traverse::{check_move, Obstacles, Traverse, TraverseOptions};
-use crate::{PoseArray, ProcessError, Result};
+use crate::{Pose, ProcessError, Result};
 
 /// Most pieces one rapid move between two waypoints is split into.
 const MAX_SPLIT: usize = 64;
@@ -16,30 +16,19 @@ const MAX_SPLIT: usize = 64;
 /// The machine axes of a traverse's rapid moves.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RapidMoves {
-    /// `[X, Y, Z, tilt, C]` (mm, degrees) of every rapid waypoint, from the retract point to
-    /// the point above the pierce (the cut's end and the next pierce not included).
-    pub axes: Vec<[f64; 5]>,
+    /// The machine axes of every rapid waypoint, from the retract point to the point above
+    /// the pierce (the cut's end and the next pierce not included).
+    pub axes: Vec<Axes>,
     /// The tip and tool axis at each of those (workpiece frame).
-    pub poses: Vec<PoseArray>,
+    pub poses: Vec<Pose>,
     /// The smallest surface distance measured over the sampled machine moves, mm.
     pub min_distance_mm: f64,
     /// How many moves had to be split so that their swing clears the part.
     pub split_moves: usize,
 }
 
-fn pose_array(p: &Pose) -> PoseArray {
-    [
-        p.position.x,
-        p.position.y,
-        p.position.z,
-        p.axis.x,
-        p.axis.y,
-        p.axis.z,
-    ]
-}
-
 /// The axes that put the tip at `tip` with the rotary axes at `tilt`, `c` (degrees).
-fn linear_at(kin: &dyn Kinematics, tip: &Point3<f64>, tilt: f64, c: f64) -> [f64; 5] {
+fn linear_at(kin: &dyn Kinematics, tip: &Point3<f64>, tilt: f64, c: f64) -> Axes {
     let axis = kin.forward(&Axes::new(0.0, 0.0, 0.0, tilt, c)).axis;
     let q = kin.inverse_with_c(
         &Pose {
@@ -48,7 +37,7 @@ fn linear_at(kin: &dyn Kinematics, tip: &Point3<f64>, tilt: f64, c: f64) -> [f64
         },
         c,
     );
-    [q.x, q.y, q.z, tilt, c]
+    Axes::new(q.x, q.y, q.z, tilt, c)
 }
 
 /// Where the tool axis is this close to the C axis (radians), C is free: a waypoint there keeps
@@ -67,15 +56,15 @@ const POLE_RAD: f64 = 1e-9;
 /// run then turn the tilt alone, in the plane of the tool axes, as the traverse's check assumes.
 pub(crate) fn waypoint_rotaries(
     kin: &dyn Kinematics,
-    way: &[PoseArray],
-    from: &[f64; 5],
-    to: &[f64; 5],
+    way: &[Pose],
+    from: &Axes,
+    to: &Axes,
     tilt: Option<(f64, f64)>,
 ) -> Vec<[f64; 2]> {
     let n = way.len();
-    let axis = |i: usize| Vector3::new(way[i][3], way[i][4], way[i][5]);
+    let axis = |i: usize| way[i].axis;
     let same = |a: Vector3<f64>, b: Vector3<f64>| (a - b).norm() <= 1e-12 * (1.0 + a.norm());
-    let (rf, rt) = ([from[3], from[4]], [to[3], to[4]]);
+    let (rf, rt) = ([from.tilt, from.c], [to.tilt, to.c]);
     if n == 0 {
         return Vec::new();
     }
@@ -97,7 +86,7 @@ pub(crate) fn waypoint_rotaries(
     for i in p + 1..s {
         let prev = rot[i - 1];
         let pose = Pose {
-            position: Point3::new(way[i][0], way[i][1], way[i][2]),
+            position: way[i].position,
             axis: axis(i).normalize(),
         };
         if kin.pole_angle(&pose.axis) <= POLE_RAD {
@@ -124,21 +113,16 @@ pub(crate) fn waypoint_rotaries(
 
 /// The poses of the joint-linear move `a -> b`, sampled so that the tip moves at most
 /// `step` between samples (doubling the count until it does, at most 2^16 samples).
-fn joint_samples(kin: &dyn Kinematics, a: &[f64; 5], b: &[f64; 5], step: f64) -> Vec<PoseArray> {
-    let at = |f: f64| {
-        let v: [f64; 5] = std::array::from_fn(|k| a[k] + (b[k] - a[k]) * f);
-        pose_array(&kin.forward(&Axes::new(v[0], v[1], v[2], v[3], v[4])))
-    };
+fn joint_samples(kin: &dyn Kinematics, a: &Axes, b: &Axes, step: f64) -> Vec<Pose> {
+    let at = |f: f64| kin.forward(&a.lerp(b, f));
     let mut k = 8usize;
     loop {
-        let poses: Vec<PoseArray> = (0..=k).map(|j| at(j as f64 / k as f64)).collect();
+        let poses: Vec<Pose> = (0..=k).map(|j| at(j as f64 / k as f64)).collect();
         let widest = poses
             .windows(2)
             .map(|w| {
-                ((w[1][0] - w[0][0]).powi(2)
-                    + (w[1][1] - w[0][1]).powi(2)
-                    + (w[1][2] - w[0][2]).powi(2))
-                .sqrt()
+                let (p, q) = (w[0].position, w[1].position);
+                ((q.x - p.x).powi(2) + (q.y - p.y).powi(2) + (q.z - p.z).powi(2)).sqrt()
             })
             .fold(0.0, f64::max);
         if widest <= step || k >= 1 << 16 {
@@ -165,8 +149,8 @@ fn joint_samples(kin: &dyn Kinematics, a: &[f64; 5], b: &[f64; 5], step: f64) ->
 pub fn rapid_moves(
     kin: &dyn Kinematics,
     obs: &Obstacles,
-    end_axes: [f64; 5],
-    start_axes: [f64; 5],
+    end_axes: Axes,
+    start_axes: Axes,
     traverse: &Traverse,
     opts: &TraverseOptions,
 ) -> Result<RapidMoves> {
@@ -182,8 +166,8 @@ struct MovesRefused {
 
 /// True when every limited axis of `q` lies inside its range, a thousandth of the range
 /// from either end.
-fn inside_limits(q: &[f64; 5], limits: &[Option<(f64, f64)>; 5]) -> bool {
-    q.iter().zip(limits).all(|(v, l)| {
+fn inside_limits(q: &Axes, limits: &[Option<(f64, f64)>; 5]) -> bool {
+    q.to_array().iter().zip(limits).all(|(v, l)| {
         l.is_none_or(|(lo, hi)| {
             let m = 1e-3 * (hi - lo);
             *v >= lo + m && *v <= hi - m
@@ -199,8 +183,8 @@ fn inside_limits(q: &[f64; 5], limits: &[Option<(f64, f64)>; 5]) -> bool {
 fn rapid_moves_within(
     kin: &dyn Kinematics,
     obs: &Obstacles,
-    end_axes: [f64; 5],
-    start_axes: [f64; 5],
+    end_axes: Axes,
+    start_axes: Axes,
     traverse: &Traverse,
     opts: &TraverseOptions,
     limits: Option<&[Option<(f64, f64)>; 5]>,
@@ -209,11 +193,11 @@ fn rapid_moves_within(
     let c = opts.clearance_mm;
     let step = c / 8.0;
     let rot = waypoint_rotaries(kin, &traverse.waypoints, &end_axes, &start_axes, tilt);
-    let waypoint_axes: Vec<[f64; 5]> = traverse
+    let waypoint_axes: Vec<Axes> = traverse
         .waypoints
         .iter()
         .zip(&rot)
-        .map(|(w, r)| linear_at(kin, &Point3::new(w[0], w[1], w[2]), r[0], r[1]))
+        .map(|(w, r)| linear_at(kin, &w.position, r[0], r[1]))
         .collect();
     let mut axes = Vec::new();
     let mut least = f64::INFINITY;
@@ -228,22 +212,18 @@ fn rapid_moves_within(
         let mut pieces = 1;
         loop {
             // The pieces' ends: on the straight line between the waypoints' tips.
-            let ta = kin
-                .forward(&Axes::new(a[0], a[1], a[2], a[3], a[4]))
-                .position;
-            let tb = kin
-                .forward(&Axes::new(b[0], b[1], b[2], b[3], b[4]))
-                .position;
+            let ta = kin.forward(&a).position;
+            let tb = kin.forward(&b).position;
             // The axes at fraction `f` of the tip's straight line, the rotaries shared out.
             let split_at = |f: f64| {
                 linear_at(
                     kin,
                     &(ta + (tb - ta) * f),
-                    a[3] + (b[3] - a[3]) * f,
-                    a[4] + (b[4] - a[4]) * f,
+                    a.tilt + (b.tilt - a.tilt) * f,
+                    a.c + (b.c - a.c) * f,
                 )
             };
-            let ends: Vec<[f64; 5]> = (0..=pieces)
+            let ends: Vec<Axes> = (0..=pieces)
                 .map(|j| {
                     if j == 0 {
                         a
@@ -312,10 +292,7 @@ fn rapid_moves_within(
             }
         }
     }
-    let poses = axes
-        .iter()
-        .map(|a| pose_array(&kin.forward(&Axes::new(a[0], a[1], a[2], a[3], a[4]))))
-        .collect();
+    let poses = axes.iter().map(|a| kin.forward(a)).collect();
     Ok(RapidMoves {
         axes,
         poses,
@@ -329,17 +306,17 @@ fn rapid_moves_within(
 #[derive(Debug, Clone, PartialEq)]
 pub struct Gap {
     /// The end of the last cut (its lead-out's end).
-    pub from: PoseArray,
+    pub from: Pose,
     /// The machine axes there.
-    pub from_axes: [f64; 5],
+    pub from_axes: Axes,
     /// The next pierce point.
-    pub to: PoseArray,
+    pub to: Pose,
     /// The machine axes there.
-    pub to_axes: [f64; 5],
+    pub to_axes: Axes,
     /// The last cutting point of the last cut on its contour (before the lead-out), mm.
-    pub from_contour: [f64; 3],
+    pub from_contour: Point3<f64>,
     /// The first cutting point of the next cut on its contour (after the lead-in), mm.
-    pub to_contour: [f64; 3],
+    pub to_contour: Point3<f64>,
     /// The surfaces the last cut's curve names (ids as in [`Obstacles::from_file`]).
     pub from_surfaces: Vec<String>,
     /// The surfaces the next cut's curve names.
@@ -372,18 +349,16 @@ pub fn in_the_cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<
 pub fn own_surfaces_over_the_head(obs: &Obstacles, g: &Gap, opts: &TraverseOptions) -> Vec<String> {
     let c = opts.clearance_mm;
     let mut own: Vec<String> = Vec::new();
-    let (exit, pierce) = (
-        [g.from[0], g.from[1], g.from[2]],
-        [g.to[0], g.to[1], g.to[2]],
-    );
+    let (exit, pierce) = (g.from.position, g.to.position);
     for (p, axis, named) in [
         (&g.from_contour, &g.from, &g.from_surfaces),
         (&exit, &g.from, &g.from_surfaces),
         (&g.to_contour, &g.to, &g.to_surfaces),
         (&pierce, &g.to, &g.to_surfaces),
     ] {
-        let at = Point3::new(p[0], p[1], p[2]);
-        let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
+        let at = *p;
+        let n = axis
+            .axis
             .try_normalize(1e-12)
             .unwrap_or_else(nalgebra::Vector3::z);
         let top = at + n * (opts.retract_mm + opts.nozzle_mm);
@@ -401,11 +376,8 @@ pub fn own_surfaces_over_the_head(obs: &Obstacles, g: &Gap, opts: &TraverseOptio
 fn cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions, all: bool) -> Vec<String> {
     let c = opts.clearance_mm;
     let mut absent: Vec<String> = Vec::new();
-    let (exit, pierce) = (
-        [g.from[0], g.from[1], g.from[2]],
-        [g.to[0], g.to[1], g.to[2]],
-    );
-    let lines: Vec<(&[f64; 3], &PoseArray, &Vec<String>)> = if all {
+    let (exit, pierce) = (g.from.position, g.to.position);
+    let lines: Vec<(&Point3<f64>, &Pose, &Vec<String>)> = if all {
         vec![
             (&g.from_contour, &g.from, &g.from_surfaces),
             (&exit, &g.from, &g.from_surfaces),
@@ -419,8 +391,9 @@ fn cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions, all: bool) -> Vec<
         ]
     };
     for (p, axis, named) in lines {
-        let at = Point3::new(p[0], p[1], p[2]);
-        let n = nalgebra::Vector3::new(axis[3], axis[4], axis[5])
+        let at = *p;
+        let n = axis
+            .axis
             .try_normalize(1e-12)
             .unwrap_or_else(nalgebra::Vector3::z);
         let top = at + n * (opts.retract_mm + opts.nozzle_mm);
@@ -480,10 +453,10 @@ pub fn plan_rapids(
             // axes as [`rapid_moves`] sets them): the machine runs each rapid straight in its
             // axes, inside the limits when its ends are (the points a split move adds are
             // checked where it is split, `rapid_moves_within`).
-            let reachable = |way: &[PoseArray]| {
+            let reachable = |way: &[Pose]| {
                 let rots = waypoint_rotaries(kin, way, &g.from_axes, &g.to_axes, limits[3]);
                 way.iter().zip(&rots).all(|(w, r)| {
-                    let tip = Point3::new(w[0], w[1], w[2]);
+                    let tip = w.position;
                     inside_limits(&linear_at(kin, &tip, r[0], r[1]), limits)
                 })
             };
@@ -514,7 +487,7 @@ pub fn plan_rapids(
                                 ProcessError::TraverseBlocked(b) => {
                                     (Point3::from(b.at), b.distance_mm)
                                 }
-                                _ => (Point3::from(g.from_contour), 0.0),
+                                _ => (g.from_contour, 0.0),
                             };
                             crate::traverse::Refusal {
                                 at,

@@ -5,7 +5,7 @@ use nalgebra::Point3;
 
 use crate::geometry::{normal, position};
 use crate::traverse::{Obstacles, TraverseOptions};
-use crate::PoseArray;
+use crate::Pose;
 
 /// Most contour points whose head lines [`head_lines`] looks at (spread along the contour,
 /// both ends always).
@@ -75,7 +75,7 @@ impl HeadLines {
 /// the clearance of a line is always found, one within half of it where a sample comes that
 /// close. The lines start at 3/4 of the clearance because their foot is on the part by design.
 /// Options that [`crate::plan_traverse`] would refuse look at nothing.
-pub fn head_lines(obs: &Obstacles, poses: &[PoseArray], opts: &TraverseOptions) -> HeadLines {
+pub fn head_lines(obs: &Obstacles, poses: &[Pose], opts: &TraverseOptions) -> HeadLines {
     let c = opts.clearance_mm;
     let n = poses.len();
     if n == 0 || obs.is_empty() || opts.validate().is_err() {

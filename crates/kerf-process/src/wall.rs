@@ -12,7 +12,7 @@
 use nalgebra::{Point3, Vector3};
 
 use crate::geometry::{normal, position};
-use crate::{PoseArray, Side};
+use crate::{Pose, Side};
 
 /// A contour whose surface is a wall at most `max_wall_mm` wide across it ([`wall_axis`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -20,7 +20,7 @@ use crate::{PoseArray, Side};
 pub struct Wall {
     /// The cutting points with the tool axis along the wall (unit), pointing away from the
     /// wall, toward the face of the sheet the contour lies on.
-    pub poses: Vec<PoseArray>,
+    pub poses: Vec<Pose>,
     /// The scrap side with these tool axes (`left` is `axis x tangent`): the side the wall's
     /// normal points to.
     pub scrap: Side,
@@ -62,7 +62,7 @@ const STRAIGHT_POINTS: usize = 16;
 /// contour too) would be taken for a wall.
 pub fn wall_axis(
     hull: &[Point3<f64>],
-    poses: &[PoseArray],
+    poses: &[Pose],
     max_wall_mm: f64,
     normal_near: &dyn Fn(&Point3<f64>) -> Option<Vector3<f64>>,
 ) -> Option<Wall> {
@@ -137,7 +137,10 @@ pub fn wall_axis(
     let poses = pts
         .iter()
         .zip(&dirs)
-        .map(|(p, (w, _, _))| [p.x, p.y, p.z, s * w.x, s * w.y, s * w.z])
+        .map(|(&position, (w, _, _))| Pose {
+            position,
+            axis: s * w,
+        })
         .collect();
     Some(Wall {
         poses,

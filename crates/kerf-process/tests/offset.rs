@@ -6,19 +6,19 @@
 
 use kerf_discretize::{discretize, Options};
 use kerf_nurbs::{NurbsCurve, Segment};
-use kerf_process::{offset, OffsetInput, OffsetOptions, OffsetPath, PoseArray, ProcessError, Side};
+use kerf_process::{offset, OffsetInput, OffsetOptions, OffsetPath, Pose, ProcessError, Side};
 use nalgebra::{Point3, Vector2, Vector3};
 
 const TOL: f64 = 0.01;
 
 /// The discretized contour with a fixed tool axis.
-fn contour(curve: &NurbsCurve, axis: Vector3<f64>) -> (Vec<f64>, Vec<PoseArray>) {
+fn contour(curve: &NurbsCurve, axis: Vector3<f64>) -> (Vec<f64>, Vec<Pose>) {
     let d = discretize(curve, &Options::with_tolerance(TOL)).expect("discretize");
     let a = axis.normalize();
     let poses = d
         .points()
         .iter()
-        .map(|p| [p.x, p.y, p.z, a.x, a.y, a.z])
+        .map(|p| Pose::new(p.x, p.y, p.z, a.x, a.y, a.z))
         .collect();
     (d.params().to_vec(), poses)
 }
@@ -55,11 +55,7 @@ fn run(
 
 /// Points along every chord of the path (what the machine runs), 8 per chord.
 fn along_chords(path: &OffsetPath) -> Vec<Point3<f64>> {
-    let p: Vec<Point3<f64>> = path
-        .poses
-        .iter()
-        .map(|q| Point3::new(q[0], q[1], q[2]))
-        .collect();
+    let p: Vec<Point3<f64>> = path.poses.iter().map(|q| q.position).collect();
     let mut out = Vec::new();
     for w in p.windows(2) {
         for k in 0..8 {
@@ -148,12 +144,7 @@ fn contour_to_path(curve: &NurbsCurve, path: &OffsetPath) -> (f64, f64) {
     let segs: Vec<Segment<3>> = path
         .poses
         .windows(2)
-        .map(|w| {
-            Segment::between(
-                &Point3::new(w[0][0], w[0][1], w[0][2]),
-                &Point3::new(w[1][0], w[1][1], w[1][2]),
-            )
-        })
+        .map(|w| Segment::between(&w[0].position, &w[1].position))
         .collect();
     let (a, b) = curve.domain();
     let mut lo = f64::INFINITY;
@@ -243,7 +234,10 @@ fn sharp_corners_get_arcs_outside_and_cut_backs_inside() {
         assert_at(&hole, sdf, -r, "square hole");
         assert_eq!(hole.poses.len(), 5, "{:?}", hole.poses);
         for q in &hole.poses {
-            assert!((q[0].abs() - (h - r)).abs() < 1e-9 && (q[1].abs() - (h - r)).abs() < 1e-9);
+            assert!(
+                (q.position.x.abs() - (h - r)).abs() < 1e-9
+                    && (q.position.y.abs() - (h - r)).abs() < 1e-9
+            );
         }
         // A round beam leaves (sqrt 2 - 1) r in each inside corner.
         let left = (2f64.sqrt() - 1.0) * r;
@@ -290,7 +284,7 @@ fn a_tilted_beam_touches_the_contour_with_its_edge_at_the_surface() {
                 let path = run(&c, a, Some(&[[0.0, 0.0, 1.0]]), side, kerf).expect("tilted");
                 assert!(path.proven, "a fixed tilted axis on a plane is proven");
                 for q in &path.poses {
-                    assert!(q[2].abs() < 1e-9, "the tip is on the sheet: {q:?}");
+                    assert!(q.position.z.abs() < 1e-9, "the tip is on the sheet: {q:?}");
                 }
                 // Seen along the beam, the beam's centre is r from the contour.
                 let worst = along_chords(&path)
@@ -416,7 +410,7 @@ fn point_at_runs_on_the_exact_offset_between_points() {
     }
     for (k, q) in path.poses.iter().enumerate() {
         let p = path.point_at(k as f64, &c);
-        assert!((p - Point3::new(q[0], q[1], q[2])).norm() < 1e-12);
+        assert!((p - q.position).norm() < 1e-12);
     }
 }
 
@@ -448,14 +442,8 @@ fn beam_to_contour(path: &OffsetPath, curve: &NurbsCurve, r: f64) -> f64 {
     };
     let mut worst = 0.0_f64;
     for w in path.poses.windows(2) {
-        let (p0, p1) = (
-            Point3::new(w[0][0], w[0][1], w[0][2]),
-            Point3::new(w[1][0], w[1][1], w[1][2]),
-        );
-        let (a0, a1) = (
-            Vector3::new(w[0][3], w[0][4], w[0][5]),
-            Vector3::new(w[1][3], w[1][4], w[1][5]),
-        );
+        let (p0, p1) = (w[0].position, w[1].position);
+        let (a0, a1) = (w[0].axis, w[1].axis);
         for k in 0..8 {
             let f = k as f64 / 8.0;
             let p = p0 + (p1 - p0) * f;
@@ -543,7 +531,7 @@ fn on_curved_surfaces_and_tilted_beams_the_beams_edge_runs_on_the_contour() {
         for tilt_deg in [0.0_f64, 10.0, 20.0, 30.0] {
             let beta = tilt_deg.to_radians();
             // The beam leans sideways: the normal turned about the contour's tangent.
-            let poses: Vec<PoseArray> = d
+            let poses: Vec<Pose> = d
                 .points()
                 .iter()
                 .zip(d.params())
@@ -551,7 +539,7 @@ fn on_curved_surfaces_and_tilted_beams_the_beams_edge_runs_on_the_contour() {
                 .map(|((p, &t), n)| {
                     let tangent = case.curve.tangent(t).expect("tangent");
                     let a = n * beta.cos() + tangent.cross(n) * beta.sin();
-                    [p.x, p.y, p.z, a.x, a.y, a.z]
+                    Pose::new(p.x, p.y, p.z, a.x, a.y, a.z)
                 })
                 .collect();
             let m: Vec<[f64; 3]> = normals.iter().map(|n| [n.x, n.y, n.z]).collect();
@@ -616,7 +604,7 @@ fn a_repeated_cutting_point_a_zero_axis_and_an_open_closure_are_handled() {
     );
     let curve = circle(5.0);
     let (params, mut poses) = contour(&curve, Vector3::z());
-    poses[3][3..].copy_from_slice(&[0.0, 0.0, 0.0]);
+    poses[3].axis = Vector3::zeros();
     let zero = OffsetInput {
         id: "c",
         curve: &curve,

@@ -1,22 +1,22 @@
 //! Sides, start points, lead-ins and the cut order against exact geometry: circles and squares
 //! whose inside and outside are known, tangents known in closed form.
 
-use kerf_process::{plan_cuts, Contour, LeadOptions, PoseArray, Side};
+use kerf_process::{plan_cuts, Contour, LeadOptions, Pose, Side};
 
 /// A circle of radius `r` about (`cx`, `cy`) in z = 0, `n` segments, counter-clockwise seen from
 /// +z if `ccw`, normal +z; closed (the first point repeated).
-fn circle(cx: f64, cy: f64, r: f64, n: usize, ccw: bool) -> Vec<PoseArray> {
+fn circle(cx: f64, cy: f64, r: f64, n: usize, ccw: bool) -> Vec<Pose> {
     (0..=n)
         .map(|i| {
             let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
             let a = if ccw { a } else { -a };
-            [cx + r * a.cos(), cy + r * a.sin(), 0.0, 0.0, 0.0, 1.0]
+            Pose::new(cx + r * a.cos(), cy + r * a.sin(), 0.0, 0.0, 0.0, 1.0)
         })
         .collect()
 }
 
 /// A square of side `s` about the origin with `k` points per edge, counter-clockwise.
-fn square(s: f64, k: usize) -> Vec<PoseArray> {
+fn square(s: f64, k: usize) -> Vec<Pose> {
     let h = s / 2.0;
     let c = [(-h, -h), (h, -h), (h, h), (-h, h)];
     let mut out = Vec::new();
@@ -24,21 +24,21 @@ fn square(s: f64, k: usize) -> Vec<PoseArray> {
         let (a, b) = (c[e], c[(e + 1) % 4]);
         for i in 0..k {
             let t = i as f64 / k as f64;
-            out.push([
+            out.push(Pose::new(
                 a.0 + t * (b.0 - a.0),
                 a.1 + t * (b.1 - a.1),
                 0.0,
                 0.0,
                 0.0,
                 1.0,
-            ]);
+            ));
         }
     }
     out.push(out[0]);
     out
 }
 
-fn contour<'a>(id: &'a str, poses: &'a [PoseArray]) -> Contour<'a> {
+fn contour<'a>(id: &'a str, poses: &'a [Pose]) -> Contour<'a> {
     Contour {
         id,
         poses,
@@ -47,8 +47,8 @@ fn contour<'a>(id: &'a str, poses: &'a [PoseArray]) -> Contour<'a> {
     }
 }
 
-fn r_of(p: &PoseArray, cx: f64, cy: f64) -> f64 {
-    ((p[0] - cx).powi(2) + (p[1] - cy).powi(2)).sqrt()
+fn r_of(p: &Pose, cx: f64, cy: f64) -> f64 {
+    ((p.position.x - cx).powi(2) + (p.position.y - cy).powi(2)).sqrt()
 }
 
 #[test]
@@ -59,7 +59,7 @@ fn holes_first_lead_ins_in_the_scrap_and_tangent() {
         (-30.0, 10.0, 6.0, false),
         (0.0, -30.0, 4.0, true),
     ];
-    let hole_pts: Vec<Vec<PoseArray>> = holes
+    let hole_pts: Vec<Vec<Pose>> = holes
         .iter()
         .map(|&(x, y, r, ccw)| circle(x, y, r, 120, ccw))
         .collect();
@@ -147,11 +147,17 @@ fn holes_first_lead_ins_in_the_scrap_and_tangent() {
         let l = &plan.leads[i];
         let cut = plan.cut(i, pts);
         let last = l.lead_in.last().expect("lead-in");
-        let a = [cut[0][0] - last[0], cut[0][1] - last[1]];
+        let a = [
+            cut[0].position.x - last.position.x,
+            cut[0].position.y - last.position.y,
+        ];
         let (cx, cy) = centres[i];
-        let radial = [cut[0][0] - cx, cut[0][1] - cy];
+        let radial = [cut[0].position.x - cx, cut[0].position.y - cy];
         let mut t = [-radial[1], radial[0]];
-        let along = [cut[1][0] - cut[0][0], cut[1][1] - cut[0][1]];
+        let along = [
+            cut[1].position.x - cut[0].position.x,
+            cut[1].position.y - cut[0].position.y,
+        ];
         if t[0] * along[0] + t[1] * along[1] < 0.0 {
             t = [-t[0], -t[1]];
         }
@@ -220,18 +226,22 @@ fn the_file_scrap_key_wins_and_open_contours_lead_along_their_tangent() {
             .all(|p| r_of(p, 0.0, 0.0) < 10.0),
         "inside"
     );
-    let line: Vec<PoseArray> = (0..=10)
-        .map(|i| [i as f64, 0.0, 0.0, 0.0, 0.0, 1.0])
+    let line: Vec<Pose> = (0..=10)
+        .map(|i| Pose::new(i as f64, 0.0, 0.0, 0.0, 0.0, 1.0))
         .collect();
     let plan = plan_cuts(&[contour("trim", &line)], &LeadOptions::default()).expect("plan");
     let l = &plan.leads[0];
     assert_eq!(l.lead_in.len(), 1, "one straight move");
     assert!(
-        (l.lead_in[0][0] + 3.0).abs() < 1e-12 && l.lead_in[0][1] == 0.0,
+        (l.lead_in[0].position.x + 3.0).abs() < 1e-12 && l.lead_in[0].position.y == 0.0,
         "{:?}",
         l.lead_in
     );
-    assert!((l.lead_out[0][0] - 11.5).abs() < 1e-12, "{:?}", l.lead_out);
+    assert!(
+        (l.lead_out[0].position.x - 11.5).abs() < 1e-12,
+        "{:?}",
+        l.lead_out
+    );
 }
 
 #[test]
@@ -259,7 +269,7 @@ fn island_in_a_hole_and_a_shorter_order_than_the_file() {
     );
     // A row of holes listed in a zig-zag file order.
     let centres: Vec<f64> = vec![0.0, 80.0, 10.0, 70.0, 20.0, 60.0, 30.0, 50.0, 40.0];
-    let holes: Vec<Vec<PoseArray>> = centres
+    let holes: Vec<Vec<Pose>> = centres
         .iter()
         .map(|&x| circle(x, 0.0, 2.0, 40, true))
         .collect();
@@ -280,11 +290,11 @@ fn island_in_a_hole_and_a_shorter_order_than_the_file() {
 
 /// `n` cutting points (and the first again) of a loop of radius 20 around the z axis, the tool
 /// axes radial.
-fn tube_loop(n: usize) -> Vec<PoseArray> {
+fn tube_loop(n: usize) -> Vec<Pose> {
     (0..=n)
         .map(|i| {
             let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
-            [20.0 * a.cos(), 20.0 * a.sin(), 0.0, a.cos(), a.sin(), 0.0]
+            Pose::new(20.0 * a.cos(), 20.0 * a.sin(), 0.0, a.cos(), a.sin(), 0.0)
         })
         .collect()
 }
@@ -309,11 +319,14 @@ fn a_loop_around_a_tube_leads_in_on_its_scrap_side() {
         assert!((l.scale - 1.0).abs() < 1e-12, "{side:?}: full size");
         let pierce = l.lead_in[0];
         assert!(
-            pierce[2] * sign > 2.0,
+            pierce.position.z * sign > 2.0,
             "{side:?}: the pierce is up/down the tube: {pierce:?}"
         );
         for q in l.lead_in.iter().chain(&l.lead_out) {
-            assert!(q[2] * sign >= -1e-9, "{side:?}: on the scrap side: {q:?}");
+            assert!(
+                q.position.z * sign >= -1e-9,
+                "{side:?}: on the scrap side: {q:?}"
+            );
         }
     }
 }
@@ -338,19 +351,20 @@ fn the_overcut_ends_with_the_axis_of_where_it_ends() {
     assert_eq!(l.lead_out.len(), 2, "the overcut's end and the exit: {l:?}");
     let end = l.lead_out[0];
     let (p, a) = (
-        nalgebra::Vector3::new(end[0], end[1], end[2]),
-        nalgebra::Vector3::new(end[3], end[4], end[5]),
+        nalgebra::Vector3::new(end.position.x, end.position.y, end.position.z),
+        end.axis,
     );
     // The overcut's end lies inside the first chord after the start, not on a cutting point.
     let s = l.start;
-    let along = (p - nalgebra::Vector3::new(ring[s][0], ring[s][1], ring[s][2])).norm();
+    let along =
+        (p - nalgebra::Vector3::new(ring[s].position.x, ring[s].position.y, ring[s].position.z))
+            .norm();
     assert!(
         (along - opts.overcut_mm).abs() < 1e-9,
         "{along} mm past the start"
     );
     assert!(
-        ring.iter()
-            .all(|q| (nalgebra::Vector3::new(q[3], q[4], q[5]) - a).norm() > 1e-3),
+        ring.iter().all(|q| (q.axis - a).norm() > 1e-3),
         "the axis is not a cutting point's: {a:?}"
     );
     let radial = nalgebra::Vector3::new(p.x, p.y, 0.0).normalize();
@@ -359,5 +373,5 @@ fn the_overcut_ends_with_the_axis_of_where_it_ends() {
         "axis {a:?}, radial at the overcut's end {radial:?}"
     );
     let exit = l.lead_out[1];
-    assert_eq!(exit[3..], end[3..], "the exit keeps the overcut's axis");
+    assert_eq!(exit.axis, end.axis, "the exit keeps the overcut's axis");
 }

@@ -6,7 +6,7 @@ mod common;
 
 use kerf_nurbs::NurbsSurface;
 use kerf_process::{
-    plan_traverse, plan_traverse_within, Obstacles, PoseArray, ProcessError, Route, TraverseOptions,
+    plan_traverse, plan_traverse_within, Obstacles, Pose, ProcessError, Route, TraverseOptions,
 };
 use nalgebra::{Point3, Vector3};
 
@@ -62,7 +62,7 @@ fn obstacles(rects: &[Rect]) -> Obstacles {
 }
 
 /// The smallest exact distance to `rects` over a dense sampling of the route.
-fn dense_min(rects: &[Rect], way: &[PoseArray], nozzle: f64) -> f64 {
+fn dense_min(rects: &[Rect], way: &[Pose], nozzle: f64) -> f64 {
     common::dense_min(way, nozzle, 80, &|q| {
         rects
             .iter()
@@ -73,11 +73,11 @@ fn dense_min(rects: &[Rect], way: &[PoseArray], nozzle: f64) -> f64 {
 
 /// A floor (z = 0) and a roof 40 mm above it over `x` in [-30, 30]: a pierce on the floor
 /// under the roof, an exit on the roof's top, both with the tool axis up.
-fn roof() -> (Vec<Rect>, PoseArray, PoseArray) {
+fn roof() -> (Vec<Rect>, Pose, Pose) {
     let floor = Rect::new([-100.0, -100.0, 0.0], [200.0, 0.0, 0.0], [0.0, 200.0, 0.0]);
     let roof = Rect::new([-30.0, -100.0, 40.0], [60.0, 0.0, 0.0], [0.0, 200.0, 0.0]);
-    let exit = [0.0, 0.0, 40.0, 0.0, 0.0, 1.0];
-    let pierce = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    let exit = Pose::new(0.0, 0.0, 40.0, 0.0, 0.0, 1.0);
+    let pierce = Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0);
     (vec![floor, roof], exit, pierce)
 }
 
@@ -110,21 +110,28 @@ fn a_pierce_under_a_roof_is_reached_around_the_roofs_edge() {
     // It leaves along the exit's axis and arrives above the pierce on its axis, and goes
     // round the roof's edge (beyond x = 30 by the clearance).
     let (first, last) = (t.waypoints[0], t.waypoints[t.waypoints.len() - 1]);
-    assert!(first[0].abs() < 1e-9 && first[1].abs() < 1e-9 && first[2] > 40.0);
-    assert!(last[0].abs() < 1e-9 && last[1].abs() < 1e-9 && last[2] > 0.0 && last[2] < 40.0);
+    assert!(
+        first.position.x.abs() < 1e-9 && first.position.y.abs() < 1e-9 && first.position.z > 40.0
+    );
+    assert!(
+        last.position.x.abs() < 1e-9
+            && last.position.y.abs() < 1e-9
+            && last.position.z > 0.0
+            && last.position.z < 40.0
+    );
     let out = t
         .waypoints
         .iter()
-        .map(|w| w[0].abs().max(w[1].abs() - 100.0))
+        .map(|w| w.position.x.abs().max(w.position.y.abs() - 100.0))
         .fold(0.0, f64::max);
     assert!(
         out >= 30.0 + opts.clearance_mm,
         "goes round the edge: {out}"
     );
     // The length counts the retract, the path and the approach.
-    let mut pts = vec![Point3::new(exit[0], exit[1], exit[2])];
-    pts.extend(t.waypoints.iter().map(|w| Point3::new(w[0], w[1], w[2])));
-    pts.push(Point3::new(pierce[0], pierce[1], pierce[2]));
+    let mut pts = vec![exit.position];
+    pts.extend(t.waypoints.iter().map(|w| w.position));
+    pts.push(pierce.position);
     let length: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
     assert!((t.length_mm - length).abs() < 1e-9);
 }
@@ -136,8 +143,8 @@ fn an_approach_line_blocked_at_every_height_is_proven_impossible() {
     // sweeps within half the clearance of it. No route can end above the pierce.
     let floor = Rect::new([-100.0, -100.0, 0.0], [400.0, 0.0, 0.0], [0.0, 200.0, 0.0]);
     let opts = TraverseOptions::default();
-    let pierce = [100.0, 0.0, 0.0, 0.0, 0.0, 1.0];
-    let exit = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    let pierce = Pose::new(100.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+    let exit = Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0);
     for (height, proven) in [(32.0, true), (33.5, false)] {
         let ceiling = Rect::new([50.0, -100.0, height], [250.0, 0.0, 0.0], [0.0, 200.0, 0.0]);
         let rects = [floor, ceiling];
@@ -189,9 +196,9 @@ fn the_search_stops_within_its_budget() {
     );
     let obs = obstacles(&[wall]);
     let opts = TraverseOptions::default();
-    let exit = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
-    let pierce = [0.0, 10.0, 0.0, -1.0, 0.0, 0.0];
-    let low = |w: &[PoseArray]| w.iter().all(|p| p[2] < 100.0);
+    let exit = Pose::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0);
+    let pierce = Pose::new(0.0, 10.0, 0.0, -1.0, 0.0, 0.0);
+    let low = |w: &[Pose]| w.iter().all(|p| p.position.z < 100.0);
     let start = std::time::Instant::now();
     let e = plan_traverse_within(&obs, &exit, &pierce, &opts, &low).expect_err("no route");
     let text = e.to_string();

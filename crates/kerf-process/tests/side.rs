@@ -4,7 +4,7 @@
 //! wall; from the other side nothing is there, unless a plate is put in the way.
 
 use kerf_nurbs::NurbsSurface;
-use kerf_process::{head_lines, Obstacles, PoseArray, TraverseOptions};
+use kerf_process::{head_lines, Obstacles, Pose, TraverseOptions};
 use nalgebra::{Point3, Vector3};
 
 const R: f64 = 3.0;
@@ -15,11 +15,11 @@ fn wall() -> NurbsSurface {
 }
 
 /// The hole's edge at `z = 0`, `n` points, the tool axis the wall's normal into the hole.
-fn edge(n: usize) -> Vec<PoseArray> {
+fn edge(n: usize) -> Vec<Pose> {
     (0..=n)
         .map(|k| {
             let a = std::f64::consts::TAU * k as f64 / n as f64;
-            [R * a.cos(), R * a.sin(), 0.0, -a.cos(), -a.sin(), 0.0]
+            Pose::new(R * a.cos(), R * a.sin(), 0.0, -a.cos(), -a.sin(), 0.0)
         })
         .collect()
 }
@@ -66,7 +66,7 @@ fn a_plate_on_the_other_side_makes_both_sides_meet_the_part() {
     let reach = opts.retract_mm + opts.nozzle_mm;
     let want = poses
         .iter()
-        .filter(|p| x - (R + reach) * (-p[3]) < 0.5 * opts.clearance_mm)
+        .filter(|p| x - (R + reach) * (-p.axis.x) < 0.5 * opts.clearance_mm)
         .count();
     assert!(
         want > 0 && want < 41,
@@ -97,8 +97,8 @@ fn a_flat_sheet_meets_nothing_and_bad_input_is_harmless() {
         )
         .expect("sheet"),
     );
-    let on_sheet: Vec<PoseArray> = (0..10)
-        .map(|k| [f64::from(k), 0.0, 0.0, 0.0, 0.0, 1.0])
+    let on_sheet: Vec<Pose> = (0..10)
+        .map(|k| Pose::new(f64::from(k), 0.0, 0.0, 0.0, 0.0, 1.0))
         .collect();
     let h = head_lines(&obs, &on_sheet, &opts);
     assert_eq!((h.points, h.given, h.other), (10, 0, 0), "{h:?}");
@@ -106,8 +106,8 @@ fn a_flat_sheet_meets_nothing_and_bad_input_is_harmless() {
     // No points, a zero axis, a non-finite point: nothing counted, no panic.
     assert_eq!(head_lines(&obs, &[], &opts).points, 0);
     let bad = [
-        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        [f64::NAN, 0.0, 0.0, 0.0, 0.0, 1.0],
+        Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        Pose::new(f64::NAN, 0.0, 0.0, 0.0, 0.0, 1.0),
     ];
     let h = head_lines(&obs, &bad, &opts);
     assert_eq!((h.given, h.other), (0, 0), "{h:?}");

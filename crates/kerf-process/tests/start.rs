@@ -3,7 +3,7 @@
 
 use kerf_discretize::{discretize, Discretization, Options};
 use kerf_nurbs::NurbsCurve;
-use kerf_process::{index_of_param, plan_cuts, prepare_start, Contour, LeadOptions, PoseArray};
+use kerf_process::{index_of_param, plan_cuts, prepare_start, Contour, LeadOptions, Pose};
 use nalgebra::Point3;
 
 /// A closed degree-1 rectangle `w` x `h` (counter-clockwise from the origin), domain [0, 4].
@@ -18,10 +18,10 @@ fn rectangle(w: f64, h: f64) -> NurbsCurve {
     .expect("rectangle")
 }
 
-fn poses(points: &[Point3<f64>]) -> Vec<PoseArray> {
+fn poses(points: &[Point3<f64>]) -> Vec<Pose> {
     points
         .iter()
-        .map(|p| [p.x, p.y, p.z, 0.0, 0.0, 1.0])
+        .map(|p| Pose::new(p.x, p.y, p.z, 0.0, 0.0, 1.0))
         .collect()
 }
 
@@ -55,7 +55,7 @@ fn a_polygon_of_corners_starts_in_the_middle_of_its_longest_edge() {
     assert!(!plan.leads[0].pierce_on_contour, "a full lead-in fits");
     for q in &plan.leads[0].lead_in {
         assert!(
-            q[1] < -1e-9,
+            q.position.y < -1e-9,
             "the lead-in lies outside (below the bottom edge): {q:?}"
         );
     }

@@ -5,7 +5,7 @@
 mod common;
 
 use kerf_nurbs::NurbsSurface;
-use kerf_process::{plan_traverse, Obstacles, PoseArray, ProcessError, Route, TraverseOptions};
+use kerf_process::{plan_traverse, Obstacles, Pose, ProcessError, Route, TraverseOptions};
 use nalgebra::{Point3, Vector3};
 
 const R: f64 = 50.0;
@@ -49,14 +49,14 @@ fn arch_distance(p: &Point3<f64>) -> f64 {
 }
 
 /// A cutting pose on the arch's outer face at angle `deg` (from +x) and height `y`.
-fn on_arch(deg: f64, y: f64) -> PoseArray {
+fn on_arch(deg: f64, y: f64) -> Pose {
     let a = deg.to_radians();
-    [R * a.cos(), y, R * a.sin(), a.cos(), 0.0, a.sin()]
+    Pose::new(R * a.cos(), y, R * a.sin(), a.cos(), 0.0, a.sin())
 }
 
 /// The smallest exact distance over a dense sampling of the route (0.05 mm along the tip's
 /// polyline, the nozzle at 41 points).
-fn dense_min(way: &[PoseArray], nozzle: f64) -> f64 {
+fn dense_min(way: &[Pose], nozzle: f64) -> f64 {
     common::dense_min(way, nozzle, 40, &arch_distance)
 }
 
@@ -72,17 +72,18 @@ fn the_straight_traverse_over_an_arch_cuts_through_it_and_the_planned_one_clears
     let opts = TraverseOptions::default();
     let (from, to) = (on_arch(20.0, 30.0), on_arch(160.0, 50.0));
     // Today's traverse: the retract points joined straight. It runs through the arch.
-    let lift = |p: &PoseArray| {
+    let lift = |p: &Pose| {
         let mut q = *p;
-        for k in 0..3 {
-            q[k] += p[k + 3] * opts.retract_mm;
-        }
+        q.position += p.axis * opts.retract_mm;
         q
     };
     let (a, b) = (lift(&from), lift(&to));
     let inside = (0..=1000).any(|j| {
         let f = j as f64 / 1000.0;
-        let (x, z) = (a[0] + (b[0] - a[0]) * f, a[2] + (b[2] - a[2]) * f);
+        let (x, z) = (
+            a.position.x + (b.position.x - a.position.x) * f,
+            a.position.z + (b.position.z - a.position.z) * f,
+        );
         x.hypot(z) < R - 10.0 && z > 0.0
     });
     assert!(
@@ -105,15 +106,23 @@ fn the_straight_traverse_over_an_arch_cuts_through_it_and_the_planned_one_clears
     let first = t.waypoints[0];
     let last = t.waypoints[t.waypoints.len() - 1];
     for (w, p) in [(first, from), (last, to)] {
-        let d = Vector3::new(w[0] - p[0], w[1] - p[1], w[2] - p[2]);
-        let n = Vector3::new(p[3], p[4], p[5]);
+        let d = Vector3::new(
+            w.position.x - p.position.x,
+            w.position.y - p.position.y,
+            w.position.z - p.position.z,
+        );
+        let n = p.axis;
         assert!(
             d.cross(&n).norm() < 1e-9 && d.dot(&n) > 0.0,
             "retract along the axis: {d:?}"
         );
     }
     // The travel is not absurdly high: the safe plane is just above the arch.
-    let top = t.waypoints.iter().map(|w| w[2]).fold(f64::MIN, f64::max);
+    let top = t
+        .waypoints
+        .iter()
+        .map(|w| w.position.z)
+        .fold(f64::MIN, f64::max);
     assert!(top < R + opts.clearance_mm + 2.0, "safe plane at z = {top}");
     assert!(
         t.min_distance_mm >= opts.clearance_mm,
@@ -126,9 +135,9 @@ fn the_straight_traverse_over_an_arch_cuts_through_it_and_the_planned_one_clears
         .collect::<Vec<_>>()
         .windows(2)
         .map(|w| {
-            ((w[1][0] - w[0][0]).powi(2)
-                + (w[1][1] - w[0][1]).powi(2)
-                + (w[1][2] - w[0][2]).powi(2))
+            ((w[1].position.x - w[0].position.x).powi(2)
+                + (w[1].position.y - w[0].position.y).powi(2)
+                + (w[1].position.z - w[0].position.z).powi(2))
             .sqrt()
         })
         .sum();
@@ -212,7 +221,7 @@ fn a_head_under_a_roof_it_cannot_leave_is_refused_with_the_place() {
     // fine; one pointing up into the crown from just below it cannot back off 5 mm clear.
     let obs = obstacles();
     let opts = TraverseOptions::default();
-    let inside = [0.0, 40.0, R - 6.0, 0.0, 0.0, 1.0];
+    let inside = Pose::new(0.0, 40.0, R - 6.0, 0.0, 0.0, 1.0);
     let e = plan_traverse(&obs, &inside, &on_arch(90.0, 40.0), &opts).unwrap_err();
     assert!(matches!(e, ProcessError::TraverseBlocked(..)), "{e}");
     assert!(
@@ -238,7 +247,7 @@ fn bad_options_and_poses_are_errors() {
         "retract below the clearance"
     );
     let mut nan = p;
-    nan[1] = f64::NAN;
+    nan.position.y = f64::NAN;
     assert!(
         matches!(
             plan_traverse(&obs, &nan, &p, &TraverseOptions::default()),
@@ -259,8 +268,8 @@ fn far_surfaces_are_not_queried() {
     // exact query of it.
     let obs = obstacles();
     let before = obs.queries();
-    let p = [0.0, 1e4, 0.0, 0.0, 0.0, 1.0];
-    let q = [10.0, 1e4, 0.0, 0.0, 0.0, 1.0];
+    let p = Pose::new(0.0, 1e4, 0.0, 0.0, 0.0, 1.0);
+    let q = Pose::new(10.0, 1e4, 0.0, 0.0, 0.0, 1.0);
     let t = plan_traverse(&obs, &p, &q, &TraverseOptions::default()).expect("clear");
     assert_eq!(t.route, Route::Straight, "nothing near");
     assert_eq!(obs.queries(), before, "no exact query");
@@ -297,16 +306,13 @@ fn the_machines_rapid_moves_clear_the_arch_as_the_machine_runs_them() {
         let obs = obstacles();
         let opts = TraverseOptions::default().with_clearance(clearance);
         let (from, to) = (on_arch(a, 30.0), on_arch(b, 50.0));
-        let solve = |p: &PoseArray| {
-            let a = kin.inverse(&Pose::new(p[0], p[1], p[2], p[3], p[4], p[5]))[0];
-            [a.x, a.y, a.z, a.tilt, a.c]
-        };
+        let solve = |p: &Pose| kin.inverse(p)[0];
         let (end, start) = (solve(&from), solve(&to));
         let t = plan_traverse(&obs, &from, &to, &opts).expect("route");
         let r = rapid_moves(&kin, &obs, end, start, &t, &opts).expect("rapids");
         splits += r.split_moves;
         assert_eq!(r.axes.len(), r.poses.len(), "one pose per waypoint");
-        let forward = |v: &[f64; 5]| kin.forward(&Axes::new(v[0], v[1], v[2], v[3], v[4]));
+        let forward = |v: &Axes| kin.forward(v);
         let mut least = f64::INFINITY;
         let mut all = vec![end];
         all.extend_from_slice(&r.axes);
@@ -314,7 +320,7 @@ fn the_machines_rapid_moves_clear_the_arch_as_the_machine_runs_them() {
         for w in all[1..all.len() - 1].windows(2) {
             for j in 0..=1000 {
                 let f = j as f64 / 1000.0;
-                let v: [f64; 5] = std::array::from_fn(|k| w[0][k] + (w[1][k] - w[0][k]) * f);
+                let v = w[0].lerp(&w[1], f);
                 let p = forward(&v);
                 for s in 0..=20 {
                     let q = p.position + p.axis * (opts.nozzle_mm * s as f64 / 20.0);
@@ -328,18 +334,20 @@ fn the_machines_rapid_moves_clear_the_arch_as_the_machine_runs_them() {
             r.split_moves
         );
         // The first waypoint keeps the exit's rotaries, the last the next start's.
-        assert_eq!(&r.axes[0][3..], &end[3..], "rotaries stand on the retract");
+        let rotaries = |a: &Axes| (a.tilt, a.c);
         assert_eq!(
-            &r.axes[r.axes.len() - 1][3..],
-            &start[3..],
+            rotaries(&r.axes[0]),
+            rotaries(&end),
+            "rotaries stand on the retract"
+        );
+        assert_eq!(
+            rotaries(&r.axes[r.axes.len() - 1]),
+            rotaries(&start),
             "and on the approach"
         );
         let tip = forward(&r.axes[0]).position;
         let want = t.waypoints[0];
-        assert!(
-            (tip - Point3::new(want[0], want[1], want[2])).norm() < 1e-9,
-            "first waypoint"
-        );
+        assert!((tip - want.position).norm() < 1e-9, "first waypoint");
     }
     assert!(
         splits > 0,
@@ -357,16 +365,16 @@ fn a_route_turning_the_head_upright_runs_on_the_machine_as_checked() {
     use kerf_kinematics::{AcHead, Axes, Kinematics, Pose};
     use kerf_process::{rapid_moves, Traverse};
     let kin = AcHead::try_new(180.0, 95.0).expect("head");
-    let exit = [0.0, 10.0, 0.0, 0.0, 1.0, 0.0];
-    let pierce = [40.0, -10.0, 5.0, 0.0, -1.0, 0.0];
+    let exit = Pose::new(0.0, 10.0, 0.0, 0.0, 1.0, 0.0);
+    let pierce = Pose::new(40.0, -10.0, 5.0, 0.0, -1.0, 0.0);
     let up = [0.0, 0.0, 1.0];
-    let way: Vec<PoseArray> = vec![
-        [0.0, 20.0, 0.0, 0.0, 1.0, 0.0],
-        [0.0, 20.0, 0.0, up[0], up[1], up[2]],
-        [0.0, 20.0, 30.0, up[0], up[1], up[2]],
-        [40.0, -20.0, 30.0, up[0], up[1], up[2]],
-        [40.0, -20.0, 5.0, up[0], up[1], up[2]],
-        [40.0, -20.0, 5.0, 0.0, -1.0, 0.0],
+    let way: Vec<Pose> = vec![
+        Pose::new(0.0, 20.0, 0.0, 0.0, 1.0, 0.0),
+        Pose::new(0.0, 20.0, 0.0, up[0], up[1], up[2]),
+        Pose::new(0.0, 20.0, 30.0, up[0], up[1], up[2]),
+        Pose::new(40.0, -20.0, 30.0, up[0], up[1], up[2]),
+        Pose::new(40.0, -20.0, 5.0, up[0], up[1], up[2]),
+        Pose::new(40.0, -20.0, 5.0, 0.0, -1.0, 0.0),
     ];
     let t = Traverse {
         waypoints: way.clone(),
@@ -374,13 +382,10 @@ fn a_route_turning_the_head_upright_runs_on_the_machine_as_checked() {
         min_distance_mm: f64::INFINITY,
         length_mm: 0.0,
     };
-    let solve = |p: &PoseArray| {
-        let a = kin.inverse(&Pose::new(p[0], p[1], p[2], p[3], p[4], p[5]))[0];
-        [a.x, a.y, a.z, a.tilt, a.c]
-    };
+    let solve = |p: &Pose| kin.inverse(p)[0];
     let (end, start) = (solve(&exit), solve(&pierce));
     assert!(
-        (end[4] - start[4]).abs() > 1.0 || (end[3] - start[3]).abs() > 1.0,
+        (end.c - start.c).abs() > 1.0 || (end.tilt - start.tilt).abs() > 1.0,
         "the two solutions differ"
     );
     let r = rapid_moves(
@@ -394,31 +399,26 @@ fn a_route_turning_the_head_upright_runs_on_the_machine_as_checked() {
     .expect("nothing in the way");
     assert_eq!(r.split_moves, 0);
     assert_eq!(r.axes.len(), way.len());
-    let forward = |v: &[f64; 5]| kin.forward(&Axes::new(v[0], v[1], v[2], v[3], v[4]));
+    let forward = |v: &Axes| kin.forward(v);
     for (a, w) in r.axes.iter().zip(&way) {
         let p = forward(a);
-        assert!(
-            (p.position - Point3::new(w[0], w[1], w[2])).norm() < 1e-9,
-            "{a:?}"
-        );
-        assert!(
-            (p.axis - Vector3::new(w[3], w[4], w[5])).norm() < 1e-9,
-            "{a:?}"
-        );
+        assert!((p.position - w.position).norm() < 1e-9, "{a:?}");
+        assert!((p.axis - w.axis).norm() < 1e-9, "{a:?}");
     }
-    assert_eq!(&r.axes[0][3..], &end[3..]);
-    assert_eq!(&r.axes[way.len() - 1][3..], &start[3..]);
+    let rotaries = |a: &Axes| (a.tilt, a.c);
+    assert_eq!(rotaries(&r.axes[0]), rotaries(&end));
+    assert_eq!(rotaries(&r.axes[way.len() - 1]), rotaries(&start));
     // Into the upright stretch and out of it: the tilt alone turns.
     assert_eq!(
-        r.axes[0][4], r.axes[1][4],
+        r.axes[0].c, r.axes[1].c,
         "C stands while the head turns upright"
     );
     assert_eq!(
-        r.axes[4][4], r.axes[5][4],
+        r.axes[4].c, r.axes[5].c,
         "and while it turns to the pierce's axis"
     );
     assert!(
-        r.axes[1][3].abs() < 1e-9 && r.axes[4][3].abs() < 1e-9,
+        r.axes[1].tilt.abs() < 1e-9 && r.axes[4].tilt.abs() < 1e-9,
         "upright"
     );
 }
@@ -461,8 +461,8 @@ fn under_a_ceiling(
     let top = opts.retract_mm + opts.nozzle_mm;
     let z = top + opts.clearance_mm + gap;
     let obs = ceiling(z);
-    let from = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
-    let to = [length, 0.0, 0.0, 0.0, 0.0, 1.0];
+    let from = Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+    let to = Pose::new(length, 0.0, 0.0, 0.0, 0.0, 1.0);
     (plan_traverse(&obs, &from, &to, &opts), z, obs)
 }
 
@@ -481,8 +481,8 @@ fn a_route_that_keeps_the_clearance_by_less_than_the_margin_is_proven() {
         for w in t.waypoints.windows(2) {
             for j in 0..=2000 {
                 let f = f64::from(j) / 2000.0;
-                let zt = w[0][2] + (w[1][2] - w[0][2]) * f;
-                let nz = w[0][5] + (w[1][5] - w[0][5]) * f;
+                let zt = w[0].position.z + (w[1].position.z - w[0].position.z) * f;
+                let nz = w[0].axis.z + (w[1].axis.z - w[0].axis.z) * f;
                 for s in 0..=40 {
                     least = least.min(z - (zt + nz * opts.nozzle_mm * f64::from(s) / 40.0));
                 }

@@ -2,7 +2,7 @@
 //! run into the part before the one taken are not traced to their blockage.
 
 use kerf_nurbs::NurbsSurface;
-use kerf_process::{plan_traverse, Obstacles, Route, TraverseOptions};
+use kerf_process::{plan_traverse, Obstacles, Pose, Route, TraverseOptions};
 use nalgebra::{Point3, Vector3};
 
 /// A sheet at z = 0 (x from -50 to 450) with a flange standing 40 mm high across it at
@@ -50,16 +50,20 @@ fn routes_running_into_the_flange_are_not_traced_to_it() {
     // only the route taken is traced, rising away from the sheet.
     let obs = sheet_with_flange();
     let opts = TraverseOptions::default();
-    let from = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
-    let to = [430.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    let from = Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+    let to = Pose::new(430.0, 0.0, 0.0, 0.0, 0.0, 1.0);
     let t = plan_traverse(&obs, &from, &to, &opts).expect("over the flange");
     // The route taken is the one taken before: straight from the lowest retract point over
     // the exit to the one at 60 mm over the pierce.
     assert_eq!(t.route, Route::Straight);
     assert_eq!(t.waypoints.len(), 2);
-    assert!((t.waypoints[0][2] - 7.5).abs() < 1e-12, "{:?}", t.waypoints);
     assert!(
-        (t.waypoints[1][2] - 60.0).abs() < 1e-12,
+        (t.waypoints[0].position.z - 7.5).abs() < 1e-12,
+        "{:?}",
+        t.waypoints
+    );
+    assert!(
+        (t.waypoints[1].position.z - 60.0).abs() < 1e-12,
         "{:?}",
         t.waypoints
     );
@@ -70,9 +74,11 @@ fn routes_running_into_the_flange_are_not_traced_to_it() {
         let f = f64::from(j) / 10_000.0;
         for s in 0..=40 {
             let q = Point3::new(
-                a[0] + (b[0] - a[0]) * f,
-                a[1] + (b[1] - a[1]) * f,
-                a[2] + (b[2] - a[2]) * f + opts.nozzle_mm * f64::from(s) / 40.0,
+                a.position.x + (b.position.x - a.position.x) * f,
+                a.position.y + (b.position.y - a.position.y) * f,
+                a.position.z
+                    + (b.position.z - a.position.z) * f
+                    + opts.nozzle_mm * f64::from(s) / 40.0,
             );
             least = least.min(distance(&q));
         }

@@ -4,7 +4,7 @@
 //! turns across it) and a bend as long as a flange.
 
 use kerf_nurbs::NurbsSurface;
-use kerf_process::{wall_axis, PoseArray, Side};
+use kerf_process::{wall_axis, Pose, Side};
 use nalgebra::{Point3, Vector3};
 
 const R: f64 = 5.0;
@@ -25,12 +25,12 @@ fn normal_near(s: &NurbsSurface) -> impl Fn(&Point3<f64>) -> Option<Vector3<f64>
 
 /// The rim of a wall about the z axis at height `z`, counter-clockwise seen from +z, 73 points
 /// (closed), with the unit normal `sign * r` (`r` radial outward).
-fn rim(z: f64, sign: f64) -> Vec<PoseArray> {
+fn rim(z: f64, sign: f64) -> Vec<Pose> {
     (0..=72)
         .map(|k| {
             let a = f64::from(k) * std::f64::consts::TAU / 72.0;
             let (s, c) = a.sin_cos();
-            [R * c, R * s, z, sign * c, sign * s, 0.0]
+            Pose::new(R * c, R * s, z, sign * c, sign * s, 0.0)
         })
         .collect()
 }
@@ -48,7 +48,7 @@ fn a_hole_wall_is_cut_along_the_holes_axis_with_the_scrap_inside() {
         let poses = rim(z, -1.0);
         let w = wall_axis(&hull(&wall), &poses, 4.0, &into_hole).expect("a thin wall");
         for p in &w.poses {
-            let a = Vector3::new(p[3], p[4], p[5]);
+            let a = p.axis;
             assert!(
                 (a - Vector3::z() * axis).norm() < 1e-9,
                 "z = {z}: axis {a:?}"
@@ -76,7 +76,7 @@ fn a_round_parts_edge_face_is_cut_along_it_with_the_scrap_outside() {
     let poses = rim(THICK, 1.0); // outward normals: the material is inside
     let w = wall_axis(&hull(&edge), &poses, 4.0, &normal_near(&edge)).expect("a thin wall");
     for p in &w.poses {
-        assert!((Vector3::new(p[3], p[4], p[5]) - Vector3::z()).norm() < 1e-9);
+        assert!((p.axis - Vector3::z()).norm() < 1e-9);
     }
     // Head above, counter-clockwise: the outside is on the right.
     assert_eq!(w.scrap, Side::Right);
@@ -103,8 +103,8 @@ fn a_fillet_and_a_long_bend_are_not_walls() {
         ]),
     )
     .expect("fillet");
-    let along: Vec<PoseArray> = (0..=50)
-        .map(|k| [f64::from(k), 0.0, 1.5, 0.0, 0.0, 1.0])
+    let along: Vec<Pose> = (0..=50)
+        .map(|k| Pose::new(f64::from(k), 0.0, 1.5, 0.0, 0.0, 1.0))
         .collect();
     let hull_f = hull(&fillet);
     assert!(
@@ -136,14 +136,14 @@ fn bad_input_is_not_a_wall() {
     );
     assert!(wall_axis(&hull(&wall), &poses, 0.0, &near).is_none(), "off");
     let mut bad = poses.clone();
-    bad[5][0] = f64::NAN;
+    bad[5].position.x = f64::NAN;
     assert!(
         wall_axis(&hull(&wall), &bad, 4.0, &near).is_none(),
         "NaN point"
     );
     // The normal along the contour: no wall direction.
-    let along: Vec<PoseArray> = (0..10)
-        .map(|k| [f64::from(k), 0.0, 0.0, 1.0, 0.0, 0.0])
+    let along: Vec<Pose> = (0..10)
+        .map(|k| Pose::new(f64::from(k), 0.0, 0.0, 1.0, 0.0, 0.0))
         .collect();
     assert!(
         wall_axis(&hull(&wall), &along, 4.0, &near).is_none(),

@@ -4,12 +4,14 @@ use std::borrow::Borrow;
 use std::io::Write;
 use std::path::Path;
 
+use kerf_kinematics::Axes;
+
 use crate::error::{positive, InterpError, Result};
 
 /// The CSV text: header `t,<names>` and one row `t,q0,...,q4` per set-point, row `i` at
 /// `t = i * cycle` seconds (written with 9 decimals). Builds the whole text in memory; for
 /// long programs stream with [`write_csv_to`] or [`write_csv`].
-pub fn csv_string(names: [&str; 5], cycle: f64, rows: &[[f64; 5]]) -> String {
+pub fn csv_string(names: [&str; 5], cycle: f64, rows: &[Axes]) -> String {
     let mut bytes = Vec::with_capacity(rows.len() * 80 + 32);
     // Writing into a Vec cannot fail.
     let _ = write_csv_to(&mut bytes, names, cycle, rows);
@@ -22,7 +24,7 @@ pub fn csv_string(names: [&str; 5], cycle: f64, rows: &[[f64; 5]]) -> String {
 ///
 /// # Errors
 /// The writer's error.
-pub fn write_csv_to<R: Borrow<[f64; 5]>>(
+pub fn write_csv_to<R: Borrow<Axes>>(
     w: &mut dyn Write,
     names: [&str; 5],
     cycle: f64,
@@ -35,7 +37,7 @@ pub fn write_csv_to<R: Borrow<[f64; 5]>>(
     w.write_all(b"\n")?;
     for (i, q) in rows.into_iter().enumerate() {
         write!(w, "{:.9}", i as f64 * cycle)?;
-        for v in q.borrow() {
+        for v in q.borrow().iter() {
             write!(w, ",{}", v + 0.0)?; // + 0.0 turns -0 into 0
         }
         w.write_all(b"\n")?;
@@ -50,7 +52,7 @@ pub fn write_csv_to<R: Borrow<[f64; 5]>>(
 ///
 /// # Errors
 /// [`InterpError::Io`]; [`InterpError::BadParameter`] for a cycle that is not finite and > 0.
-pub fn write_csv<R: Borrow<[f64; 5]>>(
+pub fn write_csv<R: Borrow<Axes>>(
     path: impl AsRef<Path>,
     names: [&str; 5],
     cycle: f64,

@@ -41,6 +41,8 @@
 
 use std::path::Path;
 
+use kerf_kinematics::Axes;
+
 use crate::block::{Block, Geometry};
 use crate::error::{positive, InterpError, Result};
 use crate::model::AxisModel;
@@ -418,7 +420,7 @@ fn refuse_pierces_out_of_range<M: AxisModel + ?Sized>(
 }
 
 /// The first axis of `q` outside its range: its name, value and range.
-fn out_of_range<M: AxisModel + ?Sized>(model: &M, q: &[f64; 5]) -> Option<(String, f64, [f64; 2])> {
+fn out_of_range<M: AxisModel + ?Sized>(model: &M, q: &Axes) -> Option<(String, f64, [f64; 2])> {
     let names = model.axis_names();
     model
         .limits()

@@ -32,6 +32,8 @@
 //!   `ID=1 WHENEVER TRUE DO SYNFCT(1, $A_OUTA[1], $AC_VACTW)` (`k` in percent per mm/min of
 //!   the tool tip under TRAORI). Not executed on a Sinumerik here.
 
+use kerf_kinematics::Axes;
+
 use crate::error::{InterpError, Result};
 
 /// Laser power that follows the tool tip's speed (module docs): the cut's power at a
@@ -145,11 +147,11 @@ impl LaserPower {
 /// `P -> L(P, t, C)` at the middle's rotary axes).
 pub(super) fn rotary_coefficients<M: crate::AxisModel + ?Sized>(
     model: &M,
-    a: &[f64; 5],
-    b: &[f64; 5],
+    a: &Axes,
+    b: &Axes,
 ) -> [f64; 6] {
     use nalgebra::{Matrix3, Point3, Vector3};
-    let m: [f64; 5] = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
+    let m = Axes::from_array(std::array::from_fn(|k| 0.5 * (a[k] + b[k])));
     let (t, c) = (m[3], m[4]);
     let l = |p: &Point3<f64>, t: f64, c: f64| Vector3::from(model.linear_axes(p, t, c));
     let o = l(&Point3::origin(), t, c);
@@ -198,10 +200,10 @@ pub(super) const POWER_SPEED_TOLERANCE: f64 = 0.025;
 /// piece.
 pub(super) fn pieces<M: crate::AxisModel + ?Sized>(
     model: &M,
-    a: &[f64; 5],
-    b: &[f64; 5],
+    a: &Axes,
+    b: &Axes,
 ) -> Vec<(f64, [f64; 6])> {
-    let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| a[k] + f * (b[k] - a[k])) };
+    let at = |f: f64| a.lerp(b, f);
     let d: [f64; 5] = std::array::from_fn(|k| b[k] - a[k]);
     let speed = |c: &[f64; 6]| tip_travel(&d, c);
     let mut out = Vec::new();

@@ -7,6 +7,7 @@
 //! dialect). The trait and the writer live in one module because each names the other (the
 //! writer calls the rules, the rules write through the writer).
 
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 use crate::block::{Block, Geometry};
@@ -56,7 +57,7 @@ pub(super) struct Writer<'a> {
     /// The numbers last written as the controller reads them, for feed and zero-move
     /// decisions: the axis words (raw-axis dialects), or the tip's `X Y Z` and the rotary axes
     /// (the tool-tip dialects; Sinumerik keeps the axes).
-    pub(super) last: Option<[f64; 5]>,
+    pub(super) last: Option<Axes>,
     pub(super) in_cut: bool,
     /// True while the controller's cutter compensation is on (`G41.1`/`G42.1` written).
     pub(super) compensating: bool,
@@ -85,7 +86,7 @@ pub(super) struct Writer<'a> {
     pub(super) machine_lines: Vec<String>,
     /// The machine axes where the last move ended (the tool-tip dialects: the start of the
     /// next rapid's joint-space path).
-    pub(super) last_axes: Option<[f64; 5]>,
+    pub(super) last_axes: Option<Axes>,
     /// The largest distance (mm) of a tool-tip rapid's piece from its joint-space traverse,
     /// where [`RAPID_TCP_MAX_PIECES`] were not enough: the program is refused.
     pub(super) rapid_too_curved: Option<f64>,
@@ -166,20 +167,20 @@ impl<'a> Writer<'a> {
     }
 
     /// Axis values rounded as the program writes them.
-    pub(super) fn printed(&self, q: &[f64; 5]) -> [f64; 5] {
+    pub(super) fn printed(&self, q: &Axes) -> Axes {
         q.map(|v| self.num(v).parse().unwrap_or(v))
     }
 
     /// The move to `q` (axes, or the tip and the rotary axes) as printed and the position it
     /// starts from (the last printed, or `q`'s where nothing was written yet): `None` where the
     /// printed words do not change.
-    pub(super) fn moved(&self, q: &[f64; 5]) -> Option<([f64; 5], [f64; 5])> {
+    pub(super) fn moved(&self, q: &Axes) -> Option<(Axes, Axes)> {
         let qp = self.printed(q);
         let prev = self.last.unwrap_or(qp);
         (prev != qp).then_some((qp, prev))
     }
 
-    pub(super) fn axis_words(&self, q: &[f64; 5]) -> String {
+    pub(super) fn axis_words(&self, q: &Axes) -> String {
         let n = &self.names;
         format!(
             "{}{} {}{} {}{} {}{} {}{}",
@@ -294,12 +295,7 @@ impl<'a> Writer<'a> {
     }
 
     /// A rapid to the axes `q` (tip `p`, tool axis `u`).
-    pub(super) fn rapid(
-        &mut self,
-        p: nalgebra::Point3<f64>,
-        q: [f64; 5],
-        u: nalgebra::Vector3<f64>,
-    ) {
+    pub(super) fn rapid(&mut self, p: nalgebra::Point3<f64>, q: Axes, u: nalgebra::Vector3<f64>) {
         self.rules.rapid(self, p, q, u);
     }
 
@@ -383,7 +379,7 @@ impl<'a> Writer<'a> {
         &mut self,
         b: &Block,
         t: f64,
-        mut step: impl FnMut(&mut Self, f64, [f64; 5], f64, f64),
+        mut step: impl FnMut(&mut Self, f64, Axes, f64, f64),
     ) {
         let mut ends = Vec::new();
         if let Geometry::Arc(a) = &b.geometry {
@@ -443,13 +439,13 @@ impl<'a> Writer<'a> {
     /// [`Writer::held`]).
     pub(super) fn powered_pieces(
         &mut self,
-        a: &[f64; 5],
-        b: &[f64; 5],
+        a: &Axes,
+        b: &Axes,
         line: impl Fn(&Self, f64, f64) -> String,
         t: f64,
     ) {
         let pieces = super::power::pieces(self.model, a, b);
-        let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| a[k] + f * (b[k] - a[k])) };
+        let at = |f: f64| a.lerp(b, f);
         let mut f0 = 0.0;
         for (i, &(f1, coeffs)) in pieces.iter().enumerate() {
             let f1 = if i + 1 == pieces.len() { 1.0 } else { f1 };
@@ -467,7 +463,7 @@ impl<'a> Writer<'a> {
 
     /// LinuxCNC's rotary coefficients `coeffs` for the piece from `a` to `b`, written where
     /// the last ones written would misjudge its tip travel by more than [`POWER_STEP`].
-    fn write_coefficients(&mut self, a: &[f64; 5], b: &[f64; 5], coeffs: [f64; 6]) {
+    fn write_coefficients(&mut self, a: &Axes, b: &Axes, coeffs: [f64; 6]) {
         let d: [f64; 5] = std::array::from_fn(|k| b[k] - a[k]);
         let (new, old) = (
             super::power::tip_travel(&d, &coeffs),
@@ -522,8 +518,8 @@ impl<'a> Writer<'a> {
         &mut self,
         g0: &str,
         p: nalgebra::Point3<f64>,
-        q: [f64; 5],
-        words: impl Fn(&Self, &nalgebra::Point3<f64>, &[f64; 5]) -> String,
+        q: Axes,
+        words: impl Fn(&Self, &nalgebra::Point3<f64>, &Axes) -> String,
     ) {
         let pieces = match self.last_axes {
             Some(from) => {
@@ -544,7 +540,7 @@ impl<'a> Writer<'a> {
             let l = format!("{g0} {}", words(self, &tip, &a));
             self.line(&l);
         }
-        self.last = Some(self.printed(&[p.x, p.y, p.z, q[3], q[4]]));
+        self.last = Some(self.printed(&Axes::new(p.x, p.y, p.z, q[3], q[4])));
         self.last_axes = Some(q);
     }
 
@@ -581,8 +577,8 @@ pub(super) fn digital_output(line: &str) -> Option<(u32, u32)> {
 /// [`RAPID_TCP_TOLERANCE_MM`] of the joint-space path's tip at each piece's middle; with the
 /// largest middle distance of the pieces returned (above the tolerance, or infinite, only when
 /// [`RAPID_TCP_MAX_PIECES`] were not enough).
-fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> (Vec<[f64; 5]>, f64) {
-    let at = |f: f64| -> [f64; 5] { std::array::from_fn(|k| from[k] + f * (to[k] - from[k])) };
+fn rapid_pieces(model: &dyn AxisModel, from: &Axes, to: &Axes) -> (Vec<Axes>, f64) {
+    let at = |f: f64| from.lerp(to, f);
     let turn = (to[3] - from[3]).abs().max((to[4] - from[4]).abs());
     let steps = (turn / RAPID_TCP_MAX_STEP_DEG).ceil();
     // False for NaN too.
@@ -623,7 +619,7 @@ fn rapid_pieces(model: &dyn AxisModel, from: &[f64; 5], to: &[f64; 5]) -> (Vec<[
 /// The feed of a move from `prev` to `now` (printed `X Y Z` and rotary axes) taking `t`
 /// seconds by the RS274/NGC rule: mm/min of the `X Y Z` motion, or deg/min of the rotary
 /// motion where `X Y Z` stand.
-pub(super) fn rs274_feed(prev: &[f64; 5], now: &[f64; 5], t: f64) -> f64 {
+pub(super) fn rs274_feed(prev: &Axes, now: &Axes, t: f64) -> f64 {
     let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
     let lin = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     let len = if lin > 0.0 {
@@ -660,13 +656,13 @@ pub(super) fn exit_point<M: AxisModel + ?Sized>(
     model: &M,
     process: &ProcessCodes,
     b: &Block,
-) -> (nalgebra::Point3<f64>, [f64; 5], nalgebra::Vector3<f64>, f64) {
+) -> (nalgebra::Point3<f64>, Axes, nalgebra::Vector3<f64>, f64) {
     let (tilt, c) = (b.end_axes[3], b.end_axes[4]);
     let u = model.tool_axis(tilt, c);
     let h = process.pierce_standoff.max(crate::EXIT_RETRACT_MIN_MM);
     let p = b.end_tip() + u * h;
     let lin = model.linear_axes(&p, tilt, c);
-    (p, [lin[0], lin[1], lin[2], tilt, c], u, h)
+    (p, Axes::new(lin[0], lin[1], lin[2], tilt, c), u, h)
 }
 
 /// The pierce point of the cut starting with `b` (`pierce_standoff` above its start along the
@@ -675,14 +671,14 @@ pub(super) fn pierce_point<M: AxisModel + ?Sized>(
     model: &M,
     process: &ProcessCodes,
     b: &Block,
-) -> (nalgebra::Point3<f64>, [f64; 5], nalgebra::Vector3<f64>) {
+) -> (nalgebra::Point3<f64>, Axes, nalgebra::Vector3<f64>) {
     let (tilt, c) = (b.start_axes[3], b.start_axes[4]);
     let u = model.tool_axis(tilt, c);
     let h = process.pierce_standoff;
     let pierce = b.start_tip() + u * h;
     let q = if h > 0.0 {
         let lin = model.linear_axes(&pierce, tilt, c);
-        [lin[0], lin[1], lin[2], tilt, c]
+        Axes::new(lin[0], lin[1], lin[2], tilt, c)
     } else {
         b.start_axes
     };
@@ -749,7 +745,7 @@ pub(super) trait Rules: Sync {
     fn power_header(&self, w: &mut Writer<'_>);
 
     /// A rapid to the axes `q` (tip `p`, tool axis `u`).
-    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], u: Vector3<f64>);
+    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: Axes, u: Vector3<f64>);
 
     /// A beam-on line as written at the pierce (where it must act at once).
     fn pierce_beam_on(&self, line: String) -> String {
@@ -857,14 +853,18 @@ mod tests {
     fn rapids_are_split_until_their_tip_follows_the_traverse_or_refused() {
         let m = trunnion();
         // A straight move of the linear axes alone: one piece, on the traverse.
-        let (p, worst) = rapid_pieces(&m, &[0.0; 5], &[100.0, 50.0, 20.0, 0.0, 0.0]);
+        let (p, worst) = rapid_pieces(
+            &m,
+            &Axes::default(),
+            &Axes::new(100.0, 50.0, 20.0, 0.0, 0.0),
+        );
         assert_eq!(p.len(), 1);
         assert!(worst < 1e-9, "{worst}");
         // Half a turn of C with the tip 200 mm from the C axis: the tip's circle, split into
         // pieces of at most 10 degrees and then until every piece's middle is within the
         // tolerance, by the fewest halvings.
-        let from = [200.0, 0.0, 0.0, 0.0, 0.0];
-        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 180.0]);
+        let from = Axes::new(200.0, 0.0, 0.0, 0.0, 0.0);
+        let (p, worst) = rapid_pieces(&m, &from, &Axes::new(200.0, 0.0, 0.0, 0.0, 180.0));
         assert!(worst <= RAPID_TCP_TOLERANCE_MM, "{worst}");
         // The tip turns about the C axis through rot_point (3, -2) of xyzac_trt.json.
         let t = m.tip(&from);
@@ -885,17 +885,17 @@ mod tests {
         assert_eq!(p.len(), need(180.0), "r = {r}");
         // Two whole turns: the tip comes back to its start at the middle too, yet the rapid
         // swings it round twice; pieces of 10 degrees see the circle.
-        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 720.0]);
+        let (p, worst) = rapid_pieces(&m, &from, &Axes::new(200.0, 0.0, 0.0, 0.0, 720.0));
         assert_eq!(p.len(), need(720.0), "r = {r}");
         assert!(worst <= RAPID_TCP_TOLERANCE_MM, "{worst}");
         // A hundred turns at the same distance: 4096 pieces of 8.8 degrees leave 0.59 mm, more
         // than RAPID_TCP_MAX_PIECES would be needed: the distance left is reported, and the
         // writer refuses the program.
-        let (p, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 36000.0]);
+        let (p, worst) = rapid_pieces(&m, &from, &Axes::new(200.0, 0.0, 0.0, 0.0, 36000.0));
         assert_eq!(p.len(), RAPID_TCP_MAX_PIECES);
         assert!(worst > RAPID_TCP_TOLERANCE_MM, "{worst}");
         // Two thousand turns cannot even be cut into 10-degree pieces: refused at once.
-        let (_, worst) = rapid_pieces(&m, &from, &[200.0, 0.0, 0.0, 0.0, 720000.0]);
+        let (_, worst) = rapid_pieces(&m, &from, &Axes::new(200.0, 0.0, 0.0, 0.0, 720000.0));
         assert!(worst.is_infinite());
     }
 }

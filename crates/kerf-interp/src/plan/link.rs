@@ -1,5 +1,7 @@
 //! Joining the paths of a program with rapid (laser-off) moves.
 
+use kerf_kinematics::Axes;
+
 use crate::block::Block;
 use crate::model::AxisModel;
 
@@ -57,14 +59,14 @@ pub fn link_paths_with_retract<M: AxisModel + ?Sized>(
     } else {
         retract.max(0.0)
     };
-    let station = |tip: nalgebra::Point3<f64>, axes: [f64; 5]| {
+    let station = |tip: nalgebra::Point3<f64>, axes: Axes| {
         let axis = model.tool_axis(axes[3], axes[4]);
         let lin = model.linear_axes(&tip, axes[3], axes[4]);
         crate::block::Station {
             tip,
             axis,
             param: None,
-            axes: [lin[0], lin[1], lin[2], axes[3], axes[4]],
+            axes: Axes::new(lin[0], lin[1], lin[2], axes[3], axes[4]),
         }
     };
     let mut out: Vec<Block> = Vec::new();

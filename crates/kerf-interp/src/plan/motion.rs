@@ -1,5 +1,7 @@
 //! A planned program ([`Motion`]) and its set-points one cycle at a time ([`Cycles`]).
 
+use kerf_kinematics::Axes;
+
 use super::profile::Timed;
 use crate::block::Block;
 use crate::fit::BlockCounts;
@@ -206,7 +208,7 @@ impl Motion {
     }
 
     /// The set-points, one per cycle, computed by [`Motion::iter`].
-    pub fn setpoints<M: AxisModel + ?Sized>(&self, model: &M) -> Vec<[f64; 5]> {
+    pub fn setpoints<M: AxisModel + ?Sized>(&self, model: &M) -> Vec<Axes> {
         let mut out = Vec::with_capacity(self.cycles() + 1);
         out.extend(self.iter(model));
         out
@@ -253,7 +255,7 @@ impl Motion {
         model: &M,
         t: f64,
         run: &mut usize,
-    ) -> [f64; 5] {
+    ) -> Axes {
         while *run + 1 < self.runs.len() && t >= self.starts[*run + 1] {
             *run += 1;
         }
@@ -282,7 +284,7 @@ pub struct Cycles<'a, M: ?Sized> {
 impl<M: AxisModel + ?Sized> Cycles<'_, M> {
     /// The set-point of the next cycle, its time and its run (internal).
     #[inline]
-    pub(super) fn next_full(&mut self) -> Option<([f64; 5], f64, usize)> {
+    pub(super) fn next_full(&mut self) -> Option<(Axes, f64, usize)> {
         if self.i > self.n || self.motion.blocks.is_empty() {
             return None;
         }
@@ -307,10 +309,10 @@ impl<M: AxisModel + ?Sized> Cycles<'_, M> {
 }
 
 impl<M: AxisModel + ?Sized> Iterator for Cycles<'_, M> {
-    type Item = [f64; 5];
+    type Item = Axes;
 
     #[inline]
-    fn next(&mut self) -> Option<[f64; 5]> {
+    fn next(&mut self) -> Option<Axes> {
         self.next_full().map(|(q, _, _)| q)
     }
 

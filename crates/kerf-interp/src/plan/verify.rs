@@ -1,6 +1,8 @@
 //! The verification of a plan the way a test checks it: every cycle of the set-points against
 //! every limit by finite differences, and every set-point against the axis ranges.
 
+use kerf_kinematics::Axes;
+
 use super::motion::Motion;
 use crate::error::InterpError;
 use crate::model::AxisModel;
@@ -141,11 +143,7 @@ pub(super) fn verify<M: AxisModel + ?Sized>(
 }
 
 /// [`InterpError::OutOfRange`] if set-point `cycle` leaves an axis range (1e-9 slack).
-fn out_of_range<M: AxisModel + ?Sized>(
-    model: &M,
-    cycle: usize,
-    q: &[f64; 5],
-) -> Option<InterpError> {
+fn out_of_range<M: AxisModel + ?Sized>(model: &M, cycle: usize, q: &Axes) -> Option<InterpError> {
     let lim = model.limits();
     (0..5).find_map(|k| {
         let [lo, hi] = lim.range[k]?;

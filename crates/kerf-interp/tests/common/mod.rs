@@ -4,6 +4,7 @@
 
 use kerf_discretize::{discretize, Options};
 use kerf_interp::{solve_stations, AxisModel, PaperAcHead, Station};
+use kerf_kinematics::Axes;
 use kerf_nurbs::NurbsCurve;
 use nalgebra::{Point3, Vector3};
 
@@ -75,7 +76,7 @@ pub fn stations(
 /// Largest ratio, over every cycle and axis, of the finite-difference velocity and
 /// acceleration to the machine's limits (rest before the first and after the last row).
 /// Returns (velocity ratio, acceleration ratio, worst cycle of each).
-pub fn limit_ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> (f64, f64, usize, usize) {
+pub fn limit_ratios(m: &dyn AxisModel, rows: &[Axes], t: f64) -> (f64, f64, usize, usize) {
     let lim = m.limits();
     let n = rows.len() as isize;
     let at = |i: isize| rows[i.clamp(0, n - 1) as usize];
@@ -99,7 +100,7 @@ pub fn limit_ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> (f64, f64, 
 
 /// Largest ratio of finite-difference velocity, acceleration and jerk to the limits over every
 /// cycle, at rest before the first and after the last row.
-pub fn ratios(m: &dyn AxisModel, rows: &[[f64; 5]], t: f64) -> [f64; 3] {
+pub fn ratios(m: &dyn AxisModel, rows: &[Axes], t: f64) -> [f64; 3] {
     let lim = m.limits();
     let n = rows.len() as isize;
     let at = |i: isize| rows[i.clamp(0, n - 1) as usize];

@@ -6,7 +6,7 @@
 use nalgebra::{Point3, Vector2, Vector3};
 
 use super::{nlerp, slide, ArcPiece, Context, CurvePiece, Node, OffsetPath, Piece, Seg};
-use crate::{ProcessError, Result};
+use crate::{Pose, ProcessError, Result};
 
 /// How many chords on each side of an inside corner the cut-back searches for the crossing.
 const TRIM_WINDOW: usize = 256;
@@ -85,7 +85,10 @@ pub(super) fn assemble(
     let poses = b
         .nodes
         .iter()
-        .map(|n| [n.pos.x, n.pos.y, n.pos.z, n.axis.x, n.axis.y, n.axis.z])
+        .map(|n| Pose {
+            position: n.pos,
+            axis: n.axis,
+        })
         .collect();
     let source = b.nodes.iter().map(|n| n.source).collect();
     Ok(OffsetPath {

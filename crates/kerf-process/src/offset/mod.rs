@@ -32,7 +32,7 @@ use kerf_discretize::chord_error;
 use kerf_nurbs::{NurbsCurve, Segment};
 use nalgebra::{Point3, Vector3, Vector4};
 
-use crate::{PoseArray, ProcessError, Result, Side};
+use crate::{Pose, ProcessError, Result, Side};
 
 /// How to offset: the kerf width and the tolerance the offset path keeps.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -116,7 +116,7 @@ pub struct OffsetInput<'a> {
     pub params: &'a [f64],
     /// The cutting points with their tool axes (`[x, y, z, i, j, k]`, the axis pointing from
     /// the tip toward the head), one per parameter.
-    pub poses: &'a [PoseArray],
+    pub poses: &'a [Pose],
     /// The surface's unit normal at each cutting point where it is not the tool axis (a tilted
     /// beam): the tip slides along the beam onto the tangent plane there. `None`: the axis is
     /// the normal, or the beam runs along a wall and stays where the offset puts it.
@@ -133,7 +133,7 @@ pub struct OffsetInput<'a> {
 pub struct OffsetPath {
     /// The tip points with the tool axes, in the contour's direction; a closed contour's last
     /// point repeats its first.
-    pub poses: Vec<PoseArray>,
+    pub poses: Vec<Pose>,
     /// The contour parameter each point comes from (non-decreasing; the points of a corner
     /// arc share the corner's).
     pub source: Vec<f64>,
@@ -306,14 +306,14 @@ pub fn offset(input: &OffsetInput<'_>, options: &OffsetOptions) -> Result<Offset
     if input.params.windows(2).any(|w| !bound::exceeds(w[1], w[0])) {
         return Err(bad("the cutting points' parameters must increase".into()));
     }
-    if input.poses.iter().flatten().any(|v| !v.is_finite()) {
+    if !input.poses.iter().all(Pose::is_finite) {
         return Err(bad("a cutting point holds a non-finite value".into()));
     }
     let unit = |v: [f64; 3]| {
         let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         (n - 1.0).abs() <= 1e-6
     };
-    if let Some(i) = input.poses.iter().position(|p| !unit([p[3], p[4], p[5]])) {
+    if let Some(i) = input.poses.iter().position(|p| !unit(p.axis.into())) {
         return Err(bad(format!(
             "cutting point {i}: the tool axis is not a unit vector"
         )));
@@ -406,9 +406,7 @@ impl<'a> Context<'a> {
 
     fn axis(&self, i: usize) -> Vector3<f64> {
         let p = &self.input.poses[i];
-        Vector3::new(p[3], p[4], p[5])
-            .try_normalize(0.0)
-            .unwrap_or_else(Vector3::z)
+        p.axis.try_normalize(0.0).unwrap_or_else(Vector3::z)
     }
 
     fn normal(&self, i: usize) -> (Vector3<f64>, bool) {
@@ -701,11 +699,7 @@ struct Tight {
 /// same, the contour's control points in one plane across that normal (to 1e-9 of its size),
 /// the beam tilted less than 80 degrees from the normal.
 fn flat(input: &OffsetInput<'_>) -> Option<Flat> {
-    let axes: Vec<Vector3<f64>> = input
-        .poses
-        .iter()
-        .map(|p| Vector3::new(p[3], p[4], p[5]).normalize())
-        .collect();
+    let axes: Vec<Vector3<f64>> = input.poses.iter().map(|p| p.axis.normalize()).collect();
     let axis = axes[0];
     if axes.iter().any(|a| (a - axis).norm() > 1e-9) {
         return None;
@@ -826,6 +820,6 @@ fn nlerp(a: &Vector3<f64>, b: &Vector3<f64>, f: f64) -> Vector3<f64> {
     (a * (1.0 - f) + b * f).try_normalize(0.0).unwrap_or(*a)
 }
 
-fn position(p: &PoseArray) -> Point3<f64> {
-    Point3::new(p[0], p[1], p[2])
+fn position(p: &Pose) -> Point3<f64> {
+    p.position
 }

@@ -4,7 +4,7 @@ use nalgebra::{Point3, Vector3};
 
 use super::Obstacles;
 use crate::geometry::{normal, position};
-use crate::PoseArray;
+use crate::Pose;
 
 /// Why a stretch of a traverse is not clear: the first offending sample.
 #[derive(Debug, Clone, Copy)]
@@ -83,13 +83,7 @@ pub(super) struct Trace<'a> {
 
 impl<'a> Trace<'a> {
     /// The move `a -> b` with its nozzle, kept `need` from `obs`.
-    pub(super) fn new(
-        obs: &'a Obstacles,
-        a: &PoseArray,
-        b: &PoseArray,
-        need: f64,
-        nozzle: f64,
-    ) -> Self {
+    pub(super) fn new(obs: &'a Obstacles, a: &Pose, b: &Pose, need: f64, nozzle: f64) -> Self {
         let (pa, pb) = (position(a), position(b));
         let (na, nb) = (normal(a).normalize(), normal(b).normalize());
         let half_cos = (0.5 * (1.0 + na.dot(&nb)))
@@ -317,7 +311,7 @@ impl<'a> Trace<'a> {
 /// not decided within the finest margin or the budget).
 pub fn check_move(
     obs: &Obstacles,
-    samples: &[PoseArray],
+    samples: &[Pose],
     need_mm: f64,
     nozzle_mm: f64,
 ) -> std::result::Result<f64, (Point3<f64>, f64)> {

@@ -23,7 +23,7 @@ use nalgebra::Point3;
 
 use super::check::Trace;
 use super::Obstacles;
-use crate::PoseArray;
+use crate::Pose;
 
 /// Below the need by at least this (mm): far above the rounding of positions and distances
 /// (about 1e-12 mm at a metre), so the certificate's own rounding cannot pass such a point.
@@ -62,7 +62,7 @@ impl<'a> Probe<'a> {
 
     /// True if a point of the move `a -> b`'s swept surface is measured closer than the need
     /// (by a known point or a probe; each probe is one distance query). False says nothing.
-    pub(super) fn violated(&mut self, a: &PoseArray, b: &PoseArray) -> bool {
+    pub(super) fn violated(&mut self, a: &Pose, b: &Pose) -> bool {
         let trace = Trace::new(self.obs, a, b, self.need, self.nozzle);
         // Beyond this the trace's argument may not cover the surface (a turn of the axis by
         // nearly half a turn): no point is looked for there.

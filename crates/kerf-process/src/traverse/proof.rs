@@ -8,7 +8,7 @@ use nalgebra::{Point3, Vector3};
 use super::check::Blocked;
 use super::{Obstacles, TraverseOptions};
 use crate::geometry::{normal, position};
-use crate::PoseArray;
+use crate::Pose;
 
 /// Most samples the proof takes along one line (beyond them it gives up: no proof).
 const LINE_SAMPLES: usize = 1 << 16;
@@ -29,7 +29,7 @@ const LINE_SAMPLES: usize = 1 << 16;
 /// pierce").
 pub(super) fn line_blocked(
     obs: &Obstacles,
-    p: &PoseArray,
+    p: &Pose,
     opts: &TraverseOptions,
     what: &str,
 ) -> Option<(Blocked, String)> {

@@ -6,7 +6,7 @@ use super::check::{Blocked, Trace, Work, MOVE_SAMPLES};
 use super::obstacles::top_along;
 use super::{Obstacles, TraverseOptions};
 use crate::geometry::{normal, position};
-use crate::{PoseArray, ProcessError, Result};
+use crate::{Pose, ProcessError, Result};
 
 /// How a traverse runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,7 +46,7 @@ pub struct Traverse {
     /// to the point above the pierce; the head reaches the first along the exit's tool axis
     /// and leaves the last along the pierce's tool axis. Between waypoints it moves straight,
     /// the tool axis turning from one waypoint's to the next's.
-    pub waypoints: Vec<PoseArray>,
+    pub waypoints: Vec<Pose>,
     /// The route taken.
     pub route: Route,
     /// The smallest surface distance found over the travel's samples (tip and nozzle), mm;
@@ -57,8 +57,11 @@ pub struct Traverse {
     pub length_mm: f64,
 }
 
-fn with_axis(p: Point3<f64>, n: Vector3<f64>) -> PoseArray {
-    [p.x, p.y, p.z, n.x, n.y, n.z]
+fn with_axis(p: Point3<f64>, n: Vector3<f64>) -> Pose {
+    Pose {
+        position: p,
+        axis: n,
+    }
 }
 
 fn path_length(points: &[Point3<f64>]) -> f64 {
@@ -88,8 +91,8 @@ fn path_length(points: &[Point3<f64>]) -> f64 {
 /// into a pocket the head cannot back out of).
 pub fn plan_traverse(
     obs: &Obstacles,
-    from: &PoseArray,
-    to: &PoseArray,
+    from: &Pose,
+    to: &Pose,
     opts: &TraverseOptions,
 ) -> Result<Traverse> {
     plan_traverse_within(obs, from, to, opts, &|_| true)
@@ -102,10 +105,10 @@ pub fn plan_traverse(
 /// As [`plan_traverse`].
 pub fn plan_traverse_within(
     obs: &Obstacles,
-    from: &PoseArray,
-    to: &PoseArray,
+    from: &Pose,
+    to: &Pose,
     opts: &TraverseOptions,
-    reachable: &dyn Fn(&[PoseArray]) -> bool,
+    reachable: &dyn Fn(&[Pose]) -> bool,
 ) -> Result<Traverse> {
     plan_traverse_accepting(obs, from, to, opts, reachable, &mut |_| Ok(()), true).map(|(t, ())| t)
 }
@@ -116,7 +119,8 @@ type MoveKey = [u64; 12];
 /// The coarse outcomes of the moves of one gap's routes, by their poses.
 type MoveOutcomes = std::collections::HashMap<MoveKey, std::result::Result<f64, Blocked>>;
 
-fn move_key(a: &PoseArray, b: &PoseArray) -> MoveKey {
+fn move_key(a: &Pose, b: &Pose) -> MoveKey {
+    let (a, b) = (a.to_array(), b.to_array());
     std::array::from_fn(|k| if k < 6 { a[k] } else { b[k - 6] }.to_bits())
 }
 
@@ -143,7 +147,7 @@ enum Coarse {
 fn fails_for_sure(
     traced: &MoveOutcomes,
     probe: &mut super::probe::Probe<'_>,
-    way: &[PoseArray],
+    way: &[Pose],
 ) -> bool {
     let moves = way.len().saturating_sub(1);
     let known = |i: usize| traced.get(&move_key(&way[i], &way[i + 1]));
@@ -244,7 +248,7 @@ impl Tally {
 
 /// The clear route of `route`'s shape through `waypoints` (`length_mm` long), keeping
 /// `least` mm from the part.
-fn traverse_of(length_mm: f64, route: Route, waypoints: &[PoseArray], least: f64) -> Traverse {
+fn traverse_of(length_mm: f64, route: Route, waypoints: &[Pose], least: f64) -> Traverse {
     Traverse {
         length_mm,
         waypoints: waypoints.to_vec(),
@@ -266,7 +270,7 @@ pub(crate) struct Refusal {
 }
 
 /// An axial move's check: the retract point reached, or why it is blocked.
-type AxialOutcome = std::result::Result<PoseArray, Blocked>;
+type AxialOutcome = std::result::Result<Pose, Blocked>;
 
 /// [`plan_traverse_within`], where a route that is clear is also handed to `accept` (e.g.
 /// the check of the machine's own rapid moves); the first route both accept is returned with
@@ -278,17 +282,17 @@ type AxialOutcome = std::result::Result<PoseArray, Blocked>;
 /// Which route is found, if any, does not depend on `explain`.
 pub(crate) fn plan_traverse_accepting<T>(
     obs: &Obstacles,
-    from: &PoseArray,
-    to: &PoseArray,
+    from: &Pose,
+    to: &Pose,
     opts: &TraverseOptions,
-    reachable: &dyn Fn(&[PoseArray]) -> bool,
+    reachable: &dyn Fn(&[Pose]) -> bool,
     accept: &mut dyn FnMut(&Traverse) -> std::result::Result<T, Refusal>,
     explain: bool,
 ) -> Result<(Traverse, T)> {
     opts.validate()?;
     for (name, p) in [("from", from), ("to", to)] {
         let axis_ok = normal(p).norm() > 1e-9;
-        if !p.iter().all(|v| v.is_finite()) || !axis_ok {
+        if !p.is_finite() || !axis_ok {
             return Err(ProcessError::BadContour {
                 id: format!("traverse {name}"),
                 reason: "a non-finite pose or a zero tool axis".into(),
@@ -299,7 +303,7 @@ pub(crate) fn plan_traverse_accepting<T>(
     let h = opts.step();
     let floor = opts.margin();
     let up = opts.up.normalize();
-    let unit = |p: &PoseArray| {
+    let unit = |p: &Pose| {
         let n = normal(p).normalize();
         with_axis(position(p), n)
     };
@@ -309,7 +313,7 @@ pub(crate) fn plan_traverse_accepting<T>(
     // height plus its length) keep half the clearance; raised where they do not. (The head
     // at the retract point, where the travel starts, keeps the full clearance: the travel's
     // check.)
-    let axial = |p: &PoseArray, height: f64| -> std::result::Result<PoseArray, Blocked> {
+    let axial = |p: &Pose, height: f64| -> std::result::Result<Pose, Blocked> {
         let (q, n) = (position(p), normal(p));
         let low = with_axis(q + n * (0.75 * c), n);
         let high = with_axis(q + n * height, n);
@@ -319,7 +323,7 @@ pub(crate) fn plan_traverse_accepting<T>(
         Trace::new(obs, &low, &top, 0.5 * c, 0.0).prove(floor, &mut Work::new(MOVE_SAMPLES))?;
         Ok(high)
     };
-    let length_of = |way: &[PoseArray]| {
+    let length_of = |way: &[Pose]| {
         let mut pts = vec![position(&from)];
         pts.extend(way.iter().map(position));
         pts.push(position(&to));
@@ -333,31 +337,30 @@ pub(crate) fn plan_traverse_accepting<T>(
     // retract point rises along the same move; half the moves checked on the real files are
     // repeats): each is traced once per gap.
     let traced: std::cell::RefCell<MoveOutcomes> = Default::default();
-    let tip_ends =
-        |w: &[PoseArray], fine: Option<&mut Work>| -> std::result::Result<f64, Blocked> {
-            let mut least = f64::INFINITY;
-            let mut fine = fine;
-            for s in w.windows(2) {
-                let trace = Trace::new(obs, &s[0], &s[1], c, opts.nozzle_mm);
-                least = least.min(match fine.as_deref_mut() {
-                    None => {
-                        let key = move_key(&s[0], &s[1]);
-                        let known = traced.borrow().get(&key).copied();
-                        let outcome = known.unwrap_or_else(|| {
-                            trace.certify_or_witness(floor, &mut Work::new(MOVE_SAMPLES))
-                        });
-                        traced.borrow_mut().insert(key, outcome);
-                        outcome?
-                    }
-                    Some(work) => trace.prove(floor, work)?,
-                });
-            }
-            Ok(least)
-        };
+    let tip_ends = |w: &[Pose], fine: Option<&mut Work>| -> std::result::Result<f64, Blocked> {
+        let mut least = f64::INFINITY;
+        let mut fine = fine;
+        for s in w.windows(2) {
+            let trace = Trace::new(obs, &s[0], &s[1], c, opts.nozzle_mm);
+            least = least.min(match fine.as_deref_mut() {
+                None => {
+                    let key = move_key(&s[0], &s[1]);
+                    let known = traced.borrow().get(&key).copied();
+                    let outcome = known.unwrap_or_else(|| {
+                        trace.certify_or_witness(floor, &mut Work::new(MOVE_SAMPLES))
+                    });
+                    traced.borrow_mut().insert(key, outcome);
+                    outcome?
+                }
+                Some(work) => trace.prove(floor, work)?,
+            });
+        }
+        Ok(least)
+    };
     let blocked_err = |b: Blocked, why: String| {
         ProcessError::TraverseBlocked(Box::new(crate::Blockage {
-            from: [from[0], from[1], from[2]],
-            to: [to[0], to[1], to[2]],
+            from: from.position.into(),
+            to: to.position.into(),
             at: [b.at.x, b.at.y, b.at.z],
             distance_mm: b.distance,
             clearance_mm: c,
@@ -381,7 +384,7 @@ pub(crate) fn plan_traverse_accepting<T>(
     // neither, and where a route is taken the higher retract points are seldom reached.
     // Every end's axial moves are checked before the routes are counted or searched.
     let axial_done: std::cell::RefCell<[[Option<AxialOutcome>; 5]; 2]> = Default::default();
-    let axial_at = |side: usize, k: usize| -> std::result::Result<PoseArray, Blocked> {
+    let axial_at = |side: usize, k: usize| -> std::result::Result<Pose, Blocked> {
         if let Some(known) = axial_done.borrow()[side][k] {
             return known;
         }
@@ -390,7 +393,7 @@ pub(crate) fn plan_traverse_accepting<T>(
         outcome
     };
     // The retract point at height `k` of an end, whether or not its axial move is clear.
-    let retract_point = |p: &PoseArray, k: usize| {
+    let retract_point = |p: &Pose, k: usize| {
         let (q, n) = (position(p), normal(p));
         with_axis(q + n * heights[k], n)
     };
@@ -399,10 +402,10 @@ pub(crate) fn plan_traverse_accepting<T>(
     // first. Built for every pair of retract heights; a route whose retract points' axial
     // moves are not both clear does not exist (sorting is stable, so the order of the others
     // is that of the routes built from the clear retract points alone).
-    let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::new();
+    let mut routes: Vec<(f64, Route, Vec<Pose>)> = Vec::new();
     let mut route_ends: Vec<(usize, usize)> = Vec::new();
     let lift_to = |level: f64| {
-        move |p: &PoseArray| {
+        move |p: &Pose| {
             let q = position(p);
             let rise = (level - q.coords.dot(&up)).max(0.0);
             with_axis(q + up * rise, normal(p))
@@ -440,9 +443,8 @@ pub(crate) fn plan_traverse_accepting<T>(
     }
     let mut order: Vec<usize> = (0..routes.len()).collect();
     order.sort_by(|&x, &y| routes[x].0.total_cmp(&routes[y].0));
-    let mut sorted: Vec<Option<(f64, Route, Vec<PoseArray>)>> =
-        routes.into_iter().map(Some).collect();
-    let mut routes: Vec<(f64, Route, Vec<PoseArray>)> = Vec::with_capacity(order.len());
+    let mut sorted: Vec<Option<(f64, Route, Vec<Pose>)>> = routes.into_iter().map(Some).collect();
+    let mut routes: Vec<(f64, Route, Vec<Pose>)> = Vec::with_capacity(order.len());
     let mut ends_of: Vec<(usize, usize)> = Vec::with_capacity(order.len());
     for &k in &order {
         routes.extend(sorted[k].take());
@@ -510,7 +512,7 @@ pub(crate) fn plan_traverse_accepting<T>(
     // No route clears with the coarse margin. Every end's axial moves now, as they were
     // checked before any route: where all of one end's fail, that is the gap's error.
     let top = heights[heights.len() - 1];
-    let mut retracts: [Vec<PoseArray>; 2] = [Vec::new(), Vec::new()];
+    let mut retracts: [Vec<Pose>; 2] = [Vec::new(), Vec::new()];
     for (side, what) in [
         (0, "the retract along the tool axis from the exit"),
         (1, "the approach along the tool axis to the pierce"),
@@ -764,20 +766,20 @@ mod tests {
     /// the axis limits would clear.
     fn refused_everywhere(outside_limits: bool) -> String {
         let obs = Obstacles::new();
-        let from = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
-        let to = [50.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        let from = Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+        let to = Pose::new(50.0, 0.0, 0.0, 0.0, 0.0, 1.0);
         let mut offered = 0;
         let e = plan_traverse_accepting(
             &obs,
             &from,
             &to,
             &TraverseOptions::default(),
-            &|_: &[PoseArray]| true,
+            &|_: &[Pose]| true,
             &mut |t: &Traverse| -> std::result::Result<(), Refusal> {
                 offered += 1;
                 let w = t.waypoints[t.waypoints.len() / 2];
                 Err(Refusal {
-                    at: Point3::new(w[0], w[1], w[2]),
+                    at: w.position,
                     distance: 1.0,
                     outside_limits,
                 })

@@ -28,7 +28,7 @@ use nalgebra::{Point3, Vector3};
 use super::check::{Trace, Work};
 use super::{Obstacles, TraverseOptions};
 use crate::geometry::{normal, position};
-use crate::PoseArray;
+use crate::Pose;
 
 /// A lattice point: integer coordinates along the lattice's three axes.
 type Cell = (i32, i32, i32);
@@ -342,8 +342,11 @@ fn meet(lat: &Lattice<'_>, sides: &[Side; 2], k: Cell) -> Found {
     (source, target, points)
 }
 
-fn with_axis(p: &Point3<f64>, n: &Vector3<f64>) -> PoseArray {
-    [p.x, p.y, p.z, n.x, n.y, n.z]
+fn with_axis(p: &Point3<f64>, n: &Vector3<f64>) -> Pose {
+    Pose {
+        position: *p,
+        axis: *n,
+    }
 }
 
 /// The tool axes a turn from `a` to `b` at one point passes: `b` alone where the turn is at
@@ -371,8 +374,8 @@ pub(super) fn turn_axes(
 /// One end of a gap for the search: the exit (or the pierce) with its tool axis, and the
 /// retract points on that axis whose axial moves are clear.
 pub(super) struct GapEnd<'a> {
-    pub(super) at: &'a PoseArray,
-    pub(super) retracts: &'a [PoseArray],
+    pub(super) at: &'a Pose,
+    pub(super) retracts: &'a [Pose],
 }
 
 /// A route from `a` (the exit) to `b` (the pierce) around the part with the head turned to
@@ -387,7 +390,7 @@ pub(super) fn route(
     m: &Vector3<f64>,
     opts: &TraverseOptions,
     work: &mut Work,
-) -> Option<Vec<PoseArray>> {
+) -> Option<Vec<Pose>> {
     let (from, to, ends_a, ends_b) = (a.at, b.at, a.retracts, b.retracts);
     let c = opts.clearance_mm;
     let m = m.try_normalize(1e-12)?;
@@ -498,7 +501,7 @@ pub(super) fn route(
     }
     // The route: the retract point with the exit's axis, the turn to `m`, the path, the turn to
     // the pierce's axis over the approach.
-    let mut way: Vec<PoseArray> = turns[0][source]
+    let mut way: Vec<Pose> = turns[0][source]
         .iter()
         .map(|n| with_axis(&kept[0], n))
         .collect();

@@ -16,6 +16,7 @@
 //! chooses kerf's (the nearest, as kerf does), and where the tip stands the feed kerf writes
 //! is deg/min of kerf's rotary motion, which the program does not name.
 
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 use super::super::writer::Rules;
@@ -96,7 +97,7 @@ impl Rules for Fanuc {
         w.comment("power: S = % per block from kerf's planned tip speed");
     }
 
-    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
+    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: Axes, _u: Vector3<f64>) {
         w.tip_rapid("G00", p, q, |w, tip, a| self.words(w, tip, a));
     }
 
@@ -135,7 +136,7 @@ impl Rules for Fanuc {
 impl Fanuc {
     /// The position words: the tip with the rotary axes (`G43.4`) or the tool direction
     /// (`G43.5`, from the axes through the machine's kinematics).
-    fn words(&self, w: &Writer<'_>, tip: &Point3<f64>, q: &[f64; 5]) -> String {
+    fn words(&self, w: &Writer<'_>, tip: &Point3<f64>, q: &Axes) -> String {
         if self.ijk {
             let u = w.model.tool_axis(q[3], q[4]);
             format!(
@@ -156,9 +157,9 @@ impl Fanuc {
     /// travel: `F` the tip's speed (deg/min of the rotary motion where the printed tip stands),
     /// the planned power as `S` where it changed; nothing if the printed position does not
     /// change.
-    fn cut_move(&self, w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64, tip_mm: f64) {
+    fn cut_move(&self, w: &mut Writer<'_>, tip: Point3<f64>, q: Axes, t: f64, tip_mm: f64) {
         w.last_axes = Some(q);
-        let Some((now, prev)) = w.moved(&[tip.x, tip.y, tip.z, q[3], q[4]]) else {
+        let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q[3], q[4])) else {
             return;
         };
         let f = rs274_feed(&prev, &now, t);

@@ -3,6 +3,7 @@
 //! without it), chosen so that each block takes its planned time; `;` comments, `M30`. Power:
 //! `S` per block from kerf's planned tip speed.
 
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 use super::super::writer::Rules;
@@ -39,7 +40,7 @@ impl Rules for Generic {
         w.comment("power: S = % per block from kerf's planned tip speed");
     }
 
-    fn rapid(&self, w: &mut Writer<'_>, _p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
+    fn rapid(&self, w: &mut Writer<'_>, _p: Point3<f64>, q: Axes, _u: Vector3<f64>) {
         axes_rapid(w, q);
     }
 
@@ -65,7 +66,7 @@ impl Rules for Generic {
 }
 
 /// A `G0` to the machine axes `q` (the raw-axis dialects).
-pub(super) fn axes_rapid(w: &mut Writer<'_>, q: [f64; 5]) {
+pub(super) fn axes_rapid(w: &mut Writer<'_>, q: Axes) {
     let l = format!("G0 {}", w.axis_words(&q));
     w.line(&l);
     w.last = Some(w.printed(&q));
@@ -75,7 +76,7 @@ pub(super) fn axes_rapid(w: &mut Writer<'_>, q: [f64; 5]) {
 /// One generic `G1` to `q`, taking `t` seconds while the tip moves `tip_mm`: `F` by the
 /// RS274/NGC rule, the planned power as `S` where it changed; nothing if the printed axes do
 /// not change.
-fn axes_move(w: &mut Writer<'_>, q: [f64; 5], t: f64, tip_mm: f64) {
+fn axes_move(w: &mut Writer<'_>, q: Axes, t: f64, tip_mm: f64) {
     let Some((qp, prev)) = w.moved(&q) else {
         return;
     };

@@ -22,6 +22,7 @@
 //! are computed ahead of the motion, not with it; the header says the technology's power is
 //! not commanded, and the machine's laser control must follow the path speed itself.
 
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 use super::super::writer::Rules;
@@ -142,7 +143,7 @@ impl Rules for Heidenhain {
         Some("a Klartext program has no power word that acts with the motion [S belongs to TOOL CALL, Q parameters are computed ahead of it]: the machine's laser control must follow the path speed itself")
     }
 
-    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
+    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: Axes, _u: Vector3<f64>) {
         let l = if self.axes { "L" } else { "LN" };
         w.tip_rapid(l, p, q, |w, tip, a| {
             format!("{} R0 FMAX", self.words(w, tip, a))
@@ -193,7 +194,7 @@ impl Rules for Heidenhain {
 impl Heidenhain {
     /// The position words: the tip with the rotary axes (`L`) or with the tool direction
     /// (`LN`, from the axes through the machine's kinematics).
-    fn words(&self, w: &Writer<'_>, tip: &Point3<f64>, q: &[f64; 5]) -> String {
+    fn words(&self, w: &Writer<'_>, tip: &Point3<f64>, q: &Axes) -> String {
         let xyz = format!(
             "X{} Y{} Z{}",
             signed(w, tip.x),
@@ -222,9 +223,9 @@ impl Heidenhain {
     /// One `L`/`LN` to the tip `tip` with the axes `q`, taking `t` seconds: `F` the tip's
     /// speed (deg/min of the rotary motion where the printed tip stands); nothing if the
     /// printed position does not change.
-    fn cut_move(&self, w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64) {
+    fn cut_move(&self, w: &mut Writer<'_>, tip: Point3<f64>, q: Axes, t: f64) {
         w.last_axes = Some(q);
-        let Some((now, prev)) = w.moved(&[tip.x, tip.y, tip.z, q[3], q[4]]) else {
+        let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q[3], q[4])) else {
             return;
         };
         let f = rs274_feed(&prev, &now, t);
@@ -316,9 +317,9 @@ mod tests {
             Vec::new(),
         );
         let tip = Point3::new(31.737, 21.954, 33.165);
-        let q = [0.0, 0.0, 0.0, 12.357, 5.896];
+        let q = Axes::new(0.0, 0.0, 0.0, 12.357, 5.896);
         // 1000 mm/min: 10 mm of tip travel in 0.6 s from a tip 10 mm away along X.
-        w.last = Some([21.737, 21.954, 33.165, 12.357, 5.896]);
+        w.last = Some(Axes::new(21.737, 21.954, 33.165, 12.357, 5.896));
         Heidenhain { axes: true }.cut_move(&mut w, tip, q, 0.6);
         assert_eq!(
             w.finish(),

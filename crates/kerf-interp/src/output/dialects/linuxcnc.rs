@@ -5,6 +5,7 @@
 //! synchronized `M63`/`M62`, power through HAL (`M67`/`M68`: module docs of `power`), and the
 //! controller's own kerf compensation (`G41.1`/`G42.1 D`).
 
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 use super::super::writer::Rules;
@@ -52,7 +53,7 @@ impl Rules for Linuxcnc {
         w.comment("power: E2..E7 mm/deg, set with M67 [synchronized with the next block] where the rotary axes move");
     }
 
-    fn rapid(&self, w: &mut Writer<'_>, _p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
+    fn rapid(&self, w: &mut Writer<'_>, _p: Point3<f64>, q: Axes, _u: Vector3<f64>) {
         axes_rapid(w, q);
     }
 
@@ -117,7 +118,7 @@ impl Rules for Linuxcnc {
 /// from the joints: the rotary coefficients go with the block where stale ones would misjudge
 /// its tip travel by more than the writer's power step, the block in pieces of its own joint
 /// line where they turn inside it.
-fn joint_move(w: &mut Writer<'_>, q: [f64; 5], t: f64) {
+fn joint_move(w: &mut Writer<'_>, q: Axes, t: f64) {
     let Some((qp, prev)) = w.moved(&q) else {
         return;
     };
@@ -129,7 +130,7 @@ fn joint_move(w: &mut Writer<'_>, q: [f64; 5], t: f64) {
                 let end = if f == 1.0 {
                     q
                 } else {
-                    w.printed(&std::array::from_fn(|k| prev[k] + f * (qp[k] - prev[k])))
+                    w.printed(&prev.lerp(&qp, f))
                 };
                 format!("G1 {} F{}", w.axis_words(&end), feed_number(60.0 / dt))
             },

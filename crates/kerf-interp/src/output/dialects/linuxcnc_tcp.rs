@@ -31,6 +31,7 @@
 //! is the direction from LinuxCNC's tip to its pivot. Those are the machines this dialect
 //! writes for; any other is refused by name ([`linuxcnc_kinematics`]).
 
+use kerf_kinematics::Axes;
 use kerf_kinematics::{Machine, Parameter};
 use nalgebra::{Point3, Vector3};
 
@@ -215,7 +216,7 @@ impl Rules for LinuxcncTcp {
         Linuxcnc.power_header(w);
     }
 
-    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], _u: Vector3<f64>) {
+    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: Axes, _u: Vector3<f64>) {
         w.tip_rapid("G0", p, q, |w, tip, a| tcp_words(w, tip, a[3], a[4]));
     }
 
@@ -291,9 +292,9 @@ pub(super) fn tcp_words(w: &Writer<'_>, tip: &Point3<f64>, tilt: f64, c: f64) ->
 /// nothing if the printed words do not change. With power the controller computes the tip's
 /// speed from its joints as for the joint-space dialect: the same coefficients, the move in
 /// pieces of its own tip line.
-fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64) {
+fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: Axes, t: f64) {
     let from = w.last_axes.replace(q);
-    let Some((now, prev)) = w.moved(&[tip.x, tip.y, tip.z, q[3], q[4]]) else {
+    let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q[3], q[4])) else {
         return;
     };
     let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
@@ -302,7 +303,7 @@ fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: [f64; 5], t: f64) {
     match (w.power().is_some() && w.in_cut, from) {
         (true, Some(from)) => {
             let words = |w: &Writer<'_>, fr: f64| -> String {
-                let p: [f64; 5] = std::array::from_fn(|k| prev[k] + fr * d[k]);
+                let p = Axes::from_array(std::array::from_fn(|k| prev[k] + fr * d[k]));
                 tcp_words(w, &Point3::new(p[0], p[1], p[2]), p[3], p[4])
             };
             let (a, b) = (w.printed(&from), w.printed(&q));

@@ -8,6 +8,7 @@
 //! Siemens' documented pattern, not executed here). No micro-joints: its arcs and merged lines
 //! are not split.
 
+use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 use super::super::writer::Rules;
@@ -81,7 +82,7 @@ impl Rules for Sinumerik {
     /// controller turns the orientation on a great circle (`ORIVECT`), not the rotary axes
     /// linearly: the tip follows within the tolerance, the head within about its distance
     /// from the tip times the square of the piece's turn.
-    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: [f64; 5], u: Vector3<f64>) {
+    fn rapid(&self, w: &mut Writer<'_>, p: Point3<f64>, q: Axes, u: Vector3<f64>) {
         let model = w.model;
         w.tip_rapid("G0", p, q, |w, tip, a| {
             // The last piece's orientation is the caller's own `u` (exactly the pose's).

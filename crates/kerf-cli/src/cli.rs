@@ -623,12 +623,10 @@ impl RunArgs {
             .with_lead_out(self.lead_out.0, self.lead_out.1)
     }
 
-    /// The traverse options these arguments ask for (`None`: unchecked traverses).
+    /// The traverse options these arguments ask for (`None`: unchecked traverses); the job
+    /// raises their retract to `--retract` (`JobOptions::checked_traverse`).
     pub(crate) fn traverse_options(&self) -> Option<kerf_process::TraverseOptions> {
-        (self.clearance > 0.0).then(|| {
-            let mut t = kerf_process::TraverseOptions::default().with_clearance(self.clearance);
-            t.retract_mm = t.retract_mm.max(self.retract);
-            t
-        })
+        (self.clearance > 0.0)
+            .then(|| kerf_process::TraverseOptions::default().with_clearance(self.clearance))
     }
 }

@@ -110,7 +110,8 @@ pub struct JobOptions {
     /// Traverses between cuts checked against the part's surfaces (retract along the tool
     /// axis, travel at a clearance, approach; `kerf-process`), or `None` for the unchecked
     /// retract and straight traverse. Default `Some(TraverseOptions::default())`: 5 mm
-    /// clearance, 20 mm nozzle; the retract is never shorter than `retract_mm`.
+    /// clearance, 20 mm nozzle; the run backs off as far as the larger of its retract and
+    /// `retract_mm` ([`JobOptions::checked_traverse`]).
     pub traverse: Option<kerf_process::TraverseOptions>,
     /// The most cutting points of all curves together ([`crate::discretize_curves_within`]):
     /// a job that needs more is refused from the discretizer's estimate before the points are
@@ -314,6 +315,18 @@ impl JobOptions {
         self
     }
 
+    /// The traverse checks as the run applies them: [`traverse`](Self::traverse) with its
+    /// retract raised to [`retract_mm`](Self::retract_mm), the job's one retract (the
+    /// traverse's own, 1.5 times its clearance by default and at least 1.25 times it, is what
+    /// a checked traverse needs to clear the part; the program backs off as far as the larger
+    /// of the two).
+    pub fn checked_traverse(&self) -> Option<kerf_process::TraverseOptions> {
+        self.traverse.map(|t| {
+            let retract_mm = t.retract_mm.max(self.retract_mm);
+            t.with_retract_mm(retract_mm)
+        })
+    }
+
     /// Checks every option against its documented range ([`crate::ranges`]) and the stages'
     /// own checks, before any work ([`Job::validate`] runs it, and so [`Job::run`]): the
     /// discretizer's ([`Options::validate`]), the chord tolerance and the segment lengths, the
@@ -387,10 +400,8 @@ impl JobOptions {
             LEAD_MM.check(name, v)?;
         }
         l.validate().map_err(process)?;
-        if let Some(t) = self.traverse {
+        if let Some(t) = self.checked_traverse() {
             CLEARANCE_MM.check("traverse.clearance_mm", t.clearance_mm)?;
-            // As the run uses them: never a shorter retract than `retract_mm`.
-            let t = t.with_retract_mm(t.retract_mm.max(self.retract_mm));
             t.validate().map_err(process)?;
         }
         Ok(())

@@ -146,10 +146,7 @@ impl<'a> Run<'a> {
                 .process
                 .standoff_mm
                 .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM),
-            traverse: o.traverse.map(|mut t| {
-                t.retract_mm = t.retract_mm.max(o.retract_mm);
-                t
-            }),
+            traverse: o.checked_traverse(),
         })
     }
 
@@ -802,6 +799,20 @@ fn setup_program(
     Ok(())
 }
 
+/// The input's name in the view and the picture: the file's name, `curves` for a job built
+/// in code.
+fn input_name(path: Option<&Path>) -> String {
+    path.map_or_else(
+        || "curves".to_string(),
+        |path| {
+            path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            )
+        },
+    )
+}
+
 /// Stage 5: the 3D view, the picture and the report, and every stage's result as the
 /// [`crate::Output`].
 pub(crate) fn output(
@@ -823,15 +834,7 @@ pub(crate) fn output(
     let process =
         kerf_interp::ProcessCodes::resolve(o.dialect, &machine.process).map_err(interp(path))?;
     (r.progress)(Progress::new(crate::Stage::Report, 0, 1));
-    let input_name = path.map_or_else(
-        || "curves".to_string(),
-        |path| {
-            path.file_name().map_or_else(
-                || path.display().to_string(),
-                |n| n.to_string_lossy().into_owned(),
-            )
-        },
-    );
+    let input_name = input_name(path);
     let program_files = crate::output::program_names(programs.motions.len());
     let view = view_scene(
         r,

@@ -149,18 +149,7 @@ pub(crate) fn route_setup(
             positions: r.axes.iter().map(Axes::to_array).collect(),
             poses: r.poses.iter().map(Pose::to_array).collect(),
         });
-        out.stations.push(
-            r.axes
-                .iter()
-                .zip(&r.poses)
-                .map(|(a, p)| Station {
-                    tip: p.position,
-                    axis: p.axis,
-                    param: None,
-                    axes: *a,
-                })
-                .collect(),
-        );
+        out.stations.push(stations(r));
         // Surfaces left out that a neighbouring cut names itself: its own surface curls over
         // its head line (the cut meets it, whatever the traverse does).
         let over = kerf_process::own_surfaces_over_the_head(&obs, gap, opts);
@@ -202,6 +191,20 @@ pub(crate) fn route_setup(
         out.plot.push(line);
     }
     Ok(out)
+}
+
+/// The interpolator's stations of a traverse's rapid waypoints (no curve parameters).
+fn stations(r: &kerf_process::RapidMoves) -> Vec<Station> {
+    r.axes
+        .iter()
+        .zip(&r.poses)
+        .map(|(a, p)| Station {
+            tip: p.position,
+            axis: p.axis,
+            param: None,
+            axes: *a,
+        })
+        .collect()
 }
 
 /// The gap from cut `a` to cut `b`: the end and start poses with their axes, the contour's

@@ -485,3 +485,55 @@ fn sinumerik_arcs_and_merged_lines_stay_within_chord_plus_fit_of_the_curve() {
     assert!(merged > 10, "arcs and merged lines to test: {merged}");
     assert!(measured <= 0.01 + 0.01, "{measured} mm from the curve");
 }
+
+/// A run has one retract: the job's `retract_mm`, raised to the traverse checks' own where
+/// that is longer (`JobOptions::checked_traverse`). The head backs off at least that far
+/// along the tool axis before every checked traverse (the first waypoint of each, read back
+/// against the end of the cut before it), and the report states the retract used.
+#[test]
+fn the_retract_is_the_jobs_raised_to_what_the_traverse_check_needs() {
+    let run = |retract_mm: f64, clearance_mm: f64| {
+        let traverse = kerf_process::TraverseOptions::default().with_clearance(clearance_mm);
+        let options = JobOptions::default()
+            .with_retract_mm(retract_mm)
+            .with_traverse(Some(traverse));
+        assert_eq!(
+            options.checked_traverse().map(|t| t.retract_mm),
+            Some(retract_mm.max(1.5 * clearance_mm))
+        );
+        let job = Job::from_files(fixture("mixed.json"), fixture("machines/ac_head.json"))
+            .expect("inputs")
+            .with_options(options);
+        job.run().expect("run")
+    };
+    for (retract_mm, clearance_mm, want) in [(12.0, 5.0, 12.0), (10.0, 10.0, 15.0)] {
+        let out = run(retract_mm, clearance_mm);
+        assert_eq!(out.report.traverses.retract_mm, Some(want), "stated");
+        // Each traverse starts on the tool-axis line above the end of some cut (the one
+        // before it in cutting order), at least the retract up.
+        let ends: Vec<[f64; 6]> = (out.axes.paths.iter())
+            .map(|p| {
+                let last = p.lead_out.as_ref().map_or(&p.poses, |m| &m.poses);
+                last[last.len() - 1]
+            })
+            .collect();
+        let mut seen = 0;
+        for t in out.axes.paths.iter().filter_map(|p| p.traverse.as_ref()) {
+            let first = t.poses[0];
+            let (up, off) = ends
+                .iter()
+                .map(|e| {
+                    let d: [f64; 3] = std::array::from_fn(|k| first[k] - e[k]);
+                    let up: f64 = (0..3).map(|k| d[k] * e[k + 3]).sum();
+                    let off = (0..3).map(|k| (d[k] - up * e[k + 3]).powi(2)).sum::<f64>();
+                    (up, off.sqrt())
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .expect("cuts");
+            assert!(off < 1e-6, "on a cut end's tool-axis line ({off} mm off)");
+            assert!(up >= want - 1e-6, "backed off {up} mm, want {want}");
+            seen += 1;
+        }
+        assert!(seen > 0, "checked traverses");
+    }
+}

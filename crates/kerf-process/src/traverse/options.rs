@@ -12,7 +12,8 @@ pub struct TraverseOptions {
     /// (default 5).
     pub clearance_mm: f64,
     /// How far the head first backs off along the tool axis, mm; at least 1.25 times the
-    /// clearance, raised where the retract point is not clear (default 7.5).
+    /// clearance, raised where the retract point is not clear (default 7.5). A
+    /// `kerf_pipeline::Job` raises it to its own `retract_mm`, the one retract of a run.
     pub retract_mm: f64,
     /// Length of the nozzle, a segment from the tip along the tool axis toward the head that
     /// must keep the clearance too, mm (default 20).

@@ -6,13 +6,11 @@ use std::time::Instant;
 
 use kerf_discretize::{Discretization, Options};
 use kerf_format::toolpath;
-use kerf_format::{CurveRecord, CurvesFile};
+use kerf_format::CurvesFile;
 use kerf_normals::NormalOptions;
 use kerf_pipeline::{
-    discretize_curves, orient_curves, toolpath_of_poses, MissingSurface, OrientOptions, Progress,
-    Stage,
+    discretize_curves, orient_curves, toolpath_of_poses, MissingSurface, OrientOptions,
 };
-use rayon::prelude::*;
 use serde_json::json;
 
 use crate::cli::DiscretizeArgs;
@@ -83,10 +81,14 @@ const GROUP: usize = 256;
 /// Discretizes every curve and writes its cutting points to `dest` as they come (positions
 /// only), in input order; on any failure `dest` is untouched (`toolpath::write_with`).
 ///
-/// Writing is serial (one file, in order), so it overlaps the discretization: while this
-/// thread formats and writes group `g`, the thread pool discretizes group `g + 1`. The bytes
-/// are those of discretizing and writing one group after the other; the CPU time is the same,
-/// the wall time on two cores drops by about the writing's share.
+/// One batch of the discretizer in groups of [`GROUP`] (`kerf_discretize::Batch`): the
+/// refusals known from the control points come before any walk and before `dest` is opened (a
+/// curve late in the file whose tolerance is below its rounding margin is refused at once, not
+/// after the walks of the curves before it, which took minutes at 1e-10 mm). Writing is serial
+/// (one file, in order), so it overlaps the discretization: while this thread formats and
+/// writes group `g`, the thread pool discretizes group `g + 1`. The bytes are those of
+/// discretizing and writing one group after the other; the CPU time is the same, the wall time
+/// on two cores drops by about the writing's share.
 fn discretize_to_file(
     file: &CurvesFile,
     input: &Path,
@@ -94,69 +96,17 @@ fn discretize_to_file(
     dest: &Path,
     bar: &ProgressBar,
 ) -> Result<Totals, CliError> {
-    opts.validate().map_err(kerf_pipeline::Error::Options)?;
-    // Refusals known from the control points come before any walk: a curve late in the file
-    // whose tolerance is below its rounding margin is refused at once, not after the walks of
-    // the curves before it (which took minutes at 1e-10 mm).
-    let checks: Vec<_> = file
-        .curves
-        .par_iter()
-        .map(|r| kerf_discretize::check_tolerance(&r.curve, opts.tolerance_mm))
-        .collect();
-    if let Some((index, Err(source))) = checks.into_iter().enumerate().find(|(_, r)| r.is_err()) {
-        return Err(kerf_pipeline::Error::Discretize {
-            file: Some(input.to_path_buf()),
-            index,
-            id: file.curves[index].id.clone(),
-            source,
-        }
-        .into());
-    }
-    let total = file.curves.len();
+    let batch = kerf_pipeline::curves_batch(file, opts, Some(input))?.in_groups_of(GROUP);
     let mut totals = Totals::default();
-    bar.update(Progress::new(Stage::Discretize, 0, total));
-    let discretize_group = |group: &[CurveRecord]| -> Vec<_> {
-        group
-            .par_iter()
-            .map(|r| kerf_discretize::discretize(&r.curve, opts))
-            .collect()
-    };
-    let groups: Vec<&[CurveRecord]> = file.curves.chunks(GROUP).collect();
+    let progress = |p| bar.update(p);
     toolpath::write_with(dest, file.units, opts.tolerance_mm, |w| {
-        let mut discs = groups
-            .first()
-            .map_or_else(Vec::new, |g| discretize_group(g));
-        for (g, group) in groups.iter().enumerate() {
-            let mut next = Vec::new();
-            // The pool discretizes the next group while this thread writes this one; the scope
-            // waits for it, also when the writing fails.
-            let written = rayon::in_place_scope(|s| {
-                if let Some(following) = groups.get(g + 1) {
-                    let next = &mut next;
-                    s.spawn(move |_| *next = discretize_group(following));
-                }
-                for (k, (rec, d)) in group.iter().zip(discs).enumerate() {
-                    let d = d.map_err(|source| kerf_pipeline::Error::Discretize {
-                        file: Some(input.to_path_buf()),
-                        index: g * GROUP + k,
-                        id: rec.id.clone(),
-                        source,
-                    })?;
-                    w.path(&rec.id, d.params(), d.points(), d.max_chord_error())
-                        .map_err(|e| e.in_file(dest))?;
-                    totals.add(&d, opts.tolerance_mm);
-                }
-                Ok::<(), CliError>(())
-            });
-            written?;
-            discs = next;
-            bar.update(Progress::new(
-                Stage::Discretize,
-                (g * GROUP + group.len()).min(total),
-                total,
-            ));
-        }
-        Ok::<(), CliError>(())
+        kerf_pipeline::discretize_batch(&batch, Some(input), &progress, |index, d| {
+            let rec = &file.curves[index];
+            w.path(&rec.id, d.params(), d.points(), d.max_chord_error())
+                .map_err(|e| e.in_file(dest))?;
+            totals.add(&d, opts.tolerance_mm);
+            Ok::<(), CliError>(())
+        })
     })?;
     Ok(totals)
 }

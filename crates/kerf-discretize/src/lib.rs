@@ -29,6 +29,7 @@
 //! # Ok::<(), kerf_discretize::DiscretizeError>(())
 //! ```
 
+mod batch;
 mod bound;
 mod classic;
 mod error;
@@ -37,6 +38,7 @@ mod options;
 mod sphere;
 mod walk;
 
+pub use batch::{Batch, BatchError, BatchRefusal};
 pub use bound::{chord_error, Bound, Certifier, Scratch, MARGIN_FACTOR, MAX_SUBDIVISION_DEPTH};
 pub use error::{DiscretizeError, Result};
 pub use minimum::{
@@ -578,7 +580,8 @@ pub fn discretize_range(
 }
 
 /// Discretizes many curves in parallel (rayon); results in input order, identical to calling
-/// [`discretize`] on each curve in turn when every curve's tolerance can be certified.
+/// [`discretize`] on each curve in turn when every curve's tolerance can be certified. One
+/// [`Batch`] of the curves, every result kept.
 ///
 /// Refusals known from the options and the control points come first, before any walk: if the
 /// options are invalid every result is that error, and if the tolerance is below the rounding
@@ -587,18 +590,37 @@ pub fn discretize_range(
 /// [`DiscretizeError::NotWalked`] naming the first refused curve (a batch at a tolerance that
 /// cannot hold for all of it is refused at once, not after the walks of the others).
 pub fn discretize_all(curves: &[NurbsCurve], opts: &Options) -> Vec<Result<Discretization>> {
-    if let Err(e) = opts.validate() {
-        return curves.iter().map(|_| Err(e.clone())).collect();
+    let batch = match Batch::new(curves, |c| c, opts) {
+        Ok(batch) => batch,
+        Err(BatchRefusal::Options(e)) => return curves.iter().map(|_| Err(e.clone())).collect(),
+        Err(BatchRefusal::Curve { index, .. }) => {
+            // Every curve's own refusal (control points only), the others not walked.
+            return curves
+                .par_iter()
+                .map(|c| {
+                    check_tolerance(c, opts.tolerance_mm)
+                        .and(Err(DiscretizeError::NotWalked { index }))
+                })
+                .collect();
+        }
+    };
+    let mut results = Vec::with_capacity(curves.len());
+    let ran = batch.each(&|_, _| {}, |_, r| {
+        results.push(r);
+        Ok::<(), std::convert::Infallible>(())
+    });
+    match ran {
+        Ok(()) => {}
+        // Not reached: the batch has no total limit and the sink does not fail.
+        Err(BatchError::TooManyPoints { limit, reached, .. }) => {
+            results.resize_with(curves.len(), || {
+                Err(DiscretizeError::TooManyPoints {
+                    limit,
+                    estimate: reached,
+                })
+            });
+        }
+        Err(BatchError::Sink { source, .. }) => match source {},
     }
-    let checks: Vec<Result<()>> = curves
-        .par_iter()
-        .map(|c| check_tolerance(c, opts.tolerance_mm))
-        .collect();
-    if let Some(index) = checks.iter().position(Result::is_err) {
-        return checks
-            .into_iter()
-            .map(|r| r.and(Err(DiscretizeError::NotWalked { index })))
-            .collect();
-    }
-    curves.par_iter().map(|c| discretize(c, opts)).collect()
+    results
 }

@@ -4,11 +4,11 @@
 //! `kerf.toolpath/1` records.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-use kerf_discretize::{Discretization, DiscretizeError, Options};
+use kerf_discretize::{Batch, BatchError, BatchRefusal, Discretization, Options};
 use kerf_format::toolpath::{ToolpathFile, ToolpathPoints, ToolpathRecord};
-use kerf_format::{CurvesFile, Pose, SurfaceGeometry};
+use kerf_format::{CurveRecord, CurvesFile, Pose, SurfaceGeometry};
 use kerf_normals::{orient, Hint, MeshNormals, NormalSource, NurbsNormals, Oriented, Projection};
 use rayon::prelude::*;
 
@@ -38,15 +38,19 @@ pub fn discretize_curves(
 }
 
 /// [`discretize_curves`] with at most `max_total_points` cutting points over all curves
-/// together (`opts.max_points` still limits each curve). A curve whose estimate (the
-/// discretizer's own, before it allocates anything) is more than twice what the others have
-/// left is refused at once; the estimate is not a bound, so the total itself is then counted
-/// exactly: a curve that takes it past the limit fails the job and stops the curves not yet
-/// started. Memory stays within about three times the limit whatever the input; the error
-/// names the curve that passed it, which with several threads depends on their timing.
+/// together (`opts.max_points` still limits each curve): one batch of the discretizer
+/// ([`curves_batch`], [`Batch::with_max_total_points`], which says exactly what the limit
+/// guarantees). In short: a curve whose estimate (the discretizer's own, before it allocates
+/// anything) is more than twice what the others have left is refused at once; the estimate is
+/// not a bound, so the total itself is then counted exactly: a curve that takes it past the
+/// limit fails the job and stops the curves not yet started. Memory stays within about three
+/// times the limit on one thread (twice the limit more per further thread) whatever the input;
+/// the error names the curve that passed it, which with several threads depends on their
+/// timing. The curves are one group, so every thread is busy to the end.
 ///
 /// # Errors
-/// [`Error::Options`] for an option out of range (before any work); [`Error::TooManyPoints`]
+/// [`Error::Options`] for an option out of range, [`Error::Discretize`] for a curve whose
+/// tolerance is below its rounding margin (both before any walk); [`Error::TooManyPoints`]
 /// when the curves together need more than `max_total_points`; else [`Error::Discretize`]
 /// naming the first curve (in file order) that failed.
 pub fn discretize_curves_within(
@@ -56,98 +60,87 @@ pub fn discretize_curves_within(
     source: Option<&Path>,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Vec<Discretization>> {
-    opts.validate().map_err(Error::Options)?;
-    // Every curve's rounding margin against the tolerance before any walk: a tolerance no
-    // curve can hold is refused at once, not after the curves before it were walked.
-    for (index, r) in file.curves.iter().enumerate() {
-        kerf_discretize::check_tolerance(&r.curve, opts.tolerance_mm).map_err(|error| {
-            Error::Discretize {
-                file: source.map(Path::to_path_buf),
-                index,
-                id: r.id.clone(),
-                source: error,
-            }
-        })?;
-    }
-    /// Why one curve has no discretization.
-    enum Failed {
-        Curve(DiscretizeError),
-        /// The job's limit, passed with this total (reached or estimated).
-        Limit(f64),
-        /// Not started: another curve passed the limit.
-        Stopped,
-    }
-    // The records are discretized in place (no copy of the curves), in parallel; results come
-    // back in input order.
-    let total = file.curves.len();
-    let done = AtomicUsize::new(0);
-    let used = AtomicUsize::new(0);
-    let over = AtomicBool::new(false);
-    progress(Progress::new(Stage::Discretize, 0, total));
-    let results: Vec<_> = file
-        .curves
-        .par_iter()
-        .map(|r| {
-            if over.load(Ordering::Relaxed) {
-                return Err(Failed::Stopped);
-            }
-            let before = used.load(Ordering::Relaxed);
-            let left = max_total_points.saturating_sub(before);
-            let allowed = left.saturating_mul(2).max(1024);
-            let job_bound = allowed < opts.max_points;
-            let copts = opts.with_max_points(allowed.min(opts.max_points));
-            let d = match kerf_discretize::discretize(&r.curve, &copts) {
-                Ok(d) => {
-                    let n = d.points().len();
-                    let now = used.fetch_add(n, Ordering::Relaxed) + n;
-                    if now > max_total_points {
-                        over.store(true, Ordering::Relaxed);
-                        Err(Failed::Limit(now as f64))
-                    } else {
-                        Ok(d)
-                    }
-                }
-                Err(DiscretizeError::TooManyPoints { estimate, .. }) if job_bound => {
-                    over.store(true, Ordering::Relaxed);
-                    Err(Failed::Limit(before as f64 + estimate))
-                }
-                Err(e) => Err(Failed::Curve(e)),
-            };
-            let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-            progress(Progress::new(Stage::Discretize, n, total));
-            d
-        })
-        .collect();
-    let file_path = || source.map(Path::to_path_buf);
-    // The job's limit first: a curve stopped by it has no error of its own.
-    if let Some((index, reached)) = results.iter().enumerate().find_map(|(i, r)| match r {
-        Err(Failed::Limit(reached)) => Some((i, *reached)),
-        _ => None,
-    }) {
-        return Err(Error::TooManyPoints {
-            file: file_path(),
-            limit: max_total_points,
-            reached,
+    let batch = curves_batch(file, opts, source)?.with_max_total_points(max_total_points);
+    let mut discs = Vec::with_capacity(file.curves.len());
+    discretize_batch(&batch, source, progress, |_, d| {
+        discs.push(d);
+        Ok::<(), Error>(())
+    })?;
+    Ok(discs)
+}
+
+/// Every curve of `file` as one batch of the discretizer ([`Batch`], one group, no total
+/// limit: set them with [`Batch::in_groups_of`] and [`Batch::with_max_total_points`]), checked
+/// before any walk: the options, then every curve's tolerance against its rounding margin, so
+/// that a tolerance a curve late in the file cannot hold is refused at once, not after the
+/// walks of the curves before it. Run it with [`discretize_batch`]; `source` names the file in
+/// errors.
+///
+/// # Errors
+/// [`Error::Options`]; [`Error::Discretize`] naming the first curve (in file order) whose
+/// tolerance is below its rounding margin.
+pub fn curves_batch<'a>(
+    file: &'a CurvesFile,
+    opts: &Options,
+    source: Option<&Path>,
+) -> Result<Batch<'a, CurveRecord>> {
+    Batch::new(&file.curves, |r| &r.curve, opts).map_err(|refusal| match refusal {
+        BatchRefusal::Options(error) => Error::Options(error),
+        BatchRefusal::Curve {
+            index,
+            source: error,
+        } => Error::Discretize {
+            file: source.map(Path::to_path_buf),
             index,
             id: file.curves[index].id.clone(),
-        });
-    }
-    results
-        .into_iter()
-        .enumerate()
-        .map(|(i, r)| match r {
-            Ok(d) => Ok(d),
-            Err(Failed::Curve(error)) => Err(Error::Discretize {
+            source: error,
+        },
+    })
+}
+
+/// Runs `batch` (from [`curves_batch`]; [`Batch::each`]): gives `sink` the discretization of
+/// every curve on the calling thread, in file order, with its index, while the thread pool
+/// discretizes the next group; `progress` as each curve is done. The first error ends it.
+/// `source` names the file in errors.
+///
+/// # Errors
+/// [`Error::TooManyPoints`] when the batch has a total limit and a group passes it (checked
+/// before the sink sees that group); else [`Error::Discretize`] naming the first curve (in
+/// file order) that failed, or the sink's error.
+pub fn discretize_batch<E: From<Error>>(
+    batch: &Batch<'_, CurveRecord>,
+    source: Option<&Path>,
+    progress: &(dyn Fn(Progress) + Sync),
+    mut sink: impl FnMut(usize, Discretization) -> std::result::Result<(), E>,
+) -> std::result::Result<(), E> {
+    let records = batch.items();
+    let file_path = || source.map(Path::to_path_buf);
+    let ran = batch.each(
+        &|done, total| progress(Progress::new(Stage::Discretize, done, total)),
+        |index, r| match r {
+            Ok(d) => sink(index, d),
+            Err(error) => Err(E::from(Error::Discretize {
                 file: file_path(),
-                index: i,
-                id: file.curves[i].id.clone(),
+                index,
+                id: records[index].id.clone(),
                 source: error,
-            }),
-            Err(Failed::Limit(_) | Failed::Stopped) => Err(Error::Inconsistent(
-                "a curve was stopped by the job's point limit, but no curve passed it".into(),
-            )),
-        })
-        .collect()
+            })),
+        },
+    );
+    ran.map_err(|e| match e {
+        BatchError::TooManyPoints {
+            limit,
+            reached,
+            index,
+        } => E::from(Error::TooManyPoints {
+            file: file_path(),
+            limit,
+            reached,
+            index,
+            id: records[index].id.clone(),
+        }),
+        BatchError::Sink { source, .. } => source,
+    })
 }
 
 /// The `kerf.toolpath/1` document of `discs` (positions only, no normals): one path per

@@ -54,8 +54,9 @@ mod view;
 
 pub use certify::CertifiedToolpath;
 pub use discretize::{
-    beyond_run_tolerance, discretize_curves, discretize_curves_within, orient_curves,
-    toolpath_of_points, toolpath_of_poses, DEFAULT_MAX_TOTAL_POINTS,
+    beyond_run_tolerance, curves_batch, discretize_batch, discretize_curves,
+    discretize_curves_within, orient_curves, toolpath_of_points, toolpath_of_poses,
+    DEFAULT_MAX_TOTAL_POINTS,
 };
 pub use error::{Error, Result};
 pub use job::{

@@ -29,15 +29,13 @@
 //! # Ok::<(), kerf_nurbs::NurbsError>(())
 //! ```
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
-
 use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::basis::binomial;
 use crate::bezier::RationalBezier;
 use crate::curve::{project, NurbsCurve};
 use crate::knots;
+use crate::queue::BestFirst;
 use crate::{MAX_DEGREE, MAX_ORDER};
 
 /// Result of projecting a point onto a curve.
@@ -70,34 +68,8 @@ const G_LEN: usize = 3 * MAX_DEGREE;
 
 /// A Bezier piece waiting in the best-first queue.
 struct Pending {
-    lower_bound: f64,
-    order: u64,
     depth: u32,
     piece: RationalBezier,
-}
-
-impl PartialEq for Pending {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-
-impl Eq for Pending {}
-
-impl PartialOrd for Pending {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Pending {
-    /// Reversed, so that the max-heap pops the smallest lower bound (then the oldest entry).
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .lower_bound
-            .total_cmp(&self.lower_bound)
-            .then(other.order.cmp(&self.order))
-    }
 }
 
 /// The best candidate so far.
@@ -168,22 +140,19 @@ impl NurbsCurve {
                 t1
             }
         };
-        let mut heap = BinaryHeap::new();
-        let mut order = 0u64;
+        let mut heap = BestFirst::new();
         self.for_each_bezier_piece(a, b, |piece| {
-            heap.push(Pending {
-                lower_bound: box_distance(piece, p),
-                order,
+            let pending = Pending {
                 depth: 0,
                 piece: *piece,
-            });
-            order += 1;
+            };
+            heap.push(box_distance(piece, p), pending);
         });
         // Work budget: a fixed number of pieces examined per Bezier piece of the curve, so that
         // no input (however many near-equal candidates it has) makes the search exponential.
         let mut budget = CLOSEST_POPS_PER_PIECE * heap.len() + 256;
-        while let Some(entry) = heap.pop() {
-            if entry.lower_bound >= best.distance || entry.lower_bound.is_nan() {
+        while let Some((lower_bound, entry)) = heap.pop() {
+            if lower_bound >= best.distance || lower_bound.is_nan() {
                 break;
             }
             if budget == 0 {
@@ -222,13 +191,11 @@ impl NurbsCurve {
                     for half in [left, right] {
                         let lower_bound = box_distance(&half, p);
                         if lower_bound < best.distance {
-                            heap.push(Pending {
-                                lower_bound,
-                                order,
+                            let pending = Pending {
                                 depth: entry.depth + 1,
                                 piece: half,
-                            });
-                            order += 1;
+                            };
+                            heap.push(lower_bound, pending);
                         }
                     }
                 }
@@ -442,10 +409,7 @@ pub(crate) fn hull_box_distance(net: &[Vector4<f64>], p: &Point3<f64>) -> f64 {
         lo = lo.inf(&x);
         hi = hi.sup(&x);
     }
-    (lo - p.coords)
-        .sup(&(p.coords - hi))
-        .sup(&Vector3::zeros())
-        .norm()
+    crate::distance_to_box(p, &lo.into(), &hi.into())
 }
 
 /// Row `n` of Pascal's triangle, `C(n, 0..=n)`.

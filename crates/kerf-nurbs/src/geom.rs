@@ -1,6 +1,7 @@
 //! Point-to-segment distance: the one implementation every kerf crate calls (the discretizer's
 //! certified bound, the arc fitter, the linearization error of the kinematics, the checker's
-//! dense sampling, the cut-order geometry of the process crate).
+//! dense sampling, the cut-order geometry of the process crate); and the point-to-box
+//! distance ([`distance_to_box`]), the lower bound of every bounding-box search.
 //!
 //! The nearest point of the segment `a + s (b - a)`, `s` in `[0, 1]`, to `q` is at
 //! `s = clamp((q - a).(b - a) / |b - a|^2, 0, 1)`; a segment of zero length (or one whose
@@ -8,7 +9,7 @@
 //! `q - a` is formed once and the distance taken as `|(q - a) - s (b - a)|`, so a point on the
 //! segment gives exactly 0 at its ends.
 
-use nalgebra::{Point3, SVector};
+use nalgebra::{Point3, SVector, Vector3};
 
 /// A segment from `start` to `start + direction` in `D` dimensions, prepared for many distance
 /// queries (its squared length is computed once).
@@ -119,10 +120,31 @@ pub fn nearest_on_segment(q: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> 
     Segment::between(a, b).nearest(&q.coords)
 }
 
+/// The distance from `p` to the axis-aligned box with corners `lo <= hi` (0 inside or on it):
+/// the length of `max(lo - p, p - hi, 0)` taken per coordinate. A lower bound on the distance
+/// from `p` to anything inside the box (the convex hull of a NURBS piece's control points, a
+/// bounding-volume node, a face's vertices).
+#[inline]
+pub fn distance_to_box(p: &Point3<f64>, lo: &Point3<f64>, hi: &Point3<f64>) -> f64 {
+    Vector3::from_fn(|k, _| (lo[k] - p[k]).max(p[k] - hi[k]).max(0.0)).norm()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Vector3;
+
+    /// The box distance against the distances it must be: 0 inside and on the faces, the
+    /// distance to a face, an edge (a hypotenuse) and a corner (a 3D diagonal) outside.
+    #[test]
+    fn distance_to_box_is_zero_inside_and_the_nearest_face_edge_or_corner_outside() {
+        let (lo, hi) = (Point3::new(0.0, 0.0, 0.0), Point3::new(2.0, 3.0, 4.0));
+        let d = |x: f64, y: f64, z: f64| distance_to_box(&Point3::new(x, y, z), &lo, &hi);
+        assert_eq!(d(1.0, 1.0, 1.0), 0.0, "inside");
+        assert_eq!(d(2.0, 3.0, 0.0), 0.0, "on a corner");
+        assert_eq!(d(1.0, 1.0, 7.0), 3.0, "above a face");
+        assert_eq!(d(-3.0, 7.0, 2.0), 5.0, "beside an edge: 3-4-5");
+        assert_eq!(d(4.0, 6.0, 10.0), 7.0, "off a corner: 2-3-6-7");
+    }
 
     /// `distance_upper` (reciprocal) against the analytic distance: on a segment along x, the
     /// distance of `(x, y, z)` is `hypot(y, z)` beside it and the distance to the nearer end

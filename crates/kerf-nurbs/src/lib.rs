@@ -34,6 +34,7 @@ mod geom;
 mod knots;
 mod local;
 mod param;
+mod queue;
 #[cfg(feature = "samples")]
 mod samples;
 mod shapes;
@@ -52,7 +53,7 @@ pub use curve::{
     FrenetFrame, NurbsCurve, MIN_NORMALISED_WEIGHT,
 };
 pub use error::{NurbsError, Readable, Result};
-pub use geom::{distance_to_segment, nearest_on_segment, Segment};
+pub use geom::{distance_to_box, distance_to_segment, nearest_on_segment, Segment};
 pub use knots::{find_span, interior_knots, multiplicity, validate as validate_knots};
 pub use local::{is_power_of_two, LocalCurve};
 pub use param::CurvePoint;

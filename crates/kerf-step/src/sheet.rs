@@ -13,7 +13,7 @@
 
 use std::collections::HashMap;
 
-use kerf_nurbs::{NurbsCurve, NurbsSurface};
+use kerf_nurbs::{distance_to_box, NurbsCurve, NurbsSurface};
 use nalgebra::{Point3, Vector3};
 
 use crate::shape::Face;
@@ -291,7 +291,7 @@ pub(crate) fn recognise<E>(
                 let mut order: Vec<(f64, usize)> = boxes
                     .iter()
                     .enumerate()
-                    .map(|(i, (lo, hi))| (box_distance(&p, lo, hi), i))
+                    .map(|(i, (lo, hi))| (distance_to_box(&p, lo, hi), i))
                     .collect();
                 order.sort_by(|x, y| x.0.total_cmp(&y.0));
                 for (gap, i) in order {
@@ -367,7 +367,7 @@ pub(crate) fn recognise<E>(
                 let q = p - n * t;
                 let mut best = f64::INFINITY;
                 for (c, lo, hi) in &twin_edges {
-                    if box_distance(&q, lo, hi) <= slack {
+                    if distance_to_box(&q, lo, hi) <= slack {
                         best = best.min(c.closest_point(&q).distance);
                         if best <= slack {
                             break;
@@ -491,12 +491,6 @@ fn curve_box(c: &NurbsCurve) -> (Point3<f64>, Point3<f64>) {
         }
     }
     (lo, hi)
-}
-
-/// The distance from `p` to the box `lo hi` (0 inside).
-fn box_distance(p: &Point3<f64>, lo: &Point3<f64>, hi: &Point3<f64>) -> f64 {
-    let d = Vector3::from_fn(|i, _| (lo[i] - p[i]).max(p[i] - hi[i]).max(0.0));
-    d.norm()
 }
 
 /// Chains the side's sharp edges into closed loops: each edge is followed by the unused edge

@@ -1,9 +1,6 @@
 //! Closest point on a surface: a global branch-and-bound over Bezier sub-patches (net boxes
 //! as lower bounds), a warm-started walking Newton, and the edge and corner minima.
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
-
 use nalgebra::{Point3, Vector3, Vector4};
 
 use super::net::{simple_net, split_net, stationarity_sign, Edge, Span};
@@ -14,6 +11,7 @@ use super::{
 use crate::closest::{float_before, hull_box_distance};
 use crate::curve::{project, NurbsCurve};
 use crate::knots;
+use crate::queue::BestFirst;
 use crate::MAX_ORDER;
 
 /// A candidate closest point.
@@ -43,10 +41,6 @@ pub(super) struct Patch {
 /// A sub-patch of a cell in the global closest-point search.
 #[derive(Debug, Clone)]
 pub(super) struct SubPatch {
-    /// Distance from the query point to the bounding box of the sub-patch's net.
-    lower_bound: f64,
-    /// Creation order, for deterministic ties.
-    order: u64,
     /// Number of halvings from the cell.
     depth: u32,
     /// The cell: indices into the lists of non-empty spans.
@@ -55,30 +49,6 @@ pub(super) struct SubPatch {
     rect: (f64, f64, f64, f64),
     /// Rational Bezier net, `(degree_u + 1) x (degree_v + 1)`, row-major over u.
     net: Vec<Vector4<f64>>,
-}
-
-impl PartialEq for SubPatch {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-
-impl Eq for SubPatch {}
-
-impl PartialOrd for SubPatch {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for SubPatch {
-    /// Reversed, so that the max-heap pops the smallest lower bound (then the oldest entry).
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .lower_bound
-            .total_cmp(&self.lower_bound)
-            .then(other.order.cmp(&self.order))
-    }
 }
 
 impl NurbsSurface {
@@ -325,8 +295,7 @@ impl NurbsSurface {
         mut best: Candidate,
     ) -> Candidate {
         let (deg_u, deg_v) = (self.degree_u, self.degree_v);
-        let mut heap = BinaryHeap::new();
-        let mut order = 0u64;
+        let mut heap = BestFirst::new();
         let mut net = [[Vector4::zeros(); MAX_ORDER]; MAX_ORDER];
         for iu in 0..spans_u.len() {
             for iv in 0..spans_v.len() {
@@ -337,17 +306,16 @@ impl NurbsSurface {
                     .flat_map(|row| row.iter().take(deg_v + 1).copied())
                     .collect();
                 let cell = self.patch(spans_u, spans_v, iu, iv);
+                // The distance from the query point to the bounding box of the sub-patch's net.
+                let lower_bound = hull_box_distance(&flat, p);
                 let sub = SubPatch {
-                    lower_bound: hull_box_distance(&flat, p),
-                    order,
                     depth: 0,
                     cell: (iu, iv),
                     rect: (cell.u0, cell.u1, cell.v0, cell.v1),
                     net: flat,
                 };
                 self.offer_corners(p, &cell, &sub, &mut best);
-                heap.push(sub);
-                order += 1;
+                heap.push(lower_bound, sub);
             }
         }
         // Distances closer than rounding cannot be told apart: a sub-patch whose lower bound is
@@ -356,8 +324,8 @@ impl NurbsSurface {
         let slack =
             16.0 * f64::EPSILON * lo.coords.amax().max(hi.coords.amax()).max(p.coords.amax());
         let mut budget = SUBPATCH_BUDGET;
-        while let Some(sub) = heap.pop() {
-            if sub.lower_bound >= best.distance - slack || sub.lower_bound.is_nan() {
+        while let Some((lower_bound, sub)) = heap.pop() {
+            if lower_bound >= best.distance - slack || lower_bound.is_nan() {
                 break;
             }
             let cell = self.patch(spans_u, spans_v, sub.cell.0, sub.cell.1);
@@ -399,18 +367,16 @@ impl NurbsSurface {
             for (half, (a, b)) in [(left, (u0, um)), (right, (um, u1))] {
                 let (low, high) = split_net(&half, deg_u, deg_v, false);
                 for (quarter, (c, d)) in [(low, (v0, vm)), (high, (vm, v1))] {
+                    let lower_bound = hull_box_distance(&quarter, p);
                     let child = SubPatch {
-                        lower_bound: hull_box_distance(&quarter, p),
-                        order,
                         depth: sub.depth + 1,
                         cell: sub.cell,
                         rect: (a, b, c, d),
                         net: quarter,
                     };
-                    order += 1;
                     self.offer_corners(p, &cell, &child, &mut best);
-                    if child.lower_bound < best.distance - slack {
-                        heap.push(child);
+                    if lower_bound < best.distance - slack {
+                        heap.push(lower_bound, child);
                     }
                 }
             }

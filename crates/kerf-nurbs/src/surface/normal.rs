@@ -149,42 +149,19 @@ impl NurbsSurface {
         sign: f64,
     ) -> Option<Vector3<f64>> {
         const K: usize = TAYLOR_ORDER + 2;
+        // The k-th coefficient is sum_i C(k, i) X_i x Y_(k-i), X_i and Y_j the derivatives of
+        // Su and Sv along the line (with their rounding bounds).
         if along_u {
             let mut s = [[Vector3::zeros(); 2]; K];
             let mut b = [[0.0; 2]; K];
             self.derivs(u, v, &mut s, Some(&mut b));
-            for k in 0..=TAYLOR_ORDER {
-                let mut t = Vector3::zeros();
-                let mut noise = 0.0;
-                for i in 0..=k {
-                    let c = binomial(k, i);
-                    let (x, y) = (s[i + 1][0], s[k - i][1]);
-                    t += x.cross(&y) * c;
-                    noise += c * (b[i + 1][0] * y.norm() + x.norm() * b[k - i][1]);
-                }
-                if t.norm() > NOISE * noise && t.norm().is_finite() {
-                    return Some(t.normalize() * sign.powi(k as i32));
-                }
-            }
+            first_taylor_term(|i| (s[i + 1][0], b[i + 1][0]), |j| (s[j][1], b[j][1]), sign)
         } else {
             let mut s = [[Vector3::zeros(); K]; 2];
             let mut b = [[0.0; K]; 2];
             self.derivs(u, v, &mut s, Some(&mut b));
-            for k in 0..=TAYLOR_ORDER {
-                let mut t = Vector3::zeros();
-                let mut noise = 0.0;
-                for i in 0..=k {
-                    let c = binomial(k, i);
-                    let (x, y) = (s[1][i], s[0][k - i + 1]);
-                    t += x.cross(&y) * c;
-                    noise += c * (b[1][i] * y.norm() + x.norm() * b[0][k - i + 1]);
-                }
-                if t.norm() > NOISE * noise && t.norm().is_finite() {
-                    return Some(t.normalize() * sign.powi(k as i32));
-                }
-            }
+            first_taylor_term(|i| (s[1][i], b[1][i]), |j| (s[0][j + 1], b[0][j + 1]), sign)
         }
-        None
     }
 
     /// The homogeneous control points `Q_j = sum_i N_i(t) P_ij` of the boundary curve at
@@ -246,4 +223,30 @@ impl NurbsSurface {
         let closed = [same(&edges[0], &edges[1]), same(&edges[2], &edges[3])];
         (collapsed, closed)
     }
+}
+
+/// The unit direction of the first Taylor coefficient of `Su x Sv` along a parameter line that
+/// stands above its rounding noise, turned by `sign^k`: the k-th coefficient is
+/// `sum_i C(k, i) X_i x Y_(k-i)` with `(X_i, bound)` = `x(i)` and `(Y_j, bound)` = `y(j)`, and its
+/// noise `sum_i C(k, i) (|Y| b_X + |X| b_Y)`. `None` when every coefficient up to
+/// `TAYLOR_ORDER` vanishes within its noise.
+fn first_taylor_term(
+    x: impl Fn(usize) -> (Vector3<f64>, f64),
+    y: impl Fn(usize) -> (Vector3<f64>, f64),
+    sign: f64,
+) -> Option<Vector3<f64>> {
+    for k in 0..=TAYLOR_ORDER {
+        let mut t = Vector3::zeros();
+        let mut noise = 0.0;
+        for i in 0..=k {
+            let c = binomial(k, i);
+            let ((x, bx), (y, by)) = (x(i), y(k - i));
+            t += x.cross(&y) * c;
+            noise += c * (bx * y.norm() + x.norm() * by);
+        }
+        if t.norm() > NOISE * noise && t.norm().is_finite() {
+            return Some(t.normalize() * sign.powi(k as i32));
+        }
+    }
+    None
 }

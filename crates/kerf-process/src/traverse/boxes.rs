@@ -7,7 +7,7 @@
 
 use nalgebra::Point3;
 
-use super::tessellated::box_distance;
+use kerf_nurbs::distance_to_box;
 
 /// Boxes per leaf.
 const LEAF: usize = 4;
@@ -83,52 +83,45 @@ impl BoxTree {
         at
     }
 
-    /// Calls `found(i, g)` for every box `i` whose distance `g` from `p` ([`box_distance`]) is
+    /// Calls `found(i, g)` for every box `i` whose distance `g` from `p` ([`distance_to_box`]) is
     /// below `limit`.
     pub(super) fn within(&self, p: &Point3<f64>, limit: f64, mut found: impl FnMut(usize, f64)) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let mut stack = [0usize; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top]];
-            if box_distance(p, &node.lo, &node.hi) >= limit {
-                continue;
+        self.search(p, limit, |i, g, _| {
+            if g < limit {
+                found(i, g);
             }
-            match node.children {
-                Some((a, b)) if top + 2 <= stack.len() => {
-                    stack[top] = a;
-                    stack[top + 1] = b;
-                    top += 2;
-                }
-                _ => {
-                    for &i in &self.order[node.start..node.end] {
-                        let (lo, hi) = self.boxes[i];
-                        let g = box_distance(p, &lo, &hi);
-                        if g < limit {
-                            found(i, g);
-                        }
-                    }
-                }
-            }
-        }
+        });
     }
 
     /// The least distance from `p` of the boxes at least `limit` away, where it is below
     /// `bound`; otherwise `bound` (or more).
     pub(super) fn nearest_beyond(&self, p: &Point3<f64>, limit: f64, bound: f64) -> f64 {
-        let mut best = bound;
+        self.search(p, bound, |_, g, best| {
+            if g >= limit {
+                *best = best.min(g);
+            }
+        })
+    }
+
+    /// The tree's walk: every node nearer `p` than `bound` is opened, and at a leaf `leaf(i,
+    /// g, &mut bound)` is called for each of its boxes `i` (`g` its distance from `p`), which
+    /// may lower the bound the rest of the walk prunes with; returns the final bound. Depth
+    /// first on a fixed stack of 64 (a deeper node is searched as a leaf).
+    fn search(
+        &self,
+        p: &Point3<f64>,
+        mut bound: f64,
+        mut leaf: impl FnMut(usize, f64, &mut f64),
+    ) -> f64 {
         if self.nodes.is_empty() {
-            return best;
+            return bound;
         }
         let mut stack = [0usize; 64];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top]];
-            if box_distance(p, &node.lo, &node.hi) >= best {
+            if distance_to_box(p, &node.lo, &node.hi) >= bound {
                 continue;
             }
             match node.children {
@@ -140,15 +133,12 @@ impl BoxTree {
                 _ => {
                     for &i in &self.order[node.start..node.end] {
                         let (lo, hi) = self.boxes[i];
-                        let g = box_distance(p, &lo, &hi);
-                        if g >= limit {
-                            best = best.min(g);
-                        }
+                        leaf(i, distance_to_box(p, &lo, &hi), &mut bound);
                     }
                 }
             }
         }
-        best
+        bound
     }
 }
 
@@ -185,14 +175,14 @@ mod tests {
                     let scan: Vec<(usize, u64)> = boxes
                         .iter()
                         .enumerate()
-                        .map(|(i, (lo, hi))| (i, box_distance(&p, lo, hi)))
+                        .map(|(i, (lo, hi))| (i, distance_to_box(&p, lo, hi)))
                         .filter(|&(_, g)| g < limit)
                         .map(|(i, g)| (i, g.to_bits()))
                         .collect();
                     assert_eq!(found, scan, "{n} {p} {limit}");
                     let beyond = boxes
                         .iter()
-                        .map(|(lo, hi)| box_distance(&p, lo, hi))
+                        .map(|(lo, hi)| distance_to_box(&p, lo, hi))
                         .filter(|&g| g >= limit)
                         .fold(f64::INFINITY, f64::min);
                     let tree_beyond = tree.nearest_beyond(&p, limit, f64::INFINITY);

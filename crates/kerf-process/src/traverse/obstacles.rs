@@ -7,8 +7,9 @@ use parry3d_f64::shape::{TriMesh, TriMeshFlags};
 use kerf_nurbs::NurbsSurface;
 
 use super::boxes::BoxTree;
-use super::tessellated::{box_distance, Tessellated};
+use super::tessellated::Tessellated;
 use crate::{ProcessError, Result};
+use kerf_nurbs::distance_to_box;
 
 /// One surface of the part, placed in the workpiece frame.
 #[derive(Debug)]
@@ -172,7 +173,7 @@ impl Obstacles {
         for (i, item) in self.items.iter().enumerate() {
             for b in boundary_points(&item.shape) {
                 for (j, other) in self.items.iter().enumerate() {
-                    if j == i || box_distance(&b, &other.lo, &other.hi) > tolerance_mm {
+                    if j == i || distance_to_box(&b, &other.lo, &other.hi) > tolerance_mm {
                         continue;
                     }
                     let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
@@ -219,7 +220,7 @@ impl Obstacles {
             .filter(|i| {
                 (0..=k).any(|j| {
                     let p = a + (b - a) * (j as f64 / k as f64);
-                    box_distance(&p, &i.lo, &i.hi) < distance_mm
+                    distance_to_box(&p, &i.lo, &i.hi) < distance_mm
                         && shape_distance(&i.shape, &p) < distance_mm
                 })
             })
@@ -232,7 +233,7 @@ impl Obstacles {
     pub fn touching(&self, p: &Point3<f64>, tolerance_mm: f64) -> Vec<String> {
         self.items
             .iter()
-            .filter(|i| box_distance(p, &i.lo, &i.hi) <= tolerance_mm)
+            .filter(|i| distance_to_box(p, &i.lo, &i.hi) <= tolerance_mm)
             .filter(|i| shape_distance(&i.shape, p) <= tolerance_mm)
             .map(|i| i.id.clone())
             .collect()
@@ -587,7 +588,7 @@ impl Obstacles {
         let mut best = f64::INFINITY;
         let mut floor = f64::INFINITY;
         for item in &self.items {
-            let gap = box_distance(p, &item.lo, &item.hi);
+            let gap = distance_to_box(p, &item.lo, &item.hi);
             let below = limit.min(best);
             if gap >= below {
                 floor = floor.min(gap);

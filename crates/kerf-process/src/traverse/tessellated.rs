@@ -1,11 +1,11 @@
 //! A NURBS surface's tessellation and the proven boxes of its pieces: the fast lower bound
 //! and the exact distance of one surface.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 use parry3d_f64::query::{PointQuery, PointQueryWithLocation};
 use parry3d_f64::shape::{TriMesh, TriMeshFlags};
 
-use kerf_nurbs::NurbsSurface;
+use kerf_nurbs::{distance_to_box, NurbsSurface};
 
 /// A NURBS surface with a triangle mesh through points of it: the mesh finds, fast, which
 /// surfaces are far (its distance less the estimated deviation `sag`) and where on the surface
@@ -199,13 +199,13 @@ impl Tessellated {
     fn lower_bound(&self, p: &Point3<f64>, enough: f64) -> f64 {
         let mut best = f64::INFINITY;
         for s in &self.strips {
-            let d = box_distance(p, &s.lo, &s.hi);
+            let d = distance_to_box(p, &s.lo, &s.hi);
             if d >= best || d >= enough {
                 best = best.min(d);
                 continue;
             }
             for (lo, hi) in &s.cells {
-                best = best.min(box_distance(p, lo, hi));
+                best = best.min(distance_to_box(p, lo, hi));
             }
         }
         best
@@ -238,7 +238,7 @@ impl Tessellated {
         let mut ds = [0.0_f64; NEAREST_STRIPS];
         let mut first = 0;
         for (k, s) in self.strips.iter().enumerate() {
-            ds[k] = box_distance(p, &s.lo, &s.hi);
+            ds[k] = distance_to_box(p, &s.lo, &s.hi);
             if ds[k] < ds[first] {
                 first = k;
             }
@@ -247,7 +247,7 @@ impl Tessellated {
             self.strips[k]
                 .cells
                 .iter()
-                .fold(best, |b, (lo, hi)| b.min(box_distance(p, lo, hi)))
+                .fold(best, |b, (lo, hi)| b.min(distance_to_box(p, lo, hi)))
         };
         let mut best = f64::INFINITY;
         if n > 0 && ds[first] < enough {
@@ -286,14 +286,10 @@ impl Tessellated {
     }
 }
 
-pub(super) fn box_distance(p: &Point3<f64>, lo: &Point3<f64>, hi: &Point3<f64>) -> f64 {
-    let d = Vector3::from_fn(|k, _| (lo[k] - p[k]).max(p[k] - hi[k]).max(0.0));
-    d.norm()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector3;
 
     /// The proven lower bound never exceeds the exact distance (a sphere and a cylinder,
     /// distances known in closed form), and the far skip returns it only above the limit.

@@ -115,7 +115,14 @@ fn discretize_to_file(
 pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let path = args.curves.as_path();
-    let dest = args.output.clone().unwrap_or_else(|| default_output(path));
+    // Standard input goes to standard output.
+    let dest = args
+        .output
+        .clone()
+        .unwrap_or_else(|| match path == Path::new("-") {
+            true => "-".into(),
+            false => crate::input::default_output(path, "curves", "", ".toolpath.json"),
+        });
     crate::guard::refuse_overwrite("--output", &dest, &[path])?;
     let file = load_curves(path)?;
     let opts = options(args);
@@ -185,12 +192,7 @@ pub(crate) fn run(args: &DiscretizeArgs) -> Result<(), CliError> {
             "max_surface_distance": surface_dist,
             "normal_jumps": jumps,
         });
-        // The summary goes to standard output unless the toolpath itself does.
-        if dest == Path::new("-") {
-            eprintln!("{summary}");
-        } else {
-            println!("{summary}");
-        }
+        crate::input::print_summary(&summary, Some(&dest));
     } else if !args.quiet {
         if args.normals {
             eprintln!(
@@ -224,17 +226,4 @@ fn n_star_text(segments: usize, nstar: f64) -> String {
     } else {
         format!("N* {nstar:.1} (no curvature measured, so no segments / N* ratio)")
     }
-}
-
-/// `dir/part.json` -> `part.toolpath.json` in the current directory (the input's folder may be
-/// read-only).
-fn default_output(input: &Path) -> std::path::PathBuf {
-    if input == Path::new("-") {
-        return "-".into();
-    }
-    let stem = input.file_stem().map_or_else(
-        || "curves".to_string(),
-        |s| s.to_string_lossy().into_owned(),
-    );
-    format!("{stem}.toolpath.json").into()
 }

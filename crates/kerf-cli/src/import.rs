@@ -231,13 +231,10 @@ fn sheet_json(s: Option<&kerf_step::SheetReport>) -> serde_json::Value {
 pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let (file, import) = load_step(&args.step, &args.step_args)?;
-    let dest = args.output.clone().unwrap_or_else(|| {
-        let stem = args
-            .step
-            .file_stem()
-            .map_or_else(|| "part".to_string(), |s| s.to_string_lossy().into_owned());
-        format!("{stem}.curves.json").into()
-    });
+    let dest = args
+        .output
+        .clone()
+        .unwrap_or_else(|| crate::input::default_output(&args.step, "part", "", ".curves.json"));
     curves::write_raw(&import.file, &dest)?;
     let r = &import.report;
     if args.json {
@@ -261,11 +258,7 @@ pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
             "sheet": sheet_json(r.sheet.as_ref()),
             "seconds": start.elapsed().as_secs_f64(),
         });
-        if dest == Path::new("-") {
-            eprintln!("{summary}");
-        } else {
-            println!("{summary}");
-        }
+        crate::input::print_summary(&summary, Some(&dest));
     } else if !args.quiet {
         print_account(&args.step, &import.report, &file);
         eprintln!(

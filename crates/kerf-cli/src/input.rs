@@ -2,13 +2,38 @@
 //! terminal.
 
 use std::io;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use kerf_format::{curves, CurvesFile};
 use kerf_kinematics::{KinematicsError, Machine};
 use kerf_pipeline::{Progress, Stage};
 
 use crate::error::CliError;
+
+/// Prints a command's `--json` summary: on standard output, unless the command's own output
+/// `dest` goes there (`-`), then on standard error.
+pub(crate) fn print_summary(summary: &impl std::fmt::Display, dest: Option<&Path>) {
+    if dest.is_some_and(|d| d == Path::new("-")) {
+        eprintln!("{summary}");
+    } else {
+        println!("{summary}");
+    }
+}
+
+/// A command's default output, in the working directory (the input's folder may be
+/// read-only): the input's file stem (`fallback` where it has none) less a trailing `strip`,
+/// then `ext` (`dir/part.toolpath.json` to `part.axes.json` for `kerf post`).
+pub(crate) fn default_output(input: &Path, fallback: &str, strip: &str, ext: &str) -> PathBuf {
+    let stem = input.file_stem().map_or_else(
+        || fallback.to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    let stem = stem
+        .strip_suffix(strip)
+        .filter(|_| !strip.is_empty())
+        .unwrap_or(&stem);
+    format!("{stem}{ext}").into()
+}
 
 /// Loads a curves file, or standard input for `-`, and prints its near-miss keys as warnings
 /// ([`warn_unknown_keys`]).

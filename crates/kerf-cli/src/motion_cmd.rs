@@ -54,12 +54,7 @@ fn summary(args: &MotionArgs, p: &Program, out: Option<&PathBuf>, json: bool, qu
                 "paths": path_report(&p.motion, &p.ids),
                 "output": out.map(|o| o.display().to_string()),
         });
-        // The summary goes to standard output unless the program or CSV itself does.
-        if out.is_some_and(|o| o == Path::new("-")) {
-            eprintln!("{text}");
-        } else {
-            println!("{text}");
-        }
+        crate::input::print_summary(&text, out.map(PathBuf::as_path));
     } else if !quiet {
         eprintln!(
             "{}: {} lines, {} arcs, {} turns; {} cycles of {} s = {:.3} s of motion, {:.1} % of the cutting time at the programmed feed{}",

@@ -41,13 +41,10 @@ pub(crate) struct PlotArgs {
 
 /// Runs `kerf plot`.
 pub(crate) fn run(args: &PlotArgs) -> Result<(), CliError> {
-    let dest = args.output.clone().unwrap_or_else(|| {
-        let stem = args
-            .toolpath
-            .file_stem()
-            .map_or_else(|| "toolpath".into(), |s| s.to_string_lossy().into_owned());
-        format!("{stem}.svg").into()
-    });
+    let dest = args
+        .output
+        .clone()
+        .unwrap_or_else(|| crate::input::default_output(&args.toolpath, "toolpath", "", ".svg"));
     let mut inputs = vec![args.curves.as_path(), args.toolpath.as_path()];
     inputs.extend(args.axes.as_deref());
     inputs.extend(args.machine.as_deref());

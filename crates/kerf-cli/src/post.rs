@@ -2,7 +2,6 @@
 //! `[x, y, z, i, j, k]` points), written as `kerf.axes/1`: argument parsing and printing over
 //! [`kerf_pipeline::post_toolpath`].
 
-use std::path::Path;
 use std::time::Instant;
 
 use kerf_format::toolpath;
@@ -31,10 +30,9 @@ pub(crate) fn options(args: &PostArgs) -> PathOptions {
 /// Runs `kerf post`.
 pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
     let start = Instant::now();
-    let dest = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&args.toolpath));
+    let dest = args.output.clone().unwrap_or_else(|| {
+        crate::input::default_output(&args.toolpath, "toolpath", ".toolpath", ".axes.json")
+    });
     crate::guard::refuse_overwrite("--output", &dest, &[&args.toolpath, &args.machine])?;
     let machine = crate::input::load_machine(&args.machine)?;
     let tp = toolpath::load(&args.toolpath)?;
@@ -79,11 +77,7 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
             "placement": placed.report(&ids),
             "seconds": elapsed,
         });
-        if dest == Path::new("-") {
-            eprintln!("{summary}");
-        } else {
-            println!("{summary}");
-        }
+        crate::input::print_summary(&summary, Some(&dest));
     } else if !args.quiet {
         eprintln!(
             "{}: {} paths on {:?}, {points} poses ({inserted} inserted), largest rotary step \
@@ -102,14 +96,4 @@ pub(crate) fn run(args: &PostArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
-}
-
-/// `dir/part.toolpath.json` -> `part.axes.json` in the current directory.
-fn default_output(input: &Path) -> std::path::PathBuf {
-    let stem = input.file_stem().map_or_else(
-        || "toolpath".to_string(),
-        |s| s.to_string_lossy().into_owned(),
-    );
-    let stem = stem.strip_suffix(".toolpath").unwrap_or(&stem).to_string();
-    format!("{stem}.axes.json").into()
 }

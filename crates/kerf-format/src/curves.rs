@@ -42,8 +42,9 @@ use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
-use crate::error::{json_type_name, FormatError, MeshDefect, Result};
+use crate::error::{FormatError, MeshDefect, Result};
 use crate::{json, stl, Units, CURVES_FORMAT};
+use kerf_io::json_type_name;
 
 mod keys;
 

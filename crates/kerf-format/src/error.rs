@@ -441,19 +441,6 @@ fn describe_ids(ids: &[String]) -> String {
     s
 }
 
-/// Formats a JSON value's type for messages: `an array`, `a string`, ...
-pub(crate) fn json_type_name(value: &serde_json::Value) -> &'static str {
-    use serde_json::Value;
-    match value {
-        Value::Null => "null",
-        Value::Bool(_) => "a boolean",
-        Value::Number(_) => "a number",
-        Value::String(_) => "a string",
-        Value::Array(_) => "an array",
-        Value::Object(_) => "an object",
-    }
-}
-
 /// What [`FormatError::PointCurve`] says of a curve that `curves::is_a_point` finds: the same words for a
 /// file and for a curve built in code (`kerf_pipeline::Job::validate`).
 pub const POINT_CURVE: &str = "all control points coincide: a point, not a contour";

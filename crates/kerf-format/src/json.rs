@@ -23,8 +23,9 @@ use serde_json::{Map, Value};
 
 use kerf_io::JsonError;
 
-use crate::error::{json_type_name, FormatError, Result};
+use crate::error::{FormatError, Result};
 use crate::Units;
+use kerf_io::json_type_name;
 
 /// Reads a whole file, at most [`kerf_io::MAX_INPUT_BYTES`].
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {

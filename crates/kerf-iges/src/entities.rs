@@ -204,6 +204,33 @@ impl<'a> Reader<'a> {
             })
     }
 
+    /// [`Reader::get`], refused unless the entity is of type `ty`: `{what} D12 is a 110
+    /// (line), not a 124`.
+    ///
+    /// # Errors
+    /// As [`Reader::get`], and [`IgesError`] at `from` for another type.
+    pub(crate) fn get_typed(
+        &self,
+        from: &Entry,
+        de: i64,
+        what: &str,
+        ty: i64,
+    ) -> Result<&'a Entry> {
+        let e = self.get(from, de, what)?;
+        if e.ty != ty {
+            return Err(err(
+                from,
+                format!(
+                    "{what} D{} is a {} ({}), not a {ty}",
+                    e.de,
+                    e.ty,
+                    kind_name(e.ty)
+                ),
+            ));
+        }
+        Ok(e)
+    }
+
     /// The entity's own transformation (its matrix, chained through the matrices' own).
     fn transform(&self, e: &Entry) -> Result<Affine> {
         let mut out = Affine::identity();
@@ -213,18 +240,7 @@ impl<'a> Reader<'a> {
             if ptr == 0 {
                 return Ok(out);
             }
-            let m = self.get(from, ptr, "its transformation matrix")?;
-            if m.ty != 124 {
-                return Err(err(
-                    from,
-                    format!(
-                        "its transformation matrix D{} is a {} ({}), not a 124",
-                        m.de,
-                        m.ty,
-                        kind_name(m.ty)
-                    ),
-                ));
-            }
+            let m = self.get_typed(from, ptr, "its transformation matrix", 124)?;
             let v = reals(m, 0, 12, "matrix")?;
             let a = Affine {
                 r: Matrix3::new(v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10]),
@@ -572,13 +588,7 @@ impl<'a> Reader<'a> {
                 // Location point (116) and normal (123); form 1 adds the reference direction
                 // (x) of its parametrization.
                 let xyz = |what: &str, i: usize, ty: i64| -> Result<Vector3<f64>> {
-                    let p = self.get(e, int(e, i, what)?, &format!("its {what}"))?;
-                    if p.ty != ty {
-                        return Err(err(
-                            e,
-                            format!("its {what} D{} is a {} ({}), not a {ty}", p.de, p.ty, kind_name(p.ty)),
-                        ));
-                    }
+                    let p = self.get_typed(e, int(e, i, what)?, &format!("its {what}"), ty)?;
                     let v = reals(p, 0, 3, what)?;
                     Ok(Vector3::new(v[0], v[1], v[2]))
                 };

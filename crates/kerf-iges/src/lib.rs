@@ -665,18 +665,7 @@ fn boundary(
     de: i64,
     what: &str,
 ) -> Result<(Vec<NurbsCurve>, Vec<u64>)> {
-    let b = reader.get(face, de, &format!("its {what}"))?;
-    if b.ty != 142 {
-        return Err(err(
-            face,
-            format!(
-                "its {what} D{} is a {} ({}), not a 142",
-                b.de,
-                b.ty,
-                kind_name(b.ty)
-            ),
-        ));
-    }
+    let b = reader.get_typed(face, de, &format!("its {what}"), 142)?;
     let c = int(b, 3, "model-space curve")?;
     if c == 0 {
         return Err(err(

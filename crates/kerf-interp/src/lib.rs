@@ -71,7 +71,7 @@ pub use error::{InterpError, Result};
 pub use fit::{fit_blocks, BlockCounts, CurveFn, FitOptions};
 pub use geometry::SpaceArc;
 pub use machine::{stations_from_axes, stations_from_solved, MachineModel};
-pub use model::{AxisLimits, AxisModel, PaperAcHead};
+pub use model::{AxisLimits, AxisModel, PaperAcHead, RANGE_SLACK};
 pub use output::{comment_text, write_atomic, MAX_COMMENT};
 
 /// The default controller-blending term (the planner's and the G-code writer's, so it lives

@@ -48,12 +48,6 @@ impl MachineModel {
             limits,
         })
     }
-
-    fn in_range(&self, q: &Axes) -> bool {
-        (0..5).all(|k| {
-            self.limits.range[k].is_none_or(|[lo, hi]| q[k] >= lo - 1e-9 && q[k] <= hi + 1e-9)
-        })
-    }
 }
 
 impl AxisModel for MachineModel {
@@ -98,7 +92,7 @@ impl AxisModel for MachineModel {
             k.inverse(&pose).to_vec()
         };
         let previous = Axes::new(0.0, 0.0, 0.0, prev_t, prev_c);
-        nearest_solution(candidates, &previous, |q| self.in_range(q))
+        nearest_solution(candidates, &previous, |q| self.limits.contain(q))
             .ok_or_else(|| InterpError::unreachable("no solution within the axis ranges"))
     }
 

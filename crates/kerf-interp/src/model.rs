@@ -35,7 +35,22 @@ pub struct AxisLimits {
     pub max_jerk: Option<[f64; 5]>,
 }
 
+/// The slack of [`AxisLimits::contains`]: a value this far past a range's end (mm or
+/// degrees) is still inside (a solution or set-point on the limit, rounded).
+pub const RANGE_SLACK: f64 = 1e-9;
+
 impl AxisLimits {
+    /// True when `v` lies in axis `k`'s range, [`RANGE_SLACK`] allowed past either end
+    /// (always for a continuous axis; never for NaN on a limited one).
+    pub fn contains(&self, k: usize, v: f64) -> bool {
+        self.range[k].is_none_or(|[lo, hi]| v >= lo - RANGE_SLACK && v <= hi + RANGE_SLACK)
+    }
+
+    /// True when every axis of `q` lies in its range ([`AxisLimits::contains`]).
+    pub fn contain(&self, q: &Axes) -> bool {
+        (0..5).all(|k| self.contains(k, q[k]))
+    }
+
     /// Limits from the units of `kerf.machine/1`: velocities in mm/min or deg/min (divided by
     /// 60 here), accelerations in mm/s^2 or deg/s^2.
     ///
@@ -236,13 +251,6 @@ impl PaperAcHead {
             pole_tolerance_deg: kerf_kinematics::DEFAULT_POLE_TOLERANCE_DEG,
         }
     }
-
-    fn in_range(&self, k: usize, v: f64) -> bool {
-        match self.limits.range[k] {
-            Some([lo, hi]) => v >= lo - 1e-9 && v <= hi + 1e-9,
-            None => true,
-        }
-    }
 }
 
 impl AxisModel for PaperAcHead {
@@ -289,10 +297,8 @@ impl AxisModel for PaperAcHead {
             Axes::new(x, y, z, a, c)
         });
         let previous = Axes::new(0.0, 0.0, 0.0, prev_a, prev_c);
-        nearest_solution(solutions, &previous, |q| {
-            (0..5).all(|k| self.in_range(k, q[k]))
-        })
-        .ok_or_else(|| kin("no solution within the axis ranges".into()))
+        nearest_solution(solutions, &previous, |q| self.limits.contain(q))
+            .ok_or_else(|| kin("no solution within the axis ranges".into()))
     }
 
     #[inline]

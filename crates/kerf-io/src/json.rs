@@ -10,6 +10,19 @@ use serde_json::{Map, Number, Value};
 
 use crate::read::strip_bom;
 
+/// What a JSON value is, as an error message names it: `null`, `a boolean`, `a number`, `a
+/// string`, `an array`, `an object` ("expected an object, found an array").
+pub fn json_type_name(value: &Value) -> &'static str {
+    match value {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
 /// What can be wrong with JSON text, before any format-specific check.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum JsonError {

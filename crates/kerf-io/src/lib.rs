@@ -42,7 +42,7 @@ mod shape;
 mod text;
 mod write;
 
-pub use json::{parse_json, path_at, JsonError, StrictValue};
+pub use json::{json_type_name, parse_json, path_at, JsonError, StrictValue};
 pub use keys::{near_misses_in, UnknownKey};
 pub use read::{read_file, read_regular_file, read_to_end, strip_bom, MAX_INPUT_BYTES};
 pub use shape::{deserialize_at, duplicate_key_message, JsonProblem, ShapeError};

@@ -23,7 +23,8 @@
 
 use serde_json::Value;
 
-use crate::error::{json_type_name, KinematicsError, Result};
+use crate::error::{KinematicsError, Result};
+use kerf_io::json_type_name;
 
 /// The most solids a head may list: a nozzle, a body and a few steps of it.
 pub const MAX_HEAD_SOLIDS: usize = 16;
@@ -228,17 +229,7 @@ impl Head {
                     format!("unknown key (known: {})", Self::SOLID_KEYS.join(", ")),
                 ));
             }
-            let number = |key: &str| -> Result<Option<f64>> {
-                match s.get(key) {
-                    None => Ok(None),
-                    Some(v) => v.as_f64().map(Some).ok_or_else(|| {
-                        KinematicsError::doc(
-                            format!("{path}.{key}"),
-                            format!("expected a number, found {}", json_type_name(v)),
-                        )
-                    }),
-                }
-            };
+            let number = |key: &str| crate::json::optional_number(s, &path, key);
             let needed = |key: &str| -> Result<f64> {
                 number(key)?.ok_or_else(|| KinematicsError::doc(format!("{path}.{key}"), "missing"))
             };

@@ -40,6 +40,26 @@ pub(crate) fn read_with<T>(path: &Path, parse: impl FnOnce(&[u8]) -> Result<T>) 
     })
 }
 
+/// The number at `map[key]`, `None` when the key is absent.
+///
+/// # Errors
+/// [`KinematicsError::Document`] at `{path}.{key}` for a value that is not a number.
+pub(crate) fn optional_number(
+    map: &serde_json::Map<String, Value>,
+    path: &str,
+    key: &str,
+) -> Result<Option<f64>> {
+    match map.get(key) {
+        None => Ok(None),
+        Some(v) => v.as_f64().map(Some).ok_or_else(|| {
+            KinematicsError::doc(
+                format!("{path}.{key}"),
+                format!("expected a number, found {}", kerf_io::json_type_name(v)),
+            )
+        }),
+    }
+}
+
 /// Checks that a text that may reach a program is one printable line.
 pub(crate) fn check_text(path: &str, text: &str) -> Result<()> {
     kerf_io::check_text(text).map_err(|defect| KinematicsError::doc(path, defect.to_string()))
@@ -59,7 +79,7 @@ pub(crate) fn top_object<'a>(
             "top level",
             format!(
                 "expected an object {{\"format\": \"{format}\", ...}}, found {}",
-                crate::error::json_type_name(value)
+                kerf_io::json_type_name(value)
             ),
         ));
     };

@@ -33,11 +33,12 @@ use std::sync::Arc;
 
 use serde_json::{Map, Value};
 
-use crate::error::{json_type_name, KinematicsError, Result};
+use crate::error::{KinematicsError, Result};
 use crate::head::Head;
 use crate::kinematics::Kinematics;
 use crate::pose::{Axes, Axis};
 use crate::registry;
+use kerf_io::json_type_name;
 
 /// The `format` value of a machine file.
 pub const MACHINE_FORMAT: &str = "kerf.machine/1";
@@ -396,17 +397,7 @@ impl Process {
                 .collect::<Result<Vec<_>>>()
                 .map(Some)
         };
-        let number = |key: &str| -> Result<Option<f64>> {
-            match map.get(key) {
-                None => Ok(None),
-                Some(v) => v.as_f64().map(Some).ok_or_else(|| {
-                    KinematicsError::doc(
-                        format!("process.{key}"),
-                        format!("expected a number, found {}", json_type_name(v)),
-                    )
-                }),
-            }
-        };
+        let number = |key: &str| crate::json::optional_number(map, "process", key);
         let p = Self {
             beam_on: lines("beam_on")?,
             beam_off: lines("beam_off")?,

@@ -7,8 +7,9 @@ use std::sync::Arc;
 
 use serde_json::{Map, Value};
 
-use crate::error::{json_type_name, KinematicsError, Result};
+use crate::error::{KinematicsError, Result};
 use crate::kinematics::Kinematics;
+use kerf_io::json_type_name;
 
 /// A kinematic type: its `kinematics.type` name and how to read its parameters.
 pub(crate) struct KinematicsType {

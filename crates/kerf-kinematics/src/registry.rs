@@ -7,10 +7,11 @@ use std::sync::Arc;
 
 use serde_json::Value;
 
-use crate::error::{json_type_name, KinematicsError, Result};
+use crate::error::{KinematicsError, Result};
 use crate::kinematics::Kinematics;
 use crate::params::{KinematicsType, Params};
 use crate::{ac_head, fork_head, head_table, table_table};
+use kerf_io::json_type_name;
 
 /// Every known kinematic type, in the order of `docs/formats.md`.
 pub(crate) const TYPES: &[KinematicsType] = &[

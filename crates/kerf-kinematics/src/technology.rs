@@ -22,7 +22,8 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use crate::error::{json_type_name, KinematicsError, Result};
+use crate::error::{KinematicsError, Result};
+use kerf_io::json_type_name;
 
 /// The `format` value of a technology file.
 pub const TECHNOLOGY_FORMAT: &str = "kerf.technology/1";

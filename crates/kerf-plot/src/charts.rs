@@ -149,14 +149,7 @@ pub(crate) fn draw_chord_chart(doc: &mut Doc, scene: &Scene, panel: Rect) {
         total += p.segment_errors.len();
     }
     if total == 0 {
-        doc.rect(frame.x, frame.y, frame.w, frame.h, "class=\"frame\"");
-        doc.text(
-            frame.x + frame.w / 2.0,
-            frame.y + frame.h / 2.0,
-            "no segments",
-            "class=\"note\" text-anchor=\"middle\"",
-        );
-        doc.close();
+        doc.empty_panel(frame, "no segments");
         return;
     }
     let worst = scene

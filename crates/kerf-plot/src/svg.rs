@@ -120,6 +120,18 @@ impl Doc {
         );
     }
 
+    /// An empty panel: the frame with `note` in its middle, and the panel's `<g>` closed.
+    pub(crate) fn empty_panel(&mut self, frame: crate::layout::Rect, note: &str) {
+        self.rect(frame.x, frame.y, frame.w, frame.h, "class=\"frame\"");
+        self.text(
+            frame.x + frame.w / 2.0,
+            frame.y + frame.h / 2.0,
+            note,
+            "class=\"note\" text-anchor=\"middle\"",
+        );
+        self.close();
+    }
+
     /// A rectangle.
     pub(crate) fn rect(&mut self, x: f64, y: f64, w: f64, h: f64, attrs: &str) {
         let _ = writeln!(

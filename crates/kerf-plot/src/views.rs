@@ -211,14 +211,7 @@ pub(crate) fn draw_view(doc: &mut Doc, scene: &Scene, view: View, panel: Rect, n
             .for_each(|q| grow(view.project(q)));
     }
     if !b.0.is_finite() {
-        doc.rect(frame.x, frame.y, frame.w, frame.h, "class=\"frame\"");
-        doc.text(
-            frame.x + frame.w / 2.0,
-            frame.y + frame.h / 2.0,
-            "no paths",
-            "class=\"note\" text-anchor=\"middle\"",
-        );
-        doc.close();
+        doc.empty_panel(frame, "no paths");
         return;
     }
     let fit = Fit::new(frame, b);

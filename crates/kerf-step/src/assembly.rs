@@ -154,13 +154,7 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     let mut named: Vec<u64> = Vec::new();
     // Relationships written alone (SHAPE_REPRESENTATION_RELATIONSHIP, ..._WITH_TRANSFORMATION)
     // or as one complex instance of several; each read once.
-    let mut rel_ids: Vec<u64> = Vec::new();
-    for kind in RELATIONSHIP_KINDS {
-        rel_ids.extend(m.ex.ids_of(kind));
-    }
-    rel_ids.sort_unstable();
-    rel_ids.dedup();
-    for id in rel_ids {
+    for id in m.ex.ids_of_any(&RELATIONSHIP_KINDS) {
         let Some(inst) = m.ex.get(id)? else { continue };
         // rep_1 and rep_2: parameters 3 and 4 of whichever record carries the relationship's
         // own attributes.
@@ -206,13 +200,7 @@ pub(crate) fn placements(m: &Model<'_>) -> Result<Placements> {
     if !mapped.is_empty() {
         // Which representation holds each mapped item.
         let mut holder: HashMap<u64, Vec<u64>> = HashMap::new();
-        let mut rep_ids: Vec<u64> = Vec::new();
-        for kind in REPRESENTATION_KINDS {
-            rep_ids.extend(m.ex.ids_of(kind));
-        }
-        rep_ids.sort_unstable();
-        rep_ids.dedup();
-        for r in rep_ids {
+        for r in m.ex.ids_of_any(&REPRESENTATION_KINDS) {
             let Some(rep) = m.ex.get(r)? else { continue };
             for id in items(&rep) {
                 holder.entry(id).or_default().push(rep.id);

@@ -141,11 +141,21 @@ impl<'t> Exchange<'t> {
     /// The ids of every instance that is (or, complex, contains) entity `name`, in file order;
     /// decided from the index, without parsing any instance.
     pub(crate) fn ids_of(&self, name: &str) -> Vec<u64> {
-        let hit: Vec<bool> = self
-            .kinds
-            .iter()
-            .map(|k| k.iter().any(|n| n == name))
-            .collect();
+        self.ids_where(|n| n == name)
+    }
+
+    /// The ids of the instances of any of `names` (a complex instance is one of them if any
+    /// of its records is), each once, ascending.
+    pub(crate) fn ids_of_any(&self, names: &[&str]) -> Vec<u64> {
+        let mut ids = self.ids_where(|n| names.contains(&n));
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    }
+
+    /// The ids of the instances with a record whose name `is` picks, in file order.
+    fn ids_where(&self, is: impl Fn(&str) -> bool) -> Vec<u64> {
+        let hit: Vec<bool> = self.kinds.iter().map(|k| k.iter().any(|n| is(n))).collect();
         self.slots
             .iter()
             .filter(|s| hit[s.kind as usize])

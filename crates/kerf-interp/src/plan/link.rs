@@ -2,41 +2,24 @@
 
 use kerf_kinematics::Axes;
 
-use crate::block::Block;
+use crate::block::{Block, Station};
 use crate::model::AxisModel;
 
 /// Joins the blocks of several paths into one program: between the end of one path and the
 /// start of the next, a rapid (laser-off) line, planned at the axes' own limits.
 pub fn link_paths(paths: Vec<Vec<Block>>) -> Vec<Block> {
-    let mut out: Vec<Block> = Vec::new();
-    for blocks in paths {
-        let Some(first) = blocks.first() else {
-            continue;
-        };
-        if let Some(last) = out.last() {
-            if last.end_axes != first.start_axes {
-                let a = crate::block::Station {
-                    tip: last.end_tip(),
-                    axis: last.end_tool_axis,
-                    param: None,
-                    axes: last.end_axes,
-                };
-                let b = crate::block::Station {
-                    tip: first.start_tip(),
-                    axis: first.end_tool_axis,
-                    param: None,
-                    axes: first.start_axes,
-                };
-                let mut rapid = Block::line(&a, &b);
-                rapid.rapid = true;
-                rapid.path = first.path;
-                rapid.stations = [0, 0];
-                out.push(rapid);
-            }
+    link(paths, |_, last, first| {
+        if last.end_axes == first.start_axes {
+            return Vec::new();
         }
-        out.extend(blocks);
-    }
-    out
+        let b = Station {
+            tip: first.start_tip(),
+            axis: first.end_tool_axis,
+            param: None,
+            axes: first.start_axes,
+        };
+        vec![end_station(last), b]
+    })
 }
 
 /// Like [`link_paths`], but each rapid move backs off `retract` mm along the tool axis from
@@ -52,51 +35,9 @@ pub fn link_paths_with_retract<M: AxisModel + ?Sized>(
     paths: Vec<Vec<Block>>,
     retract: f64,
 ) -> Vec<Block> {
-    // Without a retract: one straight rapid, with the tool axes of the model at both ends
-    // (the next path's start orientation, not its first block's end).
-    let retract = if retract.is_nan() {
-        0.0
-    } else {
-        retract.max(0.0)
-    };
-    let station = |tip: nalgebra::Point3<f64>, axes: Axes| {
-        let axis = model.tool_axis(axes[3], axes[4]);
-        let lin = model.linear_axes(&tip, axes[3], axes[4]);
-        crate::block::Station {
-            tip,
-            axis,
-            param: None,
-            axes: Axes::new(lin[0], lin[1], lin[2], axes[3], axes[4]),
-        }
-    };
-    let mut out: Vec<Block> = Vec::new();
-    for blocks in paths {
-        let Some(first) = blocks.first() else {
-            continue;
-        };
-        if let Some(last) = out.last() {
-            if last.end_axes != first.start_axes {
-                let end = station(last.end_tip(), last.end_axes);
-                let start = station(first.start_tip(), first.start_axes);
-                let up = station(end.tip + end.axis * retract, end.axes);
-                let over = station(start.tip + start.axis * retract, start.axes);
-                let moves = if retract > 0.0 {
-                    vec![(&end, &up), (&up, &over), (&over, &start)]
-                } else {
-                    vec![(&end, &start)]
-                };
-                for (a, b) in moves {
-                    let mut rapid = Block::line(a, b);
-                    rapid.rapid = true;
-                    rapid.path = first.path;
-                    rapid.stations = [0, 0];
-                    out.push(rapid);
-                }
-            }
-        }
-        out.extend(blocks);
-    }
-    out
+    link(paths, |_, last, first| {
+        retract_stops(model, last, first, retract)
+    })
 }
 
 /// Like [`link_paths_with_retract`], but the rapid moves between path `k` and path `k + 1` run
@@ -108,8 +49,42 @@ pub fn link_paths_with_retract<M: AxisModel + ?Sized>(
 pub fn link_paths_through<M: AxisModel + ?Sized>(
     model: &M,
     paths: Vec<Vec<Block>>,
-    traverses: &[Vec<crate::block::Station>],
+    traverses: &[Vec<Station>],
     retract: f64,
+) -> Vec<Block> {
+    link(paths, |k, last, first| {
+        let Some(way) = traverses.get(k).filter(|w| !w.is_empty()) else {
+            return retract_stops(model, last, first, retract);
+        };
+        let start = Station {
+            tip: first.start_tip(),
+            axis: model.tool_axis(first.start_axes[3], first.start_axes[4]),
+            param: None,
+            axes: first.start_axes,
+        };
+        let mut stops = vec![end_station(last)];
+        stops.extend(way.iter().map(|s| Station { param: None, ..*s }));
+        stops.push(start);
+        stops
+    })
+}
+
+/// The station where `last` ends, with its own tool axis there.
+fn end_station(last: &Block) -> Station {
+    Station {
+        tip: last.end_tip(),
+        axis: last.end_tool_axis,
+        param: None,
+        axes: last.end_axes,
+    }
+}
+
+/// The one loop of the three linkers: the paths' blocks in order (empty paths left out), and
+/// between two paths a rapid line from each stop `gap(k, last, first)` gives to the next (`k`
+/// counts the gaps from 0; no stops, no rapid).
+fn link(
+    paths: Vec<Vec<Block>>,
+    mut gap: impl FnMut(usize, &Block, &Block) -> Vec<Station>,
 ) -> Vec<Block> {
     let mut out: Vec<Block> = Vec::new();
     let mut k = 0usize;
@@ -118,46 +93,56 @@ pub fn link_paths_through<M: AxisModel + ?Sized>(
             continue;
         };
         if let Some(last) = out.last() {
-            let way = traverses.get(k).filter(|w| !w.is_empty());
+            let stops = gap(k, last, first);
             k += 1;
-            match way {
-                Some(way) => {
-                    let end = crate::block::Station {
-                        tip: last.end_tip(),
-                        axis: last.end_tool_axis,
-                        param: None,
-                        axes: last.end_axes,
-                    };
-                    let start = crate::block::Station {
-                        tip: first.start_tip(),
-                        axis: model.tool_axis(first.start_axes[3], first.start_axes[4]),
-                        param: None,
-                        axes: first.start_axes,
-                    };
-                    let mut stops = vec![end];
-                    stops.extend(
-                        way.iter()
-                            .map(|s| crate::block::Station { param: None, ..*s }),
-                    );
-                    stops.push(start);
-                    for w in stops.windows(2) {
-                        let mut rapid = Block::line(&w[0], &w[1]);
-                        rapid.rapid = true;
-                        rapid.path = first.path;
-                        rapid.stations = [0, 0];
-                        out.push(rapid);
-                    }
-                }
-                None => {
-                    let mut linked =
-                        link_paths_with_retract(model, vec![vec![*last], vec![*first]], retract);
-                    linked.pop();
-                    linked.remove(0);
-                    out.extend(linked);
-                }
+            for w in stops.windows(2) {
+                let mut rapid = Block::line(&w[0], &w[1]);
+                rapid.rapid = true;
+                rapid.path = first.path;
+                rapid.stations = [0, 0];
+                out.push(rapid);
             }
         }
         out.extend(blocks);
     }
     out
+}
+
+/// The stops of [`link_paths_with_retract`]'s rapid from `last`'s end to `first`'s start: up
+/// `retract` mm along the end's tool axis, over to `retract` mm above the start along its tool
+/// axis and down (straight across for `retract <= 0` or NaN), the tool axes the model's at
+/// both ends; none where the axes already stand at the start.
+fn retract_stops<M: AxisModel + ?Sized>(
+    model: &M,
+    last: &Block,
+    first: &Block,
+    retract: f64,
+) -> Vec<Station> {
+    if last.end_axes == first.start_axes {
+        return Vec::new();
+    }
+    let retract = if retract.is_nan() {
+        0.0
+    } else {
+        retract.max(0.0)
+    };
+    let station = |tip: nalgebra::Point3<f64>, axes: Axes| {
+        let axis = model.tool_axis(axes[3], axes[4]);
+        let lin = model.linear_axes(&tip, axes[3], axes[4]);
+        Station {
+            tip,
+            axis,
+            param: None,
+            axes: Axes::new(lin[0], lin[1], lin[2], axes[3], axes[4]),
+        }
+    };
+    let end = station(last.end_tip(), last.end_axes);
+    let start = station(first.start_tip(), first.start_axes);
+    if retract > 0.0 {
+        let up = station(end.tip + end.axis * retract, end.axes);
+        let over = station(start.tip + start.axis * retract, start.axes);
+        vec![end, up, over, start]
+    } else {
+        vec![end, start]
+    }
 }

@@ -138,34 +138,32 @@ impl Timed {
             self.t[i]
         } else {
             // Inside interval i - 1: solve s_i + v tau + u tau^2 / 2 = s by bisection too.
-            let (mut lo, mut hi) = (self.t[i - 1], self.t[i]);
-            for _ in 0..50 {
-                let mid = 0.5 * (lo + hi);
-                if self.s_raw(mid) >= s {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            hi
+            bisect(self.t[i - 1], self.t[i], 0.0, |tau| self.s_raw(tau) >= s)
         };
         if self.tau <= 0.0 {
             return raw;
         }
-        let (mut lo, mut hi) = (raw, (raw + self.tau).min(self.duration));
-        for _ in 0..50 {
-            let mid = 0.5 * (lo + hi);
-            if self.s_at(mid) >= s {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-            if hi - lo <= 1e-13 * self.duration {
-                break;
-            }
-        }
-        hi
+        let hi = (raw + self.tau).min(self.duration);
+        bisect(raw, hi, 1e-13 * self.duration, |tau| self.s_at(tau) >= s)
     }
+}
+
+/// The least time in `[lo, hi]` where `reached` turns true (it must be monotone), by at most
+/// 50 halvings, stopping once the bracket is `width` wide or less: the bracket's upper end.
+/// (A bracket of width 0 no longer changes, so `width` 0 is the full 50 halvings.)
+fn bisect(mut lo: f64, mut hi: f64, width: f64, reached: impl Fn(f64) -> bool) -> f64 {
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        if reached(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+        if hi - lo <= width {
+            break;
+        }
+    }
+    hi
 }
 
 /// The grid of one run: nodes subdivided to at most `step`, at least two intervals each, and

@@ -147,7 +147,7 @@ fn out_of_range<M: AxisModel + ?Sized>(model: &M, cycle: usize, q: &Axes) -> Opt
     let lim = model.limits();
     (0..5).find_map(|k| {
         let [lo, hi] = lim.range[k]?;
-        (!(q[k] >= lo - 1e-9 && q[k] <= hi + 1e-9)).then(|| InterpError::OutOfRange {
+        (!lim.contains(k, q[k])).then(|| InterpError::OutOfRange {
             cycle,
             axis: model.axis_names()[k].to_string(),
             value: q[k],

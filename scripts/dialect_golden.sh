@@ -22,5 +22,6 @@ done
 # micro-joints and kerf in control on the flat part
 for d in generic linuxcnc linuxcnc-tcp; do $K run fixtures/sheet_metal_holes.json -m fixtures/machines/gantry_ac.json --dialect $d --micro-joints 0.5,40 -o "$OUT"/mj-$d -q 2>"$OUT"/mj-$d.err; echo $? > "$OUT"/mj-$d.rc; done
 $K run fixtures/sheet_metal_holes.json -m fixtures/machines/gantry_ac.json --dialect linuxcnc --kerf-width 0.2 --kerf-in-control -o "$OUT"/kic -q 2>"$OUT"/kic.err; echo $? > "$OUT"/kic.rc
+$K run fixtures/sheet_metal_holes.json -m fixtures/machines/gantry_ac.json --dialect sinumerik --kerf-width 0.2 --kerf-in-control -o "$OUT"/kic-sinumerik -q 2>"$OUT"/kic-sinumerik.err; echo $? > "$OUT"/kic-sinumerik.rc
 $K run fixtures/sheet_metal_holes.json -m fixtures/machines/xyzac_trt.json --dialect linuxcnc-tcp --micro-joints 0.5,40 $TECH -o "$OUT"/mj-tcp-tech -q 2>"$OUT"/mj-tcp-tech.err; echo $? > "$OUT"/mj-tcp-tech.rc
 find $OUT -name report.json -delete; find $OUT -name plot.svg -delete

@@ -567,10 +567,12 @@ pub(crate) struct RunArgs {
     pub(crate) kerf_width: Option<f64>,
 
     /// With a kerf width (this run's or the machine file's), leave the kerf compensation to
-    /// the controller: the program holds the contours
-    /// themselves with LinuxCNC's G41.1/G42.1 D<kerf> from each lead-in on and G40 after the
-    /// beam is off (`--dialect linuxcnc` only; every compensated cut must stand the beam
-    /// vertical with the rotary axes still, else the run is refused with the reason).
+    /// the controller: the program holds the contours themselves with the controller's
+    /// compensation from each lead-in on. `--dialect linuxcnc`: G41.1/G42.1 D<kerf>, G40
+    /// before the beam goes off; every compensated cut must stand the beam vertical with the
+    /// rotary axes still, else the run is refused with the reason. `--dialect sinumerik`:
+    /// CUT3DC with G41/G42 and OFFN=<kerf/2> (the active tool's radius must be 0), G40 after
+    /// the beam is off; any tool orientation. Other dialects: refused.
     #[arg(long)]
     pub(crate) kerf_in_control: bool,
 

@@ -457,7 +457,8 @@ fn machines_linuxcnc_has_no_tool_tip_kinematics_for_are_refused_by_name() {
             "setp xyzac-trt-kins.z-rot-point 0"
         ]
     );
-    // The controller's kerf compensation is LinuxCNC's joint-space dialect's only.
+    // The controller's kerf compensation is LinuxCNC's joint-space dialect's (and
+    // Sinumerik's), not the tool-tip dialect's.
     let dir = tempfile::tempdir().expect("tmp");
     let r = kerf()
         .args(["run"])
@@ -478,7 +479,7 @@ fn machines_linuxcnc_has_no_tool_tip_kinematics_for_are_refused_by_name() {
         .expect("kerf runs");
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(
-        !r.status.success() && err.contains("linuxcnc dialect only"),
+        !r.status.success() && err.contains("not linuxcnc-tcp"),
         "{err}"
     );
 }

@@ -120,8 +120,26 @@ pub(crate) struct Kerf {
     pub(crate) source: &'static str,
     /// The chord tolerance the offset paths keep, mm.
     pub(crate) tolerance_mm: f64,
-    /// True when the controller compensates (`G41.1`/`G42.1`): the paths stay on the contour.
+    /// True when the controller compensates (LinuxCNC's `G41.1`/`G42.1`, Sinumerik's
+    /// `CUT3DC` with `G41`/`G42`): the paths stay on the contour.
     pub(crate) in_control: bool,
+    /// The program's dialect (which of the controllers' compensations).
+    pub(crate) dialect: kerf_interp::Dialect,
+}
+
+impl Kerf {
+    /// How the controller compensates, in the header's words: only numbers and kerf's own
+    /// words (Sinumerik: the half kerf as `OFFN`, so the active tool's radius, `$TC_DP6` plus
+    /// the wear `$TC_DP15`, must be 0).
+    fn controller_words(&self) -> String {
+        match self.dialect {
+            kerf_interp::Dialect::Sinumerik => format!(
+                "CUT3DC G41/G42 OFFN={} (tool radius 0)",
+                0.5 * self.width_mm
+            ),
+            _ => format!("G41.1/G42.1 D{}", self.width_mm),
+        }
+    }
 }
 
 /// What kerf compensation did to one contour.
@@ -436,8 +454,9 @@ pub(crate) fn kerf_header(kerf: Option<&Kerf>, compensated: &[Compensated]) -> S
     };
     if k.in_control {
         format!(
-            "kerf compensation in the controller: G41.1/G42.1 D{} from {} on {done} paths{rest}",
-            k.width_mm, k.source
+            "kerf compensation in the controller: {} from {} on {done} paths{rest}",
+            k.controller_words(),
+            k.source
         )
     } else {
         format!(
@@ -516,15 +535,16 @@ pub(crate) fn compensation_report(
         tolerance_mm: Some(k.tolerance_mm),
         proven: Some(!compensated.is_empty() && compensated.iter().all(|c| matches!(&c.outcome, Outcome::Offset(p) if p.proven))),
         paths: Some(paths),
-        note: "in the computer, each path moved half the kerf toward its scrap side, at right angles to the path and the tool axis; outside corners swung round on an arc about the corner, inside corners cut back to where the offsets cross (the round beam leaves max_corner_material_mm there); proven: every chord within the tolerance of the exact offset (flat contours at a fixed tool axis), else measured at 15 points per chord; in the controller, the program holds the contours with G41.1/G42.1 D<kerf> from the lead-in on and G40 after the beam is off (docs/process.md, Kerf compensation)".into(),
+        note: "in the computer, each path moved half the kerf toward its scrap side, at right angles to the path and the tool axis; outside corners swung round on an arc about the corner, inside corners cut back to where the offsets cross (the round beam leaves max_corner_material_mm there); proven: every chord within the tolerance of the exact offset (flat contours at a fixed tool axis), else measured at 15 points per chord; in the controller, the program holds the contours with the controller's compensation from the lead-in's first move on: LinuxCNC G41.1/G42.1 D<kerf>, G40 before the beam's off codes; Sinumerik CUT3DC, OFFN=<kerf/2> with G41/G42, G40 after the beam is off (docs/process.md, Kerf compensation)".into(),
     }
 }
 
 /// The controller's compensation of every cut (`cuts[k]`, solved as `solved[k]`): the side
-/// for those the controller compensates, checked to stand the beam vertical (tool axis `+z`)
-/// with the tilt axis at 0 and C still along the whole cut, lead-in and lead-out included
-/// (LinuxCNC's `G41.1` offsets X and Y only), with a lead-in whose first move is longer than
-/// half the kerf (the controller's entry move); `None` for the others.
+/// for those the controller compensates, with a lead-in whose first move is longer than half
+/// the kerf (the controller's entry move); for LinuxCNC also checked to stand the beam
+/// vertical (tool axis `+z`) with the tilt axis at 0 and C still along the whole cut, lead-in
+/// and lead-out included (`G41.1` offsets X and Y only; Sinumerik's `CUT3DC` offsets at right
+/// angles to the path and the tool orientation, whatever it is); `None` for the others.
 ///
 /// # Errors
 /// [`kerf_process::ProcessError::Compensation`] for a cut the controller cannot compensate,
@@ -559,7 +579,10 @@ pub(crate) fn controller_compensation(
             let tilt = range(&|a| a.tilt);
             let c = range(&|a| a.c);
             let vertical = s.poses.iter().all(|p| p.axis.z >= 1.0 - 1e-12);
-            if !(vertical && tilt.0.abs() <= 1e-9 && tilt.1.abs() <= 1e-9 && c.1 - c.0 <= 1e-9) {
+            let any_orientation = k.dialect != kerf_interp::Dialect::Linuxcnc;
+            if !(any_orientation
+                || vertical && tilt.0.abs() <= 1e-9 && tilt.1.abs() <= 1e-9 && c.1 - c.0 <= 1e-9)
+            {
                 return Err(kerf_process::ProcessError::Compensation {
                     id: file.curves[cut.curve].id.clone(),
                     kerf_width_mm: k.width_mm,

@@ -130,9 +130,10 @@ pub struct JobOptions {
     /// machine's `process.kerf_width_mm`; with neither, the path is the contour itself.
     pub kerf_width_mm: Option<f64>,
     /// With a kerf width, leave the compensation to the controller: the program holds the
-    /// contours with LinuxCNC's `G41.1`/`G42.1 D` (linuxcnc dialect only; every compensated cut
-    /// must stand the beam vertical with the rotary axes still). Default false: compensate in
-    /// the computer.
+    /// contours with LinuxCNC's `G41.1`/`G42.1 D` (every compensated cut must then stand the
+    /// beam vertical with the rotary axes still) or Sinumerik's `CUT3DC` with `G41`/`G42` and
+    /// `OFFN` (any orientation); other dialects are refused. Default false: compensate in the
+    /// computer.
     pub kerf_in_control: bool,
     /// The distance the head (the machine file's `head`, else
     /// [`kerf_kinematics::Head::laser_default`]) must keep from the part's surfaces along

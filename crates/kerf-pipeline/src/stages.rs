@@ -116,18 +116,22 @@ impl<'a> Run<'a> {
                 source,
                 tolerance_mm: dopts.tolerance_mm,
                 in_control: o.kerf_in_control,
+                dialect: o.dialect,
             });
         MachineModel::new(machine.clone())
             .and_then(|m| o.dialect.check_machine(&m))
             .map_err(interp(path))?;
         if kerf.as_ref().is_some_and(|k| k.in_control)
-            && o.dialect != kerf_interp::Dialect::Linuxcnc
+            && !matches!(
+                o.dialect,
+                kerf_interp::Dialect::Linuxcnc | kerf_interp::Dialect::Sinumerik
+            )
         {
             return Err(crate::Error::BadOption {
                 name: "kerf_in_control",
                 value: 1.0,
                 requirement: format!(
-                    "the controller's kerf compensation is written for the linuxcnc dialect only (G41.1/G42.1), not {}; compensate in the computer instead",
+                    "the controller's kerf compensation is written for the linuxcnc (G41.1/G42.1) and sinumerik (CUT3DC with G41/G42) dialects only, not {}; compensate in the computer instead",
                     o.dialect.name()
                 ),
             });
@@ -579,9 +583,10 @@ struct SetupShared<'a> {
     points: &'a [PlacedCurve<'a>],
 }
 
-/// Stage 4: the controller's compensation per path (G41.1/G42.1, where the beam stands
-/// vertical and still along the whole cut), the axes document, then per set-up the checked
-/// traverses, the fit, the feed plan and the G-code.
+/// Stage 4: the controller's compensation per path (LinuxCNC's G41.1/G42.1 where the beam
+/// stands vertical and still along the whole cut, Sinumerik's CUT3DC at any orientation), the
+/// axes document, then per set-up the checked traverses, the fit, the feed plan and the
+/// G-code.
 pub(crate) fn programs(
     r: &Run<'_>,
     cuts: &Cuts,

@@ -288,6 +288,25 @@ fn in_control(
     Ok((curves, out))
 }
 
+/// The paths are the contours themselves: every cut pose of the holes on its circle.
+fn holes_cut_on_their_circles(out: &Output, file: &CurvesFile) {
+    for curve in file.curves.iter().filter(|c| c.id.starts_with("hole-d")) {
+        let cps = curve.curve.control_points();
+        let centre = cps[..cps.len() - 1]
+            .iter()
+            .fold(Vector3::zeros(), |s, p| s + p.coords)
+            / (cps.len() - 1) as f64;
+        let radius = (cps[0].coords - centre).norm();
+        for p in cut_points(out, file, &curve.id) {
+            assert!(
+                ((p.coords - centre).norm() - radius).abs() <= TOL,
+                "{}",
+                curve.id
+            );
+        }
+    }
+}
+
 #[test]
 fn the_controller_compensates_the_contours_themselves_with_g41_and_g42() {
     let (file, out) =
@@ -308,21 +327,7 @@ fn the_controller_compensates_the_contours_themselves_with_g41_and_g42() {
     };
     assert_eq!(sides(&out), sides(&computer), "the same sides");
     // The paths are the contours: the holes' cut poses on their circles.
-    for curve in file.curves.iter().filter(|c| c.id.starts_with("hole-d")) {
-        let cps = curve.curve.control_points();
-        let centre = cps[..cps.len() - 1]
-            .iter()
-            .fold(Vector3::zeros(), |s, p| s + p.coords)
-            / (cps.len() - 1) as f64;
-        let radius = (cps[0].coords - centre).norm();
-        for p in cut_points(&out, &file, &curve.id) {
-            assert!(
-                ((p.coords - centre).norm() - radius).abs() <= TOL,
-                "{}",
-                curve.id
-            );
-        }
-    }
+    holes_cut_on_their_circles(&out, &file);
     // Every cut: beam on, the descent, G41.1 (scrap on the left) or G42.1 before the lead-in,
     // G40 before the beam goes off; holes (left of their counter-clockwise contour) G41.1.
     let text = &out.programs[0].text;
@@ -361,12 +366,106 @@ fn the_controller_compensates_the_contours_themselves_with_g41_and_g42() {
     );
 }
 
+/// A number after `word` (`X`, `A3=`, `OFFN=`) in a Sinumerik line.
+fn word(line: &str, word: &str) -> Option<f64> {
+    line.split_whitespace()
+        .find_map(|w| w.strip_prefix(word))
+        .and_then(|v| v.parse().ok())
+}
+
+/// Sinumerik's `CUT3DC` compensates at right angles to the path and the tool orientation, so
+/// the leaning, turning beam of the door trim is compensated too. Each cut's compensation side
+/// is checked against the part, not against kerf's own choice: read back from the program,
+/// the tips of each compensated stretch (lead-in, contour, lead-out) run round their loop
+/// counter-clockwise or clockwise seen down the tool axis, and `G41` (the left, seen from the
+/// tool's side) must put the beam inside a hole or slot (the scrap) and outside the outline.
+#[test]
+fn sinumerik_compensates_with_cut3dc_offn_and_g41_or_g42_on_the_scrap_side() {
+    let (file, out) =
+        in_control("sheet_metal_holes.json", kerf_interp::Dialect::Sinumerik).expect("run");
+    let text = &out.programs[0].text;
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    let at = |l: &str| lines.iter().position(|x| *x == l);
+    let traori = at("TRAORI").expect("TRAORI");
+    assert_eq!(
+        lines[traori + 3],
+        "CUT3DC",
+        "CUT3DC after the orientation modes"
+    );
+    assert_eq!(lines[traori + 4], "G450", "circles at outside corners");
+    assert!(at("CUT2D").expect("CUT2D") < at("TRAFOOF").expect("TRAFOOF"));
+    assert!(text.contains(
+        "kerf compensation in the controller: CUT3DC G41/G42 OFFN=0.1 [tool radius 0] from the run's kerf_width_mm on 8 paths"
+    ));
+    let mut cuts = 0;
+    for (i, l) in lines.iter().enumerate() {
+        let left = match *l {
+            "G41" => true,
+            "G42" => false,
+            _ => continue,
+        };
+        cuts += 1;
+        let offn = word(lines[i - 1], "OFFN=").expect("OFFN before G41/G42");
+        assert!((offn - 0.1).abs() < 1e-9, "half the kerf: {offn}");
+        let id = lines[..i]
+            .iter()
+            .rev()
+            .find_map(|l| l.strip_prefix("; curve ").and_then(|r| r.split(',').next()))
+            .expect("the cut's curve");
+        // The beam is on, and G40 and OFFN=0 come after it is off.
+        let m5 = (i..lines.len())
+            .find(|&j| lines[j] == "M5")
+            .expect("beam off");
+        assert_eq!(&lines[m5 + 1..m5 + 3], ["G40", "OFFN=0"], "{id}");
+        assert!(
+            lines[..i].iter().rev().take(8).any(|l| *l == "M3"),
+            "{id}: on after the beam"
+        );
+        // The compensated tips (a CIP arc's intermediate point before its end), and the
+        // orientation of their loop seen down the tool axis.
+        let tips: Vec<(f64, f64)> = lines[i + 1..m5]
+            .iter()
+            .flat_map(|l| {
+                let mid = word(l, "I1=").zip(word(l, "J1="));
+                mid.into_iter().chain(word(l, "X").zip(word(l, "Y")))
+            })
+            .collect();
+        assert!(tips.len() >= 6, "{id}: {} points", tips.len());
+        let axis_up = lines[i + 1..m5]
+            .iter()
+            .filter_map(|l| word(l, "C3="))
+            .all(|k| k > 0.999_999);
+        assert!(axis_up, "{id}: the gantry's beam stands vertical here");
+        let area: f64 = tips
+            .iter()
+            .zip(tips.iter().cycle().skip(1))
+            .map(|(a, b)| a.0 * b.1 - b.0 * a.1)
+            .sum();
+        // Every loop but the outline is a cut-out: its scrap is inside.
+        let hole = id != "outline";
+        let scrap_on_the_left = (area > 0.0) == hole;
+        assert_eq!(left, scrap_on_the_left, "{id}: area {area}, hole {hole}");
+    }
+    assert_eq!(cuts, 8, "one compensation per cut");
+    // The paths are the contours themselves (the holes' cut poses on their circles).
+    holes_cut_on_their_circles(&out, &file);
+    // The door trim's beam leans and turns: G41.1 cannot, CUT3DC can.
+    let (_, door) = in_control("door_trim.json", kerf_interp::Dialect::Sinumerik).expect("door");
+    let text = &door.programs[0].text;
+    let comps = text
+        .lines()
+        .filter(|l| matches!(l.trim(), "G41" | "G42"))
+        .count();
+    assert_eq!(comps, door.solved.len(), "every cut compensated");
+    assert_eq!(door.report.compensation.mode.as_deref(), Some("controller"));
+}
+
 #[test]
 fn the_controller_compensation_is_refused_where_it_cannot_hold() {
     let Err(e) = in_control("sheet_metal_holes.json", kerf_interp::Dialect::Generic) else {
         panic!("generic has no compensation")
     };
-    assert!(e.to_string().contains("linuxcnc dialect only"), "{e}");
+    assert!(e.to_string().contains("dialects only"), "{e}");
     // The door trim's beam leans and turns: G41.1 offsets X and Y only.
     let Err(e) = in_control("door_trim.json", kerf_interp::Dialect::Linuxcnc) else {
         panic!("a turning beam")

@@ -468,7 +468,7 @@ pub fn gcode_timed<M: AxisModel>(
         return Err(InterpError::BadParameter {
             name: "cutter_compensation",
             value: 1.0,
-            reason: "the controller's kerf compensation is written for the linuxcnc dialect only (G41.1/G42.1); compensate in the computer for the others",
+            reason: "the controller's kerf compensation is written for the linuxcnc (G41.1/G42.1) and sinumerik (CUT3DC with G41/G42) dialects only; compensate in the computer for the others",
         });
     }
     let process = ProcessCodes::resolve(opts.dialect, &opts.process)?;

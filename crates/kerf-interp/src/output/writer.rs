@@ -344,20 +344,32 @@ impl<'a> Writer<'a> {
     /// The controller's kerf compensation from the next move (the lead-in's first, the entry
     /// move), until [`Writer::end_cut`].
     pub(super) fn compensation_on(&mut self, c: &super::CutterCompensation) {
-        let g = if c.left { "G41.1" } else { "G42.1" };
-        let l = format!("{g} D{}", feed_number(c.kerf_width_mm));
-        self.line(&l);
+        for l in self.rules.compensation_on(c) {
+            self.line(&l);
+        }
         self.compensating = true;
     }
 
     pub(super) fn end_cut(&mut self) {
-        // Off before the beam: LinuxCNC sets no output while the compensation is on.
-        if self.compensating {
-            self.line("G40");
+        // Off before or after the beam, as the dialect says ([`Rules::compensation_off`]).
+        let (off, before_beam) = if self.compensating {
             self.compensating = false;
+            self.rules.compensation_off()
+        } else {
+            (Vec::new(), true)
+        };
+        if before_beam {
+            for l in &off {
+                self.line(l);
+            }
         }
         for l in self.process.beam_off.clone() {
             self.line(&l);
+        }
+        if !before_beam {
+            for l in &off {
+                self.line(l);
+            }
         }
         self.rules.blend_off(self);
         self.in_cut = false;
@@ -810,9 +822,23 @@ pub(super) trait Rules: Sync {
         Ok((process.beam_off.clone(), process.beam_on.clone()))
     }
 
-    /// True where the controller's kerf compensation can be written (`G41.1`/`G42.1`).
+    /// True where the controller's kerf compensation can be written
+    /// ([`Rules::compensation_on`]).
     fn controller_compensation(&self) -> bool {
         false
+    }
+
+    /// The lines that switch the controller's kerf compensation on for the next move (the
+    /// lead-in's first, the controller's entry move): none by default (see
+    /// [`Rules::controller_compensation`]).
+    fn compensation_on(&self, _c: &super::CutterCompensation) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// The lines that switch it off at the cut's end, and whether they come before the beam's
+    /// off codes (`true`) or after them: `G40` before the beam by default.
+    fn compensation_off(&self) -> (Vec<String>, bool) {
+        (vec!["G40".to_string()], true)
     }
 
     /// The program's last lines.

@@ -10,7 +10,7 @@ use nalgebra::{Point3, Vector3};
 
 use super::super::writer::Rules;
 use super::super::writer::{digital_output, feed_number, Writer};
-use super::super::{LaserPower, ProcessCodes};
+use super::super::{CutterCompensation, LaserPower, ProcessCodes};
 use super::generic::axes_rapid;
 use crate::block::Block;
 
@@ -106,6 +106,19 @@ impl Rules for Linuxcnc {
 
     fn controller_compensation(&self) -> bool {
         true
+    }
+
+    /// `G41.1 D<kerf>` (left) or `G42.1 D<kerf>` (right): the diameter in the block, no
+    /// tool table.
+    fn compensation_on(&self, c: &CutterCompensation) -> Vec<String> {
+        let g = if c.left { "G41.1" } else { "G42.1" };
+        vec![format!("{g} D{}", feed_number(c.kerf_width_mm))]
+    }
+
+    /// `G40` before the beam's off codes: LinuxCNC sets no digital output while it
+    /// compensates.
+    fn compensation_off(&self) -> (Vec<String>, bool) {
+        (vec!["G40".to_string()], true)
     }
 
     fn footer(&self, w: &mut Writer<'_>) {

@@ -6,14 +6,18 @@
 //! of the machine's axes) within [`crate::RAPID_TCP_TOLERANCE_MM`]. Power
 //! by the synchronized action `SYNFCT` on `$AC_VACTW` with `FCTDEF` per cut (written to
 //! Siemens' documented pattern, not executed here). No micro-joints: its arcs and merged lines
-//! are not split.
+//! are not split. The controller's kerf compensation (`kerf run --kerf-in-control`): `CUT3DC`
+//! (the offset at right angles to the path tangent and the tool orientation, as kerf's own)
+//! with `G450` (circles at outside corners), and per cut `OFFN=<half kerf>` with `G41` or `G42`
+//! before the lead-in's first move, `G40` and `OFFN=0` after the beam is off, `CUT2D` at the
+//! end (written to Siemens' documented pattern, not executed here).
 
 use kerf_kinematics::Axes;
 use nalgebra::{Point3, Vector3};
 
 use super::super::writer::Rules;
 use super::super::writer::{feed_number, Writer};
-use super::super::{LaserPower, ProcessCodes};
+use super::super::{CutterCompensation, LaserPower, ProcessCodes};
 use crate::block::{Block, Geometry};
 
 /// The Sinumerik-style dialect.
@@ -59,6 +63,12 @@ impl Rules for Sinumerik {
         w.line("TRAORI");
         w.line("ORIWKS");
         w.line("ORIVECT");
+        if compensating(w) {
+            // 3D radius compensation at right angles to the path and the tool orientation;
+            // outside corners rounded with circles, as kerf's own offset.
+            w.line("CUT3DC");
+            w.line("G450");
+        }
         // G0 interpolated along the tip's line (not axis by axis): each rapid piece below runs
         // as written.
         w.line("RTLION");
@@ -173,10 +183,39 @@ impl Rules for Sinumerik {
         Err("micro-joints are written for the linuxcnc and generic dialects (the Sinumerik dialect's arcs and merged lines are not split)")
     }
 
+    fn controller_compensation(&self) -> bool {
+        true
+    }
+
+    /// `OFFN=<half kerf>` and `G41` (left) or `G42` (right): the programmed contour offset
+    /// on top of the active tool's radius, which must be 0 for a laser (the header says so).
+    /// The compensation builds up over the next move, the lead-in's first.
+    fn compensation_on(&self, c: &CutterCompensation) -> Vec<String> {
+        let g = if c.left { "G41" } else { "G42" };
+        vec![
+            format!("OFFN={}", feed_number(0.5 * c.kerf_width_mm)),
+            g.to_string(),
+        ]
+    }
+
+    /// `G40` and `OFFN=0` after the beam's off codes: the control leaves the compensated path
+    /// on the next move (the retract), which must not cut.
+    fn compensation_off(&self) -> (Vec<String>, bool) {
+        (vec!["G40".to_string(), "OFFN=0".to_string()], false)
+    }
+
     fn footer(&self, w: &mut Writer<'_>) {
+        if compensating(w) {
+            w.line("CUT2D");
+        }
         w.line("TRAFOOF");
         w.line("M30");
     }
+}
+
+/// True where some path of the program is compensated by the controller.
+fn compensating(w: &Writer<'_>) -> bool {
+    w.opts.cutter_compensation.iter().any(Option::is_some)
 }
 
 /// `X Y Z A3= B3= C3=`: the tip and the orientation vector.

@@ -153,9 +153,9 @@ impl Block {
                 travel,
             )
         } else {
-            let rot = (b.axes[3] - a.axes[3])
+            let rot = (b.axes.tilt - a.axes.tilt)
                 .abs()
-                .max((b.axes[4] - a.axes[4]).abs());
+                .max((b.axes.c - a.axes.c).abs());
             (Geometry::Turn { at: a.tip }, rot)
         };
         Self {

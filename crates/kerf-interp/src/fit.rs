@@ -338,8 +338,8 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
                 return false;
             }
             last_t = t;
-            let tilt = a.axes[3] + t * (b.axes[3] - a.axes[3]);
-            let c = a.axes[4] + t * (b.axes[4] - a.axes[4]);
+            let tilt = a.axes.tilt + t * (b.axes.tilt - a.axes.tilt);
+            let c = a.axes.c + t * (b.axes.c - a.axes.c);
             if !self.orientation_ok(k, tilt, c) {
                 return false;
             }
@@ -395,14 +395,14 @@ impl<M: AxisModel + ?Sized> Fitter<'_, M> {
                 let (tilt, c) = if theta < arc.angle_mid {
                     let f = theta / arc.angle_mid;
                     (
-                        a.axes[3] + f * (mid.axes[3] - a.axes[3]),
-                        a.axes[4] + f * (mid.axes[4] - a.axes[4]),
+                        a.axes.tilt + f * (mid.axes.tilt - a.axes.tilt),
+                        a.axes.c + f * (mid.axes.c - a.axes.c),
                     )
                 } else {
                     let f = (theta - arc.angle_mid) / (arc.angle_end - arc.angle_mid);
                     (
-                        mid.axes[3] + f * (b.axes[3] - mid.axes[3]),
-                        mid.axes[4] + f * (b.axes[4] - mid.axes[4]),
+                        mid.axes.tilt + f * (b.axes.tilt - mid.axes.tilt),
+                        mid.axes.c + f * (b.axes.c - mid.axes.c),
                     )
                 };
                 if !self.orientation_ok(k, tilt, c) {

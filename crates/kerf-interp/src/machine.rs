@@ -179,11 +179,14 @@ pub fn stations_from_axes(positions: &[[f64; 5]], poses: &[[f64; 6]]) -> Result<
     Ok(positions
         .iter()
         .zip(poses)
-        .map(|(q, p)| Station {
-            tip: Point3::new(p[0], p[1], p[2]),
-            axis: Vector3::new(p[3], p[4], p[5]),
-            param: None,
-            axes: Axes::from_array(*q),
+        .map(|(q, p)| {
+            let pose = Pose::from_array(*p);
+            Station {
+                tip: pose.position,
+                axis: pose.axis,
+                param: None,
+                axes: Axes::from_array(*q),
+            }
         })
         .collect())
 }

@@ -145,7 +145,7 @@ pub trait AxisModel {
     /// and `tip = M^T (XYZ - o)` (four calls). A model with its own forward kinematics should
     /// say so.
     fn tip(&self, q: &Axes) -> Point3<f64> {
-        let (tilt, c) = (q[3], q[4]);
+        let (tilt, c) = (q.tilt, q.c);
         let at = |p: Point3<f64>| Vector3::from(self.linear_axes(&p, tilt, c));
         let o = at(Point3::origin());
         let m = nalgebra::Matrix3::from_columns(&[

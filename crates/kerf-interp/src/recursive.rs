@@ -443,7 +443,7 @@ pub fn spline_through(stations: &[Station]) -> Result<Vec<(NewBasisSegment<5>, f
     }
     let pts: Vec<[f64; 5]> = stations
         .iter()
-        .map(|s| [s.tip.x, s.tip.y, s.tip.z, s.axes[3], s.axes[4]])
+        .map(|s| [s.tip.x, s.tip.y, s.tip.z, s.axes.tilt, s.axes.c])
         .collect();
     for (i, p) in pts.iter().enumerate() {
         if !p.iter().all(|v| v.is_finite()) {

@@ -794,11 +794,11 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
             ty.push([tip.x, tip.y, tip.z]);
         }
         rs.push(s0);
-        ry.push([b.start_axes[3], b.start_axes[4]]);
+        ry.push([b.start_axes.tilt, b.start_axes.c]);
         let mid = b.mid_length();
         if b.is_arc() && mid > 0.0 && mid < b.length() {
             rs.push(s0 + mid / ratio[j]);
-            ry.push([b.mid_axes[3], b.mid_axes[4]]);
+            ry.push([b.mid_axes.tilt, b.mid_axes.c]);
         }
     }
     let end = &run[run.len() - 1];
@@ -806,7 +806,7 @@ fn build(blocks: &[Block], first: usize, last: usize, opts: &PathOptions) -> Run
     let e = end.end_tip();
     ty.push([e.x, e.y, e.z]);
     rs.push(s);
-    ry.push([end.end_axes[3], end.end_axes[4]]);
+    ry.push([end.end_axes.tilt, end.end_axes.c]);
     let (m0, m1) = if moves_tip {
         // The curve's tangent where it can be estimated (circle through the neighbours), the
         // neighbour taken inside the run only: a run of one block ends at corners on both

@@ -129,12 +129,13 @@ pub(crate) struct Kerf {
 
 impl Kerf {
     /// How the controller compensates, in the header's words: only numbers and kerf's own
-    /// words (Sinumerik: the half kerf as `OFFN`, so the active tool's radius, `$TC_DP6` plus
-    /// the wear `$TC_DP15`, must be 0).
+    /// words (Sinumerik: the half kerf as `OFFN`, so an active tool offset `D` is needed
+    /// whose radius, `$TC_DP6` plus the wear `$TC_DP15`, is 0, and `CUT3DC` needs Siemens' 3D
+    /// tool radius compensation option).
     fn controller_words(&self) -> String {
         match self.dialect {
             kerf_interp::Dialect::Sinumerik => format!(
-                "CUT3DC G41/G42 OFFN={} (tool radius 0)",
+                "CUT3DC G41/G42 OFFN={} (active D radius 0; 3D TRC option)",
                 0.5 * self.width_mm
             ),
             _ => format!("G41.1/G42.1 D{}", self.width_mm),
@@ -592,12 +593,15 @@ pub(crate) fn controller_compensation(
                     ),
                 });
             }
-            // The controller engages on the lead-in's first move (LinuxCNC's entry move), which
-            // must be a straight line longer than the compensation's radius.
+            // The controller engages on the lead-in's first move (the entry move), which must
+            // be longer than the compensation's radius at right angles to the tool axis (the
+            // plane the offset is in: X and Y for LinuxCNC's vertical beam); the G-code writer
+            // refuses an entry move fitted as an arc.
             let [m, _, _] = cut.counts;
             let entry = if m > 0 {
                 let (a, b) = (cut.poses[0], cut.poses[1]);
-                ((b.position.x - a.position.x).powi(2) + (b.position.y - a.position.y).powi(2)).sqrt()
+                let (d, u) = (b.position - a.position, a.axis.normalize());
+                (d - u * d.dot(&u)).norm()
             } else {
                 0.0
             };

@@ -192,7 +192,8 @@ pub struct CompensationReport {
     /// process.kerf_width_mm`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub source: Option<String>,
-    /// `computer` (kerf offsets the path) or `controller` (`G41.1`/`G42.1`).
+    /// `computer` (kerf offsets the path) or `controller` (LinuxCNC's `G41.1`/`G42.1`,
+    /// Sinumerik's `CUT3DC` with `G41`/`G42`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mode: Option<String>,
     /// Half the kerf, mm.

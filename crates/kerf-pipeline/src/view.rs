@@ -183,7 +183,7 @@ fn paths(
             rapid.clear();
             let id = su.ids.get(b.path).map_or("", String::as_str);
             let (lead_in, lead_out) = leads(id);
-            let u = model.tool_axis(b.start_axes[3], b.start_axes[4]);
+            let u = model.tool_axis(b.start_axes.tilt, b.start_axes.c);
             let pierce = b.start_tip() + u * standoff;
             let mut c = Cut::default();
             c.id = id.to_string();
@@ -249,7 +249,7 @@ fn timeline(motion: &Motion, model: &MachineModel, feed_mm_per_min: f64) -> Time
             let (block, _) = motion.locate(i as f64 * cycle);
             let rapid = motion.blocks().get(block).is_some_and(|b| b.rapid);
             t.samples
-                .extend(pose_numbers(&tip, &model.tool_axis(q[3], q[4])));
+                .extend(pose_numbers(&tip, &model.tool_axis(q.tilt, q.c)));
             t.samples
                 .extend([unit(speed / feed), if rapid { 1.0 } else { 0.0 }]);
             t.samples.extend(q.iter().map(mm));

@@ -373,12 +373,82 @@ fn word(line: &str, word: &str) -> Option<f64> {
         .and_then(|v| v.parse().ok())
 }
 
+/// Checks every compensated cut of a Sinumerik program against the part, not against kerf's
+/// own choice of side, and returns how many there are and the largest tilt of the beam (degrees
+/// from +z) among them: `OFFN` of half the kerf before `G41`/`G42`, which come after the beam
+/// is on; `G40` and `OFFN=0` after it is off. The tips of each compensated stretch (lead-in,
+/// contour, lead-out; a `CIP` arc's intermediate point before its end) run round their loop
+/// one way or the other seen down the stretch's mean tool axis (`A3 B3 C3`), and `G41`, the
+/// left of the path seen from the tool's side, must put the beam inside every cut-out (its
+/// scrap) and outside `outline`.
+fn sinumerik_sides(text: &str, outline: &str) -> (usize, f64) {
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    let (mut cuts, mut tilt) = (0, 0.0f64);
+    for (i, l) in lines.iter().enumerate() {
+        let left = match *l {
+            "G41" => true,
+            "G42" => false,
+            _ => continue,
+        };
+        cuts += 1;
+        let offn = word(lines[i - 1], "OFFN=").expect("OFFN before G41/G42");
+        assert!((offn - 0.1).abs() < 1e-9, "half the kerf: {offn}");
+        let id = lines[..i]
+            .iter()
+            .rev()
+            .find_map(|l| l.strip_prefix("; curve ").and_then(|r| r.split(',').next()))
+            .expect("the cut's curve");
+        let m5 = (i..lines.len())
+            .find(|&j| lines[j] == "M5")
+            .expect("beam off");
+        assert_eq!(&lines[m5 + 1..m5 + 3], ["G40", "OFFN=0"], "{id}");
+        assert!(
+            lines[..i].iter().rev().take(8).any(|l| *l == "M3"),
+            "{id}: on after the beam"
+        );
+        let stretch = &lines[i + 1..m5];
+        let point = |l: &str, x: &str, y: &str, z: &str| {
+            Some(Point3::new(word(l, x)?, word(l, y)?, word(l, z)?))
+        };
+        let tips: Vec<Point3<f64>> = stretch
+            .iter()
+            .flat_map(|l| {
+                point(l, "I1=", "J1=", "K1=")
+                    .into_iter()
+                    .chain(point(l, "X", "Y", "Z"))
+            })
+            .collect();
+        assert!(tips.len() >= 6, "{id}: {} points", tips.len());
+        let axis = stretch
+            .iter()
+            .filter_map(|l| point(l, "A3=", "B3=", "C3="))
+            .fold(Vector3::zeros(), |s, a| s + a.coords)
+            .normalize();
+        for l in stretch {
+            if let Some(a) = point(l, "A3=", "B3=", "C3=") {
+                tilt = tilt.max(a.coords.normalize().z.clamp(-1.0, 1.0).acos().to_degrees());
+            }
+        }
+        // Twice the loop's area seen down the mean axis (about its centroid: Newell's sum).
+        let c = tips.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / tips.len() as f64;
+        let turn: f64 = tips
+            .iter()
+            .zip(tips.iter().cycle().skip(1))
+            .map(|(a, b)| (a.coords - c).cross(&(b.coords - c)).dot(&axis))
+            .sum();
+        let cut_out = id != outline;
+        assert_eq!(
+            left,
+            (turn > 0.0) == cut_out,
+            "{id}: turn {turn}, cut-out {cut_out}"
+        );
+    }
+    (cuts, tilt)
+}
+
 /// Sinumerik's `CUT3DC` compensates at right angles to the path and the tool orientation, so
-/// the leaning, turning beam of the door trim is compensated too. Each cut's compensation side
-/// is checked against the part, not against kerf's own choice: read back from the program,
-/// the tips of each compensated stretch (lead-in, contour, lead-out) run round their loop
-/// counter-clockwise or clockwise seen down the tool axis, and `G41` (the left, seen from the
-/// tool's side) must put the beam inside a hole or slot (the scrap) and outside the outline.
+/// the leaning, turning beam of the door trim is compensated too; the sides are checked on
+/// both parts against the part ([`sinumerik_sides`]).
 #[test]
 fn sinumerik_compensates_with_cut3dc_offn_and_g41_or_g42_on_the_scrap_side() {
     let (file, out) =
@@ -395,68 +465,21 @@ fn sinumerik_compensates_with_cut3dc_offn_and_g41_or_g42_on_the_scrap_side() {
     assert_eq!(lines[traori + 4], "G450", "circles at outside corners");
     assert!(at("CUT2D").expect("CUT2D") < at("TRAFOOF").expect("TRAFOOF"));
     assert!(text.contains(
-        "kerf compensation in the controller: CUT3DC G41/G42 OFFN=0.1 [tool radius 0] from the run's kerf_width_mm on 8 paths"
+        "kerf compensation in the controller: CUT3DC G41/G42 OFFN=0.1 [active D radius 0; 3D TRC option] from the run's kerf_width_mm on 8 paths"
     ));
-    let mut cuts = 0;
-    for (i, l) in lines.iter().enumerate() {
-        let left = match *l {
-            "G41" => true,
-            "G42" => false,
-            _ => continue,
-        };
-        cuts += 1;
-        let offn = word(lines[i - 1], "OFFN=").expect("OFFN before G41/G42");
-        assert!((offn - 0.1).abs() < 1e-9, "half the kerf: {offn}");
-        let id = lines[..i]
-            .iter()
-            .rev()
-            .find_map(|l| l.strip_prefix("; curve ").and_then(|r| r.split(',').next()))
-            .expect("the cut's curve");
-        // The beam is on, and G40 and OFFN=0 come after it is off.
-        let m5 = (i..lines.len())
-            .find(|&j| lines[j] == "M5")
-            .expect("beam off");
-        assert_eq!(&lines[m5 + 1..m5 + 3], ["G40", "OFFN=0"], "{id}");
-        assert!(
-            lines[..i].iter().rev().take(8).any(|l| *l == "M3"),
-            "{id}: on after the beam"
-        );
-        // The compensated tips (a CIP arc's intermediate point before its end), and the
-        // orientation of their loop seen down the tool axis.
-        let tips: Vec<(f64, f64)> = lines[i + 1..m5]
-            .iter()
-            .flat_map(|l| {
-                let mid = word(l, "I1=").zip(word(l, "J1="));
-                mid.into_iter().chain(word(l, "X").zip(word(l, "Y")))
-            })
-            .collect();
-        assert!(tips.len() >= 6, "{id}: {} points", tips.len());
-        let axis_up = lines[i + 1..m5]
-            .iter()
-            .filter_map(|l| word(l, "C3="))
-            .all(|k| k > 0.999_999);
-        assert!(axis_up, "{id}: the gantry's beam stands vertical here");
-        let area: f64 = tips
-            .iter()
-            .zip(tips.iter().cycle().skip(1))
-            .map(|(a, b)| a.0 * b.1 - b.0 * a.1)
-            .sum();
-        // Every loop but the outline is a cut-out: its scrap is inside.
-        let hole = id != "outline";
-        let scrap_on_the_left = (area > 0.0) == hole;
-        assert_eq!(left, scrap_on_the_left, "{id}: area {area}, hole {hole}");
-    }
+    let (cuts, tilt) = sinumerik_sides(text, "outline");
     assert_eq!(cuts, 8, "one compensation per cut");
+    assert!(
+        tilt < 1e-3,
+        "the gantry's beam stands vertical here: {tilt}"
+    );
     // The paths are the contours themselves (the holes' cut poses on their circles).
     holes_cut_on_their_circles(&out, &file);
-    // The door trim's beam leans and turns: G41.1 cannot, CUT3DC can.
+    // The door trim's beam leans (5 to 16 degrees) and turns: G41.1 cannot, CUT3DC can.
     let (_, door) = in_control("door_trim.json", kerf_interp::Dialect::Sinumerik).expect("door");
-    let text = &door.programs[0].text;
-    let comps = text
-        .lines()
-        .filter(|l| matches!(l.trim(), "G41" | "G42"))
-        .count();
-    assert_eq!(comps, door.solved.len(), "every cut compensated");
+    let (cuts, tilt) = sinumerik_sides(&door.programs[0].text, "trim-outline");
+    assert_eq!(cuts, door.solved.len(), "every cut compensated");
+    assert!(tilt > 4.0, "a leaning beam: {tilt} deg");
     assert_eq!(door.report.compensation.mode.as_deref(), Some("controller"));
 }
 

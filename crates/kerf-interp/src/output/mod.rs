@@ -122,10 +122,12 @@ pub struct GcodeOptions {
     /// sanitizer), e.g. the placement of the part and its set-up (default none).
     pub header: Vec<String>,
     /// The controller's own cutter (kerf) compensation per path (indexed like the blocks'
-    /// `path`): `Some` writes LinuxCNC's `G41.1 D` / `G42.1 D` after the pierce descent, before
-    /// the lead-in, and `G40` at the cut's end, before the beam goes off (LinuxCNC sets no output
-    /// while it compensates); the paths are then the contours themselves.
-    /// Only the LinuxCNC dialect writes it ([`gcode_timed`] refuses it elsewhere). Default none.
+    /// `path`): `Some` switches it on after the pierce descent, for the lead-in's first move
+    /// (which must be a line), and off at the cut's end; the paths are then the contours
+    /// themselves. LinuxCNC: `G41.1 D` / `G42.1 D`, `G40` before the beam goes off (LinuxCNC
+    /// sets no output while it compensates). Sinumerik: `CUT3DC` and `G450` in the header,
+    /// `OFFN=<kerf/2>` with `G41` / `G42`, `G40` and `OFFN=0` after the beam is off, `CUT2D`
+    /// at the end. The other dialects refuse it ([`gcode_timed`]). Default none.
     pub cutter_compensation: Vec<Option<CutterCompensation>>,
     /// Laser power that follows the tip's speed ([`LaserPower`]; its module docs give each
     /// dialect's words). `None` (the default): the program switches the beam and commands
@@ -147,9 +149,9 @@ pub struct GcodeOptions {
 /// the path from above (the tool axis toward the viewer), and the kerf width.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CutterCompensation {
-    /// True for the left of the path (`G41.1`), false for the right (`G42.1`).
+    /// True for the left of the path (`G41.1`, `G41`), false for the right (`G42.1`, `G42`).
     pub left: bool,
-    /// The kerf width, mm: the compensation's diameter `D`.
+    /// The kerf width, mm: LinuxCNC's diameter `D`; Sinumerik's `OFFN` is half of it.
     pub kerf_width_mm: f64,
 }
 
@@ -528,6 +530,15 @@ pub fn gcode_timed<M: AxisModel>(
             w.path_s = 0.0;
             w.start_cut(b);
             if let Some(Some(c)) = opts.cutter_compensation.get(b.path) {
+                // The controllers select their compensation on a line (LinuxCNC's entry move,
+                // Sinumerik's G41/G42 in a G1 block), not on an arc.
+                if matches!(b.geometry, Geometry::Arc(_)) {
+                    return Err(InterpError::BadParameter {
+                        name: "cutter_compensation",
+                        value: b.path as f64,
+                        reason: "the controller's kerf compensation is switched on for the lead-in's first move, and an arc was fitted there: the controllers select it on a line; give the lead-in a straight start or compensate in the computer",
+                    });
+                }
                 w.compensation_on(c);
             }
         }

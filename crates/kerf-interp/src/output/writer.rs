@@ -59,7 +59,8 @@ pub(super) struct Writer<'a> {
     /// (the tool-tip dialects; Sinumerik keeps the axes).
     pub(super) last: Option<Axes>,
     pub(super) in_cut: bool,
-    /// True while the controller's cutter compensation is on (`G41.1`/`G42.1` written).
+    /// True while the controller's cutter compensation is on ([`Rules::compensation_on`]
+    /// written).
     pub(super) compensating: bool,
     /// The last `F` written (Sinumerik, modal).
     pub(super) last_f: Option<String>,
@@ -552,7 +553,7 @@ impl<'a> Writer<'a> {
             let l = format!("{g0} {}", words(self, &tip, &a));
             self.line(&l);
         }
-        self.last = Some(self.printed(&Axes::new(p.x, p.y, p.z, q[3], q[4])));
+        self.last = Some(self.printed(&Axes::new(p.x, p.y, p.z, q.tilt, q.c)));
         self.last_axes = Some(q);
     }
 
@@ -669,7 +670,7 @@ pub(super) fn exit_point<M: AxisModel + ?Sized>(
     process: &ProcessCodes,
     b: &Block,
 ) -> (nalgebra::Point3<f64>, Axes, nalgebra::Vector3<f64>, f64) {
-    let (tilt, c) = (b.end_axes[3], b.end_axes[4]);
+    let (tilt, c) = (b.end_axes.tilt, b.end_axes.c);
     let u = model.tool_axis(tilt, c);
     let h = process.pierce_standoff.max(crate::EXIT_RETRACT_MIN_MM);
     let p = b.end_tip() + u * h;
@@ -684,7 +685,7 @@ pub(super) fn pierce_point<M: AxisModel + ?Sized>(
     process: &ProcessCodes,
     b: &Block,
 ) -> (nalgebra::Point3<f64>, Axes, nalgebra::Vector3<f64>) {
-    let (tilt, c) = (b.start_axes[3], b.start_axes[4]);
+    let (tilt, c) = (b.start_axes.tilt, b.start_axes.c);
     let u = model.tool_axis(tilt, c);
     let h = process.pierce_standoff;
     let pierce = b.start_tip() + u * h;

@@ -58,7 +58,7 @@ pub fn link_paths_through<M: AxisModel + ?Sized>(
         };
         let start = Station {
             tip: first.start_tip(),
-            axis: model.tool_axis(first.start_axes[3], first.start_axes[4]),
+            axis: model.tool_axis(first.start_axes.tilt, first.start_axes.c),
             param: None,
             axes: first.start_axes,
         };
@@ -127,13 +127,13 @@ fn retract_stops<M: AxisModel + ?Sized>(
         retract.max(0.0)
     };
     let station = |tip: nalgebra::Point3<f64>, axes: Axes| {
-        let axis = model.tool_axis(axes[3], axes[4]);
-        let lin = model.linear_axes(&tip, axes[3], axes[4]);
+        let axis = model.tool_axis(axes.tilt, axes.c);
+        let lin = model.linear_axes(&tip, axes.tilt, axes.c);
         Station {
             tip,
             axis,
             param: None,
-            axes: Axes::new(lin[0], lin[1], lin[2], axes[3], axes[4]),
+            axes: Axes::new(lin[0], lin[1], lin[2], axes.tilt, axes.c),
         }
     };
     let end = station(last.end_tip(), last.end_axes);

@@ -114,8 +114,8 @@ pub struct OffsetInput<'a> {
     /// The curve parameter of every cutting point (strictly increasing; every C0 break of the
     /// curve among them, as the discretizer puts them).
     pub params: &'a [f64],
-    /// The cutting points with their tool axes (`[x, y, z, i, j, k]`, the axis pointing from
-    /// the tip toward the head), one per parameter.
+    /// The cutting points with their tool axes (the axis pointing from the tip toward the
+    /// head), one per parameter.
     pub poses: &'a [Pose],
     /// The surface's unit normal at each cutting point where it is not the tool axis (a tilted
     /// beam): the tip slides along the beam onto the tangent plane there. `None`: the axis is

@@ -138,7 +138,7 @@ impl Fanuc {
     /// (`G43.5`, from the axes through the machine's kinematics).
     fn words(&self, w: &Writer<'_>, tip: &Point3<f64>, q: &Axes) -> String {
         if self.ijk {
-            let u = w.model.tool_axis(q[3], q[4]);
+            let u = w.model.tool_axis(q.tilt, q.c);
             format!(
                 "X{} Y{} Z{} I{} J{} K{}",
                 w.num(tip.x),
@@ -149,7 +149,7 @@ impl Fanuc {
                 w.num(u.z)
             )
         } else {
-            tcp_words(w, tip, q[3], q[4])
+            tcp_words(w, tip, q.tilt, q.c)
         }
     }
 
@@ -159,7 +159,7 @@ impl Fanuc {
     /// change.
     fn cut_move(&self, w: &mut Writer<'_>, tip: Point3<f64>, q: Axes, t: f64, tip_mm: f64) {
         w.last_axes = Some(q);
-        let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q[3], q[4])) else {
+        let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q.tilt, q.c)) else {
             return;
         };
         let f = rs274_feed(&prev, &now, t);

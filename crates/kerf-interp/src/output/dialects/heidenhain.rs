@@ -210,7 +210,7 @@ impl Heidenhain {
                 signed(w, q[4])
             )
         } else {
-            let u = w.model.tool_axis(q[3], q[4]).normalize();
+            let u = w.model.tool_axis(q.tilt, q.c).normalize();
             format!(
                 "{xyz} TX{} TY{} TZ{}",
                 direction(u.x),
@@ -225,7 +225,7 @@ impl Heidenhain {
     /// printed position does not change.
     fn cut_move(&self, w: &mut Writer<'_>, tip: Point3<f64>, q: Axes, t: f64) {
         w.last_axes = Some(q);
-        let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q[3], q[4])) else {
+        let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q.tilt, q.c)) else {
             return;
         };
         let f = rs274_feed(&prev, &now, t);

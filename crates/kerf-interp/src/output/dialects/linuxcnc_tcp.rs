@@ -294,7 +294,7 @@ pub(super) fn tcp_words(w: &Writer<'_>, tip: &Point3<f64>, tilt: f64, c: f64) ->
 /// pieces of its own tip line.
 fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: Axes, t: f64) {
     let from = w.last_axes.replace(q);
-    let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q[3], q[4])) else {
+    let Some((now, prev)) = w.moved(&Axes::new(tip.x, tip.y, tip.z, q.tilt, q.c)) else {
         return;
     };
     let d: [f64; 5] = std::array::from_fn(|k| now[k] - prev[k]);
@@ -312,7 +312,7 @@ fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: Axes, t: f64) {
                 &b,
                 |w, fr, _| {
                     let end = if fr == 1.0 {
-                        tcp_words(w, &tip, q[3], q[4])
+                        tcp_words(w, &tip, q.tilt, q.c)
                     } else {
                         words(w, fr)
                     };
@@ -322,7 +322,7 @@ fn tcp_move(w: &mut Writer<'_>, tip: Point3<f64>, q: Axes, t: f64) {
             );
         }
         _ => {
-            let l = format!("G1 {} F{f}", tcp_words(w, &tip, q[3], q[4]));
+            let l = format!("G1 {} F{f}", tcp_words(w, &tip, q.tilt, q.c));
             w.line(&l);
         }
     }

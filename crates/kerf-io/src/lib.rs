@@ -46,5 +46,5 @@ pub use json::{json_type_name, parse_json, path_at, JsonError, StrictValue};
 pub use keys::{near_misses_in, UnknownKey};
 pub use read::{read_file, read_regular_file, read_to_end, strip_bom, MAX_INPUT_BYTES};
 pub use shape::{deserialize_at, duplicate_key_message, JsonProblem, ShapeError};
-pub use text::{check_text, TextDefect};
+pub use text::{check_text, decimal, TextDefect};
 pub use write::{same_file, write_dir_all_or_nothing, write_file, Contents, DirEntry, DirError};

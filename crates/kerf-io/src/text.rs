@@ -56,9 +56,45 @@ pub fn check_text(text: &str) -> Result<(), TextDefect> {
     }
 }
 
+/// `x` with at most `places` decimals, trailing zeros and a trailing point dropped, `-0` as
+/// `0`: a number for a human or a file that wants no noise (`0.031000000000000003` to 12
+/// places is `0.031`, `2.50` to 2 is `2.5`). A non-finite `x` is written as Rust writes it
+/// (`NaN`, `inf`).
+pub fn decimal(x: f64, places: usize) -> String {
+    let s = format!("{x:.places$}");
+    if !x.is_finite() {
+        return s;
+    }
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn decimals_drop_their_noise_and_trailing_zeros_only() {
+        assert_eq!(decimal(0.01 + 0.01 + 0.005 + 0.001 + 0.005, 12), "0.031");
+        assert_eq!(decimal(2.5, 2), "2.5");
+        assert_eq!(decimal(100.0, 2), "100", "zeros before the point stay");
+        assert_eq!(decimal(120.0, 0), "120", "no point: nothing trimmed");
+        assert_eq!(decimal(-0.001, 2), "0", "-0 is 0");
+        assert_eq!(
+            decimal(-1.25, 1),
+            "-1.2",
+            "rounded half to even as format! does"
+        );
+        assert_eq!(decimal(f64::NAN, 3), "NaN");
+    }
 
     #[test]
     fn printable_text_passes() {

@@ -16,13 +16,7 @@ pub(crate) fn num(x: f64) -> String {
     if !x.is_finite() {
         return "0".into();
     }
-    let s = format!("{x:.2}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".into()
-    } else {
-        s.to_owned()
-    }
+    kerf_io::decimal(x, 2)
 }
 
 /// Escapes `&`, `<`, `>`, `"` and `'` for text content and attribute values.

@@ -251,7 +251,7 @@ impl<'a> Writer<'a> {
         self.comment(&format!(
             "tolerance budget mm: {} = {}{qualifier}",
             terms.join(" + "),
-            decimal(o.budget_total())
+            kerf_io::decimal(o.budget_total(), 12)
         ));
         for note in notes {
             self.comment(&format!("tolerance budget: {note}"));
@@ -660,19 +660,6 @@ pub(super) fn feed_number(f: f64) -> String {
     let mag = f.log10().floor() as i32;
     let decimals = (5 - mag).clamp(0, 12) as usize;
     format!("{f:.decimals$}")
-}
-
-/// `x` as a decimal of at most 12 places, trailing zeros dropped: a sum of decimal terms
-/// without its binary rounding noise (`0.01 + 0.01 + 0.005 + 0.001 + 0.005` is
-/// `0.031000000000000003` as a double, written `0.031`).
-fn decimal(x: f64) -> String {
-    let s = format!("{x:.12}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".to_string()
-    } else {
-        s.to_string()
-    }
 }
 
 /// The end of the retract after the program's last cut, `b` (along the tool axis at its

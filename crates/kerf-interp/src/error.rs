@@ -224,6 +224,15 @@ pub enum InterpError {
         /// What does not match.
         reason: String,
     },
+    /// The controller's kerf compensation is switched on for a path whose first cutting
+    /// block (the lead-in's first move, the controller's entry move) was fitted as an arc:
+    /// LinuxCNC and Sinumerik select their compensation on a line. Fix: give the lead-in a
+    /// straight start, or compensate in the computer.
+    #[error("{path}: the controller's kerf compensation is switched on for the lead-in's first move, which was fitted as an arc; the controllers select it on a line: give the lead-in a straight start or compensate in the computer")]
+    CompensationOnArc {
+        /// The path's id (its curve's).
+        path: String,
+    },
 }
 
 impl InterpError {

@@ -605,12 +605,13 @@ pub(crate) fn controller_compensation(
             } else {
                 0.0
             };
-            if entry <= 0.5 * k.width_mm {
+            // A NaN length (a degenerate axis) is refused too.
+            if entry.is_nan() || entry <= 0.5 * k.width_mm {
                 return Err(kerf_process::ProcessError::Compensation {
                     id: file.curves[cut.curve].id.clone(),
                     kerf_width_mm: k.width_mm,
                     reason: format!(
-                        "the controller engages its compensation on the lead-in's first move, which must be a line longer than half the kerf ({} mm); here it is {entry:.4} mm{}: give a longer lead-in or compensate in the computer",
+                        "the controller engages its compensation on the lead-in's first move, which must be a line longer than half the kerf ({} mm) at right angles to the tool axis; here it is {entry:.4} mm{}: give a longer lead-in or compensate in the computer",
                         0.5 * k.width_mm,
                         if m == 0 { " (no lead-in)" } else { "" }
                     ),

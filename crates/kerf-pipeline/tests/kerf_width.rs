@@ -494,6 +494,31 @@ fn the_controller_compensation_is_refused_where_it_cannot_hold() {
         panic!("a turning beam")
     };
     assert!(e.to_string().contains("needs the beam vertical"), "{e}");
+    // Both controllers engage on the lead-in's first line, which must be longer than half
+    // the kerf at right angles to the tool axis: a 0.05 mm straight start is refused by name.
+    for dialect in [
+        kerf_interp::Dialect::Linuxcnc,
+        kerf_interp::Dialect::Sinumerik,
+    ] {
+        let curves = kerf_format::curves::load(fixture("sheet_metal_holes.json")).expect("curves");
+        let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+        let e = Job::new(curves, machine)
+            .with_options(
+                JobOptions::default()
+                    .with_dialect(dialect)
+                    .with_kerf_width_mm(Some(0.2))
+                    .with_kerf_in_control(true)
+                    .with_leads(kerf_process::LeadOptions::default().with_lead_in(0.05, 0.0)),
+            )
+            .run()
+            .expect_err("too short an entry move");
+        let text = e.to_string();
+        assert!(
+            text.contains("longer than half the kerf (0.1 mm) at right angles to the tool axis")
+                && text.contains("here it is 0.0500 mm"),
+            "{dialect:?}: {text}"
+        );
+    }
 }
 
 #[test]

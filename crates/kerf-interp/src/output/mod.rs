@@ -533,10 +533,11 @@ pub fn gcode_timed<M: AxisModel>(
                 // The controllers select their compensation on a line (LinuxCNC's entry move,
                 // Sinumerik's G41/G42 in a G1 block), not on an arc.
                 if matches!(b.geometry, Geometry::Arc(_)) {
-                    return Err(InterpError::BadParameter {
-                        name: "cutter_compensation",
-                        value: b.path as f64,
-                        reason: "the controller's kerf compensation is switched on for the lead-in's first move, and an arc was fitted there: the controllers select it on a line; give the lead-in a straight start or compensate in the computer",
+                    return Err(InterpError::CompensationOnArc {
+                        path: path_ids
+                            .get(b.path)
+                            .cloned()
+                            .unwrap_or_else(|| format!("path {}", b.path)),
                     });
                 }
                 w.compensation_on(c);

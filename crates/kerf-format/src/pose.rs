@@ -28,6 +28,11 @@ impl Pose {
         }
     }
 
+    /// The pose at `position` with the tool axis `axis`.
+    pub fn at(position: Point3<f64>, axis: Vector3<f64>) -> Self {
+        Self { position, axis }
+    }
+
     /// The pose from `[x, y, z, i, j, k]` (a toolpath point with its normal).
     pub fn from_array(a: [f64; 6]) -> Self {
         Self::new(a[0], a[1], a[2], a[3], a[4], a[5])

@@ -127,22 +127,6 @@ pub(crate) struct Kerf {
     pub(crate) dialect: kerf_interp::Dialect,
 }
 
-impl Kerf {
-    /// How the controller compensates, in the header's words: only numbers and kerf's own
-    /// words (Sinumerik: the half kerf as `OFFN`, so an active tool offset `D` is needed
-    /// whose radius, `$TC_DP6` plus the wear `$TC_DP15`, is 0, and `CUT3DC` needs Siemens' 3D
-    /// tool radius compensation option).
-    fn controller_words(&self) -> String {
-        match self.dialect {
-            kerf_interp::Dialect::Sinumerik => format!(
-                "CUT3DC G41/G42 OFFN={} (active D radius 0; 3D TRC option)",
-                0.5 * self.width_mm
-            ),
-            _ => format!("G41.1/G42.1 D{}", self.width_mm),
-        }
-    }
-}
-
 /// What kerf compensation did to one contour.
 pub(crate) struct Compensated {
     pub(crate) curve: usize,
@@ -456,7 +440,7 @@ pub(crate) fn kerf_header(kerf: Option<&Kerf>, compensated: &[Compensated]) -> S
     if k.in_control {
         format!(
             "kerf compensation in the controller: {} from {} on {done} paths{rest}",
-            k.controller_words(),
+            k.dialect.compensation_words(k.width_mm),
             k.source
         )
     } else {
@@ -580,7 +564,7 @@ pub(crate) fn controller_compensation(
             let tilt = range(&|a| a.tilt);
             let c = range(&|a| a.c);
             let vertical = s.poses.iter().all(|p| p.axis.z >= 1.0 - 1e-12);
-            let any_orientation = k.dialect != kerf_interp::Dialect::Linuxcnc;
+            let any_orientation = !k.dialect.compensation_xy_only();
             if !(any_orientation
                 || vertical && tilt.0.abs() <= 1e-9 && tilt.1.abs() <= 1e-9 && c.1 - c.0 <= 1e-9)
             {

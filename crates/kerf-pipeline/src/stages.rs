@@ -121,12 +121,7 @@ impl<'a> Run<'a> {
         MachineModel::new(machine.clone())
             .and_then(|m| o.dialect.check_machine(&m))
             .map_err(interp(path))?;
-        if kerf.as_ref().is_some_and(|k| k.in_control)
-            && !matches!(
-                o.dialect,
-                kerf_interp::Dialect::Linuxcnc | kerf_interp::Dialect::Sinumerik
-            )
-        {
+        if kerf.as_ref().is_some_and(|k| k.in_control) && !o.dialect.controller_compensation() {
             return Err(crate::Error::BadOption {
                 name: "kerf_in_control",
                 value: 1.0,

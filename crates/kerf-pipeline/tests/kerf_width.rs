@@ -168,12 +168,7 @@ fn sheet_metal_holes_shrink_by_half_the_kerf_and_the_outline_grows() {
     let (file, out) = run("sheet_metal_holes.json", Some(0.2), PlaceMode::AsModelled);
     let (_, plain) = run("sheet_metal_holes.json", None, PlaceMode::AsModelled);
     for c in file.curves.iter().filter(|c| c.id.starts_with("hole-d")) {
-        let cps = c.curve.control_points();
-        let centre = cps[..cps.len() - 1]
-            .iter()
-            .fold(Vector3::zeros(), |s, p| s + p.coords)
-            / (cps.len() - 1) as f64;
-        let radius = (cps[0].coords - centre).norm();
+        let (centre, radius) = circle_of(&c.curve);
         for (o, want) in [(&out, radius - 0.1), (&plain, radius)] {
             for p in cut_points(o, &file, &c.id) {
                 let d = (p.coords - centre).norm();
@@ -288,15 +283,21 @@ fn in_control(
     Ok((curves, out))
 }
 
+/// The centre and radius of a fixture's circle: its control polygon is a regular one closed
+/// on itself, so the centre is the mean of its distinct control points.
+fn circle_of(curve: &kerf_nurbs::NurbsCurve) -> (Vector3<f64>, f64) {
+    let cps = curve.control_points();
+    let centre = cps[..cps.len() - 1]
+        .iter()
+        .fold(Vector3::zeros(), |s, p| s + p.coords)
+        / (cps.len() - 1) as f64;
+    (centre, (cps[0].coords - centre).norm())
+}
+
 /// The paths are the contours themselves: every cut pose of the holes on its circle.
 fn holes_cut_on_their_circles(out: &Output, file: &CurvesFile) {
     for curve in file.curves.iter().filter(|c| c.id.starts_with("hole-d")) {
-        let cps = curve.curve.control_points();
-        let centre = cps[..cps.len() - 1]
-            .iter()
-            .fold(Vector3::zeros(), |s, p| s + p.coords)
-            / (cps.len() - 1) as f64;
-        let radius = (cps[0].coords - centre).norm();
+        let (centre, radius) = circle_of(&curve.curve);
         for p in cut_points(out, file, &curve.id) {
             assert!(
                 ((p.coords - centre).norm() - radius).abs() <= TOL,

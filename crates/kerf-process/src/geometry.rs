@@ -7,16 +7,6 @@ use nalgebra::{Point3, Vector2, Vector3};
 
 use crate::Pose;
 
-/// The position of a pose (for `map`).
-pub(crate) fn position(p: &Pose) -> Point3<f64> {
-    p.position
-}
-
-/// The normal of a pose (for `map`).
-pub(crate) fn normal(p: &Pose) -> Vector3<f64> {
-    p.axis
-}
-
 /// A closed contour in the plane through its first point perpendicular to its mean normal.
 #[derive(Debug, Clone)]
 pub(crate) struct Projected {
@@ -39,21 +29,21 @@ impl Projected {
         if poses.len() < 4 {
             return None;
         }
-        let first = position(&poses[0]);
-        let last = position(&poses[poses.len() - 1]);
+        let first = poses[0].position;
+        let last = poses[poses.len() - 1].position;
         if (first - last).norm() > tol {
             return None;
         }
         // Whether the normals cancel over the distinct points (the closing point repeats the
         // first); the projection keeps the sum over all points.
-        let distinct: Vector3<f64> = poses[..poses.len() - 1].iter().map(normal).sum();
+        let distinct: Vector3<f64> = poses[..poses.len() - 1].iter().map(|p| p.axis).sum();
         let wraps = distinct.norm() < 1e-6 * poses.len() as f64;
-        let mut n: Vector3<f64> = poses.iter().map(normal).sum();
+        let mut n: Vector3<f64> = poses.iter().map(|p| p.axis).sum();
         if n.norm() < 1e-6 * poses.len() as f64 {
             // Normals cancel (a loop around a tube): use the polygon's own plane (Newell).
             n = Vector3::zeros();
             for w in poses.windows(2) {
-                n += position(&w[0]).coords.cross(&position(&w[1]).coords);
+                n += w[0].position.coords.cross(&w[1].position.coords);
             }
         }
         let n = n.try_normalize(1e-300)?;
@@ -67,7 +57,7 @@ impl Projected {
         let poly: Vec<Vector2<f64>> = poses[..poses.len() - 1]
             .iter()
             .map(|p| {
-                let d = position(p) - first;
+                let d = p.position - first;
                 Vector2::new(d.dot(&e1), d.dot(&e2))
             })
             .collect();
@@ -127,7 +117,7 @@ impl Projected {
         let n = poses.len();
         [0, n / 3, (2 * n) / 3]
             .iter()
-            .all(|&i| self.contains(&position(&poses[i.min(n - 1)])))
+            .all(|&i| self.contains(&poses[i.min(n - 1)].position))
     }
 
     /// True if the segment `a b` (projected) crosses an edge of the polygon other than the

@@ -2,7 +2,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use crate::geometry::{normal, position, Projected};
+use crate::geometry::Projected;
 use crate::{Contour, Pose, ProcessError, Result, Side};
 
 /// Options of the lead-ins, lead-outs and start points.
@@ -242,9 +242,9 @@ impl Leads {
 /// plane of the normal there).
 fn closed_tangent(poses: &[Pose], i: usize) -> (Vector3<f64>, Vector3<f64>) {
     let m = poses.len() - 1; // distinct points
-    let prev = position(&poses[(i + m - 1) % m]);
-    let next = position(&poses[(i + 1) % m]);
-    let n = normal(&poses[i]).normalize();
+    let prev = poses[(i + m - 1) % m].position;
+    let next = poses[(i + 1) % m].position;
+    let n = poses[i].axis.normalize();
     let mut t = next - prev;
     t -= n * n.dot(&t);
     (t.try_normalize(1e-300).unwrap_or_else(Vector3::x), n)
@@ -257,9 +257,9 @@ fn candidates(poses: &[Pose], opts: &LeadOptions) -> Vec<usize> {
     let m = poses.len() - 1;
     let turn: Vec<(f64, f64)> = (0..m)
         .map(|i| {
-            let a = position(&poses[(i + m - 1) % m]);
-            let b = position(&poses[i]);
-            let c = position(&poses[(i + 1) % m]);
+            let a = poses[(i + m - 1) % m].position;
+            let b = poses[i].position;
+            let c = poses[(i + 1) % m].position;
             let (u, v) = (b - a, c - b);
             let angle = u.angle(&v);
             let angle = if angle.is_finite() { angle } else { 0.0 };
@@ -298,13 +298,6 @@ fn candidates(poses: &[Pose], opts: &LeadOptions) -> Vec<usize> {
     flat.into_iter().step_by(step).collect()
 }
 
-fn with_axis(p: &Point3<f64>, n: &Vector3<f64>) -> Pose {
-    Pose {
-        position: *p,
-        axis: *n,
-    }
-}
-
 /// The quarter-arc-and-line lead-in and the overcut-and-exit lead-out of a closed contour
 /// starting at `s`, halved until they stay in the scrap.
 fn closed_leads(
@@ -318,15 +311,15 @@ fn closed_leads(
 ) -> LeadIn {
     let (t, n) = closed_tangent(poses, s);
     let toward = n.cross(&t) * side.sign();
-    let start = position(&poses[s]);
+    let start = poses[s].position;
     let full = opts.lead_in_mm + opts.lead_in_radius_mm;
     let mut scale = 1.0;
     let in_scrap = |p: &Point3<f64>| poly.contains(p) == scrap_inside;
     let m = poses.len() - 1;
     let near = 0.5
-        * (position(&poses[(s + 1) % m]) - start)
+        * (poses[(s + 1) % m].position - start)
             .norm()
-            .min((position(&poses[(s + m - 1) % m]) - start).norm());
+            .min((poses[(s + m - 1) % m].position - start).norm());
     loop {
         let r = opts.lead_in_radius_mm * scale;
         let l = opts.lead_in_mm * scale;
@@ -383,12 +376,12 @@ fn closed_leads(
             if opts.lead_out_mm > 0.0 && fits {
                 // The exit keeps the axis the overcut ends with (the start's where there is no
                 // overcut): the beam does not turn while it leaves.
-                let axis = out.last().map_or(n, normal);
-                out.push(with_axis(&exit, &axis));
+                let axis = out.last().map_or(n, |p| p.axis);
+                out.push(Pose::at(exit, axis));
             }
             return LeadIn {
                 start: s,
-                lead_in: pts.iter().map(|p| with_axis(p, &n)).collect(),
+                lead_in: pts.iter().map(|&p| Pose::at(p, n)).collect(),
                 lead_out: out,
                 scale: if fits { scale } else { 0.0 },
                 pierce_on_contour: !fits || pts.is_empty(),
@@ -403,14 +396,14 @@ fn closed_leads(
 fn side_in_3d(poses: &[Pose], p: &Point3<f64>, side: Side) -> bool {
     let m = poses.len() - 1;
     let Some(i) = (0..m).min_by(|&a, &b| {
-        (position(&poses[a]) - p)
+        (poses[a].position - p)
             .norm_squared()
-            .total_cmp(&(position(&poses[b]) - p).norm_squared())
+            .total_cmp(&(poses[b].position - p).norm_squared())
     }) else {
         return false;
     };
     let (t, n) = closed_tangent(poses, i);
-    let v = (p - position(&poses[i])).dot(&(n.cross(&t) * side.sign()));
+    let v = (p - poses[i].position).dot(&(n.cross(&t) * side.sign()));
     v > 1e-9
 }
 
@@ -426,10 +419,10 @@ fn overcut(
     let mut out = Vec::new();
     let mut left = length;
     let mut i = s;
-    let mut here = position(&poses[s]);
+    let mut here = poses[s].position;
     while left > 0.0 && out.len() < m {
         let j = (i + 1) % m;
-        let next = position(&poses[j]);
+        let next = poses[j].position;
         let d = (next - here).norm();
         if d >= left {
             // The overcut ends inside the segment: the point and the tool axis both at the
@@ -437,8 +430,8 @@ fn overcut(
             // segment's whole turn at the overcut's end: 0.54 deg on the saddle in LinuxCNC.)
             let f = left / d;
             let p = here + (next - here) * f;
-            let a = normal(&poses[i]) * (1.0 - f) + normal(&poses[j]) * f;
-            let a = a.try_normalize(1e-300).unwrap_or_else(|| normal(&poses[j]));
+            let a = poses[i].axis * (1.0 - f) + poses[j].axis * f;
+            let a = a.try_normalize(1e-300).unwrap_or_else(|| poses[j].axis);
             out.push(Pose {
                 position: p,
                 axis: a,
@@ -462,25 +455,25 @@ fn overcut(
 /// Lead-in and lead-out of an open contour: straight along its tangent extensions.
 fn open_leads(poses: &[Pose], opts: &LeadOptions) -> LeadIn {
     let n = poses.len();
-    let p0 = position(&poses[0]);
-    let p1 = position(&poses[1]);
-    let a0 = normal(&poses[0]);
+    let p0 = poses[0].position;
+    let p1 = poses[1].position;
+    let a0 = poses[0].axis;
     let t0 = (p1 - p0).try_normalize(1e-300).unwrap_or_else(Vector3::x);
     let len_in = opts.lead_in_mm + opts.lead_in_radius_mm;
-    let pe = position(&poses[n - 1]);
-    let pd = position(&poses[n - 2]);
-    let ae = normal(&poses[n - 1]);
+    let pe = poses[n - 1].position;
+    let pd = poses[n - 2].position;
+    let ae = poses[n - 1].axis;
     let te = (pe - pd).try_normalize(1e-300).unwrap_or_else(Vector3::x);
     let len_out = opts.overcut_mm + opts.lead_out_mm;
     LeadIn {
         start: 0,
         lead_in: if len_in > 0.0 {
-            vec![with_axis(&(p0 - t0 * len_in), &a0)]
+            vec![Pose::at(p0 - t0 * len_in, a0)]
         } else {
             Vec::new()
         },
         lead_out: if len_out > 0.0 {
-            vec![with_axis(&(pe + te * len_out), &ae)]
+            vec![Pose::at(pe + te * len_out, ae)]
         } else {
             Vec::new()
         },

@@ -254,7 +254,7 @@ pub fn scrap_sides(contours: &[Contour<'_>], options: &LeadOptions) -> Result<Ve
                 if p.wraps
                     || c.poses
                         .iter()
-                        .any(|q| geometry::normal(q).normalize().dot(&p.normal()).abs() < 0.5) =>
+                        .any(|q| q.axis.normalize().dot(&p.normal()).abs() < 0.5) =>
             {
                 None
             }

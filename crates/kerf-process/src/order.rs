@@ -1,6 +1,5 @@
 //! The cutting order: holes before the contours around them, then the shortest traverse.
 
-use crate::geometry::position;
 use crate::lead::{LeadIn, Leads};
 use crate::{Contour, Pose, Side};
 
@@ -49,7 +48,7 @@ impl CutPlan {
 }
 
 fn dist(a: &Pose, b: &Pose) -> f64 {
-    (position(a) - position(b)).norm()
+    (a.position - b.position).norm()
 }
 
 pub(crate) fn plan(

@@ -3,7 +3,6 @@
 
 use nalgebra::Point3;
 
-use crate::geometry::{normal, position};
 use crate::traverse::{Obstacles, TraverseOptions};
 use crate::Pose;
 
@@ -102,8 +101,8 @@ pub fn head_lines(obs: &Obstacles, poses: &[Pose], opts: &TraverseOptions) -> He
         ..HeadLines::default()
     };
     for &i in &picked {
-        let p = position(&poses[i]);
-        let Some(axis) = normal(&poses[i]).try_normalize(1e-12) else {
+        let p = poses[i].position;
+        let Some(axis) = poses[i].axis.try_normalize(1e-12) else {
             continue;
         };
         if !p.coords.iter().all(|v| v.is_finite()) {

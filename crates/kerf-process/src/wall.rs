@@ -11,7 +11,6 @@
 
 use nalgebra::{Point3, Vector3};
 
-use crate::geometry::{normal, position};
 use crate::{Pose, Side};
 
 /// A contour whose surface is a wall at most `max_wall_mm` wide across it ([`wall_axis`]).
@@ -70,7 +69,7 @@ pub fn wall_axis(
     if n < 2 || hull.is_empty() || !max_wall_mm.is_finite() || max_wall_mm <= 0.0 {
         return None;
     }
-    let pts: Vec<Point3<f64>> = poses.iter().map(position).collect();
+    let pts: Vec<Point3<f64>> = poses.iter().map(|p| p.position).collect();
     let closed = (pts[0] - pts[n - 1]).norm() <= 1e-6;
     let mut dirs = Vec::with_capacity(n);
     for i in 0..n {
@@ -84,7 +83,7 @@ pub fn wall_axis(
             (k, _) => (pts[k - 1], pts[k + 1]),
         };
         let t = (b - a).try_normalize(1e-12)?;
-        let nn = normal(&poses[i]).try_normalize(1e-12)?;
+        let nn = poses[i].axis.try_normalize(1e-12)?;
         let w = nn.cross(&t);
         if w.norm().is_nan() || w.norm() < MIN_CROSS {
             return None;

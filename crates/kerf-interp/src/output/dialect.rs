@@ -77,6 +77,25 @@ impl Dialect {
         self.rules().power_refusal().is_none()
     }
 
+    /// True where the dialect writes the controller's own kerf compensation (`linuxcnc`:
+    /// `G41.1`/`G42.1`; `sinumerik`: `CUT3DC` with `G41`/`G42`): the program then holds the
+    /// contours themselves ([`GcodeOptions::cutter_compensation`](crate::GcodeOptions)).
+    pub fn controller_compensation(self) -> bool {
+        self.rules().controller_compensation()
+    }
+
+    /// True where that compensation offsets in X and Y only (`linuxcnc`'s `G41.1`), so that
+    /// every compensated cut must stand the beam vertical with the rotary axes still.
+    pub fn compensation_xy_only(self) -> bool {
+        self.rules().compensation_xy_only()
+    }
+
+    /// How the controller compensates a kerf of `kerf_width_mm`, in the program header's
+    /// words (`G41.1/G42.1 D0.2`, `CUT3DC G41/G42 OFFN=0.1 (...)`); empty where it cannot.
+    pub fn compensation_words(self, kerf_width_mm: f64) -> String {
+        self.rules().compensation_words(kerf_width_mm)
+    }
+
     /// The dialect's name as the CLI spells it.
     pub fn name(self) -> &'static str {
         self.rules().name()

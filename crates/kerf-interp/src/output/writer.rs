@@ -836,6 +836,18 @@ pub(super) trait Rules: Sync {
         Vec::new()
     }
 
+    /// True where the controller's compensation offsets in X and Y only, so that a compensated
+    /// cut must stand the beam vertical with the rotary axes still (LinuxCNC's `G41.1`).
+    fn compensation_xy_only(&self) -> bool {
+        false
+    }
+
+    /// How the controller compensates a kerf of `kerf_width_mm`, in the program header's
+    /// words: empty where it cannot ([`Rules::controller_compensation`]).
+    fn compensation_words(&self, _kerf_width_mm: f64) -> String {
+        String::new()
+    }
+
     /// The lines that switch it off at the cut's end, and whether they come before the beam's
     /// off codes (`true`) or after them: `G40` before the beam by default.
     fn compensation_off(&self) -> (Vec<String>, bool) {

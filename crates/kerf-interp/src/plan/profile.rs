@@ -138,21 +138,33 @@ impl Timed {
             self.t[i]
         } else {
             // Inside interval i - 1: solve s_i + v tau + u tau^2 / 2 = s by bisection too.
-            bisect(self.t[i - 1], self.t[i], 0.0, |tau| self.s_raw(tau) >= s)
+            bisect(self.t[i - 1], self.t[i], 50, 0.0, |tau| {
+                self.s_raw(tau) >= s
+            })
+            .1
         };
         if self.tau <= 0.0 {
             return raw;
         }
         let hi = (raw + self.tau).min(self.duration);
-        bisect(raw, hi, 1e-13 * self.duration, |tau| self.s_at(tau) >= s)
+        bisect(raw, hi, 50, 1e-13 * self.duration, |tau| {
+            self.s_at(tau) >= s
+        })
+        .1
     }
 }
 
-/// The least time in `[lo, hi]` where `reached` turns true (it must be monotone), by at most
-/// 50 halvings, stopping once the bracket is `width` wide or less: the bracket's upper end.
-/// (A bracket of width 0 no longer changes, so `width` 0 is the full 50 halvings.)
-fn bisect(mut lo: f64, mut hi: f64, width: f64, reached: impl Fn(f64) -> bool) -> f64 {
-    for _ in 0..50 {
+/// The bracket `(lo, hi)` in `[lo, hi]` of where a monotone `reached` turns true (false at
+/// `lo`'s side, true at `hi`'s), by at most `halvings` halvings, stopping once it is `width`
+/// wide or less. (A bracket of width 0 no longer changes, so `width` 0 is all the halvings.)
+fn bisect(
+    mut lo: f64,
+    mut hi: f64,
+    halvings: usize,
+    width: f64,
+    reached: impl Fn(f64) -> bool,
+) -> (f64, f64) {
+    for _ in 0..halvings {
         let mid = 0.5 * (lo + hi);
         if reached(mid) {
             hi = mid;
@@ -163,7 +175,7 @@ fn bisect(mut lo: f64, mut hi: f64, width: f64, reached: impl Fn(f64) -> bool) -
             break;
         }
     }
-    hi
+    (lo, hi)
 }
 
 /// The grid of one run: nodes subdivided to at most `step`, at least two intervals each, and
@@ -530,19 +542,12 @@ fn reversal_caps(
             let (lo, hi) = plateau(c);
             c > 0.0 && (s[hi] - s[lo]) >= PLATEAU_MARGIN * tau * c.sqrt()
         };
-        let (mut lo_c, mut hi_c) = (0.0, x[top]);
-        if lasts(hi_c) {
+        if lasts(x[top]) {
             i = b;
             continue;
         }
-        for _ in 0..60 {
-            let mid = 0.5 * (lo_c + hi_c);
-            if lasts(mid) {
-                lo_c = mid;
-            } else {
-                hi_c = mid;
-            }
-        }
+        // The largest cap that still lasts.
+        let (lo_c, _) = bisect(0.0, x[top], 60, 0.0, |c| !lasts(c));
         if lo_c > 0.0 {
             let (p0, p1) = plateau(lo_c);
             caps.extend((p0..=p1).map(|k| (k, lo_c)));

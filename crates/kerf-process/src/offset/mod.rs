@@ -168,12 +168,12 @@ impl OffsetPath {
     pub fn point_at(&self, u: f64, curve: &NurbsCurve) -> Point3<f64> {
         let n = self.poses.len();
         if n == 1 || !u.is_finite() {
-            return position(&self.poses[0]);
+            return self.poses[0].position;
         }
         let u = u.clamp(0.0, (n - 1) as f64);
         let k = (u.floor() as usize).min(n - 2);
         let f = u - k as f64;
-        let (p0, p1) = (position(&self.poses[k]), position(&self.poses[k + 1]));
+        let (p0, p1) = (self.poses[k].position, self.poses[k + 1].position);
         if f == 1.0 {
             return p1;
         }
@@ -325,7 +325,7 @@ pub fn offset(input: &OffsetInput<'_>, options: &OffsetOptions) -> Result<Offset
         return Err(bad(format!("surface normal {i} is not a unit vector")));
     }
     if input.closed {
-        let (a, b) = (position(&input.poses[0]), position(&input.poses[n - 1]));
+        let (a, b) = (input.poses[0].position, input.poses[n - 1].position);
         // As `LeadOptions::closed_tolerance_mm` has it by default.
         if (a - b).norm() > 1e-6 {
             return Err(bad(
@@ -462,8 +462,8 @@ impl<'a> Context<'a> {
         let input = self.input;
         let curve = input.curve;
         let (t0, t1) = (input.params[i], input.params[i + 1]);
-        let c0 = position(&input.poses[i]);
-        let c1 = position(&input.poses[i + 1]);
+        let c0 = input.poses[i].position;
+        let c1 = input.poses[i + 1].position;
         if (c1 - c0).norm() == 0.0 {
             return Ok(());
         }
@@ -818,8 +818,4 @@ fn nlerp(a: &Vector3<f64>, b: &Vector3<f64>, f: f64) -> Vector3<f64> {
         return *b;
     }
     (a * (1.0 - f) + b * f).try_normalize(0.0).unwrap_or(*a)
-}
-
-fn position(p: &Pose) -> Point3<f64> {
-    p.position
 }

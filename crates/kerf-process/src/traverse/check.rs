@@ -3,7 +3,6 @@
 use nalgebra::{Point3, Vector3};
 
 use super::Obstacles;
-use crate::geometry::{normal, position};
 use crate::Pose;
 
 /// Why a stretch of a traverse is not clear: the first offending sample.
@@ -84,8 +83,8 @@ pub(super) struct Trace<'a> {
 impl<'a> Trace<'a> {
     /// The move `a -> b` with its nozzle, kept `need` from `obs`.
     pub(super) fn new(obs: &'a Obstacles, a: &Pose, b: &Pose, need: f64, nozzle: f64) -> Self {
-        let (pa, pb) = (position(a), position(b));
-        let (na, nb) = (normal(a).normalize(), normal(b).normalize());
+        let (pa, pb) = (a.position, b.position);
+        let (na, nb) = (a.axis.normalize(), b.axis.normalize());
         let half_cos = (0.5 * (1.0 + na.dot(&nb)))
             .max(0.0)
             .sqrt()

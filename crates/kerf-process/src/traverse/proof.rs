@@ -7,7 +7,6 @@ use nalgebra::{Point3, Vector3};
 
 use super::check::Blocked;
 use super::{Obstacles, TraverseOptions};
-use crate::geometry::{normal, position};
 use crate::Pose;
 
 /// Most samples the proof takes along one line (beyond them it gives up: no proof).
@@ -35,8 +34,8 @@ pub(super) fn line_blocked(
 ) -> Option<(Blocked, String)> {
     let c = opts.clearance_mm;
     let noz = opts.nozzle_mm;
-    let q = position(p);
-    let n = normal(p).try_normalize(1e-12)?;
+    let q = p.position;
+    let n = p.axis.try_normalize(1e-12)?;
     let lo = 0.75 * c;
     let r = opts.retract_mm;
     // Beyond the surfaces' box (grown by the clearance) every point keeps the clearance: the

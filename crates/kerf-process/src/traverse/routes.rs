@@ -1,11 +1,10 @@
 //! The routes of a traverse (straight, lifted, over the safe plane), checked shortest first.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 
 use super::check::{Blocked, Trace, Work, MOVE_SAMPLES};
 use super::obstacles::top_along;
 use super::{Obstacles, TraverseOptions};
-use crate::geometry::{normal, position};
 use crate::{Pose, ProcessError, Result};
 
 /// How a traverse runs.
@@ -55,13 +54,6 @@ pub struct Traverse {
     /// The length of the tip's path from the exit to the pierce: retract, travel, approach,
     /// mm.
     pub length_mm: f64,
-}
-
-fn with_axis(p: Point3<f64>, n: Vector3<f64>) -> Pose {
-    Pose {
-        position: p,
-        axis: n,
-    }
 }
 
 fn path_length(points: &[Point3<f64>]) -> f64 {
@@ -291,7 +283,7 @@ pub(crate) fn plan_traverse_accepting<T>(
 ) -> Result<(Traverse, T)> {
     opts.validate()?;
     for (name, p) in [("from", from), ("to", to)] {
-        let axis_ok = normal(p).norm() > 1e-9;
+        let axis_ok = p.axis.norm() > 1e-9;
         if !p.is_finite() || !axis_ok {
             return Err(ProcessError::BadContour {
                 id: format!("traverse {name}"),
@@ -304,8 +296,8 @@ pub(crate) fn plan_traverse_accepting<T>(
     let floor = opts.margin();
     let up = opts.up.normalize();
     let unit = |p: &Pose| {
-        let n = normal(p).normalize();
-        with_axis(position(p), n)
+        let n = p.axis.normalize();
+        Pose::at(p.position, n)
     };
     let (from, to) = (unit(from), unit(to));
     // The retract (and the approach) along the tool axis: from 3/4 of the clearance to the
@@ -314,19 +306,19 @@ pub(crate) fn plan_traverse_accepting<T>(
     // at the retract point, where the travel starts, keeps the full clearance: the travel's
     // check.)
     let axial = |p: &Pose, height: f64| -> std::result::Result<Pose, Blocked> {
-        let (q, n) = (position(p), normal(p));
-        let low = with_axis(q + n * (0.75 * c), n);
-        let high = with_axis(q + n * height, n);
+        let (q, n) = (p.position, p.axis);
+        let low = Pose::at(q + n * (0.75 * c), n);
+        let high = Pose::at(q + n * height, n);
         // The tip and the nozzle sweep the one line from `low` to the height plus the
         // nozzle: traced as the tip's.
-        let top = with_axis(q + n * (height + opts.nozzle_mm), n);
+        let top = Pose::at(q + n * (height + opts.nozzle_mm), n);
         Trace::new(obs, &low, &top, 0.5 * c, 0.0).prove(floor, &mut Work::new(MOVE_SAMPLES))?;
         Ok(high)
     };
     let length_of = |way: &[Pose]| {
-        let mut pts = vec![position(&from)];
-        pts.extend(way.iter().map(position));
-        pts.push(position(&to));
+        let mut pts = vec![from.position];
+        pts.extend(way.iter().map(|p| p.position));
+        pts.push(to.position);
         path_length(&pts)
     };
     // The travel between the waypoints, tip and nozzle keeping the clearance: with the
@@ -394,8 +386,8 @@ pub(crate) fn plan_traverse_accepting<T>(
     };
     // The retract point at height `k` of an end, whether or not its axial move is clear.
     let retract_point = |p: &Pose, k: usize| {
-        let (q, n) = (position(p), normal(p));
-        with_axis(q + n * heights[k], n)
+        let (q, n) = (p.position, p.axis);
+        Pose::at(q + n * heights[k], n)
     };
     // Every route: straight between any two retract points, lifted along `up` over the
     // surfaces near the travel, or over the safe plane above every surface; checked shortest
@@ -406,9 +398,9 @@ pub(crate) fn plan_traverse_accepting<T>(
     let mut route_ends: Vec<(usize, usize)> = Vec::new();
     let lift_to = |level: f64| {
         move |p: &Pose| {
-            let q = position(p);
+            let q = p.position;
             let rise = (level - q.coords.dot(&up)).max(0.0);
-            with_axis(q + up * rise, normal(p))
+            Pose::at(q + up * rise, p.axis)
         }
     };
     let global_top = obs
@@ -421,7 +413,7 @@ pub(crate) fn plan_traverse_accepting<T>(
             let straight = vec![*a, *b];
             routes.push((length_of(&straight), Route::Straight, straight));
             route_ends.push((ka, kb));
-            let (pa, pb) = (position(a), position(b));
+            let (pa, pb) = (a.position, b.position);
             // Each lift at a clearance and two steps above the boxes' top, and a clearance
             // higher (where a tilted nozzle reaches down past the first).
             let local = obs.local_top(&pa, &pb, &up, 2.0 * c + opts.nozzle_mm + 4.0 * h);
@@ -687,7 +679,7 @@ pub(crate) fn plan_traverse_accepting<T>(
     // Then a search around the part with the head turned to one tool axis for the travel:
     // upright, the pierce's, the exit's (each once), sharing one work budget.
     let mut axes: Vec<nalgebra::Vector3<f64>> = Vec::new();
-    for m in [up, normal(&to), normal(&from)] {
+    for m in [up, to.axis, from.axis] {
         if axes.iter().all(|a| (a - m).norm() > 1e-9) {
             axes.push(m);
         }
@@ -740,7 +732,7 @@ pub(crate) fn plan_traverse_accepting<T>(
         return Ok(done);
     }
     if !explain {
-        return Err(unexplained(Blocked::at(position(&from), 0.0)));
+        return Err(unexplained(Blocked::at(from.position, 0.0)));
     }
     let n = routes.len() + searched;
     let search_note = if opts.search {
@@ -753,7 +745,7 @@ pub(crate) fn plan_traverse_accepting<T>(
         String::new()
     };
     let why = tally_text(&tally, n) + &search_note;
-    let b = tally.nearest.unwrap_or(Blocked::at(position(&from), 0.0));
+    let b = tally.nearest.unwrap_or(Blocked::at(from.position, 0.0));
     Err(blocked_err(b, why))
 }
 

@@ -27,7 +27,6 @@ use nalgebra::{Point3, Vector3};
 
 use super::check::{Trace, Work};
 use super::{Obstacles, TraverseOptions};
-use crate::geometry::{normal, position};
 use crate::Pose;
 
 /// A lattice point: integer coordinates along the lattice's three axes.
@@ -342,13 +341,6 @@ fn meet(lat: &Lattice<'_>, sides: &[Side; 2], k: Cell) -> Found {
     (source, target, points)
 }
 
-fn with_axis(p: &Point3<f64>, n: &Vector3<f64>) -> Pose {
-    Pose {
-        position: *p,
-        axis: *n,
-    }
-}
-
 /// The tool axes a turn from `a` to `b` at one point passes: `b` alone where the turn is at
 /// most a right angle, else the great circle's middle first (for opposite axes, the middle
 /// nearest `up`), so that no move of a route turns the axis by more than a right angle.
@@ -395,7 +387,7 @@ pub(super) fn route(
     let c = opts.clearance_mm;
     let m = m.try_normalize(1e-12)?;
     let up = opts.up.normalize();
-    let (na, nb) = (normal(from).normalize(), normal(to).normalize());
+    let (na, nb) = (from.axis.normalize(), to.axis.normalize());
     let first = ends_a.first()?;
     let e1 = if m.x.abs() < 0.9 {
         Vector3::x().cross(&m).normalize()
@@ -410,7 +402,7 @@ pub(super) fn route(
     }
     let mut lat = Lattice {
         obs,
-        origin: position(first),
+        origin: first.position,
         e1,
         e2: m.cross(&e1),
         m,
@@ -434,7 +426,7 @@ pub(super) fn route(
         .enumerate()
     {
         for p in list {
-            let at = position(p);
+            let at = p.position;
             let (start, goal) = if side == 0 { (axis, m) } else { (m, axis) };
             let mut axes = vec![start];
             axes.extend(turn_axes(&start, &goal, &up));
@@ -442,8 +434,8 @@ pub(super) fn route(
                 w[0] == w[1]
                     || Trace::new(
                         obs,
-                        &with_axis(&at, &w[0]),
-                        &with_axis(&at, &w[1]),
+                        &Pose::at(at, w[0]),
+                        &Pose::at(at, w[1]),
                         c,
                         opts.nozzle_mm,
                     )
@@ -459,7 +451,7 @@ pub(super) fn route(
             }
             ends[side].push(End {
                 at,
-                cost: (at - position(base)).norm(),
+                cost: (at - base.position).norm(),
                 slack,
             });
             turns[side].push(axes);
@@ -481,8 +473,8 @@ pub(super) fn route(
         while j > i + 1 {
             let ok = Trace::new(
                 obs,
-                &with_axis(&pts[i], &m),
-                &with_axis(&pts[j], &m),
+                &Pose::at(pts[i], m),
+                &Pose::at(pts[j], m),
                 c,
                 opts.nozzle_mm,
             )
@@ -503,13 +495,13 @@ pub(super) fn route(
     // the pierce's axis over the approach.
     let mut way: Vec<Pose> = turns[0][source]
         .iter()
-        .map(|n| with_axis(&kept[0], n))
+        .map(|&n| Pose::at(kept[0], n))
         .collect();
-    way.extend(kept[1..kept.len() - 1].iter().map(|p| with_axis(p, &m)));
+    way.extend(kept[1..kept.len() - 1].iter().map(|&p| Pose::at(p, m)));
     way.extend(
         turns[1][target]
             .iter()
-            .map(|n| with_axis(&kept[kept.len() - 1], n)),
+            .map(|&n| Pose::at(kept[kept.len() - 1], n)),
     );
     way.dedup();
     Some(way)

@@ -115,6 +115,15 @@ impl Rules for Linuxcnc {
         vec![format!("{g} D{}", feed_number(c.kerf_width_mm))]
     }
 
+    /// `G41.1` offsets X and Y only.
+    fn compensation_xy_only(&self) -> bool {
+        true
+    }
+
+    fn compensation_words(&self, kerf_width_mm: f64) -> String {
+        format!("G41.1/G42.1 D{kerf_width_mm}")
+    }
+
     /// `G40` before the beam's off codes: LinuxCNC sets no digital output while it
     /// compensates.
     fn compensation_off(&self) -> (Vec<String>, bool) {

@@ -198,6 +198,16 @@ impl Rules for Sinumerik {
         ]
     }
 
+    /// The half kerf is `OFFN`, so an active tool offset `D` of radius 0 (`$TC_DP6` plus the
+    /// wear `$TC_DP15`) is needed, and `CUT3DC` needs Siemens' 3D tool radius compensation
+    /// option.
+    fn compensation_words(&self, kerf_width_mm: f64) -> String {
+        format!(
+            "CUT3DC G41/G42 OFFN={} (active D radius 0; 3D TRC option)",
+            0.5 * kerf_width_mm
+        )
+    }
+
     /// `G40` and `OFFN=0` after the beam's off codes: the control leaves the compensated path
     /// on the next move (the retract), which must not cut.
     fn compensation_off(&self) -> (Vec<String>, bool) {

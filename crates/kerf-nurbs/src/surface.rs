@@ -64,6 +64,8 @@ pub struct NurbsSurface {
     /// Directions in which the surface is closed (its boundary curves at both ends of the
     /// domain coincide): `[u, v]`.
     closed: [bool; 2],
+    /// The cells' Bezier nets, for the closest-point search.
+    cells: net::NetCache,
 }
 
 /// Result of projecting a point onto a surface ([`NurbsSurface::closest_point`]).
@@ -256,6 +258,7 @@ impl NurbsSurface {
             rational,
             collapsed: [false; 4],
             closed: [false; 2],
+            cells: net::NetCache::default(),
         };
         (surface.collapsed, surface.closed) = surface.detect_edges();
         Ok(surface)

@@ -367,6 +367,57 @@ fn warm_starts_are_local_and_never_beat_the_global_search() {
     assert!(total > 150, "enough queries ({total})");
 }
 
+/// The cold search reads each cell's Bezier net from a cache filled on the first query. The
+/// cache must not show: the first query of a fresh surface, every later query, a query on a
+/// clone taken after the cache filled and one on a surface rebuilt from the same data all give
+/// the same bits, and the surfaces compare equal whichever of them has filled its cache.
+#[test]
+fn the_cell_net_cache_changes_no_answer() {
+    let mut compared = 0;
+    for seed in 0..40u64 {
+        let Some(s) = random_surface(seed) else {
+            continue;
+        };
+        let rebuild = || {
+            let (pts, w) = (s.control_points(), s.weights());
+            NurbsSurface::try_new(
+                s.degree_u(),
+                s.degree_v(),
+                s.knots_u().to_vec(),
+                s.knots_v().to_vec(),
+                pts,
+                Some(w),
+            )
+            .expect("the same surface")
+        };
+        let points: Vec<Point3<f64>> = (0..8)
+            .map(|i| {
+                let t = i as f64 / 7.0;
+                Point3::new(-1.3 + 2.6 * t, 0.9 - 1.7 * t, 0.4 * t - 0.2)
+            })
+            .collect();
+        // Each point on a fresh surface: its first query fills the cache.
+        let first: Vec<_> = points
+            .iter()
+            .map(|p| rebuild().closest_point(p, None))
+            .collect();
+        let fresh = rebuild();
+        assert_eq!(fresh, s, "seed {seed}: rebuilt surface equals the original");
+        let _ = s.closest_point(&points[0], None);
+        let copy = s.clone();
+        assert_eq!(
+            fresh, copy,
+            "seed {seed}: a filled cache takes no part in equality"
+        );
+        for (p, want) in points.iter().zip(&first) {
+            assert_eq!(s.closest_point(p, None), *want, "seed {seed}: filled cache");
+            assert_eq!(copy.closest_point(p, None), *want, "seed {seed}: clone");
+            compared += 1;
+        }
+    }
+    assert!(compared > 200, "enough queries ({compared})");
+}
+
 #[test]
 fn evaluation_does_not_allocate() {
     let surfaces: Vec<NurbsSurface> = (0..40).filter_map(random_surface).collect();

@@ -1,6 +1,8 @@
 //! Closest point on a surface: a global branch-and-bound over Bezier sub-patches (net boxes
 //! as lower bounds), a warm-started walking Newton, and the edge and corner minima.
 
+use std::borrow::Cow;
+
 use nalgebra::{Point3, Vector3, Vector4};
 
 use super::net::{simple_net, split_net, stationarity_sign, Edge, Span};
@@ -12,7 +14,6 @@ use crate::closest::{float_before, hull_box_distance};
 use crate::curve::{project, NurbsCurve};
 use crate::knots;
 use crate::queue::BestFirst;
-use crate::MAX_ORDER;
 
 /// A candidate closest point.
 #[derive(Debug, Clone, Copy)]
@@ -38,9 +39,10 @@ pub(super) struct Patch {
     v1: f64,
 }
 
-/// A sub-patch of a cell in the global closest-point search.
+/// A sub-patch of a cell in the global closest-point search (a whole cell borrows its net from
+/// the surface's [`CellNets`](super::net::CellNets)).
 #[derive(Debug, Clone)]
-pub(super) struct SubPatch {
+pub(super) struct SubPatch<'a> {
     /// Number of halvings from the cell.
     depth: u32,
     /// The cell: indices into the lists of non-empty spans.
@@ -48,7 +50,7 @@ pub(super) struct SubPatch {
     /// Parameter rectangle `(u0, u1, v0, v1)`.
     rect: (f64, f64, f64, f64),
     /// Rational Bezier net, `(degree_u + 1) x (degree_v + 1)`, row-major over u.
-    net: Vec<Vector4<f64>>,
+    net: Cow<'a, [Vector4<f64>]>,
 }
 
 impl NurbsSurface {
@@ -63,7 +65,10 @@ impl NurbsSurface {
     /// sub-patches, best first by a lower bound on their distance: the distance from `p` to
     /// the box of their projected control points (convex hull property). It starts from the
     /// cells' Bezier nets and stops when no remaining bound is below the best distance found
-    /// (the corners of every sub-patch are candidates). A sub-patch is then
+    /// (the corners of every sub-patch are candidates). The cells' nets and their boxes are
+    /// extracted on the first cold query and kept with the surface (clones share them), as
+    /// extracting them on every query was most of its cost on surfaces of many cells. A
+    /// sub-patch is then
     /// - *reduced to an edge* if the Bernstein coefficients of `(S - p) . Su` (or `. Sv`) all
     ///   have one sign: the distance is then monotone in u (or v) on the whole sub-patch, so
     ///   its minimum lies on one edge, a rational Bezier curve, whose closest point
@@ -296,23 +301,19 @@ impl NurbsSurface {
     ) -> Candidate {
         let (deg_u, deg_v) = (self.degree_u, self.degree_v);
         let mut heap = BestFirst::new();
-        let mut net = [[Vector4::zeros(); MAX_ORDER]; MAX_ORDER];
+        let cells = self.cell_nets();
         for iu in 0..spans_u.len() {
             for iv in 0..spans_v.len() {
-                self.bezier_net(spans_u[iu], spans_v[iv], &mut net);
-                let flat: Vec<Vector4<f64>> = net
-                    .iter()
-                    .take(deg_u + 1)
-                    .flat_map(|row| row.iter().take(deg_v + 1).copied())
-                    .collect();
+                let k = iu * spans_v.len() + iv;
                 let cell = self.patch(spans_u, spans_v, iu, iv);
-                // The distance from the query point to the bounding box of the sub-patch's net.
-                let lower_bound = hull_box_distance(&flat, p);
+                // The distance from the query point to the bounding box of the cell's net.
+                let (lo, hi) = cells.bounds(k);
+                let lower_bound = crate::distance_to_box(p, &lo, &hi);
                 let sub = SubPatch {
                     depth: 0,
                     cell: (iu, iv),
                     rect: (cell.u0, cell.u1, cell.v0, cell.v1),
-                    net: flat,
+                    net: Cow::Borrowed(cells.net(k)),
                 };
                 self.offer_corners(p, &cell, &sub, &mut best);
                 heap.push(lower_bound, sub);
@@ -372,7 +373,7 @@ impl NurbsSurface {
                         depth: sub.depth + 1,
                         cell: sub.cell,
                         rect: (a, b, c, d),
-                        net: quarter,
+                        net: Cow::Owned(quarter),
                     };
                     self.offer_corners(p, &cell, &child, &mut best);
                     if lower_bound < best.distance - slack {

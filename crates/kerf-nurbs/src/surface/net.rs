@@ -2,6 +2,8 @@
 //! flatness measures, box distances, subdivision and the sign tests of the closest-point
 //! search.
 
+use std::sync::{Arc, OnceLock};
+
 use nalgebra::{Point3, Vector3, Vector4};
 
 use super::{NurbsSurface, COEFFICIENT_NOISE, LEAF_NORMAL_CONE, LEAF_TURNING};
@@ -25,7 +27,83 @@ pub(super) enum Edge {
     V1,
 }
 
+/// The rational Bezier nets of a surface's knot-span cells and the boxes of their projected
+/// control points, computed once per surface: every cold closest-point query starts from all
+/// of them (a lower bound per cell, then the cells in order of it), and extracting them by
+/// blossoming cost more than the rest of a query on surfaces of many cells.
+#[derive(Debug)]
+pub(super) struct CellNets {
+    /// The nets, cell `iu * spans_v + iv` at `[k * stride, (k + 1) * stride)`, each row-major
+    /// over u with `stride = (degree_u + 1) (degree_v + 1)` entries.
+    nets: Vec<Vector4<f64>>,
+    /// The box `(min, max)` of each cell's projected control points.
+    boxes: Vec<(Point3<f64>, Point3<f64>)>,
+    stride: usize,
+}
+
+impl CellNets {
+    /// The net of cell `k` (`iu * spans_v + iv`).
+    pub(super) fn net(&self, k: usize) -> &[Vector4<f64>] {
+        &self.nets[k * self.stride..(k + 1) * self.stride]
+    }
+
+    /// The box of cell `k`'s projected control points.
+    pub(super) fn bounds(&self, k: usize) -> (Point3<f64>, Point3<f64>) {
+        self.boxes[k]
+    }
+}
+
+/// A surface's [`CellNets`], filled on first use. It is derived from the surface's own fields
+/// (which never change after construction), so it takes no part in equality and a clone shares
+/// it.
+#[derive(Clone, Default)]
+pub(super) struct NetCache(OnceLock<Arc<CellNets>>);
+
+impl PartialEq for NetCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for NetCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.get().is_some() {
+            "NetCache(filled)"
+        } else {
+            "NetCache(empty)"
+        })
+    }
+}
+
 impl NurbsSurface {
+    /// The Bezier nets of every knot-span cell (the spans of [`NurbsSurface::spans_u`] by
+    /// those of [`NurbsSurface::spans_v`]), computed on the first call.
+    pub(super) fn cell_nets(&self) -> &CellNets {
+        self.cells.0.get_or_init(|| {
+            let (spans_u, spans_v) = (self.spans_u(), self.spans_v());
+            let stride = (self.degree_u + 1) * (self.degree_v + 1);
+            let cells = spans_u.len() * spans_v.len();
+            let mut nets = Vec::with_capacity(cells * stride);
+            let mut boxes = Vec::with_capacity(cells);
+            let mut net = [[Vector4::zeros(); MAX_ORDER]; MAX_ORDER];
+            for &su in &spans_u {
+                for &sv in &spans_v {
+                    self.bezier_net(su, sv, &mut net);
+                    let start = nets.len();
+                    for row in net.iter().take(self.degree_u + 1) {
+                        nets.extend(row.iter().take(self.degree_v + 1));
+                    }
+                    boxes.push(crate::curve::hull_box(&nets[start..]));
+                }
+            }
+            Arc::new(CellNets {
+                nets,
+                boxes,
+                stride,
+            })
+        })
+    }
+
     /// The homogeneous Bezier net of the knot-span cell `[u0, u1] x [v0, v1]` (spans `su`,
     /// `sv`), `net[a][b]` for `a <= degree_u`, `b <= degree_v`, by blossoming in each direction
     /// (see [`NurbsCurve::bezier_in_span`](crate::NurbsCurve::bezier_in_span)).

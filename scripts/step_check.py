@@ -11,7 +11,9 @@ Open CASCADE (STEPControl_Reader, or IGESControl_Reader for .igs/.iges; lengths 
   (so nothing is missing), and the curves run the same way (tangents agree); near a gap kerf
   closed, the tolerance is the largest pole move kerf reported;
 - every imported surface `face #N` lies within TOL of Open CASCADE's face #N on a 15 x 15 grid,
-  covers that face's parameter box (a grid over Open CASCADE's UV bounds projects within TOL),
+  covers that face's parameter box (a grid over the box of Open CASCADE's parameter-space
+  boundary curves projects within TOL; for IGES within the largest tolerance Open CASCADE gives
+  the face's edges, as it builds those curves from the model-space curves by approximation),
   and has the same orientation: `Su x Sv` of kerf's surface agrees with Open CASCADE's normal of
   the face (reversed where the face is REVERSED).
 
@@ -38,6 +40,7 @@ from OCP.OCP.collections import Array1_double, Array1_gp_Pnt, Array1_int, Array2
 from OCP.OCP.Bnd import Bnd_Box
 from OCP.OCP.BndLib import BndLib_Add3dCurve
 from OCP.OCP.BRepBndLib import BRepBndLib
+from OCP.OCP.BRepAdaptor import BRepAdaptor_Curve2d
 from OCP.OCP.GeomAdaptor import GeomAdaptor_Curve
 from OCP.OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
 from OCP.OCP.GeomAPI import GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
@@ -316,10 +319,27 @@ def check_file(kerf, step, edges, failures, counts, iges_tol=IGES_TOL):
                     flipped += 1
         if worst > surface_tol:
             failures.append(f"{step}: {s['id']}: {worst:.3e} mm from Open CASCADE's surface")
-        if cover > surface_tol:
+        # An IGES face's parameter-space curves are Open CASCADE's own (read.surfacecurve.mode
+        # 3 builds them from the model-space curves by approximation), good to the tolerance it
+        # gives the face's edges; its parameter box is no more exact than that.
+        cover_tol = max(surface_tol, edge_tolerance(face)) if iges else surface_tol
+        if cover > cover_tol:
             failures.append(f"{step}: {s['id']}: misses part of Open CASCADE's face box by {cover:.3e} mm")
+        elif cover > surface_tol:
+            print(f"  {step.name}: {s['id']}: misses Open CASCADE's face box by {cover:.3e} mm, within its edges' tolerance {cover_tol:.1e}")
         if flipped:
             failures.append(f"{step}: {s['id']}: normal disagrees with Open CASCADE's face orientation at {flipped} of {len(grid)} grid points")
+
+
+def edge_tolerance(face):
+    """The largest tolerance Open CASCADE gives an edge of the face (the bound it keeps between
+    an edge's 3D curve and its parameter-space curve on the face)."""
+    tol = 0.0
+    ex = TopExp_Explorer(face, TopAbs_EDGE)
+    while ex.More():
+        tol = max(tol, BRep_Tool.Tolerance_s(TopoDS.Edge(ex.Current())))
+        ex.Next()
+    return tol
 
 
 def project_distance(surface, p):
@@ -330,9 +350,28 @@ def project_distance(surface, p):
     return (pr.LowerDistance(), a, b)
 
 
+def uv_box(face):
+    """The face's parameter box: the extremes of its boundary's parameter-space curves, sampled
+    (400 intervals per edge). BRepTools.UVBounds is looser: it boxes the curves' poles, up to
+    1.7e-3 of the parameter range beyond the boundary on pyiges' impeller."""
+    lo, hi = [math.inf, math.inf], [-math.inf, -math.inf]
+    ex = TopExp_Explorer(face, TopAbs_EDGE)
+    while ex.More():
+        c = BRepAdaptor_Curve2d(TopoDS.Edge(ex.Current()), face)
+        ex.Next()
+        a, b = c.FirstParameter(), c.LastParameter()
+        for k in range(401):
+            q = c.Value(a + (b - a) * k / 400)
+            lo = [min(lo[0], q.X()), min(lo[1], q.Y())]
+            hi = [max(hi[0], q.X()), max(hi[1], q.Y())]
+    if not all(math.isfinite(x) for x in lo + hi):
+        return BRepTools.UVBounds_s(face)
+    return lo[0], hi[0], lo[1], hi[1]
+
+
 def coverage(face, os_, ks):
     """How far the worst point of a 9 x 9 grid over the face's UV box is from kerf's surface."""
-    fu0, fu1, fv0, fv1 = BRepTools.UVBounds_s(face)
+    fu0, fu1, fv0, fv1 = uv_box(face)
     cover = 0.0
     for i in range(9):
         for j in range(9):

@@ -267,6 +267,12 @@ impl<'a> Reader<'a> {
             .collect()
     }
 
+    /// The segments of a parameter-space curve (a 142's B): its own matrix applied, no unit
+    /// scale (parameters have none).
+    pub(crate) fn parameter_curve(&self, e: &Entry) -> Result<Vec<(NurbsCurve, String)>> {
+        self.curve_at(e, 0)
+    }
+
     /// `to_mm` after the matrices of `within` (innermost first).
     fn outer(&self, within: &[&Entry]) -> Result<Affine> {
         let mut t = Affine::identity();

@@ -700,6 +700,66 @@ fn a_trimmed_surfaces_matrix_moves_it_and_its_boundary() {
     );
 }
 
+/// A 142 that prefers its parameter-space curve (PREF 1, as SolidWorks and CATIA write it)
+/// over a model-space copy a little inside it: the face's surface reaches both. A 100 x 100 mm
+/// patch over [0, 1]^2 trimmed by the square 10..50 mm; the parameter-space square reaches
+/// u = 0.5005 (50.05 mm). One 3 mm out does not map onto the model-space curve: not used.
+#[test]
+fn the_preferred_parameter_space_boundary_widens_the_face() {
+    let x_range = |u_max: &str| {
+        let dep = "00010000";
+        let patch = "1,1,1,1,0,0,1,0,0,0.,0.,1.,1.,0.,0.,1.,1.,1.,1.,1.,1.,0.,0.,0.,100.,0.,0.,0.,100.,0.,100.,100.,0.,0.,1.,0.,1.";
+        let b = [
+            format!("0.1,0.1,0.,{u_max},0.1,0."),
+            format!("{u_max},0.1,0.,{u_max},0.5,0."),
+            format!("{u_max},0.5,0.,0.1,0.5,0."),
+            "0.1,0.5,0.,0.1,0.1,0.".to_string(),
+        ];
+        let imp = import(
+            iges_text(
+                "2",
+                &[
+                    (128, 0, 0, dep, "", patch),
+                    (110, 0, 0, dep, "", "10.,10.,0.,50.,10.,0."),
+                    (110, 0, 0, dep, "", "50.,10.,0.,50.,50.,0."),
+                    (110, 0, 0, dep, "", "50.,50.,0.,10.,50.,0."),
+                    (110, 0, 0, dep, "", "10.,50.,0.,10.,10.,0."),
+                    (102, 0, 0, dep, "", "4,3,5,7,9"),
+                    (110, 0, 0, dep, "", &b[0]),
+                    (110, 0, 0, dep, "", &b[1]),
+                    (110, 0, 0, dep, "", &b[2]),
+                    (110, 0, 0, dep, "", &b[3]),
+                    (102, 0, 0, dep, "", "4,13,15,17,19"),
+                    (142, 0, 0, dep, "", "0,1,21,11,1"),
+                    (144, 0, 0, FREE, "", "1,1,0,23"),
+                ],
+            )
+            .as_bytes(),
+            &ImportOptions::default().with_edges(None),
+        )
+        .expect("imports");
+        let c = by_id(&imp.file, "face D25 loop 1");
+        for p in samples(&curve(c), 40) {
+            assert!(
+                (10.0 - 1e-12..=50.0 + 1e-12).contains(&p.x),
+                "the cut is the model-space curve: {p}"
+            );
+        }
+        let (lo, hi) = surface(surface_of(&imp.file, c)).bounding_box();
+        (lo.x, hi.x)
+    };
+    let (lo, hi) = x_range("0.5005");
+    assert!(
+        (lo - 10.0).abs() < 1e-9 && (hi - 50.05).abs() < 1e-9,
+        "widened: {lo} .. {hi}"
+    );
+    let (lo, hi) = x_range("0.53");
+    assert!(
+        (lo - 10.0).abs() < 1e-9 && (hi - 50.0).abs() < 1e-9,
+        "a boundary 3 mm off is not used: {lo} .. {hi}"
+    );
+}
+
 #[test]
 fn trailing_pointers_strings_and_huge_matrices() {
     // A composite whose parameters end with one property pointer (to the 406 at D5): the free

@@ -114,6 +114,7 @@ fn face(m: &Model<'_>, inst: &Instance, flip: bool) -> Result<Face> {
         loops,
         edge_ids,
         &vertices,
+        &[],
         None,
         (same_sense == flip) ^ turned,
     )

@@ -35,6 +35,9 @@ pub trait Place {
 /// `sigil` and `id` name the face (`face #12` for STEP, `face D45` for IGES); `edge_ids[l][k]`
 /// names edge `k` of loop `l` (the same id in two faces is the edge they share; give distinct
 /// ids where the format has no shared edges). `vertices` are boundary points of vertex loops.
+/// `params` are boundary points already in the surface's natural parameters, where the format
+/// gives them (an IGES boundary's parameter-space curve on a B-spline surface, which the file
+/// may prefer to its model-space curve): the range covers them too.
 /// `natural` is the surface's own parameter box where the format gives one (an IGES surface
 /// of revolution's start and end angles): a direction in which the boundary samples span
 /// nothing (a whole sphere bounded by its seam, run down and back) takes its range from it.
@@ -52,6 +55,7 @@ pub fn face<P: Place>(
     loops: Vec<Vec<NurbsCurve>>,
     edge_ids: Vec<Vec<u64>>,
     vertices: &[Point3<f64>],
+    params: &[(f64, f64)],
     natural: Option<ParamBox>,
     reversed: bool,
 ) -> Result<Face, P::Error> {
@@ -59,23 +63,33 @@ pub fn face<P: Place>(
     // The parameter range: every boundary sample mapped to natural parameters.
     let mut us = Vec::new();
     let mut vs = Vec::new();
-    let mut add = |q: &Point3<f64>| {
-        let (u, v) = g.params_of(q);
+    let mut add = |q: &Point3<f64>, warm: &mut Option<(f64, f64)>| {
+        let (u, v) = g.params_near(q, warm);
         us.push(u);
         vs.push(v);
     };
     let uses: usize = loops.iter().map(Vec::len).sum();
     place.charge(uses * EDGE_SAMPLES)?;
     for l in &loops {
+        // Each sample's projection starts from its neighbour's parameters (an edge's first
+        // from the previous edge's last: a loop's edges join end to start).
+        let mut warm = None;
         for e in l {
             let (a, b) = e.domain();
             for k in 0..EDGE_SAMPLES {
-                add(&e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64));
+                add(
+                    &e.point(a + (b - a) * k as f64 / (EDGE_SAMPLES - 1) as f64),
+                    &mut warm,
+                );
             }
         }
     }
     for q in vertices {
-        add(q);
+        add(q, &mut None);
+    }
+    for &(u, v) in params {
+        us.push(u);
+        vs.push(v);
     }
     let (pu, pv) = g.periodic();
     let whole = loops.is_empty();

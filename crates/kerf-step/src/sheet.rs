@@ -444,9 +444,13 @@ pub(crate) fn recognise<E>(
 fn tangent(edge: &NurbsCurve, a: &NurbsSurface, b: &NurbsSurface) -> bool {
     let (t0, t1) = edge.domain();
     let cos = SMOOTH_DEG.to_radians().cos();
+    // The samples run along the edge: each foot starts from the previous one's.
+    let (mut warm_a, mut warm_b) = (None, None);
     (0..EDGE_TESTS).all(|k| {
         let p = edge.point(t0 + (t1 - t0) * (k as f64 + 1.0) / (EDGE_TESTS as f64 + 1.0));
-        match (normal_at(a, &p), normal_at(b, &p)) {
+        let fa = crate::surfaces::foot_near(a, &p, &mut warm_a);
+        let fb = crate::surfaces::foot_near(b, &p, &mut warm_b);
+        match (a.normal(fa.u, fa.v), b.normal(fb.u, fb.v)) {
             (Some(na), Some(nb)) => na.dot(&nb) >= cos,
             _ => false,
         }

@@ -348,3 +348,65 @@ fn sinumerik_rapids_follow_the_machines_straight_moves() {
         "a piece's middle {worst} mm off the machine's straight move"
     );
 }
+
+/// Two paths where the second starts exactly where the first ends, at the same axes (a circle
+/// and a smaller one touching it from inside at (10, 0)), with no traverse between them: each is
+/// its own cut, beam off after the first, a pierce before the second, not one cut run on.
+#[test]
+fn a_path_that_starts_where_the_last_one_ended_is_pierced_again() {
+    let m = PaperAcHead::paper_000();
+    let lines_only = FitOptions::default()
+        .with_arcs(false)
+        .with_merge_lines(false);
+    let mut blocks = Vec::new();
+    for (path, c) in [circle(10.0, 0.0, 0.0, 0.0), circle(5.0, 5.0, 0.0, 0.0)]
+        .iter()
+        .enumerate()
+    {
+        let st = stations(&m, c, 0.001, |_| Vector3::z());
+        blocks.extend(fit_blocks(&m, &st, None, path, &lines_only).expect("fit"));
+    }
+    let first_end = blocks
+        .iter()
+        .rfind(|b| b.path == 0)
+        .expect("path 0")
+        .end_axes;
+    let second_start = blocks
+        .iter()
+        .find(|b| b.path == 1)
+        .expect("path 1")
+        .start_axes;
+    assert!(
+        (0..5).all(|k| (first_end[k] - second_start[k]).abs() < 1e-9),
+        "the second path starts at the first one's end: {first_end:?} {second_start:?}"
+    );
+    let ids = ["outer".to_string(), "inner".to_string()];
+    let opts = GcodeOptions::new(Dialect::Generic, 6000.0);
+    let text = gcode(&m, &blocks, &ids, None, &opts).expect("gcode");
+    let code_lines: Vec<&str> = text
+        .lines()
+        .map(|l| l.split(';').next().unwrap_or("").trim())
+        .collect();
+    // The program opens with a beam off (the safe state); the cuts follow.
+    let opened = code_lines
+        .iter()
+        .position(|l| *l == "M3")
+        .expect("a beam on");
+    let on = code_lines.iter().filter(|l| **l == "M3").count();
+    let off = code_lines[opened..].iter().filter(|l| **l == "M5").count();
+    assert_eq!((on, off), (2, 2), "one beam on and off per path:\n{text}");
+    // The second cut's beam-on comes after the first cut's beam-off.
+    let first_off = opened
+        + code_lines[opened..]
+            .iter()
+            .position(|l| *l == "M5")
+            .expect("off");
+    let second_on = code_lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| **l == "M3")
+        .nth(1)
+        .expect("second on")
+        .0;
+    assert!(first_off < second_on, "off before the second pierce");
+}

@@ -496,7 +496,10 @@ pub fn gcode_timed<M: AxisModel>(
     w.header(blocks);
     let mut last_path = usize::MAX;
     for (bi, b) in blocks.iter().enumerate() {
-        if b.rapid && w.in_cut {
+        // A cut ends at a rapid, and where the next path starts without one (it starts where
+        // the last path ended, at the same axes): each path is pierced and compensated as its
+        // own cut, with its own power factor and micro-joints.
+        if w.in_cut && (b.rapid || b.path != last_path) {
             w.end_cut();
         }
         if b.path != last_path {

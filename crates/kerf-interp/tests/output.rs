@@ -410,3 +410,47 @@ fn a_path_that_starts_where_the_last_one_ended_is_pierced_again() {
         .0;
     assert!(first_off < second_on, "off before the second pierce");
 }
+
+/// The controllers select their kerf compensation on a straight move: a compensated cut whose
+/// first block is an arc (a circle fitted with arcs, no lead-in) is refused by name in the
+/// Sinumerik dialect (LinuxCNC's raw-axis dialect writes no arcs at all and refuses the block
+/// before); the same cut fitted with lines only is written, with its compensation.
+#[test]
+fn controller_compensation_refuses_an_arc_as_the_entry_move() {
+    let m = PaperAcHead::paper_000();
+    let st = stations(&m, &circle(10.0, 0.0, 0.0, 0.0), 0.001, |_| Vector3::z());
+    let arcs = fit_blocks(&m, &st, None, 0, &FitOptions::default()).expect("fit");
+    assert!(
+        matches!(arcs[0].geometry, Geometry::Arc(_)),
+        "the circle's first block is an arc"
+    );
+    let c = kerf_interp::CutterCompensation {
+        left: true,
+        kerf_width_mm: 0.2,
+    };
+    let ids = ["hole-7".to_string()];
+    let opts =
+        GcodeOptions::new(Dialect::Sinumerik, 3000.0).with_cutter_compensation(vec![Some(c)]);
+    match gcode(&m, &arcs, &ids, None, &opts) {
+        Err(kerf_interp::InterpError::CompensationOnArc { path }) => {
+            assert_eq!(path, "hole-7", "the refusal names the path")
+        }
+        other => panic!("an arc entry must be refused, got {other:?}"),
+    }
+    let linuxcnc =
+        GcodeOptions::new(Dialect::Linuxcnc, 3000.0).with_cutter_compensation(vec![Some(c)]);
+    assert!(
+        matches!(
+            gcode(&m, &arcs, &ids, None, &linuxcnc),
+            Err(kerf_interp::InterpError::UncheckedBlock { .. })
+        ),
+        "LinuxCNC's raw-axis dialect refuses arcs"
+    );
+    let lines = FitOptions::default().with_arcs(false);
+    let blocks = fit_blocks(&m, &st, None, 0, &lines).expect("fit");
+    let text = gcode(&m, &blocks, &ids, None, &opts).expect("lines are written");
+    assert!(
+        text.lines().any(|l| l.contains("G41")) && text.contains("OFFN=0.1"),
+        "compensated with G41 and OFFN = kerf / 2"
+    );
+}

@@ -311,9 +311,16 @@ impl GcodeOptions {
         terms
     }
 
-    /// The sum of the known budget terms, mm.
+    /// The sum of the known budget terms, mm, rounded to 1e-12 mm: the binary sum of decimal
+    /// terms carries noise (0.01 + 0.01 + 0.005 + 0.001 + 0.005 is 0.031000000000000003),
+    /// which neither the program's header nor report.json should state.
     pub fn budget_total(&self) -> f64 {
-        self.budget().iter().filter_map(|(_, v)| *v).sum()
+        let sum: f64 = self.budget().iter().filter_map(|(_, v)| *v).sum();
+        if sum.is_finite() {
+            (sum * 1e12).round() / 1e12
+        } else {
+            sum
+        }
     }
 }
 

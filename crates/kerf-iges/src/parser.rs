@@ -75,6 +75,31 @@ fn syntax(line: usize, message: impl Into<String>) -> IgesError {
     }
 }
 
+/// The file's 80-column records with their numbers: its lines (a `\r` before the line break
+/// dropped), numbered from 1. A file without line breaks between its records (IGES defines
+/// records of 80 characters, not lines; Open CASCADE reads such files too) is one line whose
+/// length is a multiple of 80 with a section letter in column 73 of every 80: it is cut into
+/// its records, numbered as if each were a line.
+fn records(bytes: &[u8]) -> Vec<(usize, &[u8])> {
+    let is_letter = |b: u8| matches!(b, b'S' | b'G' | b'D' | b'P' | b'T');
+    let mut out = Vec::new();
+    for raw in bytes.split(|&b| b == b'\n') {
+        let line = raw.strip_suffix(b"\r").unwrap_or(raw);
+        let packed =
+            line.len() > 80 && line.len() % 80 == 0 && line.chunks(80).all(|r| is_letter(r[72]));
+        if packed {
+            out.extend(
+                line.chunks(80)
+                    .map(|r| (out.len() + 1, r))
+                    .collect::<Vec<_>>(),
+            );
+        } else {
+            out.push((out.len() + 1, line));
+        }
+    }
+    out
+}
+
 /// Reads the layout of a whole file.
 pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
     let bytes = kerf_io::strip_bom(bytes);
@@ -82,9 +107,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
     let mut sections: [Vec<(usize, &[u8])>; 5] = Default::default();
     let mut last = 0usize;
     let mut seen_any = false;
-    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let line_no = i + 1;
-        let line = raw.strip_suffix(b"\r").unwrap_or(raw);
+    for (line_no, line) in records(bytes) {
         if line.iter().all(|b| b.is_ascii_whitespace()) {
             continue;
         }
@@ -142,7 +165,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
     }
     if sections[1].is_empty() {
         return Err(syntax(
-            bytes.split(|&b| b == b'\n').count(),
+            records(bytes).len(),
             "no global (G) section: not an IGES file",
         ));
     }

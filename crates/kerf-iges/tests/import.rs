@@ -172,6 +172,27 @@ fn an_inch_file_is_the_mm_file() {
     }
 }
 
+/// IGES defines 80-character records, not lines: the same file with its records run together
+/// (no line breaks, as some systems write it) or with CR LF line ends reads to the same
+/// document; a run-together file whose length is not a whole number of records is refused by
+/// its column-73 rule.
+#[test]
+fn records_without_line_breaks_or_with_crlf_read_the_same() {
+    let text = std::fs::read_to_string(fixture("iges", "faces.igs")).expect("fixture");
+    let opts = ImportOptions::default().with_edges(None);
+    let want = import(text.as_bytes(), &opts).expect("lines").file;
+    let packed: String = text.lines().collect();
+    assert!(!packed.contains('\n') && packed.len() % 80 == 0);
+    assert_eq!(import(packed.as_bytes(), &opts).expect("packed").file, want);
+    let crlf = text.replace('\n', "\r\n");
+    assert_eq!(import(crlf.as_bytes(), &opts).expect("crlf").file, want);
+    let cut = &packed[..packed.len() - 3];
+    assert!(
+        import(cut.as_bytes(), &opts).is_err(),
+        "a run-together file cut short is refused"
+    );
+}
+
 #[test]
 fn every_face_matches_the_step_file_it_was_written_from() {
     let opts = ImportOptions::default()

@@ -140,6 +140,21 @@ pub struct Block {
     length: f64,
 }
 
+/// True where cutting block `k` of `blocks` starts a cut (a pierce, the beam switched on): it
+/// is the first block, follows a rapid, or begins another path than the block before it (a
+/// path may start where the last one ended, at the same axes, with no traverse between). The
+/// one rule of the program writer, its pierce checks, the report's count and the view.
+pub fn starts_cut(blocks: &[Block], k: usize) -> bool {
+    let Some(b) = blocks.get(k) else {
+        return false;
+    };
+    !b.rapid
+        && match k.checked_sub(1).and_then(|j| blocks.get(j)) {
+            None => true,
+            Some(before) => before.rapid || before.path != b.path,
+        }
+}
+
 impl Block {
     /// A line (or a [`Geometry::Turn`] when the tips coincide) from `a` to `b`.
     pub fn line(a: &Station, b: &Station) -> Self {

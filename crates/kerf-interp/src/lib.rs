@@ -63,7 +63,7 @@ mod recursive;
 pub(crate) mod smooth;
 pub(crate) mod topp;
 
-pub use block::{increments, solve_stations, Block, Geometry, Station, MIN_TRAVEL};
+pub use block::{increments, solve_stations, starts_cut, Block, Geometry, Station, MIN_TRAVEL};
 #[cfg(feature = "research")]
 pub use chord::paper_eq19;
 pub use chord::{chord_error, max_feed, max_step};

@@ -454,3 +454,51 @@ fn controller_compensation_refuses_an_arc_as_the_entry_move() {
         "compensated with G41 and OFFN = kerf / 2"
     );
 }
+
+/// A path that starts where the last one ended is pierced again, so its pierce point is held to
+/// the axis ranges too: two lines, the second starting 5 mm higher where the first ends; with
+/// Z's range ending 1 mm above the second's start, a 1.5 mm standoff is refused for path 1
+/// (the first path's pierce, 5 mm lower, is within it), and a 0.5 mm one is written.
+#[test]
+fn the_pierce_of_a_path_without_a_traverse_before_it_is_range_checked() {
+    use nalgebra::Point3;
+    let m = PaperAcHead::paper_000();
+    let lines_only = FitOptions::default()
+        .with_arcs(false)
+        .with_merge_lines(false);
+    let (a, b, c) = (
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(10.0, 0.0, 5.0),
+        Point3::new(20.0, 0.0, 5.0),
+    );
+    let mut blocks = Vec::new();
+    for (path, (p, q)) in [(a, b), (b, c)].into_iter().enumerate() {
+        let line = kerf_nurbs::NurbsCurve::line(p, q).expect("line");
+        let st = stations(&m, &line, 0.001, |_| Vector3::z());
+        blocks.extend(fit_blocks(&m, &st, None, path, &lines_only).expect("fit"));
+    }
+    let second = blocks.iter().position(|b| b.path == 1).expect("path 1");
+    assert!(kerf_interp::starts_cut(&blocks, second) && kerf_interp::starts_cut(&blocks, 0));
+    assert_eq!(
+        (0..blocks.len())
+            .filter(|&k| kerf_interp::starts_cut(&blocks, k))
+            .count(),
+        2
+    );
+    let top = blocks[second].start_axes[2];
+    let mut low = m.clone();
+    low.limits.range[2] = Some([-1000.0, top + 1.0]);
+    let with = |standoff: f64| {
+        GcodeOptions::new(Dialect::Generic, 6000.0).with_process(kerf_kinematics::Process {
+            pierce_standoff: Some(standoff),
+            ..kerf_kinematics::Process::default()
+        })
+    };
+    match gcode(&low, &blocks, &[], None, &with(1.5)) {
+        Err(kerf_interp::InterpError::PierceOutOfRange { path, axis, .. }) => {
+            assert_eq!((path, axis.as_str()), (1, "Z"), "the second path's pierce")
+        }
+        other => panic!("the second pierce is above Z's range: {other:?}"),
+    }
+    gcode(&low, &blocks, &[], None, &with(0.5)).expect("within the range");
+}

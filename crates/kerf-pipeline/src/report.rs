@@ -703,13 +703,13 @@ impl ProgramReport {
             beam_off: process.beam_off.clone(),
             pierce_dwell_s: process.pierce_dwell_s,
             pierce_standoff_mm: process.pierce_standoff,
-            // A cut: a stretch of cutting blocks after a rapid (or at the start).
+            // A cut: a stretch of cutting blocks of one path after a rapid (or at the start).
             cuts: motions
                 .iter()
                 .map(|m| {
                     let b = m.blocks();
                     (0..b.len())
-                        .filter(|&i| !b[i].rapid && (i == 0 || b[i - 1].rapid))
+                        .filter(|&i| kerf_interp::starts_cut(b, i))
                         .count()
                 })
                 .sum(),

@@ -148,8 +148,8 @@ fn tessellate(id: &str, g: &SurfaceGeometry, grid: usize, placement: &Placement)
     m
 }
 
-/// The cuts (maximal runs of cutting blocks) and the traverses between them of a set-up's
-/// planned blocks.
+/// The cuts (maximal runs of cutting blocks of one path, [`kerf_interp::starts_cut`]) and the
+/// traverses between them of a set-up's planned blocks.
 fn paths(
     su: &SetupInput<'_>,
     model: &MachineModel,
@@ -163,7 +163,12 @@ fn paths(
     let mut beams: Vec<[f32; 6]> = Vec::new();
     let flat = |p: &Point3<f64>| [mm(p.x), mm(p.y), mm(p.z)];
     let mut in_cut = false;
-    for b in blocks {
+    for (k, b) in blocks.iter().enumerate() {
+        if in_cut && kerf_interp::starts_cut(blocks, k) {
+            // Another path starting where the last one ended: a cut of its own.
+            finish_beams(cuts.last_mut(), &mut beams);
+            in_cut = false;
+        }
         if b.rapid {
             if in_cut {
                 finish_beams(cuts.last_mut(), &mut beams);

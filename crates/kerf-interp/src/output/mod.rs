@@ -32,10 +32,11 @@
 //!
 //! Every program starts with a header (machine, source, units, feed semantics, the tolerance
 //! budget term by term, the process codes) and names the source curve in a comment where each
-//! path starts. Every cut (a maximal run of cutting blocks) is framed the same way: a rapid to
-//! the pierce point `pierce_standoff` mm above the cut's start along the tool axis, the beam-on
-//! lines, a dwell of `pierce_dwell_s`, the descent to the start with the beam on, the cut, and
-//! the beam-off lines before the next rapid. No text of the input (curve ids, machine names,
+//! path starts. Every cut (a maximal run of cutting blocks of one path, [`crate::starts_cut`])
+//! is framed the same way: a rapid to the pierce point `pierce_standoff` mm above the cut's
+//! start along the tool axis, the beam-on lines, a dwell of `pierce_dwell_s`, the descent to
+//! the start with the beam on, the cut, and the beam-off lines before the next rapid or the
+//! next path. No text of the input (curve ids, machine names,
 //! file names) reaches a program except through [`comment_text`], which cannot open a new block
 //! in any dialect.
 
@@ -409,8 +410,7 @@ fn refuse_pierces_out_of_range<M: AxisModel + ?Sized>(
     process: &ProcessCodes,
 ) -> Result<()> {
     for (k, b) in blocks.iter().enumerate() {
-        let starts_cut = !b.rapid && (k == 0 || blocks[k - 1].rapid);
-        if !starts_cut {
+        if !crate::starts_cut(blocks, k) {
             continue;
         }
         let (_, q, _) = writer::pierce_point(model, process, b);
@@ -505,8 +505,8 @@ pub fn gcode_timed<M: AxisModel>(
     for (bi, b) in blocks.iter().enumerate() {
         // A cut ends at a rapid, and where the next path starts without one (it starts where
         // the last path ended, at the same axes): each path is pierced and compensated as its
-        // own cut, with its own power factor and micro-joints.
-        if w.in_cut && (b.rapid || b.path != last_path) {
+        // own cut, with its own power factor and micro-joints ([`crate::starts_cut`]).
+        if w.in_cut && (b.rapid || crate::starts_cut(blocks, bi)) {
             w.end_cut();
         }
         if b.path != last_path {

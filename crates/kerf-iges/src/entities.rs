@@ -332,8 +332,10 @@ impl<'a> Reader<'a> {
                     if s.ty == 116 {
                         continue; // a point in a composite joins nothing
                     }
-                    out.extend(self.curve_at(s, depth + 1).map_err(|x| {
-                        err(e, format!("segment {} (D{}): {x}", k + 1, s.de))
+                    out.extend(self.curve_at(s, depth + 1).map_err(|x| match x {
+                        // The work budget's error stays what it is, wherever it trips.
+                        x @ IgesError::Budget { .. } => x,
+                        x => err(e, format!("segment {} (D{}): {x}", k + 1, s.de)),
                     })?);
                 }
                 out

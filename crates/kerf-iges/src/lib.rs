@@ -674,9 +674,10 @@ fn box_loop(
     Ok((loop_, ids))
 }
 
-/// Samples of a 142's parameter-space curve (none where it has none): a B-spline surface's
-/// `(u, v)` along the boundary, 181 per segment, plus each segment's extremes in u and in v,
-/// found by golden-section search about the extreme sample.
+/// The extremes in u and in v of a 142's parameter-space curve (none where it has none): a
+/// B-spline surface's parameters at the boundary's least and greatest u and v, each found on
+/// 181 samples per segment and refined by golden-section search about the extreme sample
+/// (the better of the two taken).
 ///
 /// A 142's PREF says which of its curves the file prefers; CAD systems commonly write 1, the
 /// parameter-space curve, with a model-space copy that lies up to a few micrometres off it
@@ -684,9 +685,10 @@ fn box_loop(
 /// the face's parameter range covers both: the projections of the model-space curve and these
 /// points, so the face's surface reaches the boundary the file prefers too. The curve is read
 /// in its own space: its matrix applies; the 142's and the face's (which move model space)
-/// and the unit scale do not. A parameter-space curve kerf cannot read, or whose extremes do
-/// not map within [`cad::ON_GEOMETRY_TOLERANCE_MM`] of the model-space curve (another
-/// parametrisation, a wrong curve), is not used.
+/// and the unit scale do not. A parameter-space curve kerf cannot read (a pointer or a curve
+/// that is not one), or whose extremes do not map within [`cad::ON_GEOMETRY_TOLERANCE_MM`] of
+/// the model-space curve (another parametrisation, a wrong curve), is not used. The samples
+/// and the four checks are charged to the face-test budget before they are made.
 fn parameter_points(
     reader: &Reader<'_>,
     face: &Entry,
@@ -694,9 +696,10 @@ fn parameter_points(
     surface: &kerf_nurbs::NurbsSurface,
     edges: &[NurbsCurve],
 ) -> Result<Vec<(f64, f64)>> {
+    const SAMPLES: usize = 181;
     let b = reader.get_typed(face, de, "its boundary", 142)?;
-    let pc = int(b, 2, "parameter-space curve")?;
-    if pc == 0 {
+    let pc = int(b, 2, "parameter-space curve").unwrap_or(0);
+    if pc <= 0 {
         return Ok(Vec::new());
     }
     // The parameter-space curve only widens the range: one kerf cannot read is left out (the
@@ -709,41 +712,66 @@ fn parameter_points(
         Err(x @ IgesError::Budget { .. }) => return Err(x),
         Err(_) => return Ok(Vec::new()),
     };
-    const SAMPLES: usize = 181;
-    let mut out = Vec::with_capacity(segs.len() * (SAMPLES + 4));
+    reader.charge(
+        face,
+        Charge::FaceTests,
+        segs.len() * SAMPLES + 4 * edges.len(),
+    )?;
+    // extremes[axis][0]: the least, [1]: the greatest, as (value, point).
+    let mut extremes = [[(f64::INFINITY, (0.0, 0.0)); 2]; 2];
     for (c, _) in &segs {
         let (a, z) = c.domain();
         let t_at = |k: usize| a + (z - a) * k as f64 / (SAMPLES - 1) as f64;
-        out.extend((0..SAMPLES).map(|k| {
-            let p = c.point(t_at(k));
-            (p.x, p.y)
-        }));
+        let values: Vec<(f64, f64)> = (0..SAMPLES)
+            .map(|k| {
+                let p = c.point(t_at(k));
+                (p.x, p.y)
+            })
+            .collect();
         for axis in [0, 1] {
-            for sign in [1.0, -1.0] {
-                let f = |t: f64| sign * c.point(t)[axis];
+            let coord = |q: (f64, f64)| if axis == 0 { q.0 } else { q.1 };
+            for (end, sign) in [(0, -1.0), (1, 1.0)] {
+                // The extreme sample, then the search about it (the better of the two).
                 let best = (0..SAMPLES)
-                    .max_by(|&i, &j| f(t_at(i)).total_cmp(&f(t_at(j))))
+                    .max_by(|&i, &j| {
+                        (sign * coord(values[i])).total_cmp(&(sign * coord(values[j])))
+                    })
                     .unwrap_or(0);
                 let lo = t_at(best.saturating_sub(1));
                 let hi = t_at((best + 1).min(SAMPLES - 1));
-                let p = c.point(golden_max(f, lo, hi));
-                let on = surface.point(p.x, p.y);
-                let off = edges
-                    .iter()
-                    .filter(|e| {
-                        let (lo, hi) = e.bounding_box();
-                        kerf_nurbs::distance_to_box(&on, &lo, &hi) <= cad::ON_GEOMETRY_TOLERANCE_MM
-                    })
-                    .map(|e| e.closest_point(&on).distance)
-                    .fold(f64::INFINITY, f64::min);
-                if !(off <= cad::ON_GEOMETRY_TOLERANCE_MM) {
-                    return Ok(Vec::new());
+                let p = c.point(golden_max(|t| sign * c.point(t)[axis], lo, hi));
+                let mut found = values[best];
+                if sign * coord((p.x, p.y)) > sign * coord(found) {
+                    found = (p.x, p.y);
                 }
-                out.push((p.x, p.y));
+                let key = -sign * coord(found);
+                if key < extremes[axis][end].0 {
+                    extremes[axis][end] = (key, found);
+                }
             }
         }
     }
-    Ok(out)
+    let points: Vec<(f64, f64)> = extremes
+        .iter()
+        .flatten()
+        .filter(|(key, _)| key.is_finite())
+        .map(|&(_, q)| q)
+        .collect();
+    for &(u, v) in &points {
+        let on = surface.point(u, v);
+        let off = edges
+            .iter()
+            .filter(|e| {
+                let (lo, hi) = e.bounding_box();
+                kerf_nurbs::distance_to_box(&on, &lo, &hi) <= cad::ON_GEOMETRY_TOLERANCE_MM
+            })
+            .map(|e| e.closest_point(&on).distance)
+            .fold(f64::INFINITY, f64::min);
+        if !(off <= cad::ON_GEOMETRY_TOLERANCE_MM) {
+            return Ok(Vec::new());
+        }
+    }
+    Ok(points)
 }
 
 /// The argument of the largest value of `f` on `[lo, hi]` where `f` rises then falls there,
@@ -791,9 +819,10 @@ fn boundary(
     }
     let ce = reader.get(b, c, "its model-space curve")?;
     // The curve's matrices, then the 142's, then the face's.
-    let segs = reader
-        .curve(ce, &[b, face])
-        .map_err(|x| err(face, format!("{what} D{}: {x}", b.de)))?;
+    let segs = reader.curve(ce, &[b, face]).map_err(|x| match x {
+        x @ IgesError::Budget { .. } => x,
+        x => err(face, format!("{what} D{}: {x}", b.de)),
+    })?;
     let ids = segs
         .iter()
         .map(|(_, n)| n.trim_start_matches('D').parse::<u64>().unwrap_or(0))

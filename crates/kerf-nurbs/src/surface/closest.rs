@@ -66,7 +66,7 @@ impl NurbsSurface {
     /// the box of their projected control points (convex hull property). It starts from the
     /// cells' Bezier nets and stops when no remaining bound is below the best distance found
     /// (the corners of every sub-patch are candidates). The cells' nets and their boxes are
-    /// extracted on the first cold query and kept with the surface (clones share them), as
+    /// extracted on the first cold query and kept with the surface (and its later clones), as
     /// extracting them on every query was most of its cost on surfaces of many cells. A
     /// sub-patch is then
     /// - *reduced to an edge* if the Bernstein coefficients of `(S - p) . Su` (or `. Sv`) all

@@ -54,8 +54,8 @@ impl CellNets {
 }
 
 /// A surface's [`CellNets`], filled on first use. It is derived from the surface's own fields
-/// (which never change after construction), so it takes no part in equality and a clone shares
-/// it.
+/// (which never change after construction), so it takes no part in equality; a clone taken
+/// after it is filled shares it, one taken before fills its own.
 #[derive(Clone, Default)]
 pub(super) struct NetCache(OnceLock<Arc<CellNets>>);
 

@@ -712,10 +712,11 @@ fn parameter_points(
         Err(x @ IgesError::Budget { .. }) => return Err(x),
         Err(_) => return Ok(Vec::new()),
     };
+    // Per segment its samples and four searches; per boundary four checks on every edge.
     reader.charge(
         face,
         Charge::FaceTests,
-        segs.len() * SAMPLES + 4 * edges.len(),
+        segs.len() * (SAMPLES + 4 * (GOLDEN_STEPS + 2)) + 4 * edges.len(),
     )?;
     // extremes[axis][0]: the least, [1]: the greatest, as (value, point).
     let mut extremes = [[(f64::INFINITY, (0.0, 0.0)); 2]; 2];
@@ -774,14 +775,18 @@ fn parameter_points(
     Ok(points)
 }
 
+/// Steps of [`golden_max`]: the bracket (two of 180 sample intervals) shrinks by 0.618^60
+/// (3e-13), below the resolution of a parameter there.
+const GOLDEN_STEPS: usize = 60;
+
 /// The argument of the largest value of `f` on `[lo, hi]` where `f` rises then falls there,
-/// by golden-section search: 80 steps shrink the bracket by 0.618^80 (1e-17).
+/// by golden-section search ([`GOLDEN_STEPS`] steps, two evaluations to start).
 fn golden_max(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
     let r = 0.5 * (5f64.sqrt() - 1.0);
     let mut x1 = hi - r * (hi - lo);
     let mut x2 = lo + r * (hi - lo);
     let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..80 {
+    for _ in 0..GOLDEN_STEPS {
         if f1 < f2 {
             lo = x1;
             x1 = x2;

@@ -79,25 +79,31 @@ fn syntax(line: usize, message: impl Into<String>) -> IgesError {
 /// dropped), numbered from 1. A file without line breaks between its records (IGES defines
 /// records of 80 characters, not lines; Open CASCADE reads such files too) is one line whose
 /// length is a multiple of 80 with a section letter in column 73 of every 80: it is cut into
-/// its records, numbered as if each were a line.
-fn records(bytes: &[u8]) -> Vec<(usize, &[u8])> {
+/// its records, numbered as if each were a line. A line of 160 characters or more that starts
+/// like a record but is not a whole number of them is refused.
+fn records(bytes: &[u8]) -> Result<Vec<(usize, &[u8])>> {
     let is_letter = |b: u8| matches!(b, b'S' | b'G' | b'D' | b'P' | b'T');
     let mut out = Vec::new();
     for raw in bytes.split(|&b| b == b'\n') {
         let line = raw.strip_suffix(b"\r").unwrap_or(raw);
-        let packed =
-            line.len() > 80 && line.len() % 80 == 0 && line.chunks(80).all(|r| is_letter(r[72]));
-        if packed {
-            out.extend(
-                line.chunks(80)
-                    .map(|r| (out.len() + 1, r))
-                    .collect::<Vec<_>>(),
-            );
+        let base = out.len();
+        if line.len() >= 160 && is_letter(line[72]) {
+            // Records run together: whole 80-column records, each with its section letter.
+            if line.len() % 80 != 0 || !line.chunks(80).all(|r| is_letter(r[72])) {
+                return Err(syntax(
+                    base + 1,
+                    format!(
+                        "records run together without line breaks, but {} characters are not a whole number of 80-column records each with its section letter in column 73",
+                        line.len()
+                    ),
+                ));
+            }
+            out.extend(line.chunks(80).enumerate().map(|(i, r)| (base + i + 1, r)));
         } else {
-            out.push((out.len() + 1, line));
+            out.push((base + 1, line));
         }
     }
-    out
+    Ok(out)
 }
 
 /// Reads the layout of a whole file.
@@ -107,7 +113,8 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
     let mut sections: [Vec<(usize, &[u8])>; 5] = Default::default();
     let mut last = 0usize;
     let mut seen_any = false;
-    for (line_no, line) in records(bytes) {
+    let records = records(bytes)?;
+    for &(line_no, line) in &records {
         if line.iter().all(|b| b.is_ascii_whitespace()) {
             continue;
         }
@@ -165,7 +172,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Iges> {
     }
     if sections[1].is_empty() {
         return Err(syntax(
-            records(bytes).len(),
+            records.len(),
             "no global (G) section: not an IGES file",
         ));
     }

@@ -174,8 +174,8 @@ fn an_inch_file_is_the_mm_file() {
 
 /// IGES defines 80-character records, not lines: the same file with its records run together
 /// (no line breaks, as some systems write it) or with CR LF line ends reads to the same
-/// document; a run-together file whose length is not a whole number of records is refused by
-/// its column-73 rule.
+/// document; a run-together file whose length is not a whole number of records is refused as
+/// such, and errors name a run-together record by its number.
 #[test]
 fn records_without_line_breaks_or_with_crlf_read_the_same() {
     let text = std::fs::read_to_string(fixture("iges", "faces.igs")).expect("fixture");
@@ -187,9 +187,29 @@ fn records_without_line_breaks_or_with_crlf_read_the_same() {
     let crlf = text.replace('\n', "\r\n");
     assert_eq!(import(crlf.as_bytes(), &opts).expect("crlf").file, want);
     let cut = &packed[..packed.len() - 3];
+    let e = import(cut.as_bytes(), &opts)
+        .expect_err("cut short")
+        .to_string();
     assert!(
-        import(cut.as_bytes(), &opts).is_err(),
-        "a run-together file cut short is refused"
+        e.contains("line 1: records run together") && e.contains("not a whole number"),
+        "a run-together file cut short is refused as such: {e}"
+    );
+    // Errors name the record: spoil the entity type on the second line of directory entry 3
+    // (counted from the file's first record, as its line would be).
+    let lines: Vec<&str> = text.lines().collect();
+    let d_first = lines
+        .iter()
+        .position(|l| &l[72..73] == "D")
+        .expect("D section");
+    let at = d_first + 3;
+    let mut spoiled: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    spoiled[at].replace_range(0..8, "    9999");
+    let e = import(spoiled.concat().as_bytes(), &opts)
+        .expect_err("spoiled")
+        .to_string();
+    assert!(
+        e.contains(&format!("line {}:", at + 1)),
+        "the record's number: {e}"
     );
 }
 

@@ -572,23 +572,18 @@ fn trimmed_outline<'e>(reader: &Reader<'e>, e: &'e Entry) -> Result<Pending<'e>>
         loops.push(l);
         ids.push(i);
     } else {
-        let (l, i) = boundary(reader, e, int(e, 3, "outer boundary")?, "outer boundary")?;
+        let de = int(e, 3, "outer boundary")?;
+        let (l, i) = boundary(reader, e, de, "outer boundary")?;
         if let kerf_step::cad::Geometry::Nurbs(surface) = &g {
-            let de = int(e, 3, "outer boundary")?;
             params.extend(parameter_points(reader, e, de, surface, &l)?);
         }
         loops.push(l);
         ids.push(i);
     }
     for k in 0..n2 {
-        let (l, i) = boundary(
-            reader,
-            e,
-            int(e, 4 + k, "inner boundary")?,
-            &format!("inner boundary {}", k + 1),
-        )?;
+        let de = int(e, 4 + k, "inner boundary")?;
+        let (l, i) = boundary(reader, e, de, &format!("inner boundary {}", k + 1))?;
         if let kerf_step::cad::Geometry::Nurbs(surface) = &g {
-            let de = int(e, 4 + k, "inner boundary")?;
             params.extend(parameter_points(reader, e, de, surface, &l)?);
         }
         loops.push(l);

@@ -33,7 +33,7 @@ use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::basis::binomial;
 use crate::bezier::RationalBezier;
-use crate::curve::{project, NurbsCurve};
+use crate::curve::NurbsCurve;
 use crate::knots;
 use crate::queue::BestFirst;
 use crate::{MAX_DEGREE, MAX_ORDER};
@@ -402,14 +402,8 @@ fn box_distance(piece: &RationalBezier, p: &Point3<f64>) -> f64 {
 /// `net` (of a curve piece or a surface patch): a lower bound on the distance to the piece
 /// (convex hull property, positive weights).
 pub(crate) fn hull_box_distance(net: &[Vector4<f64>], p: &Point3<f64>) -> f64 {
-    let mut lo = Vector3::repeat(f64::INFINITY);
-    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for c in net {
-        let x = project(c).coords;
-        lo = lo.inf(&x);
-        hi = hi.sup(&x);
-    }
-    crate::distance_to_box(p, &lo.into(), &hi.into())
+    let (lo, hi) = crate::curve::hull_box(net);
+    crate::distance_to_box(p, &lo, &hi)
 }
 
 /// Row `n` of Pascal's triangle, `C(n, 0..=n)`.

@@ -580,12 +580,15 @@ pub(crate) struct RunArgs {
     /// machine file's `head` (else a 3 mm nozzle cone 25 mm long on a 90 mm body) standing at
     /// its `process.standoff_mm` must keep this distance, mm, from the part's surfaces, proven
     /// over the poses and the motion between them; a cut that comes closer is refused naming
-    /// the stretch and the surface. The report's `head` gives the figures per path.
+    /// the stretch and the surface. The checked traverses (a --clearance above 0) keep it too:
+    /// a route the head does not clear is not taken, and a traverse on which the head clears no
+    /// route is refused by name. The report's `head`
+    /// gives the figures per path, `traverses` those of the traverses.
     #[arg(long, value_name = "MM", value_parser = crate::guard::clearance_mm)]
     pub(crate) cut_clearance: Option<f64>,
 
-    /// With --cut-clearance: report cuts where the head comes closer as warnings instead of
-    /// refusing the run.
+    /// With --cut-clearance: report cuts and traverses where the head comes closer as
+    /// warnings instead of refusing the run.
     #[arg(long, requires = "cut_clearance")]
     pub(crate) accept_head_collisions: bool,
 

@@ -12,6 +12,10 @@ use nalgebra::{Point3, Vector3};
 
 use crate::report::{HeadPath, HeadReport, HeadStretch, HeadTilt};
 
+/// How near a surface's boundary must come to another for the two to be one part, mm (CAD
+/// edges meet within hundredths of a millimetre).
+pub(crate) const PART_JOIN_TOLERANCE_MM: f64 = 0.05;
+
 /// Rounds of tilting and checking again a path may take.
 const MAX_ROUNDS: usize = 4;
 

@@ -137,11 +137,12 @@ pub struct JobOptions {
     pub kerf_in_control: bool,
     /// The distance the head (the machine file's `head`, else
     /// [`kerf_kinematics::Head::laser_default`]) must keep from the part's surfaces along
-    /// every cut (contour, lead-in, lead-out), mm ([`kerf_process::check_cut`]). `None` (the
-    /// default for now): cuts are not checked against the head.
+    /// every cut (contour, lead-in, lead-out), mm ([`kerf_process::check_cut`]), and along
+    /// every traverse ([`kerf_process::TraverseHead`]: a route it does not clear is not
+    /// taken). `None` (the default for now): neither is checked against the head.
     pub cut_clearance_mm: Option<f64>,
-    /// With [`JobOptions::cut_clearance_mm`], cuts where the head comes closer are warnings
-    /// instead of a refused run. Default false.
+    /// With [`JobOptions::cut_clearance_mm`], cuts and traverses where the head comes closer
+    /// are warnings instead of a refused run. Default false.
     pub accept_head_collisions: bool,
     /// Micro-joints: `Some((length_mm, spacing_mm))` leaves `length_mm` of each part's outline
     /// (and of each cut-out wider than `spacing_mm`) uncut every `spacing_mm` of path, away

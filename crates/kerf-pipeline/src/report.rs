@@ -567,6 +567,21 @@ pub struct TraversesReport {
     /// The least distance proven on them, mm (`null`: infinite).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub min_distance_mm: Option<f64>,
+    /// With the head check (`cut_clearance_mm`): the clearance the head model keeps along
+    /// every checked traverse, mm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub head_clearance_mm: Option<f64>,
+    /// With the head check: the least distance proven between the head model and the part
+    /// over the checked traverses, mm (`null`: infinite).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub head_min_distance_mm: Option<f64>,
+    /// With the head check: traverses on which the head cleared no route, taken on the
+    /// nozzle line's check with a warning (head collisions accepted).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub head_too_close: Option<usize>,
+    /// What the head check of the traverses covers.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub head_note: Option<String>,
     /// Surfaces left out where a cut ends or starts.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub surfaces_in_the_cuts_way: Option<Vec<String>>,

@@ -32,9 +32,7 @@ use crate::report::{
 use crate::timing::{Lap, Timings};
 use crate::Progress;
 
-/// How near a surface's boundary must come to another for the two to be one part, mm (CAD
-/// edges meet within hundredths of a millimetre).
-const PART_JOIN_TOLERANCE_MM: f64 = 0.05;
+use crate::head::PART_JOIN_TOLERANCE_MM;
 
 /// The least tilt the head check's tip zone allows for, degrees: a lead-in's or a blended
 /// pose's axis may stand a little off the surface normal even without a tilt tolerance.
@@ -476,6 +474,27 @@ fn micro_joints_report(
         .collect()
 }
 
+/// The head check's options at `clearance` mm: the machine's standoff, the run's tilt
+/// tolerance (at least [`HEAD_CHECK_MIN_TILT_DEG`] for the tip zone), the controller's path
+/// deviation and, where the program's blocks merge poses, the fit's orientation tolerance.
+fn head_options(r: &Run<'_>, clearance: f64) -> kerf_process::HeadCheckOptions {
+    let (o, popts) = (r.o, &r.o.path);
+    kerf_process::HeadCheckOptions::default()
+        .with_clearance_mm(clearance)
+        .with_standoff_mm(r.head_standoff_mm)
+        .with_max_tilt_deg(popts.tilt_tolerance_deg.max(HEAD_CHECK_MIN_TILT_DEG))
+        // The controller's tip leaves the chords by the non-linearity error and its blending
+        // (an infinite tolerance leaves the check unproven).
+        .with_path_deviation_mm(popts.linearization_tolerance_mm + o.blend_tolerance_mm)
+        // Where the program's blocks merge poses (lines and arcs over several), each pose's
+        // axis is held within the fit's orientation tolerance only.
+        .with_axis_deviation_deg(if r.fit.merge_lines || r.fit.arcs {
+            r.fit.orientation_tolerance_deg
+        } else {
+            0.0
+        })
+}
+
 /// The head check of every set-up at `clearance` mm ([`crate::head::check_and_clear`]): each
 /// cut against the part it lies on, the surfaces its curve names and every surface joined to
 /// those (a wall beside a hole), not another part the file holds.
@@ -492,20 +511,7 @@ fn check_heads(
     out: &mut Solved,
 ) -> Result<()> {
     let (file, o, popts) = (r.file, r.o, &r.o.path);
-    let hopts = kerf_process::HeadCheckOptions::default()
-        .with_clearance_mm(clearance)
-        .with_standoff_mm(r.head_standoff_mm)
-        .with_max_tilt_deg(popts.tilt_tolerance_deg.max(HEAD_CHECK_MIN_TILT_DEG))
-        // The controller's tip leaves the chords by the non-linearity error and its blending
-        // (an infinite tolerance leaves the check unproven).
-        .with_path_deviation_mm(popts.linearization_tolerance_mm + o.blend_tolerance_mm)
-        // Where the program's blocks merge poses (lines and arcs over several), each pose's
-        // axis is held within the fit's orientation tolerance only.
-        .with_axis_deviation_deg(if r.fit.merge_lines || r.fit.arcs {
-            r.fit.orientation_tolerance_deg
-        } else {
-            0.0
-        });
+    let hopts = head_options(r, clearance);
     for setup in 0..placed.plan.setups.len() {
         let ks: Vec<usize> = (0..solved.len())
             .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
@@ -722,6 +728,14 @@ fn setup_program(
         },
         r.machine,
         r.traverse.as_ref(),
+        o.cut_clearance_mm
+            .map(|c| crate::traverses::HeadAlong {
+                head: &r.head,
+                // The traverses' rapids are one block per waypoint (no merged axes).
+                opts: head_options(r, c).with_axis_deviation_deg(0.0),
+                accept: o.accept_head_collisions,
+            })
+            .as_ref(),
         o.retract_mm,
         &mut out.axes,
         &mut out.traverses,

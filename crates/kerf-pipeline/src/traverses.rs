@@ -9,8 +9,8 @@ use std::path::Path;
 
 use kerf_format::CurvesFile;
 use kerf_interp::Station;
-use kerf_kinematics::{Axes, AxesFile, AxesMove, Machine, SolvedPath};
-use kerf_process::{Gap, Obstacles, Pose, Route, TraverseOptions};
+use kerf_kinematics::{Axes, AxesFile, AxesMove, Head, Machine, SolvedPath};
+use kerf_process::{Gap, HeadCheckOptions, Obstacles, Pose, Route, TraverseHead, TraverseOptions};
 use nalgebra::Point3;
 
 use crate::cuts::CutPath;
@@ -29,6 +29,10 @@ pub(crate) struct Tally {
     own: Vec<OwnSurfaces>,
     /// Gaps a search around the part cleared.
     searched: Vec<SearchedTraverse>,
+    /// The clearance the head model kept along the traverses, mm (with the head check).
+    head_clearance_mm: Option<f64>,
+    /// Traverses no route cleared the head on, taken (head collisions accepted).
+    head_too_close: usize,
 }
 
 /// What the report keeps of one checked traverse.
@@ -40,6 +44,9 @@ struct Checked {
     length_mm: f64,
     /// The least distance from the part proven for the route and the machine's moves, mm.
     min_distance_mm: f64,
+    /// The least distance proven between the head model and the part along the moves, mm
+    /// (with the head check).
+    head_min_distance_mm: Option<f64>,
     /// The machine's moves split so that they clear.
     split_moves: usize,
     /// The surfaces left out of its check.
@@ -55,6 +62,16 @@ pub(crate) struct SetupTraverses {
     pub(crate) plot: Vec<Vec<Point3<f64>>>,
     /// A warning per gap that fell back to the unchecked traverse.
     pub(crate) warnings: Vec<String>,
+}
+
+/// The head check of the traverses (with the cuts' head check).
+pub(crate) struct HeadAlong<'a> {
+    /// The machine's head.
+    pub(crate) head: &'a Head,
+    /// The cuts' head check options (the cutting clearance).
+    pub(crate) opts: HeadCheckOptions,
+    /// A traverse whose head no route clears is a warning, not a refusal.
+    pub(crate) accept: bool,
 }
 
 /// The set-up's cuts and where they come from.
@@ -85,6 +102,7 @@ pub(crate) fn route_setup(
     s: &SetupCuts<'_>,
     machine: &Machine,
     opts: Option<&TraverseOptions>,
+    head: Option<&HeadAlong<'_>>,
     retract_mm: f64,
     axes: &mut AxesFile,
     tally: &mut Tally,
@@ -107,13 +125,41 @@ pub(crate) fn route_setup(
         file: s.path.map(Path::to_path_buf),
         source,
     })?;
+    // With the head check: the head model along every route too, against every surface of the
+    // parts the gap's cuts lie on (a wall beside a hole, which no curve names).
+    let all = match head {
+        Some(_) => Some(
+            Obstacles::from_all_surfaces(file, |p| placement.apply_point(p)).map_err(|source| {
+                crate::Error::Process {
+                    file: s.path.map(Path::to_path_buf),
+                    source,
+                }
+            })?,
+        ),
+        None => None,
+    };
+    let parts = all
+        .as_ref()
+        .map(|a| a.parts(crate::head::PART_JOIN_TOLERANCE_MM))
+        .unwrap_or_default();
+    tally.head_clearance_mm = head.map(|h| h.opts.clearance_mm);
+    let traverse_head = head
+        .zip(all.as_ref())
+        .map(|(h, a)| TraverseHead::new(h.head, h.opts, a, &parts));
     let limits = machine.limits.map(|r| r.map(|r| (r.min, r.max)));
     let gaps: Vec<Gap> = s
         .in_setup
         .windows(2)
         .map(|w| gap(file, cuts, solved, w[0], w[1]))
         .collect();
-    let rapids = kerf_process::plan_rapids(machine.kinematics.as_ref(), &limits, &obs, &gaps, opts);
+    let rapids = kerf_process::plan_rapids(
+        machine.kinematics.as_ref(),
+        &limits,
+        &obs,
+        &gaps,
+        opts,
+        traverse_head.as_ref(),
+    );
     let cut_end = |k: usize| cuts[k].poses[cuts[k].poses.len() - 1];
     for ((w, planned), gap) in s.in_setup.windows(2).zip(&rapids).zip(&gaps) {
         let (after, before) = (&solved[w[0]].id, &solved[w[1]].id);
@@ -145,6 +191,27 @@ pub(crate) fn route_setup(
                 continue;
             }
         };
+        if let Some(close) = &r.head_too_close {
+            // The tip and the nozzle line clear, the head on no route: refused, or taken with
+            // a warning where head collisions are accepted.
+            let e = kerf_process::ProcessError::TraverseHeadTooClose {
+                after: after.clone(),
+                before: before.clone(),
+                reason: format!(
+                    "on every route whose tip and nozzle keep the traverse clearance, the head comes {close} (cutting clearance {} mm; the first route it was tried on, or where it stands at a cut's end or at every retract height); the route taken is checked for its tip and nozzle line only",
+                    head.map_or(0.0, |h| h.opts.clearance_mm),
+                ),
+            };
+            if !head.is_some_and(|h| h.accept) {
+                return Err(crate::Error::Process {
+                    file: s.path.map(Path::to_path_buf),
+                    source: e,
+                });
+            }
+            out.warnings
+                .push(format!("{e} (accepted: accept_head_collisions)"));
+            tally.head_too_close += 1;
+        }
         axes.paths[w[1]].traverse = Some(AxesMove {
             positions: r.axes.iter().map(Axes::to_array).collect(),
             poses: r.poses.iter().map(Pose::to_array).collect(),
@@ -178,6 +245,7 @@ pub(crate) fn route_setup(
             route: t.route,
             length_mm: t.length_mm,
             min_distance_mm: t.min_distance_mm.min(r.min_distance_mm),
+            head_min_distance_mm: r.head_min_distance_mm,
             split_moves: r.split_moves,
             absent: absent.clone(),
         });
@@ -239,6 +307,8 @@ impl Tally {
             unchecked: blocked,
             own,
             searched,
+            head_clearance_mm,
+            head_too_close,
         } = self;
         let mut unchecked: Vec<String> = Vec::new();
         for Checked { absent, .. } in &rapids {
@@ -276,6 +346,10 @@ impl Tally {
                 split_moves: None,
                 length_mm: None,
                 min_distance_mm: None,
+                head_clearance_mm: None,
+                head_min_distance_mm: None,
+                head_too_close: None,
+                head_note: None,
                 surfaces_in_the_cuts_way: None,
                 surfaces_note: None,
                 own_surface_over_the_head: None,
@@ -298,6 +372,16 @@ impl Tally {
             split_moves: Some(rapids.iter().map(|c| c.split_moves).sum::<usize>()),
             length_mm: Some(rapids.iter().map(|c| c.length_mm).sum::<f64>()),
             min_distance_mm: Some(rapids.iter().map(|c| c.min_distance_mm).fold(f64::INFINITY, f64::min)),
+            head_clearance_mm,
+            // Absent where no traverse cleared the head (none, or every one too close).
+            head_min_distance_mm: head_clearance_mm.and_then(|_| {
+                rapids
+                    .iter()
+                    .filter_map(|c| c.head_min_distance_mm)
+                    .reduce(f64::min)
+            }),
+            head_too_close: head_clearance_mm.map(|_| head_too_close),
+            head_note: head_clearance_mm.map(|_| "the head model (head.paths' solids) checked along every checked traverse as along the cuts: the machine's moves from a cut's end through the waypoints to the next pierce, against every surface of the parts the two cuts lie on (those in the cuts' way left out): the retract and the approach with head.tip_zone_mm left out (the nozzle is at the surface there), the travel between the retract points with the whole head; a route the head does not clear is not taken; where the head clears no route, the run is refused, or with accept_head_collisions the route the nozzle line clears is taken with a warning (head_too_close counts them; head_min_distance_mm leaves them out, and is absent where no traverse cleared the head)".into()),
             surfaces_in_the_cuts_way: Some(unchecked),
             surfaces_note: Some("surfaces that lie on the tool axis line where a cut ends or starts (its contour end and exit, its pierce and contour start, up to the retract plus the nozzle) are not checked for the traverse there: the head meets them while it cuts or pierces, whatever the traverse does; a surface the cut's curve does not name (another workpiece in the same place, or in the way of the cut), or one it names that comes back over the head line from 3/4 of the clearance up (listed in own_surface_over_the_head)".into()),
             own_surface_over_the_head: Some(own),

@@ -199,6 +199,65 @@ fn written_poses(
         .collect()
 }
 
+/// A tip and its tool axis in part coordinates.
+type Placed = (Point3<f64>, Vector3<f64>);
+
+/// The head's poses along every written traverse (part coordinates): the machine's
+/// joint-linear moves from the previous path's last axes through the traverse's waypoints to
+/// the path's first axes, 64 samples a move, through `machine`'s forward kinematics; and how
+/// many traverses there were.
+fn traverse_poses(
+    machine: &Machine,
+    curves: &kerf_format::CurvesFile,
+    out: &kerf_pipeline::Output,
+) -> (Vec<Placed>, usize) {
+    use kerf_kinematics::Axes;
+    let paths = &out.axes.paths;
+    let mut poses = Vec::new();
+    let mut count = 0;
+    for k in 1..paths.len() {
+        let Some(t) = &paths[k].traverse else {
+            continue;
+        };
+        count += 1;
+        let prev = &paths[k - 1];
+        let last = prev
+            .lead_out
+            .as_ref()
+            .and_then(|m| m.positions.last())
+            .or(prev.positions.last())
+            .expect("the previous path's end");
+        let first = paths[k]
+            .lead_in
+            .as_ref()
+            .and_then(|m| m.positions.first())
+            .or(paths[k].positions.first())
+            .expect("the path's start");
+        let mut way: Vec<Axes> = vec![Axes::from(*last)];
+        way.extend(t.positions.iter().map(|q| Axes::from(*q)));
+        way.push(Axes::from(*first));
+        let i = curves
+            .curves
+            .iter()
+            .position(|c| c.id == paths[k].id)
+            .expect("curve");
+        let pl = out.placement.placement_of(i);
+        let (r, shift) = (pl.rotation(), pl.translation_mm);
+        for w in way.windows(2) {
+            for j in 0..=64 {
+                let q = machine
+                    .kinematics
+                    .forward(&w[0].lerp(&w[1], j as f64 / 64.0));
+                poses.push((
+                    Point3::from(r.inverse() * (q.position - shift)),
+                    r.inverse() * q.axis.normalize(),
+                ));
+            }
+        }
+    }
+    (poses, count)
+}
+
 /// A head fixture run with a tilt tolerance: every path clears by tilting (reported), and
 /// dense sampling of the head at every written pose agrees; upright on the curve's own
 /// normals (`normal` at each written point), the same sampling finds it closer than the
@@ -208,7 +267,7 @@ fn tilted_fixture(
     id: &str,
     clearance: f64,
     normal: impl Fn(&Point3<f64>) -> Vector3<f64>,
-) -> f64 {
+) -> (f64, usize) {
     let curves = kerf_format::curves::load(fixture(name)).expect("curves");
     let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
     let run = |tilt: f64| {
@@ -244,16 +303,37 @@ fn tilted_fixture(
         d >= clearance - kerf_process::RESOLUTION_MM - kerf_process::SAMPLE_STEP_MM / 2.0,
         "{name}: dense sampling finds the head within {d} mm of the part"
     );
+    // The traverses too: the head model along the machine's moves keeps the clearance (the
+    // head check of the traverses), by the same sampling.
+    let (along, traverses) = traverse_poses(&machine, &curves, &out);
+    if traverses > 0 {
+        let proven = out
+            .report
+            .traverses
+            .head_min_distance_mm
+            .expect("the traverses' head distance");
+        let t = sampled_distance(&along, zone, &surfaces);
+        assert!(
+            t >= clearance - kerf_process::RESOLUTION_MM - kerf_process::SAMPLE_STEP_MM / 2.0
+                && t >= proven - 0.05,
+            "{name}: along the traverses dense sampling finds the head within {t} mm (proven {proven})"
+        );
+    }
     let upright: Vec<(Point3<f64>, Vector3<f64>)> =
         poses.iter().map(|(p, _)| (*p, normal(p))).collect();
     let u = sampled_distance(&upright, zone, &surfaces);
     assert!(u < clearance, "{name}: upright the head keeps {u} mm");
-    tilt
+    (tilt, traverses)
 }
 
 #[test]
 fn a_tilt_within_the_tolerance_clears_the_wall_and_dense_sampling_agrees() {
-    let tilt = tilted_fixture("head_wall.json", "hole-near-wall", 3.0, |_| Vector3::z());
+    let (tilt, traverses) =
+        tilted_fixture("head_wall.json", "hole-near-wall", 3.0, |_| Vector3::z());
+    assert_eq!(
+        traverses, 1,
+        "the traverse between the holes is sampled too"
+    );
     assert!(tilt < 5.0, "{tilt}");
 }
 
@@ -281,5 +361,130 @@ fn without_a_tilt_tolerance_the_refusal_says_which_tilt_would_clear() {
         e.contains("deg away from surface wall would clear it")
             && e.contains("a tilt_tolerance_deg of"),
         "{e}"
+    );
+}
+
+/// Two holes of radius 5 at `y = -60` and `y = 60` in a floor, and between them a rib 40 mm
+/// high at `x = 30` (`y` from -10 to 10): the tip and the nozzle line pass it 25 mm off at any
+/// retract, the head's 90 mm body (from 26 mm above the tip) meets it below 14 mm of retract.
+fn rib_file() -> kerf_format::CurvesFile {
+    let hole = |id: &str, y: f64| {
+        format!(
+            r#"{{"id": "{id}", "degree": 2, "knots": [0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1],
+            "control_points": [[5, {y}, 0], [5, {a}, 0], [0, {a}, 0], [-5, {a}, 0], [-5, {y}, 0], [-5, {b}, 0], [0, {b}, 0], [5, {b}, 0], [5, {y}, 0]],
+            "weights": [1, 0.7071067811865476, 1, 0.7071067811865476, 1, 0.7071067811865476, 1, 0.7071067811865476, 1],
+            "surface": "floor", "scrap": "left"}}"#,
+            a = y + 5.0,
+            b = y - 5.0
+        )
+    };
+    let text = format!(
+        r#"{{"format": "kerf.curves/1", "units": "mm", "curves": [{}, {}], "surfaces": [
+        {{"type": "nurbs", "id": "floor", "degree_u": 1, "degree_v": 1, "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+          "control_points": [[[-200, -200, 0], [-200, 200, 0]], [[200, -200, 0], [200, 200, 0]]]}},
+        {{"type": "nurbs", "id": "rib", "degree_u": 1, "degree_v": 1, "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+          "control_points": [[[30, -10, 0], [30, -10, 40]], [[30, 10, 0], [30, 10, 40]]]}}]}}"#,
+        hole("hole-a", -60.0),
+        hole("hole-b", 60.0)
+    );
+    kerf_format::curves::from_str(&text, std::path::Path::new(".")).expect("the rib file")
+}
+
+/// The rib's and the floor's exact surfaces.
+fn rib_surfaces() -> Vec<Exact> {
+    let p = Point3::new;
+    let v = Vector3::new;
+    vec![
+        Exact::Rect(
+            p(-200.0, -200.0, 0.0),
+            v(400.0, 0.0, 0.0),
+            v(0.0, 400.0, 0.0),
+        ),
+        Exact::Rect(p(30.0, -10.0, 0.0), v(0.0, 20.0, 0.0), v(0.0, 0.0, 40.0)),
+    ]
+}
+
+fn rib_run(
+    machine: &Machine,
+    clearance: Option<f64>,
+    accept: bool,
+) -> Result<kerf_pipeline::Output, kerf_pipeline::Error> {
+    Job::new(rib_file(), machine.clone())
+        .with_options(
+            JobOptions::default()
+                .with_cut_clearance_mm(clearance)
+                .with_accept_head_collisions(accept),
+        )
+        .run()
+}
+
+/// With the head check, the traverse between the holes rises over the rib (the head model
+/// along the traverse, `kerf_process::TraverseHead`): dense sampling of the head along the
+/// machine's written moves against the exact rib finds at least the clearance less the
+/// check's resolution, and not less than the distance the report claims proven; without the
+/// head check the same sampling finds the body in the rib.
+#[test]
+fn the_traverse_rises_over_a_rib_the_head_would_meet() {
+    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    let curves = rib_file();
+    let surfaces = rib_surfaces();
+    let out = rib_run(&machine, Some(1.0), false).expect("clear");
+    let zone = out.report.head.tip_zone_mm.flatten().expect("zone");
+    let (along, n) = traverse_poses(&machine, &curves, &out);
+    assert_eq!(n, 1);
+    let proven = out
+        .report
+        .traverses
+        .head_min_distance_mm
+        .expect("the head checked along the traverse");
+    assert_eq!(out.report.traverses.head_too_close, Some(0));
+    let d = sampled_distance(&along, zone, &surfaces);
+    assert!(
+        d >= 1.0 - kerf_process::RESOLUTION_MM - kerf_process::SAMPLE_STEP_MM / 2.0
+            && d >= proven - 0.05,
+        "sampled {d}, proven {proven}"
+    );
+    let plain = rib_run(&machine, None, false).expect("without the head check");
+    let (along, n) = traverse_poses(&machine, &curves, &plain);
+    assert_eq!(n, 1);
+    let d = sampled_distance(&along, zone, &surfaces);
+    assert!(
+        d < 0.5,
+        "the body meets the rib without the head check: {d}"
+    );
+}
+
+/// The same part on a machine whose Z travel ends 2 mm above the retract point: no route the
+/// machine reaches clears the head, and the run is refused naming the traverse and the rib;
+/// accepted, the route the nozzle line clears is taken with a warning, counted in the report.
+#[test]
+fn a_traverse_the_head_clears_on_no_route_is_refused_by_name() {
+    let mut machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    let plain = rib_run(&machine, None, false).expect("without the head check");
+    let z = plain.axes.paths[1]
+        .traverse
+        .as_ref()
+        .expect("traverse")
+        .positions[0][2];
+    machine.limits[2] = Some(kerf_kinematics::Range {
+        min: z - 100.0,
+        max: z + 2.0,
+    });
+    let e = rib_run(&machine, Some(1.0), false)
+        .expect_err("refused")
+        .to_string();
+    let named = |m: &str| {
+        m.contains("the traverse from \"hole-b\" to \"hole-a\"")
+            || m.contains("the traverse from \"hole-a\" to \"hole-b\"")
+    };
+    assert!(named(&e) && e.contains("surface rib"), "{e}");
+    let out = rib_run(&machine, Some(1.0), true).expect("accepted");
+    assert_eq!(out.report.traverses.head_too_close, Some(1));
+    assert!(
+        out.warnings
+            .iter()
+            .any(|w| named(w) && w.contains("accepted")),
+        "{:?}",
+        out.warnings
     );
 }

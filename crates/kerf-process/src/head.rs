@@ -78,6 +78,13 @@ pub struct HeadCheckOptions {
     /// The most exact distance queries one cut may make: past it the rest of the cut is not
     /// proven clear ([`CutClearance::proven`] false).
     pub max_queries: usize,
+    /// Stop at the first sample witnessed closer than the clearance (its one-sample stretch
+    /// the only one reported): for a caller that only needs to know the head does not clear,
+    /// such as a traverse trying its routes. Default false (every close stretch, in full).
+    pub stop_at_first_close: bool,
+    /// Check the head down to its nozzle tip, no tip zone left out: for poses away from the
+    /// surface being cut (a traverse's travel). Default false.
+    pub whole_head: bool,
 }
 
 impl Default for HeadCheckOptions {
@@ -89,6 +96,8 @@ impl Default for HeadCheckOptions {
             path_deviation_mm: 0.0,
             axis_deviation_deg: 0.0,
             max_queries: 2_000_000,
+            stop_at_first_close: false,
+            whole_head: false,
         }
     }
 }
@@ -122,6 +131,16 @@ impl HeadCheckOptions {
     /// Sets [`max_queries`](Self::max_queries).
     pub fn with_max_queries(mut self, max_queries: usize) -> Self {
         self.max_queries = max_queries;
+        self
+    }
+    /// Sets [`stop_at_first_close`](Self::stop_at_first_close).
+    pub fn with_stop_at_first_close(mut self, stop: bool) -> Self {
+        self.stop_at_first_close = stop;
+        self
+    }
+    /// Sets [`whole_head`](Self::whole_head).
+    pub fn with_whole_head(mut self, whole: bool) -> Self {
+        self.whole_head = whole;
         self
     }
 }
@@ -221,8 +240,12 @@ fn unusable(head: &Head, poses: &[Pose], opts: &HeadCheckOptions, zone: f64) -> 
 }
 
 /// The height above the nozzle tip from which the head keeps `clearance + STRETCH_SLACK_MM`
-/// from a plane through the cutting point tilted by up to `max_tilt_deg` from the tool axis.
+/// from a plane through the cutting point tilted by up to `max_tilt_deg` from the tool axis
+/// (0 with [`HeadCheckOptions::whole_head`]).
 pub fn tip_zone_mm(head: &Head, opts: &HeadCheckOptions) -> f64 {
+    if opts.whole_head {
+        return 0.0;
+    }
     let (s, c) = opts.max_tilt_deg.to_radians().sin_cos();
     let need = opts.clearance_mm + STRETCH_SLACK_MM;
     let len = head.length_mm();
@@ -675,6 +698,9 @@ pub fn check_cut_along(
                 point,
             } if i == j => {
                 close_at[m] = Some((bound, height, point));
+                if opts.stop_at_first_close {
+                    break;
+                }
                 // Then probes every RUN_STRIDE samples on either side: two witnesses that
                 // close make the samples between them part of one close stretch.
                 for dir in [1isize, -1] {

@@ -45,7 +45,8 @@ pub use lead::{LeadIn, LeadOptions};
 pub use offset::{offset, OffsetInput, OffsetOptions, OffsetPath};
 pub use order::CutPlan;
 pub use rapid::{
-    in_the_cuts_way, own_surfaces_over_the_head, plan_rapids, rapid_moves, Gap, RapidMoves,
+    in_the_cuts_way, own_surfaces_over_the_head, plan_rapids, rapid_moves, Gap, HeadWitness,
+    RapidMoves, TraverseHead,
 };
 pub use side::{head_lines, HeadLines, HEAD_LINE_POINTS};
 pub use start::{index_of_param, prepare_start};
@@ -181,6 +182,19 @@ pub enum ProcessError {
         /// The path's id.
         id: String,
         /// The stretch, the distance, the surface.
+        reason: String,
+    },
+    /// On every route of a traverse that the machine reaches and whose tip and nozzle line
+    /// keep the traverse clearance, the head model comes closer to the part than the cutting
+    /// clearance ([`TraverseHead`]). Fix: wider axis limits (a higher retract or safe plane),
+    /// another cutting order or placement, or accept it as a warning.
+    #[error("the traverse from \"{after}\" to \"{before}\": the head comes too close to the part: {reason}")]
+    TraverseHeadTooClose {
+        /// The path the traverse leaves.
+        after: String,
+        /// The path it goes to.
+        before: String,
+        /// The distance, the point, the surface.
         reason: String,
     },
     /// No traverse route between two cuts keeps the clearance: the retract along the tool

@@ -4,9 +4,12 @@
 //! swings; each move is sampled through the forward kinematics and checked, and a move that
 //! comes too close is split into shorter ones along the straight line until it clears.
 
-use kerf_kinematics::{Axes, Kinematics};
+use kerf_kinematics::{Axes, Head, Kinematics};
 use nalgebra::{Point3, Vector3};
 
+use crate::head::{
+    axis_curvature, check_cut_along, CutClearance, HeadCheckOptions, SAMPLE_STEP_MM,
+};
 use crate::traverse::{check_move, Obstacles, Traverse, TraverseOptions};
 use crate::{Pose, ProcessError, Result};
 
@@ -25,6 +28,237 @@ pub struct RapidMoves {
     pub min_distance_mm: f64,
     /// How many moves had to be split so that their swing clears the part.
     pub split_moves: usize,
+    /// With a head model ([`TraverseHead`]): the least distance proven between the head and
+    /// the part over the machine's moves it checks, mm; `None` without one, or where no route
+    /// cleared the head (then [`head_too_close`](Self::head_too_close)).
+    pub head_min_distance_mm: Option<f64>,
+    /// With a head model: where the head came too close on the first route it refused, when
+    /// no route the tip and nozzle line clear cleared the head too (or where it stands too
+    /// close at one end whatever the route); the route is then the one the traverse's own
+    /// check takes without the head, for the caller to refuse or accept.
+    pub head_too_close: Option<HeadWitness>,
+}
+
+/// Where the head model comes closer to the part than the cutting clearance on a traverse
+/// ([`RapidMoves::head_too_close`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeadWitness {
+    /// The head point witnessed too close, or the tip where the check ran out of work
+    /// (workpiece frame).
+    pub at: Point3<f64>,
+    /// Its distance from the part, mm (an upper bound of the least distance there; negative:
+    /// inside the part); `None` where the head was not proven clear within the work budget.
+    pub distance_mm: Option<f64>,
+    /// The surface nearest that point.
+    pub surface: Option<String>,
+}
+
+impl std::fmt::Display for HeadWitness {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let p = self.at;
+        match self.distance_mm {
+            Some(d) => write!(
+                f,
+                "within {d:.3} mm of the part at ({:.3}, {:.3}, {:.3})",
+                p.x, p.y, p.z
+            )?,
+            None => write!(
+                f,
+                "not proven clear within the work budget near ({:.3}, {:.3}, {:.3})",
+                p.x, p.y, p.z
+            )?,
+        }
+        if let Some(id) = &self.surface {
+            write!(f, ", surface {id}")?;
+        }
+        Ok(())
+    }
+}
+
+/// The cutting head a traverse keeps clear of the part besides its tip and nozzle line
+/// ([`plan_rapids`]): the head model standing on every sample of the machine's moves from the
+/// cut's end to the next pierce, checked as the cuts are ([`check_cut_along`]): the retract
+/// from the cut's end and the approach to the pierce with the cut's tip zone left out (the
+/// nozzle is at the surface there), the travel between the retract points with the whole
+/// head; against every surface of the parts the two cuts lie on.
+#[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
+pub struct TraverseHead<'a> {
+    /// The head's solids.
+    pub head: &'a Head,
+    /// The clearance (the cutting clearance: the head keeps it while it cuts, so the moves
+    /// next to a cut can keep no more), the standoff and the tilt of the tip zone.
+    pub opts: HeadCheckOptions,
+    /// Every surface of the set-up, placed.
+    pub obstacles: &'a Obstacles,
+    /// The part of each surface of `obstacles` ([`Obstacles::parts`]).
+    pub parts: &'a [usize],
+}
+
+/// One machine move's head check: the least distance proven, or where the head came too
+/// close.
+type HeadMove = std::result::Result<f64, HeadWitness>;
+
+/// A machine move's key in a gap's cache of head checks: its two axes (bits), whether with
+/// the whole head, and which surfaces (those with the cuts' way's `first` or `all` left out).
+type HeadMoveKey = ([[u64; 5]; 2], bool, usize);
+
+/// The witness of a check that found the head too close or could not prove it clear
+/// (`poses` the poses checked); `None` where it is proven clear.
+fn witness(obs: &Obstacles, c: &CutClearance, poses: &[Pose]) -> Option<HeadWitness> {
+    if let Some(s) = c.close.first() {
+        return Some(HeadWitness {
+            at: s.point,
+            distance_mm: Some(s.distance_mm),
+            surface: s.surface.clone(),
+        });
+    }
+    (!c.proven).then(|| {
+        let at = poses
+            .get(c.at_pose)
+            .or(poses.first())
+            .map_or(Point3::origin(), |p| p.position);
+        HeadWitness {
+            at,
+            distance_mm: None,
+            surface: obs.nearest(&at).map(|(id, _)| id),
+        }
+    })
+}
+
+impl<'a> TraverseHead<'a> {
+    /// The head `head` checked with `opts` against the surfaces of `obstacles` in the parts
+    /// the gap's two cuts lie on (`parts` from [`Obstacles::parts`]).
+    pub fn new(
+        head: &'a Head,
+        opts: HeadCheckOptions,
+        obstacles: &'a Obstacles,
+        parts: &'a [usize],
+    ) -> Self {
+        Self {
+            head,
+            opts,
+            obstacles,
+            parts,
+        }
+    }
+
+    /// The surfaces one gap's head check keeps clear of: the parts its two cuts lie on,
+    /// without those left out of its traverse check (`absent`: in the cuts' way).
+    fn obstacles_of(&self, g: &Gap, absent: &[String]) -> Obstacles {
+        let mut seeds = g.from_surfaces.clone();
+        seeds.extend(g.to_surfaces.iter().cloned());
+        self.obstacles.of_parts(self.parts, &seeds).without(absent)
+    }
+
+    /// The options of a check: stopping at the first witness, the whole head or not.
+    fn options(&self, whole: bool) -> HeadCheckOptions {
+        self.opts
+            .with_stop_at_first_close(true)
+            .with_whole_head(whole)
+    }
+
+    /// The head standing at `p` alone against `obs` (`whole`: down to the nozzle tip): `None`
+    /// where it clears, else where it comes too close (or is not proven clear).
+    fn stands_clear(&self, obs: &Obstacles, p: &Pose, whole: bool) -> Option<HeadWitness> {
+        let one = [Pose::at(p.position, p.axis.normalize())];
+        let c = check_cut_along(obs, self.head, &one, &[], &self.options(whole));
+        witness(obs, &c, &one)
+    }
+
+    /// Where no route of gap `g` can clear the head against `obs` (the surfaces with the most
+    /// a route is checked without left out): every route starts with the retract from the
+    /// cut's end and ends with the approach to the pierce, each through a retract point at one
+    /// of the retract heights; so where the head standing at a cut's end comes too close, or
+    /// the whole head at every retract point of one end does, that witness. `None` where each
+    /// end has a retract point the head clears.
+    fn no_route_clears(
+        &self,
+        g: &Gap,
+        obs: &Obstacles,
+        opts: &TraverseOptions,
+    ) -> Option<HeadWitness> {
+        let heights = crate::traverse::retract_heights(opts);
+        [g.from, g.to].iter().find_map(|end| {
+            if let Some(w) = self.stands_clear(obs, end, false) {
+                return Some(w);
+            }
+            let n = end.axis.normalize();
+            let mut lowest = None;
+            for h in heights {
+                match self.stands_clear(obs, &Pose::at(end.position + n * h, n), true) {
+                    None => return None,
+                    Some(w) => {
+                        lowest.get_or_insert(w);
+                    }
+                }
+            }
+            lowest
+        })
+    }
+
+    /// The head along the joint-linear moves through `axes` (sampled every
+    /// [`SAMPLE_STEP_MM`] of the tip, the rotary axes' departure from the great circle counted
+    /// on each sample step), `whole` or with the tip zone left out: the least distance proven,
+    /// or where it comes too close.
+    fn along(&self, kin: &dyn Kinematics, obs: &Obstacles, axes: &[Axes], whole: bool) -> HeadMove {
+        let mut poses: Vec<Pose> = Vec::new();
+        let mut bends: Vec<f64> = Vec::new();
+        if let [one] = axes {
+            poses.push(kin.forward(one));
+        }
+        for w in axes.windows(2) {
+            let samples = joint_samples(kin, &w[0], &w[1], SAMPLE_STEP_MM);
+            let k = (samples.len() - 1) as f64;
+            let (dt, dc) = ((w[1].tilt - w[0].tilt) / k, (w[1].c - w[0].c) / k);
+            let skip = usize::from(!poses.is_empty());
+            for (j, p) in samples.iter().enumerate().skip(skip) {
+                if j > 0 {
+                    let start = w[0].tilt + dt * (j - 1) as f64;
+                    bends.push(axis_curvature(
+                        start.to_radians(),
+                        dt.to_radians(),
+                        dc.to_radians(),
+                    ));
+                }
+                poses.push(Pose::at(p.position, p.axis.normalize()));
+            }
+        }
+        let c = check_cut_along(obs, self.head, &poses, &bends, &self.options(whole));
+        match witness(obs, &c, &poses) {
+            Some(w) => Err(w),
+            None => Ok(c.min_distance_mm),
+        }
+    }
+
+    /// The head along the machine's moves of `r` for gap `g` against `obs`, each move checked
+    /// by `one_move` (the move's two axes, whether with the whole head; [`Self::along`] or a
+    /// cache of it): the retract from the cut's end to the first waypoint and the approach
+    /// from the last to the pierce with the tip zone left out, the moves of the travel between
+    /// them with the whole head (the head standing at the two retract points first: a route
+    /// from one it does not clear fails at once).
+    fn check(
+        &self,
+        g: &Gap,
+        obs: &Obstacles,
+        r: &RapidMoves,
+        one_move: &mut dyn FnMut([Axes; 2], bool) -> HeadMove,
+    ) -> HeadMove {
+        let (Some(first), Some(last)) = (r.axes.first(), r.axes.last()) else {
+            return one_move([g.from_axes, g.to_axes], false);
+        };
+        for p in [r.poses.first(), r.poses.last()].into_iter().flatten() {
+            if let Some(w) = self.stands_clear(obs, p, true) {
+                return Err(w);
+            }
+        }
+        let mut least = one_move([g.from_axes, *first], false)?;
+        least = least.min(one_move([*last, g.to_axes], false)?);
+        for w in r.axes.windows(2) {
+            least = least.min(one_move([w[0], w[1]], true)?);
+        }
+        Ok(least)
+    }
 }
 
 /// The axes that put the tip at `tip` with the rotary axes at `tilt`, `c` (degrees).
@@ -298,6 +532,8 @@ fn rapid_moves_within(
         poses,
         min_distance_mm: least,
         split_moves,
+        head_min_distance_mm: None,
+        head_too_close: None,
     })
 }
 
@@ -420,6 +656,20 @@ fn cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions, all: bool) -> Vec<
     absent
 }
 
+/// `e` (no route clears the tip and nozzle line) with where the head came too close too.
+fn with_head_witness(e: ProcessError, w: &HeadWitness) -> ProcessError {
+    match e {
+        ProcessError::TraverseBlocked(mut b) => {
+            b.why = format!(
+                "{}; the head model comes {w} on the routes it was tried on",
+                b.why
+            );
+            ProcessError::TraverseBlocked(b)
+        }
+        other => other,
+    }
+}
+
 /// Plans and checks the traverse of every gap ([`crate::plan_traverse_within`] among the
 /// routes whose waypoints lie within `limits`, `(min, max)` of `[X, Y, Z, tilt, C]` or `None`
 /// for an unlimited axis, then [`rapid_moves`]), in order; one result per gap (a blocked gap does not stop the others:
@@ -432,8 +682,9 @@ fn cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions, all: bool) -> Vec<
 /// they can be reported.
 ///
 /// A route is taken only if its waypoints and the interpolated moves between them lie within
-/// the limits and the machine's own rapid moves ([`rapid_moves`]) clear too; otherwise the
-/// next shortest route is tried.
+/// the limits and the machine's own rapid moves ([`rapid_moves`]) clear too, and, with `head`,
+/// the head model along those moves ([`TraverseHead`]); otherwise the next shortest route is
+/// tried.
 ///
 /// Each result's error is as [`crate::plan_traverse`] and [`rapid_moves`].
 pub fn plan_rapids(
@@ -442,6 +693,7 @@ pub fn plan_rapids(
     obs: &Obstacles,
     gaps: &[Gap],
     opts: &TraverseOptions,
+    head: Option<&TraverseHead<'_>>,
 ) -> Vec<Result<(Traverse, RapidMoves, Vec<String>)>> {
     use rayon::prelude::*;
     gaps.par_iter()
@@ -463,8 +715,19 @@ pub fn plan_rapids(
             // Where no route clears with `first` left out and more surfaces are in the cuts'
             // way, the reason is not reported (the gap is tried again without them).
             let all = cuts_way(obs, g, opts, true);
-            // A route is taken only if the machine's own rapid moves along it clear too.
-            let plan = |absent: &[String], explain: bool| {
+            // A route is taken only if the machine's own rapid moves along it clear too, and
+            // the head along them (`with_head`); where the head refuses a route, the last
+            // refusal is kept.
+            let refused: std::cell::RefCell<Option<HeadWitness>> = Default::default();
+            // The head's surfaces for the gap, with `first` and with `all` left out (built once:
+            // every route the gap tries queries them).
+            let head_obs = head.map(|h| [h.obstacles_of(g, &first), h.obstacles_of(g, &all)]);
+            // Each machine move's head check, once per gap: the routes of a gap share their
+            // retract and approach and many of their moves.
+            let head_moves: std::cell::RefCell<std::collections::HashMap<HeadMoveKey, HeadMove>> =
+                Default::default();
+            let plan = |with_all: bool, explain: bool, with_head: bool| {
+                let absent = if with_all { &all } else { &first };
                 let here = obs.without(absent);
                 crate::traverse::plan_traverse_accepting(
                     &here,
@@ -495,19 +758,76 @@ pub fn plan_rapids(
                                 outside_limits: r.outside_limits,
                             }
                         })
+                        .and_then(|mut r| {
+                            let (Some(h), Some(ho), true) = (head, &head_obs, with_head) else {
+                                return Ok(r);
+                            };
+                            let k = usize::from(with_all);
+                            match h.check(g, &ho[k], &r, &mut |m: [Axes; 2], whole: bool| {
+                                let key = (m.map(|a| a.to_array().map(f64::to_bits)), whole, k);
+                                if let Some(known) = head_moves.borrow().get(&key) {
+                                    return known.clone();
+                                }
+                                let outcome = h.along(kin, &ho[k], &m, whole);
+                                head_moves.borrow_mut().insert(key, outcome.clone());
+                                outcome
+                            }) {
+                                Ok(d) => {
+                                    r.head_min_distance_mm = Some(d);
+                                    Ok(r)
+                                }
+                                Err(w) => {
+                                    let refusal = crate::traverse::Refusal {
+                                        at: w.at,
+                                        distance: w.distance_mm.unwrap_or(0.0),
+                                        outside_limits: false,
+                                    };
+                                    // The first route the head refused: the one the nozzle
+                                    // line's check alone takes, if no route clears the head.
+                                    refused.borrow_mut().get_or_insert(w);
+                                    Err(refusal)
+                                }
+                            }
+                        })
                     },
                     explain,
                 )
             };
-            match plan(&first, all.len() == first.len()) {
-                Ok((t, r)) => Ok((t, r, first)),
+            let planned = |with_head: bool| match plan(false, all.len() == first.len(), with_head) {
+                Ok((t, r)) => Ok((t, r, first.clone())),
                 Err(e) => {
                     if all.len() == first.len() {
                         return Err(e);
                     }
-                    let (t, r) = plan(&all, true)?;
-                    Ok((t, r, all))
+                    let (t, r) = plan(true, true, with_head)?;
+                    Ok((t, r, all.clone()))
                 }
+            };
+            // Where the head stands too close at a cut's end, or clears no retract point at one
+            // end, no route can clear it: the gap is planned without it.
+            let hopeless = head
+                .zip(head_obs.as_ref())
+                .and_then(|(h, ho)| h.no_route_clears(g, &ho[1], opts));
+            let outcome = planned(head.is_some() && hopeless.is_none());
+            match (outcome, hopeless, refused.take()) {
+                // Planned without the head: with where it comes too close.
+                (Ok((t, mut r, a)), Some(w), _) => {
+                    r.head_too_close = Some(w);
+                    Ok((t, r, a))
+                }
+                (Err(e), Some(w), _) => Err(with_head_witness(e, &w)),
+                // With the head (if any): every route taken cleared it.
+                (Ok(ok), None, _) => Ok(ok),
+                (Err(e), None, None) => Err(e),
+                // The head refused every route the tip and nozzle line clear: the route
+                // without the head, with where the head came too close on the first.
+                (Err(_), None, Some(w)) => match planned(false) {
+                    Ok((t, mut r, a)) => {
+                        r.head_too_close = Some(w);
+                        Ok((t, r, a))
+                    }
+                    Err(e) => Err(with_head_witness(e, &w)),
+                },
             }
         })
         .collect()

@@ -320,3 +320,292 @@ fn the_linear_rotary_move_widens_the_bound_by_its_departure() {
     let wild = opts.with_axis_deviation_deg(f64::INFINITY);
     assert!(!kerf_process::check_cut_along(&obs, &head, &poses, &[], &wild).proven);
 }
+
+/// The A/C head the traverse tests run on (150 mm pivot).
+fn ac_head() -> kerf_kinematics::AcHead {
+    kerf_kinematics::AcHead::try_new(150.0, 0.0).expect("head")
+}
+
+/// The gap from a hole at `y = -60` to one at `y = 60` on the floor (surface `#0`), the beam
+/// vertical.
+fn holes_gap(kin: &dyn kerf_kinematics::Kinematics) -> kerf_process::Gap {
+    let up = Vector3::z();
+    let (from, to) = (
+        Pose::at(Point3::new(0.0, -60.0, 0.0), up),
+        Pose::at(Point3::new(0.0, 60.0, 0.0), up),
+    );
+    kerf_process::Gap {
+        from,
+        from_axes: kin.inverse(&from)[0],
+        to,
+        to_axes: kin.inverse(&to)[0],
+        from_contour: from.position,
+        to_contour: to.position,
+        from_surfaces: vec!["#0".into()],
+        to_surfaces: vec!["#0".into()],
+    }
+}
+
+/// A rib 40 mm high and 20 mm long at `x = 30`, standing on the floor.
+fn rib() -> NurbsSurface {
+    NurbsSurface::plane(
+        Point3::new(30.0, -10.0, 0.0),
+        Vector3::y(),
+        Vector3::z(),
+        20.0,
+        40.0,
+    )
+    .expect("rib")
+}
+
+/// The exact distance from `p` to the floor (`z = 0`) or the rib, whichever is nearer.
+fn floor_or_rib(p: &Point3<f64>) -> f64 {
+    let dy = (p.y.abs() - 10.0).max(0.0);
+    let dz = (p.z - 40.0).max(-p.z).max(0.0);
+    let rib = ((p.x - 30.0).powi(2) + dy * dy + dz * dz).sqrt();
+    rib.min(p.z.abs())
+}
+
+/// The least exact distance from the default head, sampled densely (the surface of each
+/// solid every 0.5 mm of height and 3 degrees, the flat ends every 1 mm of radius), standing
+/// on every pose of the machine's joint-linear moves through `axes` (200 samples a move),
+/// to the floor and the rib; the nozzle's lowest `zone` mm (the tip zone) left out.
+fn head_sweep_distance(
+    kin: &dyn kerf_kinematics::Kinematics,
+    axes: &[kerf_kinematics::Axes],
+    standoff: f64,
+    zone: f64,
+) -> f64 {
+    let head = Head::laser_default();
+    // Head points as (height above the nozzle tip, radius).
+    let mut rings: Vec<(f64, f64)> = Vec::new();
+    let len = head.length_mm();
+    let mut h = zone;
+    while h <= len {
+        rings.push((h, head.radius_at(h).expect("on the head")));
+        h += 0.5;
+    }
+    // The body's flat bottom (at 25 mm, from the cone's 7 mm to the body's 45 mm) and top.
+    for k in 0..=38 {
+        rings.push((25.0, 7.0 + k as f64));
+    }
+    for k in 0..=45 {
+        rings.push((len, k as f64));
+    }
+    let mut least = f64::INFINITY;
+    for w in axes.windows(2) {
+        for j in 0..=200 {
+            let p = kin.forward(&w[0].lerp(&w[1], j as f64 / 200.0));
+            let a = p.axis.normalize();
+            let e1 = a
+                .cross(&Vector3::x())
+                .try_normalize(1e-9)
+                .unwrap_or_else(|| a.cross(&Vector3::y()).normalize());
+            let e2 = a.cross(&e1);
+            for &(h, r) in &rings {
+                let c = p.position + a * (standoff + h);
+                for k in 0..120 {
+                    let t = std::f64::consts::TAU * k as f64 / 120.0;
+                    least = least.min(floor_or_rib(&(c + (e1 * t.cos() + e2 * t.sin()) * r)));
+                }
+            }
+        }
+    }
+    least
+}
+
+/// A traverse between two holes on either side of a rib that the tip and nozzle line pass
+/// 30 mm from, but the head's 90 mm body runs through: with the head model
+/// (`kerf_process::TraverseHead`), the straight route at the retract height is refused and
+/// a higher one taken;
+/// a dense sampling of the head along the machine's moves, against the exact floor and rib,
+/// finds the straight route's head inside the rib and the chosen route's at least the
+/// clearance less the check's resolution away.
+#[test]
+fn the_head_model_keeps_a_traverse_off_a_rib_the_nozzle_line_clears() {
+    use kerf_process::{plan_rapids, Route, TraverseHead, TraverseOptions, RESOLUTION_MM};
+    let kin = ac_head();
+    let mut obs = Obstacles::new();
+    obs.add_nurbs(floor());
+    obs.add_nurbs(rib());
+    let parts = obs.parts(0.05);
+    assert_eq!(parts[0], parts[1], "the rib stands on the floor: one part");
+    let gap = holes_gap(&kin);
+    let opts = TraverseOptions::default();
+    let hopts = HeadCheckOptions::default();
+    let head = Head::laser_default();
+    let limits = [None; 5];
+    let moves = |with_head: bool| {
+        let th = TraverseHead::new(&head, hopts, &obs, &parts);
+        let planned = plan_rapids(
+            &kin,
+            &limits,
+            &obs,
+            std::slice::from_ref(&gap),
+            &opts,
+            with_head.then_some(&th),
+        );
+        let (t, r, _) = planned
+            .into_iter()
+            .next()
+            .expect("one gap")
+            .expect("a route");
+        let mut axes = vec![gap.from_axes];
+        axes.extend_from_slice(&r.axes);
+        axes.push(gap.to_axes);
+        // The highest point of the tip on the way.
+        let top = t
+            .waypoints
+            .iter()
+            .map(|w| w.position.z)
+            .fold(f64::MIN, f64::max);
+        (t.route, top, r.head_min_distance_mm, axes)
+    };
+    let zone = kerf_process::tip_zone_mm(&head, &hopts);
+    let (route, low, none, axes) = moves(false);
+    assert_eq!(route, Route::Straight, "the nozzle line clears the rib");
+    assert_eq!(low, opts.retract_mm, "at the retract height");
+    assert_eq!(none, None, "no head model, no head distance");
+    let straight = head_sweep_distance(&kin, &axes, hopts.standoff_mm, zone);
+    assert!(straight < 0.01, "the body runs through the rib: {straight}");
+    let (_, high, proven, axes) = moves(true);
+    // The body's bottom (26 mm above the tip) over the rib's top (40 mm) and the clearance.
+    assert!(
+        high >= 40.0 + hopts.clearance_mm - 26.0,
+        "the head refuses the route at the retract height: {high}"
+    );
+    let proven = proven.expect("a head distance");
+    let sampled = head_sweep_distance(&kin, &axes, hopts.standoff_mm, zone);
+    assert!(
+        proven >= hopts.clearance_mm - RESOLUTION_MM - 0.5 * kerf_process::SAMPLE_STEP_MM,
+        "proven {proven}"
+    );
+    assert!(
+        sampled >= proven - 0.05,
+        "sampled {sampled} below the proven {proven}"
+    );
+    assert!(
+        sampled >= hopts.clearance_mm - RESOLUTION_MM,
+        "sampled {sampled}"
+    );
+}
+
+/// The same rib where the machine's Z travel ends 2 mm above the retract height: every
+/// route the machine reaches passes the rib at the retract height, so the head clears none;
+/// the route the tip and nozzle line clear is returned with where the head comes too close
+/// (the rib), for the caller to refuse or accept, and no head distance is claimed.
+#[test]
+fn where_the_head_clears_no_route_the_traverse_says_where() {
+    use kerf_kinematics::Kinematics;
+    use kerf_process::{plan_rapids, Route, TraverseHead, TraverseOptions};
+    let kin = ac_head();
+    let mut obs = Obstacles::new();
+    obs.add_nurbs(floor());
+    obs.add_nurbs(rib());
+    let parts = obs.parts(0.05);
+    let opts = TraverseOptions::default();
+    let above = Pose::at(Point3::new(0.0, 0.0, opts.retract_mm), Vector3::z());
+    let top = kin.inverse(&above)[0].z;
+    let mut limits = [None; 5];
+    limits[2] = Some((top - 100.0, top + 2.0));
+    let gap = holes_gap(&kin);
+    let head = Head::laser_default();
+    let th = TraverseHead::new(&head, HeadCheckOptions::default(), &obs, &parts);
+    let plan = |h: Option<&TraverseHead<'_>>| {
+        plan_rapids(&kin, &limits, &obs, std::slice::from_ref(&gap), &opts, h)
+            .into_iter()
+            .next()
+            .expect("one gap")
+            .expect("the nozzle line clears")
+    };
+    let (t, r, _) = plan(Some(&th));
+    assert_eq!(t.route, Route::Straight);
+    let top_z = t
+        .waypoints
+        .iter()
+        .map(|w| w.position.z)
+        .fold(f64::MIN, f64::max);
+    assert_eq!(top_z, opts.retract_mm, "the machine reaches no higher");
+    let close = r.head_too_close.expect("the head clears no route");
+    assert!(close.distance_mm.expect("witnessed") < 1.0, "{close:?}");
+    assert_eq!(close.surface.as_deref(), Some("#1"), "the rib: {close:?}");
+    assert_eq!(r.head_min_distance_mm, None, "no distance claimed");
+    let (t2, r2, _) = plan(None);
+    assert_eq!(
+        t2.waypoints, t.waypoints,
+        "the route the nozzle line's check takes"
+    );
+    assert_eq!(r2.head_too_close, None);
+}
+
+/// A ceiling plate 210 mm up over the second hole: the head standing on the hole (its top 206
+/// mm up) clears it, the head at every retract point above the hole (10 to 120 mm up) does
+/// not, so no route can clear the head and none is tried with it: the traverse the nozzle
+/// line's check takes comes back with the ceiling named (the tip and the nozzle, 20 mm long,
+/// never come near it).
+#[test]
+fn where_the_head_clears_no_retract_point_no_route_is_tried_with_it() {
+    use kerf_process::{plan_rapids, TraverseHead, TraverseOptions};
+    let kin = ac_head();
+    let mut obs = Obstacles::new();
+    obs.add_nurbs(floor());
+    // The ceiling, joined to the floor by a post at its far end (one part).
+    obs.add_nurbs(
+        NurbsSurface::plane(
+            Point3::new(-60.0, 30.0, 210.0),
+            Vector3::x(),
+            Vector3::y(),
+            120.0,
+            80.0,
+        )
+        .expect("ceiling"),
+    );
+    obs.add_nurbs(
+        NurbsSurface::plane(
+            Point3::new(-60.0, 110.0, 0.0),
+            Vector3::x(),
+            Vector3::z(),
+            120.0,
+            210.0,
+        )
+        .expect("post"),
+    );
+    let parts = obs.parts(0.05);
+    assert!(
+        parts[0] == parts[2] && parts[1] == parts[2],
+        "one part: {parts:?}"
+    );
+    let gap = holes_gap(&kin);
+    let opts = TraverseOptions::default();
+    let head = Head::laser_default();
+    let hopts = HeadCheckOptions::default();
+    let standing = check_cut(&obs, &head, &[gap.to], &hopts);
+    assert!(
+        standing.close.is_empty() && standing.proven,
+        "the head clears the hole itself"
+    );
+    let th = TraverseHead::new(&head, hopts, &obs, &parts);
+    let limits = [None; 5];
+    let (_, r, _) = plan_rapids(
+        &kin,
+        &limits,
+        &obs,
+        std::slice::from_ref(&gap),
+        &opts,
+        Some(&th),
+    )
+    .into_iter()
+    .next()
+    .expect("one gap")
+    .expect("the nozzle line clears");
+    let w = r.head_too_close.expect("no route can clear the head");
+    assert_eq!(w.surface.as_deref(), Some("#1"), "the ceiling: {w:?}");
+    // The lowest retract point: the head's top 1 + 205 + 7.5 mm up, 3.5 mm into the ceiling.
+    let d = w.distance_mm.expect("witnessed");
+    assert!(d < hopts.clearance_mm, "{w:?}");
+    assert!(
+        (w.at.z - 210.0).abs() < 5.0 && w.at.y > 30.0,
+        "on the ceiling: {w:?}"
+    );
+    assert_eq!(r.head_min_distance_mm, None);
+}

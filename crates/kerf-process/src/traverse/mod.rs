@@ -24,4 +24,4 @@ pub use check::check_move;
 pub use obstacles::Obstacles;
 pub use options::TraverseOptions;
 pub use routes::{plan_traverse, plan_traverse_within, Route, Traverse};
-pub(crate) use routes::{plan_traverse_accepting, Refusal};
+pub(crate) use routes::{plan_traverse_accepting, retract_heights, Refusal};

@@ -261,6 +261,13 @@ pub(crate) struct Refusal {
     pub(crate) outside_limits: bool,
 }
 
+/// The retract heights a traverse tries at each end, doubling from the retract: every route
+/// (searched ones included) leaves and reaches the part through a retract point at one of
+/// them.
+pub(crate) fn retract_heights(opts: &TraverseOptions) -> [f64; 5] {
+    std::array::from_fn(|k| opts.retract_mm * f64::from(1u32 << k))
+}
+
 /// An axial move's check: the retract point reached, or why it is blocked.
 type AxialOutcome = std::result::Result<Pose, Blocked>;
 
@@ -368,9 +375,7 @@ pub(crate) fn plan_traverse_accepting<T>(
         )
     };
     // The retract heights tried at each end (doubling), those whose axial move is clear.
-    let heights: Vec<f64> = (0..5)
-        .map(|k| opts.retract_mm * f64::from(1 << k))
-        .collect();
+    let heights = retract_heights(opts);
     // The axial moves, each checked once and only where needed: a route is taken only if
     // both its retract points' axial moves are clear, but a route put off (below) needs
     // neither, and where a route is taken the higher retract points are seldom reached.

@@ -36,6 +36,59 @@ pub(crate) struct HeadOutcome {
     pub tip_zone_mm: Option<f64>,
     /// A refusal (the first path that could not be cleared), unless accepted.
     pub refusal: Option<kerf_process::ProcessError>,
+    /// Per cut checked (its index) with anything to mark, where the picture marks it.
+    pub marks: Vec<(usize, HeadMarks)>,
+}
+
+/// Where the picture marks what the head check did to one cut: ranges `[first, last]` of its
+/// cutting points (indices into the cut's poses: lead-in, contour, lead-out).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct HeadMarks {
+    /// Runs of cutting points whose tool axis was tilted to clear the head.
+    pub(crate) tilted: Vec<[usize; 2]>,
+    /// Stretches where the head came within the clearance (accepted as warnings), widened to
+    /// the cutting points around them.
+    pub(crate) close: Vec<[usize; 2]>,
+}
+
+impl HeadMarks {
+    /// The marks of a cut whose cutting points `tilted` says were tilted, with the close
+    /// stretches of `c` (indices into the solved poses, whose `source` gives the cutting point
+    /// each stands on).
+    fn of(s: &SolvedPath, c: &CutClearance, tilted: &[bool]) -> Self {
+        let mut runs = Vec::new();
+        let mut k = 0;
+        while k < tilted.len() {
+            if tilted[k] {
+                let start = k;
+                while k + 1 < tilted.len() && tilted[k + 1] {
+                    k += 1;
+                }
+                runs.push([start, k]);
+            }
+            k += 1;
+        }
+        let last = tilted.len().saturating_sub(1);
+        let close = c
+            .close
+            .iter()
+            .map(|st| {
+                let [a, b] = st.poses.map(|i| i.min(s.source.len().saturating_sub(1)));
+                let lo = s.source[..=a].iter().rev().find_map(|x| *x).unwrap_or(0);
+                let hi = s.source[b..].iter().find_map(|x| *x).unwrap_or(last);
+                [lo.min(last), hi.min(last)]
+            })
+            .collect();
+        Self {
+            tilted: runs,
+            close,
+        }
+    }
+
+    /// True if there is nothing to mark.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.tilted.is_empty() && self.close.is_empty()
+    }
 }
 
 /// The tool axis tilted by `alpha` (radians) from `n` toward the unit `d` (at right angles to
@@ -227,6 +280,11 @@ pub(crate) fn check_and_clear(
             .map(|(a, _)| a.to_degrees())
             .fold(0.0, f64::max);
         let entry = report_entry(&solved[k], &c, rounds, tilted_poses, max_tilt_deg);
+        let tilted: Vec<bool> = applied.iter().map(Option::is_some).collect();
+        let marks = HeadMarks::of(&solved[k], &c, &tilted);
+        if !marks.is_empty() {
+            out.marks.push((k, marks));
+        }
         if c.close.is_empty() && c.proven {
             out.report.push(entry);
             continue;

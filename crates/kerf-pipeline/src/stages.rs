@@ -379,6 +379,8 @@ pub(crate) struct Solved {
     pub(crate) head_warnings: Vec<String>,
     /// The tip zone the head check left out, mm.
     pub(crate) head_tip_zone_mm: Option<f64>,
+    /// Per cut, where the picture marks what the head check did (empty without it).
+    pub(crate) head_marks: Vec<crate::head::HeadMarks>,
 }
 
 /// Stage 3d: the cuts placed, micro-joints where the beam leaves each part's outline (and big
@@ -424,6 +426,7 @@ pub(crate) fn solve(r: &Run<'_>, cuts: &Cuts, part: &Part, clock: &mut Clock) ->
         head_report: Vec::new(),
         head_warnings: Vec::new(),
         head_tip_zone_mm: None,
+        head_marks: vec![crate::head::HeadMarks::default(); cuts.cuts.len()],
     };
     if let Some(clearance) = r.o.cut_clearance_mm {
         check_heads(
@@ -535,6 +538,9 @@ fn check_heads(
         out.head_report.extend(h.report);
         out.head_warnings.extend(h.warnings);
         out.head_tip_zone_mm = h.tip_zone_mm.or(out.head_tip_zone_mm);
+        for (k, m) in h.marks {
+            out.head_marks[k] = m;
+        }
         if let Some(source) = h.refusal {
             return Err(r.process_error(source));
         }
@@ -870,6 +876,7 @@ pub(crate) fn output(
             cuts: &cuts.cuts,
             placed,
             joints: &solved.joints,
+            head_marks: &solved.head_marks,
         },
         programs.plot_traverses,
     )?;
@@ -1036,11 +1043,29 @@ struct Picture<'a> {
     placed: &'a crate::place::Placed,
     /// Per cut, its micro-joints (mm along the cut).
     joints: &'a [Vec<[f64; 2]>],
+    /// Per cut, what the head check tilted and found close.
+    head_marks: &'a [crate::head::HeadMarks],
+}
+
+/// The polylines through `poses` (part coordinates) of the ranges `[first, last]`, each
+/// widened by a cutting point on either side where it has one (a single point is a segment).
+fn marked(poses: &[Pose], ranges: &[[usize; 2]]) -> Vec<Vec<nalgebra::Point3<f64>>> {
+    ranges
+        .iter()
+        .filter(|[a, _]| *a < poses.len())
+        .map(|&[a, b]| {
+            let hi = (b + 1).min(poses.len() - 1);
+            poses[a.saturating_sub(1)..=hi]
+                .iter()
+                .map(|q| q.position)
+                .collect()
+        })
+        .collect()
 }
 
 /// The picture: the paths and their axes, the process over them (pierces numbered in cutting
-/// order, leads, micro-joints) and `traverses` (part coordinates), set-up by set-up as the
-/// programs run them.
+/// order, leads, micro-joints, what the head check tilted or found close) and `traverses`
+/// (part coordinates), set-up by set-up as the programs run them.
 fn picture(p: &Picture<'_>, traverses: Vec<Vec<nalgebra::Point3<f64>>>) -> Result<String> {
     let mut scene = kerf_plot::Scene::new(p.file, p.tp, &kerf_plot::SceneOptions::default())?;
     scene.title = format!("kerf run \u{2014} {} on {}", p.input_name, p.machine.name);
@@ -1069,6 +1094,8 @@ fn picture(p: &Picture<'_>, traverses: Vec<Vec<nalgebra::Point3<f64>>>) -> Resul
                     } else {
                         Vec::new()
                     },
+                    head_tilted: marked(&c.poses, &p.head_marks[k].tilted),
+                    head_close: marked(&c.poses, &p.head_marks[k].close),
                     micro_joints: {
                         let part: Vec<[f64; 3]> =
                             c.poses.iter().map(|q| q.position.into()).collect();

@@ -60,6 +60,18 @@ fn the_wall_is_named_when_the_clearance_is_three_millimetres() {
         "{:?}",
         out.warnings
     );
+    // The picture marks the close stretch, once per view (top, front, side, iso), nothing
+    // tilted.
+    assert_eq!(
+        out.plot_svg.matches("class=\"head-close\"").count(),
+        4,
+        "one band a view"
+    );
+    assert_eq!(
+        out.plot_svg.matches("class=\"head-tilted\"").count(),
+        0,
+        "nothing tilted"
+    );
     let paths = out.report.head.paths.as_ref().expect("paths");
     let near = paths
         .iter()
@@ -296,6 +308,14 @@ fn tilted_fixture(
         .clone();
     let tilt = entry.tilted.max_tilt_deg;
     assert!(tilt > 0.5 && tilt <= 10.0, "{entry:?}");
+    // The picture marks the tilted stretches in every view, and nothing close.
+    let bands = out.plot_svg.matches("class=\"head-tilted\"").count();
+    assert!(bands >= 4 && bands % 4 == 0, "{name}: {bands} tilted bands");
+    assert_eq!(
+        out.plot_svg.matches("class=\"head-close\"").count(),
+        0,
+        "nothing close"
+    );
     let surfaces = exact_surfaces(name);
     let poses = written_poses(&curves, &out, id);
     let d = sampled_distance(&poses, zone, &surfaces);

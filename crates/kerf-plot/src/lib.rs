@@ -23,7 +23,9 @@
 //! `class="process"`: each traverse a dashed `<polyline class="traverse">`, each lead-in a
 //! `<polyline class="lead-in">`, each lead-out a `<polyline class="lead-out">`, each
 //! micro-joint a `<polyline class="micro-joint">` (a bar wider than the path, from where the beam
-//! goes off to where it comes on), each pierce a `<circle class="pierce" data-order="k">` and
+//! goes off to where it comes on), each stretch the head check tilted a wide amber band
+//! `<polyline class="head-tilted">` and each where it found the head too close a wide red band
+//! `<polyline class="head-close">` under the path, each pierce a `<circle class="pierce" data-order="k">` and
 //! beside it `<text class="order">k</text>`, `k` from 1 in cutting order.
 //!
 //! The picture's size is bounded whatever the input: beyond [`MAX_DRAWN_SEGMENTS`] segments,
@@ -640,6 +642,16 @@ mod tests {
                         Point3::new(20.0, -10.0, 0.0),
                         Point3::new(20.5, -10.0, 0.0),
                     ]],
+                    head_tilted: vec![
+                        vec![Point3::new(5.0, -10.0, 0.0), Point3::new(9.0, -10.0, 0.0)],
+                        // A single point is not a stretch: not drawn.
+                        vec![Point3::new(12.0, -10.0, 0.0)],
+                    ],
+                    head_close: vec![vec![
+                        Point3::new(30.0, -10.0, 0.0),
+                        Point3::new(31.0, -10.0, 0.0),
+                        Point3::new(32.0, -10.0, 0.0),
+                    ]],
                 },
                 CutPicture {
                     id: "arc".into(),
@@ -647,6 +659,8 @@ mod tests {
                     lead_in: vec![p1, Point3::new(30.0, 0.0, 0.0)],
                     lead_out: Vec::new(),
                     micro_joints: Vec::new(),
+                    head_tilted: Vec::new(),
+                    head_close: Vec::new(),
                 },
             ],
             traverses: vec![vec![Point3::new(42.0, -8.0, 0.0), p1]],
@@ -659,18 +673,17 @@ mod tests {
             2,
             "one marker a pierce"
         );
-        assert_eq!(top.matches("class=\"traverse\"").count(), 1);
-        assert_eq!(top.matches("class=\"lead-in\"").count(), 2);
-        assert_eq!(
-            top.matches("class=\"micro-joint\"").count(),
-            1,
-            "one bar a joint"
-        );
-        assert_eq!(
-            top.matches("class=\"lead-out\"").count(),
-            1,
-            "none drawn when empty"
-        );
+        for (class, count, why) in [
+            ("traverse", 1, "one traverse"),
+            ("lead-in", 2, "one a cut"),
+            ("micro-joint", 1, "one bar a joint"),
+            ("lead-out", 1, "none drawn when empty"),
+            ("head-tilted", 1, "a single tilted point is not drawn"),
+            ("head-close", 1, "one close stretch"),
+        ] {
+            let tag = format!("class=\"{class}\"");
+            assert_eq!(top.matches(&tag).count(), count, "{class}: {why}");
+        }
         // The numbers, in document order, are 1..n, each beside its own marker.
         let mut numbers = Vec::new();
         let mut rest = top;

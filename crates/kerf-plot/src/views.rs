@@ -506,6 +506,16 @@ fn draw_process(doc: &mut Doc, process: &crate::ProcessPicture, view: View, fit:
             doc.polyline(&line(t), "class=\"traverse\"");
         }
     }
+    // Under the leads: the stretches the head check tilted, and those where it found the
+    // head too close, as wide bands along the path.
+    for c in &process.cuts {
+        for t in c.head_tilted.iter().filter(|t| t.len() >= 2) {
+            doc.polyline(&line(t), "class=\"head-tilted\"");
+        }
+        for t in c.head_close.iter().filter(|t| t.len() >= 2) {
+            doc.polyline(&line(t), "class=\"head-close\"");
+        }
+    }
     for c in &process.cuts {
         if c.lead_in.len() >= 2 {
             doc.polyline(&line(&c.lead_in), "class=\"lead-in\"");
@@ -550,5 +560,7 @@ pub(crate) const STYLE: &str = concat!(
     ".lead-out{stroke:#8e44ad;stroke-width:1.4;stroke-dasharray:2 2}",
     ".pierce{fill:#d62728;stroke:#fff;stroke-width:0.8}",
     ".micro-joint{stroke:#0a8f3c;stroke-width:6;stroke-linecap:round}",
+    ".head-tilted{stroke:#f2b134;stroke-width:9;stroke-opacity:0.55;stroke-linecap:round;stroke-linejoin:round}",
+    ".head-close{stroke:#d62728;stroke-width:11;stroke-opacity:0.45;stroke-linecap:round;stroke-linejoin:round}",
     ".order{font-size:10px;font-weight:bold;fill:#d62728;stroke:#fff;stroke-width:2.5px;paint-order:stroke}",
 );

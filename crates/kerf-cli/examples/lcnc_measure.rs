@@ -25,6 +25,17 @@
 //! kerf to the controller (`--kerf-in-control`) is measured against kerf's own offset: the
 //! beam-on samples at the offset distance from the designed curve, against the other run's
 //! cut of the same contour (`kerf_compare`).
+//!
+//! With `KERF_HEAD_CHECK=1` the machine's head model (the machine file's `head`, standing at
+//! its `process.standoff_mm`) is swept along every executed sample from the first beam-on to
+//! the last beam-off, the traverses between included (a sample
+//! kept where the tip has moved 0.25 mm or the tool axis turned 0.05 degrees since the last),
+//! its surface sampled every 0.5 mm of height and 5 degrees (the flat ends of its solids every
+//! millimetre of radius), above the tip zone the report states, and the least distance of
+//! those points from the input's surfaces measured exactly: each must be a flat rectangle (a
+//! degree 1 x 1 patch of 2 x 2 control points, as the head fixtures are), whose distance is
+//! closed-form (`head_clearance`): independent of kerf's head check, its cells and its closest
+//! points.
 
 use std::path::Path;
 
@@ -538,6 +549,11 @@ fn main() {
         "kerf_compare": compare,
         "power": power_fig,
         "micro_joints": joints_fig,
+        "head_clearance": std::env::var("KERF_HEAD_CHECK").is_ok_and(|v| v == "1").then(|| {
+            let design = curves.as_ref().unwrap_or_else(|| fail("KERF_HEAD_CHECK: the input curves file is not readable".into()));
+            let first = axes.paths.first().map(|a| a.id.clone()).unwrap_or_default();
+            head_clearance(&machine, &report, design, &tips, &beam, placement_of(&first))
+        }),
     });
     println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
 }
@@ -729,4 +745,176 @@ fn group_joints(
             "max_dark_length_error_mm": worst_length,
         }),
     )
+}
+
+/// An exact flat rectangle: a corner and its two edges (at right angles).
+struct Rect {
+    id: String,
+    origin: Point3<f64>,
+    u: Vector3<f64>,
+    v: Vector3<f64>,
+}
+
+impl Rect {
+    /// The rectangle of a degree 1 x 1 NURBS patch of 2 x 2 control points with equal weights
+    /// whose fourth corner closes the parallelogram and whose edges are at right angles.
+    fn of(s: &kerf_format::SurfaceRecord) -> Option<Rect> {
+        let kerf_format::SurfaceGeometry::Nurbs(n) = &s.geometry else {
+            return None;
+        };
+        if n.degree_u() != 1 || n.degree_v() != 1 {
+            return None;
+        }
+        let cp = n.control_points();
+        if cp.len() != 2 || cp.iter().any(|r| r.len() != 2) {
+            return None;
+        }
+        let w = n.weights();
+        let w0 = w[0][0];
+        if w.iter()
+            .flatten()
+            .any(|x| (x - w0).abs() > 1e-12 * w0.abs())
+        {
+            return None;
+        }
+        let (o, u, v) = (cp[0][0], cp[1][0] - cp[0][0], cp[0][1] - cp[0][0]);
+        let size = u.norm() + v.norm();
+        let closes = (cp[1][1] - (o + u + v)).norm() <= 1e-9 * size;
+        let square = u.dot(&v).abs() <= 1e-9 * u.norm() * v.norm();
+        (closes && square).then(|| Rect {
+            id: s.id.clone(),
+            origin: o,
+            u,
+            v,
+        })
+    }
+
+    /// The exact distance from `q`.
+    fn distance(&self, q: &Point3<f64>) -> f64 {
+        let w = q - self.origin;
+        let a = (w.dot(&self.u) / self.u.norm_squared()).clamp(0.0, 1.0);
+        let b = (w.dot(&self.v) / self.v.norm_squared()).clamp(0.0, 1.0);
+        (q - (self.origin + self.u * a + self.v * b)).norm()
+    }
+}
+
+/// The head swept along the executed samples (`tips`, workpiece frame, mapped to part
+/// coordinates by `placement`) against the input's rectangles: the least distance of the
+/// sampled head surface above the report's tip zone, where and when.
+fn head_clearance(
+    machine: &Machine,
+    report: &Value,
+    design: &kerf_format::CurvesFile,
+    tips: &[(Point3<f64>, Vector3<f64>)],
+    beam: &[bool],
+    placement: (nalgebra::Rotation3<f64>, Vector3<f64>),
+) -> Value {
+    let rects: Vec<Rect> = design
+        .surfaces
+        .iter()
+        .map(|s| {
+            Rect::of(s).unwrap_or_else(|| {
+                fail(format!(
+                    "KERF_HEAD_CHECK: surface {} is not a flat rectangle",
+                    s.id
+                ))
+            })
+        })
+        .collect();
+    let head = machine
+        .head
+        .clone()
+        .unwrap_or_else(kerf_kinematics::Head::laser_default);
+    let standoff = machine
+        .process
+        .standoff_mm
+        .unwrap_or(kerf_kinematics::DEFAULT_STANDOFF_MM);
+    let zone = report["head"]["tip_zone_mm"].as_f64().unwrap_or(0.0);
+    // Head points as (height above the nozzle tip, radius): its surface every 0.5 mm of
+    // height, and the flat ends where one solid meets the next (and the top) every mm.
+    let len = head.length_mm();
+    let mut rings: Vec<(f64, f64)> = Vec::new();
+    let steps = ((len - zone) / 0.5).ceil().max(1.0) as usize;
+    for j in 0..=steps {
+        let h = zone + (len - zone) * j as f64 / steps as f64;
+        rings.push((h, head.radius_at(h).unwrap_or(0.0)));
+    }
+    let mut base = 0.0;
+    for (i, sld) in head.solids.iter().enumerate() {
+        let below = if i == 0 {
+            0.0
+        } else {
+            head.solids[i - 1].top_diameter_mm / 2.0
+        };
+        let (lo, hi) = {
+            let r = sld.bottom_diameter_mm / 2.0;
+            (below.min(r), below.max(r))
+        };
+        if base >= zone {
+            let n = (hi - lo).ceil() as usize;
+            for k in 0..=n {
+                rings.push((base, lo + (hi - lo) * k as f64 / n.max(1) as f64));
+            }
+        }
+        base += sld.length_mm;
+    }
+    let top = head.solids.last().map_or(0.0, |s| s.top_diameter_mm / 2.0);
+    for k in 0..=(top.ceil() as usize) {
+        rings.push((len, (k as f64).min(top)));
+    }
+    let angles: Vec<(f64, f64)> = (0..72)
+        .map(|k| (f64::from(k) * 5.0).to_radians().sin_cos())
+        .collect();
+    let (rot, shift) = placement;
+    let mut least = f64::INFINITY;
+    let mut at: Option<(usize, Point3<f64>, String)> = None;
+    let mut checked = 0usize;
+    let mut last: Option<(Point3<f64>, Vector3<f64>)> = None;
+    // From the first beam-on to the last beam-off: the cuts and the traverses between them
+    // (the move from wherever the machine stood before the program, and the one after it, are
+    // not kerf's).
+    let first_on = beam.iter().position(|&b| b).unwrap_or(tips.len());
+    let last_on = beam.iter().rposition(|&b| b).unwrap_or(0);
+    for (i, (p, a)) in tips.iter().enumerate() {
+        if i < first_on || i > last_on {
+            continue;
+        }
+        if let Some((lp, la)) = last {
+            if (p - lp).norm() < 0.25 && a.angle(&la) < 0.05f64.to_radians() {
+                continue;
+            }
+        }
+        last = Some((*p, *a));
+        checked += 1;
+        let tip = Point3::from(rot.inverse() * (p - shift));
+        let axis = (rot.inverse() * a).normalize();
+        let e1 = axis
+            .cross(&Vector3::y())
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| axis.cross(&Vector3::x()).normalize());
+        let e2 = axis.cross(&e1);
+        for &(h, r) in &rings {
+            let c = tip + axis * (standoff + h);
+            for &(sn, cs) in &angles {
+                let q = c + (e1 * cs + e2 * sn) * r;
+                for rc in &rects {
+                    let d = rc.distance(&q);
+                    if d < least {
+                        least = d;
+                        at = Some((i, q, rc.id.clone()));
+                    }
+                }
+            }
+        }
+    }
+    json!({
+        "min_distance_mm": least,
+        "sample": at.as_ref().map(|a| a.0),
+        "beam_on": at.as_ref().map(|a| beam.get(a.0).copied().unwrap_or(false)),
+        "at": at.as_ref().map(|a| [a.1.x, a.1.y, a.1.z]),
+        "surface": at.as_ref().map(|a| a.2.clone()),
+        "tip_zone_mm": zone,
+        "samples_checked": checked,
+        "points_per_sample": rings.len() * angles.len(),
+    })
 }

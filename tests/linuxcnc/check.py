@@ -455,7 +455,9 @@ def simulate_head(kerf, measure, outdir):
                  f"(beam {'on' if h.get('beam_on') else 'off'}), {h.get('samples_checked')} samples "
                  f"x {h.get('points_per_sample')} head points above the {h.get('tip_zone_mm'):.2f} mm tip zone")
         if negative:
-            if d >= need:
+            if h.get("surface") != "wall":
+                fail(f"negative control {name}: the nearest surface is not the wall ({where})")
+            elif d >= need:
                 fail(f"negative control {name}: the head measure did not notice the upright head ({where})")
             else:
                 print(f"negative control {name}: the upright head measured {where}, under {need:.3f} mm as it must", flush=True)

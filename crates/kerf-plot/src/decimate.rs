@@ -10,7 +10,7 @@
 
 use std::borrow::Cow;
 
-use crate::scene::{AxesChart, PathPicture, ProcessPicture, Scene};
+use crate::scene::{AxesChart, CutPicture, PathPicture, ProcessPicture, Scene};
 
 /// The most chord segments drawn over all paths (each view draws them and their points).
 pub const MAX_DRAWN_SEGMENTS: usize = 20_000;
@@ -50,7 +50,15 @@ pub(crate) fn bounded(scene: &Scene) -> (Cow<'_, Scene>, Option<String>) {
             .cuts
             .iter()
             .filter(|c| ids.contains(&c.id.as_str()))
-            .cloned()
+            .map(|c| {
+                // The head check's bands run along the cut: thinned as its cutting points.
+                let thin = |bands: &[Vec<_>]| bands.iter().map(|b| every(b, step)).collect();
+                CutPicture {
+                    head_tilted: thin(&c.head_tilted),
+                    head_close: thin(&c.head_close),
+                    ..c.clone()
+                }
+            })
             .collect(),
         traverses: pr.traverses.iter().take(MAX_DRAWN_PATHS).cloned().collect(),
     });

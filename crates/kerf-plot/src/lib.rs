@@ -23,9 +23,9 @@
 //! `class="process"`: each traverse a dashed `<polyline class="traverse">`, each lead-in a
 //! `<polyline class="lead-in">`, each lead-out a `<polyline class="lead-out">`, each
 //! micro-joint a `<polyline class="micro-joint">` (a bar wider than the path, from where the beam
-//! goes off to where it comes on), each stretch the head check tilted a wide amber band
-//! `<polyline class="head-tilted">` and each where it found the head too close a wide red band
-//! `<polyline class="head-close">` under the path, each pierce a `<circle class="pierce" data-order="k">` and
+//! goes off to where it comes on), each stretch the head check tilted a wide translucent amber
+//! band `<polyline class="head-tilted">` and each where it found the head too close a wide
+//! translucent red band `<polyline class="head-close">` over the path, each pierce a `<circle class="pierce" data-order="k">` and
 //! beside it `<text class="order">k</text>`, `k` from 1 in cutting order.
 //!
 //! The picture's size is bounded whatever the input: beyond [`MAX_DRAWN_SEGMENTS`] segments,

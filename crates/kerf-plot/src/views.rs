@@ -506,8 +506,8 @@ fn draw_process(doc: &mut Doc, process: &crate::ProcessPicture, view: View, fit:
             doc.polyline(&line(t), "class=\"traverse\"");
         }
     }
-    // Under the leads: the stretches the head check tilted, and those where it found the
-    // head too close, as wide bands along the path.
+    // Under the leads (over the path, translucent): the stretches the head check tilted, and
+    // those where it found the head too close, as wide bands along the path.
     for c in &process.cuts {
         for t in c.head_tilted.iter().filter(|t| t.len() >= 2) {
             doc.polyline(&line(t), "class=\"head-tilted\"");

@@ -43,14 +43,16 @@ pub struct RapidMoves {
 /// ([`RapidMoves::head_too_close`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeadWitness {
-    /// The head point witnessed too close, or the tip where the check ran out of work
-    /// (workpiece frame).
+    /// The head point witnessed too close, or, where the check was not proven, the tip at the
+    /// pose nearest its least proven distance (workpiece frame).
     pub at: Point3<f64>,
     /// Its distance from the part, mm (an upper bound of the least distance there; negative:
     /// inside the part); `None` where the head was not proven clear within the work budget.
     pub distance_mm: Option<f64>,
     /// The surface nearest that point.
     pub surface: Option<String>,
+    /// Why the head is not proven clear, where it is not ([`CutClearance::unproven`]).
+    pub unproven: Option<String>,
 }
 
 impl std::fmt::Display for HeadWitness {
@@ -64,8 +66,13 @@ impl std::fmt::Display for HeadWitness {
             )?,
             None => write!(
                 f,
-                "not proven clear within the work budget near ({:.3}, {:.3}, {:.3})",
-                p.x, p.y, p.z
+                "not proven clear ({}) near ({:.3}, {:.3}, {:.3})",
+                self.unproven
+                    .as_deref()
+                    .unwrap_or("the check did not finish"),
+                p.x,
+                p.y,
+                p.z
             )?,
         }
         if let Some(id) = &self.surface {
@@ -111,6 +118,7 @@ fn witness(obs: &Obstacles, c: &CutClearance, poses: &[Pose]) -> Option<HeadWitn
             at: s.point,
             distance_mm: Some(s.distance_mm),
             surface: s.surface.clone(),
+            unproven: None,
         });
     }
     (!c.proven).then(|| {
@@ -122,6 +130,7 @@ fn witness(obs: &Obstacles, c: &CutClearance, poses: &[Pose]) -> Option<HeadWitn
             at,
             distance_mm: None,
             surface: obs.nearest(&at).map(|(id, _)| id),
+            unproven: c.unproven.clone(),
         }
     })
 }
@@ -660,10 +669,7 @@ fn cuts_way(obs: &Obstacles, g: &Gap, opts: &TraverseOptions, all: bool) -> Vec<
 fn with_head_witness(e: ProcessError, w: &HeadWitness) -> ProcessError {
     match e {
         ProcessError::TraverseBlocked(mut b) => {
-            b.why = format!(
-                "{}; the head model comes {w} on the routes it was tried on",
-                b.why
-            );
+            b.why = format!("{}; the head model comes {w} as well", b.why);
             ProcessError::TraverseBlocked(b)
         }
         other => other,
@@ -716,7 +722,7 @@ pub fn plan_rapids(
             // way, the reason is not reported (the gap is tried again without them).
             let all = cuts_way(obs, g, opts, true);
             // A route is taken only if the machine's own rapid moves along it clear too, and
-            // the head along them (`with_head`); where the head refuses a route, the last
+            // the head along them (`with_head`); where the head refuses a route, the first
             // refusal is kept.
             let refused: std::cell::RefCell<Option<HeadWitness>> = Default::default();
             // The head's surfaces for the gap, with `first` and with `all` left out (built once:
@@ -796,7 +802,11 @@ pub fn plan_rapids(
             let planned = |with_head: bool| match plan(false, all.len() == first.len(), with_head) {
                 Ok((t, r)) => Ok((t, r, first.clone())),
                 Err(e) => {
-                    if all.len() == first.len() {
+                    // Where the head refused routes the tip and nozzle line clear, fewer
+                    // surfaces are not tried for the head's sake: the fallback plans without
+                    // it, from `first` again.
+                    let head_refused = with_head && refused.borrow().is_some();
+                    if all.len() == first.len() || head_refused {
                         return Err(e);
                     }
                     let (t, r) = plan(true, true, with_head)?;

@@ -539,12 +539,13 @@ fn where_the_head_clears_no_route_the_traverse_says_where() {
 }
 
 /// A ceiling plate 210 mm up over the second hole: the head standing on the hole (its top 206
-/// mm up) clears it, the head at every retract point above the hole (10 to 120 mm up) does
-/// not, so no route can clear the head and none is tried with it: the traverse the nozzle
-/// line's check takes comes back with the ceiling named (the tip and the nozzle, 20 mm long,
-/// never come near it).
+/// mm up) clears it, the head at every retract point above the hole (7.5 to 120 mm up) does
+/// not, so no route can clear the head: the traverse the nozzle line's check takes comes back
+/// with the ceiling named (the tip and the nozzle, 20 mm long, never come near it). (Whether
+/// the routes were tried with the head first is not observable here: the pre-check and each
+/// route's check of its retract points give the same witness.)
 #[test]
-fn where_the_head_clears_no_retract_point_no_route_is_tried_with_it() {
+fn where_the_head_clears_no_retract_point_the_traverse_names_what_is_in_the_way() {
     use kerf_process::{plan_rapids, TraverseHead, TraverseOptions};
     let kin = ac_head();
     let mut obs = Obstacles::new();

@@ -19,6 +19,12 @@ pub const MAX_DRAWN_PATHS: usize = 2_000;
 /// The most curve samples drawn over all paths, and the most axis positions charted.
 pub const MAX_DRAWN_CURVE_SAMPLES: usize = 20_000;
 
+/// In a thinned picture, the cuts whose head-check bands are drawn (the first ones).
+const MAX_DRAWN_BAND_CUTS: usize = 200;
+
+/// In a thinned picture, the most points of the head-check bands in all.
+const MAX_DRAWN_BAND_POINTS: usize = 5_000;
+
 /// `scene` as drawn: itself when it is within the limits, else a reduced copy, with the line
 /// that says what was left out.
 pub(crate) fn bounded(scene: &Scene) -> (Cow<'_, Scene>, Option<String>) {
@@ -45,14 +51,30 @@ pub(crate) fn bounded(scene: &Scene) -> (Cow<'_, Scene>, Option<String>) {
         .map(|p| thin_path(p, step, sample_step))
         .collect();
     let ids: Vec<&str> = paths.iter().map(|p| p.id.as_str()).collect();
+    let band_points: usize = scene.process.as_ref().map_or(0, |pr| {
+        pr.cuts
+            .iter()
+            .take(MAX_DRAWN_BAND_CUTS)
+            .flat_map(|c| c.head_tilted.iter().chain(&c.head_close))
+            .map(Vec::len)
+            .sum()
+    });
+    let band_step = band_points.div_ceil(MAX_DRAWN_BAND_POINTS).max(1);
     let process = scene.process.as_ref().map(|pr| ProcessPicture {
         cuts: pr
             .cuts
             .iter()
             .filter(|c| ids.contains(&c.id.as_str()))
-            .map(|c| {
-                // The head check's bands run along the cut: thinned as its cutting points.
-                let thin = |bands: &[Vec<_>]| bands.iter().map(|b| every(b, step)).collect();
+            .enumerate()
+            .map(|(k, c)| {
+                // The head check's bands: those of the first MAX_DRAWN_BAND_CUTS cuts, thinned
+                // to MAX_DRAWN_BAND_POINTS points in all (ends kept).
+                let thin = |bands: &[Vec<_>]| {
+                    if k >= MAX_DRAWN_BAND_CUTS {
+                        return Vec::new();
+                    }
+                    bands.iter().map(|b| every(b, band_step)).collect()
+                };
                 CutPicture {
                     head_tilted: thin(&c.head_tilted),
                     head_close: thin(&c.head_close),

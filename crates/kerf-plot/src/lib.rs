@@ -31,8 +31,8 @@
 //! The picture's size is bounded whatever the input: beyond [`MAX_DRAWN_SEGMENTS`] segments,
 //! [`MAX_DRAWN_PATHS`] paths or [`MAX_DRAWN_CURVE_SAMPLES`] curve samples or axis positions,
 //! every `k`-th cutting point of each path is drawn (ends kept, each drawn segment carrying the
-//! largest chord error of those it stands for), and a line under the title
-//! (`<text id="decimated">`) says so.
+//! largest chord error of those it stands for; the head check's bands of the first 200 cuts
+//! only, 5,000 points in all), and a line under the title (`<text id="decimated">`) says so.
 //!
 //! The chord errors drawn are sampled estimates ([`sampled_chord_error`]), for display; the
 //! independent measurement is `kerf check` (crate `kerf-check`).
@@ -599,7 +599,21 @@ mod tests {
                     limits: [None; 5],
                     limits_known: false,
                 }),
-                process: None,
+                // A head check's band the whole contour long: thinned with the path.
+                process: Some(ProcessPicture {
+                    cuts: (0..paths)
+                        .map(|i| CutPicture {
+                            id: format!("p{i}"),
+                            pierce: pt(0),
+                            lead_in: Vec::new(),
+                            lead_out: Vec::new(),
+                            micro_joints: Vec::new(),
+                            head_tilted: vec![(0..=n).map(pt).collect()],
+                            head_close: Vec::new(),
+                        })
+                        .collect(),
+                    traverses: Vec::new(),
+                }),
             };
             let svg = render(&scene);
             (svg.len(), svg.contains("id=\"decimated\""), svg)
@@ -621,7 +635,14 @@ mod tests {
             noted && svg.contains("the first 2000 of 10000 paths"),
             "paths"
         );
-        assert!(many < 12_000_000, "{many} bytes for 10,000 paths");
+        // The 2000 drawn cuts' pierce markers and numbers add about 1 MB over four views; the
+        // head-check bands are drawn for the first 200 cuts only.
+        assert!(many < 14_000_000, "{many} bytes for 10,000 paths");
+        assert_eq!(
+            svg.matches("class=\"head-tilted\"").count(),
+            4 * 200,
+            "bands of the first 200 cuts, in four views"
+        );
         well_formed(&svg).expect("well-formed");
     }
 

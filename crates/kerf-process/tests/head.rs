@@ -358,6 +358,34 @@ fn rib() -> NurbsSurface {
     .expect("rib")
 }
 
+/// The one gap `gap` planned by `plan_rapids` with the default traverse options (the
+/// machine's `limits`, the head `th` if any).
+fn plan_one(
+    kin: &dyn kerf_kinematics::Kinematics,
+    obs: &Obstacles,
+    gap: &kerf_process::Gap,
+    limits: &[Option<(f64, f64)>; 5],
+    th: Option<&kerf_process::TraverseHead<'_>>,
+) -> (kerf_process::Traverse, kerf_process::RapidMoves) {
+    let opts = kerf_process::TraverseOptions::default();
+    let (t, r, _) =
+        kerf_process::plan_rapids(kin, limits, obs, std::slice::from_ref(gap), &opts, th)
+            .into_iter()
+            .next()
+            .expect("one gap")
+            .expect("a route the tip and nozzle line clear");
+    (t, r)
+}
+
+/// The floor and the rib as obstacles (`#0`, `#1`), with their parts.
+fn floor_and_rib() -> (Obstacles, Vec<usize>) {
+    let mut obs = Obstacles::new();
+    obs.add_nurbs(floor());
+    obs.add_nurbs(rib());
+    let parts = obs.parts(0.05);
+    (obs, parts)
+}
+
 /// The exact distance from `p` to the floor (`z = 0`) or the rib, whichever is nearer.
 fn floor_or_rib(p: &Point3<f64>) -> f64 {
     let dy = (p.y.abs() - 10.0).max(0.0);
@@ -425,10 +453,7 @@ fn head_sweep_distance(
 fn the_head_model_keeps_a_traverse_off_a_rib_the_nozzle_line_clears() {
     use kerf_process::{plan_rapids, Route, TraverseHead, TraverseOptions, RESOLUTION_MM};
     let kin = ac_head();
-    let mut obs = Obstacles::new();
-    obs.add_nurbs(floor());
-    obs.add_nurbs(rib());
-    let parts = obs.parts(0.05);
+    let (obs, parts) = floor_and_rib();
     assert_eq!(parts[0], parts[1], "the rib stands on the floor: one part");
     let gap = holes_gap(&kin);
     let opts = TraverseOptions::default();
@@ -499,10 +524,7 @@ fn where_the_head_clears_no_route_the_traverse_says_where() {
     use kerf_kinematics::Kinematics;
     use kerf_process::{plan_rapids, Route, TraverseHead, TraverseOptions};
     let kin = ac_head();
-    let mut obs = Obstacles::new();
-    obs.add_nurbs(floor());
-    obs.add_nurbs(rib());
-    let parts = obs.parts(0.05);
+    let (obs, parts) = floor_and_rib();
     let opts = TraverseOptions::default();
     let above = Pose::at(Point3::new(0.0, 0.0, opts.retract_mm), Vector3::z());
     let top = kin.inverse(&above)[0].z;
@@ -546,7 +568,7 @@ fn where_the_head_clears_no_route_the_traverse_says_where() {
 /// route's check of its retract points give the same witness.)
 #[test]
 fn where_the_head_clears_no_retract_point_the_traverse_names_what_is_in_the_way() {
-    use kerf_process::{plan_rapids, TraverseHead, TraverseOptions};
+    use kerf_process::TraverseHead;
     let kin = ac_head();
     let mut obs = Obstacles::new();
     obs.add_nurbs(floor());
@@ -577,7 +599,6 @@ fn where_the_head_clears_no_retract_point_the_traverse_names_what_is_in_the_way(
         "one part: {parts:?}"
     );
     let gap = holes_gap(&kin);
-    let opts = TraverseOptions::default();
     let head = Head::laser_default();
     let hopts = HeadCheckOptions::default();
     let standing = check_cut(&obs, &head, &[gap.to], &hopts);
@@ -586,19 +607,7 @@ fn where_the_head_clears_no_retract_point_the_traverse_names_what_is_in_the_way(
         "the head clears the hole itself"
     );
     let th = TraverseHead::new(&head, hopts, &obs, &parts);
-    let limits = [None; 5];
-    let (_, r, _) = plan_rapids(
-        &kin,
-        &limits,
-        &obs,
-        std::slice::from_ref(&gap),
-        &opts,
-        Some(&th),
-    )
-    .into_iter()
-    .next()
-    .expect("one gap")
-    .expect("the nozzle line clears");
+    let (_, r) = plan_one(&kin, &obs, &gap, &[None; 5], Some(&th));
     let w = r.head_too_close.expect("no route can clear the head");
     assert_eq!(w.surface.as_deref(), Some("#1"), "the ceiling: {w:?}");
     // The lowest retract point: the head's top 1 + 205 + 7.5 mm up, 3.5 mm into the ceiling.
@@ -609,4 +618,47 @@ fn where_the_head_clears_no_retract_point_the_traverse_names_what_is_in_the_way(
         "on the ceiling: {w:?}"
     );
     assert_eq!(r.head_min_distance_mm, None);
+}
+
+/// The rib again with the beam leaning 20 degrees at both holes, toward -x at the first and
+/// toward +y at the second: the traverse turns C a quarter turn, so the machine's joint-linear
+/// moves leave the great circle the check's samples follow, and the bound counts that
+/// (`axis_curvature`). A dense sampling of the head along the machine's own moves (the joint
+/// values interpolated, forward kinematics) against the exact floor and rib finds no point
+/// closer than the bound the check proved.
+#[test]
+fn a_traverse_that_turns_the_head_keeps_the_bound_it_proves() {
+    use kerf_kinematics::Kinematics;
+    use kerf_process::{TraverseHead, RESOLUTION_MM};
+    let kin = ac_head();
+    let (obs, parts) = floor_and_rib();
+    let t = 20f64.to_radians();
+    let mut gap = holes_gap(&kin);
+    gap.from = Pose::at(gap.from.position, Vector3::new(-t.sin(), 0.0, t.cos()));
+    gap.to = Pose::at(gap.to.position, Vector3::new(0.0, t.sin(), t.cos()));
+    gap.from_axes = kin.inverse(&gap.from)[0];
+    gap.to_axes = kin.inverse(&gap.to)[0];
+    let turn = (gap.to_axes.c - gap.from_axes.c).abs() % 360.0;
+    assert!(
+        (turn - 90.0).abs() < 1e-6 || (turn - 270.0).abs() < 1e-6,
+        "C turns: {turn}"
+    );
+    let head = Head::laser_default();
+    let hopts = HeadCheckOptions::default();
+    let th = TraverseHead::new(&head, hopts, &obs, &parts);
+    let (_, r) = plan_one(&kin, &obs, &gap, &[None; 5], Some(&th));
+    let proven = r.head_min_distance_mm.expect("the head cleared a route");
+    let mut axes = vec![gap.from_axes];
+    axes.extend_from_slice(&r.axes);
+    axes.push(gap.to_axes);
+    let zone = kerf_process::tip_zone_mm(&head, &hopts);
+    let sampled = head_sweep_distance(&kin, &axes, hopts.standoff_mm, zone);
+    assert!(
+        sampled >= proven - 1e-6,
+        "sampled {sampled} below the proven {proven}"
+    );
+    assert!(
+        proven >= hopts.clearance_mm - RESOLUTION_MM - kerf_process::SAMPLE_STEP_MM,
+        "proven {proven}"
+    );
 }

@@ -19,10 +19,11 @@ pub const MAX_DRAWN_PATHS: usize = 2_000;
 /// The most curve samples drawn over all paths, and the most axis positions charted.
 pub const MAX_DRAWN_CURVE_SAMPLES: usize = 20_000;
 
-/// In a thinned picture, the cuts whose head-check bands are drawn (the first ones).
-const MAX_DRAWN_BAND_CUTS: usize = 200;
+/// In a thinned picture, the most head-check bands drawn (the first ones in cutting order).
+const MAX_DRAWN_BANDS: usize = 200;
 
-/// In a thinned picture, the most points of the head-check bands in all.
+/// In a thinned picture, about the most points of the head-check bands in all (each band
+/// keeps its two ends besides).
 const MAX_DRAWN_BAND_POINTS: usize = 5_000;
 
 /// `scene` as drawn: itself when it is within the limits, else a reduced copy, with the line
@@ -51,38 +52,18 @@ pub(crate) fn bounded(scene: &Scene) -> (Cow<'_, Scene>, Option<String>) {
         .map(|p| thin_path(p, step, sample_step))
         .collect();
     let ids: Vec<&str> = paths.iter().map(|p| p.id.as_str()).collect();
-    let band_points: usize = scene.process.as_ref().map_or(0, |pr| {
-        pr.cuts
-            .iter()
-            .take(MAX_DRAWN_BAND_CUTS)
-            .flat_map(|c| c.head_tilted.iter().chain(&c.head_close))
-            .map(Vec::len)
-            .sum()
-    });
-    let band_step = band_points.div_ceil(MAX_DRAWN_BAND_POINTS).max(1);
-    let process = scene.process.as_ref().map(|pr| ProcessPicture {
-        cuts: pr
+    let process = scene.process.as_ref().map(|pr| {
+        let mut cuts: Vec<CutPicture> = pr
             .cuts
             .iter()
             .filter(|c| ids.contains(&c.id.as_str()))
-            .enumerate()
-            .map(|(k, c)| {
-                // The head check's bands: those of the first MAX_DRAWN_BAND_CUTS cuts, thinned
-                // to MAX_DRAWN_BAND_POINTS points in all (ends kept).
-                let thin = |bands: &[Vec<_>]| {
-                    if k >= MAX_DRAWN_BAND_CUTS {
-                        return Vec::new();
-                    }
-                    bands.iter().map(|b| every(b, band_step)).collect()
-                };
-                CutPicture {
-                    head_tilted: thin(&c.head_tilted),
-                    head_close: thin(&c.head_close),
-                    ..c.clone()
-                }
-            })
-            .collect(),
-        traverses: pr.traverses.iter().take(MAX_DRAWN_PATHS).cloned().collect(),
+            .cloned()
+            .collect();
+        thin_bands(&mut cuts);
+        ProcessPicture {
+            cuts,
+            traverses: pr.traverses.iter().take(MAX_DRAWN_PATHS).cloned().collect(),
+        }
     });
     let axes = scene.axes.as_ref().map(|a| {
         let step = positions.div_ceil(MAX_DRAWN_CURVE_SAMPLES).max(1);
@@ -118,6 +99,30 @@ pub(crate) fn bounded(scene: &Scene) -> (Cow<'_, Scene>, Option<String>) {
         process,
     };
     (Cow::Owned(reduced), Some(note))
+}
+
+/// The head check's bands of the drawn `cuts`, bounded: the first [`MAX_DRAWN_BANDS`] bands
+/// in cutting order (the others dropped), each thinned to every `k`-th point (its ends kept)
+/// with `k` such that they hold about [`MAX_DRAWN_BAND_POINTS`] points in all (at most that
+/// and their two ends each).
+fn thin_bands(cuts: &mut [CutPicture]) {
+    let mut left = MAX_DRAWN_BANDS;
+    let mut points = 0usize;
+    for c in cuts.iter_mut() {
+        for bands in [&mut c.head_tilted, &mut c.head_close] {
+            bands.truncate(left);
+            left -= bands.len();
+            points += bands.iter().map(Vec::len).sum::<usize>();
+        }
+    }
+    let step = points.div_ceil(MAX_DRAWN_BAND_POINTS).max(1);
+    for c in cuts.iter_mut() {
+        for bands in [&mut c.head_tilted, &mut c.head_close] {
+            for b in bands.iter_mut() {
+                *b = every(b, step);
+            }
+        }
+    }
 }
 
 /// Every `step`-th item of `items`, the last always kept.

@@ -31,8 +31,9 @@
 //! The picture's size is bounded whatever the input: beyond [`MAX_DRAWN_SEGMENTS`] segments,
 //! [`MAX_DRAWN_PATHS`] paths or [`MAX_DRAWN_CURVE_SAMPLES`] curve samples or axis positions,
 //! every `k`-th cutting point of each path is drawn (ends kept, each drawn segment carrying the
-//! largest chord error of those it stands for; the head check's bands of the first 200 cuts
-//! only, 5,000 points in all), and a line under the title (`<text id="decimated">`) says so.
+//! largest chord error of those it stands for), and a line under the title
+//! (`<text id="decimated">`) says so; the head check's bands are then bounded too (the first
+//! 200 in cutting order, about 5,000 points in all, each keeping its ends).
 //!
 //! The chord errors drawn are sampled estimates ([`sampled_chord_error`]), for display; the
 //! independent measurement is `kerf check` (crate `kerf-check`).
@@ -636,12 +637,12 @@ mod tests {
             "paths"
         );
         // The 2000 drawn cuts' pierce markers and numbers add about 1 MB over four views; the
-        // head-check bands are drawn for the first 200 cuts only.
+        // first 200 head-check bands are drawn.
         assert!(many < 14_000_000, "{many} bytes for 10,000 paths");
         assert_eq!(
             svg.matches("class=\"head-tilted\"").count(),
             4 * 200,
-            "bands of the first 200 cuts, in four views"
+            "the first 200 bands, in four views"
         );
         well_formed(&svg).expect("well-formed");
     }

@@ -683,9 +683,11 @@ fn with_head_witness(e: ProcessError, w: &HeadWitness) -> ProcessError {
 ///
 /// Which surfaces are checked: all of `obs`, except, for one gap, those a cut's curve does not
 /// name that come within half the clearance of the tool axis line at the last cut's contour
-/// end or the next cut's contour start; only where no route clears then, all those
-/// [`in_the_cuts_way`] at its two ends. The ids left out are returned with the gap so that
-/// they can be reported.
+/// end or the next cut's contour start; only where no route clears then (and the head, if
+/// any, refused none of those the tip and nozzle line clear), all those [`in_the_cuts_way`]
+/// at its two ends. The ids left out are returned with the gap so that they can be reported.
+/// Where the head clears no route, the gap is planned without it and
+/// [`RapidMoves::head_too_close`] says where it came too close.
 ///
 /// A route is taken only if its waypoints and the interpolated moves between them lie within
 /// the limits and the machine's own rapid moves ([`rapid_moves`]) clear too, and, with `head`,

@@ -621,11 +621,12 @@ fn where_the_head_clears_no_retract_point_the_traverse_names_what_is_in_the_way(
 }
 
 /// The rib again with the beam leaning 20 degrees at both holes, toward -x at the first and
-/// toward +y at the second: the traverse turns C a quarter turn, so the machine's joint-linear
-/// moves leave the great circle the check's samples follow, and the bound counts that
-/// (`axis_curvature`). A dense sampling of the head along the machine's own moves (the joint
-/// values interpolated, forward kinematics) against the exact floor and rib finds no point
-/// closer than the bound the check proved.
+/// toward +y at the second: the traverse turns C a quarter turn on its travel. A dense
+/// sampling of the head along the machine's own moves (the joint values interpolated, forward
+/// kinematics) against the exact floor and rib finds no point closer than the bound the check
+/// proved for the whole traverse. (The least bound is likely set near the holes, where the
+/// head stands as it cut; the rotary departure's own bound is tested on its own by
+/// `the_linear_rotary_move_widens_the_bound_by_its_departure`.)
 #[test]
 fn a_traverse_that_turns_the_head_keeps_the_bound_it_proves() {
     use kerf_kinematics::Kinematics;

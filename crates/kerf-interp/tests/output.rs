@@ -39,6 +39,13 @@ fn words(line: &str) -> (String, HashMap<String, f64>) {
     (head, map)
 }
 
+/// Fit options for one line block per pose step (no arcs, no merged lines).
+fn lines_only() -> FitOptions {
+    FitOptions::default()
+        .with_arcs(false)
+        .with_merge_lines(false)
+}
+
 #[test]
 fn csv_header_and_rows() {
     let m = PaperAcHead::paper_000();
@@ -106,9 +113,7 @@ fn generic_gcode_parses_back_to_the_machine_axes() {
         ),
         "arcs or merged lines in a generic program are refused: {refused:?}"
     );
-    let lines_only = FitOptions::default()
-        .with_arcs(false)
-        .with_merge_lines(false);
+    let lines_only = lines_only();
     let blocks = fit_blocks(&m, &st, Some(&curve), 0, &lines_only).expect("fit");
     assert_eq!(blocks.len(), st.len() - 1, "one block per pose step");
     let text = gcode(&m, &blocks, &["door-trim-1".to_string()], None, &opts).expect("gcode");
@@ -355,9 +360,7 @@ fn sinumerik_rapids_follow_the_machines_straight_moves() {
 #[test]
 fn a_path_that_starts_where_the_last_one_ended_is_pierced_again() {
     let m = PaperAcHead::paper_000();
-    let lines_only = FitOptions::default()
-        .with_arcs(false)
-        .with_merge_lines(false);
+    let lines_only = lines_only();
     let mut blocks = Vec::new();
     for (path, c) in [circle(10.0, 0.0, 0.0, 0.0), circle(5.0, 5.0, 0.0, 0.0)]
         .iter()
@@ -463,9 +466,7 @@ fn controller_compensation_refuses_an_arc_as_the_entry_move() {
 fn the_pierce_of_a_path_without_a_traverse_before_it_is_range_checked() {
     use nalgebra::Point3;
     let m = PaperAcHead::paper_000();
-    let lines_only = FitOptions::default()
-        .with_arcs(false)
-        .with_merge_lines(false);
+    let lines_only = lines_only();
     let (a, b, c) = (
         Point3::new(0.0, 0.0, 0.0),
         Point3::new(10.0, 0.0, 5.0),

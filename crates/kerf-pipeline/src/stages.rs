@@ -381,6 +381,10 @@ pub(crate) struct Solved {
     pub(crate) head_tip_zone_mm: Option<f64>,
     /// Per cut, where the picture marks what the head check did (empty without it).
     pub(crate) head_marks: Vec<crate::head::HeadMarks>,
+    /// Per set-up, every surface of the file placed with it and the part of each, as the head
+    /// check built them (the traverses' head check takes them again); empty without it, `None`
+    /// for a set-up without cuts.
+    pub(crate) head_surfaces: Vec<Option<(kerf_process::Obstacles, Vec<usize>)>>,
 }
 
 /// Stage 3d: the cuts placed, micro-joints where the beam leaves each part's outline (and big
@@ -427,6 +431,7 @@ pub(crate) fn solve(r: &Run<'_>, cuts: &Cuts, part: &Part, clock: &mut Clock) ->
         head_warnings: Vec::new(),
         head_tip_zone_mm: None,
         head_marks: vec![crate::head::HeadMarks::default(); cuts.cuts.len()],
+        head_surfaces: Vec::new(),
     };
     if let Some(clearance) = r.o.cut_clearance_mm {
         check_heads(
@@ -515,6 +520,7 @@ fn check_heads(
 ) -> Result<()> {
     let (file, o, popts) = (r.file, r.o, &r.o.path);
     let hopts = head_options(r, clearance);
+    out.head_surfaces = (0..placed.plan.setups.len()).map(|_| None).collect();
     for setup in 0..placed.plan.setups.len() {
         let ks: Vec<usize> = (0..solved.len())
             .filter(|&k| placed.plan.setup_of(cuts[k].curve) == setup)
@@ -544,6 +550,7 @@ fn check_heads(
         if let Some(source) = h.refusal {
             return Err(r.process_error(source));
         }
+        out.head_surfaces[setup] = Some((all, parts));
     }
     Ok(())
 }
@@ -735,11 +742,14 @@ fn setup_program(
         r.machine,
         r.traverse.as_ref(),
         o.cut_clearance_mm
-            .map(|c| crate::traverses::HeadAlong {
+            .zip(s.solved.head_surfaces.get(setup).and_then(Option::as_ref))
+            .map(|(c, (obstacles, parts))| crate::traverses::HeadAlong {
                 head: &r.head,
                 // The traverses' rapids are one block per waypoint (no merged axes).
                 opts: head_options(r, c).with_axis_deviation_deg(0.0),
                 accept: o.accept_head_collisions,
+                obstacles,
+                parts,
             })
             .as_ref(),
         o.retract_mm,

@@ -72,6 +72,10 @@ pub(crate) struct HeadAlong<'a> {
     pub(crate) opts: HeadCheckOptions,
     /// A traverse whose head no route clears is a warning, not a refusal.
     pub(crate) accept: bool,
+    /// Every surface of the file placed with the set-up (the head check's).
+    pub(crate) obstacles: &'a Obstacles,
+    /// The part of each of `obstacles`.
+    pub(crate) parts: &'a [usize],
 }
 
 /// The set-up's cuts and where they come from.
@@ -127,25 +131,8 @@ pub(crate) fn route_setup(
     })?;
     // With the head check: the head model along every route too, against every surface of the
     // parts the gap's cuts lie on (a wall beside a hole, which no curve names).
-    let all = match head {
-        Some(_) => Some(
-            Obstacles::from_all_surfaces(file, |p| placement.apply_point(p)).map_err(|source| {
-                crate::Error::Process {
-                    file: s.path.map(Path::to_path_buf),
-                    source,
-                }
-            })?,
-        ),
-        None => None,
-    };
-    let parts = all
-        .as_ref()
-        .map(|a| a.parts(crate::head::PART_JOIN_TOLERANCE_MM))
-        .unwrap_or_default();
     tally.head_clearance_mm = head.map(|h| h.opts.clearance_mm);
-    let traverse_head = head
-        .zip(all.as_ref())
-        .map(|(h, a)| TraverseHead::new(h.head, h.opts, a, &parts));
+    let traverse_head = head.map(|h| TraverseHead::new(h.head, h.opts, h.obstacles, h.parts));
     let limits = machine.limits.map(|r| r.map(|r| (r.min, r.max)));
     let gaps: Vec<Gap> = s
         .in_setup

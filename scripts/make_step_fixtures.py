@@ -26,6 +26,9 @@ Files:
   8) by -3; and a face on a RECTANGULAR_TRIMMED_SURFACE of a cylinder of radius 15 with its u
   sense reversed (.F.), which this script writes in place of the face's CYLINDRICAL_SURFACE
   (Open CASCADE writes the basis alone): the face's normal turns inward.
+- offset_freeform.step: offsets of free-form bases, which kerf approximates with a proven
+  bound: a bicubic B-spline sheet of two spans by +2.5, a rational biquadratic cap by -1.5, the
+  extrusion of a rational cubic by +1.5 and the revolution of a rational cubic (2 rad) by -1.
 - assembly.step: an assembly as Open CASCADE writes one (`write.step.assembly` 1: NEXT_
   ASSEMBLY_USAGE_OCCURRENCE, representation relationships with ITEM_DEFINED_TRANSFORMATIONs): a
   box 40 x 30 x 5 placed twice, where it is and turned 0.5 rad about z then moved by
@@ -362,6 +365,44 @@ def make_offsets(out: Path):
     path.write_text(text)
 
 
+def make_offset_freeform(out: Path):
+    from OCP.Geom import Geom_OffsetSurface, Geom_SurfaceOfLinearExtrusion, Geom_SurfaceOfRevolution
+
+    def face(surface, u0, u1, v0, v1):
+        return BRepBuilderAPI_MakeFace(surface, u0, u1, v0, v1, 1e-7).Face()
+
+    faces = []
+    # Free-form bases (approximated by kerf, with the bound it proves): a bicubic B-spline of
+    # two spans in u, a wavy sheet over [200, 300] x [0, 80], offset by +2.5; and a rational
+    # biquadratic dome cap over [200, 260] x [100, 160], offset by -1.5.
+    net = TColgp_Array2OfPnt(1, 5, 1, 4)
+    zs = [[0, 6, -3, 2], [4, -2, 8, 0], [-3, 5, 1, 4], [2, -4, 3, -1], [0, 3, -2, 1]]
+    for i in range(5):
+        for j in range(4):
+            net.SetValue(i + 1, j + 1, gp_Pnt(200 + 25 * i, 80 * j / 3, zs[i][j]))
+    wavy = Geom_BSplineSurface(net, arr_real([0, 0.5, 1]), arr_real([0, 1]), arr_int([4, 1, 4]), arr_int([4, 4]), 3, 3)
+    faces.append(face(Geom_OffsetSurface(wavy, 2.5), 0.0, 1.0, 0.0, 1.0))
+    net = TColgp_Array2OfPnt(1, 3, 1, 3)
+    w = TColStd_Array2OfReal(1, 3, 1, 3)
+    for i in range(3):
+        for j in range(3):
+            net.SetValue(i + 1, j + 1, gp_Pnt(200 + 30 * i, 100 + 30 * j, 12 if (i, j) == (1, 1) else 4 * ((i + j) % 2)))
+            w.SetValue(i + 1, j + 1, 0.7 if (i + j) % 2 else 1.0)
+    dome = Geom_BSplineSurface(net, w, arr_real([0, 1]), arr_real([0, 1]), arr_int([3, 3]), arr_int([3, 3]), 2, 2)
+    faces.append(face(Geom_OffsetSurface(dome, -1.5), 0.0, 1.0, 0.0, 1.0))
+    # An extrusion of a rational cubic along (0, 0.3, 1) offset by +1.5, and a revolution of a
+    # rational cubic profile (about the z axis through (300, 300, 0), 2 rad) offset by -1.
+    prof = bspline([(200, 200, 0), (215, 215, 0), (235, 195, 0), (250, 210, 0)], [1, 1.4, 0.8, 1], [0, 1], [4, 4], 3)
+    faces.append(face(Geom_OffsetSurface(Geom_SurfaceOfLinearExtrusion(prof, gp_Dir(0, 0.3, 1)), 1.5), 0.0, 1.0, 0.0, 20.0))
+    prof2 = bspline([(320, 300, 0), (330, 300, 8), (326, 300, 16), (335, 300, 25)], [1, 1.2, 0.9, 1], [0, 1], [4, 4], 3)
+    rev = Geom_SurfaceOfRevolution(prof2, gp_Ax1(gp_Pnt(300, 300, 0), gp_Dir(0, 0, 1)))
+    faces.append(face(Geom_OffsetSurface(rev, -1.0), 0.0, 2.0, 0.0, 1.0))
+    path = out / "offset_freeform.step"
+    write(compound(faces), path)
+    text = re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", r"\1'2026-12-05T00:00:00'", path.read_text(), count=1)
+    path.write_text(text)
+
+
 def make_assembly(out: Path):
     from OCP.gp import gp_Trsf
     from OCP.TopLoc import TopLoc_Location
@@ -391,6 +432,7 @@ def make_assembly(out: Path):
 MAKERS = {
     "assembly.step": make_assembly,
     "offsets.step": make_offsets,
+    "offset_freeform.step": make_offset_freeform,
     "composite_mm.step": lambda out: make_composites(out, "MM", "composite_mm.step"),
     "composite_inch.step": lambda out: make_composites(out, "INCH", "composite_inch.step"),
     "faces.step": make_faces,

@@ -256,6 +256,11 @@ pub(crate) fn run(args: &ImportArgs) -> Result<(), CliError> {
             "largest_pole_move_mm": r.largest_move,
         "opened": r.opened,
             "sheet": sheet_json(r.sheet.as_ref()),
+            "approximated": r.approximated.iter().map(|(id, a)| json!({
+                "id": id,
+                "position_mm": a.position_mm,
+                "normal_rad": a.normal_rad,
+            })).collect::<Vec<_>>(),
             "seconds": start.elapsed().as_secs_f64(),
         });
         crate::input::print_summary(&summary, Some(&dest));

@@ -59,7 +59,10 @@ pub use local::{is_power_of_two, LocalCurve};
 pub use param::CurvePoint;
 #[cfg(feature = "samples")]
 pub use samples::{smooth_random_curves, Lcg};
-pub use surface::{NurbsSurface, SurfaceProjection};
+pub use surface::{
+    NurbsSurface, OffsetSurface, SurfaceOffsetError, SurfaceOffsetOptions, SurfaceProjection,
+    MAX_OFFSET_DEGREE, MAX_OFFSET_DEGREE_RATIONAL,
+};
 pub use work::{counted, evaluations, knot_reads, tick, tick_knots};
 
 /// The largest degree kerf accepts. CAD systems use degree <= 11 in practice; the fixed-size

@@ -40,6 +40,13 @@ mod closest;
 mod eval;
 mod net;
 mod normal;
+mod offset;
+mod poly;
+
+pub use offset::{
+    OffsetSurface, SurfaceOffsetError, SurfaceOffsetOptions, MAX_OFFSET_DEGREE,
+    MAX_OFFSET_DEGREE_RATIONAL,
+};
 
 /// A non-uniform rational B-spline surface in 3D.
 ///

@@ -16,8 +16,11 @@ pub use crate::curves::sub_curve;
 pub use crate::model::Charge;
 pub use crate::model::Frame;
 use crate::shape::associate;
-pub use crate::shape::{face, first_with_same_surface, sew, Face, ParamBox, Place};
-pub use crate::surfaces::{Geometry, SurfaceRangeError};
+pub use crate::shape::{
+    face, first_with_same_surface, sew, Approximation, Face, ParamBox, Place,
+    PROJECTIONS_PER_OFFSET_CELL,
+};
+pub use crate::surfaces::{Geometry, SurfaceRangeError, OFFSET_APPROXIMATION_MM};
 
 /// `segments` (in order) joined into one curve with a C0 knot at each join, gaps up to
 /// `close_below` mm closed by moving the shared pole (a swept surface's profile given as a
@@ -325,15 +328,22 @@ pub fn finish(
     for &fi in &used {
         let f = &faces[fi];
         report.surfaces.push(format!(
-            "{} ({}{})",
+            "{} ({}{}{})",
             face_id(f),
             f.kind,
             if f.name.is_empty() {
                 String::new()
             } else {
                 format!(", {:?}", f.name)
-            }
+            },
+            f.approximation.map_or(String::new(), |a| format!(
+                ", approximated within {:.1e} mm of the exact offset, normals within {:.1e} rad",
+                a.position_mm, a.normal_rad
+            ))
         ));
+        if let Some(a) = f.approximation {
+            report.approximated.push((face_id(f), a));
+        }
     }
     let surfaces: Vec<RawSurface> = used
         .iter()
@@ -379,6 +389,20 @@ pub fn finish(
         // `edges` and of a sheet recognised without it.
         if face_edges && raw.surface.is_some() {
             raw.on_surface_tolerance_mm = edge_tolerance;
+        }
+        // A face whose surface approximates the file's (an offset of a B-spline surface): the
+        // contour lies on the file's surface, within the approximation's proven distance of
+        // the one written.
+        let approximated = named
+            .iter()
+            .filter_map(|&f| faces[f].approximation)
+            .map(|a| a.position_mm)
+            .fold(0.0, f64::max);
+        if approximated > 0.0 && raw.surface.is_some() {
+            raw.on_surface_tolerance_mm = Some(
+                (raw.on_surface_tolerance_mm.unwrap_or(0.0) + approximated)
+                    .min(kerf_format::MAX_CURVE_ON_SURFACE_TOLERANCE_MM),
+            );
         }
         raw_curves.push(raw);
     }

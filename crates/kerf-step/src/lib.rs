@@ -203,6 +203,9 @@ pub struct Report {
     /// With `edges` and every face: the sheet the faces form, its features each cut once
     /// (`None` when no face loop was asked for or `--faces` chose them).
     pub sheet: Option<SheetReport>,
+    /// The surfaces written that approximate the file's (offsets of B-spline surfaces), by
+    /// their id in the curves file, with what is proven about each.
+    pub approximated: Vec<(String, cad::Approximation)>,
 }
 
 /// What sheet recognition found (`--edges` on a solid).

@@ -448,8 +448,8 @@ fn tangent(edge: &NurbsCurve, a: &NurbsSurface, b: &NurbsSurface) -> bool {
     let (mut warm_a, mut warm_b) = (None, None);
     (0..EDGE_TESTS).all(|k| {
         let p = edge.point(t0 + (t1 - t0) * (k as f64 + 1.0) / (EDGE_TESTS as f64 + 1.0));
-        let fa = crate::surfaces::foot_near(a, &p, &mut warm_a);
-        let fb = crate::surfaces::foot_near(b, &p, &mut warm_b);
+        let fa = crate::surfaces::foot_near(a, &p, &mut warm_a, 0.0);
+        let fb = crate::surfaces::foot_near(b, &p, &mut warm_b, 0.0);
         match (a.normal(fa.u, fa.v), b.normal(fb.u, fb.v)) {
             (Some(na), Some(nb)) => na.dot(&nb) >= cos,
             _ => false,

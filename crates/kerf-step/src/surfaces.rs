@@ -8,6 +8,8 @@
 use std::f64::consts::{PI, TAU};
 
 use kerf_nurbs::{NurbsCurve, NurbsSurface};
+
+use crate::shape::Approximation;
 use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::curves::{arc_homogeneous, basis, expand_knots, sub_curve, Basis};
@@ -49,6 +51,16 @@ pub enum Geometry {
     },
     /// A B-spline surface over its own domain.
     Nurbs(NurbsSurface),
+    /// `basis + distance n` (`n` the basis's unit normal `Su x Sv / |Su x Sv|`) where the
+    /// basis has no exact NURBS offset (a B-spline surface, an extrusion, a revolution), over
+    /// the basis's parameters: [`Geometry::to_nurbs_bounded`] approximates it with a proven
+    /// bound ([`NurbsSurface::offset`]).
+    Offset {
+        /// The surface offset.
+        basis: Box<Geometry>,
+        /// The distance along its normal, mm.
+        distance: f64,
+    },
 }
 
 /// Which parameters are angles (periodic with period 2 pi).
@@ -86,6 +98,7 @@ impl Geometry {
             Geometry::Cylinder(..) | Geometry::Cone(..) | Geometry::Sphere(..) => (true, false),
             Geometry::Revolution { .. } => (true, false),
             Geometry::Torus(..) => (true, true),
+            Geometry::Offset { basis, .. } => basis.periodic(),
         }
     }
 
@@ -100,6 +113,22 @@ impl Geometry {
             Geometry::Extrusion(..) => "extrusion",
             Geometry::Revolution { .. } => "revolution",
             Geometry::Nurbs(_) => "b-spline",
+            Geometry::Offset { basis, .. } => match **basis {
+                Geometry::Nurbs(_) => "offset b-spline",
+                Geometry::Extrusion(..) => "offset extrusion",
+                Geometry::Revolution { .. } => "offset revolution",
+                _ => "offset surface",
+            },
+        }
+    }
+
+    /// The B-spline surface whose domain bounds the parameters: the surface itself, or the
+    /// basis of its offset.
+    pub(crate) fn nurbs_domain(&self) -> Option<&NurbsSurface> {
+        match self {
+            Geometry::Nurbs(s) => Some(s),
+            Geometry::Offset { basis, .. } => basis.nurbs_domain(),
+            _ => None,
         }
     }
 
@@ -113,11 +142,21 @@ impl Geometry {
     /// samples was most of the reading time of a file of B-spline faces (15 s of 15.6 s on a
     /// 277-face impeller).
     pub(crate) fn params_near(&self, p: &Point3<f64>, warm: &mut Option<(f64, f64)>) -> (f64, f64) {
-        if let Geometry::Nurbs(s) = self {
-            let pr = foot_near(s, p, warm);
-            return (pr.u, pr.v);
+        self.params_at(p, warm, 0.0)
+    }
+
+    /// [`Geometry::params_near`] for a point `offset` mm from the surface along its normal:
+    /// the foot on the basis of a point of its offset is the point it was offset from (where
+    /// the offset does not fold over), so an offset surface's parameters are its basis's.
+    fn params_at(&self, p: &Point3<f64>, warm: &mut Option<(f64, f64)>, offset: f64) -> (f64, f64) {
+        match self {
+            Geometry::Nurbs(s) => {
+                let pr = foot_near(s, p, warm, offset.abs());
+                (pr.u, pr.v)
+            }
+            Geometry::Offset { basis, distance } => basis.params_at(p, warm, offset + distance),
+            _ => self.params_cold(p),
         }
-        self.params_cold(p)
     }
 
     /// [`Geometry::params_near`] without a start.
@@ -171,6 +210,7 @@ impl Geometry {
                 let pr = s.closest_point(p, None);
                 (pr.u, pr.v)
             }
+            Geometry::Offset { basis, .. } => basis.params_cold(p),
         }
     }
 
@@ -185,6 +225,40 @@ impl Geometry {
         u: (f64, f64),
         v: (f64, f64),
     ) -> std::result::Result<NurbsSurface, SurfaceRangeError> {
+        self.to_nurbs_bounded(u, v).map(|(s, _)| s)
+    }
+
+    /// [`Geometry::to_nurbs`] with what is proven where the surface is approximated: an
+    /// [`Geometry::Offset`] is its basis over the range offset by [`NurbsSurface::offset`]
+    /// within [`OFFSET_APPROXIMATION_MM`], with the bounds it proves (exact surfaces: `None`).
+    ///
+    /// # Errors
+    /// As [`Geometry::to_nurbs`], and [`SurfaceRangeError::Offset`] where the offset is not
+    /// built (it folds over, the normal vanishes, the budget runs out).
+    pub fn to_nurbs_bounded(
+        &self,
+        u: (f64, f64),
+        v: (f64, f64),
+    ) -> std::result::Result<(NurbsSurface, Option<Approximation>), SurfaceRangeError> {
+        if let Geometry::Offset { basis, distance } = self {
+            let (b, inner) = basis.to_nurbs_bounded(u, v)?;
+            let o = b.offset(
+                *distance,
+                &kerf_nurbs::SurfaceOffsetOptions::new(OFFSET_APPROXIMATION_MM),
+            )?;
+            // The basis is exact (offsets of offsets add their distances), so `inner` is None;
+            // were it not, the bounds would add.
+            let (p0, n0, w0) =
+                inner.map_or((0.0, 0.0, 0), |a| (a.position_mm, a.normal_rad, a.work));
+            return Ok((
+                o.surface,
+                Some(Approximation {
+                    position_mm: o.position_bound_mm + p0,
+                    normal_rad: o.normal_bound_rad + n0,
+                    work: o.work + w0,
+                }),
+            ));
+        }
         if !(u.1 > u.0) {
             return Err(SurfaceRangeError::Empty { direction: 'u' });
         }
@@ -241,8 +315,9 @@ impl Geometry {
                 revolution(origin, axis, x0, u, &c)
             }
             Geometry::Nurbs(s) => cut(s, u, v),
+            Geometry::Offset { .. } => unreachable!("offsets are built above"),
         };
-        Ok(s?)
+        Ok((s?, None))
     }
 }
 
@@ -260,6 +335,10 @@ pub enum SurfaceRangeError {
     /// source).
     #[error("{0}")]
     Nurbs(#[from] kerf_nurbs::NurbsError),
+    /// The offset of a surface could not be approximated over the range (the reason as the
+    /// source).
+    #[error("the offset of its surface: {0}")]
+    Offset(#[from] kerf_nurbs::SurfaceOffsetError),
 }
 
 /// Projects a curve along `dir` onto the plane through `base` normal to `dir` (same knots
@@ -438,10 +517,15 @@ fn cut(s: &NurbsSurface, u: (f64, f64), v: (f64, f64)) -> kerf_nurbs::Result<Nur
 /// `Su x Sv` is the opposite of the returned geometry's (a `RECTANGULAR_TRIMMED_SURFACE` that
 /// reverses one of its two directions). `RECTANGULAR_TRIMMED_SURFACE` is its basis (the face's
 /// boundary cuts it); `OFFSET_SURFACE` is exact where its basis is a plane, cylinder, cone,
-/// sphere or torus ([`offset`]), refused otherwise.
+/// sphere or torus, a [`Geometry::Offset`] to approximate otherwise ([`offset`]).
 pub(crate) fn sensed_geometry(m: &Model<'_>, inst: &Instance) -> Result<(Geometry, bool)> {
     sensed_at(m, inst, 0)
 }
+
+/// The distance, mm, within which the offset of a B-spline surface is approximated (a hundredth
+/// of the default on-surface tolerance): the bound proven is added to the on-surface tolerance
+/// of every contour on the face.
+pub const OFFSET_APPROXIMATION_MM: f64 = 1e-4;
 
 /// The deepest nesting of trimmed and offset surfaces read.
 const MAX_SURFACE_NESTING: usize = 16;
@@ -453,17 +537,19 @@ const MAX_SURFACE_NESTING: usize = 16;
 /// sample and for samples the walk loses (it stops short or lands farther than this).
 pub(crate) const WARM_ACCEPT_MM: f64 = crate::curves::ON_GEOMETRY_TOLERANCE_MM;
 
-/// The foot of `p` on `s` for a run of nearby points on the surface (the samples along an
-/// edge): Newton's method from the previous foot in `warm`, taken where it ends within
-/// [`WARM_ACCEPT_MM`] of `p`, the global search otherwise (and always without a start); `warm`
-/// then holds this foot's parameters.
+/// The foot of `p` on `s` for a run of nearby points on the surface, or `offset` mm off it
+/// along its normal (the samples along an edge of the surface or of its offset): Newton's
+/// method from the previous foot in `warm`, taken where it ends within [`WARM_ACCEPT_MM`] of
+/// `offset` from `p`, the global search otherwise (and always without a start); `warm` then
+/// holds this foot's parameters.
 pub(crate) fn foot_near(
     s: &NurbsSurface,
     p: &Point3<f64>,
     warm: &mut Option<(f64, f64)>,
+    offset: f64,
 ) -> kerf_nurbs::SurfaceProjection {
     let mut pr = s.closest_point(p, *warm);
-    if warm.is_some() && !(pr.distance <= WARM_ACCEPT_MM) {
+    if warm.is_some() && !((pr.distance - offset).abs() <= WARM_ACCEPT_MM) {
         pr = s.closest_point(p, None);
     }
     *warm = Some((pr.u, pr.v));
@@ -502,9 +588,11 @@ fn sensed_at(m: &Model<'_>, inst: &Instance, depth: usize) -> Result<(Geometry, 
 /// (their natural normal points outward); a cone `O + (r + v tan a)(cos u x + sin u y) + v z`,
 /// whose unit normal is `cos a radial - sin a z`, becomes the cone of radius `r + d / cos a` at
 /// its placement with the same angle (the point `P + d n` has height `v - d sin a` and radius
-/// `r + v tan a + d cos a = r + (v - d sin a) tan a + d / cos a`). An offset that leaves no
-/// surface (a radius at or below zero) or whose basis has no exact NURBS offset (B-spline,
-/// extrusion, revolution) is refused with the reason.
+/// `r + v tan a + d cos a = r + (v - d sin a) tan a + d / cos a`). The offset of a B-spline
+/// surface, an extrusion or a revolution is not rational: it is [`Geometry::Offset`], which
+/// [`Geometry::to_nurbs_bounded`] approximates over the face's range once that is known (an
+/// offset of such an offset adds the distances: the normal is the same). An offset that leaves
+/// no surface (a radius at or below zero) is refused with the reason.
 pub(crate) fn offset(g: Geometry, d: f64) -> std::result::Result<Geometry, String> {
     let radius = |r: f64, what: &str| {
         if r > 0.0 && r.is_finite() {
@@ -532,11 +620,15 @@ pub(crate) fn offset(g: Geometry, d: f64) -> std::result::Result<Geometry, Strin
         }
         Geometry::Sphere(f, r) => Geometry::Sphere(f, radius(r + d, "sphere")?),
         Geometry::Torus(f, big, r) => Geometry::Torus(f, big, radius(r + d, "torus tube")?),
-        other => {
-            return Err(format!(
-                "an offset of a {} surface has no exact NURBS form: not read",
-                other.kind()
-            ))
+        Geometry::Offset { basis, distance } => Geometry::Offset {
+            basis,
+            distance: distance + d,
+        },
+        basis @ (Geometry::Nurbs(_) | Geometry::Extrusion(..) | Geometry::Revolution { .. }) => {
+            Geometry::Offset {
+                basis: Box::new(basis),
+                distance: d,
+            }
         }
     })
 }
@@ -825,7 +917,7 @@ mod tests {
     }
 
     #[test]
-    fn offsets_that_leave_no_surface_or_are_not_exact_are_refused() {
+    fn offsets_that_leave_no_surface_are_refused_and_free_form_ones_approximated() {
         let cyl = Geometry::Cylinder(frame(), 3.0);
         let e = offset(cyl, -3.0).expect_err("radius 0");
         assert!(e.contains("leaves a radius of 0 mm"), "{e}");
@@ -845,10 +937,61 @@ mod tests {
             None,
         )
         .expect("surface");
-        let e = offset(Geometry::Nurbs(s), 1.0).expect_err("not exact");
+        // A B-spline surface's offset, offset again: one offset by the sum, approximated over
+        // the range asked for, with its bounds.
+        let g = offset(
+            offset(Geometry::Nurbs(s.clone()), 1.0).expect("offset"),
+            0.5,
+        )
+        .expect("offset");
         assert!(
-            e.contains("b-spline surface has no exact NURBS form"),
-            "{e}"
+            matches!(&g, Geometry::Offset { distance, .. } if *distance == 1.5),
+            "{g:?}"
+        );
+        let (a, bound) = g
+            .to_nurbs_bounded((0.25, 1.0), (0.0, 0.5))
+            .expect("approximated");
+        let bound = bound.expect("the bounds");
+        assert!(bound.position_mm <= OFFSET_APPROXIMATION_MM, "{bound:?}");
+        assert_eq!(
+            (a.domain_u(), a.domain_v()),
+            ((0.25, 1.0), (0.0, 0.5)),
+            "the range asked for"
+        );
+        let (p, su, sv) = s.eval_d1(0.6, 0.3);
+        let exact = p + su.cross(&sv).normalize() * 1.5;
+        assert!(
+            (a.point(0.6, 0.3) - exact).norm() <= bound.position_mm,
+            "within the bound of S + 1.5 n"
+        );
+        // An extrusion of a circle of radius 10 about z: its offset by 2 is the radius-12
+        // cylinder (`C' x z` points outward); by -12 it folds over and is refused.
+        let circle = NurbsCurve::circle(Point3::origin(), Vector3::z(), 10.0).expect("circle");
+        let ext = Geometry::Extrusion(circle, Vector3::z());
+        let (c12, bound) = offset(ext.clone(), 2.0)
+            .expect("offset")
+            .to_nurbs_bounded((0.0, 1.0), (-3.0, 4.0))
+            .expect("approximated");
+        let bound = bound.expect("the bounds");
+        for k in 0..=40 {
+            let q = c12.point(k as f64 / 40.0, 1.5);
+            assert!(
+                (q.x.hypot(q.y) - 12.0).abs() <= bound.position_mm
+                    && (q.z - 1.5).abs() <= bound.position_mm,
+                "on the radius-12 cylinder: {q}"
+            );
+        }
+        let fold = offset(ext, -12.0)
+            .expect("offset")
+            .to_nurbs_bounded((0.0, 1.0), (0.0, 1.0));
+        assert!(
+            matches!(
+                fold,
+                Err(SurfaceRangeError::Offset(
+                    kerf_nurbs::SurfaceOffsetError::Folds { .. }
+                ))
+            ),
+            "{fold:?}"
         );
     }
 

@@ -1352,6 +1352,100 @@ fn offset_and_rectangular_trimmed_surfaces_are_exact() {
 }
 
 #[test]
+fn offsets_of_b_spline_surfaces_are_approximated_within_the_bound_they_state() {
+    // fixtures/step/offset_freeform.step (scripts/make_step_fixtures.py): a bicubic B-spline
+    // sheet of two spans offset by +2.5 (face #47), a rational biquadratic cap by -1.5, an
+    // extrusion by +1.5 and a revolution by -1.
+    let imp = import_file(
+        fixture("offset_freeform.step"),
+        &ImportOptions::default()
+            .with_edges(None)
+            .with_all_faces(true),
+    )
+    .expect("imports");
+    assert_eq!(imp.report.approximated.len(), 4, "every face approximated");
+    for (id, a) in &imp.report.approximated {
+        assert!(
+            a.position_mm > 0.0 && a.position_mm <= kerf_step::cad::OFFSET_APPROXIMATION_MM,
+            "{id}: bound {} within the reader's tolerance",
+            a.position_mm
+        );
+    }
+    // The sheet's basis, as the script builds it, and its exact offset S + 2.5 n.
+    let zs = [
+        [0.0, 6.0, -3.0, 2.0],
+        [4.0, -2.0, 8.0, 0.0],
+        [-3.0, 5.0, 1.0, 4.0],
+        [2.0, -4.0, 3.0, -1.0],
+        [0.0, 3.0, -2.0, 1.0],
+    ];
+    let basis = NurbsSurface::try_new(
+        3,
+        3,
+        vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0],
+        vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+        (0..5)
+            .map(|i| {
+                (0..4)
+                    .map(|j| Point3::new(200.0 + 25.0 * i as f64, 80.0 * j as f64 / 3.0, zs[i][j]))
+                    .collect()
+            })
+            .collect(),
+        None,
+    )
+    .expect("basis");
+    let (_, bound) = imp
+        .report
+        .approximated
+        .iter()
+        .find(|(id, _)| id == "face #47")
+        .expect("face #47 approximated");
+    let raw = imp
+        .file
+        .surfaces
+        .iter()
+        .find(|s| matches!(s, RawSurface::Nurbs(n) if n.id == "face #47"))
+        .expect("face #47");
+    let a = surface(raw);
+    let mut worst: f64 = 0.0;
+    let mut worst_normal: f64 = 0.0;
+    for i in 0..=80 {
+        for j in 0..=80 {
+            let (u, v) = (i as f64 / 80.0, j as f64 / 80.0);
+            let (p, su, sv) = basis.eval_d1(u, v);
+            let n = su.cross(&sv).normalize();
+            worst = worst.max((a.point(u, v) - (p + n * 2.5)).norm());
+            let an = a.normal(u, v).expect("regular");
+            worst_normal = worst_normal.max(an.cross(&n).norm().atan2(an.dot(&n)));
+        }
+    }
+    assert!(
+        worst <= bound.position_mm,
+        "dense distance {worst:.3e} within the stated {:.3e}",
+        bound.position_mm
+    );
+    assert!(
+        worst_normal <= bound.normal_rad,
+        "normal {worst_normal:.3e} within the stated {:.3e}",
+        bound.normal_rad
+    );
+    // The contour on the face carries the bound in its on-surface tolerance.
+    let c = imp
+        .file
+        .curves
+        .iter()
+        .find(|c| matches!(&c.surface, Some(SurfaceRef::One(f)) if f == "face #47"))
+        .expect("the sheet's boundary");
+    assert!(
+        c.on_surface_tolerance_mm
+            .is_some_and(|t| t >= bound.position_mm),
+        "on-surface tolerance {:?} covers the bound {}",
+        c.on_surface_tolerance_mm,
+        bound.position_mm
+    );
+}
+
+#[test]
 fn an_assembly_places_each_instance_of_its_parts() {
     // fixtures/step/assembly.step (Open CASCADE's assembly structure): a box placed where it
     // is and again turned 0.5 rad about z and moved by (100, 20, 3); a cylinder of radius 5 and

@@ -1,0 +1,194 @@
+//! Offsets of NURBS surfaces against closed forms: a cylinder's offsets are cylinders, a
+//! height field's offset is `S + d (-z_x, -z_y, 1) / |.|` with the partial derivatives taken
+//! from the Bernstein polynomials directly, and the bound proven is checked by dense sampling.
+
+use kerf_nurbs::{NurbsSurface, SurfaceOffsetError, SurfaceOffsetOptions};
+use nalgebra::{Point3, Vector3};
+
+/// The angle between two vectors, rad.
+fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+#[test]
+fn a_cylinders_offsets_are_the_cylinders_of_the_radius_plus_and_minus_the_distance() {
+    let r = 20.0;
+    let c = NurbsSurface::cylinder(Point3::origin(), Vector3::z(), r, 10.0).expect("cylinder");
+    for d in [2.0, -2.0, 0.5] {
+        let tol = 1e-4;
+        let o = c
+            .offset(d, &SurfaceOffsetOptions::new(tol))
+            .expect("certified");
+        assert!(
+            o.position_bound_mm <= tol,
+            "bound {} within the tolerance",
+            o.position_bound_mm
+        );
+        assert!(
+            o.position_bound_mm > 0.0,
+            "a curved offset is not claimed exact"
+        );
+        let mut worst: f64 = 0.0;
+        let mut worst_normal: f64 = 0.0;
+        for i in 0..=200 {
+            for j in 0..=10 {
+                let (u, v) = (i as f64 / 200.0, j as f64 / 10.0);
+                let p = o.surface.point(u, v);
+                // Against the closed form: the radius r + d, at the same height and angle.
+                let s = c.point(u, v);
+                let radial = Vector3::new(s.x, s.y, 0.0) / r;
+                let exact = s + radial * d;
+                worst = worst.max((p - exact).norm());
+                let n = o.surface.normal(u, v).expect("regular");
+                worst_normal = worst_normal.max(angle(&n, &radial));
+            }
+        }
+        assert!(
+            worst <= o.position_bound_mm,
+            "d {d}: the dense distance {worst:.3e} is within the bound {:.3e}",
+            o.position_bound_mm
+        );
+        assert!(
+            worst_normal <= o.normal_bound_rad,
+            "d {d}: normal angle {worst_normal:.3e} within the bound {:.3e}",
+            o.normal_bound_rad
+        );
+        // Not vacuous: the bound is within two orders of the error found.
+        assert!(
+            o.position_bound_mm < 100.0 * worst.max(1e-9),
+            "d {d}: bound {:.3e} vs measured {worst:.3e}",
+            o.position_bound_mm
+        );
+    }
+}
+
+/// Bernstein basis of degree 3 and its derivative at `t`.
+fn bern3(t: f64) -> ([f64; 4], [f64; 4]) {
+    let s = 1.0 - t;
+    (
+        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
+        [
+            -3.0 * s * s,
+            3.0 * s * s - 6.0 * t * s,
+            6.0 * t * s - 3.0 * t * t,
+            3.0 * t * t,
+        ],
+    )
+}
+
+#[test]
+fn a_height_fields_offset_follows_its_analytic_normal() {
+    // z(u, v) = sum z_ij B_i(u) B_j(v) over x = 100 u, y = 80 v (linear precision).
+    let z = [
+        [0.0, 12.0, -6.0, 3.0],
+        [8.0, -4.0, 15.0, 0.0],
+        [-5.0, 10.0, 2.0, 9.0],
+        [4.0, -8.0, 6.0, -2.0],
+    ];
+    let (lx, ly) = (100.0, 80.0);
+    let net: Vec<Vec<Point3<f64>>> = (0..4)
+        .map(|i| {
+            (0..4)
+                .map(|j| Point3::new(lx * i as f64 / 3.0, ly * j as f64 / 3.0, z[i][j]))
+                .collect()
+        })
+        .collect();
+    let k = || vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+    let s = NurbsSurface::try_new(3, 3, k(), k(), net, None).expect("patch");
+    let d = 3.0;
+    let tol = 1e-4;
+    let o = s
+        .offset(d, &SurfaceOffsetOptions::new(tol))
+        .expect("certified");
+    assert!(o.cells > 1, "a curved patch is split ({} cells)", o.cells);
+    let mut worst: f64 = 0.0;
+    let mut worst_normal: f64 = 0.0;
+    for i in 0..=120 {
+        for j in 0..=120 {
+            let (u, v) = (i as f64 / 120.0, j as f64 / 120.0);
+            let ((bu, du), (bv, dv)) = (bern3(u), bern3(v));
+            let (mut h, mut hu, mut hv) = (0.0, 0.0, 0.0);
+            for a in 0..4 {
+                for b in 0..4 {
+                    h += z[a][b] * bu[a] * bv[b];
+                    hu += z[a][b] * du[a] * bv[b];
+                    hv += z[a][b] * bu[a] * dv[b];
+                }
+            }
+            let n = Vector3::new(-hu / lx, -hv / ly, 1.0).normalize();
+            let exact = Point3::new(lx * u, ly * v, h) + n * d;
+            worst = worst.max((o.surface.point(u, v) - exact).norm());
+            let na = o.surface.normal(u, v).expect("regular");
+            worst_normal = worst_normal.max(angle(&na, &n));
+        }
+    }
+    assert!(
+        worst <= o.position_bound_mm && o.position_bound_mm <= tol,
+        "dense {worst:.3e} <= bound {:.3e} <= {tol}",
+        o.position_bound_mm
+    );
+    assert!(
+        worst_normal <= o.normal_bound_rad,
+        "normal {worst_normal:.3e} <= bound {:.3e}",
+        o.normal_bound_rad
+    );
+}
+
+#[test]
+fn a_plane_offsets_exactly_and_a_fold_or_a_pole_is_refused_within_the_budget() {
+    let plane = NurbsSurface::plane(
+        Point3::new(1.0, 2.0, 3.0),
+        Vector3::x(),
+        Vector3::y(),
+        50.0,
+        20.0,
+    )
+    .expect("plane");
+    let o = plane
+        .offset(-1.5, &SurfaceOffsetOptions::new(1e-6))
+        .expect("plane");
+    assert_eq!(o.cells, 1, "a plane needs one cell");
+    let p = o.surface.point(0.25, 0.75);
+    assert!(
+        (p - Point3::new(13.5, 17.0, 1.5)).norm() <= 1e-9,
+        "the plane moved 1.5 against its normal: {p}"
+    );
+    // A cylinder of radius 20 offset 25 inward folds over: refused, within the budget.
+    let c = NurbsSurface::cylinder(Point3::origin(), Vector3::z(), 20.0, 10.0).expect("cylinder");
+    let budget = 300;
+    let fold = c.offset(
+        -25.0,
+        &SurfaceOffsetOptions::new(1e-4).with_max_work(budget),
+    );
+    assert!(
+        matches!(fold, Err(SurfaceOffsetError::Folds { distance_mm, .. }) if distance_mm == -25.0),
+        "a fold must be refused, got {fold:?}"
+    );
+    // A sphere's poles have no normal polynomial direction: refused, naming it.
+    let sphere = NurbsSurface::sphere(Point3::origin(), 10.0).expect("sphere");
+    let pole = sphere.offset(1.0, &SurfaceOffsetOptions::new(1e-4).with_max_work(budget));
+    assert!(
+        matches!(pole, Err(SurfaceOffsetError::NormalVanishes { .. })),
+        "a pole must be refused, got {pole:?}"
+    );
+    // A tolerance no cell reaches spends the budget, and stops there.
+    let fine = c.offset(2.0, &SurfaceOffsetOptions::new(1e-30).with_max_work(budget));
+    match fine {
+        Err(SurfaceOffsetError::Budget { cells, work, .. }) => {
+            // The cylinder is rational (degree 3 once raised): 7 bicubic cells each.
+            assert_eq!(work, 7 * cells, "each rational bicubic cell weighs 7");
+            assert!(
+                work <= budget && work + 7 > budget,
+                "the work {work} stops within one cell of the budget {budget}"
+            )
+        }
+        other => panic!("an unreachable tolerance must stop at the budget, got {other:?}"),
+    }
+    assert!(
+        matches!(
+            c.offset(f64::NAN, &SurfaceOffsetOptions::new(1e-4)),
+            Err(SurfaceOffsetError::Arguments { .. })
+        ),
+        "NaN refused"
+    );
+}

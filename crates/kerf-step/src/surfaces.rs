@@ -885,8 +885,10 @@ mod tests {
 
     /// Along a boundary, each B-spline projection starts from the previous sample's foot: it
     /// finds the foot the global search finds, the exact one, on a multi-cell rational surface
-    /// (a torus patch as a B-spline face) for a curve across many cells, on the surface and
-    /// 0.05 mm off it along the normal.
+    /// (a torus patch as a B-spline face) for a curve across many cells, on the surface,
+    /// 0.05 mm off it along the normal and on its offset by 0.5 mm; and it is the warm path that finds it, counted in
+    /// surface evaluations (kerf-nurbs' `eval-counter`): a small part of what the global
+    /// searches of the same samples cost.
     #[test]
     fn warm_started_parameters_along_an_edge_are_the_global_ones() {
         let torus = Geometry::Torus(frame(), 6.0, 1.5)
@@ -895,24 +897,62 @@ mod tests {
         let (ua, ub) = torus.domain_u();
         let (va, vb) = torus.domain_v();
         let g = Geometry::Nurbs(torus.clone());
-        for off in [0.0, 0.05] {
+        // 0.5 mm off is read as a point of the surface's offset by 0.5 mm (its parameters are
+        // the basis's, the warm foot accepted 0.5 mm away).
+        let offset = Geometry::Offset {
+            basis: Box::new(g.clone()),
+            distance: 0.5,
+        };
+        for off in [0.0, 0.05, 0.5] {
+            let g = if off == 0.5 { &offset } else { &g };
+            let samples: Vec<(f64, f64, Point3<f64>)> = (0..=180)
+                .map(|k| {
+                    let t = k as f64 / 180.0;
+                    let (a, b) = (ua + (ub - ua) * t, va + (vb - va) * (0.1 + 0.8 * t * t));
+                    let n = torus.normal(a, b).expect("regular");
+                    (a, b, torus.point(a, b) + n * off)
+                })
+                .collect();
             let mut warm = None;
-            for k in 0..=180 {
-                let t = k as f64 / 180.0;
-                let (a, b) = (ua + (ub - ua) * t, va + (vb - va) * (0.1 + 0.8 * t * t));
-                let n = torus.normal(a, b).expect("regular");
-                let p = torus.point(a, b) + n * off;
+            let (warm_feet, warm_work) = kerf_nurbs::counted(|| {
+                samples
+                    .iter()
+                    .map(|(_, _, p)| g.params_near(p, &mut warm))
+                    .collect::<Vec<_>>()
+            });
+            let (cold_feet, cold_work) = kerf_nurbs::counted(|| {
+                samples
+                    .iter()
+                    .map(|(_, _, p)| {
+                        let c = torus.closest_point(p, None);
+                        (c.u, c.v)
+                    })
+                    .collect::<Vec<_>>()
+            });
+            for (k, ((a, b, _), (wf, cf))) in samples
+                .iter()
+                .zip(warm_feet.iter().zip(&cold_feet))
+                .enumerate()
+            {
                 // The foot of a point on the normal (within the tube's 1.5 mm radius) is
-                // (a, b) itself: both searches must find it.
-                let (u, v) = g.params_near(&p, &mut warm);
-                let cold = torus.closest_point(&p, None);
-                for (what, (x, y)) in [("warm", (u, v)), ("global", (cold.u, cold.v))] {
+                // (a, b) itself: both searches must find it (to 1e-8, or 1e-7 where the
+                // point is 0.5 mm off and the distance's minimum is flatter).
+                let tol = if off == 0.5 { 1e-7 } else { 1e-8 };
+                for (what, (x, y)) in [("warm", wf), ("global", cf)] {
                     assert!(
-                        (x - a).abs() < 1e-8 && (y - b).abs() < 1e-8,
+                        (x - a).abs() < tol && (y - b).abs() < tol,
                         "sample {k}, {off} mm off: {what} ({x}, {y}), foot ({a}, {b})"
                     );
                 }
             }
+            let (w, c) = (
+                warm_work.expect("kerf-nurbs' eval-counter is on in these tests"),
+                cold_work.expect("counter"),
+            );
+            assert!(
+                8 * w < c,
+                "{off} mm off: the warm walk took {w} evaluations, the global searches {c}"
+            );
         }
     }
 

@@ -192,3 +192,59 @@ fn a_plane_offsets_exactly_and_a_fold_or_a_pole_is_refused_within_the_budget() {
         "NaN refused"
     );
 }
+
+#[test]
+fn an_offset_near_the_radius_of_curvature_is_built_and_past_it_refused() {
+    // A cubic Bezier arc of 60 degrees and radius 20 about the y axis (not rational: its
+    // radius of curvature is 20 to within 0.1 %), extruded 30 mm along y; its normal points
+    // away from the axis. Offset by -19 it comes within about 1 mm of the axis without turning
+    // inside out, and is built within the tolerance; by -21 it turns inside out, which the
+    // exact offset's normal `(S_u + d n_u) x (S_v + d n_v)` shows at a grid point.
+    let (r, phi) = (20.0_f64, 60f64.to_radians());
+    let k = 4.0 / 3.0 * (phi / 4.0).tan();
+    let at = |t: f64| Point3::new(r * t.sin(), 0.0, r * t.cos());
+    let tangent = |t: f64| Vector3::new(t.cos(), 0.0, -t.sin());
+    let (a, b) = (-phi / 2.0, phi / 2.0);
+    let arc = [
+        at(a),
+        at(a) + tangent(a) * (k * r),
+        at(b) - tangent(b) * (k * r),
+        at(b),
+    ];
+    let net: Vec<Vec<Point3<f64>>> = arc
+        .iter()
+        .map(|p| vec![*p, p + Vector3::y() * 30.0])
+        .collect();
+    let s = NurbsSurface::try_new(
+        3,
+        1,
+        vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+        vec![0.0, 0.0, 1.0, 1.0],
+        net,
+        None,
+    )
+    .expect("patch");
+    let tol = 1e-4;
+    let o = s
+        .offset(-19.0, &SurfaceOffsetOptions::new(tol))
+        .expect("no fold: built");
+    let mut worst: f64 = 0.0;
+    for i in 0..=200 {
+        for j in 0..=4 {
+            let (u, v) = (i as f64 / 200.0, j as f64 / 4.0);
+            let (p, su, sv) = s.eval_d1(u, v);
+            let exact = p + su.cross(&sv).normalize() * -19.0;
+            worst = worst.max((o.surface.point(u, v) - exact).norm());
+        }
+    }
+    assert!(
+        worst <= o.position_bound_mm && o.position_bound_mm <= tol,
+        "dense {worst:.3e} <= bound {:.3e} <= {tol}",
+        o.position_bound_mm
+    );
+    let past = s.offset(-21.0, &SurfaceOffsetOptions::new(tol));
+    assert!(
+        matches!(past, Err(SurfaceOffsetError::Folds { .. })),
+        "past the radius it folds: {past:?}"
+    );
+}

@@ -151,13 +151,20 @@ pub fn face<P: Place>(
             ));
         }
     }
-    let (mut surface, approximation) = g
-        .to_nurbs_bounded(u, v)
-        .map_err(|m| place.defect(m.to_string()))?;
+    // An approximation's work is charged after it is done (it has a budget of its own), and
+    // also where it failed: the reader's budget then bounds a file of many offset faces.
+    let charge = |work: usize| place.charge(work.saturating_mul(PROJECTIONS_PER_OFFSET_CELL));
+    let (mut surface, approximation) = match g.to_nurbs_bounded(u, v) {
+        Ok(x) => x,
+        Err(e) => {
+            if let crate::surfaces::SurfaceRangeError::Offset(o) = &e {
+                charge(o.work())?;
+            }
+            return Err(place.defect(e.to_string()));
+        }
+    };
     if let Some(a) = approximation {
-        // After the work (the approximation has a budget of its own): the reader's budget
-        // then bounds a file of many offset faces.
-        place.charge(a.work.saturating_mul(PROJECTIONS_PER_OFFSET_CELL))?;
+        charge(a.work)?;
     }
     edges_on_surface(place, sigil, &surface, g.kind(), &loops, &edge_ids)?;
     if reversed {
@@ -389,9 +396,11 @@ pub struct Face {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct Approximation {
-    /// The largest distance, mm, between the surface and the file's at the same parameters.
+    /// The largest distance, mm, between a point of the surface and the point of the file's it
+    /// stands for (the same point of the basis offset; the parameters are the basis's NURBS
+    /// ones, mirrored where the face is reversed).
     pub position_mm: f64,
-    /// The largest angle, rad, between their normals there.
+    /// The largest angle, rad, between their normals at such points.
     pub normal_rad: f64,
     /// The work the approximation took, in cells of a bicubic polynomial surface
     /// ([`kerf_nurbs::OffsetSurface::work`]): charged to the reader's budget as

@@ -103,8 +103,9 @@ pub enum SurfaceOffsetError {
         /// The tolerance.
         tolerance_mm: f64,
     },
-    /// The offset turns inside out: at a point of the grid the approximation's normal (which
-    /// there interpolates the offset) points against the surface's. No approximation fixes it.
+    /// The exact offset turns inside out: at a point of the grid its normal
+    /// `(S_u + d n_u) x (S_v + d n_v)` points against the surface's (`1 - 2 H d + K d^2 < 0`).
+    /// No approximation fixes it.
     #[error("the offset by {distance_mm} mm near (u, v) = ({u}, {v}): {}", FOLDS)]
     Folds {
         /// The distance.
@@ -113,6 +114,8 @@ pub enum SurfaceOffsetError {
         u: f64,
         /// The middle of the cell where it was seen.
         v: f64,
+        /// The work spent ([`OffsetSurface::work`]).
+        work: usize,
     },
     /// The surface's normal vanishes (a collapsed edge, a cusp): the offset has no direction
     /// there.
@@ -122,6 +125,8 @@ pub enum SurfaceOffsetError {
         u: f64,
         /// The middle of the cell where it was seen.
         v: f64,
+        /// The work spent ([`OffsetSurface::work`]).
+        work: usize,
     },
     /// The budget ran out before every cell was certified.
     #[error("the offset by {distance_mm} mm is not certified within {tolerance_mm} mm after {cells} cells (the work budget, {work} bicubic cells): {why} near (u, v) = ({u}, {v})")]
@@ -143,6 +148,19 @@ pub enum SurfaceOffsetError {
     },
 }
 
+impl SurfaceOffsetError {
+    /// The work spent before the error ([`OffsetSurface::work`]; 0 where none was done), for a
+    /// caller that charges it to a budget of its own.
+    pub fn work(&self) -> usize {
+        match self {
+            Self::Degree { .. } | Self::Arguments { .. } => 0,
+            Self::Folds { work, .. }
+            | Self::NormalVanishes { work, .. }
+            | Self::Budget { work, .. } => *work,
+        }
+    }
+}
+
 /// The highest degree (in either direction) of a polynomial surface whose offset is built.
 pub const MAX_OFFSET_DEGREE: usize = 7;
 /// The highest degree of a rational surface whose offset is built.
@@ -160,6 +178,8 @@ struct CellPolys {
     corner: Point3<f64>,
     /// The raised degrees.
     deg: (usize, usize),
+    /// The exact offset turns inside out at one of the cell's grid points.
+    folds: bool,
 }
 
 /// One certified (or refused) cell.
@@ -174,7 +194,7 @@ struct Cell {
 enum Unproven {
     /// Smaller cells may prove it.
     Refine(String),
-    /// No cell will: the offset turns inside out at one of the cell's grid points.
+    /// No cell will: the exact offset turns inside out at one of the cell's grid points.
     Folds,
     /// No cell will: the surface's normal vanishes at one of the cell's grid points (to
     /// double precision: a collapsed edge, a cusp).
@@ -272,7 +292,8 @@ impl NurbsSurface {
                             });
                         }
                         certified += 1;
-                        let cp = self.cell_polys((u0, u1), (v0, v1), &spans_u, &spans_v);
+                        let cp =
+                            self.cell_polys((u0, u1), (v0, v1), &spans_u, &spans_v, distance_mm);
                         slot.insert(offset_cell(&cp, distance_mm, self.size()));
                     }
                     let cell = &cells[&k];
@@ -285,12 +306,14 @@ impl NurbsSurface {
                                 distance_mm,
                                 u: 0.5 * (u0 + u1),
                                 v: 0.5 * (v0 + v1),
+                                work: certified * cost,
                             })
                         }
                         Err(Unproven::Vanishes) => {
                             return Err(SurfaceOffsetError::NormalVanishes {
                                 u: 0.5 * (u0 + u1),
                                 v: 0.5 * (v0 + v1),
+                                work: certified * cost,
                             })
                         }
                     };
@@ -299,11 +322,24 @@ impl NurbsSurface {
                     failed = Some((why, 0.5 * (u0 + u1), 0.5 * (v0 + v1)));
                 }
             }
-            if failed.is_none() {
+            let Some((why, u, v)) = failed else {
                 break;
+            };
+            let (nu, nv) = (bisect(&us, &bad_u), bisect(&vs, &bad_v));
+            if nu.len() == us.len() && nv.len() == vs.len() {
+                // The failing cells are too narrow to halve in floating point: no finer grid
+                // exists, and the cached cells would be tried again for ever.
+                return Err(SurfaceOffsetError::Budget {
+                    distance_mm,
+                    tolerance_mm: tol,
+                    cells: certified,
+                    work: certified * cost,
+                    why: format!("{why}, in cells too narrow to halve"),
+                    u,
+                    v,
+                });
             }
-            us = bisect(&us, &bad_u);
-            vs = bisect(&vs, &bad_v);
+            (us, vs) = (nu, nv);
         }
         // Assemble the cells as one Bezier-form B-spline surface.
         let (pe, qe) = (p.max(3), q.max(3));
@@ -374,13 +410,15 @@ impl NurbsSurface {
         })
     }
 
-    /// The polynomials of the cell `[u0, u1] x [v0, v1]` (inside one knot span each way).
+    /// The polynomials of the cell `[u0, u1] x [v0, v1]` (inside one knot span each way), and
+    /// whether the exact offset by `distance_mm` turns inside out at one of its grid points.
     fn cell_polys(
         &self,
         (u0, u1): (f64, f64),
         (v0, v1): (f64, f64),
         spans_u: &[(usize, f64, f64)],
         spans_v: &[(usize, f64, f64)],
+        distance_mm: f64,
     ) -> CellPolys {
         let span = |spans: &[(usize, f64, f64)], a: f64, b: f64| {
             let mid = 0.5 * (a + b);
@@ -410,6 +448,13 @@ impl NurbsSurface {
         ];
         let w = self.rational.then(|| comp(&|h| h.w));
         let m = normal_direction(&pp, w.as_ref());
+        let folds = (0..=pe).any(|a| {
+            (0..=qe).any(|b| {
+                let u = u0 + (u1 - u0) * a as f64 / pe as f64;
+                let v = v0 + (v1 - v0) * b as f64 / qe as f64;
+                self.offset_turns(u, v, distance_mm)
+            })
+        });
         CellPolys {
             p: pp,
             w,
@@ -417,7 +462,28 @@ impl NurbsSurface {
             m,
             corner,
             deg: (pe, qe),
+            folds,
         }
+    }
+
+    /// Whether the exact offset by `d` turns inside out at `(u, v)`: its normal
+    /// `(S_u + d n_u) x (S_v + d n_v)` points against `n` (`n_u = P(m_u) / |m|`, `m = S_u x S_v`,
+    /// `P` the projection across `n`). False where the surface's normal nearly vanishes (there
+    /// the test means nothing; the cell refuses on its own).
+    fn offset_turns(&self, u: f64, v: f64, d: f64) -> bool {
+        let s = self.derivatives(u, v);
+        let (su, sv) = (s[1][0], s[0][1]);
+        let m = su.cross(&sv);
+        let len = m.norm();
+        // Against the larger derivative (at a collapsed edge the other is rounding noise).
+        if len.is_nan() || len <= 1e-9 * su.norm_squared().max(sv.norm_squared()) {
+            return false;
+        }
+        let n = m / len;
+        let across = |x: nalgebra::Vector3<f64>| (x - n * n.dot(&x)) / len;
+        let nu = across(s[2][0].cross(&sv) + su.cross(&s[1][1]));
+        let nv = across(s[1][1].cross(&sv) + su.cross(&s[0][2]));
+        (su + nu * d).cross(&(sv + nv * d)).dot(&n) < 0.0
     }
 }
 
@@ -450,6 +516,12 @@ fn weight(cp: &CellPolys) -> Poly {
 /// `E` interpolating `W d n` on the cell's uniform grid, `A`'s net and the position bound.
 fn offset_cell(cp: &CellPolys, d: f64, size: f64) -> Cell {
     let (pe, qe) = cp.deg;
+    if cp.folds {
+        return Cell {
+            bound: Err(Unproven::Folds),
+            net: Vec::new(),
+        };
+    }
     let w = weight(cp);
     // The values W d n at the grid points.
     let mut f = [
@@ -537,8 +609,7 @@ fn position_bound(cp: &CellPolys, e: &Poly3, w: &Poly, d: f64, size: f64) -> Res
     Ok((t_hi.max(0.0) + normal * normal).sqrt() + allowance)
 }
 
-/// The proven bound of the angle between the normals of `A` (its net) and of the surface;
-/// [`Unproven::Folds`] where `A`'s normal points against the surface's at a grid point.
+/// The proven bound of the angle between the normals of `A` (its net) and of the surface.
 fn normal_angle(cp: &CellPolys, net: &[Vector4<f64>]) -> Result<f64, Unproven> {
     let (pe, qe) = cp.deg;
     // A's P (translated to the same corner).
@@ -550,22 +621,12 @@ fn normal_angle(cp: &CellPolys, net: &[Vector4<f64>]) -> Result<f64, Unproven> {
         )
     });
     let ma = normal_direction(&pa, cp.w.as_ref());
-    let along = dot(&ma, &cp.m);
-    if !positive(along.min_coefficient()) {
-        // Reversed where the surface's normal is healthy (at a collapsed edge it vanishes and
-        // the interpolated direction there means nothing).
-        let scale = coefficient_scale(&cp.m);
-        let reversed = (0..=pe).any(|a| {
-            (0..=qe).any(|b| {
-                let (u, v) = (a as f64 / pe as f64, b as f64 / qe as f64);
-                value3(&cp.m, u, v).norm() > 1e-3 * scale && along.eval(u, v) < 0.0
-            })
-        });
-        return Err(if reversed {
-            Unproven::Folds
-        } else {
-            Unproven::Refine("the approximation's normal is not proven on the offset's side".into())
-        });
+    if !positive(dot(&ma, &cp.m).min_coefficient()) {
+        // Not proven here; the exact offset does not turn at the grid points (checked before),
+        // so a finer cell may prove it.
+        return Err(Unproven::Refine(
+            "the approximation's normal is not proven on the offset's side".into(),
+        ));
     }
     let x = cross(&ma, &cp.m);
     let den = dot(&ma, &ma).mul(&dot(&cp.m, &cp.m));

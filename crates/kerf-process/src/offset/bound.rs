@@ -138,7 +138,7 @@ fn turn_sign(n: &[(Vector3<f64>, f64)], axis: &Vector3<f64>) -> f64 {
 /// bound of its rounding error. `N` does not change when the curve is translated
 /// (`A -> A - w o` leaves `A' w - A w'` as it is), so the piece is first moved to its first
 /// control point: the products then have the size of the piece, not of its coordinates.
-fn numerator(cpw: &[Vector4<f64>]) -> Vec<(Vector3<f64>, f64)> {
+pub(super) fn numerator(cpw: &[Vector4<f64>]) -> Vec<(Vector3<f64>, f64)> {
     let p = cpw.len() - 1;
     if p == 0 {
         return Vec::new();

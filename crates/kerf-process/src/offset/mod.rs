@@ -22,11 +22,14 @@
 //! The certificate: on a flat contour at a fixed tool axis every chord of the offset is proven
 //! within the tolerance of the exact offset curve (the contour's own proven chord error plus
 //! the offset's term `r (1 - cos alpha)`, [`bound`]); elsewhere (curved surfaces, turning tool
-//! axes) the distance is measured at 15 points inside each chord, and the path says so
+//! axes) by the contour's chord error plus `r sup|W''| / 8` along the chord ([`curved`]),
+//! halving a chord up to [`MAX_PROOF_SPLITS`] times more to find the proof; where none is
+//! found the distance is measured at 15 points inside the chord, and the path says so
 //! ([`OffsetPath::proven`]).
 
 mod bound;
 mod corner;
+mod curved;
 
 use kerf_discretize::chord_error;
 use kerf_nurbs::{NurbsCurve, Segment};
@@ -144,7 +147,9 @@ pub struct OffsetPath {
     /// The largest distance from a chord of the path to the exact offset curve, mm: proven
     /// where [`OffsetPath::proven`], else measured.
     pub max_chord_error_mm: f64,
-    /// True if every chord's distance is proven (a flat contour at a fixed tool axis).
+    /// True if every chord's distance is proven: on a flat contour at a fixed tool axis by the
+    /// tangents' cone, elsewhere by a bound of the offset direction's second derivative (a
+    /// chord where that fails, even halved [`MAX_PROOF_SPLITS`] times more, is measured).
     pub proven: bool,
     /// Corners swung round on an arc (turning away from the scrap).
     pub outside_corners: usize,
@@ -469,9 +474,10 @@ impl<'a> Context<'a> {
         }
         let (a0, a1) = (self.axis(i), self.axis(i + 1));
         let ((m0, slides), (m1, _)) = (self.normal(i), self.normal(i + 1));
-        // (t0, t1, point at t0, point at t1, fraction of the segment at each end), depth.
-        let mut stack = vec![((t0, 0.0, c0), (t1, 1.0, c1), 0u32)];
-        while let Some(((ta, fa, ca), (tb, fb, cb), depth)) = stack.pop() {
+        // (t0, t1, point at t0, point at t1, fraction of the segment at each end), depth, the
+        // halvings made only to find a proof.
+        let mut stack = vec![((t0, 0.0, c0), (t1, 1.0, c1), 0u32, 0u32)];
+        while let Some(((ta, fa, ca), (tb, fb, cb), depth, extra)) = stack.pop() {
             let (aa, ab) = (nlerp(&a0, &a1, fa), nlerp(&a0, &a1, fb));
             let (ma, mb) = (nlerp(&m0, &m1, fa), nlerp(&m0, &m1, fb));
             let (ta_dir, tb_dir) = end_tangents(curve, ta, tb).ok_or_else(|| {
@@ -494,7 +500,7 @@ impl<'a> Context<'a> {
                 e0: Vector3::zeros(),
                 e1: Vector3::zeros(),
             };
-            let verdict = self.certify(&start, &end, &piece)?;
+            let verdict = self.certify(&start, &end, &piece, extra < MAX_PROOF_SPLITS)?;
             if let Verdict::Tight(radius, at) = verdict {
                 tight.pending = true;
                 if tight.tightest.is_none_or(|(r, _)| radius < r) {
@@ -507,15 +513,18 @@ impl<'a> Context<'a> {
                 Verdict::Proven(b) | Verdict::Measured(b) => {
                     b <= self.tol - corner::SMOOTH_RAD * self.r
                 }
-                Verdict::Split | Verdict::Tight(..) => false,
+                Verdict::Split | Verdict::SplitAt(_) | Verdict::ProofSplit | Verdict::Tight(..) => {
+                    false
+                }
             };
             if ok || depth >= 40 {
                 let (bound, proven) = match verdict {
                     Verdict::Proven(b) => (b, true),
                     Verdict::Measured(b) => (b, false),
-                    Verdict::Split | Verdict::Tight(..) => {
-                        (self.measure(&start, &end, &piece), false)
-                    }
+                    Verdict::Split
+                    | Verdict::SplitAt(_)
+                    | Verdict::ProofSplit
+                    | Verdict::Tight(..) => (self.measure(&start, &end, &piece), false),
                 };
                 if bound > self.tol {
                     return Err(self.refuse(format!(
@@ -538,12 +547,18 @@ impl<'a> Context<'a> {
                 }
                 continue;
             }
-            let tm = 0.5 * (ta + tb);
-            let fm = 0.5 * (fa + fb);
+            // Halved, or split at a knot where the contour is only C1 (the axes' fraction is
+            // affine in the parameter).
+            let (tm, extra) = match verdict {
+                Verdict::SplitAt(k) => (k, extra),
+                Verdict::ProofSplit => (0.5 * (ta + tb), extra + 1),
+                _ => (0.5 * (ta + tb), extra),
+            };
+            let fm = fa + (fb - fa) * (tm - ta) / (tb - ta);
             let cm = curve.point(tm);
             // Right half first off the stack: push it first.
-            stack.push(((tm, fm, cm), (tb, fb, cb), depth + 1));
-            stack.push(((ta, fa, ca), (tm, fm, cm), depth + 1));
+            stack.push(((tm, fm, cm), (tb, fb, cb), depth + 1, extra));
+            stack.push(((ta, fa, ca), (tm, fm, cm), depth + 1, extra));
         }
         Ok(())
     }
@@ -559,8 +574,15 @@ impl<'a> Context<'a> {
         exact(self.input.curve, t, a, m, self.r * self.sigma, slides).map_or(fallback, |q| q.0)
     }
 
-    /// The chord error of one offset chord against the exact offset.
-    fn certify(&self, start: &Node, end: &Node, piece: &CurvePiece) -> Result<Verdict> {
+    /// The chord error of one offset chord against the exact offset. `may_split`: a chord the
+    /// measurement already keeps within the tolerance may still be halved to find a proof.
+    fn certify(
+        &self,
+        start: &Node,
+        end: &Node,
+        piece: &CurvePiece,
+        may_split: bool,
+    ) -> Result<Verdict> {
         let chord_c = end.c - start.c;
         let chord_q = end.pos - start.pos;
         if !bound::exceeds(chord_q.dot(&chord_c), 0.0) {
@@ -618,14 +640,42 @@ impl<'a> Context<'a> {
                 Verdict::Split
             });
         }
-        // Curved or turning: the exact offset measured against the chord.
+        // Curved or turning: proven by the second-derivative bound where it holds
+        // ([`curved`]), else the exact offset measured against the chord.
         let tm = 0.5 * (piece.t0 + piece.t1);
         if let Some(radius) = self.radius_toward_scrap(tm, &start.axis) {
             if radius < self.r {
                 return Err(self.small_radius(tm, radius));
             }
         }
-        Ok(Verdict::Measured(self.measure(start, end, piece)))
+        let room = self.tol - corner::SMOOTH_RAD * self.r;
+        let proof = curved::bound(&curved::Chord {
+            curve: self.input.curve,
+            t0: piece.t0,
+            t1: piece.t1,
+            c0: start.c,
+            c1: end.c,
+            a0: piece.a0,
+            a1: piece.a1,
+            m0: piece.m0,
+            m1: piece.m1,
+            slide: piece.slide,
+            r: self.r,
+            limit: room,
+        });
+        if let curved::Proof::Bound(b) = proof {
+            if b <= room {
+                return Ok(Verdict::Proven(b));
+            }
+        }
+        let measured = self.measure(start, end, piece);
+        // NaN is not within.
+        let within = measured <= room;
+        Ok(match proof {
+            curved::Proof::SplitAt(k) if may_split || !within => Verdict::SplitAt(k),
+            _ if may_split && within => Verdict::ProofSplit,
+            _ => Verdict::Measured(measured),
+        })
     }
 
     /// The largest distance of 15 points of the exact offset inside the chord from it.
@@ -676,10 +726,20 @@ impl<'a> Context<'a> {
     }
 }
 
+/// How many times a chord the measurement keeps within the tolerance may be halved to find a
+/// proof of its bound (each halving doubles the points there).
+const MAX_PROOF_SPLITS: u32 = 3;
+
 enum Verdict {
     Proven(f64),
     Measured(f64),
     Split,
+    /// Split at this knot inside the chord, where the contour is only C1 (the curved proof
+    /// needs the offset's direction once continuously differentiable along a chord).
+    SplitAt(f64),
+    /// Measured within the tolerance but not proven: halved to find a proof (at most
+    /// [`MAX_PROOF_SPLITS`] times).
+    ProofSplit,
     /// The contour bends toward the scrap tighter than half the kerf here (radius, where):
     /// the offset runs backwards, and the chord is left out: the offsets on either side are
     /// cut back to their crossing, as at an inside corner.

@@ -17,10 +17,9 @@ pub use crate::model::Charge;
 pub use crate::model::Frame;
 use crate::shape::associate;
 pub use crate::shape::{
-    face, first_with_same_surface, sew, Approximation, Face, ParamBox, Place,
-    PROJECTIONS_PER_OFFSET_CELL,
+    face, first_with_same_surface, sew, Face, ParamBox, Place, PROJECTIONS_PER_OFFSET_CELL,
 };
-pub use crate::surfaces::{Geometry, SurfaceRangeError, OFFSET_APPROXIMATION_MM};
+pub use crate::surfaces::{Approximation, Geometry, SurfaceRangeError, OFFSET_APPROXIMATION_MM};
 
 /// `segments` (in order) joined into one curve with a C0 knot at each join, gaps up to
 /// `close_below` mm closed by moving the shared pole (a swept surface's profile given as a

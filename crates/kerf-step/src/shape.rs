@@ -8,7 +8,7 @@ use kerf_nurbs::{NurbsCurve, NurbsSurface};
 use nalgebra::{Point3, Vector3};
 
 use crate::curves::ON_GEOMETRY_TOLERANCE_MM;
-use crate::surfaces::{angle_range, Geometry};
+use crate::surfaces::{angle_range, Approximation, Geometry};
 
 /// A surface's parameter box `((u0, u1), (v0, v1))`.
 pub type ParamBox = ((f64, f64), (f64, f64));
@@ -390,22 +390,6 @@ pub struct Face {
     /// Where the surface approximates the file's (the offset of a B-spline surface): what is
     /// proven about it.
     pub(crate) approximation: Option<Approximation>,
-}
-
-/// What is proven about a face's surface where it approximates the file's.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[non_exhaustive]
-pub struct Approximation {
-    /// The largest distance, mm, between a point of the surface and the point of the file's it
-    /// stands for (the same point of the basis offset; the parameters are the basis's NURBS
-    /// ones, mirrored where the face is reversed).
-    pub position_mm: f64,
-    /// The largest angle, rad, between their normals at such points.
-    pub normal_rad: f64,
-    /// The work the approximation took, in cells of a bicubic polynomial surface
-    /// ([`kerf_nurbs::OffsetSurface::work`]): charged to the reader's budget as
-    /// [`PROJECTIONS_PER_OFFSET_CELL`] projections each.
-    pub work: usize,
 }
 
 /// How many point projections one bicubic cell of an offset's approximation is charged as

@@ -9,7 +9,6 @@ use std::f64::consts::{PI, TAU};
 
 use kerf_nurbs::{NurbsCurve, NurbsSurface};
 
-use crate::shape::Approximation;
 use nalgebra::{Point3, Vector3, Vector4};
 
 use crate::curves::{arc_homogeneous, basis, expand_knots, sub_curve, Basis};
@@ -61,6 +60,22 @@ pub enum Geometry {
         /// The distance along its normal, mm.
         distance: f64,
     },
+}
+
+/// What is proven about a face's surface where it approximates the file's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Approximation {
+    /// The largest distance, mm, between a point of the surface and the point of the file's it
+    /// stands for (the same point of the basis offset; the parameters are the basis's NURBS
+    /// ones, mirrored where the face is reversed).
+    pub position_mm: f64,
+    /// The largest angle, rad, between their normals at such points.
+    pub normal_rad: f64,
+    /// The work the approximation took, in cells of a bicubic polynomial surface
+    /// ([`kerf_nurbs::OffsetSurface::work`]): charged to the reader's budget as
+    /// [`crate::cad::PROJECTIONS_PER_OFFSET_CELL`] projections each.
+    pub work: usize,
 }
 
 /// Which parameters are angles (periodic with period 2 pi).

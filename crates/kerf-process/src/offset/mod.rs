@@ -149,7 +149,7 @@ pub struct OffsetPath {
     pub max_chord_error_mm: f64,
     /// True if every chord's distance is proven: on a flat contour at a fixed tool axis by the
     /// tangents' cone, elsewhere by a bound of the offset direction's second derivative (a
-    /// chord where that fails, even halved [`MAX_PROOF_SPLITS`] times more, is measured).
+    /// chord where that fails, even halved three times more, is measured).
     pub proven: bool,
     /// Corners swung round on an arc (turning away from the scrap).
     pub outside_corners: usize,
@@ -526,7 +526,8 @@ impl<'a> Context<'a> {
                     | Verdict::ProofSplit
                     | Verdict::Tight(..) => (self.measure(&start, &end, &piece), false),
                 };
-                if bound > self.tol {
+                // NaN is refused too.
+                if bound.is_nan() || bound > self.tol {
                     return Err(self.refuse(format!(
                         "the offset between contour parameters {ta} and {tb} stays {bound:.3e} mm from its chords after 40 halvings (tolerance {} mm)",
                         self.tol
@@ -673,6 +674,8 @@ impl<'a> Context<'a> {
         let within = measured <= room;
         Ok(match proof {
             curved::Proof::SplitAt(k) if may_split || !within => Verdict::SplitAt(k),
+            // Halving cannot make a proof where the offset does not slide.
+            curved::Proof::Never => Verdict::Measured(measured),
             _ if may_split && within => Verdict::ProofSplit,
             _ => Verdict::Measured(measured),
         })

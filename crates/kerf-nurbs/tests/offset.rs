@@ -248,3 +248,71 @@ fn an_offset_near_the_radius_of_curvature_is_built_and_past_it_refused() {
         "past the radius it folds: {past:?}"
     );
 }
+
+#[test]
+fn a_crease_tears_the_offset_and_a_focal_offset_is_refused_at_once() {
+    // Two flat panels meeting at a 30-degree crease (degree 1 in u, a knot of full
+    // multiplicity at 0.5): the offsets of the two sides part along the crease.
+    let rows = [
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(20.0, 0.0, 0.0),
+        Point3::new(
+            20.0 + 20.0 * 30f64.to_radians().cos(),
+            0.0,
+            20.0 * 30f64.to_radians().sin(),
+        ),
+    ];
+    let net: Vec<Vec<Point3<f64>>> = rows
+        .iter()
+        .map(|p| vec![*p, p + Vector3::y() * 10.0])
+        .collect();
+    let creased = NurbsSurface::try_new(
+        1,
+        1,
+        vec![0.0, 0.0, 0.5, 1.0, 1.0],
+        vec![0.0, 0.0, 1.0, 1.0],
+        net,
+        None,
+    )
+    .expect("panels");
+    match creased.offset(2.0, &SurfaceOffsetOptions::new(1e-4)) {
+        Err(SurfaceOffsetError::Crease { gap_mm, .. }) => {
+            // The two sides' normals differ by 30 degrees: their offsets by 2 mm part by
+            // 2 * 2 sin 15 deg at the crease (the shared edge row's largest difference).
+            let want = 2.0 * 2.0 * 15f64.to_radians().sin();
+            assert!(
+                gap_mm > 0.5 * want && gap_mm <= want + 1e-9,
+                "gap {gap_mm} against {want}"
+            );
+        }
+        other => panic!("a crease must be refused, got {other:?}"),
+    }
+    // The same panels meeting flat (no crease) offset exactly.
+    let flat = NurbsSurface::try_new(
+        1,
+        1,
+        vec![0.0, 0.0, 0.5, 1.0, 1.0],
+        vec![0.0, 0.0, 1.0, 1.0],
+        [0.0, 20.0, 40.0]
+            .iter()
+            .map(|&x| vec![Point3::new(x, 0.0, 0.0), Point3::new(x, 10.0, 0.0)])
+            .collect(),
+        None,
+    )
+    .expect("flat");
+    let o = flat
+        .offset(2.0, &SurfaceOffsetOptions::new(1e-4))
+        .expect("flat");
+    assert!(
+        (o.surface.point(0.7, 0.3) - Point3::new(28.0, 3.0, 2.0)).norm() <= 1e-9,
+        "moved 2 mm up"
+    );
+    // A cylinder of radius 20 offset by exactly -20 collapses onto its axis (a focal line):
+    // refused at the first cells, not after spending the budget.
+    let c = NurbsSurface::cylinder(Point3::origin(), Vector3::z(), 20.0, 10.0).expect("cylinder");
+    let focal = c.offset(-20.0, &SurfaceOffsetOptions::new(1e-4).with_max_work(300));
+    assert!(
+        matches!(focal, Err(SurfaceOffsetError::Folds { work, .. }) if work < 300),
+        "{focal:?}"
+    );
+}

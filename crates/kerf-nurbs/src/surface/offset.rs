@@ -128,6 +128,21 @@ pub enum SurfaceOffsetError {
         /// The work spent ([`OffsetSurface::work`]).
         work: usize,
     },
+    /// The surface has a crease (its normal jumps across a cell edge): the offsets of the two
+    /// sides part there by `gap_mm`, and no continuous surface approximates them.
+    #[error("the offset by {distance_mm} mm tears apart by {gap_mm:.3e} mm at a crease of the surface near (u, v) = ({u}, {v})")]
+    Crease {
+        /// The distance.
+        distance_mm: f64,
+        /// How far apart the two sides' offsets are on the edge.
+        gap_mm: f64,
+        /// The middle of a cell beside the crease.
+        u: f64,
+        /// The middle of a cell beside the crease.
+        v: f64,
+        /// The work spent ([`OffsetSurface::work`]).
+        work: usize,
+    },
     /// The budget ran out before every cell was certified.
     #[error("the offset by {distance_mm} mm is not certified within {tolerance_mm} mm after {cells} cells (the work budget, {work} bicubic cells): {why} near (u, v) = ({u}, {v})")]
     Budget {
@@ -156,6 +171,7 @@ impl SurfaceOffsetError {
             Self::Degree { .. } | Self::Arguments { .. } => 0,
             Self::Folds { work, .. }
             | Self::NormalVanishes { work, .. }
+            | Self::Crease { work, .. }
             | Self::Budget { work, .. } => *work,
         }
     }
@@ -345,7 +361,10 @@ impl NurbsSurface {
         let (pe, qe) = (p.max(3), q.max(3));
         let (ncu, ncv) = (us.len() - 1, vs.len() - 1);
         let (nu, nv) = (ncu * pe + 1, ncv * qe + 1);
-        let mut net = vec![Vector4::zeros(); nu * nv];
+        let mut net: Vec<Vector4<f64>> = vec![Vector4::zeros(); nu * nv];
+        let mut written = vec![false; nu * nv];
+        // The largest difference between two cells' points on their shared edge, and where.
+        let mut seam: (f64, f64, f64) = (0.0, us[0], vs[0]);
         let mut position: f64 = 0.0;
         let mut normal: f64 = 0.0;
         for i in 0..ncu {
@@ -361,11 +380,36 @@ impl NurbsSurface {
                 normal = normal.max(theta);
                 for a in 0..=pe {
                     for b in 0..=qe {
-                        net[(i * pe + a) * nv + j * qe + b] = cell.net[a * (qe + 1) + b];
+                        let k = (i * pe + a) * nv + j * qe + b;
+                        let h = cell.net[a * (qe + 1) + b];
+                        if written[k] {
+                            let gap = (net[k].xyz() / net[k].w - h.xyz() / h.w).norm();
+                            if gap > seam.0 {
+                                seam = (gap, 0.5 * (u0 + u1), 0.5 * (v0 + v1));
+                            }
+                        }
+                        net[k] = h;
+                        written[k] = true;
                     }
                 }
             }
         }
+        // Neighbours interpolate the same values on their shared edge where the normal is
+        // continuous: their edge points then agree to rounding, and the later cell's replace
+        // the earlier's (moving that cell's surface by at most the difference: a convex
+        // combination of the moved points over the weights). Where the surface has a crease
+        // the offset tears apart there, and no continuous surface approximates it.
+        let seam_allowance = 1e-9 * (distance_mm.abs() + 1.0) + 1e-12 * self.size();
+        if seam.0 > seam_allowance {
+            return Err(SurfaceOffsetError::Crease {
+                distance_mm,
+                gap_mm: seam.0,
+                u: seam.1,
+                v: seam.2,
+                work: certified * cost,
+            });
+        }
+        position += seam.0;
         let knots = |b: &[f64], deg: usize| {
             let mut k = vec![b[0]; deg + 1];
             for x in &b[1..b.len() - 1] {
@@ -483,7 +527,9 @@ impl NurbsSurface {
         let across = |x: nalgebra::Vector3<f64>| (x - n * n.dot(&x)) / len;
         let nu = across(s[2][0].cross(&sv) + su.cross(&s[1][1]));
         let nv = across(s[1][1].cross(&sv) + su.cross(&s[0][2]));
-        (su + nu * d).cross(&(sv + nv * d)).dot(&n) < 0.0
+        // At or below 0 (to rounding): inside out, or degenerate on a focal line where the
+        // distance equals a radius of curvature (no cell would certify it).
+        (su + nu * d).cross(&(sv + nv * d)).dot(&n) <= 1e-9 * len
     }
 }
 

@@ -139,8 +139,48 @@ impl Builder<'_, '_> {
             }
             None => seg.end,
         };
-        self.bound = self.bound.max(seg.bound);
-        self.proven &= seg.proven;
+        // A chord cut back at an inside corner: on a flat contour the crossing lies on both
+        // chords and the chord's proof holds. Elsewhere the crossing `x` may sit off the chord
+        // `Q0 Q1`; every point of the exact offset past the cut is within the chord's bound `b`
+        // of `lerp(Q0, Q1, lambda)` with `lambda >= lambda_c` (the contour's chord fraction at
+        // the cut), and the segments `[lerp(Q0, Q1, lambda_c), Q1]` and `[x, Q1]` are at most
+        // `|x - lerp(Q0, Q1, lambda_c)|` apart point for point; the path adds the end's own
+        // offset `e`. So `b + that + |e|` bounds the cut piece, proven where `b` was.
+        let (bound, proven) = if (from.is_some() || to.is_some()) && self.ctx.flat.is_none() {
+            let (c0, c1) = (seg.start.c, seg.end.c);
+            let (q0, q1) = (seg.start.pos, seg.end.pos);
+            let chord = c1 - c0;
+            let along = |t: f64| {
+                let l = chord.norm_squared();
+                if l > 0.0 {
+                    ((self.ctx.input.curve.point(t) - c0).dot(&chord) / l).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            };
+            let off = |x: &Node, t: f64| (x.pos - (q0 + (q1 - q0) * along(t))).norm();
+            let mut b = seg.bound;
+            if let Some((x, _)) = &from {
+                b += off(x, piece.t0) + piece.e0.norm();
+            }
+            if let Some((x, _)) = &to {
+                b += off(x, piece.t1) + piece.e1.norm();
+            }
+            if seg.proven && b <= self.ctx.tol {
+                (b, true)
+            } else {
+                let start = from.map_or(seg.start, |(x, _)| x);
+                let ends = piece.e0.norm().max(piece.e1.norm());
+                (
+                    (self.ctx.measure(&start, &end, &piece) + ends).max(seg.bound),
+                    false,
+                )
+            }
+        } else {
+            (seg.bound, seg.proven)
+        };
+        self.bound = self.bound.max(bound);
+        self.proven &= proven;
         self.pieces.push(Piece::Curve(piece));
         self.nodes.push(end);
     }

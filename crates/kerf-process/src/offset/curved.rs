@@ -37,13 +37,10 @@ pub(super) enum Proof {
     /// Not proven here (the contour turns back along its chord, the offset direction or the
     /// slide degenerates, a rough knot lies too near an end): a shorter chord may be.
     Fails,
-    /// Not provable by halving: the beam runs within 80 degrees of the surface's normal at
-    /// neither end, so the exact offset does not slide there and the slid direction this
-    /// proof bounds is not the offset's.
-    Never,
 }
 
 /// The chord's data the proof needs.
+#[derive(Clone, Copy)]
 pub(super) struct Chord<'a> {
     pub(super) curve: &'a NurbsCurve,
     pub(super) t0: f64,
@@ -68,7 +65,17 @@ pub(super) struct Chord<'a> {
 pub(super) fn bound(ch: &Chord<'_>) -> Proof {
     let (t0, t1) = (ch.t0, ch.t1);
     if ch.slide && !slides(&ch.a0, &ch.m0) && !slides(&ch.a1, &ch.m1) {
-        return Proof::Never;
+        // A wall: the beam more than 80 degrees from the normal at both ends. Where that holds
+        // all along the chord the offset slides nowhere on it and is bounded as unslid; else
+        // a shorter chord may tell.
+        return if slides_nowhere(ch) {
+            bound(&Chord {
+                slide: false,
+                ..*ch
+            })
+        } else {
+            Proof::Fails
+        };
     }
     if let Some(k) = rough_knot(ch.curve, t0, t1) {
         // A knot within rounding of an end leaves a sub-chord too short to split further.
@@ -115,6 +122,20 @@ pub(super) fn bound(ch: &Chord<'_>) -> Proof {
 /// above 0.17, as the offset's own slide decides).
 fn slides(a: &Vector3<f64>, m: &Vector3<f64>) -> bool {
     exceeds(a.dot(m), 0.17)
+}
+
+/// Whether the normalized `a . m` stays at or below 0.17 all along the chord (so the offset
+/// slides nowhere): `a~ . m~` is a quadratic in the fraction, at most its largest Bezier
+/// coefficient, and a lerp of two unit vectors is at least `cos(angle / 2) = |x + y| / 2`
+/// long.
+fn slides_nowhere(ch: &Chord<'_>) -> bool {
+    let (a0, a1, m0, m1) = (&ch.a0, &ch.a1, &ch.m0, &ch.m1);
+    let h_max = a0
+        .dot(m0)
+        .max(0.5 * (a0.dot(m1) + a1.dot(m0)))
+        .max(a1.dot(m1));
+    let shortest = 0.5 * (a0 + a1).norm() * 0.5 * (m0 + m1).norm();
+    h_max <= 0.0 || (shortest > 0.0 && h_max <= 0.17 * shortest * (1.0 - 1e-12))
 }
 
 /// The first knot strictly inside `(t0, t1)` at which the curve is at most C1 (multiplicity at
@@ -386,11 +407,11 @@ mod tests {
         );
     }
 
-    /// Where the beam is not within 80 degrees of the surface's normal at either end (a
-    /// wall), the exact offset does not slide: the slid direction's proof does not apply and
-    /// halving cannot help, so it says so at once.
+    /// Where the beam is more than 80 degrees from the surface's normal all along a chord (a
+    /// wall), the exact offset does not slide: the chord is bounded as unslid. Where the
+    /// normal turns toward the axis inside the chord (it slides there), no proof.
     #[test]
-    fn a_beam_along_a_wall_is_never_proven_by_the_slide() {
+    fn a_beam_along_a_wall_is_proven_without_the_slide() {
         let c = setup(false);
         let ch = Chord {
             curve: &c,
@@ -406,12 +427,25 @@ mod tests {
             r: 0.1,
             limit: 10.0,
         };
-        assert_eq!(bound(&ch), Proof::Never);
         let no_slide = Chord { slide: false, ..ch };
         assert!(
             matches!(bound(&no_slide), Proof::Bound(_)),
             "without the slide it is proven"
         );
+        assert_eq!(
+            bound(&ch),
+            bound(&no_slide),
+            "the wall is bounded as unslid"
+        );
+        // The axis and the normal trade places: a . m is 0 at both ends and 1 in the middle.
+        let swap = Chord {
+            a0: Vector3::z(),
+            m0: Vector3::x(),
+            a1: Vector3::x(),
+            m1: Vector3::z(),
+            ..ch
+        };
+        assert_eq!(bound(&swap), Proof::Fails, "it slides inside: not proven");
     }
 
     /// A knot where the curve is only C1 inside a chord is where it is split.

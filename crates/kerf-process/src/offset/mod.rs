@@ -674,8 +674,6 @@ impl<'a> Context<'a> {
         let within = measured <= room;
         Ok(match proof {
             curved::Proof::SplitAt(k) if may_split || !within => Verdict::SplitAt(k),
-            // Halving cannot make a proof where the offset does not slide.
-            curved::Proof::Never => Verdict::Measured(measured),
             _ if may_split && within => Verdict::ProofSplit,
             _ => Verdict::Measured(measured),
         })

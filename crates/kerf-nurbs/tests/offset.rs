@@ -24,9 +24,11 @@ fn a_cylinders_offsets_are_the_cylinders_of_the_radius_plus_and_minus_the_distan
             "bound {} within the tolerance",
             o.position_bound_mm
         );
+        // The rational circle's `W n` is a polynomial: the interpolation is exact and the
+        // bound is the rounding allowance, never zero.
         assert!(
             o.position_bound_mm > 0.0,
-            "a curved offset is not claimed exact"
+            "the bound keeps its rounding allowance"
         );
         let mut worst: f64 = 0.0;
         let mut worst_normal: f64 = 0.0;

@@ -233,7 +233,8 @@ pub struct CompensationPath {
     /// The largest chord error of the offset against the exact offset curve, mm.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_chord_error_mm: Option<f64>,
-    /// Whether that error is proven (flat contours at a fixed axis) or measured.
+    /// Whether that error is proven for every chord (on flat contours by the tangents' cone,
+    /// elsewhere by the offset direction's second-derivative bound) or measured somewhere.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub proven: Option<bool>,
     /// Outside corners swung round on an arc.

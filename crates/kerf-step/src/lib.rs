@@ -9,7 +9,8 @@
 //!   to their midpoint (the largest move is reported), larger gaps open the contour (reported).
 //!   With [`ImportOptions::edges`], the boundary loops of the faces are the contours instead.
 //! - **Surfaces**: every face a contour lies on becomes a NURBS surface (exact for B-spline
-//!   surfaces, planes, cylinders, cones, spheres, tori, extrusions and revolutions), cut to the
+//!   surfaces, planes, cylinders, cones, spheres, tori, extrusions and revolutions and their
+//!   exact offsets; an offset of a free-form surface approximated with a proven bound), cut to the
 //!   face's parameter range and oriented so that `Su x Sv` is the face's outward normal. Faces
 //!   are found by projection: dense samples of the contour within
 //!   [`ImportOptions::face_tolerance_mm`] of the face. A contour over several faces names them all

@@ -1,6 +1,6 @@
 //! The offset of a NURBS surface, `O = S + d n` (`n` the unit normal along `Su x Sv`), as a
 //! NURBS surface with a proven bound on its distance from the exact offset and on the angle
-//! between their normals (docs/step.md, "Offset surfaces").
+//! between their normals (docs/step.md, "Offsets of free-form surfaces").
 //!
 //! The offset of a free-form surface is not rational, so it is approximated: on each cell of a
 //! grid over the domain (the knot spans, bisected where needed) the approximation is
@@ -51,7 +51,8 @@ impl SurfaceOffsetOptions {
         }
     }
 
-    /// Sets [`max_work`](Self::max_work).
+    /// Sets [`max_work`](Self::max_work): the most work, in bicubic polynomial cells, before
+    /// the offset stops with [`SurfaceOffsetError::Budget`].
     pub fn with_max_work(mut self, max_work: usize) -> Self {
         self.max_work = max_work;
         self
@@ -143,8 +144,9 @@ pub enum SurfaceOffsetError {
         /// The work spent ([`OffsetSurface::work`]).
         work: usize,
     },
-    /// The budget ran out before every cell was certified.
-    #[error("the offset by {distance_mm} mm is not certified within {tolerance_mm} mm after {cells} cells (the work budget, {work} bicubic cells): {why} near (u, v) = ({u}, {v})")]
+    /// The offset was not certified: the work budget ran out, the failing cells are too narrow
+    /// to halve, or the result is not a valid surface (`why` says which).
+    #[error("the offset by {distance_mm} mm is not certified within {tolerance_mm} mm after {cells} cells ({work} bicubic cells of work): {why} near (u, v) = ({u}, {v})")]
     Budget {
         /// The distance.
         distance_mm: f64,
@@ -222,7 +224,15 @@ const FOLDS: &str = "the offset turns inside out (the distance is beyond a radiu
 
 impl NurbsSurface {
     /// The surface offset by `distance_mm` along its unit normal `Su x Sv / |Su x Sv|`,
-    /// approximated within `options.tolerance_mm` with the bound proven (module docs).
+    /// approximated within `options.tolerance_mm` with the bound proven.
+    ///
+    /// The domain is cut into cells (the knot spans, bisected by rows and columns until every
+    /// cell is proven); on each, the surface's own rational Bezier patch `P / W` plus a
+    /// polynomial `E` that interpolates `W d n` on a uniform grid, so the result is continuous
+    /// with the surface's weights and every cell edge a knot of full multiplicity. The distance
+    /// to the exact offset and the angle between the normals are proven from Bernstein
+    /// coefficient ratios of polynomial quotients (docs/step.md, "Offsets of free-form
+    /// surfaces", has the derivation).
     ///
     /// ```
     /// use kerf_nurbs::{NurbsSurface, SurfaceOffsetOptions};
@@ -241,8 +251,10 @@ impl NurbsSurface {
     /// [`SurfaceOffsetError::Degree`] above the degree caps, [`SurfaceOffsetError::Arguments`]
     /// for a non-finite distance or tolerance, [`SurfaceOffsetError::NormalVanishes`] at a
     /// collapsed edge, [`SurfaceOffsetError::Folds`] where the offset turns inside out (the
-    /// distance beyond a radius of curvature on its side), [`SurfaceOffsetError::Budget`]
-    /// where the budget runs out (a tolerance too fine, a normal nearly vanishing).
+    /// distance beyond a radius of curvature on its side, or exactly at one),
+    /// [`SurfaceOffsetError::Crease`] where the surface's normal jumps across a cell edge (the
+    /// offset tears), [`SurfaceOffsetError::Budget`] where the budget runs out (a tolerance too
+    /// fine, a normal nearly vanishing) or no finer grid can be made.
     pub fn offset(
         &self,
         distance_mm: f64,
@@ -290,13 +302,22 @@ impl NurbsSurface {
                     let k = key(u0, u1, v0, v1);
                     if let std::collections::hash_map::Entry::Vacant(slot) = cells.entry(k) {
                         if (certified + 1).saturating_mul(cost) > options.max_work {
-                            let (why, u, v) = failed.unwrap_or_else(|| {
-                                (
-                                    "cells left to certify".into(),
-                                    0.5 * (u0 + u1),
-                                    0.5 * (v0 + v1),
-                                )
-                            });
+                            let (why, u, v) = failed.map_or_else(
+                                || {
+                                    (
+                                        "the work budget ran out with cells left to certify".into(),
+                                        0.5 * (u0 + u1),
+                                        0.5 * (v0 + v1),
+                                    )
+                                },
+                                |(why, u, v)| {
+                                    (
+                                        format!("the work budget ran out (last failure: {why})"),
+                                        u,
+                                        v,
+                                    )
+                                },
+                            );
                             return Err(SurfaceOffsetError::Budget {
                                 distance_mm,
                                 tolerance_mm: tol,
@@ -396,9 +417,8 @@ impl NurbsSurface {
         }
         // Neighbours interpolate the same values on their shared edge where the normal is
         // continuous: their edge points then agree to rounding, and the later cell's replace
-        // the earlier's (moving that cell's surface by at most the difference: a convex
-        // combination of the moved points over the weights). Where the surface has a crease
-        // the offset tears apart there, and no continuous surface approximates it.
+        // the earlier's. Where the surface has a crease the offset tears apart there, and no
+        // continuous surface approximates it.
         let seam_allowance = 1e-9 * (distance_mm.abs() + 1.0) + 1e-12 * self.size();
         if seam.0 > seam_allowance {
             return Err(SurfaceOffsetError::Crease {
@@ -409,7 +429,39 @@ impl NurbsSurface {
                 work: certified * cost,
             });
         }
-        position += seam.0;
+        if seam.0 > 0.0 {
+            // Some cells' edge rows were replaced (by rounding-level amounts): both bounds are
+            // taken again from the nets as written, so that they hold for the surface itself.
+            position = 0.0;
+            normal = 0.0;
+            for i in 0..ncu {
+                for j in 0..ncv {
+                    let cp = self.cell_polys(
+                        (us[i], us[i + 1]),
+                        (vs[j], vs[j + 1]),
+                        &spans_u,
+                        &spans_v,
+                        distance_mm,
+                    );
+                    let cell_net: Vec<Vector4<f64>> = (0..=pe)
+                        .flat_map(|a| (0..=qe).map(move |b| (a, b)))
+                        .map(|(a, b)| net[(i * pe + a) * nv + j * qe + b])
+                        .collect();
+                    let (b, theta) = written_bounds(&cp, &cell_net, distance_mm, self.size())
+                        .map_err(|why| SurfaceOffsetError::Budget {
+                            distance_mm,
+                            tolerance_mm: tol,
+                            cells: certified,
+                            work: certified * cost,
+                            why,
+                            u: 0.5 * (us[i] + us[i + 1]),
+                            v: 0.5 * (vs[j] + vs[j + 1]),
+                        })?;
+                    position = position.max(b);
+                    normal = normal.max(theta);
+                }
+            }
+        }
         let knots = |b: &[f64], deg: usize| {
             let mut k = vec![b[0]; deg + 1];
             for x in &b[1..b.len() - 1] {
@@ -616,7 +668,35 @@ fn offset_cell(cp: &CellPolys, d: f64, size: f64) -> Cell {
     Cell { bound, net }
 }
 
-/// The proven bound of `|E / W - d n|` on the cell (module docs).
+/// Both bounds of a cell from its net as written (`A`'s homogeneous points, row-major over
+/// u): `E` is the net less the surface's own, translated alike.
+fn written_bounds(
+    cp: &CellPolys,
+    net: &[Vector4<f64>],
+    d: f64,
+    size: f64,
+) -> Result<(f64, f64), String> {
+    let (pe, qe) = cp.deg;
+    let w = weight(cp);
+    let e: Poly3 = [0, 1, 2].map(|c| {
+        Poly::new(
+            pe,
+            qe,
+            net.iter()
+                .zip(cp.p[c].coefficients())
+                .map(|(h, p)| h[c] - cp.corner[c] * h.w - p)
+                .collect(),
+        )
+    });
+    let b = position_bound(cp, &e, &w, d, size)?;
+    let theta = normal_angle(cp, net).map_err(|u| match u {
+        Unproven::Refine(why) => why,
+        Unproven::Folds | Unproven::Vanishes => "the offset turns inside out".to_string(),
+    })?;
+    Ok((b, theta))
+}
+
+/// The proven bound of `|E / W - d n|` on the cell (the module's derivation).
 fn position_bound(cp: &CellPolys, e: &Poly3, w: &Poly, d: f64, size: f64) -> Result<f64, String> {
     let mm = dot(&cp.m, &cp.m);
     let den = w.mul(w).mul(&mm);

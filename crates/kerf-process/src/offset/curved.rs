@@ -1,5 +1,6 @@
 //! The offset's chord error proven where the contour is curved in space or the tool axis turns
-//! (docs/process.md, "Kerf compensation", "The certificate on curved surfaces").
+//! (docs/process.md, "Kerf compensation", "The certificate": "On curved surfaces and with
+//! turning axes").
 //!
 //! On a chord `[t0, t1]` the exact offset is `Q(t) = C(t) + r W(t)`, with `W` the unit offset
 //! direction `s normalize(a x C')` slid along the beam onto the tangent plane

@@ -393,7 +393,8 @@ pub struct Face {
 }
 
 /// How many point projections one bicubic cell of an offset's approximation is charged as
-/// (a cell took 0.2 ms, a cold projection onto a bicubic surface 0.034 ms, when measured).
+/// (about the time of 6-8 cold projections onto the same surface: docs/performance.md, the
+/// `offset_cost` example of kerf-nurbs).
 pub const PROJECTIONS_PER_OFFSET_CELL: usize = 6;
 
 impl Face {

@@ -375,6 +375,8 @@ struct Context<'a> {
     tol: f64,
     kerf: f64,
     max_points: usize,
+    /// The contour's size (its control points' box diagonal), for the rounding allowances.
+    size: f64,
     /// The flat case: the fixed axis, the surface normal, the contour projected along the axis,
     /// the cosine between axis and normal.
     flat: Option<Flat>,
@@ -397,6 +399,7 @@ impl<'a> Context<'a> {
             tol: options.tolerance_mm,
             kerf: options.kerf_width_mm,
             max_points: options.max_points,
+            size: input.curve.size(),
             flat: flat(input),
         }
     }
@@ -631,7 +634,7 @@ impl<'a> Context<'a> {
                 8.0 * f64::EPSILON * (start.pos.coords.amax() + end.pos.coords.amax() + self.r);
             // The translation and subdivision of the pieces round at the coordinates' size,
             // and the contour may leave the plane by the 1e-9 the flat test allows.
-            let size = self.input.curve.size();
+            let size = self.size;
             let coords = flat.origin.coords.amax() + start.c.coords.amax() + end.c.coords.amax();
             let rounding = 64.0 * f64::EPSILON * (coords + size) + 2e-9 * size.max(1.0);
             let b = (e + term) / flat.cos + ends + rounding;
@@ -662,6 +665,7 @@ impl<'a> Context<'a> {
             m1: piece.m1,
             slide: piece.slide,
             r: self.r,
+            size: self.size,
             limit: room,
         });
         if let curved::Proof::Bound(b) = proof {

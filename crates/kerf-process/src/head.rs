@@ -23,14 +23,15 @@
 //! split along its longest extent; a cell centre inside the head closer than the clearance is a
 //! witness that the head comes too close there.
 //!
-//! **Between poses.** From pose `P = (p, a)` to `Q = (q, b)`, every head point moves by at
-//! most `D = |p - q| + sqrt(H^2 + r_max^2) angle(a, b)` (`H` the head's top above the tip,
-//! `r_max` its largest radius): the head at `Q` lies within `D` of the head at `P`. The poses
-//! are subdivided (tip linear, axis along the great circle) until consecutive samples are
-//! within [`SAMPLE_STEP_MM`]; a stretch of samples is checked at its middle sample with the
-//! clearance plus the largest `D` from it (plus the machine's tolerance budget for its path's
-//! deviation from the chords), and split in two where that does not clear, down to single
-//! samples. `docs/process.md` ("The head") has the derivation.
+//! **Between poses.** From pose `P = (p, a)` to `Q = (q, b)`, a head point `rho` from the
+//! cutting point moves by at most `|p - q| + rho angle(a, b)`, and the whole head by at most
+//! `D = |p - q| + sqrt(H^2 + r_max^2) angle(a, b)` (`H` the head's top above the tip, `r_max`
+//! its largest radius). The poses are subdivided (tip linear, axis along the great circle)
+//! until consecutive samples are within [`SAMPLE_STEP_MM`]; a stretch of samples is checked at
+//! its middle sample, each cell with the clearance plus its own motion from it (its farthest
+//! point from the cutting point; never more than the largest `D`; plus the machine's tolerance
+//! budget for its path's deviation from the chords), and split in two where that does not
+//! clear, down to single samples. `docs/process.md` ("The head") has the derivation.
 
 use kerf_kinematics::{Head, Pose};
 use nalgebra::{Point3, Unit, UnitQuaternion, Vector3};
@@ -325,10 +326,50 @@ impl Cell {
     }
 }
 
+/// How far the head may move away from a sample, mm, for a head point `rho` mm from the
+/// cutting point (the pivot of the poses' rotations): `lin` of the tip's travel, the path's
+/// deviation and half steps, plus `ang` radians of the tool axis' turn (each point moves at
+/// most `rho` times that), and never more than `cap`, the whole head's figure (`lin + ang
+/// reach`, taken as the sum of the maxima, can exceed the maximum of the sums).
+#[derive(Debug, Clone, Copy)]
+struct Slack {
+    lin: f64,
+    ang: f64,
+    cap: f64,
+}
+
+impl Slack {
+    /// The motion of a head point `rho` mm from the cutting point.
+    fn at(&self, rho: f64) -> f64 {
+        self.cap.min(self.lin + self.ang * rho)
+    }
+
+    /// The larger of the two, part by part.
+    fn max(self, o: Slack) -> Slack {
+        Slack {
+            lin: self.lin.max(o.lin),
+            ang: self.ang.max(o.ang),
+            cap: self.cap.max(o.cap),
+        }
+    }
+
+    /// Both motions in turn.
+    fn plus(self, o: Slack) -> Slack {
+        Slack {
+            lin: self.lin + o.lin,
+            ang: self.ang + o.ang,
+            cap: self.cap + o.cap,
+        }
+    }
+}
+
+/// The smallest cell a stretch's check refines to before it splits the stretch instead, mm.
+const STRETCH_CELL_MM: f64 = 1.0;
+
 /// What one head placement showed.
 #[derive(Debug, Clone, Copy)]
 enum Verdict {
-    /// Every cell clears the requirement; the least `d - R` found.
+    /// Every cell clears the requirement; the least `d - R` found, less each cell's motion.
     Clear(f64),
     /// Not shown clear: for a stretch, the bound of the first cell that did not clear; for a
     /// single sample, the distance of a head point (a cell centre) closer than the clearance;
@@ -375,9 +416,10 @@ fn initial_cells(head: &Head, zone: f64) -> Vec<Cell> {
     cells
 }
 
-/// The head at `(tip, axis)` against `obstacles`, each cell required to clear `need` mm.
-/// With `first_only` the first cell whose centre does not clear ends the search (a stretch is
-/// then split); without it, cells are refined down to [`CLOSE_CELL_MM`], and a cell centre
+/// The head at `(tip, axis)` against `obstacles`, each cell required to clear the clearance
+/// plus its own motion (`slack` at its farthest point from the cutting point `tip`). With
+/// `first_only` the first cell that cannot clear (its centre within that, or a cell down to
+/// [`STRETCH_CELL_MM`] that does not) ends the search (a stretch is then split); without it, cells are refined down to [`CLOSE_CELL_MM`], and a cell centre
 /// inside the head closer than `clearance` is a witness that the head comes that close.
 #[allow(clippy::too_many_arguments)]
 fn place_head(
@@ -386,7 +428,7 @@ fn place_head(
     standoff: f64,
     tip: &Point3<f64>,
     axis: &Vector3<f64>,
-    need: f64,
+    slack: Slack,
     clearance: f64,
     first_only: bool,
     queries: &mut usize,
@@ -415,6 +457,9 @@ fn place_head(
             continue;
         }
         let r = cell.radius();
+        // The cell's motion: its farthest point from the cutting point turns the farthest.
+        let moved = slack.at((standoff + cell.h[1]).hypot(cell.rho[1]));
+        let need = clearance + moved;
         let hm = (cell.h[0] + cell.h[1]) / 2.0;
         let c = point(
             hm,
@@ -426,14 +471,16 @@ fn place_head(
         }
         *queries += 1;
         let d = obstacles.distance_below(&c, r + need);
-        if d >= r + need {
-            least = least.min(d - r);
-            continue;
-        }
-        if first_only && (d < need || r <= CLOSE_CELL_MM) {
+        // A stretch's cell that does not clear is not refined below `STRETCH_CELL_MM`:
+        // splitting the stretch is cheaper than cells that fine.
+        if first_only && (d < need || (d < r + need && r <= STRETCH_CELL_MM)) {
             // The stretch does not clear at its middle: it is split.
-            close = Some((d - r, hm, c));
+            close = Some((d - r - moved, hm, c));
             break;
+        }
+        if d >= r + need {
+            least = least.min(d - r - moved);
+            continue;
         }
         if r <= CLOSE_CELL_MM {
             // A witness: a head point (the centre, or where it lies outside its solid, the
@@ -459,7 +506,7 @@ fn place_head(
             // Within the resolution: every point of the cell is within `r` of the centre and
             // `2 r` of `w`, so at least `max(d - r, dw - 2 r)` from the part; with no witness
             // `dw >= clearance`, so the bound is at least the clearance less `2 r`.
-            least = least.min((d - r).max(dw - 2.0 * r));
+            least = least.min((d - r).max(dw - 2.0 * r) - moved);
             continue;
         }
         let [a, b] = cell.split();
@@ -602,24 +649,43 @@ pub fn check_cut_along(
     if samples.is_empty() || obstacles.is_empty() {
         return out;
     }
-    let disp = |a: &Sample, b: &Sample| (a.tip - b.tip).norm() + reach * a.axis.angle(&b.axis);
-    // How far the head may leave the great-circle motion on each step between poses.
+    // The motion from one sample to another: the tip's travel and the axis' turn (a head point
+    // `rho` from the cutting point moves at most the travel plus `rho` times the turn).
+    let disp = |a: &Sample, b: &Sample| {
+        let (lin, ang) = ((a.tip - b.tip).norm(), a.axis.angle(&b.axis));
+        Slack {
+            lin,
+            ang,
+            cap: lin + reach * ang,
+        }
+    };
+    let turn = |ang: f64| Slack {
+        lin: 0.0,
+        ang,
+        cap: reach * ang,
+    };
+    // How far the tool axis may leave the great-circle motion on each step between poses.
     let departure: Vec<f64> = (0..poses.len().saturating_sub(1))
         .map(|k| {
             let curvature = axis_curvature.get(k).copied().unwrap_or(0.0);
             if curvature == 0.0 {
                 return 0.0;
             }
-            reach * rotary_departure_rad(curvature, poses[k].axis.angle(&poses[k + 1].axis))
+            rotary_departure_rad(curvature, poses[k].axis.angle(&poses[k + 1].axis))
         })
         .collect();
     // A fitted block's axis within the fit's orientation tolerance of the poses' own: every
     // head point that much farther, on every sample.
-    let axis_slack = reach * opts.axis_deviation_deg.to_radians();
+    let axis_slack = turn(opts.axis_deviation_deg.to_radians());
     let step_departure = |k: usize| departure.get(k).copied().unwrap_or(0.0);
+    let none = Slack {
+        lin: 0.0,
+        ang: 0.0,
+        cap: 0.0,
+    };
     // Half the larger step from each sample to its neighbours, and the rotary departure of
     // the steps it lies on: the motion it stands for.
-    let half_step: Vec<f64> = (0..samples.len())
+    let half_step: Vec<Slack> = (0..samples.len())
         .map(|k| {
             let own = &samples[k];
             let leave = if own.exact {
@@ -633,21 +699,33 @@ pub fn check_cut_along(
             [k.checked_sub(1), (k + 1 < samples.len()).then_some(k + 1)]
                 .into_iter()
                 .flatten()
-                .map(|n| disp(&samples[n], &samples[k]) / 2.0)
-                .fold(0.0, f64::max)
-                + leave
-                + axis_slack
+                .map(|n| {
+                    let d = disp(&samples[n], &samples[k]);
+                    Slack {
+                        lin: d.lin / 2.0,
+                        ang: d.ang / 2.0,
+                        cap: d.cap / 2.0,
+                    }
+                })
+                .fold(none, Slack::max)
+                .plus(turn(leave))
+                .plus(axis_slack)
         })
         .collect();
-    // The head at sample `k`, required to clear the clearance plus `slack`.
-    let place = |k: usize, slack: f64, first_only: bool, queries: &mut usize| {
+    let deviation = Slack {
+        lin: opts.path_deviation_mm,
+        ang: 0.0,
+        cap: opts.path_deviation_mm,
+    };
+    // The head at sample `k`, required to clear the clearance plus its motion `slack`.
+    let place = |k: usize, slack: Slack, first_only: bool, queries: &mut usize| {
         place_head(
             obstacles,
             &cells0,
             opts.standoff_mm,
             &samples[k].tip,
             &samples[k].axis,
-            opts.clearance_mm + slack,
+            slack,
             opts.clearance_mm,
             first_only,
             queries,
@@ -676,13 +754,11 @@ pub fn check_cut_along(
         }
         // Each sample stands for the motion halfway to its neighbours.
         let spread = (i..=j)
-            .map(|k| disp(&samples[k], &samples[m]) + half_step[k])
-            .fold(0.0, f64::max);
-        let slack = spread + opts.path_deviation_mm;
-        let verdict = place(m, slack, i != j, &mut out.queries);
+            .map(|k| disp(&samples[k], &samples[m]).plus(half_step[k]))
+            .fold(none, Slack::max);
+        let verdict = place(m, spread.plus(deviation), i != j, &mut out.queries);
         match verdict {
-            Verdict::Clear(least) => {
-                let bound = least - slack;
+            Verdict::Clear(bound) => {
                 if bound < out.min_distance_mm {
                     out.min_distance_mm = bound;
                     out.at_pose = samples[m].pose;
@@ -711,12 +787,7 @@ pub fn check_cut_along(
                             break;
                         }
                         let k = k as usize;
-                        let probe = place(
-                            k,
-                            opts.path_deviation_mm + half_step[k],
-                            false,
-                            &mut out.queries,
-                        );
+                        let probe = place(k, half_step[k].plus(deviation), false, &mut out.queries);
                         let (bound, height, point) = match probe {
                             Verdict::Close {
                                 bound,

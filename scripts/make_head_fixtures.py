@@ -14,7 +14,10 @@ degree 1, circles and the bend as rational quadratics (weights 1/sqrt 2 at the c
   mm along the axis from the cutting point, above the body's bottom face (26 mm) and 22.7 mm
   from the axis (inside its 45 mm radius); leaning 7.5-10 degrees more brings the edge below
   the bottom face by the clearance (24.2 mm along at 22.5 degrees), while the other side of the
-  body's bottom rim stays 5 mm above the floor."""
+  body's bottom rim stays 5 mm above the floor.
+- fixtures/head_slot.json: a hole of radius 3 at the bottom of a slot 10 mm wide with walls 30 mm
+  high: the nozzle cone (14 mm across at its top, 25 mm above its tip) is wider than the slot,
+  so no tilt clears it: refused by name."""
 import json
 import math
 from pathlib import Path
@@ -99,5 +102,18 @@ write("head_bend.json", {
         plane("bend-floor", [-150.0, -200.0, 0.0], [150.0, 0.0, 0.0], [0.0, 400.0, 0.0]),
         bend,
         plane("bend-flange", [R, -200.0, R], [0.0, 0.0, H], [0.0, 400.0, 0.0]),
+    ],
+})
+
+write("head_slot.json", {
+    "format": "kerf.curves/1",
+    "units": "mm",
+    "curves": [
+        {"id": "hole-in-slot", **circle(0.0, 0.0, 3.0), "surface": "slot-floor", "scrap": "left"},
+    ],
+    "surfaces": [
+        plane("slot-floor", [-5.0, -100.0, 0.0], [10.0, 0.0, 0.0], [0.0, 200.0, 0.0]),
+        plane("slot-left", [-5.0, -100.0, 0.0], [0.0, 0.0, 30.0], [0.0, 200.0, 0.0]),
+        plane("slot-right", [5.0, -100.0, 0.0], [0.0, 200.0, 0.0], [0.0, 0.0, 30.0]),
     ],
 })

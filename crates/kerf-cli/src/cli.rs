@@ -576,20 +576,22 @@ pub(crate) struct RunArgs {
     #[arg(long)]
     pub(crate) kerf_in_control: bool,
 
-    /// Check the head against the part along every cut (contour, lead-in, lead-out): the
-    /// machine file's `head` (else a 3 mm nozzle cone 25 mm long on a 90 mm body) standing at
-    /// its `process.standoff_mm` must keep this distance, mm, from the part's surfaces, proven
-    /// over the poses and the motion between them; a cut that comes closer is refused naming
-    /// the stretch and the surface. The checked traverses (a --clearance above 0) keep it too:
-    /// a route the head does not clear is not taken, and a traverse on which the head clears no
-    /// route is refused by name. The report's `head`
-    /// gives the figures per path, `traverses` those of the traverses.
-    #[arg(long, value_name = "MM", value_parser = crate::guard::clearance_mm)]
-    pub(crate) cut_clearance: Option<f64>,
+    /// The distance the head keeps from the part along every cut (contour, lead-in,
+    /// lead-out), mm, or `off` [default: 1]: the machine file's `head` (else a 3 mm nozzle
+    /// cone 25 mm long on a 90 mm body) standing at its `process.standoff_mm` must keep it from
+    /// the part's surfaces, proven over the poses and the motion between them; a cut that
+    /// comes closer is tilted within --tilt-tolerance to clear, else refused naming the
+    /// stretch and the surface. The checked traverses (a --clearance above 0) keep it too: a
+    /// route the head does not clear is not taken, and a traverse on which the head clears no
+    /// route is refused by name. The report's `head` gives the figures per path, `traverses`
+    /// those of the traverses. `off`: the head is not checked (the traverses keep --clearance
+    /// with the tip and the nozzle line only).
+    #[arg(long, value_name = "MM|off", value_parser = crate::guard::cut_clearance)]
+    pub(crate) cut_clearance: Option<crate::guard::CutClearance>,
 
-    /// With --cut-clearance: report cuts and traverses where the head comes closer as
-    /// warnings instead of refusing the run.
-    #[arg(long, requires = "cut_clearance")]
+    /// Report cuts and traverses where the head comes closer than --cut-clearance as warnings
+    /// instead of refusing the run.
+    #[arg(long)]
     pub(crate) accept_head_collisions: bool,
 
     /// Micro-joints: leave LENGTH mm of each part's outline (and of each cut-out at least

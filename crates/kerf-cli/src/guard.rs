@@ -119,6 +119,20 @@ pub(crate) fn clearance_mm(s: &str) -> Result<f64, String> {
     within(s, CLEARANCE_MM)
 }
 
+/// `--cut-clearance`: `off` (the head is not checked) or a clearance in mm within the job's
+/// range ([`ranges::CLEARANCE_MM`], above 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CutClearance(pub(crate) Option<f64>);
+
+/// Parses `--cut-clearance`: `off`, or mm within [`ranges::CLEARANCE_MM`].
+pub(crate) fn cut_clearance(s: &str) -> Result<CutClearance, String> {
+    if s.trim().eq_ignore_ascii_case("off") {
+        Ok(CutClearance(None))
+    } else {
+        within(s, ranges::CLEARANCE_MM).map(|v| CutClearance(Some(v)))
+    }
+}
+
 /// The widest wall cut along itself, mm ([`ranges::WALL_MM`]).
 pub(crate) fn wall_mm(s: &str) -> Result<f64, String> {
     within(s, ranges::WALL_MM)

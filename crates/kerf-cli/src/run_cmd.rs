@@ -54,7 +54,10 @@ fn job_options(args: &RunArgs) -> JobOptions {
         .with_wall_axis_max_mm(args.max_wall)
         .with_kerf_width_mm(args.kerf_width)
         .with_kerf_in_control(args.kerf_in_control)
-        .with_cut_clearance_mm(args.cut_clearance)
+        .with_cut_clearance_mm(
+            args.cut_clearance
+                .map_or(kerf_pipeline::DEFAULT_CUT_CLEARANCE_MM, |c| c.0),
+        )
         .with_accept_head_collisions(args.accept_head_collisions)
         .with_micro_joints(args.micro_joints)
 }
@@ -102,6 +105,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
                 .join(t)
         })
     });
+    if args.accept_head_collisions && args.cut_clearance.is_some_and(|c| c.0.is_none()) {
+        return Err(CliError::Usage(
+            "--accept-head-collisions has nothing to accept with --cut-clearance off".into(),
+        ));
+    }
     if let (Some(_), None) = (&args.material, &table_file) {
         return Err(CliError::Usage(
             "--material needs a technology table: --technology FILE, or the machine file's process.technology".into(),

@@ -173,6 +173,10 @@ fn run_cuts_the_boundary_loops_of_chosen_faces() {
         .arg(fixture("step/faces.step"))
         .args(["--edges", "--faces", "183,#412,529,754,953", "-m"])
         .arg(fixture("machines/ac_head.json"))
+        // Along the B-spline face's loop the nozzle, 1.4 mm above its tip, comes within
+        // 0.95 mm of that face's surface (refused by default): the head check has its own
+        // tests.
+        .args(["--cut-clearance", "off"])
         .arg("--out")
         .arg(&out));
     assert_eq!(code, 0, "{err}");
@@ -226,16 +230,48 @@ fn a_real_sheet_metal_part_is_cut_once_per_feature_and_every_loop_on_request() {
     // --every-face-loop needs --edges.
     let (code, _, err) = run(kerf().arg("import").arg(&part).arg("--every-face-loop"));
     assert_eq!(code, 2, "{err}");
-    // The whole run: one cut per contour of the import, every one of them planned.
-    let out_dir = dir.path().join("run");
+    // By default the head is checked along every cut: the outline's first piece crosses the
+    // inner radius of a 3 mm bend, where the nozzle's cone 1.4 mm above its tip comes within
+    // 0.9 mm of the sheet (the end wall, face #117), and no tilt clears it: refused, naming
+    // the piece, the surface and the clearance, and nothing is written.
+    let refused = dir.path().join("refused");
     let (code, _, err) = run(kerf()
         .arg("run")
         .arg(&part)
         .args(["--edges", "--place", "auto", "-m"])
         .arg(fixture("machines/gantry_ac.json"))
         .arg("--out")
+        .arg(&refused));
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("path \"feature 1 face #239 piece 1\": the head comes too close to the part")
+            && err.contains("surface face #117 (clearance 1 mm)")
+            && err.contains("no tilt up to 60 deg"),
+        "{err}"
+    );
+    assert!(
+        !refused.exists(),
+        "a refused run wrote {}",
+        refused.display()
+    );
+    // The whole run, the close stretches accepted as warnings: one cut per contour of the
+    // import, every one of them planned.
+    let out_dir = dir.path().join("run");
+    let (code, _, err) = run(kerf()
+        .arg("run")
+        .arg(&part)
+        .args([
+            "--edges",
+            "--place",
+            "auto",
+            "--accept-head-collisions",
+            "-m",
+        ])
+        .arg(fixture("machines/gantry_ac.json"))
+        .arg("--out")
         .arg(&out_dir));
     assert_eq!(code, 0, "{err}");
+    assert!(err.contains("the head comes too close"), "{err}");
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("report.json")).unwrap())
             .unwrap();

@@ -16,6 +16,10 @@ use crate::report::{HeadPath, HeadReport, HeadStretch, HeadTilt};
 /// edges meet within hundredths of a millimetre).
 pub(crate) const PART_JOIN_TOLERANCE_MM: f64 = 0.05;
 
+/// What a refusal for the head says the user can do (the options by their library names; the
+/// command line adds its flags).
+pub(crate) const WAYS_OUT: &str = " (accept_head_collisions cuts it with a warning; cut_clearance_mm sets another clearance, or none to leave the head unchecked)";
+
 /// Rounds of tilting and checking again a path may take.
 const MAX_ROUNDS: usize = 4;
 
@@ -311,7 +315,10 @@ pub(crate) fn check_and_clear(
             out.warnings
                 .push(format!("{e} (accepted: accept_head_collisions)"));
         } else if out.refusal.is_none() {
-            out.refusal = Some(e);
+            out.refusal = Some(kerf_process::ProcessError::HeadTooClose {
+                id: solved[k].id.clone(),
+                reason: format!("{}{WAYS_OUT}", reasons.join("; ")),
+            });
         }
     }
     out
@@ -589,7 +596,7 @@ pub(crate) fn head_report(
             standoff_mm: None,
             tip_zone_mm: None,
             paths: None,
-            note: "cuts not checked against the head (cut_clearance_mm checks them)".into(),
+            note: "cuts not checked against the head (the head check is off: cut_clearance_mm None, `--cut-clearance off`)".into(),
         };
     };
     HeadReport {

@@ -139,7 +139,8 @@ pub struct JobOptions {
     /// [`kerf_kinematics::Head::laser_default`]) must keep from the part's surfaces along
     /// every cut (contour, lead-in, lead-out), mm ([`kerf_process::check_cut`]), and along
     /// every traverse ([`kerf_process::TraverseHead`]: a route it does not clear is not
-    /// taken). `None` (the default for now): neither is checked against the head.
+    /// taken). Default [`DEFAULT_CUT_CLEARANCE_MM`]; `None`: neither is checked against the
+    /// head (the traverses against the tip and the nozzle line only).
     pub cut_clearance_mm: Option<f64>,
     /// With [`JobOptions::cut_clearance_mm`], cuts and traverses where the head comes closer
     /// are warnings instead of a refused run. Default false.
@@ -165,6 +166,13 @@ pub struct JobOptions {
 /// rounded (`docs/kinematics.md`, "Tilt tolerance").
 pub const DEFAULT_TILT_TOLERANCE_DEG: f64 = 0.0;
 
+/// The default of [`JobOptions::cut_clearance_mm`]: the head keeps 1 mm from the part along
+/// every cut and traverse, a margin for the part's deviation from its model (a bent part's
+/// springback, its fixture). The nozzle tip itself stands `process.standoff_mm` over the
+/// sheet, and the head below the tip zone is left out (docs/process.md, "The head along the
+/// cuts").
+pub const DEFAULT_CUT_CLEARANCE_MM: Option<f64> = Some(1.0);
+
 /// The default of [`JobOptions::max_total_points`]: one million cutting points, about 3 GB
 /// through every stage of a run (a sheet-metal part with hundreds of holes at 0.01 mm needs
 /// tens of thousands).
@@ -188,7 +196,7 @@ impl Default for JobOptions {
             wall_axis_max_mm: 4.0,
             kerf_width_mm: None,
             kerf_in_control: false,
-            cut_clearance_mm: None,
+            cut_clearance_mm: DEFAULT_CUT_CLEARANCE_MM,
             accept_head_collisions: false,
             micro_joints: None,
             technology: None,

@@ -60,8 +60,8 @@ pub use discretize::{
 };
 pub use error::{Error, Result};
 pub use job::{
-    is_iges, Job, JobOptions, MissingSurface, OrientOptions, DEFAULT_MAX_TOTAL_POINTS_RUN,
-    DEFAULT_TILT_TOLERANCE_DEG,
+    is_iges, Job, JobOptions, MissingSurface, OrientOptions, DEFAULT_CUT_CLEARANCE_MM,
+    DEFAULT_MAX_TOTAL_POINTS_RUN, DEFAULT_TILT_TOLERANCE_DEG,
 };
 pub use motion::{fit_options, plan_program, MotionInput, MotionOptions, Program};
 pub use output::{csv_names, program_names, Output, SetupProgram, OUTPUTS};

@@ -181,20 +181,25 @@ pub(crate) fn route_setup(
         if let Some(close) = &r.head_too_close {
             // The tip and the nozzle line clear, the head on no route: refused, or taken with
             // a warning where head collisions are accepted.
-            let e = kerf_process::ProcessError::TraverseHeadTooClose {
-                after: after.clone(),
-                before: before.clone(),
-                reason: format!(
-                    "on every route whose tip and nozzle keep the traverse clearance, the head comes {close} (cutting clearance {} mm; the first route it was tried on, or where it stands at a cut's end or at every retract height); the route taken is checked for its tip and nozzle line only",
-                    head.map_or(0.0, |h| h.opts.clearance_mm),
-                ),
-            };
+            let reason = format!(
+                "on every route whose tip and nozzle keep the traverse clearance, the head comes {close} (cutting clearance {} mm; the first route it was tried on, or where it stands at a cut's end or at every retract height); the route taken is checked for its tip and nozzle line only",
+                head.map_or(0.0, |h| h.opts.clearance_mm),
+            );
             if !head.is_some_and(|h| h.accept) {
                 return Err(crate::Error::Process {
                     file: s.path.map(Path::to_path_buf),
-                    source: e,
+                    source: kerf_process::ProcessError::TraverseHeadTooClose {
+                        after: after.clone(),
+                        before: before.clone(),
+                        reason: format!("{reason}{}", crate::head::WAYS_OUT),
+                    },
                 });
             }
+            let e = kerf_process::ProcessError::TraverseHeadTooClose {
+                after: after.clone(),
+                before: before.clone(),
+                reason,
+            };
             out.warnings
                 .push(format!("{e} (accepted: accept_head_collisions)"));
             tally.head_too_close += 1;

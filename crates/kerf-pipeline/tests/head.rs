@@ -508,3 +508,27 @@ fn a_traverse_the_head_clears_on_no_route_is_refused_by_name() {
         out.warnings
     );
 }
+
+/// `fixtures/head_slot.json`: a hole at the bottom of a slot 10 mm wide, narrower than the
+/// nozzle's cone (14 mm across at its top) and with walls above the body's lower face: no tilt
+/// clears it, and the run is refused by default naming the path, the whole hole, a wall of the
+/// slot and the tilt search's failure, upright and with a 10-degree tilt tolerance.
+#[test]
+fn a_hole_in_a_slot_narrower_than_the_nozzle_is_refused_by_name() {
+    let curves = kerf_format::curves::load(fixture("head_slot.json")).expect("curves");
+    let machine = Machine::read(fixture("machines/gantry_ac.json")).expect("machine");
+    for tilt in [0.0, 10.0] {
+        let path = kerf_kinematics::PathOptions::default().with_tilt_tolerance_deg(tilt);
+        let err = Job::new(curves.clone(), machine.clone())
+            .with_options(JobOptions::default().with_path(path))
+            .run()
+            .expect_err("no tilt clears the slot");
+        let msg = err.to_string();
+        assert!(
+            msg.contains("path \"hole-in-slot\": the head comes too close to the part: poses 0..")
+                && (msg.contains("surface slot-left") || msg.contains("surface slot-right"))
+                && msg.contains("no tilt up to 60 deg"),
+            "tilt tolerance {tilt}: {msg}"
+        );
+    }
+}

@@ -29,9 +29,15 @@ fn line(a: [f64; 3], b: [f64; 3]) -> NurbsCurve {
 
 #[test]
 fn a_job_from_files_gives_every_stage_and_its_toolpath_passes_the_independent_check() {
+    // `mixed`'s curves run under its tilted plane: the head meets it (refused by default; the
+    // head check has its own tests).
     let job = Job::from_files(fixture("mixed.json"), fixture("machines/ac_head.json"))
         .expect("inputs")
-        .with_options(JobOptions::default().with_tolerance_mm(0.01));
+        .with_options(
+            JobOptions::default()
+                .with_tolerance_mm(0.01)
+                .with_cut_clearance_mm(None),
+        );
     let out = job.run().expect("run");
     let n = job.curves().curves.len();
     assert_eq!(out.discretizations.len(), n, "one discretization per curve");
@@ -230,8 +236,11 @@ fn a_model_built_in_code_is_checked_as_a_file_would_be() {
 #[test]
 fn progress_reports_every_stage_and_every_curve() {
     let seen = Mutex::new(Vec::<Progress>::new());
-    let job =
-        Job::from_files(fixture("mixed.json"), fixture("machines/ac_head.json")).expect("inputs");
+    // `mixed`'s curves run under its tilted plane: the head meets it (refused by default; the
+    // head check has its own tests).
+    let job = Job::from_files(fixture("mixed.json"), fixture("machines/ac_head.json"))
+        .expect("inputs")
+        .with_options(JobOptions::default().with_cut_clearance_mm(None));
     job.run_with_progress(&|p| seen.lock().expect("lock").push(p))
         .expect("run");
     let seen = seen.into_inner().expect("lock");
@@ -494,9 +503,11 @@ fn sinumerik_arcs_and_merged_lines_stay_within_chord_plus_fit_of_the_curve() {
 fn the_retract_is_the_jobs_raised_to_what_the_traverse_check_needs() {
     let run = |retract_mm: f64, clearance_mm: f64| {
         let traverse = kerf_process::TraverseOptions::default().with_clearance(clearance_mm);
+        // `mixed`'s curves run under its tilted plane: the head meets it (refused by default).
         let options = JobOptions::default()
             .with_retract_mm(retract_mm)
-            .with_traverse(Some(traverse));
+            .with_traverse(Some(traverse))
+            .with_cut_clearance_mm(None);
         assert_eq!(
             options.checked_traverse().map(|t| t.retract_mm),
             Some(retract_mm.max(1.5 * clearance_mm))

@@ -160,7 +160,9 @@ fn the_propeller_edge_makes_no_rotary_jumps_within_the_cone() {
             .with_options(
                 JobOptions::default()
                     .with_tolerance_mm(0.01)
-                    .with_path(PathOptions::default().with_tilt_tolerance_deg(tilt_deg)),
+                    .with_path(PathOptions::default().with_tilt_tolerance_deg(tilt_deg))
+                    // The blade edges by the hub meet the head (refused by default).
+                    .with_cut_clearance_mm(None),
             )
             .run()
             .expect("run");

@@ -54,6 +54,7 @@ fn stages_are_timed_in_order_and_cpu_time_counts_work_not_waiting() {
             "place",
             "cuts",
             "kinematics",
+            "head",
             "traverses",
             "plan",
             "gcode",

@@ -52,8 +52,8 @@ pub struct CutPicture {
     pub lead_out: Vec<Point3<f64>>,
     /// The micro-joints on the contour: where the beam goes off and on again (empty: none).
     pub micro_joints: Vec<[Point3<f64>; 2]>,
-    /// Stretches of the cut whose tool axis was tilted to clear the head (`kerf run
-    /// --cut-clearance` with a tilt tolerance; empty: none).
+    /// Stretches of the cut whose tool axis was tilted to clear the head (`kerf run`'s head
+    /// check with a tilt tolerance; empty: none).
     pub head_tilted: Vec<Vec<Point3<f64>>>,
     /// Stretches where the head comes closer to the part than the cutting clearance (accepted
     /// as warnings; empty: none).

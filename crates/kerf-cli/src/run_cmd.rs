@@ -64,6 +64,11 @@ fn job_options(args: &RunArgs) -> JobOptions {
 
 /// Runs `kerf run`.
 pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
+    if args.accept_head_collisions && args.cut_clearance.is_some_and(|c| c.0.is_none()) {
+        return Err(CliError::Usage(
+            "--accept-head-collisions has nothing to accept with --cut-clearance off".into(),
+        ));
+    }
     let start = Instant::now();
     let path = args.curves.as_path();
     let refuse = |names: &[String]| {
@@ -105,11 +110,6 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), CliError> {
                 .join(t)
         })
     });
-    if args.accept_head_collisions && args.cut_clearance.is_some_and(|c| c.0.is_none()) {
-        return Err(CliError::Usage(
-            "--accept-head-collisions has nothing to accept with --cut-clearance off".into(),
-        ));
-    }
     if let (Some(_), None) = (&args.material, &table_file) {
         return Err(CliError::Usage(
             "--material needs a technology table: --technology FILE, or the machine file's process.technology".into(),

@@ -18,7 +18,7 @@ pub(crate) const PART_JOIN_TOLERANCE_MM: f64 = 0.05;
 
 /// What a refusal for the head says the user can do (the options by their library names; the
 /// command line adds its flags).
-pub(crate) const WAYS_OUT: &str = " (accept_head_collisions cuts it with a warning; cut_clearance_mm sets another clearance, or none to leave the head unchecked)";
+pub(crate) const WAYS_OUT: &str = "; accept_head_collisions takes it with a warning, cut_clearance_mm sets another clearance or turns the check off";
 
 /// Rounds of tilting and checking again a path may take.
 const MAX_ROUNDS: usize = 4;

